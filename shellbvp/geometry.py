@@ -1,0 +1,128 @@
+"""Shell and indenter-tip shapes a scene can use.
+
+The built-in spheroid (``R = sin S, Z = -gamma cos S``) and sphere tip are
+described by name; user shapes carry SymPy formulas (validated on
+construction by ``symbolic.geometry``) and get code generated for them.
+"""
+
+from __future__ import annotations
+
+__all__ = ["Spheroid", "SphereTip", "UserShell", "UserTip"]
+
+
+class Spheroid:
+    """Built-in reference shell ``R = sin S``, ``Z = -gamma cos S``, ``L = pi/2``.
+
+    gamma is a run-time parameter of the scene (``Scene.gamma``).
+    """
+
+    kind = "spheroid"
+
+    def description(self):
+        return {"kind": "spheroid"}
+
+    def pole_curvature(self, values):
+        """kappa_theta^R at the pole: gamma."""
+        return values["gamma"]
+
+    def __repr__(self):
+        return "Spheroid()"
+
+    def __eq__(self, other):
+        return isinstance(other, Spheroid)
+
+    def __hash__(self):
+        return hash("spheroid")
+
+
+class SphereTip:
+    """Built-in spherical tip ``A = sin omega``, ``B = 1 - cos omega`` (radius rho)."""
+
+    kind = "sphere"
+
+    def description(self):
+        return {"kind": "sphere"}
+
+    def apex_curvature(self):
+        """B''(0)/A'(0)^2 in units of 1/rho."""
+        return 1.0
+
+    def __repr__(self):
+        return "SphereTip()"
+
+    def __eq__(self, other):
+        return isinstance(other, SphereTip)
+
+    def __hash__(self):
+        return hash("sphere")
+
+
+class UserShell:
+    """Reference meridian ``R(S), Z(S)``, ``0 <= S <= L`` (formulas in S).
+
+    Rescaled so that ``R(L) = 1``, ``Z(L) = 0``.  Example:
+    ``UserShell("sin(S)", "-2*cos(S)", "pi/2")`` is the gamma = 2 spheroid.
+    """
+
+    kind = "user"
+
+    def __init__(self, R, Z, L="pi/2"):
+        import sympy as sp
+
+        from symbolic import geometry as sg
+
+        self.geometry = sg.user_shell(R, Z, L)
+        self._desc = {"kind": "user", "R": sp.srepr(self.geometry.R), "Z": sp.srepr(self.geometry.Z),
+                      "L": sp.srepr(self.geometry.L)}
+        ks, kt = self.geometry.curvatures()
+        self._pole_kt = float(sp.limit(kt, sg.S, 0, "+"))
+
+    def description(self):
+        return dict(self._desc)
+
+    def pole_curvature(self, values):
+        return self._pole_kt
+
+    def __repr__(self):
+        return f"UserShell(R={str(self.geometry.R)!r}, Z={str(self.geometry.Z)!r}, L={str(self.geometry.L)!r})"
+
+    def __eq__(self, other):
+        return isinstance(other, UserShell) and self._desc == other._desc
+
+    def __hash__(self):
+        return hash(str(self._desc))
+
+
+class UserTip:
+    """Indenter tip ``r = rho A(omega)``, ``z = z_tip + rho B(omega)`` (formulas in omega)."""
+
+    kind = "user"
+
+    def __init__(self, A, B):
+        import sympy as sp
+
+        from symbolic import geometry as sg
+
+        self.geometry = sg.user_tip(A, B)
+        self._desc = {"kind": "user", "A": sp.srepr(self.geometry.A), "B": sp.srepr(self.geometry.B)}
+        w = sg.OMEGA
+        dA0 = sp.diff(self.geometry.A, w).subs(w, 0)
+        ddB0 = sp.diff(self.geometry.B, w, 2).subs(w, 0)
+        self._apex = float(ddB0 / dA0**2)
+        if self._apex <= 0:
+            raise ValueError(f"tip apex curvature B''(0)/A'(0)^2 must be > 0 (a convex tip); got {self._apex}")
+
+    def description(self):
+        return dict(self._desc)
+
+    def apex_curvature(self):
+        return self._apex
+
+    def __repr__(self):
+        return f"UserTip(A={str(self.geometry.A)!r}, B={str(self.geometry.B)!r})"
+
+    def __eq__(self, other):
+        return isinstance(other, UserTip) and self._desc == other._desc
+
+    def __hash__(self):
+        return hash(str(self._desc))

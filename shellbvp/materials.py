@@ -1,0 +1,113 @@
+"""Strain-energy choices a scene can make (formulas live in ``symbolic.materials``).
+
+Built-in families are described by name, so that loading their cached
+generated code does not import SymPy; a user energy carries its formula.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+__all__ = ["Material", "MooneyRivlin", "NeoHookean", "Gent", "StrainEnergy"]
+
+
+class Material:
+    """Base class: ``description()`` (structural, hashed) and ``values()`` (run-time)."""
+
+    family: str = ""
+
+    def description(self) -> dict:
+        return {"family": self.family}
+
+    def values(self) -> dict:
+        return {}
+
+    def validate(self) -> None:
+        pass
+
+
+@dataclass(frozen=True)
+class MooneyRivlin(Material):
+    """Mooney–Rivlin, ``W = [(1-alpha)(I1-3) + alpha(I2-3)]/2``; alpha in [0, 1]."""
+
+    alpha: float = 0.1
+    family = "mooney-rivlin"
+
+    def values(self):
+        return {"alpha": float(self.alpha)}
+
+    def validate(self):
+        a = self.alpha
+        if not (isinstance(a, (int, float)) and math.isfinite(a) and 0.0 <= a <= 1.0):
+            raise ValueError(f"alpha (Mooney-Rivlin) must be in [0, 1]; got {a!r}")
+
+
+@dataclass(frozen=True)
+class NeoHookean(Material):
+    """Neo-Hookean, ``W = (I1 - 3)/2`` (its own code: no alpha terms)."""
+
+    family = "neo-hookean"
+
+
+@dataclass(frozen=True)
+class Gent(Material):
+    """Gent, ``W = -(Jm/2) log(1 - (I1-3)/Jm)``; Jm > 0."""
+
+    Jm: float = 97.2
+    family = "gent"
+
+    def values(self):
+        return {"Jm": float(self.Jm)}
+
+    def validate(self):
+        j = self.Jm
+        if not (isinstance(j, (int, float)) and math.isfinite(j) and j > 0):
+            raise ValueError(f"Jm (Gent) must be a finite number > 0; got {j!r}")
+
+
+class StrainEnergy(Material):
+    """A user strain energy ``W(lambda_s, lambda_theta)``.
+
+    Parameters
+    ----------
+    W : str or sympy expression
+        In the symbols ``lambda_s`` and ``lambda_theta`` (shear modulus 1 in the
+        nondimensionalisation).  Checked on construction: symmetric,
+        ``W(1,1) = 0``, stress-free at (1,1), positive small-strain shear
+        modulus (reported as ``shear_modulus``; it should be 1, or forces are in
+        units of that modulus times mu).
+    name : str, optional
+        Label for output files.
+    """
+
+    family = "user"
+
+    def __init__(self, W, name: str = "user"):
+        import sympy as sp
+
+        from symbolic import materials as sm
+
+        try:
+            expr = sp.sympify(W, locals={"lambda_s": sm.LS, "lambda_theta": sm.LT})
+        except (sp.SympifyError, SyntaxError, TypeError) as exc:
+            raise ValueError(f"W: cannot parse {W!r} ({exc})") from None
+        expr = expr.xreplace({s: {"lambda_s": sm.LS, "lambda_theta": sm.LT}.get(s.name, s)
+                              for s in expr.free_symbols})
+        self.shear_modulus = float(sm.check_energy(expr, name="W"))
+        self.W = expr
+        self.name = name
+
+    def description(self):
+        import sympy as sp
+
+        return {"family": "user", "W": sp.srepr(self.W)}
+
+    def __repr__(self):
+        return f"StrainEnergy({str(self.W)!r}, name={self.name!r})"
+
+    def __eq__(self, other):
+        return isinstance(other, StrainEnergy) and self.description() == other.description()
+
+    def __hash__(self):
+        return hash(str(self.description()))

@@ -1,0 +1,155 @@
+"""A scene: shell, indenter, material, bending stiffness and model choices.
+
+Nondimensional (SPEC section 2): lengths by the rim radius R_L, forces and
+moments by mu R_L H, ``beta = B/(mu R_L^2)`` (``eps^2/12`` for a linearly
+elastic sheet of thickness ``eps = H/R_L``).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from .geometry import SphereTip, Spheroid, UserShell, UserTip
+from .materials import Gent, Material, MooneyRivlin
+from .model import load_module, structure_description
+
+__all__ = ["Scene", "PRESETS", "CONTACT_MODELS"]
+
+CONTACT_MODELS = ("smooth", "paper")
+
+
+def _finite(name, value):
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)):
+        raise ValueError(f"{name} must be a real number; got {value!r}")
+    if not math.isfinite(value):
+        raise ValueError(f"{name} must be finite; got {value!r}")
+    return float(value)
+
+
+@dataclass(frozen=True)
+class Scene:
+    """One indentation problem.
+
+    Parameters
+    ----------
+    gamma : float
+        Spheroid aspect parameter (``Z = -gamma cos S``): > 0 bowl indented
+        from inside, < 0 dome, 0 flat, 1 hemisphere.  Requires
+        ``gamma < 1/rho`` (first contact at the pole).  Ignored for a user shell.
+    rho : float
+        Indenter radius / rim radius, > 0.
+    beta : float
+        Bending stiffness ``B/(mu R_L^2)``, > 0.
+    material : Material
+        ``MooneyRivlin(alpha)``, ``NeoHookean()``, ``Gent(Jm)`` or ``StrainEnergy(W)``.
+    xi : {0, 1}
+        1: generalised tensions ``T + M kappa`` (the full theory, default);
+        0: the "first approximation" ``tau = T``.
+    contact : {"smooth", "paper"}
+        Contact-line conditions: variational (default) or the paper's eq. jumpeqns2.
+    shell, tip : optional
+        ``UserShell(R, Z, L)`` / ``UserTip(A, B)``; default spheroid and sphere.
+    """
+
+    gamma: float = 1.0
+    rho: float = 0.2
+    beta: float = 0.01
+    material: Material = field(default_factory=lambda: MooneyRivlin(0.1))
+    xi: int = 1
+    contact: str = "smooth"
+    shell: object = field(default_factory=Spheroid)
+    tip: object = field(default_factory=SphereTip)
+
+    def __post_init__(self):
+        rho = _finite("rho", self.rho)
+        if rho <= 0:
+            raise ValueError(f"rho (indenter radius / rim radius) must be > 0; got {self.rho!r}")
+        beta = _finite("beta", self.beta)
+        if beta <= 0:
+            raise ValueError(f"beta (bending stiffness) must be > 0; got {self.beta!r}")
+        gamma = _finite("gamma", self.gamma)
+        if self.xi not in (0, 1) or isinstance(self.xi, bool):
+            raise ValueError(f"xi must be 0 or 1; got {self.xi!r}")
+        if self.contact not in CONTACT_MODELS:
+            raise ValueError(f"contact must be one of {CONTACT_MODELS}; got {self.contact!r}")
+        if not isinstance(self.material, Material):
+            raise ValueError(f"material must be MooneyRivlin, NeoHookean, Gent or StrainEnergy; got {self.material!r}")
+        self.material.validate()
+        if not isinstance(self.shell, (Spheroid, UserShell)):
+            raise ValueError(f"shell must be Spheroid() or UserShell(...); got {self.shell!r}")
+        if not isinstance(self.tip, (SphereTip, UserTip)):
+            raise ValueError(f"tip must be SphereTip() or UserTip(...); got {self.tip!r}")
+        # First contact at the pole: kappa_theta^R(0) < B''(0)/(rho A'(0)^2).
+        k_shell = self.shell.pole_curvature({"gamma": gamma})
+        k_tip = self.tip.apex_curvature() / rho
+        if not k_shell < k_tip:
+            what = "gamma" if isinstance(self.shell, Spheroid) else "the shell's pole curvature"
+            raise ValueError(
+                f"{what} = {k_shell:g} must be < {k_tip:g} (the indenter's apex curvature, 1/rho for a "
+                "sphere): otherwise the indenter touches the shell away from the pole first"
+            )
+        object.__setattr__(self, "gamma", gamma)
+        object.__setattr__(self, "rho", rho)
+        object.__setattr__(self, "beta", beta)
+
+    # -- presets -----------------------------------------------------------------
+    @classmethod
+    def preset(cls, name: str, **overrides) -> "Scene":
+        """A scene of the paper (SPEC section 6), with optional overrides."""
+        if name not in PRESETS:
+            raise ValueError(f"unknown preset {name!r}; choose one of {sorted(PRESETS)}")
+        base = dict(PRESETS[name]["scene"])
+        base.update(overrides)
+        return cls(**base)
+
+    def replace(self, **changes) -> "Scene":
+        return replace(self, **changes)
+
+    # -- generated code ------------------------------------------------------------
+    def structure(self) -> dict:
+        """The structural choices the generated code is specialised on."""
+        return structure_description(self.material, self.xi, self.shell, self.tip)
+
+    def model(self):
+        """The generated module for this scene's structure (cached)."""
+        return load_module(self.structure())
+
+    def values(self) -> dict:
+        """Continuous (run-time) parameters by name."""
+        v = {"beta": self.beta, "rho": self.rho, "gamma": self.gamma}
+        v.update(self.material.values())
+        return v
+
+    def parameters(self, model=None) -> np.ndarray:
+        """Run-time parameter vector in the order of the generated functions."""
+        model = model or self.model()
+        v = self.values()
+        return np.array([v[name] for name in model.PARAMS], dtype=float)
+
+    @property
+    def shell_length(self) -> float:
+        """L, the reference meridian's length parameter."""
+        if isinstance(self.shell, Spheroid):
+            return math.pi / 2
+        return float(self.shell.geometry.L)
+
+
+PRESETS = {
+    "base": {"doc": "paper's base case: hemisphere, rho 0.2, beta 0.01, Mooney-Rivlin 0.1, xi 1",
+             "scene": dict(gamma=1.0, rho=0.2, beta=0.01, material=MooneyRivlin(0.1), xi=1)},
+    "base-xi0": {"doc": "base with the first approximation xi = 0",
+                 "scene": dict(gamma=1.0, rho=0.2, beta=0.01, material=MooneyRivlin(0.1), xi=0)},
+    "prolate2": {"doc": "prolate spheroid gamma = 2",
+                 "scene": dict(gamma=2.0, rho=0.2, beta=0.01, material=MooneyRivlin(0.1), xi=1)},
+    "fit": {"doc": "Lepidium endosperm fit case: gamma 2.5, rho 1/3",
+            "scene": dict(gamma=2.5, rho=1 / 3, beta=0.01, material=MooneyRivlin(0.1), xi=1)},
+    "flat": {"doc": "flat plate gamma = 0",
+             "scene": dict(gamma=0.0, rho=0.2, beta=0.01, material=MooneyRivlin(0.1), xi=1)},
+    "gent1": {"doc": "base with Gent Jm = 1 (strain-stiffening)",
+              "scene": dict(gamma=1.0, rho=0.2, beta=0.01, material=Gent(1.0), xi=1)},
+    "dome": {"doc": "dome gamma = -1, indented from the convex side",
+             "scene": dict(gamma=-1.0, rho=0.2, beta=0.01, material=MooneyRivlin(0.1), xi=1)},
+}

@@ -1,0 +1,58 @@
+"""From a structure description (plain JSON data) to generated module text.
+
+The description is what ``shellbvp`` hashes into the cache key, so it must
+say everything the generated code depends on, and nothing else (continuous
+parameters are run-time arguments).  User formulas travel as ``sympy.srepr``
+strings, which rebuild the exact expression.
+"""
+
+from __future__ import annotations
+
+import sympy as sp
+
+from . import codegen, geometry, materials
+from .equations import Structure, derive
+from .version import canonical_json
+
+__all__ = ["structure_from_description", "generate_source"]
+
+ALPHA = sp.Symbol("alpha", positive=True)
+JM = sp.Symbol("Jm", positive=True)
+
+
+def _expr(text: str, *syms):
+    """Rebuild an expression from its srepr (or plain) text; rename onto our symbols."""
+    e = sp.sympify(text)
+    return e.xreplace({s: t for t in syms for s in e.free_symbols if s.name == t.name})
+
+
+def structure_from_description(desc: dict) -> Structure:
+    mat = desc["material"]
+    family = mat["family"]
+    if family == "mooney-rivlin":
+        W, mpar = materials.mooney_rivlin(ALPHA), (ALPHA,)
+    elif family == "neo-hookean":
+        W, mpar = materials.neo_hookean(), ()
+    elif family == "gent":
+        W, mpar = materials.gent(JM), (JM,)
+    elif family == "user":
+        W, mpar = _expr(mat["W"], materials.LS, materials.LT), ()
+    else:
+        raise ValueError(f"unknown material family {family!r}")
+    sh = desc["shell"]
+    if sh["kind"] == "spheroid":
+        shell = geometry.spheroid()
+    else:
+        shell = geometry.user_shell(_expr(sh["R"], geometry.S), _expr(sh["Z"], geometry.S),
+                                    _expr(sh["L"]))
+    tp = desc["tip"]
+    if tp["kind"] == "sphere":
+        tip = geometry.sphere_tip()
+    else:
+        tip = geometry.user_tip(_expr(tp["A"], geometry.OMEGA), _expr(tp["B"], geometry.OMEGA))
+    return Structure(W=W, material_params=mpar, shell=shell, tip=tip, xi=int(desc["xi"]))
+
+
+def generate_source(desc: dict) -> str:
+    """Derive and print the module of a description (deterministic)."""
+    return codegen.module_source(derive(structure_from_description(desc)), canonical_json(desc))

@@ -1,0 +1,228 @@
+"""Print the derived programs as a vectorised numpy module.
+
+One module per structure (strain-energy family, xi, shell and tip shapes);
+continuous parameters are run-time arguments.  Each function evaluates only
+the assignments its outputs depend on (so, e.g., ``free_rhs`` computes no
+derivatives), after a common-subexpression pass over them.  Array layouts
+are solve_bvp's: values ``(n, m)``, Jacobians ``(n, k, m)`` with ``[i, j, :]``
+the derivative of output i by input j at each of the m nodes.
+
+Output is deterministic: the same structure gives byte-identical text.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import textwrap
+from dataclasses import dataclass, field
+
+import sympy as sp
+from sympy.printing.numpy import NumPyPrinter
+
+from .dag import Program
+from .equations import CONTACT_STATES, FREE_STATES, Derivation
+from .version import CODEGEN_VERSION
+
+__all__ = ["FunctionSpec", "module_source", "CODEGEN_VERSION"]
+
+
+
+@dataclass
+class FunctionSpec:
+    """One generated function.
+
+    ``args``: list of (argument name, tuple of symbols); a tuple of length one
+    is passed as a single array/scalar, longer tuples are unpacked row-wise.
+    ``outputs``: list of (name, sympy Matrix or list of expressions, or dict
+    for a profile).  ``shape_of``: the argument whose shape the node axis takes.
+    """
+
+    name: str
+    program: Program
+    args: list
+    outputs: list
+    doc: str
+    shape_of: str | None = None
+    returns_dict: bool = False
+    extra_doc: list = field(default_factory=list)
+
+
+class _Printer(NumPyPrinter):
+    def __init__(self):
+        super().__init__({"fully_qualified_modules": True, "allow_unknown_functions": False})
+
+
+def _flatten(outputs):
+    flat = []
+    for _, val in outputs:
+        if isinstance(val, dict):
+            flat.extend(val.values())
+        else:
+            flat.extend(sp.Matrix(val))
+    return [sp.sympify(e) for e in flat]
+
+
+def _function_source(spec: FunctionSpec) -> str:
+    prog = spec.program
+    printer = _Printer()
+    lines = [f"def {spec.name}({', '.join(a for a, _ in spec.args)}):"]
+    doc = [spec.doc.strip(), ""]
+    for a, syms in spec.args:
+        if len(syms) > 1:
+            doc.append(f"{a} : rows ({', '.join(s.name for s in syms)})")
+        else:
+            doc.append(f"{a} : {syms[0].name}")
+    doc += spec.extra_doc
+    lines.append(textwrap.indent('"""' + "\n".join(doc).rstrip() + '\n"""', "    "))
+    for a, syms in spec.args:
+        if len(syms) > 1:
+            lines.append(f"    {', '.join(s.name for s in syms)} = {a}")
+    shape = f"numpy.shape({spec.shape_of})" if spec.shape_of else "()"
+    lines.append(f"    _shape = {shape}")
+
+    flat = _flatten(spec.outputs)
+    steps = prog.dependencies(flat)
+    exprs = [prog.expression(s) for s in steps] + flat
+    reps, reduced = sp.cse(exprs, symbols=sp.numbered_symbols("_c"), order="canonical")
+    rep_expr = dict(reps)
+    rep_rank = {s: i for i, (s, _) in enumerate(reps)}
+    emitted: set = set()
+
+    def emit_reps(expr):
+        for s in sorted(expr.free_symbols & rep_expr.keys(), key=rep_rank.__getitem__):
+            if s in emitted:
+                continue
+            emit_reps(rep_expr[s])
+            lines.append(f"    {s.name} = {printer.doprint(rep_expr[s])}")
+            emitted.add(s)
+
+    for sym, e in zip(steps, reduced[: len(steps)]):
+        emit_reps(e)
+        lines.append(f"    {sym.name} = {printer.doprint(e)}")
+    outs = reduced[len(steps):]
+    for e in outs:
+        emit_reps(e)
+
+    k = 0
+    ret = []
+    for name, val in spec.outputs:
+        if isinstance(val, dict):
+            lines.append(f"    {name} = {{}}")
+            for key in val:
+                lines.append(f"    {name}[{key!r}] = numpy.zeros(_shape) + ({printer.doprint(outs[k])})")
+                k += 1
+        else:
+            mat = sp.Matrix(val)
+            dims = (mat.rows,) if mat.cols == 1 else (mat.rows, mat.cols)
+            lines.append(f"    {name} = numpy.zeros({dims!r} + _shape)")
+            for i in range(mat.rows):
+                for j in range(mat.cols):
+                    e = outs[k]
+                    k += 1
+                    if e != 0:
+                        idx = f"{i}" if mat.cols == 1 else f"{i}, {j}"
+                        lines.append(f"    {name}[{idx}] = {printer.doprint(e)}")
+        ret.append(name)
+    lines.append(f"    return {', '.join(ret)}")
+    return "\n".join(lines) + "\n"
+
+
+def function_specs(d: Derivation) -> list[FunctionSpec]:
+    """Every function of a structure's module."""
+    from .equations import DELTA, FORCE, LAMBDA0, SC
+
+    par = tuple(d.params)
+    specs = []
+    for region, prog, states, rhs, profile in (
+        ("free", d.free, d.free_states, d.free_rhs, d.free_profile),
+        ("contact", d.contact, d.contact_states, d.contact_rhs, d.contact_profile),
+    ):
+        n = len(states)
+        args = [("S", (sp.Symbol("S"),)), ("y", states), ("par", par)]
+        # S is declared positive in geometry; find the program's own S.
+        Ssym = prog.inputs[0]
+        args[0] = ("S", (Ssym,))
+        specs += [
+            FunctionSpec(f"{region}_rhs", prog, args, [("g", rhs)],
+                         f"{region} region: g = S dy/dS, shape ({n}, m).", "S"),
+            FunctionSpec(f"{region}_jac", prog, args,
+                         [("dg_dy", prog.jacobian(rhs, states)), ("dg_dS", prog.jacobian(rhs, [Ssym]))],
+                         f"{region} region: dg/dy ({n}, {n}, m) and dg/dS ({n}, m).", "S"),
+            FunctionSpec(f"{region}_jac_par", prog, args, [("dg_dpar", prog.jacobian(rhs, par))],
+                         f"{region} region: dg/dpar ({n}, {len(par)}, m).", "S"),
+            FunctionSpec(f"{region}_profile", prog, args, [("out", profile)],
+                         f"{region} region: physical fields at the nodes (dict of arrays).", "S"),
+        ]
+    # pole
+    chi, ls = d.pole_states
+    pargs = [("chi", (chi,)), ("ls", (ls,)), ("lambda0", (LAMBDA0,)), ("par", par)]
+    specs += [
+        FunctionSpec("pole_res", d.pole, pargs, [("res", d.pole_res)], "Pole conditions (2,)."),
+        FunctionSpec("pole_jac", d.pole, pargs,
+                     [("dres", d.pole.jacobian(d.pole_res, [chi, ls, LAMBDA0]))],
+                     "Pole conditions: d/d(chi, ls, lambda0), (2, 3)."),
+    ]
+    # rim (S = L)
+    Ssym = d.free.inputs[0]
+    rargs = [("S", (Ssym,)), ("y", d.free_states), ("par", par)]
+    specs += [
+        FunctionSpec("rim_res", d.free, rargs, [("res", d.rim_res)], "Rim conditions at S = L (3,)."),
+        FunctionSpec("rim_jac", d.free, rargs, [("dres", d.free.jacobian(d.rim_res, d.free_states))],
+                     "Rim conditions: d/dy (3, 6)."),
+        FunctionSpec("rim_jac_par", d.free, rargs, [("dres", d.free.jacobian(d.rim_res, par))],
+                     f"Rim conditions: d/dpar (3, {len(par)})."),
+    ]
+    # contact line
+    J = d.junction
+    Sc = d.junction_inputs[0]
+    yc = d.junction_inputs[1:3]
+    yf = d.junction_inputs[3:]
+    jargs = [("Sc", (Sc,)), ("yc", yc), ("yf", yf), ("delta", (DELTA,)), ("F", (FORCE,)), ("par", par)]
+    wrt = [Sc, *yc, *yf, DELTA]
+    for model, res in d.junction_res.items():
+        specs += [
+            FunctionSpec(f"junction_{model}_res", J, jargs, [("res", res)],
+                         f"Contact-line conditions, {model} model (5,)."),
+            FunctionSpec(f"junction_{model}_jac", J, jargs, [("dres", J.jacobian(res, wrt))],
+                         f"Contact-line conditions, {model} model: d/d(Sc, yc, yf, delta), (5, 10)."),
+            FunctionSpec(f"junction_{model}_jac_par", J, jargs, [("dres", J.jacobian(res, par))],
+                         f"Contact-line conditions, {model} model: d/dpar (5, {len(par)})."),
+        ]
+    specs += [
+        FunctionSpec("force_res", J, jargs, [("res", [d.force_res])],
+                     "Force control: F/(2 pi) of the free region minus the prescribed F/(2 pi), (1,)."),
+        FunctionSpec("force_jac", J, jargs, [("dres", J.jacobian([d.force_res], [Sc, *yf, FORCE]))],
+                     "Force control: d/d(Sc, yf, F), (1, 8)."),
+        FunctionSpec("contact_line_forces", J, jargs,
+                     [("ring", [d.ring_force]), ("cap", [d.cap_force])],
+                     "Axial force of the ring at Sc (jump of Q) and of the pressure on the cap."),
+    ]
+    return specs
+
+
+def module_source(d: Derivation, description: str) -> str:
+    """Full text of the generated module for derivation ``d``.
+
+    ``description`` is the structure's canonical description (it is hashed
+    into the cache key and written into the header).
+    """
+    key = hashlib.sha256(description.encode()).hexdigest()  # == version.description_key
+    par = [p.name for p in d.params]
+    head = [
+        "# Generated by shellbvp's symbolic/codegen.py -- DO NOT EDIT BY HAND.",
+        "# It is regenerated from the SymPy derivation in symbolic/ (see README, 'Generated code').",
+        f"# sympy {sp.__version__}, codegen version {CODEGEN_VERSION}",
+        f"# key {key}",
+        "# structure:",
+        *("#   " + line for line in description.splitlines()),
+        '"""Generated equations of one shellbvp structure (see the header)."""',
+        "import numpy",
+        "",
+        f"KEY = {key!r}",
+        f"PARAMS = {tuple(par)!r}",
+        f"FREE_STATES = {FREE_STATES!r}",
+        f"CONTACT_STATES = {CONTACT_STATES!r}",
+        "",
+    ]
+    body = [_function_source(s) for s in function_specs(d)]
+    return "\n".join(head) + "\n" + "\n\n".join(body)

@@ -1,0 +1,335 @@
+r"""The shell's equations, derived from the energy, as straight-line programs.
+
+Everything follows from the kinematics and the energy density
+
+.. math:: U = W(\lambda_s, \lambda_\theta) + \frac{\beta}{2}(\operatorname{tr}\Delta)^2,
+          \quad \operatorname{tr}\Delta = \lambda_s^2\kappa_s + \lambda_\theta^2\kappa_\theta
+          - \kappa_s^R - \kappa_\theta^R ,
+
+with ``T_s = (1/lambda_theta) dW/dlambda_s``, ``T_theta = (1/lambda_s) dW/dlambda_theta``,
+``M_alpha = h dU/dkappa_alpha`` (``h = 1/(lambda_s lambda_theta)``) and the generalised
+tensions ``tau_alpha = T_alpha + xi M_alpha kappa_alpha``; the equilibrium equations are
+the paper's (eq. equibshell), with ``P = 0`` off the indenter.
+
+State layout (one place; the solver and the tests import these tuples)
+---------------------------------------------------------------------
+Both regions are written as ``g = S dy/dS`` (the solver maps S geometrically
+onto t in [0, 1], so ``dy/dt = (d ln S/dt) g``), in O(1)-scaled states:
+
+* free region, ``Sc < S < L``  -- ``FREE_STATES``:
+  ``lt = r/R``, ``phiS = phi/S``, ``ls = lambda_s``, ``ks = kappa_s``, ``rQ = r Q``, ``z``.
+* contact region, ``zeta < S < Sc`` -- ``CONTACT_STATES``:
+  ``chi = rho omega/S``, ``ls = lambda_s``  (omega: the tip's angle parameter).
+
+Conditions (residuals; all O(1)-scaled):
+
+* pole (S = zeta, leading order of the odd series of omega): 2;
+* rim (S = L, simply supported): ``lt - 1``, ``tr Delta`` (``M_s = 0`` divided by
+  ``beta lambda_s/lambda_theta``), ``z``: 3;
+* contact line, smooth (variational) model: r, phi, z, lambda_s, kappa_s continuous
+  (so M_s and tau_s are; Q may jump): 5;
+* contact line, paper model (eq. jumpeqns2): r, phi, z, Q and tau_s continuous
+  (``[F] = r sin(phi)[tau_s]`` given the others; tau_s is the well-scaled form): 5;
+* force control: ``F/(2 pi)`` of the free region minus the prescribed value: 1.
+
+Counting: 8 ODEs (2 contact + 6 free) plus k unknown parameters need 8 + k
+conditions.  The pole (2) + rim (3) + contact line (5) give 10 = 8 + 2: the
+unknown ``ln Sc`` plus one of ``lambda0`` (delta prescribed) or ``delta``
+(lambda0 prescribed).  Force control adds the force condition and has
+k = 3 unknowns (``ln Sc``, ``lambda0``, ``delta``): 11 = 8 + 3.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import sympy as sp
+
+from .dag import Program
+from .geometry import OMEGA, S, ShellGeometry, TipGeometry
+from .materials import LS, LT
+
+__all__ = [
+    "FREE_STATES",
+    "CONTACT_STATES",
+    "Structure",
+    "Derivation",
+    "derive",
+]
+
+FREE_STATES = ("lt", "phiS", "ls", "ks", "rQ", "z")
+CONTACT_STATES = ("chi", "ls")
+CONTACT_MODELS = ("smooth", "paper")
+
+BETA, RHO = sp.symbols("beta rho", positive=True)
+SC = sp.Symbol("Sc", positive=True)
+LAMBDA0, DELTA, FORCE = sp.symbols("lambda0 delta F", real=True)
+
+
+@dataclass(frozen=True)
+class Structure:
+    """The structural choices a generated module is specialised on.
+
+    ``W`` is the strain energy in ``materials.LS, LT`` and ``material_params``;
+    shell and tip are geometries; ``xi`` in {0, 1}.
+    """
+
+    W: sp.Expr
+    material_params: tuple
+    shell: ShellGeometry
+    tip: TipGeometry
+    xi: int
+
+    @property
+    def params(self) -> tuple:
+        """Run-time parameters, in the order the generated functions take them."""
+        return (BETA, RHO) + tuple(self.shell.params) + tuple(self.material_params)
+
+
+class Derivation:
+    """All programs of one structure: physical sub-derivations and scaled systems.
+
+    Attributes (each a :class:`~symbolic.dag.Program` plus named outputs):
+    ``free``, ``contact``, ``pole``, ``rim``, ``junction``.
+    """
+
+    def __init__(self, st: Structure):
+        if st.xi not in (0, 1):
+            raise ValueError(f"xi must be 0 or 1; got {st.xi}")
+        self.structure = st
+        self.params = st.params
+        self._build_free_physical()
+        self._build_contact_physical()
+        self._build_free_scaled()
+        self._build_contact_scaled()
+        self._build_boundaries()
+
+    # ------------------------------------------------------------------ shared pieces
+    def _shell_steps(self, prog: Program, Svar, tag=""):
+        sh = self.structure.shell
+        ksR, ktR = sh.curvatures()
+        sub = {S: Svar}
+        out = {
+            "R": prog.let(f"R{tag}", sh.R.xreplace(sub)),
+            "dR": prog.let(f"dR{tag}", sp.diff(sh.R, S).xreplace(sub)),
+            "Psi": prog.let(f"Psi{tag}", sh.Psi.xreplace(sub)),
+            "ksR": prog.let(f"ksR{tag}", ksR.xreplace(sub)),
+            "ktR": prog.let(f"ktR{tag}", ktR.xreplace(sub)),
+        }
+        return out
+
+    def _constitutive(self, prog: Program, ls, lt, ks, kt, ksR, ktR, tag=""):
+        """T, M, tau and U from W and the bending energy; names get suffix ``tag``."""
+        st = self.structure
+        KS, KT = sp.symbols("kappa_s kappa_theta")
+        tr_delta = LS**2 * KS + LT**2 * KT - ksR - ktR
+        U = st.W + BETA / 2 * tr_delta**2
+        h = 1 / (LS * LT)
+        sub = {LS: ls, LT: lt, KS: ks, KT: kt}
+        m = prog.let(f"m{tag}", tr_delta.xreplace(sub))
+
+        def as_m(expr):  # write moments through the named bending strain m
+            return expr.xreplace(sub).subs(tr_delta.xreplace(sub), m)
+
+        T_s = prog.let(f"T_s{tag}", (sp.diff(st.W, LS) / LT).xreplace(sub))
+        T_t = prog.let(f"T_t{tag}", (sp.diff(st.W, LT) / LS).xreplace(sub))
+        M_s = prog.let(f"M_s{tag}", as_m(h * sp.diff(U, KS)))
+        M_t = prog.let(f"M_t{tag}", as_m(h * sp.diff(U, KT)))
+        tau_s = prog.let(f"tau_s{tag}", T_s + st.xi * M_s * ks)
+        tau_t = prog.let(f"tau_t{tag}", T_t + st.xi * M_t * kt)
+        W = prog.let(f"W{tag}", st.W.xreplace(sub))
+        U_ = prog.let(f"U{tag}", W + BETA / 2 * m**2)
+        return dict(m=m, T_s=T_s, T_t=T_t, M_s=M_s, M_t=M_t, tau_s=tau_s, tau_t=tau_t, W=W, U=U_)
+
+    def _tip_steps(self, prog: Program, omega, tag=""):
+        d = self.structure.tip.derived()
+        sub = {OMEGA: omega}
+        return {k: prog.let(f"tip_{k}{tag}", v.xreplace(sub)) for k, v in d.items()}
+
+    # ------------------------------------------------------------------ free region
+    def _build_free_physical(self):
+        """Free region over the physical variables (S, r, phi, ls, ks, Q).
+
+        Equilibrium (paper eq. equibshell, P = 0):
+        (r tau_s)' - r' tau_theta + kappa_s r Q psi = 0,
+        kappa_s tau_s + kappa_theta tau_theta - (r Q)'/(r psi) = 0,
+        (r M_s)' - r' M_theta - r Q psi = 0.
+        The first and third are linear in (lambda_s', kappa_s'): a 2x2 system
+        whose coefficients are partial derivatives of tau_s and M_s.
+        """
+        r, phi, ls, ks, Q = sp.symbols("r phi ls ks Q")
+        A = Program([S, r, phi, ls, ks, Q, *self.params])
+        g = self._shell_steps(A, S)
+        lt = A.let("lt", r / g["R"])
+        kt = A.let("kt", sp.sin(phi) / r)
+        psi = A.let("psi", ls * g["Psi"])
+        c = self._constitutive(A, ls, lt, ks, kt, g["ksR"], g["ktR"])
+        dr = A.let("dr", psi * sp.cos(phi))
+        dphi = A.let("dphi", psi * ks)
+
+        def split(f):  # f' = f_ls ls' + f_ks ks' + rest
+            rest = A.derivative(f, r) * dr + A.derivative(f, phi) * dphi + A.derivative(f, S)
+            return A.derivative(f, ls), A.derivative(f, ks), rest
+
+        ts_ls, ts_ks, ts_rest = split(c["tau_s"])
+        ms_ls, ms_ks, ms_rest = split(c["M_s"])
+        a11 = A.let("a11", r * ts_ls)
+        a12 = A.let("a12", r * ts_ks)
+        b1 = A.let("b1", -(r * ts_rest + dr * (c["tau_s"] - c["tau_t"]) + ks * r * Q * psi))
+        a21 = A.let("a21", r * ms_ls)
+        a22 = A.let("a22", r * ms_ks)
+        b2 = A.let("b2", -(r * ms_rest + dr * (c["M_s"] - c["M_t"]) - r * Q * psi))
+        det = A.let("det", a11 * a22 - a12 * a21)
+        dls = A.let("dls", (b1 * a22 - a12 * b2) / det)
+        dks = A.let("dks", (a11 * b2 - a21 * b1) / det)
+        dQ = A.let("dQ", psi * (ks * c["tau_s"] + kt * c["tau_t"]) - dr * Q / r)
+        dz = A.let("dz", psi * sp.sin(phi))
+        G = A.let("G", r * sp.sin(phi) * c["tau_s"] - r * sp.cos(phi) * Q)
+        self.free_phys = A
+        self.free_phys_vars = (r, phi, ls, ks, Q)
+        self.free_phys_out = dict(c, lt=lt, kt=kt, psi=psi, dr=dr, dphi=dphi, dls=dls, dks=dks,
+                                  dQ=dQ, dz=dz, G=G, **g)
+
+    def _build_free_scaled(self):
+        ys = sp.symbols(" ".join(FREE_STATES))
+        lt, phiS, ls, ks, rQ, z = ys
+        P = Program([S, *ys, *self.params])
+        sh = self.structure.shell
+        r = P.let("r", lt * sh.R, always=True)
+        phi = P.let("phi", S * phiS, always=True)
+        P.let("Q", rQ / r, always=True)
+        P.extend(self.free_phys, skip_defined=True)
+        o = self.free_phys_out
+        g = [
+            S * (o["dr"] - lt * o["dR"]) / o["R"],
+            o["dphi"] - phiS,
+            S * o["dls"],
+            S * o["dks"],
+            S * (o["dr"] * sp.Symbol("Q") + r * o["dQ"]),
+            S * o["dz"],
+        ]
+        self.free = P
+        self.free_states = ys
+        self.free_rhs = [P.let(f"g_{n}", e) for n, e in zip(FREE_STATES, g)]
+        self.free_profile = {
+            "r": r, "z": z, "phi": phi, "lambda_s": ls, "lambda_theta": lt,
+            "kappa_s": ks, "kappa_theta": o["kt"], "T_s": o["T_s"], "T_theta": o["T_t"],
+            "M_s": o["M_s"], "M_theta": o["M_t"], "tau_s": o["tau_s"], "tau_theta": o["tau_t"],
+            "Q": sp.Symbol("Q"), "P": sp.S.Zero, "axial_force_2pi": o["G"],
+            "energy_density": o["U"] * o["R"] * o["Psi"],
+        }
+
+    # ------------------------------------------------------------------ contact region
+    def _build_contact_physical(self):
+        """Contact region over (S, omega, ls): r, z on the tip, omega(S) unknown.
+
+        With Q eliminated by the moment balance, the tangential balance
+        ``(r tau_s)' - r' tau_theta + kappa_s[(r M_s)' - r' M_theta] = 0`` is linear
+        in lambda_s' (a second-order ODE for omega).  The normal balance then
+        gives the contact pressure P.
+        """
+        omega, ls = sp.symbols("omega ls")
+        C = Program([S, omega, ls, *self.params])
+        g = self._shell_steps(C, S)
+        t = self._tip_steps(C, omega)
+        r = C.let("r", RHO * t["A"])
+        lt = C.let("lt", r / g["R"])
+        ks = C.let("ks", t["rho_ks"] / RHO)
+        kt = C.let("kt", t["rho_kt"] / RHO)
+        psi = C.let("psi", ls * g["Psi"])
+        c = self._constitutive(C, ls, lt, ks, kt, g["ksR"], g["ktR"])
+        domega = C.let("domega", ls * g["Psi"] / (RHO * t["G"]))
+        dr = C.let("dr", psi * t["cos_phi"])
+
+        def split(f):
+            return C.derivative(f, ls), C.derivative(f, omega) * domega + C.derivative(f, S)
+
+        ts_ls, ts_rest = split(c["tau_s"])
+        ms_ls, ms_rest = split(c["M_s"])
+        num = -(r * ts_rest + dr * (c["tau_s"] - c["tau_t"]) + ks * (r * ms_rest + dr * (c["M_s"] - c["M_t"])))
+        dls = C.let("dls", num / (r * (ts_ls + ks * ms_ls)))
+        rQ = C.let("rQ", (r * (ms_ls * dls + ms_rest) + dr * (c["M_s"] - c["M_t"])) / psi)
+        Q = C.let("Q", rQ / r)
+        G = C.let("G", r * t["sin_phi"] * c["tau_s"] - r * t["cos_phi"] * Q)
+        # P from the normal balance; (rQ)' is a total derivative along the solution.
+        drQ = C.derivative(rQ, S) + C.derivative(rQ, omega) * domega + C.derivative(rQ, ls) * dls
+        P = C.let("P", ks * c["tau_s"] + kt * c["tau_t"] - drQ / (r * psi))
+        self.contact_phys = C
+        self.contact_phys_out = dict(c, **g, tip=t, r=r, lt=lt, ks=ks, kt=kt, psi=psi,
+                                     domega=domega, dls=dls, rQ=rQ, Q=Q, G=G, P=P)
+
+    def _build_contact_scaled(self):
+        ys = sp.symbols(" ".join(CONTACT_STATES))
+        chi, ls = ys
+        P = Program([S, *ys, *self.params])
+        P.let("omega", S * chi / RHO, always=True)
+        P.extend(self.contact_phys, skip_defined=True)
+        o = self.contact_phys_out
+        g = [ls * o["Psi"] / o["tip"]["G"] - chi, S * o["dls"]]
+        self.contact = P
+        self.contact_states = ys
+        self.contact_rhs = [P.let(f"g_{n}", e) for n, e in zip(CONTACT_STATES, g)]
+        t = o["tip"]
+        self.contact_profile = {
+            "r": o["r"], "z": RHO * t["B"], "phi": t["phi"], "lambda_s": ls, "lambda_theta": o["lt"],
+            "kappa_s": o["ks"], "kappa_theta": o["kt"], "T_s": o["T_s"], "T_theta": o["T_t"],
+            "M_s": o["M_s"], "M_theta": o["M_t"], "tau_s": o["tau_s"], "tau_theta": o["tau_t"],
+            "Q": o["Q"], "P": o["P"], "axial_force_2pi": o["G"],
+            "energy_density": o["U"] * o["R"] * o["Psi"], "omega": sp.Symbol("omega"),
+        }
+        # note: profile z is relative to the tip apex; the solver adds z_tip.
+
+    # ------------------------------------------------------------------ conditions
+    def _build_boundaries(self):
+        st = self.structure
+        sh = st.shell
+        # Pole: omega = omega'(0) S + O(S^3), omega'(0) = lambda0 R'(0)/(rho A'(0)), and
+        # lambda_s(0) = lambda_theta(0) = lambda0.
+        chi0, ls0 = sp.symbols("chi ls")
+        Pp = Program([chi0, ls0, LAMBDA0, *self.params])
+        dR0 = sp.diff(sh.R, S).subs(S, 0)
+        dA0 = sp.diff(st.tip.A, OMEGA).subs(OMEGA, 0)
+        self.pole = Pp
+        self.pole_states = (chi0, ls0)
+        self.pole_res = [Pp.let("res_chi", chi0 - LAMBDA0 * dR0 / dA0), Pp.let("res_ls", ls0 - LAMBDA0)]
+
+        # Rim, S = L: lambda_theta = 1, M_s = 0 (as tr Delta = 0), z = 0.
+        lt, phiS, ls, ks, rQ, z = self.free_states
+        F = self.free
+        self.rim_res = [F.let("res_lt", lt - 1), F.let("res_m", self.free_phys_out["m"]),
+                        F.let("res_z", z)]
+
+        # Contact line: contact end (chi_c, ls_c) and free start (suffix _f) at S = Sc.
+        yc = sp.symbols("chi_c ls_c")
+        yf = sp.symbols(" ".join(n + "_f" for n in FREE_STATES))
+        J = Program([SC, *yc, *yf, DELTA, FORCE, *self.params])
+        cprog, cmap = self.contact.renamed("_c", {S: SC}, keep=self.params)
+        fprog, fmap = self.free.renamed("_f", {S: SC}, keep=self.params)
+        J.extend(cprog)
+        J.extend(fprog)
+        oc = {k: v.xreplace(cmap) for k, v in self.contact_profile.items()}
+        of = {k: v.xreplace(fmap) for k, v in self.free_profile.items()}
+        z_tip = sh.Z.subs(S, 0) - DELTA
+        lt_f, phiS_f, ls_f, ks_f, rQ_f, z_f = yf
+        common = [
+            J.let("res_r", lt_f - oc["lambda_theta"]),
+            J.let("res_phi", phiS_f - oc["phi"] / SC),
+            J.let("res_z", z_f - (z_tip + oc["z"])),
+        ]
+        self.junction = J
+        self.junction_inputs = (SC, *yc, *yf)
+        self.junction_res = {
+            "smooth": common + [J.let("res_ls", ls_f - oc["lambda_s"]),
+                                J.let("res_ks", ks_f - oc["kappa_s"])],
+            "paper": common + [J.let("res_Q", rQ_f - self.contact_phys_out["rQ"].xreplace(cmap)),
+                               J.let("res_tau", of["tau_s"] - oc["tau_s"])],
+        }
+        self.force_res = J.let("res_F", of["axial_force_2pi"] - FORCE / (2 * sp.pi))
+        # Total axial force of the ring at the contact edge (Q jumps there) and of the cap.
+        self.ring_force = J.let("ring_force", 2 * sp.pi * (of["axial_force_2pi"] - oc["axial_force_2pi"]))
+        self.cap_force = J.let("cap_force", 2 * sp.pi * oc["axial_force_2pi"])
+
+
+def derive(st: Structure) -> Derivation:
+    """Derive every program of a structure (see :class:`Derivation`)."""
+    return Derivation(st)

@@ -1,0 +1,138 @@
+r"""Reference shells and indenter tips as SymPy expressions.
+
+Shell: meridian ``R(S), Z(S)`` on ``0 <= S <= L`` with ``R(0) = 0, Z'(0) = 0``,
+scaled so that ``R(L) = 1, Z(L) = 0`` (lengths in units of the rim radius).
+Tip: ``r = rho A(omega), z = z_tip + rho B(omega)`` with ``A(0) = B(0) = B'(0) = 0``.
+
+The curvature conventions are the paper's (eq. curvatures):
+``kappa_s = (R'Z'' - Z'R'')/Psi^3``, ``kappa_theta = Z'/(R Psi)``; the tip's
+are its geometric curvatures (SPEC section 2 corrects the paper's division by
+omega'), so they do not depend on how the shell is stretched over the tip.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import sympy as sp
+
+__all__ = ["S", "OMEGA", "GAMMA", "ShellGeometry", "TipGeometry", "spheroid", "user_shell",
+           "sphere_tip", "user_tip"]
+
+S = sp.Symbol("S", positive=True)
+OMEGA = sp.Symbol("omega", positive=True)
+GAMMA = sp.Symbol("gamma", real=True)
+
+
+@dataclass(frozen=True)
+class ShellGeometry:
+    """Reference meridian; ``params`` are run-time symbols (e.g. gamma)."""
+
+    R: sp.Expr
+    Z: sp.Expr
+    L: sp.Expr
+    params: tuple = ()
+
+    @property
+    def Psi(self):
+        return sp.sqrt(sp.diff(self.R, S) ** 2 + sp.diff(self.Z, S) ** 2)
+
+    def curvatures(self):
+        """(kappa_s^R, kappa_theta^R) as expressions in S."""
+        Rp, Zp = sp.diff(self.R, S), sp.diff(self.Z, S)
+        Rpp, Zpp = sp.diff(Rp, S), sp.diff(Zp, S)
+        Psi = self.Psi
+        ks = sp.simplify((Rp * Zpp - Zp * Rpp) / Psi**3)
+        kt = sp.simplify(Zp / (self.R * Psi))
+        return ks, kt
+
+
+@dataclass(frozen=True)
+class TipGeometry:
+    """Indenter tip profile in units of its radius rho.
+
+    ``phi`` is the tip's tangent angle, ``tan(phi) = B'/A'``; for the sphere
+    it is omega itself (checked in the tests), otherwise ``atan2(B', A')``.
+    """
+
+    A: sp.Expr
+    B: sp.Expr
+    phi: sp.Expr
+
+    def derived(self):
+        """Dict of tip expressions in omega: A, B, dA, dB, G=|(A',B')|,
+        kappa_s*rho, kappa_theta*rho, sin(phi), cos(phi)."""
+        dA, dB = sp.diff(self.A, OMEGA), sp.diff(self.B, OMEGA)
+        ddA, ddB = sp.diff(dA, OMEGA), sp.diff(dB, OMEGA)
+        G = sp.simplify(sp.sqrt(dA**2 + dB**2))
+        return {
+            "A": self.A,
+            "B": self.B,
+            "dA": dA,
+            "dB": dB,
+            "G": G,
+            "rho_ks": sp.simplify((dA * ddB - dB * ddA) / G**3),
+            "rho_kt": sp.simplify(dB / (self.A * G)),
+            "sin_phi": sp.simplify(dB / G),
+            "cos_phi": sp.simplify(dA / G),
+            "phi": self.phi,
+        }
+
+
+def spheroid() -> ShellGeometry:
+    """``R = sin S``, ``Z = -gamma cos S``, ``L = pi/2`` (gamma > 0: bowl, < 0: dome)."""
+    return ShellGeometry(R=sp.sin(S), Z=-GAMMA * sp.cos(S), L=sp.pi / 2, params=(GAMMA,))
+
+
+def _parse(expr, var, name, allowed=()):
+    try:
+        e = sp.sympify(expr, locals={var.name: var, "pi": sp.pi})
+    except (sp.SympifyError, TypeError, SyntaxError) as exc:
+        raise ValueError(f"{name}: cannot parse {expr!r} as a SymPy expression ({exc})") from None
+    # Map same-named symbols (e.g. a plain Symbol('S')) onto ours.
+    e = e.xreplace({s: var for s in e.free_symbols if s.name == var.name})
+    extra = e.free_symbols - {var} - set(allowed)
+    if extra:
+        raise ValueError(f"{name} may only depend on {var.name}; it also contains {sorted(map(str, extra))}")
+    return e
+
+
+def user_shell(R, Z, L) -> ShellGeometry:
+    """Any smooth meridian with ``R(0) = 0``, ``Z'(0) = 0``, ``R > 0`` on (0, L].
+
+    Rescaled so that ``R(L) = 1`` and ``Z(L) = 0``.
+    """
+    R = _parse(R, S, "R(S)")
+    Z = _parse(Z, S, "Z(S)")
+    L = sp.nsimplify(sp.sympify(L)) if not isinstance(L, sp.Basic) else L
+    if not (L.is_number and float(L) > 0):
+        raise ValueError(f"L must be a positive number; got {L}")
+    if sp.simplify(R.subs(S, 0)) != 0:
+        raise ValueError(f"R(0) must be 0 (the pole is on the axis); got {R.subs(S, 0)}")
+    if sp.simplify(sp.diff(Z, S).subs(S, 0)) != 0:
+        raise ValueError("Z'(0) must be 0 (smooth pole)")
+    RL = R.subs(S, L)
+    if not (RL.is_number and float(RL) > 0):
+        raise ValueError(f"R(L) must be positive; got {RL}")
+    return ShellGeometry(R=sp.simplify(R / RL), Z=sp.simplify((Z - Z.subs(S, L)) / RL), L=L)
+
+
+def sphere_tip() -> TipGeometry:
+    """Sphere of radius rho: ``A = sin omega``, ``B = 1 - cos omega``, phi = omega."""
+    return TipGeometry(A=sp.sin(OMEGA), B=1 - sp.cos(OMEGA), phi=OMEGA)
+
+
+def user_tip(A, B) -> TipGeometry:
+    """Any smooth tip with ``A(0) = 0``, ``B(0) = 0``, ``B'(0) = 0``, ``A'(0) > 0``."""
+    A = _parse(A, OMEGA, "A(omega)")
+    B = _parse(B, OMEGA, "B(omega)")
+    if sp.simplify(A.subs(OMEGA, 0)) != 0:
+        raise ValueError("A(0) must be 0 (tip on the axis)")
+    if sp.simplify(B.subs(OMEGA, 0)) != 0:
+        raise ValueError("B(0) must be 0 (tip height measured from its apex)")
+    if sp.simplify(sp.diff(B, OMEGA).subs(OMEGA, 0)) != 0:
+        raise ValueError("B'(0) must be 0 (smooth apex)")
+    dA0 = sp.diff(A, OMEGA).subs(OMEGA, 0)
+    if not (dA0.is_number and float(dA0) > 0):
+        raise ValueError(f"A'(0) must be positive; got {dA0}")
+    return TipGeometry(A=A, B=B, phi=sp.atan2(sp.diff(B, OMEGA), sp.diff(A, OMEGA)))

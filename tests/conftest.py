@@ -1,0 +1,28 @@
+import os
+
+import pytest
+
+
+def pytest_addoption(parser):
+    parser.addoption("--runslow", action="store_true", default=False, help="run tests marked slow")
+
+
+def pytest_collection_modifyitems(config, items):
+    if config.getoption("--runslow"):
+        return
+    skip = pytest.mark.skip(reason="slow: run with --runslow")
+    for item in items:
+        if "slow" in item.keywords:
+            item.add_marker(skip)
+
+
+@pytest.fixture(scope="session", autouse=True)
+def _fresh_code_cache(tmp_path_factory):
+    """Generate code into a private cache: the tests exercise the derivation."""
+    old = os.environ.get("SHELLBVP_CACHE_DIR")
+    os.environ["SHELLBVP_CACHE_DIR"] = str(tmp_path_factory.mktemp("codecache"))
+    yield
+    if old is None:
+        os.environ.pop("SHELLBVP_CACHE_DIR", None)
+    else:
+        os.environ["SHELLBVP_CACHE_DIR"] = old
