@@ -10,11 +10,15 @@ Quick use::
 from .geometry import SphereTip, Spheroid, UserShell, UserTip
 from .materials import Gent, MooneyRivlin, NeoHookean, StrainEnergy
 from .scene import PRESETS, Scene
+from .solve import STATUS_MESSAGES, Solution, solve
 
 __version__ = "0.1.0.dev0"
 
 __all__ = [
     "Scene",
+    "solve",
+    "Solution",
+    "STATUS_MESSAGES",
     "PRESETS",
     "MooneyRivlin",
     "NeoHookean",

@@ -39,6 +39,7 @@ class SphereTip:
     """Built-in spherical tip ``A = sin omega``, ``B = 1 - cos omega`` (radius rho)."""
 
     kind = "sphere"
+    omega_max = 1.5707963267948966  # pi/2: the sphere meets its cylinder
 
     def description(self):
         return {"kind": "sphere"}
@@ -111,6 +112,14 @@ class UserTip:
         self._apex = float(ddB0 / dA0**2)
         if self._apex <= 0:
             raise ValueError(f"tip apex curvature B''(0)/A'(0)^2 must be > 0 (a convex tip); got {self._apex}")
+        # The tip ends where A' first vanishes (it meets the cylinder r = rho A there).
+        import numpy as np
+
+        dA = sp.lambdify(w, sp.diff(self.geometry.A, w), "numpy")
+        grid = np.linspace(1e-6, 2 * np.pi, 20001)
+        vals = np.broadcast_to(dA(grid), grid.shape)
+        sign_change = np.nonzero(np.diff(np.sign(vals)) != 0)[0]
+        self.omega_max = float(grid[sign_change[0]]) if sign_change.size else float(grid[-1])
 
     def description(self):
         return dict(self._desc)

@@ -130,6 +130,11 @@ class Scene:
         return np.array([v[name] for name in model.PARAMS], dtype=float)
 
     @property
+    def tip_omega_max(self) -> float:
+        """Where the tip joins the indenter's cylinder (A' = 0): pi/2 for the sphere."""
+        return self.tip.omega_max
+
+    @property
     def shell_length(self) -> float:
         """L, the reference meridian's length parameter."""
         if isinstance(self.shell, Spheroid):

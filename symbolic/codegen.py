@@ -197,6 +197,15 @@ def function_specs(d: Derivation) -> list[FunctionSpec]:
                      [("ring", [d.ring_force]), ("cap", [d.cap_force])],
                      "Axial force of the ring at Sc (jump of Q) and of the pressure on the cap."),
     ]
+    # geometry of the scene (guesses, plots, penetration checks)
+    specs += [
+        FunctionSpec("reference_shell", d.geometry_prog, [("S", (d.geometry_S,)), ("par", par)],
+                     [("out", d.reference_shell)], "Reference meridian: R, Z, Phi (angle), curvatures.",
+                     "S", returns_dict=True),
+        FunctionSpec("tip_shape", d.geometry_prog, [("omega", (d.geometry_omega,)), ("par", par)],
+                     [("out", d.tip_shape)], "Tip profile in units of rho: A, B, phi (tangent angle).",
+                     "omega", returns_dict=True),
+    ]
     return specs
 
 

@@ -103,6 +103,7 @@ class Derivation:
         self._build_free_scaled()
         self._build_contact_scaled()
         self._build_boundaries()
+        self._build_geometry()
 
     # ------------------------------------------------------------------ shared pieces
     def _shell_steps(self, prog: Program, Svar, tag=""):
@@ -255,7 +256,7 @@ class Derivation:
         drQ = C.derivative(rQ, S) + C.derivative(rQ, omega) * domega + C.derivative(rQ, ls) * dls
         P = C.let("P", ks * c["tau_s"] + kt * c["tau_t"] - drQ / (r * psi))
         self.contact_phys = C
-        self.contact_phys_out = dict(c, **g, tip=t, r=r, lt=lt, ks=ks, kt=kt, psi=psi,
+        self.contact_phys_out = dict(c, **g, tip=t, r=r, dr=dr, lt=lt, ks=ks, kt=kt, psi=psi,
                                      domega=domega, dls=dls, rQ=rQ, Q=Q, G=G, P=P)
 
     def _build_contact_scaled(self):
@@ -328,6 +329,21 @@ class Derivation:
         # Total axial force of the ring at the contact edge (Q jumps there) and of the cap.
         self.ring_force = J.let("ring_force", 2 * sp.pi * (of["axial_force_2pi"] - oc["axial_force_2pi"]))
         self.cap_force = J.let("cap_force", 2 * sp.pi * oc["axial_force_2pi"])
+
+
+    def _build_geometry(self):
+        """Reference shell and tip shape as plain functions (no states)."""
+        sh, tip = self.structure.shell, self.structure.tip
+        G = Program([S, OMEGA, *self.params])
+        k_s, k_t = sh.curvatures()
+        dR, dZ = sp.diff(sh.R, S), sp.diff(sh.Z, S)
+        self.reference_shell = {
+            "R": G.let("ref_R", sh.R), "Z": G.let("ref_Z", sh.Z), "Phi": G.let("ref_Phi", sp.atan2(dZ, dR)),
+            "kappa_s": G.let("ref_ks", k_s), "kappa_theta": G.let("ref_kt", k_t),
+        }
+        self.tip_shape = {"A": G.let("tip_A", tip.A), "B": G.let("tip_B", tip.B),
+                          "phi": G.let("tip_phi", tip.phi), "dA": G.let("tip_dA", sp.diff(tip.A, OMEGA))}
+        self.geometry_prog, self.geometry_S, self.geometry_omega = G, S, OMEGA
 
 
 def derive(st: Structure) -> Derivation:

@@ -1,0 +1,499 @@
+"""One equilibrium state: guesses, the solve_bvp call, diagnostics, the result.
+
+``solve(scene, delta=...)`` (or ``lambda0=``, ``force=``) returns a
+:class:`Solution` in the style of scipy's ``OptimizeResult``: it never raises
+for a state that does not converge (``success=False``, a ``status`` and a
+``message`` saying what to try); only invalid input raises ``ValueError``.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import time
+
+import numpy as np
+from scipy.integrate import solve_bvp
+
+from .system import N_CONTACT, MultipointBVP
+
+__all__ = ["Solution", "solve", "STATUS_MESSAGES"]
+
+log = logging.getLogger(__name__)
+
+STATUS_MESSAGES = {
+    0: "converged",
+    1: "the maximum number of mesh nodes was exceeded: raise max_nodes or loosen tol, or start "
+       "from a neighbouring solution (guess=)",
+    2: "a singular Jacobian was met: the guess is too far from a solution; start from a "
+       "neighbouring solution (guess=) or use sb.curve",
+    3: "solve_bvp could not satisfy the boundary conditions to bc_tol",
+    4: "converged to an inadmissible state (see message): start from a neighbouring solution",
+    5: "no initial guess converged (crude guesses and continuation from small delta)",
+}
+
+_GAUSS_T, _GAUSS_W = np.polynomial.legendre.leggauss(4)
+
+
+class Solution(dict):
+    """Result of :func:`solve` (a dict with attribute access, like OptimizeResult).
+
+    Attributes
+    ----------
+    success : bool
+        Converged to an admissible state (``status == 0``).
+    status : int
+        0 converged; 1 too many nodes; 2 singular Jacobian; 3 boundary conditions
+        not met to ``bc_tol``; 4 inadmissible (delta < 0, cap beyond the tip, ...);
+        5 no guess converged.  See ``STATUS_MESSAGES``.
+    message : str
+    delta, force, lambda0, Sc : float
+        Pole displacement, indenter force F (> 0 pushing), pole stretch, contact circle.
+    x, y, p, sol, rms_residuals, niter
+        solve_bvp's mesh on t in [0, 1], stacked states (8, m) (layout in
+        ``shellbvp.system``), unknown parameters, interpolant, residuals, iterations.
+    nodes : int
+    max_residual : float
+        Largest relative collocation residual.
+    energy : float
+        ``E = 2 pi Int U R Psi dS`` (F = dE/ddelta for the smooth model).
+    ring_force, cap_force : float
+        Axial force of the ring at Sc (jump of Q) and of the pressure on the cap;
+        ``force = ring_force + cap_force``.  For ``contact="paper"`` the ring force is ~0.
+    pressure_min : float
+        Minimum contact pressure over the cap (< 0: the shell would pull the indenter).
+    penetration : float
+        Largest height of the free shell above the indenter's surface (> 0: it passes
+        through the indenter).
+    valid : bool
+        pressure_min >= 0, ring_force >= 0, no penetration, contact on the tip.
+    flags : list of str
+        Why the state is not valid (empty when valid).
+    force_defect : float
+        max |F(S) - F| over the free region (F is a first integral there).
+    force_error, delta_error : float
+        Richardson error estimates (halved mesh; NaN if not estimated).
+    wall_time : float
+        Seconds.
+    """
+
+    def __getattr__(self, name):
+        try:
+            return self[name]
+        except KeyError:
+            raise AttributeError(name) from None
+
+    __setattr__ = dict.__setitem__
+
+    def __repr__(self):
+        keys = ("success", "status", "delta", "force", "lambda0", "Sc", "nodes", "valid")
+        inner = ", ".join(f"{k}={self.get(k)!r}" for k in keys)
+        return f"Solution({inner})"
+
+    # -- fields over S ------------------------------------------------------------------
+    def profile(self, points_per_interval: int = 1):
+        """Physical fields over S (contact region first, then free region).
+
+        Returns a dict of 1-D arrays: ``S``, ``region`` (0 contact, 1 free), ``r``, ``z``,
+        ``phi``, ``lambda_s``, ``lambda_theta``, ``kappa_s``, ``kappa_theta``, ``T_s``,
+        ``T_theta``, ``M_s``, ``M_theta``, ``tau_s``, ``tau_theta``, ``Q``, ``P``,
+        ``axial_force`` (F(S), the axial force carried across the circle S), ``energy_density``.
+        ``points_per_interval > 1`` adds points between mesh nodes (from the interpolant).
+        """
+        sysm = self["system"]
+        t = self.x
+        if points_per_interval > 1:
+            t = np.unique(np.concatenate([np.linspace(a, b, points_per_interval + 1)
+                                          for a, b in zip(t[:-1], t[1:])]))
+        y = self.sol(t)
+        ln_Sc = self.p[0]
+        mod, par = sysm.model, sysm.par
+        Sc_t, Sf_t = sysm.S_contact(t, ln_Sc), sysm.S_free(t, ln_Sc)
+        pc = mod.contact_profile(Sc_t, y[:N_CONTACT], par)
+        pf = mod.free_profile(Sf_t, y[N_CONTACT:], par)
+        pc["z"] = pc["z"] + self["z_tip"]
+        out = {"S": np.concatenate([Sc_t, Sf_t]),
+               "region": np.concatenate([np.zeros(t.size, int), np.ones(t.size, int)])}
+        for key in pf:
+            if key == "axial_force_2pi":
+                out["axial_force"] = 2 * np.pi * np.concatenate([pc[key], pf[key]])
+            else:
+                out[key] = np.concatenate([pc[key], pf[key]])
+        return out
+
+
+def _undeformed_guess(sysm: MultipointBVP, ln_Sc, lambda0, delta, n=41):
+    """Crude start: the reference shell moved down by delta, a small cap at stretch lambda0."""
+    mod, par, L = sysm.model, sysm.par, sysm.L
+    t = np.linspace(0.0, 1.0, n)
+    Sf = sysm.S_free(t, ln_Sc)
+    ref = mod.reference_shell(Sf, par)
+    chi0 = -mod.pole_res(0.0, 0.0, 1.0, par)[0]  # chi at the pole for lambda0 = 1
+    Sc = np.exp(ln_Sc)
+    w = (Sf - Sc) / (L - Sc)
+    y = np.vstack([
+        np.full(n, lambda0 * chi0),
+        np.full(n, lambda0),
+        lambda0 + (1.0 - lambda0) * w,
+        ref["Phi"] / Sf,
+        np.ones(n),
+        ref["kappa_s"],
+        np.zeros(n),
+        ref["Z"] - delta * (1.0 - w),
+    ])
+    return t, y, sysm.pack(ln_Sc, lambda0, delta)
+
+
+def thin_mesh(x, keep_every: int = 3):
+    """Every ``keep_every``-th node plus the ends (solve_bvp only ever adds nodes)."""
+    idx = np.unique(np.r_[np.arange(0, x.size, keep_every), x.size - 1])
+    return x[idx]
+
+
+def _warm_guess(sysm: MultipointBVP, prev: "Solution", predictor=None):
+    """Previous solution on a thinned mesh; optional predicted (y, p) shift."""
+    x = thin_mesh(prev.x)
+    y = prev.sol(x)
+    ln_Sc, lambda0, delta, _ = _state_params(prev)
+    p = sysm.pack(ln_Sc, lambda0, delta)
+    if predictor is not None:
+        dy, dp = predictor
+        y = y + dy(x)
+        p = p + dp
+    return x, y, p
+
+
+def _state_params(sol):
+    return sol.p[0], sol["lambda0"], sol["delta"], sol["force"]
+
+
+def _integrate(sysm, sol, ln_Sc, region):
+    """Int over a region of f(S) dS with Gauss points on each mesh interval."""
+    x = sol.x
+    a, b = x[:-1], x[1:]
+    tm = 0.5 * (a + b)[:, None] + 0.5 * (b - a)[:, None] * _GAUSS_T[None, :]
+    w = 0.5 * (b - a)[:, None] * _GAUSS_W[None, :]
+    t = tm.ravel()
+    y = sol.sol(t)
+    mod, par = sysm.model, sysm.par
+    if region == "contact":
+        S = sysm.S_contact(t, ln_Sc)
+        e = mod.contact_profile(S, y[:N_CONTACT], par)["energy_density"]
+        jac = S * (-sysm.ln_eps)
+    else:
+        S = sysm.S_free(t, ln_Sc)
+        e = mod.free_profile(S, y[N_CONTACT:], par)["energy_density"]
+        jac = S * (sysm.ln_L - ln_Sc)
+    return float(np.sum(w.ravel() * e * jac))
+
+
+def _diagnose(sysm: MultipointBVP, bvp, tol):
+    """Turn solve_bvp's result into a Solution with the model's diagnostics."""
+    mod, par = sysm.model, sysm.par
+    ln_Sc, lambda0, delta, F_pres = sysm.unpack(bvp.p)
+    Sc = np.exp(ln_Sc)
+    ya, yb = bvp.y[:, 0], bvp.y[:, -1]
+    yc, yf = yb[:N_CONTACT], ya[N_CONTACT:]
+    ring, cap = mod.contact_line_forces(Sc, yc, yf, delta, F_pres, par)
+    force = float(ring[0] + cap[0])
+    res = Solution(
+        status=int(bvp.status), message=bvp.message, x=bvp.x, y=bvp.y, p=bvp.p, sol=bvp.sol,
+        rms_residuals=bvp.rms_residuals, niter=int(bvp.niter), nodes=int(bvp.x.size),
+        max_residual=float(np.max(bvp.rms_residuals)) if bvp.rms_residuals.size else float("nan"),
+        delta=float(delta), lambda0=float(lambda0), Sc=Sc, force=force,
+        ring_force=float(ring[0]), cap_force=float(cap[0]), control=sysm.control,
+        scene=sysm.scene, system=sysm, z_tip=float(mod.reference_shell(0.0, par)["Z"]) - float(delta),
+    )
+    flags = []
+    finite = np.all(np.isfinite(bvp.y)) and np.all(np.isfinite(bvp.p)) and math.isfinite(force)
+    omega_c = Sc * yc[0] / sysm.scene.rho
+    if not finite:
+        flags.append("non-finite state")
+    elif bvp.status == 0:
+        if not 0.0 < Sc < sysm.L:
+            flags.append(f"contact circle Sc = {Sc:.3g} outside (0, L)")
+        if lambda0 <= 0 or np.any(bvp.y[[1, 2, 4]] <= 0):
+            flags.append("non-positive stretch")
+        if delta < 0:
+            flags.append(f"collapsed state with delta = {delta:.3g} < 0")
+        if omega_c > sysm.scene.tip_omega_max:
+            flags.append("the contact has passed the end of the tip (the indenter's cylinder)")
+    if bvp.status == 0 and flags:
+        res.status = 4
+        res.message = STATUS_MESSAGES[4] + ": " + "; ".join(flags)
+    elif bvp.status == 0:
+        res.message = STATUS_MESSAGES[0]
+    elif not res.message:
+        res.message = STATUS_MESSAGES.get(bvp.status, "")
+    res.success = res.status == 0
+    if not finite:
+        res.update(energy=float("nan"), pressure_min=float("nan"), penetration=float("nan"),
+                   force_defect=float("nan"), valid=False, flags=flags)
+        return res
+
+    # Diagnostics on nodes and midpoints.
+    t = np.unique(np.r_[bvp.x, 0.5 * (bvp.x[1:] + bvp.x[:-1])])
+    y = bvp.sol(t)
+    pc = mod.contact_profile(sysm.S_contact(t, ln_Sc), y[:N_CONTACT], par)
+    pf = mod.free_profile(sysm.S_free(t, ln_Sc), y[N_CONTACT:], par)
+    res.force_defect = float(np.max(np.abs(2 * np.pi * pf["axial_force_2pi"] - force)))
+    res.pressure_min = float(np.min(pc["P"]))
+    res.penetration = _penetration(sysm, pf["r"], pf["z"], res.z_tip)
+    res.energy = 2 * np.pi * (_integrate(sysm, bvp, ln_Sc, "contact") + _integrate(sysm, bvp, ln_Sc, "free")
+                              + 0.5 * float(pc["energy_density"][0]) * sysm.S_contact(0.0, ln_Sc))
+    vflags = []
+    scale = 10 * tol
+    if res.pressure_min < -scale * (1 + abs(force)):
+        vflags.append(f"negative contact pressure (min P = {res.pressure_min:.3g}): the shell would "
+                      "lift off the indenter inside the cap")
+    if res.ring_force < -scale * (1 + abs(force)):
+        vflags.append(f"negative ring force ({res.ring_force:.3g}) at the contact edge")
+    if res.penetration > scale:
+        vflags.append(f"the free shell passes through the indenter (by {res.penetration:.3g})")
+    res.flags = flags + vflags
+    res.valid = res.success and not vflags
+    return res
+
+
+def _penetration(sysm, r, z, z_tip):
+    """Largest height of free-shell points above the indenter's lower surface."""
+    om = sysm.tip_grid
+    A, B = sysm.tip_A, sysm.tip_B
+    rho = sysm.scene.rho
+    inside = r < rho * A[-1]
+    if not np.any(inside):
+        return -np.inf
+    surface = z_tip + rho * np.interp(r[inside] / rho, A, B)
+    return float(np.max(z[inside] - surface))
+
+
+def _run_bvp(sysm, guess, tol, max_nodes, bc_tol):
+    x, y, p = guess
+    with np.errstate(all="ignore"):
+        return solve_bvp(sysm.fun, sysm.bc, x, y, p, fun_jac=sysm.fun_jac, bc_jac=sysm.bc_jac,
+                         tol=tol, bc_tol=bc_tol, max_nodes=max_nodes)
+
+
+def _attach_tip(sysm):
+    """Tabulated tip profile for penetration checks (A increasing up to omega_max)."""
+    om = np.linspace(0.0, sysm.scene.tip_omega_max, 401)
+    shape = sysm.model.tip_shape(om, sysm.par)
+    sysm.tip_grid, sysm.tip_A, sysm.tip_B = om, shape["A"], shape["B"]
+
+
+def make_system(scene, control, value, eps):
+    sysm = MultipointBVP(scene, control, value, eps)
+    _attach_tip(sysm)
+    return sysm
+
+
+def solve_from(sysm, guess, *, tol=1e-6, max_nodes=10000, bc_tol=None):
+    """One solve_bvp run from a given (x, y, p) guess, diagnosed."""
+    t0 = time.perf_counter()
+    bvp = _run_bvp(sysm, guess, tol, max_nodes, bc_tol if bc_tol is not None else 1e-10)
+    with np.errstate(all="ignore"):  # diagnostics of a failed run may overflow; flagged instead
+        res = _diagnose(sysm, bvp, tol)
+    res.wall_time = time.perf_counter() - t0
+    return res
+
+
+def richardson_error(sysm, res, tol, bc_tol=1e-10):
+    """Set ``force_error`` and ``delta_error`` by Richardson extrapolation.
+
+    The collocation solution (Lobatto IIIA, order 4) is recomputed on the
+    converged mesh with every interval halved, without further refinement
+    (``max_nodes`` pins the mesh; Newton converges to tol/100 and bc_tol/100, so the
+    coarse solve's iteration and boundary errors are included); the error of
+    the coarse value is then ``|X_h - X_h/2| * 16/15``.  Costs one Newton
+    solve on twice the nodes.
+    """
+    x = res.x
+    x2 = np.sort(np.r_[x, 0.5 * (x[1:] + x[:-1])])
+    ln_Sc, lambda0, delta, _ = _state_params(res)
+    guess = (x2, res.sol(x2), sysm.pack(ln_Sc, lambda0, delta))
+    with np.errstate(all="ignore"):
+        fine = solve_bvp(sysm.fun, sysm.bc, *guess, fun_jac=sysm.fun_jac, bc_jac=sysm.bc_jac,
+                         tol=tol / 100, bc_tol=bc_tol / 100, max_nodes=x2.size)
+    if fine.status == 2 or not np.all(np.isfinite(fine.p)):
+        res.force_error = res.delta_error = float("nan")
+        res.flags = list(res.flags) + ["error estimate failed (Newton on the halved mesh did not converge)"]
+        return
+    f_ln_Sc, _, f_delta, _ = sysm.unpack(fine.p)
+    ring, cap = sysm.model.contact_line_forces(np.exp(f_ln_Sc), fine.y[:N_CONTACT, -1],
+                                               fine.y[N_CONTACT:, 0], f_delta, sysm.unpack(fine.p)[3],
+                                               sysm.par)
+    res.force_error = abs(float(ring[0] + cap[0]) - res.force) * 16 / 15
+    res.delta_error = abs(float(f_delta) - res.delta) * 16 / 15
+
+
+def _default_eps(tol):
+    # Pole start zeta = eps*Sc: the truncated series errs by O(eps^2) relative.
+    return min(1e-3, 0.1 * math.sqrt(tol))
+
+
+def solve(scene, *, delta=None, lambda0=None, force=None, tol=1e-6, max_nodes=10000, guess=None,
+          eps=None, bc_tol=1e-10, estimate_error=True):
+    """Solve one indentation state.
+
+    Exactly one of ``delta`` (pole displacement), ``lambda0`` (pole stretch) or
+    ``force`` (indenter force) is prescribed.
+
+    Parameters
+    ----------
+    scene : Scene
+    tol : float
+        solve_bvp's relative collocation tolerance (states are O(1)-scaled).
+    max_nodes : int
+    guess : Solution, optional
+        A neighbouring solution to start from (warm start on a thinned mesh).
+    eps : float, optional
+        Pole start ``zeta = eps*Sc``; default ``min(1e-3, 0.1 sqrt(tol))``.
+    bc_tol : float
+        Tolerance on the boundary and contact-line conditions.
+    estimate_error : bool
+        Richardson error estimates ``force_error``, ``delta_error`` (one more Newton
+        solve on the mesh with every interval halved; see :func:`richardson_error`).
+
+    Returns
+    -------
+    Solution
+    """
+    given = {k: v for k, v in (("delta", delta), ("lambda0", lambda0), ("force", force)) if v is not None}
+    if len(given) != 1:
+        raise ValueError("give exactly one of delta, lambda0 or force; got "
+                         + (", ".join(given) if given else "none"))
+    (control, value), = given.items()
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)) \
+            or not math.isfinite(value):
+        raise ValueError(f"{control} must be a finite number; got {value!r}")
+    if control == "delta" and value <= 0:
+        raise ValueError(f"delta must be > 0 (delta = 0 is the undeformed shell); got {value!r}")
+    if control == "lambda0" and value <= 0:
+        raise ValueError(f"lambda0 (pole stretch) must be > 0; got {value!r}")
+    if not (isinstance(tol, (int, float)) and 1e-12 <= tol <= 1e-1):
+        raise ValueError(f"tol must be in [1e-12, 1e-1]; got {tol!r}")
+    if not (isinstance(max_nodes, (int, np.integer)) and max_nodes >= 10):
+        raise ValueError(f"max_nodes must be an integer >= 10; got {max_nodes!r}")
+    eps = _default_eps(tol) if eps is None else float(eps)
+    if not 0 < eps < 0.5:
+        raise ValueError(f"eps (pole start zeta = eps*Sc) must be in (0, 0.5); got {eps!r}")
+
+    t0 = time.perf_counter()
+    sysm = make_system(scene, control, value, eps)
+    kw = dict(tol=tol, max_nodes=max_nodes, bc_tol=bc_tol)
+    if guess is not None:
+        res = solve_from(sysm, _warm_guess(sysm, guess), **kw)
+    elif control == "delta":
+        res = _cold_delta(sysm, value, **kw)
+    else:
+        res = _cold_other(scene, sysm, control, value, eps, **kw)
+    if res.success and estimate_error:
+        richardson_error(sysm, res, tol, bc_tol)
+    else:
+        res.force_error = res.delta_error = float("nan")
+    res.wall_time = time.perf_counter() - t0
+    return res
+
+
+_SC_GUESSES = (0.05, 0.2, 0.01, 0.002)
+_CRUDE_MAX_NODES = 3000
+_CRUDE_TOL = 1e-4
+
+
+def _loose(kw):
+    """Settings for getting near a solution from far away: fail fast, then tighten."""
+    return dict(kw, tol=max(kw["tol"], _CRUDE_TOL), max_nodes=min(kw["max_nodes"], _CRUDE_MAX_NODES))
+
+
+def _tighten(sysm, res, **kw):
+    if not res.success or kw["tol"] >= _CRUDE_TOL:
+        return res
+    return solve_from(sysm, _warm_guess(sysm, res), **kw)
+
+
+def _cold_delta(sysm, delta, **kw):
+    """Crude guesses at a few cap sizes; then continuation in delta from a moderate depth."""
+    best = None
+    for Sc0 in _SC_GUESSES:
+        res = solve_from(sysm, _undeformed_guess(sysm, math.log(Sc0), 1.0, delta), **_loose(kw))
+        if res.success:
+            return _tighten(sysm, res, **kw)
+        best = best or res
+    res = _continue_in_delta(sysm.scene, sysm.eps, delta, **_loose(kw))
+    if res is not None and res.success:
+        return _tighten(res.system, res, **kw)
+    best.status = 5
+    best.message = STATUS_MESSAGES[5] + f" (first attempt: {best.message})"
+    best.success = False
+    return best
+
+
+def _continue_in_delta(scene, eps, target, starts=(0.1, 0.05), **kw):
+    """Natural continuation in delta to ``target`` from a depth where crude guesses work.
+
+    Cold-start fallback.  Steps grow by 1.5 after a success and halve after a
+    failure; downwards they are relative (delta * (1 - f)), since caps shrink
+    fast as delta -> 0.
+    """
+    res = None
+    for d in starts:
+        sysm = make_system(scene, "delta", d, eps)
+        for Sc0 in _SC_GUESSES:
+            res = solve_from(sysm, _undeformed_guess(sysm, math.log(Sc0), 1.0, d), **kw)
+            if res.success:
+                break
+        if res.success:
+            break
+    if res is None or not res.success:
+        return None
+    up = target > d
+    frac = min(0.5, abs(target - d) / d) if up else 0.3
+    while d != target:
+        nd = min(target, d * (1 + frac)) if up else max(target, d * (1 - frac))
+        sysm = make_system(scene, "delta", nd, eps)
+        nxt = solve_from(sysm, _warm_guess(sysm, res), **kw)
+        if nxt.success:
+            res, d = nxt, nd
+            frac = min(1.5 * frac, 0.5)
+        else:
+            frac /= 2
+            if frac < 1e-3:
+                return None
+    return res
+
+
+def _failure(status, message):
+    nan = float("nan")
+    return Solution(status=status, message=message, success=False, valid=False, flags=[],
+                    delta=nan, force=nan, lambda0=nan, Sc=nan, nodes=0, niter=0, wall_time=nan)
+
+
+_MARCH_DELTA_MAX = 2.0
+
+
+def _cold_other(scene, sysm, control, value, eps, **kw):
+    """lambda0 or force prescribed: march in delta until the target is bracketed, then switch."""
+    key = "lambda0" if control == "lambda0" else "force"
+    d, step = 0.02, 0.02
+    lk = _loose(kw)
+    cur = _cold_delta(make_system(scene, "delta", d, eps), d, **lk)
+    if not cur.success:
+        return _failure(5, STATUS_MESSAGES[5])
+    prev = None
+    while prev is None or (prev[key] - value) * (cur[key] - value) > 0:
+        nd = d + step
+        if nd > _MARCH_DELTA_MAX:
+            return _failure(5, f"{control} = {value:g} was not reached on the branch for delta up to "
+                               f"{d:.3g} ({key} there: {cur[key]:.4g})")
+        dsys = make_system(scene, "delta", nd, eps)
+        nxt = solve_from(dsys, _warm_guess(dsys, cur), **lk)
+        if nxt.success:
+            prev, cur, d = cur, nxt, nd
+            step = min(1.5 * step, 0.05)
+        else:
+            step /= 2
+            if step < 1e-4:
+                return _failure(5, f"continuation in delta towards {control} = {value:g} stalled at "
+                                   f"delta = {d:.3g}")
+    start = min((prev, cur), key=lambda s: abs(s[key] - value))
+    return solve_from(sysm, _warm_guess(sysm, start), **kw)
