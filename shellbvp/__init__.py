@@ -4,19 +4,26 @@ Quick use::
 
     import shellbvp as sb
     scene = sb.Scene.preset("base")
-    model = scene.model()          # generated, cached equations of this structure
+    sol = sb.solve(scene, delta=0.2)           # one state
+    c = sb.curve(scene, delta_max=0.5)         # force-displacement curve
+    c.to_hdf5("base.h5")
 """
 
 from .geometry import SphereTip, Spheroid, UserShell, UserTip
 from .materials import Gent, MooneyRivlin, NeoHookean, StrainEnergy
 from .scene import PRESETS, Scene
 from .solve import STATUS_MESSAGES, Solution, solve
+from .continuation import Curve, curve
+from .io import read_curve
 
 __version__ = "0.1.0.dev0"
 
 __all__ = [
     "Scene",
     "solve",
+    "curve",
+    "Curve",
+    "read_curve",
     "Solution",
     "STATUS_MESSAGES",
     "PRESETS",

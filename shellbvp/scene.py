@@ -108,6 +108,45 @@ class Scene:
     def replace(self, **changes) -> "Scene":
         return replace(self, **changes)
 
+    # -- serialisation -------------------------------------------------------------
+    def to_dict(self) -> dict:
+        """Plain data that rebuilds this scene exactly (user formulas as srepr)."""
+        return {
+            "gamma": self.gamma, "rho": self.rho, "beta": self.beta, "xi": self.xi,
+            "contact": self.contact,
+            "material": {**self.material.description(), **self.material.values()},
+            "shell": self.shell.description(), "tip": self.tip.description(),
+        }
+
+    @classmethod
+    def from_dict(cls, d: dict) -> "Scene":
+        from .geometry import UserShell, UserTip
+        from .materials import NeoHookean, StrainEnergy
+
+        m = dict(d["material"])
+        family = m.pop("family")
+        if family == "mooney-rivlin":
+            material = MooneyRivlin(m["alpha"])
+        elif family == "neo-hookean":
+            material = NeoHookean()
+        elif family == "gent":
+            material = Gent(m["Jm"])
+        elif family == "user":
+            import sympy as sp
+
+            material = StrainEnergy(sp.sympify(m["W"]))
+        else:
+            raise ValueError(f"unknown material family {family!r} in scene data")
+        shell = Spheroid() if d["shell"]["kind"] == "spheroid" else _user_shell(d["shell"])
+        tip = SphereTip() if d["tip"]["kind"] == "sphere" else _user_tip(d["tip"])
+        return cls(gamma=d["gamma"], rho=d["rho"], beta=d["beta"], material=material, xi=int(d["xi"]),
+                   contact=d["contact"], shell=shell, tip=tip)
+
+    def to_json(self) -> str:
+        import json
+
+        return json.dumps(self.to_dict(), sort_keys=True)
+
     # -- generated code ------------------------------------------------------------
     def structure(self) -> dict:
         """The structural choices the generated code is specialised on."""
@@ -140,6 +179,18 @@ class Scene:
         if isinstance(self.shell, Spheroid):
             return math.pi / 2
         return float(self.shell.geometry.L)
+
+
+def _user_shell(desc):
+    import sympy as sp
+
+    return UserShell(sp.sympify(desc["R"]), sp.sympify(desc["Z"]), sp.sympify(desc["L"]))
+
+
+def _user_tip(desc):
+    import sympy as sp
+
+    return UserTip(sp.sympify(desc["A"]), sp.sympify(desc["B"]))
 
 
 PRESETS = {

@@ -21,9 +21,14 @@ control    p                                      conditions (8 + k)
 delta      (ln Sc, lambda0)                       pole 2, contact line 5, rim 3
 lambda0    (ln Sc, delta)                         pole 2, contact line 5, rim 3
 force      (ln Sc, lambda0, delta)                the 10 above + force 1
+arclength  (ln Sc, lambda0, delta)                the 10 above + arclength 1
 =========  =====================================  ==========================
 
-The residual vector is ordered ``[pole(2), contact line(5), rim(3), force(1)?]``.
+The residual vector is ordered ``[pole(2), contact line(5), rim(3), extra(1)?]``.
+The arclength condition (pseudo-arclength continuation) is
+``sum_i t_i (X_i - Xhat_i)/s_i = 0`` over ``X = (delta, lambda0, F)`` with a unit
+tangent ``t``, a predicted point ``Xhat`` and scales ``s``; ``value`` is then the
+tuple ``(Xhat, t, s)``.
 """
 
 from __future__ import annotations
@@ -34,7 +39,7 @@ import numpy as np
 
 __all__ = ["MultipointBVP", "CONTROLS"]
 
-CONTROLS = ("delta", "lambda0", "force")
+CONTROLS = ("delta", "lambda0", "force", "arclength")
 N_CONTACT, N_FREE = 2, 6
 N = N_CONTACT + N_FREE
 
@@ -59,14 +64,19 @@ class MultipointBVP:
         self.model = mod = scene.model()
         self.par = scene.parameters(mod)
         self.control = control
-        self.value = float(value)
+        if control == "arclength":
+            xhat, tangent, scale = (np.asarray(v, float) for v in value)
+            self.arc_point, self.arc_tangent, self.arc_scale = xhat, tangent, scale
+            self.value = float("nan")
+        else:
+            self.value = float(value)
         self.eps = float(eps)
         self.ln_eps = math.log(eps)
         self.L = scene.shell_length
         self.ln_L = math.log(self.L)
         self._jres = getattr(mod, f"junction_{scene.contact}_res")
         self._jjac = getattr(mod, f"junction_{scene.contact}_jac")
-        self.k = 3 if control == "force" else 2
+        self.k = 3 if control in ("force", "arclength") else 2
         self.n_conditions = N + self.k
 
     # -- parameters -------------------------------------------------------------------
@@ -76,6 +86,8 @@ class MultipointBVP:
             return p[0], p[1], self.value, 0.0
         if self.control == "lambda0":
             return p[0], self.value, p[1], 0.0
+        if self.control == "arclength":
+            return p[0], p[1], p[2], 0.0
         return p[0], p[1], p[2], self.value
 
     def pack(self, ln_Sc, lambda0, delta):
@@ -87,11 +99,11 @@ class MultipointBVP:
 
     @property
     def _i_lambda0(self):
-        return {"delta": 1, "lambda0": None, "force": 1}[self.control]
+        return {"delta": 1, "lambda0": None, "force": 1, "arclength": 1}[self.control]
 
     @property
     def _i_delta(self):
-        return {"delta": None, "lambda0": 1, "force": 2}[self.control]
+        return {"delta": None, "lambda0": 1, "force": 2, "arclength": 2}[self.control]
 
     # -- the maps -----------------------------------------------------------------------
     def S_contact(self, t, ln_Sc):
@@ -137,6 +149,11 @@ class MultipointBVP:
         ]
         if self.control == "force":
             parts.append(mod.force_res(Sc, yb[:N_CONTACT], ya[N_CONTACT:], delta, F, par))
+        elif self.control == "arclength":
+            # F of the state: force_res with a prescribed F of 0 is F/(2 pi).
+            force = 2 * np.pi * mod.force_res(Sc, yb[:N_CONTACT], ya[N_CONTACT:], delta, 0.0, par)[0]
+            X = np.array([delta, lambda0, force])
+            parts.append([np.sum(self.arc_tangent * (X - self.arc_point) / self.arc_scale)])
         return np.concatenate(parts)
 
     def bc_jac(self, ya, yb, p):
@@ -160,4 +177,11 @@ class MultipointBVP:
             fj = mod.force_jac(Sc, yb[:N_CONTACT], ya[N_CONTACT:], delta, F, par)  # d/d(Sc, yf, F)
             P[10, 0] = fj[0, 0] * Sc
             A[10, N_CONTACT:] = fj[0, 1:7]
+        elif self.control == "arclength":
+            w = self.arc_tangent / self.arc_scale  # weights of (delta, lambda0, F)
+            fj = 2 * np.pi * mod.force_jac(Sc, yb[:N_CONTACT], ya[N_CONTACT:], delta, 0.0, par)
+            P[10, 0] = w[2] * fj[0, 0] * Sc
+            A[10, N_CONTACT:] = w[2] * fj[0, 1:7]
+            P[10, 1] = w[1]
+            P[10, 2] = w[0]
         return A, B, P

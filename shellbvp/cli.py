@@ -1,0 +1,254 @@
+"""The ``shellbvp`` command line: a thin layer over the Python API.
+
+    shellbvp curve [--preset base] [scene options] [-o base.h5]   force-displacement curve -> HDF5
+    shellbvp solve [scene options] --delta 0.2 [--profiles] [--json]   one state
+    shellbvp info FILE.h5                                            what a curve file holds
+    shellbvp presets                                                 the built-in scenes
+
+Invalid input exits with status 2 and a one-line message naming the parameter.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import logging
+import math
+import sys
+import time
+
+__all__ = ["main"]
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message):  # one line, exit 2 (argparse's own convention)
+        self.exit(2, f"shellbvp: error: {message}\n")
+
+
+def _scene_options(p):
+    g = p.add_argument_group("scene (overrides of the preset)")
+    g.add_argument("--preset", default="base", help="built-in scene (see `shellbvp presets`; default base)")
+    g.add_argument("--gamma", type=float, help="spheroid aspect parameter (< 1/rho; >0 bowl, <0 dome)")
+    g.add_argument("--rho", type=float, help="indenter radius / rim radius (> 0)")
+    g.add_argument("--beta", type=float, help="bending stiffness B/(mu R_L^2) (> 0)")
+    m = g.add_mutually_exclusive_group()
+    m.add_argument("--alpha", type=float, help="Mooney-Rivlin alpha in [0, 1]")
+    m.add_argument("--gent-jm", type=float, dest="gent_jm", help="Gent model with this Jm (> 0)")
+    m.add_argument("--neo-hookean", action="store_true", help="neo-Hookean material")
+    g.add_argument("--xi", type=int, choices=(0, 1), help="1: full generalised tensions; 0: first approximation")
+    g.add_argument("--contact", choices=("smooth", "paper"), help="contact-line model (default smooth)")
+    s = p.add_argument_group("solver")
+    s.add_argument("--tol", type=float, default=1e-6, help="collocation tolerance (default 1e-6)")
+    s.add_argument("--max-nodes", type=int, default=10000, dest="max_nodes")
+
+
+def _scene(args):
+    import shellbvp as sb
+
+    over = {k: getattr(args, k) for k in ("gamma", "rho", "beta", "xi", "contact") if getattr(args, k) is not None}
+    if args.alpha is not None:
+        over["material"] = sb.MooneyRivlin(args.alpha)
+    elif args.gent_jm is not None:
+        over["material"] = sb.Gent(args.gent_jm)
+    elif args.neo_hookean:
+        over["material"] = sb.NeoHookean()
+    return sb.Scene.preset(args.preset, **over)
+
+
+def _progress(enabled):
+    start = time.perf_counter()
+
+    def show(curve, sol):
+        if not enabled:
+            return
+        n = len(curve)
+        sys.stderr.write(f"\r  {n:4d} points  delta = {sol.delta:8.5f}  F = {sol.force:10.5f}  "
+                         f"{time.perf_counter() - start:6.1f} s")
+        sys.stderr.flush()
+
+    return show
+
+
+def _cmd_curve(args):
+    import shellbvp as sb
+
+    from .io import write_curve
+
+    scene = _scene(args)
+    units = None
+    if (args.radius is None) != (args.mu_h is None):
+        raise ValueError("--radius and --muH go together (rim radius in m, mu*H in N/m)")
+    if args.radius is not None:
+        units = {"R_L": args.radius, "mu_H": args.mu_h}
+    deltas = None
+    if args.points is not None:
+        if args.points < 2:
+            raise ValueError(f"--points must be >= 2; got {args.points}")
+        if not (math.isfinite(args.delta_max) and args.delta_max > 0):
+            raise ValueError(f"--delta-max must be a finite number > 0; got {args.delta_max}")
+        deltas = [args.delta_max * (i + 1) / args.points for i in range(args.points)]
+    out = args.output or f"{args.preset}.h5"
+    from pathlib import Path
+
+    if Path(out).exists() and not args.force:
+        raise ValueError(f"output {out} exists; use --force to replace it")
+    parent = Path(out).parent
+    if not parent.is_dir():
+        raise ValueError(f"output directory {parent} does not exist")
+    import os
+
+    if not os.access(parent, os.W_OK):
+        raise ValueError(f"output directory {parent} is not writable")
+
+    show = _progress(sys.stderr.isatty() and not args.quiet)
+    last = [time.perf_counter()]
+
+    def callback(curve, sol):
+        show(curve, sol)
+        if time.perf_counter() - last[0] > 5.0:  # checkpoint: no finished work is lost
+            write_curve(curve, out, overwrite=True, units=units)
+            last[0] = time.perf_counter()
+
+    t0 = time.perf_counter()
+    c = sb.curve(scene, args.delta_max, deltas=deltas, force_max=args.force_max,
+                 lambda0_max=args.lambda0_max, max_steps=args.max_steps, tol=args.tol,
+                 max_nodes=args.max_nodes, callback=callback)
+    if sys.stderr.isatty() and not args.quiet:
+        sys.stderr.write("\n")
+    write_curve(c, out, profiles=args.profiles, overwrite=True, units=units)
+    print(f"wrote {out}: {c.summary()} in {time.perf_counter() - t0:.1f} s")
+    if c.interrupted:
+        print("shellbvp: interrupted; the file holds the finished points (complete = False)", file=sys.stderr)
+        return 130
+    return 0 if c.complete else 1
+
+
+def _cmd_solve(args):
+    import numpy as np
+
+    import shellbvp as sb
+
+    scene = _scene(args)
+    given = {k: v for k, v in (("delta", args.delta), ("lambda0", args.lambda0), ("force", args.load))
+             if v is not None}
+    if not given:
+        given = {"delta": 0.2}
+    sol = sb.solve(scene, tol=args.tol, max_nodes=args.max_nodes, **given)
+    keys = ("success", "status", "message", "delta", "force", "lambda0", "Sc", "ring_force", "cap_force",
+            "pressure_min", "penetration", "valid", "flags", "energy", "force_defect", "force_error",
+            "delta_error", "nodes", "niter", "max_residual", "wall_time")
+    out = {k: sol.get(k) for k in keys}
+    out = {k: (float(v) if isinstance(v, (np.floating,)) else v) for k, v in out.items()}
+    if args.profiles and sol.success:
+        out["profile"] = {k: np.asarray(v).tolist() for k, v in sol.profile().items()}
+    if args.json:
+        print(json.dumps(out, default=float))
+    else:
+        for k in keys:
+            print(f"{k:>14s}: {out[k]}")
+        if args.profiles and sol.success:
+            prof = sol.profile()
+            cols = ("S", "region", "r", "z", "lambda_s", "lambda_theta", "kappa_s", "kappa_theta",
+                    "M_s", "Q", "P")
+            print(" ".join(f"{c:>13s}" for c in cols))
+            for i in range(prof["S"].size):
+                print(" ".join(f"{prof[c][i]:13.6g}" for c in cols))
+    return 0 if sol.success else 1
+
+
+def _cmd_info(args):
+    import numpy as np
+
+    from .io import read_curve
+
+    c = read_curve(args.file)
+    s = c.scene
+    mat = s.material
+    print(f"file:      {args.file} (shellbvp {c.version})")
+    print(f"scene:     gamma={s.gamma:g} rho={s.rho:g} beta={s.beta:g} xi={s.xi} contact={s.contact} "
+          f"material={mat!r} shell={s.shell!r} tip={s.tip!r}")
+    print(f"curve:     {c.summary()}")
+    print(f"complete:  {c.complete}  interrupted: {c.interrupted}")
+    res = c.energy_residual
+    if np.any(np.isfinite(res)):
+        print(f"energy identity: max |dE/ddelta - F| = {np.nanmax(np.abs(res)):.3g}")
+    if len(c):
+        print(f"{'delta':>10s} {'force':>12s} {'lambda0':>9s} {'Sc':>10s} {'status':>6s} {'valid':>5s}")
+        for i in range(len(c)):
+            print(f"{c.delta[i]:10.5f} {c.force[i]:12.6g} {c.lambda0[i]:9.5f} {c.Sc[i]:10.4g} "
+                  f"{int(c.status[i]):6d} {str(bool(c.valid[i])):>5s}")
+    return 0
+
+
+def _cmd_presets(args):
+    from .scene import PRESETS
+
+    for name, p in PRESETS.items():
+        sc = p["scene"]
+        print(f"{name:9s} gamma={sc['gamma']:<5g} rho={sc['rho']:<7.4g} beta={sc['beta']:<6g} "
+              f"xi={sc['xi']} material={sc['material']!r}  -- {p['doc']}")
+    return 0
+
+
+def build_parser():
+    p = _Parser(prog="shellbvp", description="Indentation of thin curved hyperelastic shells.")
+    p.add_argument("-v", "--verbose", action="store_true", help="log progress (INFO)")
+    sub = p.add_subparsers(dest="command", parser_class=_Parser)
+    c = sub.add_parser("curve", help="compute a force-displacement curve into an HDF5 file")
+    _scene_options(c)
+    c.add_argument("--delta-max", type=float, default=0.5, dest="delta_max", help="largest pole displacement (default 0.5)")
+    c.add_argument("--points", type=int, help="N equally spaced depths up to delta-max (default: adaptive)")
+    c.add_argument("--force-max", type=float, dest="force_max", help="stop at this force")
+    c.add_argument("--lambda0-max", type=float, dest="lambda0_max", help="stop at this pole stretch")
+    c.add_argument("--max-steps", type=int, default=400, dest="max_steps")
+    c.add_argument("--profiles", action="store_true", help="store each point's profiles")
+    c.add_argument("--radius", type=float, help="rim radius R_L in m (with --muH: SI columns)")
+    c.add_argument("--muH", type=float, dest="mu_h", help="mu*H in N/m")
+    c.add_argument("-o", "--output", help="output file (default <preset>.h5)")
+    c.add_argument("--force", action="store_true", help="replace an existing output file")
+    c.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
+    c.set_defaults(func=_cmd_curve)
+    s = sub.add_parser("solve", help="solve one state and print it")
+    _scene_options(s)
+    g = s.add_mutually_exclusive_group()
+    g.add_argument("--delta", type=float, help="pole displacement (default 0.2)")
+    g.add_argument("--lambda0", type=float, help="pole stretch")
+    g.add_argument("--load", type=float, help="indenter force F (force control)")
+    s.add_argument("--profiles", action="store_true", help="print the fields over S")
+    s.add_argument("--json", action="store_true", help="print JSON")
+    s.set_defaults(func=_cmd_solve)
+    i = sub.add_parser("info", help="describe a curve file")
+    i.add_argument("file")
+    i.set_defaults(func=_cmd_info)
+    r = sub.add_parser("presets", help="list the built-in scenes")
+    r.set_defaults(func=_cmd_presets)
+    return p
+
+
+def main(argv=None):
+    parser = build_parser()
+    argv = sys.argv[1:] if argv is None else list(argv)
+    if not argv:
+        argv = ["curve"]  # the quick start: the base preset into base.h5
+    args = parser.parse_args(argv)
+    if args.command is None:
+        args = parser.parse_args(["curve", *argv])
+    logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING,
+                        format="%(levelname)s %(name)s: %(message)s")
+    try:
+        return args.func(args)
+    except (ValueError, FileExistsError) as exc:
+        print(f"shellbvp: error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("shellbvp: interrupted", file=sys.stderr)
+        return 130
+    except BrokenPipeError:  # e.g. `shellbvp info f.h5 | head`
+        import os
+
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 141
+
+
+if __name__ == "__main__":
+    sys.exit(main())

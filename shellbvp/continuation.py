@@ -1,0 +1,387 @@
+"""Force–displacement curves by continuation of single states.
+
+Adaptive curves use pseudo-arclength continuation in ``X = (delta, lambda0, F)``
+(so folds in any of them are passed, not stopped at), with a secant predictor
+for the states and parameters, warm starts on a thinned mesh (every third
+node: solve_bvp only ever adds nodes), steps grown or shrunk with the Newton
+effort and the turning of the branch, and halved on failure.  The small-delta
+region is resolved by a leg from the first point down to ``delta_min``
+(geometric steps; caps shrink exponentially there).  Curves at requested
+depths (``deltas=``) use natural continuation in delta.
+
+A failure ends the curve cleanly: the points done so far are kept and the
+reason is recorded; Ctrl-C does the same (``curve.interrupted``).
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .solve import (STATUS_MESSAGES, Solution, _warm_guess, make_system, richardson_error, solve,
+                    solve_from, thin_mesh, _default_eps)
+
+__all__ = ["Curve", "curve", "POINT_FIELDS"]
+
+log = logging.getLogger(__name__)
+
+#: Per-point fields of a curve (arrays of the Curve and datasets of its HDF5 file).
+POINT_FIELDS = (
+    "delta", "force", "lambda0", "Sc", "status", "valid", "max_residual", "nodes", "niter",
+    "force_error", "delta_error", "energy", "ring_force", "cap_force", "pressure_min",
+    "penetration", "force_defect", "wall_time",
+)
+
+
+@dataclass
+class Curve:
+    """A force–displacement curve: per-point arrays and how it was made.
+
+    Attributes
+    ----------
+    scene : Scene
+    delta, force, lambda0, Sc, ... : ndarray
+        One entry per point (see ``POINT_FIELDS``), in the order computed along
+        the branch (increasing delta unless the branch folds back).
+    energy_residual : ndarray
+        ``dE/ddelta - F`` at each point, dE/ddelta by finite differences of the
+        energies along the curve (second order on the non-uniform grid): ~0 for
+        the smooth contact model, finite for the paper's.
+    flags : list of str
+        Per point, "; "-joined validity flags ("" when valid).
+    stop_reason : str
+    complete : bool
+        The stopping rule was reached (False: failure or interruption).
+    interrupted : bool
+    settings : dict
+        Solver and continuation settings.
+    solutions : list of Solution
+        In memory only (profiles); not stored unless ``to_hdf5(profiles=True)``.
+    """
+
+    scene: object
+    points: dict
+    flags: list
+    stop_reason: str
+    complete: bool
+    interrupted: bool
+    settings: dict
+    solutions: list = field(default_factory=list, repr=False)
+    version: str = ""
+
+    def __getattr__(self, name):
+        points = self.__dict__.get("points", {})
+        if name in points:
+            return points[name]
+        raise AttributeError(name)
+
+    def __len__(self):
+        return len(self.points["delta"])
+
+    @property
+    def energy_residual(self):
+        return energy_residual(self.points["delta"], self.points["energy"], self.points["force"])
+
+    def to_hdf5(self, path, *, profiles: bool = False, overwrite: bool = False, units=None):
+        """Write the curve to an HDF5 file atomically (see ``shellbvp.io``)."""
+        from .io import write_curve
+
+        write_curve(self, path, profiles=profiles, overwrite=overwrite, units=units)
+
+    def summary(self) -> str:
+        n = len(self)
+        if n == 0:
+            return f"0 points ({self.stop_reason})"
+        d, F = self.points["delta"], self.points["force"]
+        nvalid = int(np.sum(self.points["valid"]))
+        return (f"{n} points, delta {d.min():.4g}..{d.max():.4g}, F {F.min():.4g}..{F.max():.4g}, "
+                f"{nvalid} valid; stopped: {self.stop_reason}")
+
+
+def energy_residual(delta, energy, force):
+    """dE/ddelta - F along a curve (np.gradient, second order, non-uniform spacing)."""
+    delta, energy, force = (np.asarray(a, float) for a in (delta, energy, force))
+    if delta.size < 3 or np.any(np.diff(delta) == 0):
+        return np.full(delta.shape, np.nan)
+    return np.gradient(energy, delta, edge_order=2) - force
+
+
+class _Stop(Exception):
+    pass
+
+
+def _record(sol: Solution):
+    row = {k: sol.get(k, np.nan) for k in POINT_FIELDS}
+    row["valid"] = bool(sol.get("valid", False))
+    return row
+
+
+def _X(sol):
+    return np.array([sol.delta, sol.lambda0, sol.force])
+
+
+def curve(scene, delta_max: float = 0.5, *, deltas=None, force_max=None, lambda0_max=None,
+          max_steps: int = 400, delta_start=None, delta_min=None, tol: float = 1e-6,
+          max_nodes: int = 10000, ds_max=None, estimate_error: bool = True, callback=None):
+    """Force–displacement curve of a scene by continuation.
+
+    Parameters
+    ----------
+    scene : Scene
+    delta_max : float
+        Stop when the pole displacement reaches it (> 0).
+    deltas : sequence of float, optional
+        Compute exactly these depths (natural continuation) instead of an adaptive curve.
+    force_max, lambda0_max : float, optional
+        Further stopping rules.  The curve also stops when the contact reaches
+        the end of the tip (the indenter's cylinder).
+    max_steps : int
+    delta_start, delta_min : float, optional
+        First point (default ``min(0.05, delta_max/4)``) and the end of the
+        small-delta leg (default ``delta_max/100``).
+    tol, max_nodes : solve_bvp settings for every point.
+    ds_max : float, optional
+        Largest arclength step in (delta, lambda0, F) (default ``delta_max/10``).
+    estimate_error : bool
+        Richardson error estimate at every point (about +50 % time).
+    callback : callable, optional
+        ``callback(curve_so_far, solution)`` after each accepted point (progress,
+        checkpoints).  It may raise ``KeyboardInterrupt`` to stop the curve.
+
+    Returns
+    -------
+    Curve
+    """
+    _check_positive("delta_max", delta_max)
+    for name, v in (("force_max", force_max), ("lambda0_max", lambda0_max)):
+        if v is not None:
+            _check_positive(name, v)
+    if not (isinstance(max_steps, (int, np.integer)) and max_steps >= 1):
+        raise ValueError(f"max_steps must be an integer >= 1; got {max_steps!r}")
+    if deltas is not None:
+        deltas = np.asarray(deltas, float)
+        if deltas.ndim != 1 or deltas.size == 0 or not np.all(np.isfinite(deltas)) or np.any(deltas <= 0):
+            raise ValueError("deltas must be a non-empty 1-D sequence of finite numbers > 0")
+        deltas = np.unique(deltas)
+    delta_start = min(0.05, delta_max / 4) if delta_start is None else float(delta_start)
+    _check_positive("delta_start", delta_start)
+    delta_min = delta_max / 100 if delta_min is None else float(delta_min)
+    _check_positive("delta_min", delta_min)
+    ds_max = delta_max / 10 if ds_max is None else float(ds_max)
+    _check_positive("ds_max", ds_max)
+
+    settings = dict(tol=tol, max_nodes=max_nodes, delta_max=delta_max, force_max=force_max,
+                    lambda0_max=lambda0_max, max_steps=max_steps, delta_start=delta_start,
+                    delta_min=delta_min, ds_max=ds_max, estimate_error=estimate_error,
+                    mode="deltas" if deltas is not None else "adaptive", eps=_default_eps(tol),
+                    bc_tol=1e-10)
+    from . import __version__
+
+    out = Curve(scene=scene, points={k: [] for k in POINT_FIELDS}, flags=[], stop_reason="",
+                complete=False, interrupted=False, settings=settings, version=__version__)
+    builder = _Builder(out, callback, estimate_error, tol)
+    t0 = time.perf_counter()
+    try:
+        if deltas is not None:
+            _natural(scene, deltas, builder, settings)
+        else:
+            _adaptive(scene, builder, settings)
+    except KeyboardInterrupt:
+        out.interrupted = True
+        out.stop_reason = "interrupted"
+    except _Stop as stop:
+        out.stop_reason = str(stop)
+    builder.finish()
+    settings["wall_time"] = time.perf_counter() - t0
+    log.info("curve: %s in %.2f s", out.summary(), settings["wall_time"])
+    return out
+
+
+def _check_positive(name, v):
+    if isinstance(v, bool) or not isinstance(v, (int, float, np.floating, np.integer)) \
+            or not math.isfinite(v) or v <= 0:
+        raise ValueError(f"{name} must be a finite number > 0; got {v!r}")
+
+
+class _Builder:
+    """Collects accepted points (sorted into branch order at the end)."""
+
+    def __init__(self, out: Curve, callback, estimate_error, tol):
+        self.out, self.callback, self.estimate_error, self.tol = out, callback, estimate_error, tol
+        self.rows = []  # (order key, row, flags, solution)
+
+    def add(self, sol: Solution, key: float):
+        """Accept a point; ``key`` orders points along the branch."""
+        if self.estimate_error and sol.success:
+            richardson_error(sol.system, sol, self.tol)
+        self.rows.append((key, _record(sol), "; ".join(sol.get("flags", [])), sol))
+        if self.callback is not None:
+            self.callback(self.snapshot(), sol)
+
+    def snapshot(self) -> Curve:
+        self.finish()
+        return self.out
+
+    def finish(self):
+        rows = sorted(self.rows, key=lambda r: r[0])
+        pts = {k: np.array([r[1][k] for r in rows]) for k in POINT_FIELDS}
+        pts["valid"] = pts["valid"].astype(bool)
+        for k in ("status", "nodes", "niter"):
+            pts[k] = pts[k].astype(int) if len(rows) else pts[k]
+        self.out.points = pts
+        self.out.flags = [r[2] for r in rows]
+        self.out.solutions = [r[3] for r in rows]
+
+
+def _first_point(scene, delta, settings):
+    sol = solve(scene, delta=delta, tol=settings["tol"], max_nodes=settings["max_nodes"],
+                estimate_error=False)
+    if not sol.success:
+        raise _Stop(f"no solution at the first point delta = {delta:g}: {sol.message}")
+    return sol
+
+
+def _stop_rule(sol, settings):
+    if settings["force_max"] is not None and sol.force >= settings["force_max"]:
+        return f"force_max = {settings['force_max']:g} reached"
+    if settings["lambda0_max"] is not None and sol.lambda0 >= settings["lambda0_max"]:
+        return f"lambda0_max = {settings['lambda0_max']:g} reached"
+    return None
+
+
+def _solve_at_delta(scene, delta, prev, prev2, settings):
+    """Delta-controlled solve warm-started from prev with a secant predictor from prev2."""
+    sysm = make_system(scene, "delta", delta, settings["eps"])
+    guess = _warm_guess(sysm, prev)
+    if prev2 is not None and prev2.delta != prev.delta:
+        a = (delta - prev.delta) / (prev.delta - prev2.delta)
+        guess = _secant(sysm, prev, prev2, a)
+    return solve_from(sysm, guess, tol=settings["tol"], max_nodes=settings["max_nodes"],
+                      bc_tol=settings["bc_tol"])
+
+
+def _secant(sysm, cur, prev, a):
+    """Guess cur + a (cur - prev) on cur's thinned mesh (states and parameters)."""
+    x = thin_mesh(cur.x)
+    y = cur.sol(x) + a * (cur.sol(x) - prev.sol(x))
+    X = np.array([cur.p[0], cur.lambda0, cur.delta])
+    Xp = np.array([prev.p[0], prev.lambda0, prev.delta])
+    ln_Sc, lambda0, delta = X + a * (X - Xp)
+    return x, y, sysm.pack(ln_Sc, lambda0, delta)
+
+
+def _natural(scene, deltas, builder: _Builder, settings):
+    prev2 = None
+    prev = _first_point(scene, float(deltas[0]), settings)
+    builder.add(prev, 0)
+    for i, target in enumerate(deltas[1:], 1):
+        d = prev.delta
+        step = target - d
+        while prev.delta < target:
+            nd = min(target, prev.delta + step)
+            sol = _solve_at_delta(scene, nd, prev, prev2, settings)
+            if sol.success:
+                prev2, prev = prev, sol
+                if nd == target:
+                    builder.add(sol, i)
+                step *= 1.5
+            else:
+                step /= 2
+                if step < 1e-6:
+                    raise _Stop(f"no solution near delta = {nd:.6g}: {sol.message}")
+        rule = _stop_rule(prev, settings)
+        if rule:
+            raise _Stop(rule)
+        if prev.Sc * prev.y[0, -1] / scene.rho > scene.tip_omega_max:
+            raise _Stop("the contact reached the end of the tip (the indenter's cylinder)")
+    builder.out.complete = True
+    builder.out.stop_reason = "all requested deltas computed"
+
+
+def _adaptive(scene, builder: _Builder, settings):
+    st = settings
+    first = _first_point(scene, st["delta_start"], st)
+    builder.add(first, 0)
+    steps = 1
+    # Leg 1: down to delta_min (geometric), resolving the small-delta region.
+    prev, prev2, below = first, None, None
+    d = first.delta
+    factor = 0.6
+    while d > st["delta_min"] and steps < st["max_steps"]:
+        nd = max(st["delta_min"], d * factor)
+        sol = _solve_at_delta(scene, nd, prev, prev2, st)
+        steps += 1
+        if sol.success:
+            builder.add(sol, -steps)
+            below = below or sol
+            prev2, prev, d = prev, sol, nd
+        else:
+            factor = 1 - (1 - factor) / 2
+            if factor > 0.97:
+                log.info("small-delta leg stopped at delta = %.4g: %s", d, sol.message)
+                break
+    # Leg 2: pseudo-arclength upwards from the first point.
+    scale = np.array([1.0, 1.0, 1.0])
+    cur = first
+    if below is None:  # need a second point for the tangent
+        below = _solve_at_delta(scene, first.delta * 0.9, first, None, st)
+        if not below.success:
+            raise _Stop(f"no second point near delta = {first.delta:g}: {below.message}")
+    prev = below
+    ds = min(st["ds_max"], 2 * np.linalg.norm((_X(cur) - _X(prev)) / scale))
+    ds_min = 1e-7
+    tangent = None
+    while True:
+        if steps >= st["max_steps"]:
+            raise _Stop(f"max_steps = {st['max_steps']} reached")
+        rule = _stop_rule(cur, st)
+        if rule:
+            builder.out.complete = True
+            raise _Stop(rule)
+        chord = (_X(cur) - _X(prev)) / scale
+        norm = np.linalg.norm(chord)
+        new_tangent = chord / norm
+        if tangent is not None and np.dot(new_tangent, tangent) < 0:
+            new_tangent = -new_tangent  # never reverse along the branch
+        turn = 0.0 if tangent is None else math.acos(min(1.0, max(-1.0, float(np.dot(new_tangent, tangent)))))
+        tangent = new_tangent
+        Xhat = _X(cur) + ds * tangent * scale
+        if Xhat[0] >= st["delta_max"]:
+            # land on delta_max exactly, with delta control
+            sol = _solve_at_delta(scene, st["delta_max"], cur, prev, st)
+            steps += 1
+            if sol.success:
+                builder.add(sol, steps)
+                builder.out.complete = True
+                raise _Stop(f"delta_max = {st['delta_max']:g} reached")
+            ds /= 2
+            if ds < ds_min:
+                raise _Stop(f"no solution at delta_max = {st['delta_max']:g}: {sol.message}")
+            continue
+        sysm = make_system(scene, "arclength", (Xhat, tangent, scale), st["eps"])
+        a = ds / max(norm, 1e-300)
+        guess = _secant(sysm, cur, prev, a)
+        sol = solve_from(sysm, guess, tol=st["tol"], max_nodes=st["max_nodes"], bc_tol=st["bc_tol"])
+        steps += 1
+        if sol.success and sol.delta > 0:
+            builder.add(sol, steps)
+            prev, cur = cur, sol
+            if sol.y[0, -1] * sol.Sc / scene.rho > scene.tip_omega_max:
+                builder.out.complete = True
+                raise _Stop("the contact reached the end of the tip (the indenter's cylinder)")
+            # adapt: Newton effort and turning of the branch
+            grow = 1.5 if sol.niter <= 3 else (1.0 if sol.niter <= 6 else 0.6)
+            if turn > 0.3:
+                grow = min(grow, 0.5)
+            elif turn > 0.1:
+                grow = min(grow, 1.0)
+            ds = min(st["ds_max"], ds * grow)
+        else:
+            ds /= 2
+            if ds < ds_min:
+                reason = sol.message if not sol.success else "the branch turned back to delta <= 0"
+                raise _Stop(f"continuation failed near delta = {cur.delta:.6g}: {reason}")

@@ -1,0 +1,174 @@
+"""HDF5 files of curves: atomic writes, a documented self-describing layout.
+
+Layout (format ``shellbvp-curve``, version 1)::
+
+    /                       attrs: format, format_version, package_version, created (UTC ISO)
+    /curve                  NXdata group; attrs:
+                              NX_class = "NXdata", signal = "force", axes = ["delta"],
+                              scene (JSON: rebuilds the Scene exactly, user formulas as srepr),
+                              scene_<key> (gamma, rho, beta, xi, contact, material_family, ...:
+                              the same, readable at a glance),
+                              settings (JSON: solver and continuation settings),
+                              stop_reason, complete (bool), interrupted (bool),
+                              energy_identity_max (max |dE/ddelta - F| over the points),
+                              units: "nondimensional" or, with R_L and mu*H given,
+                              R_L_m, mu_H_N_per_m (then delta_m, force_N datasets exist)
+    /curve/delta            (n,) axis: pole displacement / R_L
+    /curve/force            (n,) signal: indenter force / (mu H R_L)
+    /curve/<field>          (n,) each of shellbvp.continuation.POINT_FIELDS, plus
+                            energy_residual (dE/ddelta - F) and flags (strings)
+    /curve/profiles/point_<i>   optional (profiles=True): S, region, r, z, ... at the
+                            mesh nodes of point i (see Solution.profile)
+
+Files are written to a temporary file in the same directory and renamed into
+place, so a reader never sees a half-written file; an existing file is never
+replaced unless ``overwrite=True``.
+"""
+
+from __future__ import annotations
+
+import datetime as _dt
+import json
+import os
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+__all__ = ["write_curve", "read_curve", "FORMAT", "FORMAT_VERSION"]
+
+FORMAT = "shellbvp-curve"
+FORMAT_VERSION = 1
+
+
+def _check_units(units):
+    if units is None:
+        return None
+    try:
+        R_L, mu_H = float(units["R_L"]), float(units["mu_H"])
+    except (KeyError, TypeError, ValueError):
+        raise ValueError("units must be a dict with R_L (m) and mu_H (N/m), both numbers") from None
+    for name, v in (("R_L", R_L), ("mu_H", mu_H)):
+        if not (np.isfinite(v) and v > 0):
+            raise ValueError(f"{name} must be a finite number > 0; got {v!r}")
+    return R_L, mu_H
+
+
+def write_curve(curve, path, *, profiles=False, overwrite=False, units=None):
+    """Write ``curve`` to ``path`` atomically (temporary file + rename).
+
+    Parameters
+    ----------
+    curve : Curve
+    path : str or Path
+    profiles : bool
+        Also store each point's fields over S.
+    overwrite : bool
+        Replace an existing file (otherwise ``FileExistsError``).
+    units : dict, optional
+        ``{"R_L": metres, "mu_H": N/m}``: also store ``delta_m`` and ``force_N``.
+    """
+    import h5py
+
+    from . import __version__
+
+    path = Path(path)
+    dims = _check_units(units)
+    if path.exists() and not overwrite:
+        raise FileExistsError(f"{path} exists; pass overwrite=True (CLI: --force) to replace it")
+    parent = path.parent if str(path.parent) else Path(".")
+    if not parent.is_dir():
+        raise ValueError(f"output directory {parent} does not exist")
+    if not os.access(parent, os.W_OK):
+        raise ValueError(f"output directory {parent} is not writable")
+    fd, tmp = tempfile.mkstemp(dir=parent, prefix=f".{path.name}.", suffix=".tmp")
+    os.close(fd)
+    try:
+        with h5py.File(tmp, "w") as f:
+            f.attrs["format"] = FORMAT
+            f.attrs["format_version"] = FORMAT_VERSION
+            f.attrs["package_version"] = __version__
+            f.attrs["created"] = _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds")
+            g = f.create_group("curve")
+            g.attrs["NX_class"] = "NXdata"
+            g.attrs["signal"] = "force"
+            g.attrs["axes"] = np.array(["delta"], dtype=h5py.string_dtype())
+            scene = curve.scene.to_dict()
+            g.attrs["scene"] = json.dumps(scene, sort_keys=True)
+            for k, v in scene.items():
+                if isinstance(v, dict):
+                    for kk, vv in v.items():
+                        g.attrs[f"scene_{k}_{kk}"] = vv
+                else:
+                    g.attrs[f"scene_{k}"] = v
+            g.attrs["settings"] = json.dumps(curve.settings, sort_keys=True, default=float)
+            g.attrs["stop_reason"] = curve.stop_reason
+            g.attrs["complete"] = bool(curve.complete)
+            g.attrs["interrupted"] = bool(curve.interrupted)
+            res = curve.energy_residual
+            g.attrs["energy_identity_max"] = float(np.nanmax(np.abs(res))) if np.any(np.isfinite(res)) else np.nan
+            for k, v in curve.points.items():
+                g.create_dataset(k, data=np.asarray(v))
+            g.create_dataset("energy_residual", data=res)
+            g.create_dataset("flags", data=np.array(curve.flags, dtype=object), dtype=h5py.string_dtype())
+            g["delta"].attrs["long_name"] = "pole displacement delta / R_L"
+            g["force"].attrs["long_name"] = "indenter force F / (mu H R_L)"
+            if dims is None:
+                g.attrs["units"] = "nondimensional"
+            else:
+                R_L, mu_H = dims
+                g.attrs["units"] = "nondimensional; SI columns delta_m, force_N"
+                g.attrs["R_L_m"], g.attrs["mu_H_N_per_m"] = R_L, mu_H
+                g.create_dataset("delta_m", data=R_L * np.asarray(curve.points["delta"]))
+                g.create_dataset("force_N", data=mu_H * R_L * np.asarray(curve.points["force"]))
+            if profiles:
+                pg = g.create_group("profiles")
+                for i, sol in enumerate(curve.solutions):
+                    if sol is None or not sol.get("success", False):
+                        continue
+                    sg = pg.create_group(f"point_{i:05d}")
+                    for k, v in sol.profile().items():
+                        sg.create_dataset(k, data=v)
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
+def read_curve(path):
+    """Read a curve written by :func:`write_curve`.
+
+    Raises ``ValueError`` with a one-line reason for a missing, corrupt or
+    foreign file.
+    """
+    import h5py
+
+    from .continuation import POINT_FIELDS, Curve
+    from .scene import Scene
+
+    path = Path(path)
+    if not path.exists():
+        raise ValueError(f"{path}: no such file")
+    try:
+        f = h5py.File(path, "r")
+    except OSError as exc:
+        raise ValueError(f"{path}: not a readable HDF5 file ({exc})") from None
+    with f:
+        if f.attrs.get("format") != FORMAT or "curve" not in f:
+            raise ValueError(f"{path}: not a shellbvp curve file (format attribute missing or different)")
+        version = int(f.attrs.get("format_version", -1))
+        if version > FORMAT_VERSION:
+            raise ValueError(f"{path}: format version {version} is newer than this shellbvp reads "
+                             f"({FORMAT_VERSION})")
+        g = f["curve"]
+        try:
+            scene = Scene.from_dict(json.loads(g.attrs["scene"]))
+            points = {k: g[k][()] for k in POINT_FIELDS}
+            flags = [s.decode() if isinstance(s, bytes) else str(s) for s in g["flags"][()]]
+            settings = json.loads(g.attrs["settings"])
+        except (KeyError, ValueError, TypeError) as exc:
+            raise ValueError(f"{path}: incomplete or corrupt curve ({exc})") from None
+        points["valid"] = points["valid"].astype(bool)
+        return Curve(scene=scene, points=points, flags=flags, stop_reason=str(g.attrs["stop_reason"]),
+                     complete=bool(g.attrs["complete"]), interrupted=bool(g.attrs["interrupted"]),
+                     settings=settings, version=str(f.attrs.get("package_version", "")))

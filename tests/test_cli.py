@@ -1,0 +1,88 @@
+"""The shellbvp command line (subprocess: what a user runs)."""
+
+import json
+import os
+import subprocess
+import sys
+
+import h5py
+import pytest
+
+import shellbvp as sb
+
+
+def run(*args, cwd=None):
+    env = dict(os.environ)
+    return subprocess.run([sys.executable, "-m", "shellbvp", *args], capture_output=True, text=True,
+                          cwd=cwd, env=env, timeout=600)
+
+
+def test_curve_without_arguments_writes_base_h5(tmp_path):
+    r = run(cwd=tmp_path)
+    assert r.returncode == 0, r.stderr
+    assert "wrote base.h5" in r.stdout and " s" in r.stdout
+    c = sb.read_curve(tmp_path / "base.h5")
+    assert c.complete and c.delta[-1] == pytest.approx(0.5) and c.scene == sb.Scene.preset("base")
+    assert r.stderr == ""  # no progress bar when not on a terminal
+    again = run("curve", cwd=tmp_path)
+    assert again.returncode == 2 and "exists" in again.stderr and "--force" in again.stderr
+    info = run("info", "base.h5", cwd=tmp_path)
+    assert info.returncode == 0 and "delta_max = 0.5 reached" in info.stdout and "gamma=1" in info.stdout
+
+
+def test_curve_with_options_and_points(tmp_path):
+    r = run("curve", "--preset", "flat", "--beta", "0.02", "--contact", "paper", "--points", "4",
+            "--delta-max", "0.2", "--radius", "0.001", "--muH", "52", "-o", "f.h5", cwd=tmp_path)
+    assert r.returncode == 0, r.stderr
+    with h5py.File(tmp_path / "f.h5") as f:
+        g = f["curve"]
+        assert g.attrs["scene_beta"] == 0.02 and g.attrs["scene_contact"] == "paper"
+        assert len(g["delta"]) == 4 and "force_N" in g and g.attrs["R_L_m"] == 0.001
+
+
+def test_solve_prints_state_and_json(tmp_path):
+    r = run("solve", "--preset", "base", "--delta", "0.2", "--json")
+    assert r.returncode == 0, r.stderr
+    out = json.loads(r.stdout)
+    assert out["success"] and out["delta"] == 0.2
+    assert out["force"] == pytest.approx(sb.solve(sb.Scene.preset("base"), delta=0.2).force, abs=1e-8)
+    r = run("solve", "--load", str(out["force"]), "--profiles")
+    assert r.returncode == 0 and "lambda_theta" in r.stdout and "0.2" in r.stdout
+
+
+def test_presets_lists_all():
+    r = run("presets")
+    assert r.returncode == 0
+    for name in sb.PRESETS:
+        assert name in r.stdout
+
+
+@pytest.mark.parametrize("args,words", [
+    (["curve", "--rho", "-0.2", "-o", "x.h5"], ["rho", "> 0"]),
+    (["curve", "--beta", "-1", "-o", "x.h5"], ["beta", "> 0"]),
+    (["curve", "--gamma", "5", "-o", "x.h5"], ["gamma", "< 5"]),
+    (["curve", "--alpha", "2", "-o", "x.h5"], ["alpha", "[0, 1]"]),
+    (["curve", "--gent-jm", "0", "-o", "x.h5"], ["Jm", "> 0"]),
+    (["curve", "--delta-max", "0", "-o", "x.h5"], ["delta_max", "> 0"]),
+    (["curve", "--preset", "nope", "-o", "x.h5"], ["preset", "base"]),
+    (["curve", "-o", "/nonexistent-dir/x.h5"], ["directory", "not exist"]),
+    (["info", "missing.h5"], ["missing.h5", "no such file"]),
+    (["solve", "--delta", "-1"], ["delta", "> 0"]),
+    (["curve", "--xi", "3"], ["xi"]),
+])
+def test_bad_input_exits_with_one_line_message(tmp_path, args, words):
+    r = run(*args, cwd=tmp_path)
+    assert r.returncode == 2, (r.stdout, r.stderr)
+    lines = r.stderr.strip().splitlines()
+    assert len(lines) == 1 and "Traceback" not in r.stderr, r.stderr
+    for w in words:
+        assert w in lines[0], lines[0]
+
+
+def test_info_rejects_foreign_and_corrupt_files(tmp_path):
+    with h5py.File(tmp_path / "foreign.h5", "w") as f:
+        f["x"] = [1]
+    (tmp_path / "corrupt.h5").write_bytes(b"not hdf5 at all")
+    for name in ("foreign.h5", "corrupt.h5"):
+        r = run("info", name, cwd=tmp_path)
+        assert r.returncode == 2 and name in r.stderr and "Traceback" not in r.stderr

@@ -1,0 +1,141 @@
+"""Curves by continuation, their HDF5 files (issue: curves, HDF5, CLI)."""
+
+import json
+
+import h5py
+import numpy as np
+import pytest
+
+import shellbvp as sb
+from shellbvp.continuation import POINT_FIELDS
+
+
+@pytest.fixture(scope="module")
+def base_curve():
+    return sb.curve(sb.Scene.preset("base"), delta_max=0.5)
+
+
+def test_adaptive_base_curve_reaches_delta_max_with_increasing_force(base_curve):
+    c = base_curve
+    assert c.complete and not c.interrupted and "delta_max" in c.stop_reason
+    assert c.delta[-1] == pytest.approx(0.5) and len(c) >= 20
+    assert np.all(np.diff(c.delta) > 0)
+    assert np.all(np.diff(c.force) > 0) and np.all(c.force > 0)
+    assert np.all(c.status == 0)
+    # the small-delta region is resolved: points below 0.01 with a shrinking cap
+    assert c.delta[0] <= 0.01 and c.Sc[0] < 1e-10
+    # error estimates and diagnostics are kept per point
+    assert np.all(np.isfinite(c.force_error)) and np.max(c.force_error) < 1e-6
+    assert np.max(c.force_defect) < 1e-6
+    # energy identity along the curve (finite differences between points, O(h^2))
+    assert np.nanmax(np.abs(c.energy_residual)) < 2e-3
+
+
+def test_paper_model_curve_shows_the_energy_identity_gap():
+    c = sb.curve(sb.Scene.preset("base", contact="paper"), delta_max=0.5, estimate_error=False)
+    assert c.complete
+    res = c.energy_residual
+    assert np.all(res[len(res) // 2:] > 0.1)  # ~0.13-0.15: SPEC 2b's 0.11-0.15
+
+
+def test_requested_deltas_are_computed_exactly():
+    deltas = [0.05, 0.1, 0.2, 0.3]
+    c = sb.curve(sb.Scene.preset("prolate2"), deltas=deltas)
+    assert c.complete
+    np.testing.assert_allclose(c.delta, deltas)
+    single = sb.solve(sb.Scene.preset("prolate2"), delta=0.2)
+    assert c.force[2] == pytest.approx(single.force, abs=1e-8)
+
+
+def test_fold_in_lambda0_is_passed_by_pseudo_arclength():
+    """On the dome, lambda0(delta) has a minimum near delta ~ 0.1: a fold for lambda0
+    control, which the arclength continuation in (delta, lambda0, F) passes."""
+    c = sb.curve(sb.Scene.preset("dome"), delta_max=0.3, estimate_error=False)
+    assert c.complete and np.all(c.status == 0)
+    i = int(np.argmin(c.lambda0))
+    assert 0 < i < len(c) - 1  # an interior turning point of lambda0
+    assert np.all(np.diff(c.delta) > 0) and np.all(np.diff(c.force) > 0)
+
+
+def test_stopping_rules():
+    c = sb.curve(sb.Scene.preset("base"), delta_max=0.5, force_max=0.3, estimate_error=False)
+    assert c.complete and "force_max" in c.stop_reason
+    assert c.force[-1] >= 0.3 and c.force[-2] < 0.3
+    c = sb.curve(sb.Scene.preset("base"), delta_max=0.5, max_steps=3, estimate_error=False)
+    assert not c.complete and "max_steps" in c.stop_reason and len(c) >= 1
+
+
+def test_hdf5_round_trip(base_curve, tmp_path):
+    path = tmp_path / "c.h5"
+    base_curve.to_hdf5(path)
+    back = sb.read_curve(path)
+    assert back.scene == base_curve.scene
+    for k in POINT_FIELDS:
+        np.testing.assert_array_equal(back.points[k], base_curve.points[k])
+    assert back.flags == base_curve.flags and back.stop_reason == base_curve.stop_reason
+    assert back.complete and back.settings["tol"] == base_curve.settings["tol"]
+    with h5py.File(path) as f:  # NXdata conventions for generic viewers
+        g = f["curve"]
+        assert g.attrs["NX_class"] == "NXdata" and g.attrs["signal"] == "force"
+        assert list(g.attrs["axes"]) == ["delta"]
+        assert json.loads(g.attrs["scene"])["rho"] == 0.2
+        assert "energy_residual" in g and "profiles" not in g
+    with pytest.raises(FileExistsError):
+        base_curve.to_hdf5(path)
+    base_curve.to_hdf5(path, overwrite=True, profiles=True, units={"R_L": 1e-3, "mu_H": 50.0})
+    with h5py.File(path) as f:
+        g = f["curve"]
+        assert len(g["profiles"]) == len(base_curve)
+        np.testing.assert_allclose(g["force_N"][()], 50.0 * 1e-3 * base_curve.force)
+    assert not list(tmp_path.glob(".*.tmp"))  # no temporary files left behind
+
+
+def test_user_scene_round_trips_through_hdf5(tmp_path):
+    scene = sb.Scene.preset("base", material=sb.StrainEnergy(
+        "(lambda_s**2 + lambda_theta**2 + 1/(lambda_s*lambda_theta)**2 - 3)/2"))
+    c = sb.curve(scene, deltas=[0.1, 0.15])
+    c.to_hdf5(tmp_path / "u.h5")
+    back = sb.read_curve(tmp_path / "u.h5")
+    assert back.scene == scene and back.scene.structure() == scene.structure()
+
+
+def test_interrupted_curve_keeps_finished_points(tmp_path):
+    seen = []
+
+    def stop_after_three(curve, sol):
+        seen.append(sol.delta)
+        if len(seen) == 3:
+            raise KeyboardInterrupt
+
+    c = sb.curve(sb.Scene.preset("base"), delta_max=0.5, callback=stop_after_three, estimate_error=False)
+    assert c.interrupted and not c.complete and len(c) == 3
+    c.to_hdf5(tmp_path / "partial.h5")
+    back = sb.read_curve(tmp_path / "partial.h5")
+    assert back.interrupted and len(back) == 3 and sorted(back.delta) == sorted(seen)
+
+
+@pytest.mark.parametrize("bad", ["missing.h5", "foreign.h5", "corrupt.h5"])
+def test_read_curve_rejects_bad_files(tmp_path, bad):
+    path = tmp_path / bad
+    if bad == "foreign.h5":
+        with h5py.File(path, "w") as f:
+            f["x"] = [1, 2, 3]
+    elif bad == "corrupt.h5":
+        path.write_bytes(b"\x89HDF\r\n\x1a\n" + b"\0" * 100)
+    with pytest.raises(ValueError, match=str(path.name)):
+        sb.read_curve(path)
+
+
+@pytest.mark.parametrize("kwargs,match", [
+    (dict(delta_max=0.0), "delta_max"),
+    (dict(delta_max=-1), "delta_max"),
+    (dict(force_max=-1), "force_max"),
+    (dict(deltas=[]), "deltas"),
+    (dict(deltas=[0.1, -0.2]), "deltas"),
+    (dict(max_steps=0), "max_steps"),
+])
+def test_curve_bad_input(kwargs, match):
+    kw = dict(delta_max=0.5)
+    kw.update(kwargs)
+    with pytest.raises(ValueError, match=match):
+        sb.curve(sb.Scene.preset("base"), **kw)
