@@ -25,11 +25,13 @@ def base():
 @pytest.mark.parametrize("contact", ["smooth", "paper"])
 def test_layout_counts_states_parameters_and_conditions(control, contact):
     scene = sb.Scene.preset("base", contact=contact)
-    sysm = MultipointBVP(scene, control, 0.2 if control != "lambda0" else 1.0, 1e-4)
+    value = {"delta": 0.2, "lambda0": 1.0, "force": 0.3,
+             "arclength": ([0.2, 1.0, 0.3], [0.6, 0.0, 0.8], [1.0, 1.0, 1.0])}[control]
+    sysm = MultipointBVP(scene, control, value, 1e-4)
     p = sysm.pack(math.log(0.05), 1.0, 0.2)
     ya = yb = np.array([1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 0.0, -0.5])
     assert N == 8
-    assert p.size == sysm.k == (3 if control == "force" else 2)
+    assert p.size == sysm.k == (3 if control in ("force", "arclength") else 2)
     assert sysm.bc(ya, yb, p).size == sysm.n_conditions == N + sysm.k
     A, B, P = sysm.bc_jac(ya, yb, p)
     assert A.shape == B.shape == (N + sysm.k, N) and P.shape == (N + sysm.k, sysm.k)
@@ -38,7 +40,9 @@ def test_layout_counts_states_parameters_and_conditions(control, contact):
 def test_multipoint_jacobians_equal_finite_differences(base):
     sol = sb.solve(base, delta=0.2, estimate_error=False)
     for control in CONTROLS:
-        sysm = MultipointBVP(base, control, {"delta": 0.2, "lambda0": sol.lambda0, "force": sol.force}[control], 1e-4)
+        value = {"delta": 0.2, "lambda0": sol.lambda0, "force": sol.force,
+                 "arclength": ([0.2, sol.lambda0, sol.force], [0.6, 0.0, 0.8], [1.0, 0.5, 2.0])}[control]
+        sysm = MultipointBVP(base, control, value, 1e-4)
         t = np.linspace(0, 1, 7)
         y = sol.sol(t) * (1 + 0.01 * np.sin(np.arange(N))[:, None])
         p = sysm.pack(math.log(sol.Sc) + 0.1, sol.lambda0 * 1.01, 0.19)
