@@ -12,7 +12,7 @@ Quick use::
 from .geometry import SphereTip, Spheroid, UserShell, UserTip
 from .materials import Gent, MooneyRivlin, NeoHookean, StrainEnergy
 from .scene import PRESETS, Scene
-from .solve import STATUS_MESSAGES, Solution, solve
+from .state import STATUS_MESSAGES, Solution, solve
 from .continuation import Curve, curve
 from .io import read_curve
 

@@ -22,7 +22,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .solve import (STATUS_MESSAGES, Solution, _warm_guess, make_system, richardson_error, solve,
+from .state import (STATUS_MESSAGES, Solution, _warm_guess, make_system, richardson_error, solve,
                     solve_from, thin_mesh, _default_eps)
 
 __all__ = ["Curve", "curve", "POINT_FIELDS"]

@@ -1,0 +1,52 @@
+"""Every preset at delta = 0.05, 0.1, 0.2, 0.3 with both contact models, cold starts.
+
+Writes benchmarks/results/states.json and benchmarks/results/states.md
+(F, Sc, lambda0, ring force, min contact pressure, validity, error estimate,
+time per cold solve).
+
+    python benchmarks/states_table.py
+"""
+
+import json
+import time
+from pathlib import Path
+
+import shellbvp as sb
+
+DELTAS = (0.05, 0.1, 0.2, 0.3)
+
+
+def main():
+    rows = []
+    for name in sb.PRESETS:
+        for contact in ("smooth", "paper"):
+            scene = sb.Scene.preset(name, contact=contact)
+            scene.model()  # code generation is not part of the solve time
+            for d in DELTAS:
+                t0 = time.perf_counter()
+                s = sb.solve(scene, delta=d)
+                rows.append(dict(preset=name, contact=contact, delta=d, success=bool(s.success),
+                                 status=s.status, force=s.force, Sc=float(s.Sc), lambda0=s.lambda0,
+                                 ring_force=s.get("ring_force"), pressure_min=s.get("pressure_min"),
+                                 valid=bool(s.get("valid")), force_error=s.get("force_error"),
+                                 nodes=s.nodes, seconds=time.perf_counter() - t0))
+    out = Path(__file__).parent / "results"
+    out.mkdir(exist_ok=True)
+    (out / "states.json").write_text(json.dumps(rows, indent=1, default=float))
+    lines = ["| preset | contact | delta | F | Sc | lambda0 | ring force | min P | valid | F error | nodes | time (s) |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    for r in rows:
+        if not r["success"]:
+            lines.append(f"| {r['preset']} | {r['contact']} | {r['delta']} | failed (status {r['status']}) "
+                         f"| | | | | | | | {r['seconds']:.2f} |")
+            continue
+        lines.append(f"| {r['preset']} | {r['contact']} | {r['delta']} | {r['force']:.6f} | {r['Sc']:.3g} | "
+                     f"{r['lambda0']:.4f} | {r['ring_force']:.4g} | {r['pressure_min']:.3g} | "
+                     f"{'yes' if r['valid'] else 'no'} | {r['force_error']:.1e} | {r['nodes']} | "
+                     f"{r['seconds']:.2f} |")
+    (out / "states.md").write_text("\n".join(lines) + "\n")
+    print("\n".join(lines))
+
+
+if __name__ == "__main__":
+    main()
