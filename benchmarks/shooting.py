@@ -111,6 +111,24 @@ class ShootCurve:
         raise AttributeError(key)
 
 
+class _Budget(Exception):
+    """An integration used more right-hand-side evaluations than allowed."""
+
+
+def _free_guard(tau, w):
+    """> 0 while the free trajectory is plausible: stretches in (0.05, 10), states bounded.
+
+    Poor guesses make the 2x2 system for (ls', ks') singular (ls -> infinity) or the
+    deformed radius vanish within the interval; stopping there keeps failures cheap.
+    """
+    return min(w[0] - 0.05, w[2] - 0.05, 10.0 - w[0], 10.0 - w[2],
+               1e3 - max(abs(w[1]), abs(w[3]), abs(w[4])))
+
+
+def _contact_guard(tau, w):
+    return min(w[1] - 0.05, 10.0 - w[1], 1e3 - abs(w[0]))
+
+
 class Shooter:
     """Shooting for one scene at fixed integration tolerances.
 
@@ -129,7 +147,7 @@ class Shooter:
         leading-order start errs by O(eps^2)).
     """
 
-    def __init__(self, scene, rtol=1e-8, atol=None, method="DOP853", eps=None):
+    def __init__(self, scene, rtol=1e-8, atol=None, method="DOP853", eps=None, max_fev=20000):
         self.scene = scene
         self.model = mod = scene.model()
         self.par = scene.parameters(mod)
@@ -149,6 +167,7 @@ class Shooter:
         self.ln_eps = math.log(self.eps)
         self.z_tip0 = float(mod.reference_shell(0.0, self.par)["Z"])  # z_tip at delta = 0
         self.c_pole = -mod.pole_res(0.0, 0.0, 1.0, self.par)
+        self.max_fev = int(max_fev)
         self.nfev = 0
         self.implicit = method in ("Radau", "BDF", "LSODA")
 
@@ -174,7 +193,7 @@ class Shooter:
             out[_NC:, _NC:] = J
             return out
 
-        sol = self._ivp(f, jac, (self.ln_eps, 0.0), y0)
+        sol = self._ivp(f, jac, (self.ln_eps, 0.0), y0, _contact_guard)
         if sol is None:
             return None
         w = sol.y[:, -1]
@@ -253,22 +272,36 @@ class Shooter:
             return out
 
         # d yf(0)/d lnSc: only via the junction (the start itself is accounted for in f).
-        sol = self._ivp(f, jac, (0.0, 1.0), np.r_[yf0, D0.ravel()])
+        sol = self._ivp(f, jac, (0.0, 1.0), np.r_[yf0, D0.ravel()], _free_guard)
         if sol is None:
             return None
         w = sol.y[:, -1]
         return w[:_NF], w[_NF:].reshape(_NF, 2)
 
-    def _ivp(self, f, jac, span, y0):
+    def _ivp(self, f, jac, span, y0, guard=None):
+        """solve_ivp with a budget; None if it fails, blows up or trips the guard event."""
+        count = [0]
+        budget = self.max_fev
+
+        def fc(t, w):
+            count[0] += 1
+            if count[0] > budget:
+                raise _Budget
+            return f(t, w)
+
         kw = dict(method=self.method, rtol=self.rtol, atol=self.atol)
         if self.implicit:
             kw["jac"] = jac
+        if guard is not None:
+            guard.terminal = True
+            kw["events"] = guard
         try:
             with np.errstate(all="ignore"):
-                sol = solve_ivp(f, span, y0, **kw)
-        except (ValueError, ZeroDivisionError, FloatingPointError, np.linalg.LinAlgError):
+                sol = solve_ivp(fc, span, y0, **kw)
+        except (_Budget, ValueError, ZeroDivisionError, FloatingPointError, np.linalg.LinAlgError):
+            self.nfev += count[0]
             return None
-        self.nfev += int(sol.nfev)
+        self.nfev += count[0]
         if sol.status != 0 or not np.all(np.isfinite(sol.y[:, -1])):
             return None
         return sol

@@ -6,7 +6,8 @@ for the states and parameters, warm starts on a thinned mesh (every third
 node: solve_bvp only ever adds nodes), steps grown or shrunk with the Newton
 effort and the turning of the branch, and halved on failure.  The small-delta
 region is resolved by a leg from the first point down to ``delta_min``
-(geometric steps; caps shrink exponentially there).  Curves at requested
+(geometric steps; caps shrink exponentially there, and once a cap leaves
+double precision the leg continues with its point-load limit).  Curves at requested
 depths (``deltas=``) use natural continuation in delta.
 
 A failure ends the curve cleanly: the points done so far are kept and the
@@ -22,8 +23,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .state import (STATUS_MESSAGES, Solution, _warm_guess, make_system, richardson_error, solve,
-                    solve_from, thin_mesh, _default_eps)
+from .state import (SC_POINT, Solution, _default_eps, _warm_guess, make_system, richardson_error,
+                    solve, solve_from, solve_point_load, thin_mesh)
 
 __all__ = ["Curve", "curve", "POINT_FIELDS"]
 
@@ -216,7 +217,7 @@ class _Builder:
 
     def add(self, sol: Solution, key: float):
         """Accept a point; ``key`` orders points along the branch."""
-        if self.estimate_error and sol.success:
+        if self.estimate_error and sol.success and sol.get("topology") != "point":
             richardson_error(sol.system, sol, self.tol)
         self.rows.append((key, _record(sol), "; ".join(sol.get("flags", [])), sol))
         if self.callback is not None:
@@ -313,7 +314,14 @@ def _adaptive(scene, builder: _Builder, settings):
     factor = 0.6
     while d > st["delta_min"] and steps < st["max_steps"]:
         nd = max(st["delta_min"], d * factor)
-        sol = _solve_at_delta(scene, nd, prev, prev2, st)
+        if prev.get("topology") == "point":
+            sol = solve_point_load(scene, nd, tol=st["tol"], max_nodes=st["max_nodes"], guess=prev)
+        else:
+            sol = _solve_at_delta(scene, nd, prev, prev2, st)
+            if scene.contact == "smooth" and prev.Sc < 1e-8 and (not sol.success or sol.Sc < SC_POINT):
+                # the cap is leaving double precision: continue with its point-load limit
+                point = solve_point_load(scene, nd, tol=st["tol"], max_nodes=st["max_nodes"], guess=prev)
+                sol = point if point.success else sol
         steps += 1
         if sol.success:
             builder.add(sol, -steps)

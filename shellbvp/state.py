@@ -98,6 +98,7 @@ class Solution(dict):
         ``phi``, ``lambda_s``, ``lambda_theta``, ``kappa_s``, ``kappa_theta``, ``T_s``,
         ``T_theta``, ``M_s``, ``M_theta``, ``tau_s``, ``tau_theta``, ``Q``, ``P``,
         ``axial_force`` (F(S), the axial force carried across the circle S), ``energy_density``.
+        For a point-load state (``topology == "point"``) there is no contact region.
         ``points_per_interval > 1`` adds points between mesh nodes (from the interpolant).
         """
         sysm = self["system"]
@@ -106,6 +107,13 @@ class Solution(dict):
             t = np.unique(np.concatenate([np.linspace(a, b, points_per_interval + 1)
                                           for a, b in zip(t[:-1], t[1:])]))
         y = self.sol(t)
+        if self.get("topology") == "point":
+            pf = sysm.model.free_profile(sysm.S(t), y, sysm.par)
+            out = {"S": sysm.S(t), "region": np.ones(t.size, int)}
+            for key, v in pf.items():
+                out["axial_force" if key == "axial_force_2pi" else key] = (
+                    2 * np.pi * v if key == "axial_force_2pi" else v)
+            return out
         ln_Sc = self.p[0]
         mod, par = sysm.model, sysm.par
         Sc_t, Sf_t = sysm.S_contact(t, ln_Sc), sysm.S_free(t, ln_Sc)
@@ -197,6 +205,7 @@ def _diagnose(sysm: MultipointBVP, bvp, tol):
     ring, cap = mod.contact_line_forces(Sc, yc, yf, delta, F_pres, par)
     force = float(ring[0] + cap[0])
     res = Solution(
+        topology="cap",
         status=int(bvp.status), message=bvp.message, x=bvp.x, y=bvp.y, p=bvp.p, sol=bvp.sol,
         rms_residuals=bvp.rms_residuals, niter=int(bvp.niter), nodes=int(bvp.x.size),
         max_residual=float(np.max(bvp.rms_residuals)) if bvp.rms_residuals.size else float("nan"),
@@ -326,6 +335,90 @@ def richardson_error(sysm, res, tol, bc_tol=1e-10):
     res.delta_error = abs(float(f_delta) - res.delta) * 16 / 15
 
 
+#: Caps smaller than this are replaced by the point-load limit (their own equations
+#: leave double precision near Sc ~ 1e-75; the difference is exponentially small).
+SC_POINT = 1e-30
+
+
+def _point_guess(sysm, prev):
+    """Free states for the point-load problem from a cap or point solution."""
+    if prev.get("topology") == "point":
+        x = thin_mesh(prev.x)
+        return x, prev.sol(x)
+    x = np.linspace(0.0, 1.0, 61)
+    S = sysm.S(x)
+    ln_Sc = prev.p[0]
+    tp = np.clip((np.log(S) - ln_Sc) / (sysm.ln_L - ln_Sc), 0.0, 1.0)
+    return x, prev.sol(tp)[N_CONTACT:]
+
+
+def _crude_point_guess(sysm):
+    x = np.linspace(0.0, 1.0, 61)
+    S = sysm.S(x)
+    ref = sysm.model.reference_shell(S, sysm.par)
+    lam = 0.95
+    y = np.vstack([np.full(x.size, lam), ref["Phi"] / S, np.full(x.size, lam), ref["kappa_s"],
+                   np.zeros(x.size), ref["Z"] - sysm.delta * (1 - (S - S[0]) / (S[-1] - S[0]))])
+    return x, y
+
+
+def solve_point_load(scene, delta, *, tol=1e-6, max_nodes=10000, guess=None, bc_tol=1e-10):
+    """The point-load limit of the smooth model at pole displacement ``delta`` (see PointLoadBVP)."""
+    from .system import PointLoadBVP
+
+    t0 = time.perf_counter()
+    sysm = PointLoadBVP(scene, delta)
+    x, y = _point_guess(sysm, guess) if guess is not None else _crude_point_guess(sysm)
+    with np.errstate(all="ignore"):
+        bvp = solve_bvp(sysm.fun, sysm.bc, x, y, fun_jac=sysm.fun_jac, bc_jac=sysm.bc_jac, tol=tol,
+                        bc_tol=bc_tol, max_nodes=max_nodes)
+        res = _diagnose_point(sysm, bvp)
+    res.wall_time = time.perf_counter() - t0
+    return res
+
+
+def _diagnose_point(sysm, bvp):
+    mod, par = sysm.model, sysm.par
+    nan = float("nan")
+    ya = bvp.y[:, 0]
+    force = 2 * np.pi * float(mod.free_profile(np.array([sysm.s0]), ya[:, None], par)["axial_force_2pi"][0])
+    res = Solution(
+        topology="point", status=int(bvp.status), message=bvp.message, x=bvp.x, y=bvp.y, p=np.array([]),
+        sol=bvp.sol, rms_residuals=bvp.rms_residuals, niter=int(bvp.niter), nodes=int(bvp.x.size),
+        max_residual=float(np.max(bvp.rms_residuals)) if bvp.rms_residuals.size else nan,
+        # lambda0 is not defined in this limit: the stretches vary like ln^2 S near a point force.
+        delta=sysm.delta, lambda0=float("nan"), Sc=0.0, force=force, ring_force=force, cap_force=0.0,
+        control="delta", scene=sysm.scene, system=sysm,
+        z_tip=float(mod.reference_shell(0.0, par)["Z"]) - sysm.delta,
+    )
+    flags = []
+    if not (np.all(np.isfinite(bvp.y)) and math.isfinite(force)):
+        flags.append("non-finite state")
+    elif bvp.status == 0 and np.any(bvp.y[[0, 2]] <= 0):
+        flags.append("non-positive stretch")
+    if bvp.status == 0 and flags:
+        res.status, res.message = 4, STATUS_MESSAGES[4] + ": " + "; ".join(flags)
+    elif bvp.status == 0:
+        res.message = STATUS_MESSAGES[0] + " (point-load limit: the contact cap is exponentially small)"
+    res.success = res.status == 0
+    res.update(pressure_min=nan, penetration=nan, valid=False, force_error=nan, delta_error=0.0)
+    if not res.success or flags:
+        res.update(energy=nan, force_defect=nan, flags=flags)
+        return res
+    t = np.unique(np.r_[bvp.x, 0.5 * (bvp.x[1:] + bvp.x[:-1])])
+    pf = mod.free_profile(sysm.S(t), bvp.sol(t), par)
+    res.force_defect = float(np.max(np.abs(2 * np.pi * pf["axial_force_2pi"] - force)))
+    a, b = bvp.x[:-1], bvp.x[1:]
+    tg = (0.5 * (a + b)[:, None] + 0.5 * (b - a)[:, None] * _GAUSS_T[None, :]).ravel()
+    wg = (0.5 * (b - a)[:, None] * _GAUSS_W[None, :]).ravel()
+    Sg = sysm.S(tg)
+    e = mod.free_profile(Sg, bvp.sol(tg), par)["energy_density"]
+    res.energy = 2 * np.pi * float(np.sum(wg * e * Sg * (sysm.ln_L - sysm.ln_s0)))
+    res.flags = ["point-load limit: the contact is a point (cap below 1e-30); contact pressure "
+                 "and penetration are not defined"]
+    return res
+
+
 def _default_eps(tol):
     # Pole start zeta = eps*Sc: the truncated series errs by O(eps^2) relative.
     return min(1e-3, 0.1 * math.sqrt(tol))
@@ -387,7 +480,7 @@ def solve(scene, *, delta=None, lambda0=None, force=None, tol=1e-6, max_nodes=10
         res = _cold_delta(sysm, value, **kw)
     else:
         res = _cold_other(scene, sysm, control, value, eps, **kw)
-    if res.success and estimate_error:
+    if res.success and estimate_error and res.get("topology") != "point":
         richardson_error(sysm, res, tol, bc_tol)
     else:
         res.force_error = res.delta_error = float("nan")
@@ -421,6 +514,8 @@ def _cold_delta(sysm, delta, **kw):
         best = best or res
     res = _continue_in_delta(sysm.scene, sysm.eps, delta, **_loose(kw))
     if res is not None and res.success:
+        if res.get("topology") == "point":
+            return solve_point_load(sysm.scene, delta, tol=kw["tol"], max_nodes=kw["max_nodes"], guess=res)
         return _tighten(res.system, res, **kw)
     best.status = 5
     best.message = STATUS_MESSAGES[5] + f" (first attempt: {best.message})"
@@ -450,8 +545,16 @@ def _continue_in_delta(scene, eps, target, starts=(0.1, 0.05), **kw):
     frac = min(0.5, abs(target - d) / d) if up else 0.3
     while d != target:
         nd = min(target, d * (1 + frac)) if up else max(target, d * (1 - frac))
-        sysm = make_system(scene, "delta", nd, eps)
-        nxt = solve_from(sysm, _warm_guess(sysm, res), **kw)
+        if res.get("topology") == "point":
+            nxt = solve_point_load(scene, nd, tol=kw["tol"], max_nodes=kw["max_nodes"], guess=res)
+        else:
+            sysm = make_system(scene, "delta", nd, eps)
+            nxt = solve_from(sysm, _warm_guess(sysm, res), **kw)
+            if not up and scene.contact == "smooth" and (not nxt.success or nxt.Sc < SC_POINT) \
+                    and res.Sc < 1e-8:
+                # the cap is leaving double precision: continue with its point-load limit
+                point = solve_point_load(scene, nd, tol=kw["tol"], max_nodes=kw["max_nodes"], guess=res)
+                nxt = point if point.success else nxt
         if nxt.success:
             res, d = nxt, nd
             frac = min(1.5 * frac, 0.5)
@@ -468,7 +571,8 @@ def _failure(status, message):
                     delta=nan, force=nan, lambda0=nan, Sc=nan, nodes=0, niter=0, wall_time=nan)
 
 
-_MARCH_DELTA_MAX = 2.0
+_MARCH_DELTA_MAX = 1.0  # pole displacement of a rim radius: beyond any indentation test
+_MARCH_MAX_SOLVES = 60
 
 
 def _cold_other(scene, sysm, control, value, eps, **kw):
@@ -480,7 +584,12 @@ def _cold_other(scene, sysm, control, value, eps, **kw):
     if not cur.success:
         return _failure(5, STATUS_MESSAGES[5])
     prev = None
+    attempts = 0
     while prev is None or (prev[key] - value) * (cur[key] - value) > 0:
+        attempts += 1
+        if attempts > _MARCH_MAX_SOLVES:
+            return _failure(5, f"{control} = {value:g} was not bracketed within {_MARCH_MAX_SOLVES} "
+                               f"continuation steps (delta reached {d:.3g}, {key} there {cur[key]:.4g})")
         nd = d + step
         if nd > _MARCH_DELTA_MAX:
             return _failure(5, f"{control} = {value:g} was not reached on the branch for delta up to "
@@ -490,9 +599,12 @@ def _cold_other(scene, sysm, control, value, eps, **kw):
         if nxt.success:
             prev, cur, d = cur, nxt, nd
             step = min(1.5 * step, 0.05)
+        elif nxt.status == 4 and "end of the tip" in nxt.message:
+            return _failure(5, f"{control} = {value:g} not reached before the contact reaches the end "
+                               f"of the tip (the indenter's cylinder) near delta = {nd:.3g}")
         else:
             step /= 2
-            if step < 1e-4:
+            if step < 1e-3:
                 return _failure(5, f"continuation in delta towards {control} = {value:g} stalled at "
                                    f"delta = {d:.3g}")
     start = min((prev, cur), key=lambda s: abs(s[key] - value))

@@ -185,3 +185,49 @@ class MultipointBVP:
             P[10, 1] = w[1]
             P[10, 2] = w[0]
         return A, B, P
+
+
+class PointLoadBVP:
+    """The point-load limit of the smooth model: the free region alone, delta prescribed.
+
+    When the contact cap is exponentially small (``Sc`` below ~1e-30, which
+    happens as delta -> 0) the cap's own equations leave double precision and
+    the state is the point-load solution to exponential accuracy.  The free
+    region is then solved on ``S = s0 (L/s0)**t`` with the point-load pole
+    conditions at ``s0`` (``symbolic.equations.Derivation._build_point_load``):
+    6 ODEs, 3 pole + 3 rim conditions, no unknown parameter.  ``y`` holds the
+    free states only.
+    """
+
+    k = 0
+
+    def __init__(self, scene, delta: float, s0: float = 1e-12):
+        self.scene = scene
+        self.model = scene.model()
+        self.par = scene.parameters(self.model)
+        self.control = "delta"
+        self.value = self.delta = float(delta)
+        self.s0 = float(s0)
+        self.L = scene.shell_length
+        self.ln_s0, self.ln_L = math.log(s0), math.log(self.L)
+        self.n_conditions = N_FREE
+
+    def S(self, t):
+        return np.exp(self.ln_s0 + t * (self.ln_L - self.ln_s0))
+
+    def fun(self, t, y, p=None):
+        return (self.ln_L - self.ln_s0) * self.model.free_rhs(self.S(t), y, self.par)
+
+    def fun_jac(self, t, y, p=None):
+        dy, _ = self.model.free_jac(self.S(t), y, self.par)
+        return (self.ln_L - self.ln_s0) * dy
+
+    def bc(self, ya, yb, p=None):
+        return np.concatenate([self.model.point_load_res(self.s0, ya, self.delta, self.par),
+                               self.model.rim_res(self.L, yb, self.par)])
+
+    def bc_jac(self, ya, yb, p=None):
+        A, B = np.zeros((N_FREE, N_FREE)), np.zeros((N_FREE, N_FREE))
+        A[0:3] = self.model.point_load_jac(self.s0, ya, self.delta, self.par)[:, :N_FREE]
+        B[3:6] = self.model.rim_jac(self.L, yb, self.par)
+        return A, B

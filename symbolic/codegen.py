@@ -197,6 +197,16 @@ def function_specs(d: Derivation) -> list[FunctionSpec]:
                      [("ring", [d.ring_force]), ("cap", [d.cap_force])],
                      "Axial force of the ring at Sc (jump of Q) and of the pressure on the cap."),
     ]
+    # point-load limit: pole conditions of the free region alone
+    PL = d.point_load
+    plargs = [("S", (PL.inputs[0],)), ("y", d.free_states), ("delta", (DELTA,)), ("par", par)]
+    specs += [
+        FunctionSpec("point_load_res", PL, plargs, [("res", d.point_load_res)],
+                     "Point-load pole conditions at S = s0 (3,)."),
+        FunctionSpec("point_load_jac", PL, plargs,
+                     [("dres", PL.jacobian(d.point_load_res, [*d.free_states, DELTA]))],
+                     "Point-load pole conditions: d/d(y, delta), (3, 7)."),
+    ]
     # geometry of the scene (guesses, plots, penetration checks)
     specs += [
         FunctionSpec("reference_shell", d.geometry_prog, [("S", (d.geometry_S,)), ("par", par)],

@@ -104,6 +104,7 @@ class Derivation:
         self._build_contact_scaled()
         self._build_boundaries()
         self._build_geometry()
+        self._build_point_load()
 
     # ------------------------------------------------------------------ shared pieces
     def _shell_steps(self, prog: Program, Svar, tag=""):
@@ -330,6 +331,28 @@ class Derivation:
         self.ring_force = J.let("ring_force", 2 * sp.pi * (of["axial_force_2pi"] - oc["axial_force_2pi"]))
         self.cap_force = J.let("cap_force", 2 * sp.pi * oc["axial_force_2pi"])
 
+
+    def _build_point_load(self):
+        """Pole conditions of the point-load limit (cap -> 0, smooth model), at S = s0.
+
+        Near a concentrated force the stretches tend to an isotropic lambda0, the
+        moments grow like ln S (so kappa_s ~ a ln S + b) and phi ~ psi (a (S ln S - S) + b S).
+        Hence, with a = S dkappa_s/dS from the free region's own equations:
+        ``lambda_theta = lambda_s``, ``z = Z(0) - delta`` and
+        ``phi/S = psi (kappa_s - S dkappa_s/dS)`` (this excludes the ln S deflection
+        that a finite pole displacement forbids).  Truncation error O(s0^2 ln^2 s0).
+        """
+        lt, phiS, ls, ks, rQ, z = self.free_states
+        P = Program([S, *self.free_states, DELTA, *self.params])
+        P.extend(self.free, skip_defined=True)
+        o = self.free_phys_out
+        g_ks = sp.Symbol("g_ks")
+        self.point_load = P
+        self.point_load_res = [
+            P.let("res_iso", lt - ls),
+            P.let("res_zpole", z - (self.structure.shell.Z.subs(S, 0) - DELTA)),
+            P.let("res_rot", phiS - o["psi"] * (ks - g_ks)),
+        ]
 
     def _build_geometry(self):
         """Reference shell and tip shape as plain functions (no states)."""

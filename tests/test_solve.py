@@ -159,17 +159,48 @@ def test_flat_plate_tends_to_the_kirchhoff_point_load_stiffness():
     Theory of plates and shells, sec. 19).  Membrane stiffening adds O(delta^2)."""
     scene = sb.Scene.preset("flat")
     k0 = 8 * math.pi * scene.beta
-    deltas = [0.03, 0.02, 0.015]
-    ratios = []
     s = None
-    for d in deltas:
+    ratios = {}
+    for d in (0.03, 0.02, 0.015):  # finite caps, Sc < 1e-20: already a point load
         s = sb.solve(scene, delta=d, guess=s, estimate_error=False)
-        assert s.success, s.message
-        assert s.Sc < 1e-20  # the cap shrinks exponentially: a point load
-        ratios.append(s.force / d / k0)
-    assert abs(ratios[-1] - 1) < 0.01, ratios
-    a, b = np.polyfit(np.square(deltas), ratios, 1)[::-1]
-    assert abs(a - 1) < 2e-3, (a, b, ratios)  # extrapolated to delta -> 0
+        assert s.success and s.topology == "cap" and s.Sc < 1e-20, s.message
+        ratios[d] = s.force / d / k0
+    assert abs(ratios[0.015] - 1) < 0.01, ratios
+    # below, the cap leaves double precision and the point-load limit takes over
+    tiny = sb.solve(scene, delta=0.002)
+    assert tiny.success and tiny.topology == "point"
+    assert abs(tiny.force / 0.002 / k0 - 1) < 2e-4
+    assert math.isnan(tiny.lambda0)  # not defined at a point force
+
+
+def test_point_load_limit_agrees_with_a_small_cap(base):
+    """Where a cap is tiny but representable, the point-load limit gives the same F."""
+    from shellbvp.state import solve_point_load
+
+    cap = sb.solve(base, delta=0.01, tol=1e-8, estimate_error=False)
+    assert cap.success and cap.Sc < 1e-10
+    point = solve_point_load(base, 0.01, tol=1e-8, guess=cap)
+    assert point.success and point.force == pytest.approx(cap.force, rel=1e-6)
+
+
+@pytest.mark.parametrize("beta,gap", [(1e-4, 0.10), (1e-5, 0.03)])
+def test_shallow_sphere_tends_to_reissner_point_load_stiffness(beta, gap):
+    """A spherical cap of radius 5 (rim radius 1) under a point load: Reissner's (1946)
+    shallow-shell stiffness k = 8 sqrt(D Eh)/R with this model's D = beta (bending energy
+    (beta/2)(tr Delta)^2) and in-plane Young's modulus times thickness Eh = 3 (incompressible,
+    mu = 1).  Measured (delta = 0.003 h, h = sqrt(12 beta)): F/delta/k = 1.084 at beta = 1e-4
+    and 1.018 at 1e-5; the gap closes as beta -> 0 -- finite bending length
+    (beta/3)^{1/4} sqrt(R) = 0.17 and 0.095 against the rim radius 1 and the cap's own
+    curvature."""
+    Rs = 5.0
+    shell = sb.UserShell(f"{Rs}*sin(S/{Rs})", f"-{Rs}*cos(S/{Rs})", f"{Rs}*asin(1/{Rs})")
+    scene = sb.Scene(rho=0.05, beta=beta, material=sb.MooneyRivlin(0.1), shell=shell)
+    k = 8 * math.sqrt(3 * beta) / Rs
+    d = 0.003 * math.sqrt(12 * beta)
+    s = sb.solve(scene, delta=d, estimate_error=False)
+    assert s.success, s.message
+    ratio = s.force / d / k
+    assert 1.0 < ratio < 1 + gap, ratio
 
 
 def test_base_scene_small_delta_tends_to_point_load_stiffness(base):

@@ -1,0 +1,305 @@
+"""Stability of force–displacement curves on stiff and extreme scenes (issue 5, part 2).
+
+One thing is varied at a time around the base preset (gamma 1, rho 0.2,
+beta 0.01, Mooney–Rivlin alpha 0.1, xi 1): beta, gamma (where gamma < 1/rho),
+rho, xi, alpha, and the Gent material; each scene with both contact models.
+Every scene is one ``sb.curve(scene, delta_max=..., delta_min=...,
+estimate_error=True)`` in its own process (warm code cache; code generation
+is done first and not timed), with a per-scene time limit: SIGALRM raises
+KeyboardInterrupt, which ``curve`` treats as a clean interruption (the points
+so far are kept, ``interrupted = True``); a process that does not come back
+within the limit plus a grace period is killed and recorded as such.
+
+For each scene: how far the curve got (delta range, max F), why it stopped,
+complete or not, points, max nodes, wall time, the worst Richardson error
+estimate (max force_error), min contact pressure, invalid points, where F < 0,
+and the energy-identity residual max |dE/ddelta - F|.
+
+Writes benchmarks/results/stability.json and benchmarks/results/stability.md.
+
+    python benchmarks/stability.py            # full grid (about an hour or more)
+    python benchmarks/stability.py --quick    # a few scenes, small delta_max, for smoke tests
+    python benchmarks/stability.py --only 'beta=1e-05' --contact smooth   # a subset (regex on the id)
+"""
+
+from __future__ import annotations
+
+import argparse
+import datetime
+import json
+import math
+import os
+import platform
+import re
+import signal
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+RESULTS = Path(__file__).parent / "results"
+
+BASE = dict(gamma=1.0, rho=0.2, beta=0.01, xi=1, material=("mooney-rivlin", 0.1))
+
+
+def _fmt(v):
+    return f"{v:g}" if isinstance(v, float) else str(v)
+
+
+def grid():
+    """Scenes as (id, what is varied, overrides of BASE); the base scene once."""
+    scenes = [("base", "base", {})]
+    for b in (1e-1, 1e-3, 1e-4, 1e-5):
+        scenes.append((f"beta={b:g}", "beta", dict(beta=b)))
+    for g in (-2.0, -1.0, 0.0, 0.5, 2.0, 2.5, 3.0, 4.0):
+        if g < 1 / BASE["rho"]:
+            scenes.append((f"gamma={g:g}", "gamma", dict(gamma=g)))
+    for r in (0.05, 1 / 3, 0.5):
+        if BASE["gamma"] < 1 / r:
+            scenes.append((f"rho={r:.4g}", "rho", dict(rho=r)))
+    scenes.append(("xi=0", "xi", dict(xi=0)))
+    for a in (0.0, 0.5):
+        scenes.append((f"alpha={a:g}", "alpha", dict(material=("mooney-rivlin", a))))
+    for jm in (0.4, 1.0, 97.2):
+        scenes.append((f"Gent Jm={jm:g}", "Gent", dict(material=("gent", jm))))
+    return scenes
+
+
+QUICK = ("base", "beta=0.001", "gamma=-1", "Gent Jm=1")
+
+
+def make_scene(spec):
+    import shellbvp as sb
+
+    d = dict(BASE)
+    d.update(spec["overrides"])
+    family, value = d.pop("material")
+    material = sb.MooneyRivlin(value) if family == "mooney-rivlin" else sb.Gent(value)
+    return sb.Scene(material=material, contact=spec["contact"], **d)
+
+
+# -- worker: one curve in this process -----------------------------------------------------
+
+def worker(spec_path, out_path):
+    import numpy as np
+
+    import shellbvp as sb
+
+    spec = json.loads(Path(spec_path).read_text())
+    row = {"id": spec["id"], "contact": spec["contact"], "varied": spec["varied"],
+           "overrides": spec["overrides"]}
+    try:
+        scene = make_scene(spec)
+    except ValueError as e:
+        row.update(skipped=str(e))
+        Path(out_path).write_text(json.dumps(row))
+        return
+    t0 = time.perf_counter()
+    scene.model()  # code generation / cache load: not part of the curve time
+    row["model_load_s"] = time.perf_counter() - t0
+
+    def alarm(signum, frame):
+        raise KeyboardInterrupt
+
+    signal.signal(signal.SIGALRM, alarm)
+    signal.setitimer(signal.ITIMER_REAL, spec["time_limit"])
+    t0 = time.perf_counter()
+    try:
+        c = sb.curve(scene, delta_max=spec["delta_max"], delta_min=spec["delta_min"],
+                     estimate_error=True)
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+    wall = time.perf_counter() - t0
+
+    n = len(c)
+    p = c.points
+    row.update(stop_reason=c.stop_reason, complete=bool(c.complete), interrupted=bool(c.interrupted),
+               timed_out=bool(c.interrupted), points=n, wall_time=wall)
+    if n:
+        F, d = p["force"], p["delta"]
+        neg = d[F < 0]
+        with np.errstate(all="ignore"):
+            er = c.energy_residual
+        fin = lambda a: float(np.nanmax(a)) if np.any(np.isfinite(a)) else None  # noqa: E731
+        finmin = lambda a: float(np.nanmin(a)) if np.any(np.isfinite(a)) else None  # noqa: E731
+        row.update(
+            delta_min=float(d.min()), delta_max=float(d.max()), force_max=float(F.max()),
+            force_at_delta_max=float(F[np.argmax(d)]),
+            nodes_max=int(p["nodes"].max()), force_error_max=fin(p["force_error"]),
+            force_error_nan=int(np.sum(~np.isfinite(p["force_error"]))),
+            pressure_min=finmin(p["pressure_min"]), invalid=int(np.sum(~p["valid"])),
+            F_negative=bool(neg.size), F_negative_delta=[float(neg.min()), float(neg.max())] if neg.size else None,
+            energy_residual_max=fin(np.abs(er)),
+            energy_residual_rel=(fin(np.abs(er)) / float(np.max(np.abs(F)))) if fin(np.abs(er)) is not None else None,
+            step_time_median=float(np.median(p["wall_time"])),
+            monotone_delta=bool(np.all(np.diff(d) > 0)),
+            curve={k: [float(v) for v in p[k]] for k in
+                   ("delta", "force", "lambda0", "Sc", "nodes", "force_error", "pressure_min",
+                    "ring_force", "wall_time")} | {"valid": [bool(v) for v in p["valid"]],
+                                                   "flags": list(c.flags)},
+        )
+    Path(out_path).write_text(json.dumps(row, default=float))
+
+
+# -- driver ---------------------------------------------------------------------------
+
+def run_one(spec, grace):
+    with tempfile.TemporaryDirectory() as tmp:
+        sp, op = Path(tmp, "spec.json"), Path(tmp, "out.json")
+        sp.write_text(json.dumps(spec))
+        t0 = time.perf_counter()
+        try:
+            proc = subprocess.run([sys.executable, __file__, "--worker", str(sp), str(op)],
+                                  capture_output=True, text=True, timeout=spec["time_limit"] + grace)
+        except subprocess.TimeoutExpired:
+            return {"id": spec["id"], "contact": spec["contact"], "varied": spec["varied"],
+                    "overrides": spec["overrides"], "killed": True, "timed_out": True, "complete": False,
+                    "stop_reason": f"killed after {spec['time_limit'] + grace:.0f} s (did not stop at the "
+                                   "time limit)", "points": 0, "wall_time": time.perf_counter() - t0}
+        if proc.returncode != 0 or not op.exists():
+            return {"id": spec["id"], "contact": spec["contact"], "varied": spec["varied"],
+                    "overrides": spec["overrides"], "crashed": True, "complete": False, "points": 0,
+                    "stop_reason": f"worker exited {proc.returncode}: "
+                                   + (proc.stderr.strip().splitlines() or [""])[-1][:300],
+                    "wall_time": time.perf_counter() - t0}
+        row = json.loads(op.read_text())
+        row["process_wall_s"] = time.perf_counter() - t0
+        return row
+
+
+def short_reason(r):
+    if r.get("skipped"):
+        return "skipped (invalid scene)"
+    if r.get("killed") or r.get("crashed"):
+        return r["stop_reason"][:60]
+    if r.get("interrupted"):
+        return f"time limit ({r['time_limit']:.0f} s)"
+    s = r["stop_reason"]
+    if "end of the tip" in s:
+        return "contact reached the cylinder"
+    if s.startswith("delta_max"):
+        return "delta_max reached"
+    m = re.match(r"continuation failed near delta = ([-\d.e+]+): (.*)", s)
+    if m:
+        msg = m.group(2)
+        for key, short in (("mesh nodes", "max nodes"), ("singular Jacobian", "singular Jacobian"),
+                           ("boundary conditions", "bc not met"), ("turned back", "turned back to delta <= 0"),
+                           ("inadmissible", "inadmissible")):
+            if key in msg:
+                msg = short
+                break
+        return f"failed at delta {float(m.group(1)):.4g}: {msg}"
+    m = re.match(r"no solution at delta_max = ([-\d.e+]+): (.*)", s)
+    if m:
+        return "failed landing on delta_max: " + ("max nodes" if "mesh nodes" in m.group(2) else m.group(2)[:40])
+    if s.startswith("no solution at the first point"):
+        return "first point failed"
+    return s[:60]
+
+
+def g(v, f=".3g"):
+    return "" if v is None or (isinstance(v, float) and math.isnan(v)) else format(v, f)
+
+
+def markdown(rows, meta):
+    lines = [
+        f"Measured {meta['date']} on {meta['machine']} ({meta['cpus']} cores, shared), "
+        f"shellbvp {meta['shellbvp']} ({meta['git']}), SciPy {meta['scipy']}; `sb.curve(scene, delta_max={meta['delta_max']:g}, "
+        f"delta_min={meta['delta_min']:g}, estimate_error=True)`, tol 1e-6, max_nodes 10000, "
+        f"time limit {meta['time_limit']:.0f} s per curve; total {meta['total_s']:.0f} s.",
+        "",
+        "| scene | contact | delta reached | max F | stopped | complete | points | max nodes | time (s) "
+        "| max F error | min P | invalid | F < 0 at delta | max \\|dE/dδ − F\\| |",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|",
+    ]
+    for r in rows:
+        if r.get("skipped"):
+            lines.append(f"| {r['id']} | {r['contact']} | skipped: {r['skipped'][:50]} |" + " |" * 11)
+            continue
+        if not r.get("points"):
+            lines.append(f"| {r['id']} | {r['contact']} | — | | {short_reason(r)} | no | 0 | | "
+                         f"{r['wall_time']:.1f} | | | | | |")
+            continue
+        neg = ("" if not r["F_negative"] else
+               f"{r['F_negative_delta'][0]:.3g}–{r['F_negative_delta'][1]:.3g}")
+        fe = g(r["force_error_max"], ".1e") + (f" ({r['force_error_nan']} NaN)" if r["force_error_nan"] else "")
+        lines.append(
+            f"| {r['id']} | {r['contact']} | {r['delta_min']:.3g}–{r['delta_max']:.4g} | {r['force_max']:.4g} "
+            f"| {short_reason(r)} | {'yes' if r['complete'] else 'no'} | {r['points']} | {r['nodes_max']} "
+            f"| {r['wall_time']:.1f} | {fe} | {g(r['pressure_min'])} | {r['invalid']} | {neg or 'no'} "
+            f"| {g(r['energy_residual_max'], '.1e')} |")
+    return "\n".join(lines) + "\n"
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--quick", action="store_true", help="a few scenes, delta_max 0.3, 60 s limit")
+    ap.add_argument("--only", help="regex on scene ids")
+    ap.add_argument("--contact", choices=("smooth", "paper", "both"), default="both")
+    ap.add_argument("--delta-max", type=float, default=None, help="default 1.0 (quick: 0.3)")
+    ap.add_argument("--delta-min", type=float, default=1e-4, help="end of the small-delta leg")
+    ap.add_argument("--time-limit", type=float, default=None, help="seconds per curve (default 300; quick 60)")
+    ap.add_argument("--grace", type=float, default=120.0, help="extra seconds before a worker is killed")
+    ap.add_argument("--out", default=None, help="basename in benchmarks/results (default stability[-quick])")
+    ap.add_argument("--worker", nargs=2, help=argparse.SUPPRESS)
+    args = ap.parse_args()
+    if args.worker:
+        worker(*args.worker)
+        return
+
+    import numpy
+    import scipy
+
+    import shellbvp as sb
+
+    delta_max = args.delta_max or (0.3 if args.quick else 1.0)
+    time_limit = args.time_limit or (60.0 if args.quick else 300.0)
+    contacts = ("smooth", "paper") if args.contact == "both" else (args.contact,)
+    scenes = grid()
+    if args.quick:
+        scenes = [s for s in scenes if s[0] in QUICK]
+    if args.only:
+        scenes = [s for s in scenes if re.search(args.only, s[0])]
+
+    # Generate/cache the code of every structure first (not part of any timing).
+    for sid, varied, ov in scenes:
+        try:
+            make_scene({"overrides": ov, "contact": "smooth"}).model()
+        except ValueError:
+            pass
+
+    rows = []
+    t_all = time.perf_counter()
+    for sid, varied, ov in scenes:
+        for contact in contacts:
+            spec = dict(id=sid, varied=varied, overrides=ov, contact=contact, delta_max=delta_max,
+                        delta_min=args.delta_min, time_limit=time_limit)
+            r = run_one(spec, args.grace)
+            r["time_limit"] = time_limit
+            rows.append(r)
+            print(f"{sid:>14} {contact:>6}: {short_reason(r):<45} points {r.get('points', 0):>3}  "
+                  f"delta {g(r.get('delta_min'))}..{g(r.get('delta_max'))}  "
+                  f"nodes {r.get('nodes_max', '')}  {r.get('wall_time', 0):.1f} s", flush=True)
+    total = time.perf_counter() - t_all
+
+    src = Path(sb.__file__).resolve().parent.parent
+    git = subprocess.run(["git", "-C", str(src), "describe", "--always", "--dirty"], capture_output=True,
+                         text=True)
+    meta = dict(source=str(src), git=git.stdout.strip() if git.returncode == 0 else
+                os.environ.get("STABILITY_SOURCE_NOTE", "not a git checkout"), date=datetime.date.today().isoformat(), machine=f"{platform.machine()} {platform.node()}",
+                cpus=os.cpu_count(), python=platform.python_version(), numpy=numpy.__version__,
+                scipy=scipy.__version__, shellbvp=sb.__version__, delta_max=delta_max,
+                delta_min=args.delta_min, time_limit=time_limit, total_s=total,
+                quick=args.quick, base=dict(BASE, material=list(BASE["material"])))
+    RESULTS.mkdir(exist_ok=True)
+    name = args.out or ("stability-quick" if args.quick else "stability")
+    (RESULTS / f"{name}.json").write_text(json.dumps({"meta": meta, "scenes": rows}, indent=1, default=float))
+    md = markdown(rows, meta)
+    (RESULTS / f"{name}.md").write_text(md)
+    print(md)
+    print(f"total {total:.0f} s")
+
+
+if __name__ == "__main__":
+    main()
