@@ -132,6 +132,10 @@ def _contact_guard(tau, w):
 class Shooter:
     """Shooting for one scene at fixed integration tolerances.
 
+    The shooting unknowns are ``x = (ln Sc, u, lambda0)``; Newton solves the two
+    rim conditions for two of them with the third fixed (lambda0 for the
+    paper's procedure; Sc in the cold start's homotopy).
+
     Parameters
     ----------
     scene : shellbvp.Scene
@@ -139,18 +143,23 @@ class Shooter:
         ``solve_ivp`` tolerances (atol defaults to rtol; the states are O(1)).
     method : str
         ``solve_ivp`` method.  The problem is not stiff in ln S for moderate beta
-        (eigenvalues of dg/dy are O(1..10) on the base scene), so the default is
-        the explicit 'DOP853'; 'Radau', 'BDF', 'LSODA' get an (approximate, block
-        diagonal) analytic Jacobian of the augmented system.
+        (eigenvalues of dg/dy are O(1..10) on the base scene, but with growing,
+        oscillating modes), so the default is the explicit 'DOP853'; 'Radau',
+        'BDF', 'LSODA' get an analytic (block-diagonal) Jacobian of the augmented
+        system.
     eps : float
         Pole start ``zeta = eps*Sc``; default ``min(1e-3, 0.1 sqrt(rtol))`` (the
         leading-order start errs by O(eps^2)).
+    max_fev : int
+        Right-hand-side evaluations allowed per integration (a poor guess can make
+        the trajectory singular; the step size then collapses).
     """
 
     def __init__(self, scene, rtol=1e-8, atol=None, method="DOP853", eps=None, max_fev=20000):
         self.scene = scene
         self.model = mod = scene.model()
-        self.par = scene.parameters(mod)
+        self.par = np.array(scene.parameters(mod), float)
+        self.i_beta = list(mod.PARAMS).index("beta")
         self.contact = scene.contact
         self.k_u = _UNKNOWN[self.contact]
         self.det = [i for i in range(_NF) if i != self.k_u]  # components fixed by the junction
@@ -166,42 +175,57 @@ class Shooter:
         self.eps = min(1e-3, 0.1 * math.sqrt(rtol)) if eps is None else float(eps)
         self.ln_eps = math.log(self.eps)
         self.z_tip0 = float(mod.reference_shell(0.0, self.par)["Z"])  # z_tip at delta = 0
-        self.c_pole = -mod.pole_res(0.0, 0.0, 1.0, self.par)
+        self.c_pole = -mod.pole_res(0.0, 0.0, 1.0, self.par)           # y(pole) = c lambda0
         self.max_fev = int(max_fev)
         self.nfev = 0
         self.implicit = method in ("Radau", "BDF", "LSODA")
 
+    @property
+    def beta(self):
+        return float(self.par[self.i_beta])
+
+    @beta.setter
+    def beta(self, value):
+        self.par[self.i_beta] = value
+
     # -- region 1: the contact region --------------------------------------------------------
-    def contact_end(self, lambda0, lnSc):
-        """(chi, ls) at Sc and d/d ln Sc of them (pole start fixed at zeta = eps*Sc)."""
+    def contact_end(self, lnSc, lambda0):
+        """(chi, ls) at Sc and their derivatives (2, 2) by (ln Sc, lambda0).
+
+        tau = ln(S/Sc) from ln eps to 0; the start (the pole series) is fixed in tau.
+        """
         mod, par = self.model, self.par
         Sc = math.exp(lnSc)
-        y0 = np.r_[self.c_pole * lambda0, np.zeros(_NC)]
+        w0 = np.zeros(_NC * 3)
+        w0[:_NC] = self.c_pole * lambda0
+        w0[_NC:].reshape(_NC, 2)[:, 1] = self.c_pole
 
         def f(tau, w):
             S = Sc * math.exp(tau)
             y = w[:_NC]
             g = mod.contact_rhs(S, y, par)
             J, gS = mod.contact_jac(S, y, par)
-            return np.r_[g, J @ w[_NC:] + gS * S]
+            dW = J @ w[_NC:].reshape(_NC, 2)
+            dW[:, 0] += gS * S
+            return np.r_[g, dW.ravel()]
 
         def jac(tau, w):
-            S = Sc * math.exp(tau)
-            J, _ = mod.contact_jac(S, w[:_NC], par)
-            out = np.zeros((2 * _NC, 2 * _NC))
-            out[:_NC, :_NC] = J
-            out[_NC:, _NC:] = J
-            return out
+            J, _ = mod.contact_jac(Sc * math.exp(tau), w[:_NC], par)
+            return _block_jac(J, 1.0, 2)
 
-        sol = self._ivp(f, jac, (self.ln_eps, 0.0), y0, _contact_guard)
+        sol = self._ivp(f, jac, (self.ln_eps, 0.0), w0, _contact_guard)
         if sol is None:
             return None
         w = sol.y[:, -1]
-        return w[:_NC], w[_NC:]
+        return w[:_NC], w[_NC:].reshape(_NC, 2)
 
     # -- the contact line --------------------------------------------------------------------
-    def free_start(self, lnSc, yc, dyc, u):
-        """yf(Sc+) with yf[k_u] = u, and d yf / d(ln Sc, u) (6, 2); None if unsolvable."""
+    def free_start(self, lnSc, u, yc, dyc):
+        """yf(Sc+) with yf[k_u] = u, and d yf / d(ln Sc, u, lambda0) (6, 3); None if unsolvable.
+
+        The five other components solve the generated junction residual (delta = 0) by
+        Newton with its analytic Jacobian, from the contact side's values.
+        """
         mod, par = self.model, self.par
         Sc = math.exp(lnSc)
         pc = mod.contact_profile(np.array([Sc]), yc[:, None], par)
@@ -212,38 +236,39 @@ class Shooter:
         yf[self.k_u] = u
         det = self.det
         cols = [3 + i for i in det]
-        for _ in range(30):
+        with np.errstate(all="ignore"):
+            for _ in range(30):
+                res = self.jres(Sc, yc, yf, 0.0, 0.0, par)
+                if not np.all(np.isfinite(res)):
+                    return None
+                A = self.jjac(Sc, yc, yf, 0.0, 0.0, par)[:, cols]
+                try:
+                    step = np.linalg.solve(A, res)
+                except np.linalg.LinAlgError:
+                    return None
+                yf[det] -= step
+                if np.max(np.abs(step)) <= 1e-14 * (1 + np.max(np.abs(yf))):
+                    break
+            else:
+                return None
             res = self.jres(Sc, yc, yf, 0.0, 0.0, par)
-            if not np.all(np.isfinite(res)):
+            if not (np.all(np.isfinite(yf)) and np.max(np.abs(res)) < 1e-11) or yf[2] <= 0:
                 return None
             jj = self.jjac(Sc, yc, yf, 0.0, 0.0, par)
             A = jj[:, cols]
-            try:
-                step = np.linalg.solve(A, res)
-            except np.linalg.LinAlgError:
-                return None
-            yf[det] -= step
-            if np.max(np.abs(step)) <= 1e-14 * (1 + np.max(np.abs(yf))):
-                break
-        else:
-            return None
-        res = self.jres(Sc, yc, yf, 0.0, 0.0, par)
-        if not (np.all(np.isfinite(yf)) and np.max(np.abs(res)) < 1e-11):
-            return None
-        jj = self.jjac(Sc, yc, yf, 0.0, 0.0, par)
-        A = jj[:, cols]
-        # d res = dres/dSc * Sc dlnSc + dres/dyc dyc + dres/dyf dyf = 0
-        rhs_lnSc = jj[:, 0] * Sc + jj[:, 1:3] @ dyc
-        rhs_u = jj[:, 3 + self.k_u]
-        D = np.zeros((_NF, 2))
-        D[det, 0] = -np.linalg.solve(A, rhs_lnSc)
-        D[det, 1] = -np.linalg.solve(A, rhs_u)
-        D[self.k_u, 1] = 1.0
+            # 0 = dres/dSc Sc dlnSc + dres/dyc dyc + dres/dyf dyf
+            rhs = np.zeros((5, 3))
+            rhs[:, 0] = jj[:, 0] * Sc + jj[:, 1:3] @ dyc[:, 0]
+            rhs[:, 1] = jj[:, 3 + self.k_u]
+            rhs[:, 2] = jj[:, 1:3] @ dyc[:, 1]
+            D = np.zeros((_NF, 3))
+            D[det] = -np.linalg.solve(A, rhs)
+            D[self.k_u, 1] = 1.0
         return yf, D
 
     # -- region 2: the free region -----------------------------------------------------------
     def free_end(self, lnSc, yf0, D0):
-        """yf(L) and d yf(L) / d(ln Sc, u), with S = Sc (L/Sc)^tau, tau in [0, 1]."""
+        """yf(L) and d yf(L) / d(ln Sc, u, lambda0), with S = Sc (L/Sc)^tau, tau in [0, 1]."""
         mod, par = self.model, self.par
         Sc = math.exp(lnSc)
         Lf = self.lnL - lnSc
@@ -251,32 +276,22 @@ class Shooter:
         def f(tau, w):
             S = Sc * math.exp(Lf * tau)
             y = w[:_NF]
-            V = w[_NF:].reshape(_NF, 2)
             g = mod.free_rhs(S, y, par)
             J, gS = mod.free_jac(S, y, par)
-            dV = Lf * (J @ V)
-            # explicit dependence of the mapped RHS on ln Sc (moving start of the interval)
+            dV = Lf * (J @ w[_NF:].reshape(_NF, 3))
+            # the mapped right-hand side depends on ln Sc explicitly (the interval moves)
             dV[:, 0] += -g + Lf * gS * S * (1.0 - tau)
             return np.r_[Lf * g, dV.ravel()]
 
         def jac(tau, w):
-            S = Sc * math.exp(Lf * tau)
-            J, _ = mod.free_jac(S, w[:_NF], par)
-            n = _NF * 3
-            out = np.zeros((n, n))
-            out[:_NF, :_NF] = Lf * J
-            # d(J V)/dV for V stored row-major (6, 2): column j of V is every 2nd entry
-            for j in range(2):
-                idx = _NF + np.arange(_NF) * 2 + j
-                out[np.ix_(idx, idx)] = Lf * J
-            return out
+            J, _ = mod.free_jac(Sc * math.exp(Lf * tau), w[:_NF], par)
+            return _block_jac(J, Lf, 3)
 
-        # d yf(0)/d lnSc: only via the junction (the start itself is accounted for in f).
         sol = self._ivp(f, jac, (0.0, 1.0), np.r_[yf0, D0.ravel()], _free_guard)
         if sol is None:
             return None
         w = sol.y[:, -1]
-        return w[:_NF], w[_NF:].reshape(_NF, 2)
+        return w[:_NF], w[_NF:].reshape(_NF, 3)
 
     def _ivp(self, f, jac, span, y0, guard=None):
         """solve_ivp with a budget; None if it fails, blows up or trips the guard event."""
@@ -307,19 +322,23 @@ class Shooter:
         return sol
 
     # -- the shooting map --------------------------------------------------------------------
-    def residual(self, lambda0, x, want_jac=True):
-        """Rim residual (lt - 1, m) at L and its Jacobian for x = (ln Sc, u); None on failure."""
-        lnSc, u = float(x[0]), float(x[1])
-        if not (lnSc < self.lnL - 1e-3) or not math.isfinite(u):
+    def shoot(self, x):
+        """Rim residual (lt - 1, m) at L and its Jacobian (2, 3) by x = (ln Sc, u, lambda0).
+
+        None when the trajectory cannot be computed (cap off the tip, singular or
+        non-finite trajectory, junction unsolvable).
+        """
+        lnSc, u, lambda0 = (float(v) for v in x)
+        if not (lnSc < self.lnL - 1e-3 and math.isfinite(u) and lambda0 > 0):
             return None
         Sc = math.exp(lnSc)
-        ce = self.contact_end(lambda0, lnSc)
+        ce = self.contact_end(lnSc, lambda0)
         if ce is None:
             return None
         yc, dyc = ce
-        if not (0 < Sc * yc[0] / self.rho < self.omega_max) or yc[1] <= 0:
-            return None  # the cap has left the tip (or collapsed)
-        fs = self.free_start(lnSc, yc, dyc, u)
+        if not (0 < Sc * yc[0] / self.rho < self.omega_max):
+            return None  # the cap has left the tip
+        fs = self.free_start(lnSc, u, yc, dyc)
         if fs is None:
             return None
         yf0, D0 = fs
@@ -328,146 +347,246 @@ class Shooter:
             return None
         yL, VL = fe
         res = self.model.rim_res(self.L, yL, self.par)[:2]
-        Jr = self.model.rim_jac(self.L, yL, self.par)[:2] @ VL
-        if not (np.all(np.isfinite(res)) and np.all(np.isfinite(Jr))):
+        J = self.model.rim_jac(self.L, yL, self.par)[:2] @ VL
+        if not (np.all(np.isfinite(res)) and np.all(np.isfinite(J))):
             return None
-        return res, Jr, dict(yc=yc, yf0=yf0, yL=yL)
+        return dict(res=res, J=J, yc=yc, yf0=yf0, yL=yL, x=np.array([lnSc, u, lambda0]))
 
-    def solve(self, lambda0, guess, max_iter=30, xtol=None):
-        """Damped Newton from guess = (ln Sc, u).  Returns a ShootState."""
-        t0 = time.perf_counter()
-        self.nfev = 0
+    def newton(self, x0, free=(0, 1), max_iter=30, xtol=None):
+        """Damped Newton on the components ``free`` of x (the third is held).
+
+        Returns (status, niter, info) with info = the last shoot() result (None if the
+        guess itself could not be integrated).  Convergence: a full Newton step below
+        ``xtol`` (default 10 rtol, relative to 1 + |x|), or -- at the integrator's noise
+        floor, where no step reduces the residual -- a step below 1e3 rtol.
+        """
         xtol = 10 * self.rtol if xtol is None else xtol
-        x = np.asarray(guess, float).copy()
-        st = ShootState(lambda0=float(lambda0), contact=self.contact, rtol=self.rtol)
-        cur = self.residual(lambda0, x)
+        free = list(free)
+        cur = self.shoot(np.asarray(x0, float))
         if cur is None:
-            st.status, st.message = 3, STATUS[3]
-            st.wall_time = time.perf_counter() - t0
-            st.nfev = self.nfev
-            return st
-        status = 1
+            return 3, 0, None
         for it in range(1, max_iter + 1):
-            res, Jr, info = cur
+            res, J, x = cur["res"], cur["J"], cur["x"]
             nrm = np.max(np.abs(res))
             try:
-                dx = -np.linalg.solve(Jr, res)
+                dxf = -np.linalg.solve(J[:, free], res)
             except np.linalg.LinAlgError:
-                status = 2
-                break
-            if not np.all(np.isfinite(dx)):
-                status = 2
-                break
-            if abs(dx[0]) > 0.5:
-                dx *= 0.5 / abs(dx[0])
+                return 2, it, cur
+            if not np.all(np.isfinite(dxf)):
+                return 2, it, cur
+            dx = np.zeros(3)
+            dx[free] = dxf
+            size = np.max(np.abs(dx) / (1 + np.abs(x)))
+            if size <= xtol:
+                return 0, it, cur
+            scale = min(1.0, 0.5 / max(abs(dx[0]), 1e-300), 0.2 / max(abs(dx[2]), 1e-300))
+            dx *= scale
             lam, accepted = 1.0, None
             while lam >= 1.0 / 64:
-                trial = self.residual(lambda0, x + lam * dx)
-                if trial is not None and np.max(np.abs(trial[0])) < (1 - 0.25 * lam) * nrm + 1e-15:
+                trial = self.shoot(x + lam * dx)
+                if trial is not None and np.max(np.abs(trial["res"])) < (1 - 0.1 * lam) * nrm:
                     accepted = trial
                     break
                 lam *= 0.5
-            st.niter = it
             if accepted is None:
-                # At the noise floor of the integrator no step can reduce the residual further.
-                if nrm <= 100 * max(self.rtol, 1e-14):
-                    status = 0
-                else:
-                    status = 2
-                break
-            x = x + lam * dx
+                return (0 if size <= 1e3 * self.rtol else 2), it, cur
             cur = accepted
-            step = np.max(np.abs(lam * dx) / (1 + np.abs(x)))
-            if step <= xtol and np.max(np.abs(cur[0])) <= 100 * max(self.rtol, 1e-14):
-                status = 0
-                break
-        res, Jr, info = cur
-        G0 = self.model.free_profile(np.array([math.exp(x[0])]), info["yf0"][:, None], self.par)
-        GL = self.model.free_profile(np.array([self.L]), info["yL"][:, None], self.par)
-        g0, gL = float(G0["axial_force_2pi"][0]), float(GL["axial_force_2pi"][0])
+        return 1, max_iter, cur
+
+    def state(self, status, niter, info, lambda0, t0, nfev):
+        """A ShootState from a Newton result."""
+        st = ShootState(lambda0=float(lambda0), contact=self.contact, rtol=self.rtol,
+                        status=status, niter=niter, success=status == 0, message=STATUS[status],
+                        nfev=nfev, wall_time=time.perf_counter() - t0)
+        if info is None:
+            return st
+        x = info["x"]
+        mod, par = self.model, self.par
+        G0 = mod.free_profile(np.array([math.exp(x[0])]), info["yf0"][:, None], par)["axial_force_2pi"]
+        GL = mod.free_profile(np.array([self.L]), info["yL"][:, None], par)["axial_force_2pi"]
+        st.lambda0 = float(x[2])
         st.Sc, st.u = math.exp(x[0]), float(x[1])
-        st.delta = float(info["yL"][5])  # z(L) with delta = 0; z(L) - delta = 0
-        st.F = 2 * math.pi * gL
-        st.force_defect = 2 * math.pi * abs(gL - g0)
-        st.residual = float(np.max(np.abs(res)))
-        st.status = status
-        st.success = status == 0
-        st.message = STATUS[status]
+        st.delta = float(info["yL"][5])      # z(L) with the tip at Z(0); z(L) - delta = 0
+        st.F = 2 * math.pi * float(GL[0])
+        st.force_defect = 2 * math.pi * abs(float(GL[0]) - float(G0[0]))
+        st.residual = float(np.max(np.abs(info["res"])))
         if st.success and st.delta < 0:
             st.message += f" (collapsed state: delta = {st.delta:.3g} < 0)"
-        st.nfev = self.nfev
-        st.wall_time = time.perf_counter() - t0
         return st
 
+    def solve(self, lambda0, guess, max_iter=30):
+        """One state at lambda0 from guess = (ln Sc, u)."""
+        t0, self.nfev = time.perf_counter(), 0
+        status, niter, info = self.newton(np.r_[guess[0], guess[1], lambda0], (0, 1), max_iter)
+        return self.state(status, niter, info, lambda0, t0, self.nfev)
 
-def _cold_guesses(shooter):
-    """A few crude (ln Sc, u) starts: cap sizes times a few values of the free unknown."""
-    if shooter.contact == "smooth":
-        us = (-0.05, 0.0, -0.2)      # rQ(Sc+): about -F/(2 pi) for a shallow cap
-    else:
-        us = (-2.5, 0.0, 1.0 / shooter.rho)  # kappa_s(Sc+)
-    for Sc in (0.05, 0.1, 0.02, 0.2):
+    # -- continuation ------------------------------------------------------------------------
+    def tangent(self, info):
+        """d(ln Sc, u)/d lambda0 at a converged state (from the exact Jacobian)."""
+        J = info["J"]
+        return -np.linalg.solve(J[:, :2], J[:, 2])
+
+    def march(self, info, target, max_steps=200, h0=None):
+        """Natural continuation in lambda0 from a converged state to ``target``.
+
+        Tangent predictor, adaptive steps (x1.5 after an easy success, halved after a
+        failure).  Returns (status, niter_total, info at the target or the last state).
+        """
+        lam = info["x"][2]
+        h = (target - lam) if h0 is None else math.copysign(h0, target - lam)
+        niter = 0
+        for _ in range(max_steps):
+            if lam == target:
+                return 0, niter, info
+            h = math.copysign(min(abs(h), abs(target - lam)), target - lam)
+            nxt = lam + h
+            pred = info["x"][:2] + h * self.tangent(info)
+            status, it, new = self.newton(np.r_[pred, nxt], (0, 1))
+            niter += it
+            if status == 0 and new["yL"][5] < 0 <= info["yL"][5]:
+                status = 2  # jumped to a spurious collapsed branch (delta < 0): smaller step
+            if status == 0:
+                info, lam = new, nxt
+                if it <= 3:
+                    h *= 1.5
+            else:
+                h /= 2
+                if abs(h) < 1e-6:
+                    return 2, niter, info
+        return 1, niter, info
+
+
+def _block_jac(J, factor, ncols):
+    """Block-diagonal approximation of the augmented system's Jacobian (state + ncols columns)."""
+    n = J.shape[0]
+    out = np.zeros((n * (1 + ncols), n * (1 + ncols)))
+    out[:n, :n] = factor * J
+    for j in range(ncols):
+        idx = n + np.arange(n) * ncols + j
+        out[np.ix_(idx, idx)] = factor * J
+    return out
+
+
+def _cold_start(sh, lambda0, beta_start=1.0, loose_rtol=1e-6, verbose=False):
+    """Find a first state at ``lambda0`` without a guess.
+
+    Shooting's basin of attraction is tiny for small beta (the free region has growing,
+    oscillating modes: on the base scene d M_s(L)/d rQ(Sc+) ~ 1e4, so Newton needs rQ to
+    ~1e-4), and crude guesses fail.  Homotopy, at the loose tolerance ``loose_rtol``: at a
+    fixed cap size Sc0 = rho/2 on a stiff shell (beta = beta_start) the shooting map is
+    nearly linear; solve there for (u, lambda0) from crude guesses, continue in ln beta
+    down to the scene's beta at fixed Sc0, then in lambda0 to the target; finally Newton
+    at the shooter's own tolerance.  Returns (status, niter, info); ``sh.nfev`` counts all.
+    """
+    lo = Shooter(sh.scene, rtol=max(sh.rtol, loose_rtol), method=sh.method, max_fev=5000)
+    lo.par = sh.par.copy()
+    beta_t = lo.beta
+    lnSc0 = math.log(0.5 * lo.rho)
+    niter = 0
+    us = (-0.2, -0.5, 0.0, -1.0) if lo.contact == "smooth" else (0.0, -1.0, 1.0, -2.0)
+
+    def done(status, info):
+        sh.nfev += lo.nfev
+        return status, niter, info
+
+    found = None
+    lo.beta = max(beta_t, beta_start)
+    for lam0 in (0.8, 0.65, 1.0):
         for u in us:
-            yield math.log(Sc), u
+            status, it, info = lo.newton(np.r_[lnSc0, u, lam0], (1, 2), max_iter=20)
+            niter += it
+            if status == 0:
+                found = info
+                break
+        if found is not None:
+            break
+    if found is None:
+        return done(3, None)
+    info = found
+    # continuation in ln beta at fixed Sc (secant predictor in (u, lambda0))
+    lb, lb_t = math.log(lo.beta), math.log(beta_t)
+    h, prev = -0.5, None
+    while lb > lb_t:
+        h = max(h, lb_t - lb)
+        nb = lb + h
+        x = info["x"].copy()
+        if prev is not None:
+            x[1:] += (x[1:] - prev[1][1:]) * h / (lb - prev[0])
+        lo.beta = math.exp(nb)
+        status, it, new = lo.newton(x, (1, 2))
+        niter += it
+        if status == 0:
+            prev, info, lb = (lb, info["x"]), new, nb
+            if verbose:
+                print(f"beta {lo.beta:.3g} lambda0 {new['x'][2]:.4f} u {new['x'][1]:.4g}")
+            if it <= 3:
+                h *= 1.5
+        else:
+            lo.beta = math.exp(lb)
+            h /= 2
+            if h > -1e-3:
+                return done(2, None)
+    lo.beta = beta_t
+    status, it, info = lo.march(info, lambda0, h0=0.02)
+    niter += it
+    if status != 0:
+        return done(status, None)
+    sh.nfev += lo.nfev
+    status, it, info = sh.newton(info["x"], (0, 1))
+    return status, niter + it, info
 
 
 def shoot_state(scene, lambda0, rtol=1e-8, guess=None, *, atol=None, method="DOP853", eps=None,
                 max_iter=30, shooter=None):
     """One state with the pole stretch lambda0 prescribed, by shooting.
 
-    guess : ShootState, or (Sc, u) with u = rQ(Sc+) (smooth) or kappa_s(Sc+) (paper);
-        without it a few crude starts are tried in turn (``nfev``/``wall_time`` count all).
+    guess : ShootState, or (Sc, u) with u = rQ(Sc+) (smooth) or kappa_s(Sc+) (paper).
+        Without it the state is found by a homotopy (see ``_cold_start``), much more
+        expensive than a warm start: shooting needs a guess very close to the answer.
     Returns a :class:`ShootState` (never raises for non-convergence).
     """
     sh = shooter or Shooter(scene, rtol=rtol, atol=atol, method=method, eps=eps)
     if guess is not None:
         x0 = guess.x if isinstance(guess, ShootState) else np.array([math.log(guess[0]), guess[1]])
         return sh.solve(lambda0, x0, max_iter=max_iter)
-    t0, nfev, first = time.perf_counter(), 0, None
-    for x0 in _cold_guesses(sh):
-        st = sh.solve(lambda0, x0, max_iter=max_iter)
-        nfev += st.nfev
-        if st.success and st.delta >= 0:
-            break
-        first = first or st
-    else:
-        st = first
-        st.message = "no crude start converged (first attempt: " + st.message + ")"
-    st.nfev, st.wall_time = nfev, time.perf_counter() - t0
+    t0, sh.nfev = time.perf_counter(), 0
+    status, niter, info = _cold_start(sh, lambda0)
+    st = sh.state(status, niter, info if status == 0 else None, lambda0, t0, sh.nfev)
+    if status != 0:
+        st.message = "cold start failed: " + st.message
     return st
 
 
 def shoot_curve(scene, lambda0s, rtol=1e-8, *, guess=None, **kw):
-    """States at the given lambda0 values, each warm-started from its neighbours.
+    """States at the given lambda0 values, each warm-started from its neighbour.
 
-    The first state starts from ``guess`` (or crude starts); later ones from a
-    secant prediction in (ln Sc, u) through the last two converged states (the
-    last one alone after a failure; a failed point is retried from crude starts).
-    Returns a :class:`ShootCurve`.
+    The first state starts from ``guess`` (a ShootState or (Sc, u)) or, without one, from
+    the cold-start homotopy; each later one from the previous converged state with the
+    tangent predictor (exact, from the shooting Jacobian); when that fails, by
+    continuation in lambda0 with smaller steps.  ``wall_time``/``nfev`` of a state count
+    all the work done for it.  Returns a :class:`ShootCurve`.
     """
     sh = Shooter(scene, rtol=rtol, **{k: v for k, v in kw.items() if k in ("atol", "method", "eps")})
-    mi = kw.get("max_iter", 30)
     out = ShootCurve()
-    done = []
+    info = None
     for lam in lambda0s:
-        if len(done) >= 2:
-            (l1, s1), (l2, s2) = done[-2], done[-1]
-            x0 = s2.x + (s2.x - s1.x) * (lam - l2) / (l2 - l1)
-            st = sh.solve(lam, x0, max_iter=mi)
-            if not st.success:  # predictor overshot: fall back to the last state
-                st2 = sh.solve(lam, s2.x, max_iter=mi)
-                st2.nfev += st.nfev
-                st2.wall_time += st.wall_time
-                st = st2
-        elif done:
-            st = sh.solve(lam, done[-1][1].x, max_iter=mi)
+        t0, sh.nfev = time.perf_counter(), 0
+        if info is None:
+            if guess is not None:
+                x0 = guess.x if isinstance(guess, ShootState) else (math.log(guess[0]), guess[1])
+                status, niter, new = sh.newton(np.r_[x0[0], x0[1], lam], (0, 1))
+            else:
+                status, niter, new = _cold_start(sh, lam)
         else:
-            st = shoot_state(scene, lam, rtol, guess=guess, shooter=sh, max_iter=mi)
-        if not st.success and done:
-            st = shoot_state(scene, lam, rtol, shooter=sh, max_iter=mi)
+            status, niter, new = sh.march(info, lam)
+        if status == 0:
+            st = sh.state(status, niter, new, lam, t0, sh.nfev)
+            info = new
+        else:  # do not report a neighbour's (or an unconverged iterate's) values
+            st = sh.state(status, niter, None, lam, t0, sh.nfev)
+            if info is not None:
+                st.message += f" (continuation from lambda0 = {info['x'][2]:.6g})"
         out.states.append(st)
-        if st.success:
-            done.append((lam, st))
     return out
 
 
@@ -475,67 +594,121 @@ def shoot_curve(scene, lambda0s, rtol=1e-8, *, guess=None, **kw):
 # Validation against the collocation solver and timing (run as a script)
 # ---------------------------------------------------------------------------------------------
 
-def _validate(lambdas=(1.0, 1.05, 1.1), rtols=(1e-6, 1e-8, 1e-9, 1e-10), ref_tol=1e-10):
+def _timed(fn, repeat):
+    best, out = math.inf, None
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        out = fn()
+        best = min(best, time.perf_counter() - t0)
+    return best, out
+
+
+def _validate(lambdas=(1.0, 1.05, 1.1), rtols=(1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10),
+              tols=(1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8), ref_tol=1e-10, step=0.01, repeat=3,
+              methods=("DOP853",), log=print):
+    """Both solvers on the base preset, both contact models, against sb.solve at ref_tol.
+
+    Each state is solved warm from its neighbour at lambda0 - step (collocation:
+    ``sb.solve(..., guess=neighbour, estimate_error=False)``; shooting: Newton from the
+    neighbour's (ln Sc, u), and, separately, with the exact tangent predictor).
+    The neighbours themselves come from a curve, not timed.
+    """
     import shellbvp as sb
 
     rows = []
     for contact in ("smooth", "paper"):
         scene = sb.Scene.preset("base", contact=contact)
         scene.model()
-        refs = [sb.solve(scene, lambda0=l, tol=ref_tol) for l in lambdas]
-        for r in refs:
+        refs = {l: sb.solve(scene, lambda0=l, tol=ref_tol) for l in lambdas}
+        for l, r in refs.items():
             assert r.success, r.message
-        # collocation, warm-started from the neighbour, at several tolerances
-        for tol in (1e-4, 1e-6, 1e-8):
-            prev = sb.solve(scene, lambda0=lambdas[0] - 0.01, tol=tol, estimate_error=False)
-            for l, ref in zip(lambdas, refs):
-                times = []
-                for _ in range(3):
-                    t0 = time.perf_counter()
-                    s = sb.solve(scene, lambda0=l, tol=tol, guess=prev, estimate_error=False)
-                    times.append(time.perf_counter() - t0)
+            rows.append(dict(contact=contact, solver="reference", tol=ref_tol, lambda0=l, F=r.force,
+                             delta=r.delta, Sc=r.Sc, F_err_est=r.force_error,
+                             delta_err_est=r.delta_error, time=r.wall_time))
+        # cold start of the shooting (once per contact model), timed
+        t0 = time.perf_counter()
+        cold = shoot_state(scene, lambdas[0] - step, 1e-8)
+        cold_time = time.perf_counter() - t0
+        rows.append(dict(contact=contact, solver="shooting-cold", tol=1e-8, lambda0=lambdas[0] - step,
+                         success=bool(cold.success), time=cold_time, nfev=cold.nfev,
+                         niter=cold.niter, message=cold.message))
+        log(f"{contact}: shooting cold start {cold_time:.1f} s ({cold.message})")
+        if not cold.success:
+            continue
+        for tol in tols:
+            for l in lambdas:
+                nb = sb.solve(scene, lambda0=l - step, tol=tol, estimate_error=False,
+                              guess=refs[l])
+                t, s = _timed(lambda: sb.solve(scene, lambda0=l, tol=tol, guess=nb,
+                                               estimate_error=False), repeat)
                 rows.append(dict(contact=contact, solver="collocation", tol=tol, lambda0=l,
-                                 success=bool(s.success), dF=abs(s.force - ref.force),
-                                 ddelta=abs(s.delta - ref.delta), time=min(times),
-                                 nodes=int(s.nodes)))
-                prev = s
-        # shooting: cold (crude starts) and warm (from the neighbour at lambda0 - 0.01)
-        for rtol in rtols:
-            sh = Shooter(scene, rtol=rtol)
-            for l, ref in zip(lambdas, refs):
-                cold = shoot_state(scene, l, rtol, shooter=sh)
-                nb = sh.solve(l - 0.01, cold.x) if cold.success else None
-                times, st = [], None
-                for _ in range(3):
-                    st = sh.solve(l, nb.x if nb is not None and nb.success else cold.x)
-                    times.append(st.wall_time)
-                rows.append(dict(contact=contact, solver="shooting", tol=rtol, lambda0=l,
-                                 success=bool(st.success), dF=abs(st.F - ref.force),
-                                 ddelta=abs(st.delta - ref.delta), dSc=abs(st.Sc - ref.Sc),
-                                 time=min(times), cold_time=cold.wall_time, nfev=st.nfev,
-                                 niter=st.niter, force_defect=st.force_defect,
-                                 message=st.message))
+                                 success=bool(s.success), dF=abs(s.force - refs[l].force),
+                                 ddelta=abs(s.delta - refs[l].delta), time=t, nodes=int(s.nodes),
+                                 niter=int(s.niter)))
+            log(f"{contact}: collocation tol {tol:g} done")
+        for method in methods:
+            for rtol in rtols:
+                sh = Shooter(scene, rtol=rtol, method=method)
+                x = cold.x
+                for l in lambdas:
+                    nb = sh.solve(l - step, x)
+                    if not nb.success:
+                        nb = sh.solve(l - step, cold.x)
+                    if not nb.success:
+                        rows.append(dict(contact=contact, solver=f"shooting-{method}", tol=rtol,
+                                         lambda0=l, success=False, message="neighbour failed"))
+                        continue
+                    t, st = _timed(lambda: sh.solve(l, nb.x), repeat)
+                    info = sh.shoot(np.r_[nb.x, l - step])
+                    pred = nb.x + step * sh.tangent(info)
+                    tp, stp = _timed(lambda: sh.solve(l, pred), repeat)
+                    x = st.x if st.success else x
+                    for name, tt, s in ((f"shooting-{method}", t, st),
+                                        (f"shooting-{method}+tangent", tp, stp)):
+                        rows.append(dict(contact=contact, solver=name, tol=rtol, lambda0=l,
+                                         success=bool(s.success), dF=abs(s.F - refs[l].force),
+                                         ddelta=abs(s.delta - refs[l].delta),
+                                         dSc=abs(s.Sc - refs[l].Sc), time=tt, nfev=s.nfev,
+                                         niter=s.niter, force_defect=s.force_defect,
+                                         message=s.message))
+                log(f"{contact}: shooting {method} rtol {rtol:g} done")
     return rows
+
+
+def _table(rows):
+    lines = ["| contact | solver | tol | lambda0 | ok | abs err F | abs err delta | s/state | work |",
+             "|---|---|---|---|---|---|---|---|---|"]
+    for r in rows:
+        if r["solver"] in ("reference", "shooting-cold") or "dF" not in r:
+            continue
+        work = (f"{r['nodes']} nodes, {r['niter']} it" if r["solver"] == "collocation"
+                else f"{r['niter']} it, {r['nfev']} fev")
+        lines.append(f"| {r['contact']} | {r['solver']} | {r['tol']:.0e} | {r['lambda0']} | "
+                     f"{r['success']} | {r['dF']:.1e} | {r['ddelta']:.1e} | {r['time']:.3f} | {work} |")
+    return "\n".join(lines)
 
 
 def main(argv=None):
     import argparse
     import json
+    import sys
 
-    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--out", default=None, help="write the rows as JSON here")
+    ap = argparse.ArgumentParser(description="Validate the shooting peer against sb.solve and time both.")
+    ap.add_argument("--out", default=None, help="write the rows as JSON here (and a .md table beside)")
+    ap.add_argument("--quick", action="store_true", help="fewer tolerances, one repeat")
+    ap.add_argument("--methods", default="DOP853", help="comma-separated solve_ivp methods")
     args = ap.parse_args(argv)
-    rows = _validate()
-    print("| contact | solver | tol | lambda0 | ok | |dF| | |d delta| | s/state | work |")
-    print("|---|---|---|---|---|---|---|---|---|")
-    for r in rows:
-        work = (f"{r['nodes']} nodes" if r["solver"] == "collocation"
-                else f"{r['niter']} it, {r['nfev']} fev")
-        print(f"| {r['contact']} | {r['solver']} | {r['tol']:.0e} | {r['lambda0']} | {r['success']} | "
-              f"{r['dF']:.1e} | {r['ddelta']:.1e} | {r['time']:.3f} | {work} |")
+    kw = dict(methods=tuple(args.methods.split(",")))
+    if args.quick:
+        kw.update(rtols=(1e-6, 1e-9), tols=(1e-4, 1e-7), repeat=1)
+    rows = _validate(log=lambda m: print(m, file=sys.stderr, flush=True), **kw)
+    table = _table(rows)
+    print(table)
     if args.out:
         with open(args.out, "w") as fh:
             json.dump(rows, fh, indent=1)
+        with open(args.out.rsplit(".", 1)[0] + ".md", "w") as fh:
+            fh.write(table + "\n")
 
 
 if __name__ == "__main__":
