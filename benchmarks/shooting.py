@@ -64,6 +64,7 @@ STATUS = {
     1: "Newton did not converge in max_iter iterations",
     2: "Newton stalled: no step reduced the residual (guess too far, or a fold in lambda0)",
     3: "integration failed at the guess (singular or non-finite trajectory, or the cap left the tip)",
+    4: "converged to a spurious collapsed state",
 }
 
 
@@ -153,9 +154,12 @@ class Shooter:
     max_fev : int
         Right-hand-side evaluations allowed per integration (a poor guess can make
         the trajectory singular; the step size then collapses).
+    jacobian : {"broyden", "newton"}
+        How Newton gets the shooting Jacobian (see :meth:`newton`).
     """
 
-    def __init__(self, scene, rtol=1e-8, atol=None, method="DOP853", eps=None, max_fev=20000):
+    def __init__(self, scene, rtol=1e-8, atol=None, method="DOP853", eps=None, max_fev=20000,
+                 jacobian="broyden"):
         self.scene = scene
         self.model = mod = scene.model()
         self.par = np.array(scene.parameters(mod), float)
@@ -177,7 +181,11 @@ class Shooter:
         self.z_tip0 = float(mod.reference_shell(0.0, self.par)["Z"])  # z_tip at delta = 0
         self.c_pole = -mod.pole_res(0.0, 0.0, 1.0, self.par)           # y(pole) = c lambda0
         self.max_fev = int(max_fev)
+        if jacobian not in ("broyden", "newton"):
+            raise ValueError(f"jacobian must be 'broyden' or 'newton'; got {jacobian!r}")
+        self.jacobian = jacobian
         self.nfev = 0
+        self.trace = False
         self.implicit = method in ("Radau", "BDF", "LSODA")
 
     @property
@@ -189,13 +197,17 @@ class Shooter:
         self.par[self.i_beta] = value
 
     # -- region 1: the contact region --------------------------------------------------------
-    def contact_end(self, lnSc, lambda0):
-        """(chi, ls) at Sc and their derivatives (2, 2) by (ln Sc, lambda0).
+    def contact_end(self, lnSc, lambda0, sens=True):
+        """(chi, ls) at Sc and their derivatives (2, 2) by (ln Sc, lambda0) (None if not sens).
 
         tau = ln(S/Sc) from ln eps to 0; the start (the pole series) is fixed in tau.
         """
         mod, par = self.model, self.par
         Sc = math.exp(lnSc)
+        if not sens:
+            sol = self._ivp(lambda tau, y: mod.contact_rhs(Sc * math.exp(tau), y, par), None,
+                            (self.ln_eps, 0.0), self.c_pole * lambda0, _contact_guard)
+            return None if sol is None else (sol.y[:, -1], None)
         w0 = np.zeros(_NC * 3)
         w0[:_NC] = self.c_pole * lambda0
         w0[_NC:].reshape(_NC, 2)[:, 1] = self.c_pole
@@ -220,7 +232,7 @@ class Shooter:
         return w[:_NC], w[_NC:].reshape(_NC, 2)
 
     # -- the contact line --------------------------------------------------------------------
-    def free_start(self, lnSc, u, yc, dyc):
+    def free_start(self, lnSc, u, yc, dyc=None):
         """yf(Sc+) with yf[k_u] = u, and d yf / d(ln Sc, u, lambda0) (6, 3); None if unsolvable.
 
         The five other components solve the generated junction residual (delta = 0) by
@@ -254,6 +266,8 @@ class Shooter:
             res = self.jres(Sc, yc, yf, 0.0, 0.0, par)
             if not (np.all(np.isfinite(yf)) and np.max(np.abs(res)) < 1e-11) or yf[2] <= 0:
                 return None
+            if dyc is None:
+                return yf, None
             jj = self.jjac(Sc, yc, yf, 0.0, 0.0, par)
             A = jj[:, cols]
             # 0 = dres/dSc Sc dlnSc + dres/dyc dyc + dres/dyf dyf
@@ -272,6 +286,10 @@ class Shooter:
         mod, par = self.model, self.par
         Sc = math.exp(lnSc)
         Lf = self.lnL - lnSc
+        if D0 is None:
+            sol = self._ivp(lambda tau, y: Lf * mod.free_rhs(Sc * math.exp(Lf * tau), y, par), None,
+                            (0.0, 1.0), yf0, _free_guard)
+            return None if sol is None else (sol.y[:, -1], None)
 
         def f(tau, w):
             S = Sc * math.exp(Lf * tau)
@@ -305,7 +323,7 @@ class Shooter:
             return f(t, w)
 
         kw = dict(method=self.method, rtol=self.rtol, atol=self.atol)
-        if self.implicit:
+        if self.implicit and jac is not None:
             kw["jac"] = jac
         if guard is not None:
             guard.terminal = True
@@ -322,17 +340,18 @@ class Shooter:
         return sol
 
     # -- the shooting map --------------------------------------------------------------------
-    def shoot(self, x):
+    def shoot(self, x, sens=True):
         """Rim residual (lt - 1, m) at L and its Jacobian (2, 3) by x = (ln Sc, u, lambda0).
 
         None when the trajectory cannot be computed (cap off the tip, singular or
-        non-finite trajectory, junction unsolvable).
+        non-finite trajectory, junction unsolvable).  ``sens=False``: no Jacobian (J None;
+        the states alone, about 4x cheaper).
         """
         lnSc, u, lambda0 = (float(v) for v in x)
         if not (lnSc < self.lnL - 1e-3 and math.isfinite(u) and lambda0 > 0):
             return None
         Sc = math.exp(lnSc)
-        ce = self.contact_end(lnSc, lambda0)
+        ce = self.contact_end(lnSc, lambda0, sens)
         if ce is None:
             return None
         yc, dyc = ce
@@ -347,51 +366,102 @@ class Shooter:
             return None
         yL, VL = fe
         res = self.model.rim_res(self.L, yL, self.par)[:2]
-        J = self.model.rim_jac(self.L, yL, self.par)[:2] @ VL
-        if not (np.all(np.isfinite(res)) and np.all(np.isfinite(J))):
+        J = None if VL is None else self.model.rim_jac(self.L, yL, self.par)[:2] @ VL
+        if not (np.all(np.isfinite(res)) and (J is None or np.all(np.isfinite(J)))):
             return None
         return dict(res=res, J=J, yc=yc, yf0=yf0, yL=yL, x=np.array([lnSc, u, lambda0]))
 
-    def newton(self, x0, free=(0, 1), max_iter=30, xtol=None):
-        """Damped Newton on the components ``free`` of x (the third is held).
+    def newton(self, x0, free=(0, 1), max_iter=30, xtol=None, J0=None):
+        """Damped (quasi-)Newton on the components ``free`` of x (the third is held).
+
+        ``self.jacobian == "newton"``: every iterate is shot with the variational
+        equations (exact Jacobian, quadratic convergence).  ``"broyden"``: iterates are
+        shot without them (about 4x cheaper, see ``shoot``) and the Jacobian -- ``J0``
+        (e.g. the neighbouring state's) or one variational shot at x0 -- gets Broyden
+        updates; it is recomputed exactly when a step fails.
 
         Returns (status, niter, info) with info = the last shoot() result (None if the
-        guess itself could not be integrated).  Convergence: a full Newton step below
-        ``xtol`` (default 10 rtol, relative to 1 + |x|), or -- at the integrator's noise
-        floor, where no step reduces the residual -- a step below 1e3 rtol.
+        guess itself could not be integrated).  Convergence: a (full) step below ``xtol``
+        (default 10 rtol, relative to 1 + |x|) -- that last step is taken, with a
+        states-only shoot, so the result errs by O(step^2) -- or a step predicted below
+        xtol from observed quadratic convergence (Newton), or, at the integrator's noise
+        floor where no step reduces the residual, a step below 1e3 rtol.
         """
         xtol = 10 * self.rtol if xtol is None else xtol
         free = list(free)
-        cur = self.shoot(np.asarray(x0, float))
+        broyden = self.jacobian == "broyden"
+        x0 = np.asarray(x0, float)
+        if broyden and J0 is not None:
+            cur = self.shoot(x0, sens=False)
+            if cur is not None:
+                cur["J"], fresh = np.array(J0, float), False
+        else:
+            cur, fresh = self.shoot(x0), True
         if cur is None:
             return 3, 0, None
-        for it in range(1, max_iter + 1):
+        prev_size = None
+        it = 0
+        while it < max_iter:
+            it += 1
             res, J, x = cur["res"], cur["J"], cur["x"]
             nrm = np.max(np.abs(res))
             try:
                 dxf = -np.linalg.solve(J[:, free], res)
             except np.linalg.LinAlgError:
-                return 2, it, cur
+                dxf = np.full(len(free), np.nan)
             if not np.all(np.isfinite(dxf)):
-                return 2, it, cur
+                if fresh:
+                    return 2, it, cur
+                cur, fresh = self._refresh(cur), True
+                if cur is None:
+                    return 3, it, None
+                continue
             dx = np.zeros(3)
             dx[free] = dxf
             size = np.max(np.abs(dx) / (1 + np.abs(x)))
-            if size <= xtol:
-                return 0, it, cur
+            if self.trace:
+                print(f"  {'broyden' if broyden else 'newton'} {it}: |res| {nrm:.2e} |dx| {size:.2e} "
+                      f"nfev {self.nfev}{' (fresh J)' if fresh else ''}")
+            small = size <= xtol
+            if small or (not broyden and prev_size is not None and size < prev_size
+                         and size ** 3 / prev_size ** 2 <= xtol):
+                # last step: states only (its error is O(size^2)); at the noise floor the
+                # residual need not decrease any more
+                final = self.shoot(x + dx, sens=False)
+                if final is not None and (small or np.max(np.abs(final["res"])) < nrm):
+                    final["J"] = J
+                    return 0, it, final
+                if small:
+                    return 0, it, cur
             scale = min(1.0, 0.5 / max(abs(dx[0]), 1e-300), 0.2 / max(abs(dx[2]), 1e-300))
             dx *= scale
             lam, accepted = 1.0, None
-            while lam >= 1.0 / 64:
-                trial = self.shoot(x + lam * dx)
+            while lam >= (1.0 / 64 if fresh else 0.25):
+                trial = self.shoot(x + lam * dx, sens=not broyden)
                 if trial is not None and np.max(np.abs(trial["res"])) < (1 - 0.1 * lam) * nrm:
                     accepted = trial
                     break
                 lam *= 0.5
             if accepted is None:
+                if not fresh:  # the quasi-Newton direction was poor: exact Jacobian, retry
+                    cur, fresh = self._refresh(cur), True
+                    if cur is None:
+                        return 3, it, None
+                    continue
                 return (0 if size <= 1e3 * self.rtol else 2), it, cur
+            if broyden:
+                step = accepted["x"] - x
+                sf = step[free]
+                Jn = J.copy()
+                Jn[:, free] += np.outer(accepted["res"] - res - J @ step, sf) / (sf @ sf)
+                accepted["J"], fresh = Jn, False
             cur = accepted
+            prev_size = size if lam == 1.0 and scale == 1.0 else None
         return 1, max_iter, cur
+
+    def _refresh(self, cur):
+        """Re-shoot at cur's x with the variational equations (exact Jacobian)."""
+        return self.shoot(cur["x"])
 
     def state(self, status, niter, info, lambda0, t0, nfev):
         """A ShootState from a Newton result."""
@@ -411,7 +481,8 @@ class Shooter:
         st.force_defect = 2 * math.pi * abs(float(GL[0]) - float(G0[0]))
         st.residual = float(np.max(np.abs(info["res"])))
         if st.success and st.delta < 0:
-            st.message += f" (collapsed state: delta = {st.delta:.3g} < 0)"
+            st.status, st.success = 4, False
+            st.message = STATUS[4] + f": delta = {st.delta:.3g} < 0"
         return st
 
     def solve(self, lambda0, guess, max_iter=30):
@@ -441,7 +512,7 @@ class Shooter:
             h = math.copysign(min(abs(h), abs(target - lam)), target - lam)
             nxt = lam + h
             pred = info["x"][:2] + h * self.tangent(info)
-            status, it, new = self.newton(np.r_[pred, nxt], (0, 1))
+            status, it, new = self.newton(np.r_[pred, nxt], (0, 1), J0=info["J"])
             niter += it
             if status == 0 and new["yL"][5] < 0 <= info["yL"][5]:
                 status = 2  # jumped to a spurious collapsed branch (delta < 0): smaller step
@@ -605,13 +676,14 @@ def _timed(fn, repeat):
 
 def _validate(lambdas=(1.0, 1.05, 1.1), rtols=(1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10),
               tols=(1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8), ref_tol=1e-10, step=0.01, repeat=3,
-              methods=("DOP853",), log=print):
+              jacobians=("broyden", "newton"), method="DOP853", log=print):
     """Both solvers on the base preset, both contact models, against sb.solve at ref_tol.
 
-    Each state is solved warm from its neighbour at lambda0 - step (collocation:
-    ``sb.solve(..., guess=neighbour, estimate_error=False)``; shooting: Newton from the
-    neighbour's (ln Sc, u), and, separately, with the exact tangent predictor).
-    The neighbours themselves come from a curve, not timed.
+    Each state is solved warm from its neighbour at lambda0 - step (not timed):
+    collocation ``sb.solve(..., guess=neighbour, estimate_error=False)``; shooting one
+    continuation step (tangent predictor from the neighbour, its Jacobian for Broyden)
+    -- and, for information, plain Newton from the neighbour's (ln Sc, u) ("no predictor").
+    Times are the best of ``repeat``.
     """
     import shellbvp as sb
 
@@ -626,52 +698,57 @@ def _validate(lambdas=(1.0, 1.05, 1.1), rtols=(1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-
                              delta=r.delta, Sc=r.Sc, F_err_est=r.force_error,
                              delta_err_est=r.delta_error, time=r.wall_time))
         # cold start of the shooting (once per contact model), timed
-        t0 = time.perf_counter()
-        cold = shoot_state(scene, lambdas[0] - step, 1e-8)
-        cold_time = time.perf_counter() - t0
-        rows.append(dict(contact=contact, solver="shooting-cold", tol=1e-8, lambda0=lambdas[0] - step,
-                         success=bool(cold.success), time=cold_time, nfev=cold.nfev,
-                         niter=cold.niter, message=cold.message))
-        log(f"{contact}: shooting cold start {cold_time:.1f} s ({cold.message})")
+        l_start = lambdas[0] - step
+        cold = shoot_state(scene, l_start, 1e-8)
+        rows.append(dict(contact=contact, solver="shooting-cold", tol=1e-8, lambda0=l_start,
+                         success=bool(cold.success), time=cold.wall_time, nfev=cold.nfev,
+                         niter=cold.niter, message=cold.message, F=cold.F, delta=cold.delta))
+        log(f"{contact}: shooting cold start {cold.wall_time:.1f} s, {cold.nfev} fev ({cold.message})")
         if not cold.success:
             continue
         for tol in tols:
             for l in lambdas:
-                nb = sb.solve(scene, lambda0=l - step, tol=tol, estimate_error=False,
-                              guess=refs[l])
+                nb = sb.solve(scene, lambda0=l - step, tol=tol, estimate_error=False)
                 t, s = _timed(lambda: sb.solve(scene, lambda0=l, tol=tol, guess=nb,
                                                estimate_error=False), repeat)
                 rows.append(dict(contact=contact, solver="collocation", tol=tol, lambda0=l,
                                  success=bool(s.success), dF=abs(s.force - refs[l].force),
-                                 ddelta=abs(s.delta - refs[l].delta), time=t, nodes=int(s.nodes),
-                                 niter=int(s.niter)))
+                                 ddelta=abs(s.delta - refs[l].delta), time=t,
+                                 nodes=int(s.get("nodes", 0)), niter=int(s.get("niter", 0))))
             log(f"{contact}: collocation tol {tol:g} done")
-        for method in methods:
+        for jac in jacobians:
             for rtol in rtols:
-                sh = Shooter(scene, rtol=rtol, method=method)
-                x = cold.x
+                sh = Shooter(scene, rtol=rtol, method=method, jacobian=jac)
+                status, _, info = sh.newton(np.r_[cold.x, l_start], (0, 1))
                 for l in lambdas:
-                    nb = sh.solve(l - step, x)
-                    if not nb.success:
-                        nb = sh.solve(l - step, cold.x)
-                    if not nb.success:
-                        rows.append(dict(contact=contact, solver=f"shooting-{method}", tol=rtol,
+                    if info is not None and status == 0:
+                        status, _, nb = sh.march(info, l - step)
+                    if info is None or status != 0:
+                        rows.append(dict(contact=contact, solver=f"shooting-{jac}", tol=rtol,
                                          lambda0=l, success=False, message="neighbour failed"))
-                        continue
-                    t, st = _timed(lambda: sh.solve(l, nb.x), repeat)
-                    info = sh.shoot(np.r_[nb.x, l - step])
-                    pred = nb.x + step * sh.tangent(info)
-                    tp, stp = _timed(lambda: sh.solve(l, pred), repeat)
-                    x = st.x if st.success else x
-                    for name, tt, s in ((f"shooting-{method}", t, st),
-                                        (f"shooting-{method}+tangent", tp, stp)):
+                        break
+
+                    def one(nb=nb, l=l):
+                        t0, sh.nfev = time.perf_counter(), 0
+                        stt, it, new = sh.march(nb, l, h0=step)
+                        return sh.state(stt, it, new if stt == 0 else None, l, t0, sh.nfev), new
+
+                    def plain(nb=nb, l=l):
+                        return sh.solve(l, nb["x"][:2])
+
+                    t, (st, new) = _timed(one, repeat)
+                    tp, stp = _timed(plain, 1)
+                    for name, tt, s in ((f"shooting-{jac}", t, st),
+                                        (f"shooting-{jac} no predictor", tp, stp)):
                         rows.append(dict(contact=contact, solver=name, tol=rtol, lambda0=l,
                                          success=bool(s.success), dF=abs(s.F - refs[l].force),
                                          ddelta=abs(s.delta - refs[l].delta),
                                          dSc=abs(s.Sc - refs[l].Sc), time=tt, nfev=s.nfev,
                                          niter=s.niter, force_defect=s.force_defect,
                                          message=s.message))
-                log(f"{contact}: shooting {method} rtol {rtol:g} done")
+                    if st.success:
+                        info = new
+                log(f"{contact}: shooting {jac} rtol {rtol:g} done")
     return rows
 
 
@@ -683,6 +760,8 @@ def _table(rows):
             continue
         work = (f"{r['nodes']} nodes, {r['niter']} it" if r["solver"] == "collocation"
                 else f"{r['niter']} it, {r['nfev']} fev")
+        if not r["success"]:
+            work += " FAILED: " + r.get("message", "")
         lines.append(f"| {r['contact']} | {r['solver']} | {r['tol']:.0e} | {r['lambda0']} | "
                      f"{r['success']} | {r['dF']:.1e} | {r['ddelta']:.1e} | {r['time']:.3f} | {work} |")
     return "\n".join(lines)
@@ -696,9 +775,9 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description="Validate the shooting peer against sb.solve and time both.")
     ap.add_argument("--out", default=None, help="write the rows as JSON here (and a .md table beside)")
     ap.add_argument("--quick", action="store_true", help="fewer tolerances, one repeat")
-    ap.add_argument("--methods", default="DOP853", help="comma-separated solve_ivp methods")
+    ap.add_argument("--method", default="DOP853", help="solve_ivp method")
     args = ap.parse_args(argv)
-    kw = dict(methods=tuple(args.methods.split(",")))
+    kw = dict(method=args.method)
     if args.quick:
         kw.update(rtols=(1e-6, 1e-9), tols=(1e-4, 1e-7), repeat=1)
     rows = _validate(log=lambda m: print(m, file=sys.stderr, flush=True), **kw)
