@@ -159,7 +159,7 @@ class Shooter:
     """
 
     def __init__(self, scene, rtol=1e-8, atol=None, method="DOP853", eps=None, max_fev=20000,
-                 jacobian="broyden"):
+                 jacobian="newton"):
         self.scene = scene
         self.model = mod = scene.model()
         self.par = np.array(scene.parameters(mod), float)
@@ -450,11 +450,17 @@ class Shooter:
                     continue
                 return (0 if size <= 1e3 * self.rtol else 2), it, cur
             if broyden:
-                step = accepted["x"] - x
-                sf = step[free]
-                Jn = J.copy()
-                Jn[:, free] += np.outer(accepted["res"] - res - J @ step, sf) / (sf @ sf)
-                accepted["J"], fresh = Jn, False
+                if np.max(np.abs(accepted["res"])) > 0.5 * nrm:
+                    # slow progress: the secant Jacobian has drifted; take an exact one
+                    accepted, fresh = self._refresh(accepted), True
+                    if accepted is None:
+                        return 3, it, None
+                else:
+                    step = accepted["x"] - x
+                    sf = step[free]
+                    Jn = J.copy()
+                    Jn[:, free] += np.outer(accepted["res"] - res - J @ step, sf) / (sf @ sf)
+                    accepted["J"], fresh = Jn, False
             cur = accepted
             prev_size = size if lam == 1.0 and scale == 1.0 else None
         return 1, max_iter, cur
@@ -608,7 +614,7 @@ def _cold_start(sh, lambda0, beta_start=1.0, loose_rtol=1e-6, verbose=False):
 
 
 def shoot_state(scene, lambda0, rtol=1e-8, guess=None, *, atol=None, method="DOP853", eps=None,
-                max_iter=30, shooter=None):
+                jacobian="newton", max_iter=30, shooter=None):
     """One state with the pole stretch lambda0 prescribed, by shooting.
 
     guess : ShootState, or (Sc, u) with u = rQ(Sc+) (smooth) or kappa_s(Sc+) (paper).
@@ -616,7 +622,7 @@ def shoot_state(scene, lambda0, rtol=1e-8, guess=None, *, atol=None, method="DOP
         expensive than a warm start: shooting needs a guess very close to the answer.
     Returns a :class:`ShootState` (never raises for non-convergence).
     """
-    sh = shooter or Shooter(scene, rtol=rtol, atol=atol, method=method, eps=eps)
+    sh = shooter or Shooter(scene, rtol=rtol, atol=atol, method=method, eps=eps, jacobian=jacobian)
     if guess is not None:
         x0 = guess.x if isinstance(guess, ShootState) else np.array([math.log(guess[0]), guess[1]])
         return sh.solve(lambda0, x0, max_iter=max_iter)
@@ -637,7 +643,7 @@ def shoot_curve(scene, lambda0s, rtol=1e-8, *, guess=None, **kw):
     continuation in lambda0 with smaller steps.  ``wall_time``/``nfev`` of a state count
     all the work done for it.  Returns a :class:`ShootCurve`.
     """
-    sh = Shooter(scene, rtol=rtol, **{k: v for k, v in kw.items() if k in ("atol", "method", "eps")})
+    sh = Shooter(scene, rtol=rtol, **kw)
     out = ShootCurve()
     info = None
     for lam in lambda0s:
@@ -652,7 +658,8 @@ def shoot_curve(scene, lambda0s, rtol=1e-8, *, guess=None, **kw):
             status, niter, new = sh.march(info, lam)
         if status == 0:
             st = sh.state(status, niter, new, lam, t0, sh.nfev)
-            info = new
+            if st.success:  # not a collapsed state
+                info = new
         else:  # do not report a neighbour's (or an unconverged iterate's) values
             st = sh.state(status, niter, None, lam, t0, sh.nfev)
             if info is not None:
@@ -676,7 +683,7 @@ def _timed(fn, repeat):
 
 def _validate(lambdas=(1.0, 1.05, 1.1), rtols=(1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10),
               tols=(1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8), ref_tol=1e-10, step=0.01, repeat=3,
-              jacobians=("broyden", "newton"), method="DOP853", log=print):
+              jacobians=("newton", "broyden"), method="DOP853", log=print):
     """Both solvers on the base preset, both contact models, against sb.solve at ref_tol.
 
     Each state is solved warm from its neighbour at lambda0 - step (not timed):
@@ -734,7 +741,7 @@ def _validate(lambdas=(1.0, 1.05, 1.1), rtols=(1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-
                         return sh.state(stt, it, new if stt == 0 else None, l, t0, sh.nfev), new
 
                     def plain(nb=nb, l=l):
-                        return sh.solve(l, nb["x"][:2])
+                        return sh.solve(l, nb["x"][:2], max_iter=10)
 
                     t, (st, new) = _timed(one, repeat)
                     tp, stp = _timed(plain, 1)

@@ -54,6 +54,12 @@ def _check_units(units):
     return R_L, mu_H
 
 
+def _umask():
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask
+
+
 def write_curve(curve, path, *, profiles=False, overwrite=False, units=None):
     """Write ``curve`` to ``path`` atomically (temporary file + rename).
 
@@ -129,6 +135,7 @@ def write_curve(curve, path, *, profiles=False, overwrite=False, units=None):
                     sg = pg.create_group(f"point_{i:05d}")
                     for k, v in sol.profile().items():
                         sg.create_dataset(k, data=v)
+        os.chmod(tmp, 0o666 & ~_umask())  # mkstemp makes 0600; give the usual permissions
         os.replace(tmp, path)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
