@@ -15,6 +15,8 @@ from .scene import PRESETS, Scene
 from .state import STATUS_MESSAGES, Solution, solve
 from .continuation import Curve, curve
 from .io import read_curve
+from .fitting import FitResult, fit, read_force_csv
+from .units import Dimensions, beta_from_thickness, parse_quantity
 
 __version__ = "0.1.0.dev0"
 
@@ -24,6 +26,12 @@ __all__ = [
     "curve",
     "Curve",
     "read_curve",
+    "fit",
+    "FitResult",
+    "read_force_csv",
+    "Dimensions",
+    "beta_from_thickness",
+    "parse_quantity",
     "Solution",
     "STATUS_MESSAGES",
     "PRESETS",

@@ -2,6 +2,7 @@
 
     shellbvp curve [--preset base] [scene options] [-o base.h5]   force-displacement curve -> HDF5
     shellbvp solve [scene options] --delta 0.2 [--profiles] [--json]   one state
+    shellbvp fit DATA.csv --radius 0.3mm [--units mm,mN] [--json]   mu*H from measured data
     shellbvp info FILE.h5                                            what a curve file holds
     shellbvp presets                                                 the built-in scenes
 
@@ -156,6 +157,41 @@ def _cmd_solve(args):
     return 0 if sol.success else 1
 
 
+def _cmd_fit(args):
+    import shellbvp as sb
+
+    from .units import parse_quantity
+
+    scene = _scene(args)
+    R_L = parse_quantity(args.radius, "length", default_unit="m")
+    if not R_L > 0:
+        raise ValueError(f"--radius must be a length > 0 (e.g. 0.3mm); got {args.radius!r}")
+    units = None
+    if args.units:
+        parts = [u.strip() for u in args.units.split(",")]
+        if len(parts) != 2:
+            raise ValueError(f"--units must be two units, displacement and force, e.g. mm,mN; got {args.units!r}")
+        units = tuple(parts)
+    columns = [c.strip() for c in args.columns.split(",")] if args.columns else None
+    if columns is not None and len(columns) != 2:
+        raise ValueError(f"--columns must name two columns (displacement, force); got {args.columns!r}")
+    disp, force = sb.read_force_csv(args.data, columns=columns, units=units)
+    res = sb.fit(scene, disp, force, R_L=R_L, fit_offset=not args.no_offset, tol=args.tol)
+    out = res.to_dict()
+    if args.json:
+        print(json.dumps(out))
+    else:
+        lo, hi = res.mu_H_ci95
+        print(f"mu*H   = {res.mu_H:.4g} N/m (um*MPa)   95% CI [{lo:.4g}, {hi:.4g}]")
+        if not args.no_offset:
+            o1, o2 = res.offset_ci95
+            print(f"offset = {res.offset * 1e3:.4g} mm   95% CI [{o1 * 1e3:.4g}, {o2 * 1e3:.4g}] mm")
+        print(f"rms residual = {res.residual_rms * 1e3:.4g} mN over {res.n} points; R_L = {R_L * 1e3:.4g} mm")
+    if args.output:
+        res.curve.to_hdf5(args.output, overwrite=args.force, units={"R_L": R_L, "mu_H": res.mu_H})
+    return 0 if res.success else 1
+
+
 def _cmd_info(args):
     import numpy as np
 
@@ -217,6 +253,17 @@ def build_parser():
     s.add_argument("--profiles", action="store_true", help="print the fields over S")
     s.add_argument("--json", action="store_true", help="print JSON")
     s.set_defaults(func=_cmd_solve)
+    f = sub.add_parser("fit", help="fit mu*H (and the contact point) to measured force-displacement data")
+    f.add_argument("data", help="CSV file: displacement and force columns")
+    _scene_options(f)
+    f.add_argument("--radius", required=True, help="rim radius R_L of the sample, e.g. 0.3mm")
+    f.add_argument("--columns", help="displacement,force columns by name or 0-based index (default 0,1)")
+    f.add_argument("--units", help="units of the two columns, e.g. mm,mN (default: from the header)")
+    f.add_argument("--no-offset", action="store_true", dest="no_offset", help="do not fit the contact point")
+    f.add_argument("--json", action="store_true")
+    f.add_argument("-o", "--output", help="write the fitted model curve (HDF5, with SI columns)")
+    f.add_argument("--force", action="store_true", help="replace an existing output file")
+    f.set_defaults(func=_cmd_fit)
     i = sub.add_parser("info", help="describe a curve file")
     i.add_argument("file")
     i.set_defaults(func=_cmd_info)

@@ -1,0 +1,79 @@
+"""Dimensional layer: nondimensional (delta, F) <-> SI, and unit strings.
+
+Lengths scale with the rim radius ``R_L``, forces with ``mu H R_L``:
+``delta_SI = R_L delta``, ``F_SI = mu_H R_L F`` (``mu_H`` = shear modulus times
+thickness, N/m = um*MPa).  A linearly elastic sheet of thickness H has
+``beta = (H/R_L)^2 / 12``.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import dataclass
+
+__all__ = ["Dimensions", "parse_quantity", "unit_factor", "beta_from_thickness", "LENGTH_UNITS", "FORCE_UNITS"]
+
+LENGTH_UNITS = {"m": 1.0, "mm": 1e-3, "um": 1e-6, "µm": 1e-6, "micron": 1e-6, "nm": 1e-9, "cm": 1e-2}
+FORCE_UNITS = {"N": 1.0, "mN": 1e-3, "uN": 1e-6, "µN": 1e-6, "nN": 1e-9, "kN": 1e3}
+
+
+def unit_factor(unit: str, kind: str) -> float:
+    """SI factor of a length ('length') or force ('force') unit name."""
+    table = LENGTH_UNITS if kind == "length" else FORCE_UNITS
+    u = unit.strip()
+    if u not in table:
+        raise ValueError(f"unknown {kind} unit {unit!r}; use one of {', '.join(table)}")
+    return table[u]
+
+
+def parse_quantity(text, kind: str = "length", default_unit: str | None = None) -> float:
+    """'0.3mm' -> 3e-4 (SI); a bare number takes ``default_unit`` (else SI)."""
+    if isinstance(text, (int, float)):
+        v = float(text)
+        return v * (unit_factor(default_unit, kind) if default_unit else 1.0)
+    m = re.fullmatch(r"\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*([A-Za-zµ]*)\s*", str(text))
+    if not m:
+        raise ValueError(f"cannot read {text!r} as a {kind} (e.g. 0.3mm)")
+    value, unit = float(m.group(1)), m.group(2)
+    if unit:
+        return value * unit_factor(unit, kind)
+    return value * (unit_factor(default_unit, kind) if default_unit else 1.0)
+
+
+def beta_from_thickness(H: float, R_L: float) -> float:
+    """``beta = (H/R_L)^2/12`` (linear elasticity, incompressible)."""
+    for name, v in (("H", H), ("R_L", R_L)):
+        if not (math.isfinite(v) and v > 0):
+            raise ValueError(f"{name} must be a finite length > 0; got {v!r}")
+    return (H / R_L) ** 2 / 12
+
+
+@dataclass(frozen=True)
+class Dimensions:
+    """Rim radius ``R_L`` (m) and ``mu_H`` (N/m) of an experiment."""
+
+    R_L: float
+    mu_H: float = 1.0
+
+    def __post_init__(self):
+        for name in ("R_L", "mu_H"):
+            v = getattr(self, name)
+            if not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
+                raise ValueError(f"{name} must be a finite number > 0; got {v!r}")
+
+    def displacement(self, delta):
+        """Nondimensional delta -> metres."""
+        return self.R_L * delta
+
+    def force(self, F):
+        """Nondimensional F -> newtons."""
+        return self.mu_H * self.R_L * F
+
+    def delta(self, displacement):
+        """Metres -> nondimensional delta."""
+        return displacement / self.R_L
+
+    def F(self, force):
+        """Newtons -> nondimensional F."""
+        return force / (self.mu_H * self.R_L)
