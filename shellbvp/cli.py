@@ -3,6 +3,7 @@
     shellbvp curve [--preset base] [scene options] [-o base.h5]   force-displacement curve -> HDF5
     shellbvp solve [scene options] --delta 0.2 [--profiles] [--json]   one state
     shellbvp fit DATA.csv --radius 0.3mm [--units mm,mN] [--json]   mu*H from measured data
+    shellbvp plot A.h5 [B.h5 ...] -o fig.png [--profiles 0.1,0.3]   figures (matplotlib)
     shellbvp info FILE.h5                                            what a curve file holds
     shellbvp presets                                                 the built-in scenes
 
@@ -192,6 +193,27 @@ def _cmd_fit(args):
     return 0 if res.success else 1
 
 
+def _cmd_plot(args):
+    from .io import read_curve
+    from .plotting import plot_curves, plot_profiles, require_matplotlib
+
+    plt = require_matplotlib()
+    curves = [read_curve(f) for f in args.files]
+    deltas = [float(v) for v in args.profiles.split(",")] if args.profiles else []
+    ncol = 2 if deltas else 1
+    fig, axes = plt.subplots(1, ncol, figsize=(6 * ncol, 4.8), squeeze=False)
+    plot_curves(curves, ax=axes[0, 0])
+    if deltas:
+        for d in deltas:
+            if not d > 0:
+                raise ValueError(f"--profiles depths must be > 0; got {d}")
+        plot_profiles(curves[0].scene, deltas, ax=axes[0, 1])
+    fig.tight_layout()
+    fig.savefig(args.output, dpi=args.dpi)
+    print(f"wrote {args.output}")
+    return 0
+
+
 def _cmd_info(args):
     import numpy as np
 
@@ -264,6 +286,12 @@ def build_parser():
     f.add_argument("-o", "--output", help="write the fitted model curve (HDF5, with SI columns)")
     f.add_argument("--force", action="store_true", help="replace an existing output file")
     f.set_defaults(func=_cmd_fit)
+    pl = sub.add_parser("plot", help="plot curves (and profiles) from HDF5 files (needs matplotlib)")
+    pl.add_argument("files", nargs="+", help="curve files written by `shellbvp curve`")
+    pl.add_argument("-o", "--output", default="curves.png", help="PNG or PDF (default curves.png)")
+    pl.add_argument("--profiles", help="also draw the deformed shell of the first file at these depths, e.g. 0.1,0.3")
+    pl.add_argument("--dpi", type=int, default=150)
+    pl.set_defaults(func=_cmd_plot)
     i = sub.add_parser("info", help="describe a curve file")
     i.add_argument("file")
     i.set_defaults(func=_cmd_info)

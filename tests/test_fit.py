@@ -108,3 +108,24 @@ def test_fit_cli_with_csv(model, tmp_path):
     out = json.loads(r.stdout)
     assert abs(out["mu_H"] - MU_H) < 0.02 * MU_H and out["mu_H_ci95"][0] < out["mu_H"] < out["mu_H_ci95"][1]
     assert sb.read_curve(tmp_path / "fit.h5").scene == sb.Scene.preset("fit")
+
+
+def test_plots_headless_produce_png(model, tmp_path):
+    pytest.importorskip("matplotlib")
+    from shellbvp.plotting import plot_fit, require_matplotlib
+
+    scene, c = model
+    c.to_hdf5(tmp_path / "m.h5")
+    out = tmp_path / "fig.png"
+    r = subprocess.run([sys.executable, "-m", "shellbvp", "plot", str(tmp_path / "m.h5"), "-o", str(out),
+                        "--profiles", "0.1,0.3"], capture_output=True, text=True, env=dict(os.environ),
+                       timeout=600)
+    assert r.returncode == 0, r.stderr
+    assert out.stat().st_size > 10_000 and out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    disp, force = synthetic(model, 30, seed=9)
+    res = sb.fit(scene, disp, force, R_L=R_L)
+    plt = require_matplotlib()
+    ax = plot_fit(res, disp, force)
+    ax.figure.savefig(tmp_path / "fit.png")
+    plt.close("all")
+    assert (tmp_path / "fit.png").stat().st_size > 10_000
