@@ -261,8 +261,14 @@ def _solve_at_delta(scene, delta, prev, prev2, settings):
     if prev2 is not None and prev2.delta != prev.delta:
         a = (delta - prev.delta) / (prev.delta - prev2.delta)
         guess = _secant(sysm, prev, prev2, a)
-    return solve_from(sysm, guess, tol=settings["tol"], max_nodes=settings["max_nodes"],
+    return solve_from(sysm, guess, tol=settings["tol"], max_nodes=_step_nodes(prev, settings),
                       bc_tol=settings["bc_tol"])
+
+
+def _step_nodes(prev, settings):
+    """Node budget of one continuation step: a few times the previous mesh, so that a
+    step towards a singularity (e.g. a boundary layer forming) fails fast and is halved."""
+    return int(min(settings["max_nodes"], max(2000, 4 * prev.nodes)))
 
 
 def _secant(sysm, cur, prev, a):
@@ -341,7 +347,7 @@ def _adaptive(scene, builder: _Builder, settings):
             raise _Stop(f"no second point near delta = {first.delta:g}: {below.message}")
     prev = below
     ds = min(st["ds_max"], 2 * np.linalg.norm((_X(cur) - _X(prev)) / scale))
-    ds_min = 1e-7
+    ds_min = 1e-4  # in (delta, lambda0, F): below this the branch is taken to end here
     tangent = None
     while True:
         if steps >= st["max_steps"]:
@@ -373,7 +379,7 @@ def _adaptive(scene, builder: _Builder, settings):
         sysm = make_system(scene, "arclength", (Xhat, tangent, scale), st["eps"])
         a = ds / max(norm, 1e-300)
         guess = _secant(sysm, cur, prev, a)
-        sol = solve_from(sysm, guess, tol=st["tol"], max_nodes=st["max_nodes"], bc_tol=st["bc_tol"])
+        sol = solve_from(sysm, guess, tol=st["tol"], max_nodes=_step_nodes(cur, st), bc_tol=st["bc_tol"])
         steps += 1
         if sol.success and sol.delta > 0:
             builder.add(sol, steps)
