@@ -34,7 +34,7 @@ log = logging.getLogger(__name__)
 POINT_FIELDS = (
     "delta", "force", "lambda0", "Sc", "status", "valid", "max_residual", "nodes", "niter",
     "force_error", "delta_error", "energy", "ring_force", "cap_force", "pressure_min",
-    "penetration", "force_defect", "wall_time",
+    "penetration", "force_defect", "edge_legendre", "wall_time",
 )
 
 
@@ -398,4 +398,9 @@ def _adaptive(scene, builder: _Builder, settings):
             ds /= 2
             if ds < ds_min:
                 reason = sol.message if not sol.success else "the branch turned back to delta <= 0"
+                leg = cur.get("edge_legendre", float("nan"))
+                if leg < 0.05:
+                    reason = (f"the energy loses convexity at the contact edge (Legendre determinant at Sc+ "
+                              f"down to {leg:.2g} of its mid-region value): the free region's equations "
+                              f"become singular there and the smooth single-cap branch ends ({reason})")
                 raise _Stop(f"continuation failed near delta = {cur.delta:.6g}: {reason}")

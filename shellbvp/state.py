@@ -62,6 +62,9 @@ class Solution(dict):
         ``force = ring_force + cap_force``.  For ``contact="paper"`` the ring force is ~0.
     pressure_min : float
         Minimum contact pressure over the cap (< 0: the shell would pull the indenter).
+    edge_legendre : float
+        det d(tau_s, M_s)/d(lambda_s, kappa_s) at Sc+ relative to mid-region; it goes to 0
+        where the energy loses convexity at the contact edge and the branch ends.
     penetration : float
         Largest height of the free shell above the indenter's surface (> 0: it passes
         through the indenter).
@@ -246,6 +249,11 @@ def _diagnose(sysm: MultipointBVP, bvp, tol):
     pc = mod.contact_profile(sysm.S_contact(t, ln_Sc), y[:N_CONTACT], par)
     pf = mod.free_profile(sysm.S_free(t, ln_Sc), y[N_CONTACT:], par)
     res.force_defect = float(np.max(np.abs(2 * np.pi * pf["axial_force_2pi"] - force)))
+    # Legendre condition at the contact edge relative to mid-region: -> 0 where the smooth
+    # branch ends (the free equations become singular at Sc+).
+    leg = mod.free_legendre(sysm.S_free(np.array([0.0, 0.5]), ln_Sc), bvp.sol(np.array([0.0, 0.5]))[N_CONTACT:],
+                            par)[0]
+    res.edge_legendre = float(leg[0] / leg[1]) if leg[1] != 0 else float("nan")
     res.pressure_min = float(np.min(pc["P"]))
     res.penetration = _penetration(sysm, pf["r"], pf["z"], res.z_tip)
     res.energy = 2 * np.pi * (_integrate(sysm, bvp, ln_Sc, "contact") + _integrate(sysm, bvp, ln_Sc, "free")

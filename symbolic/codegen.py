@@ -153,6 +153,13 @@ def function_specs(d: Derivation) -> list[FunctionSpec]:
             FunctionSpec(f"{region}_profile", prog, args, [("out", profile)],
                          f"{region} region: physical fields at the nodes (dict of arrays).", "S"),
         ]
+    # Legendre condition of the free region: det of the (lambda_s', kappa_s') system
+    r_ = sp.Symbol("r")
+    legendre = [d.free.let("legendre", sp.Symbol("det") / r_**2)]
+    specs.append(FunctionSpec("free_legendre", d.free, [("S", (d.free.inputs[0],)), ("y", d.free_states),
+                                                        ("par", par)], [("out", legendre)],
+                              "det d(tau_s, M_s)/d(lambda_s, kappa_s) over the free region, (1, m): "
+                              "the ODE is singular where it vanishes (loss of convexity of U)", "S"))
     # pole
     chi, ls = d.pole_states
     pargs = [("chi", (chi,)), ("ls", (ls,)), ("lambda0", (LAMBDA0,)), ("par", par)]

@@ -320,3 +320,15 @@ def test_bad_scene_names_the_parameter(kwargs, match):
         sb.Scene.preset("base", **kwargs)
     with pytest.raises(ValueError, match="preset"):
         sb.Scene.preset("nonesuch")
+
+
+def test_smooth_branch_end_is_detected_by_the_legendre_determinant(base):
+    """On the base scene the determinant of the free region's (lambda_s', kappa_s') system at
+    Sc+ falls to zero near delta = 0.6145: U loses convexity at the contact edge and the
+    smooth single-cap branch ends (README, known limits)."""
+    s = sb.solve(base, delta=0.3, estimate_error=False)
+    assert s.edge_legendre > 0.3
+    for d in (0.5, 0.58, 0.6, 0.61, 0.614):
+        s = sb.solve(base, delta=d, guess=s, estimate_error=False)
+        assert s.success
+    assert 0 < s.edge_legendre < 2e-3
