@@ -176,7 +176,12 @@ def _cmd_fit(args):
     columns = [c.strip() for c in args.columns.split(",")] if args.columns else None
     if columns is not None and len(columns) != 2:
         raise ValueError(f"--columns must name two columns (displacement, force); got {args.columns!r}")
-    disp, force = sb.read_force_csv(args.data, columns=columns, units=units)
+    if args.example == (args.data is not None):
+        raise ValueError("give a CSV file or --example (one of them)")
+    from .fitting import example_data_path
+
+    data = example_data_path() if args.example else args.data
+    disp, force = sb.read_force_csv(data, columns=columns, units=units)
     res = sb.fit(scene, disp, force, R_L=R_L, fit_offset=not args.no_offset, tol=args.tol)
     out = res.to_dict()
     if args.json:
@@ -276,7 +281,9 @@ def build_parser():
     s.add_argument("--json", action="store_true", help="print JSON")
     s.set_defaults(func=_cmd_solve)
     f = sub.add_parser("fit", help="fit mu*H (and the contact point) to measured force-displacement data")
-    f.add_argument("data", help="CSV file: displacement and force columns")
+    f.add_argument("data", nargs="?", help="CSV file: displacement and force columns")
+    f.add_argument("--example", action="store_true",
+                   help="use the synthetic Lepidium-like data shipped with shellbvp (README)")
     _scene_options(f)
     f.add_argument("--radius", required=True, help="rim radius R_L of the sample, e.g. 0.3mm")
     f.add_argument("--columns", help="displacement,force columns by name or 0-based index (default 0,1)")

@@ -22,7 +22,14 @@ from scipy.interpolate import PchipInterpolator
 
 from .units import unit_factor
 
-__all__ = ["FitResult", "fit", "read_force_csv"]
+__all__ = ["FitResult", "fit", "read_force_csv", "example_data_path"]
+
+
+def example_data_path():
+    """Path of the synthetic Lepidium-like CSV shipped with the package (README example)."""
+    from pathlib import Path
+
+    return Path(__file__).parent / "data" / "lepidium_synthetic.csv"
 
 
 @dataclass

@@ -129,3 +129,12 @@ def test_plots_headless_produce_png(model, tmp_path):
     ax.figure.savefig(tmp_path / "fit.png")
     plt.close("all")
     assert (tmp_path / "fit.png").stat().st_size > 10_000
+
+
+def test_fit_example_shipped_with_the_package():
+    r = subprocess.run([sys.executable, "-m", "shellbvp", "fit", "--example", "--preset", "fit", "--radius",
+                        "0.3mm", "--json"], capture_output=True, text=True, env=dict(os.environ), timeout=600)
+    assert r.returncode == 0, r.stderr
+    out = json.loads(r.stdout)
+    assert out["mu_H_ci95"][0] < 52.0 < out["mu_H_ci95"][1]
+    assert abs(out["offset"] - 10e-6) < 1e-6
