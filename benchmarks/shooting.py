@@ -2,7 +2,7 @@ r"""Shooting: the paper's own method, as an independent peer for the benchmarks.
 
 This re-solves the indentation problem with ``lambda0`` (the pole stretch)
 prescribed, the way the paper did (its section 3), and shares nothing with
-``shellbvp``'s collocation machinery (``shellbvp.system`` / ``shellbvp.solve``)
+``shellbvp``'s collocation machinery (``shellbvp.system`` / ``shellbvp.state``)
 except the generated equations: the right-hand sides ``g = S dy/dS`` of both
 regions, their Jacobians and the pole, contact-line and rim conditions.
 
@@ -10,38 +10,62 @@ Method, for one lambda0
 -----------------------
 1. Contact region (on the tip), states ``(chi, ls)``: start at ``S = zeta =
    eps*Sc`` from the leading term of the pole series (``chi = c*lambda0``,
-   ``ls = lambda0``; truncation error O(eps^2) relative) and integrate to Sc in
-   ``tau = ln(S/Sc)`` (``dy/dtau = g``).
+   ``ls = lambda0``, ``c = -pole_res(0, 0, 1)``; truncation error O(eps^2)
+   relative) and integrate to Sc in ``tau = ln(S/Sc)`` (``dy/dtau = g``).
 2. Contact line: the free region's start ``yf(Sc+)`` (states ``lt, phiS, ls,
    ks, rQ, z``) has one free component ``u`` -- ``rQ`` for ``contact="smooth"``
    (r, phi, z, lambda_s, kappa_s continuous; Q jumps), ``ks`` for
    ``contact="paper"`` (r, phi, z, Q continuous; lambda_s from [tau_s] = 0).
-   The other five follow from the generated junction residual (5 equations),
-   solved by Newton with its analytic Jacobian (linear rows converge in one
-   step; the paper's [tau_s] = 0 row for ``ls_f`` starts from the contact
-   value).  ``delta = 0`` there, i.e. ``z`` is measured with the tip at
-   ``z_tip = Z(0)``; delta then follows from ``z(L) = 0``.
+   The other five solve the generated junction residual (5 equations) by
+   Newton with its analytic Jacobian (the linear rows converge in one step;
+   the paper's [tau_s] = 0 row for ``ls_f`` starts from the contact value).
+   ``delta = 0`` there, i.e. ``z`` is measured with the tip at ``z_tip = Z(0)``;
+   delta then follows from ``z(L) = 0``.
 3. Free region: integrate from Sc to L in ``tau = ln(S/Sc)/ln(L/Sc)`` (so the
-   interval is [0, 1] whatever Sc).
-4. Newton on the two unknowns ``x = (ln Sc, u)`` for the rim conditions
-   ``lambda_theta(L) = 1`` and ``M_s(L) = 0`` (``rim_res`` rows 0, 1).  The
-   Jacobian is exact: the variational equations are integrated with both
-   regions (dy/d ln Sc in the contact region, d/d(ln Sc, u) in the free
-   region, including the moving start of the free interval), using the
-   generated ``*_jac``.  Steps are damped (backtracking on the residual norm,
-   ``|d ln Sc| <= 0.5``), trial states that leave the tip, blow up or fail to
-   integrate are rejected.
-5. ``delta = z(L)`` (the pole moved by delta) and ``F = 2 pi G`` with
-   ``G = r sin(phi) tau_s - r cos(phi) Q`` at the rim (``free_profile``'s
-   ``axial_force_2pi``; it is a first integral, so its drift between Sc+ and L
-   is reported as an error indicator, ``force_defect``).
+   interval is [0, 1] whatever Sc).  ``solve_ivp`` with 'DOP853' by default:
+   in ln S the system is not stiff for moderate beta (eigenvalues of dg/dy are
+   O(1..10) on the base scene), but it has growing, oscillating modes.
+4. Newton on ``x = (ln Sc, u)`` for the rim conditions ``lambda_theta(L) = 1``,
+   ``M_s(L) = 0`` (``rim_res`` rows 0, 1).  Jacobian: exact, from the
+   variational equations integrated alongside (d/d(ln Sc, u, lambda0) through
+   both regions and the junction, including the moving start of the free
+   interval; generated ``*_jac``), or Broyden updates of it
+   (``jacobian="broyden"``).  Steps are damped (backtracking,
+   ``|d ln Sc| <= 0.5``); trial states that leave the tip, become singular or
+   fail to integrate within a budget are rejected.
+5. ``delta = z(L)`` and ``F = 2 pi G``, ``G = r sin(phi) tau_s - r cos(phi) Q``
+   at the rim (``free_profile``'s ``axial_force_2pi``; a first integral, so its
+   drift between Sc+ and L is reported, ``force_defect``).  States with
+   delta < 0 (the spurious "collapsed" branch) are reported as failures.
+
+Continuation in lambda0 (:func:`shoot_curve`) uses the exact tangent
+``d(ln Sc, u)/d lambda0 = -J_x^{-1} J_lambda0`` as predictor.  Without a guess,
+:func:`shoot_state` uses a homotopy in beta (see ``_cold_start``): crude
+guesses essentially never converge (see below).
+
+What shooting meets (measured on the base preset; benchmarks/results/shooting.md)
+----------------------------------------------------------------------------------
+* The shooting map is extremely sensitive: d M_s(L)/d rQ(Sc+) ~ 8600 (smooth,
+  lambda0 = 1.05); Newton's basin is ~1e-3 relative in u.  Warm starts from the
+  neighbour at d lambda0 = 0.01 *without* a predictor fail (smooth: 0/3; paper:
+  1/3, the others end on the collapsed branch or cannot be integrated); with
+  the tangent predictor all converge in 3-6 iterations.
+* Poor guesses make the trajectory singular (lambda_s -> infinity where the
+  2x2 system for (lambda_s', kappa_s') degenerates, or r -> 0); the step size of
+  the integrator collapses -- hence a guard event and an evaluation budget.
+* The growing modes amplify integration errors: delta errs by up to ~100-1000
+  rtol (the rim conditions are enforced, the other outputs inherit the error).
+* Small beta: ||dres/dx|| grows like exp(c/sqrt(beta)): 5e5 at beta = 3e-3,
+  3e8 at 1e-3, 5e12 at 3e-4, 1e13-1e16 at 1e-4.  From beta <= 3e-4 shooting
+  fails even when started at the exact (collocation) answer (the residual
+  there is O(1..100) at rtol 1e-10) -- the paper's "singular perturbation".
 
 No exception is raised for non-convergence: ``success``, ``status`` and
 ``message`` say what happened.
 
 Run as a script to validate against ``sb.solve`` and time both::
 
-    python benchmarks/shooting.py [--out benchmarks/results/shooting.json]
+    python benchmarks/shooting.py [--quick] [--out benchmarks/results/shooting.json]
 """
 
 from __future__ import annotations
@@ -383,9 +407,13 @@ class Shooter:
         Returns (status, niter, info) with info = the last shoot() result (None if the
         guess itself could not be integrated).  Convergence: a (full) step below ``xtol``
         (default 10 rtol, relative to 1 + |x|) -- that last step is taken, with a
-        states-only shoot, so the result errs by O(step^2) -- or a step predicted below
-        xtol from observed quadratic convergence (Newton), or, at the integrator's noise
-        floor where no step reduces the residual, a step below 1e3 rtol.
+        states-only shoot, so the result errs by O(step^2) -- or, at the integrator's
+        noise floor where exact-Jacobian steps stop shrinking, a step below 100 rtol.
+        Steps smaller than 1e-4 (relative) with an exact Jacobian are taken in full; larger
+        ones are damped until the residual decreases.  (The
+        outputs are sensitive: on the base scene d delta / d rQ(Sc+) ~ 150, so a
+        looser test on x, e.g. a step predicted from quadratic convergence, left
+        delta errors of 2e-5 at rtol 1e-8.)
         """
         xtol = 10 * self.rtol if xtol is None else xtol
         free = list(free)
@@ -399,8 +427,8 @@ class Shooter:
             cur, fresh = self.shoot(x0), True
         if cur is None:
             return 3, 0, None
-        prev_size = None
         it = 0
+        prev_near, prev_floor = None, False
         while it < max_iter:
             it += 1
             res, J, x = cur["res"], cur["J"], cur["x"]
@@ -422,23 +450,27 @@ class Shooter:
             if self.trace:
                 print(f"  {'broyden' if broyden else 'newton'} {it}: |res| {nrm:.2e} |dx| {size:.2e} "
                       f"nfev {self.nfev}{' (fresh J)' if fresh else ''}")
-            small = size <= xtol
-            if small or (not broyden and prev_size is not None and size < prev_size
-                         and size ** 3 / prev_size ** 2 <= xtol):
-                # last step: states only (its error is O(size^2)); at the noise floor the
-                # residual need not decrease any more
+            near = fresh and size <= _NEAR
+            floor = near and prev_near is not None and size > 0.5 * prev_near
+            if size <= xtol or (floor and size <= 100 * self.rtol):
+                # last step: states only (its error is O(size^2)); at the integrator's
+                # noise floor (steps no longer shrink) the residual need not decrease
                 final = self.shoot(x + dx, sens=False)
-                if final is not None and (small or np.max(np.abs(final["res"])) < nrm):
+                if final is not None:
                     final["J"] = J
                     return 0, it, final
-                if small:
-                    return 0, it, cur
+                return 0, it, cur
+            if floor and prev_floor:
+                return 2, it, cur
+            prev_near, prev_floor = (size if near else None), floor
             scale = min(1.0, 0.5 / max(abs(dx[0]), 1e-300), 0.2 / max(abs(dx[2]), 1e-300))
             dx *= scale
             lam, accepted = 1.0, None
             while lam >= (1.0 / 64 if fresh else 0.25):
                 trial = self.shoot(x + lam * dx, sens=not broyden)
-                if trial is not None and np.max(np.abs(trial["res"])) < (1 - 0.1 * lam) * nrm:
+                # close to the solution with an exact Jacobian: full steps (the residual
+                # is dominated by integration noise there, a decrease test would stall)
+                if trial is not None and (near or np.max(np.abs(trial["res"])) < (1 - 0.1 * lam) * nrm):
                     accepted = trial
                     break
                 lam *= 0.5
@@ -448,7 +480,7 @@ class Shooter:
                     if cur is None:
                         return 3, it, None
                     continue
-                return (0 if size <= 1e3 * self.rtol else 2), it, cur
+                return 2, it, cur
             if broyden:
                 if np.max(np.abs(accepted["res"])) > 0.5 * nrm:
                     # slow progress: the secant Jacobian has drifted; take an exact one
@@ -462,7 +494,6 @@ class Shooter:
                     Jn[:, free] += np.outer(accepted["res"] - res - J @ step, sf) / (sf @ sf)
                     accepted["J"], fresh = Jn, False
             cur = accepted
-            prev_size = size if lam == 1.0 and scale == 1.0 else None
         return 1, max_iter, cur
 
     def _refresh(self, cur):
@@ -520,8 +551,8 @@ class Shooter:
             pred = info["x"][:2] + h * self.tangent(info)
             status, it, new = self.newton(np.r_[pred, nxt], (0, 1), J0=info["J"])
             niter += it
-            if status == 0 and new["yL"][5] < 0 <= info["yL"][5]:
-                status = 2  # jumped to a spurious collapsed branch (delta < 0): smaller step
+            if status == 0 and _jumped(info, new, np.r_[pred, nxt]):
+                status = 2  # left the branch (e.g. to a collapsed state): smaller step
             if status == 0:
                 info, lam = new, nxt
                 if it <= 3:
@@ -531,6 +562,18 @@ class Shooter:
                 if abs(h) < 1e-6:
                     return 2, niter, info
         return 1, niter, info
+
+
+def _jumped(old, new, pred):
+    """Did a continuation step leave the branch?  The corrector went far from the
+    predictor (|d ln Sc| > 0.2 or |d lambda0| > 0.05, or u by more than 20 %), or delta
+    turned negative (the spurious "collapsed" states of SPEC section 3)."""
+    d = np.abs(new["x"] - pred)
+    return bool(d[0] > 0.2 or d[2] > 0.05 or d[1] > 0.2 * (abs(old["x"][1]) + 0.05)
+                or new["yL"][5] < 0 <= old["yL"][5])
+
+
+_NEAR = 1e-4  # relative Newton step below which exact-Jacobian steps are taken in full
 
 
 def _block_jac(J, factor, ncols):
@@ -592,6 +635,8 @@ def _cold_start(sh, lambda0, beta_start=1.0, loose_rtol=1e-6, verbose=False):
         lo.beta = math.exp(nb)
         status, it, new = lo.newton(x, (1, 2))
         niter += it
+        if status == 0 and _jumped(info, new, x):
+            status = 2
         if status == 0:
             prev, info, lb = (lb, info["x"]), new, nb
             if verbose:
@@ -774,6 +819,29 @@ def _table(rows):
     return "\n".join(lines)
 
 
+def _summary(rows):
+    """One line per (contact, solver, tol): all converged?, max errors, median time per state."""
+    groups = {}
+    for r in rows:
+        if "dF" in r or r["solver"].startswith("shooting-") and r["solver"] != "shooting-cold":
+            groups.setdefault((r["contact"], r["solver"], r["tol"]), []).append(r)
+    lines = ["| contact | solver | tol | converged | max abs err F | max abs err delta | median s/state |",
+             "|---|---|---|---|---|---|---|"]
+    for (contact, solver, tol), rs in groups.items():
+        ok = [r for r in rs if r.get("success")]
+        errF = max((r["dF"] for r in ok), default=math.nan)
+        errd = max((r["ddelta"] for r in ok), default=math.nan)
+        med = float(np.median([r["time"] for r in rs if "time" in r])) if rs else math.nan
+        lines.append(f"| {contact} | {solver} | {tol:.0e} | {len(ok)}/{len(rs)} | {errF:.1e} | "
+                     f"{errd:.1e} | {med:.3f} |")
+    for r in rows:
+        if r["solver"] == "shooting-cold":
+            lines.append(f"\nShooting cold start ({r['contact']}, lambda0 = {r['lambda0']:g}, rtol "
+                         f"{r['tol']:.0e}): {r['time']:.1f} s, {r['nfev']} RHS evaluations "
+                         f"({r['message']}).")
+    return "\n".join(lines)
+
+
 def main(argv=None):
     import argparse
     import json
@@ -788,7 +856,7 @@ def main(argv=None):
     if args.quick:
         kw.update(rtols=(1e-6, 1e-9), tols=(1e-4, 1e-7), repeat=1)
     rows = _validate(log=lambda m: print(m, file=sys.stderr, flush=True), **kw)
-    table = _table(rows)
+    table = _summary(rows) + "\n\n" + _table(rows)
     print(table)
     if args.out:
         with open(args.out, "w") as fh:

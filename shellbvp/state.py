@@ -576,7 +576,8 @@ def _continue_in_delta(scene, eps, target, starts=(0.1, 0.05), **kw):
 def _failure(status, message):
     nan = float("nan")
     return Solution(status=status, message=message, success=False, valid=False, flags=[],
-                    delta=nan, force=nan, lambda0=nan, Sc=nan, nodes=0, niter=0, wall_time=nan)
+                    delta=nan, force=nan, lambda0=nan, Sc=nan, nodes=0, niter=0, wall_time=nan,
+                    x=np.empty(0), y=np.empty((8, 0)), p=np.full(2, nan), topology="cap")
 
 
 _MARCH_DELTA_MAX = 1.0  # pole displacement of a rim radius: beyond any indentation test
