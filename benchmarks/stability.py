@@ -17,7 +17,7 @@ and the energy-identity residual max |dE/ddelta - F|.
 
 Writes benchmarks/results/stability.json and benchmarks/results/stability.md.
 
-    python benchmarks/stability.py            # full grid (about an hour or more)
+    python benchmarks/stability.py            # full grid (about 30 min on 2 shared cores)
     python benchmarks/stability.py --quick    # a few scenes, small delta_max, for smoke tests
     python benchmarks/stability.py --only 'beta=1e-05' --contact smooth   # a subset (regex on the id)
 """
@@ -81,6 +81,47 @@ def make_scene(spec):
 
 # -- worker: one curve in this process -----------------------------------------------------
 
+def free_det(sol):
+    """det d(tau_s, M_s)/d(lambda_s, kappa_s) over the free region's mesh (at fixed S, r, phi).
+
+    The free-region ODE solves a 2x2 linear system with exactly this matrix for
+    (lambda_s', kappa_s') (symbolic/equations.py): where it is singular the
+    equations are.  Central differences of the generated ``free_profile``.
+    Returns (value at S = Sc+, minimum over the free mesh, S/Sc at the minimum).
+    """
+    import numpy as np
+
+    from shellbvp.system import N_CONTACT
+
+    sysm = sol["system"]
+    mod, par = sysm.model, sysm.par
+    S = sysm.S_free(sol.x, sol.p[0])
+    y = sol.y[N_CONTACT:]
+    cols = [mod.FREE_STATES.index("ls"), mod.FREE_STATES.index("ks")]
+    J = np.zeros((2, 2, S.size))
+    for j, k in enumerate(cols):
+        h = 1e-6 * np.maximum(1.0, np.abs(y[k]))
+        yp, ym = y.copy(), y.copy()
+        yp[k] += h
+        ym[k] -= h
+        pp, pm = mod.free_profile(S, yp, par), mod.free_profile(S, ym, par)
+        J[0, j] = (pp["tau_s"] - pm["tau_s"]) / (2 * h)
+        J[1, j] = (pp["M_s"] - pm["M_s"]) / (2 * h)
+    det = J[0, 0] * J[1, 1] - J[0, 1] * J[1, 0]
+    i = int(np.argmin(det))
+    return float(det[0]), float(det[i]), float(S[i] / sol.Sc)
+
+
+def gent_ratio(sol, Jm):
+    """max (I1 - 3)/Jm over the shell (Gent's limiting stretch at 1)."""
+    import numpy as np
+
+    p = sol.profile()
+    ls, lt = p["lambda_s"], p["lambda_theta"]
+    I1 = ls ** 2 + lt ** 2 + 1 / (ls * lt) ** 2
+    return float(np.nanmax(I1 - 3) / Jm)
+
+
 def worker(spec_path, out_path):
     import numpy as np
 
@@ -102,15 +143,22 @@ def worker(spec_path, out_path):
     def alarm(signum, frame):
         raise KeyboardInterrupt
 
+    accepted = []
+
+    def callback(curve_so_far, sol):
+        accepted.append(time.perf_counter())
+
     signal.signal(signal.SIGALRM, alarm)
     signal.setitimer(signal.ITIMER_REAL, spec["time_limit"])
     t0 = time.perf_counter()
     try:
         c = sb.curve(scene, delta_max=spec["delta_max"], delta_min=spec["delta_min"],
-                     estimate_error=True)
+                     estimate_error=True, callback=callback)
     finally:
         signal.setitimer(signal.ITIMER_REAL, 0)
     wall = time.perf_counter() - t0
+    # seconds spent after the last accepted point (failed attempts before the stop)
+    row["stall_s"] = wall - (accepted[-1] - t0) if accepted else wall
 
     n = len(c)
     p = c.points
@@ -139,7 +187,48 @@ def worker(spec_path, out_path):
                     "ring_force", "wall_time")} | {"valid": [bool(v) for v in p["valid"]],
                                                    "flags": list(c.flags)},
         )
+        # Diagnostics of the first and the last point of the branch (in delta).
+        # (point-load states, topology "point", have no contact region: no cap angle, no Sc+)
+        sols = c.solutions
+        cap = lambda s: s.get("topology", "cap") != "point"  # noqa: E731
+        row["point_load_points"] = int(sum(not cap(s) for s in sols))
+        row["curve"]["topology"] = [s.get("topology", "cap") for s in sols]
+        if "edge_legendre" in p:
+            row["curve"]["edge_legendre"] = [float(v) for v in p["edge_legendre"]]
+        omega_c = [float(s.Sc * s.y[0, -1] / scene.rho) if cap(s) else 0.0 for s in sols]
+        row["curve"]["omega_c"] = omega_c
+        last = sols[int(np.argmax(d))]
+        row["omega_c_last_frac"] = omega_c[int(np.argmax(d))] / scene.tip_omega_max
+        caps = [i for i in np.argsort(d) if cap(sols[i])]
+        if caps and cap(last):
+            with np.errstate(all="ignore"):
+                d0 = free_det(sols[caps[0]])
+                d1 = free_det(last)
+            row.update(det_first=d0[0], det_last=d1[0], det_last_min=d1[1], det_last_min_at=d1[2])
+        if spec["overrides"].get("material", ("",))[0] == "gent":
+            with np.errstate(all="ignore"):
+                row["gent_ratio_last"] = gent_ratio(last, spec["overrides"]["material"][1])
+        row["diagnosis"] = diagnose(row)
     Path(out_path).write_text(json.dumps(row, default=float))
+
+
+def diagnose(r):
+    """What the last point shows (automatic; the report's analysis goes further)."""
+    out = []
+    if "det_first" not in r:
+        pass
+    elif r["det_first"] > 0 and r["det_last"] < 0.05 * r["det_first"]:
+        out.append(f"free ODE singular at Sc+: det d(tau_s,M_s)/d(ls,ks) = {r['det_last']:.1e} "
+                   f"({r['det_last'] / r['det_first']:.1e} x its small-delta value)")
+    elif r["det_first"] > 0 and r["det_last_min"] < 0.05 * r["det_first"]:
+        out.append(f"free ODE nearly singular at S = {r['det_last_min_at']:.3g} Sc (det {r['det_last_min']:.1e})")
+    if r.get("gent_ratio_last", 0) > 0.95:
+        out.append(f"Gent limit: max (I1-3)/Jm = {r['gent_ratio_last']:.4f} (F -> infinity)")
+    if r["omega_c_last_frac"] > 0.95:
+        out.append(f"contact at omega_c = {r['omega_c_last_frac']:.4f} x the tip's end (cylinder)")
+    if r.get("stall_s", 0) > 20:
+        out.append(f"{r['stall_s']:.0f} s spent after the last accepted point")
+    return "; ".join(out)
 
 
 # -- driver ---------------------------------------------------------------------------
@@ -176,6 +265,9 @@ def short_reason(r):
     if r.get("interrupted"):
         return f"time limit ({r['time_limit']:.0f} s)"
     s = r["stop_reason"]
+    if "end of the tip" in s and "inadmissible" in s:
+        m = re.match(r"continuation failed near delta = ([-\d.e+]+)", s)
+        return f"failed at delta {float(m.group(1)):.4g}: contact passed the cylinder (no landing)"
     if "end of the tip" in s:
         return "contact reached the cylinder"
     if s.startswith("delta_max"):
@@ -183,6 +275,8 @@ def short_reason(r):
     m = re.match(r"continuation failed near delta = ([-\d.e+]+): (.*)", s)
     if m:
         msg = m.group(2)
+        if "loses convexity" in msg:
+            return f"branch ends at delta {float(m.group(1)):.4g}: loss of convexity at Sc+ (solver's diagnosis)"
         for key, short in (("mesh nodes", "max nodes"), ("singular Jacobian", "singular Jacobian"),
                            ("boundary conditions", "bc not met"), ("turned back", "turned back to delta <= 0"),
                            ("inadmissible", "inadmissible")):
@@ -210,25 +304,40 @@ def markdown(rows, meta):
         f"time limit {meta['time_limit']:.0f} s per curve; total {meta['total_s']:.0f} s.",
         "",
         "| scene | contact | delta reached | max F | stopped | complete | points | max nodes | time (s) "
-        "| max F error | min P | invalid | F < 0 at delta | max \\|dE/dδ − F\\| |",
-        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|",
+        "| max F error | min P | invalid | F < 0 at delta | max \\|dE/dδ − F\\| | at the last point |",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     for r in rows:
         if r.get("skipped"):
-            lines.append(f"| {r['id']} | {r['contact']} | skipped: {r['skipped'][:50]} |" + " |" * 11)
+            lines.append(f"| {r['id']} | {r['contact']} | skipped: {r['skipped'][:50]} |" + " |" * 12)
             continue
         if not r.get("points"):
             lines.append(f"| {r['id']} | {r['contact']} | — | | {short_reason(r)} | no | 0 | | "
-                         f"{r['wall_time']:.1f} | | | | | |")
+                         f"{r['wall_time']:.1f} | | | | | | |")
             continue
         neg = ("" if not r["F_negative"] else
                f"{r['F_negative_delta'][0]:.3g}–{r['F_negative_delta'][1]:.3g}")
-        fe = g(r["force_error_max"], ".1e") + (f" ({r['force_error_nan']} NaN)" if r["force_error_nan"] else "")
+        nan, npl = r["force_error_nan"], r.get("point_load_points", 0)
+        fe = g(r["force_error_max"], ".1e") + (
+            "" if not nan else f" ({npl} point-load, not estimated)" if nan == npl else f" ({nan} NaN)")
         lines.append(
             f"| {r['id']} | {r['contact']} | {r['delta_min']:.3g}–{r['delta_max']:.4g} | {r['force_max']:.4g} "
             f"| {short_reason(r)} | {'yes' if r['complete'] else 'no'} | {r['points']} | {r['nodes_max']} "
             f"| {r['wall_time']:.1f} | {fe} | {g(r['pressure_min'])} | {r['invalid']} | {neg or 'no'} "
-            f"| {g(r['energy_residual_max'], '.1e')} |")
+            f"| {g(r['energy_residual_max'], '.1e')} | {r.get('diagnosis', '')} |")
+    lines += [
+        "",
+        "delta reached: smallest and largest delta on the curve (the small-delta leg aims at delta_min; "
+        "the upward leg at delta_max or the cylinder). max F error: largest Richardson estimate. "
+        "min P: smallest contact pressure over all points (the huge negative values are exponentially "
+        "small caps at small delta, P ~ 1/Sc^2; single-cap topology, issue 7). invalid: points with "
+        "valid = False. max |dE/dδ − F|: Curve.energy_residual (finite differences along the curve; "
+        "~1e-3 for the smooth model is the differencing error at this point spacing, O(0.1-1) for the "
+        "paper model and for xi = 0 is real). at the last point: automatic diagnosis of the last point "
+        "(det of d(tau_s, M_s)/d(lambda_s, kappa_s) at the contact line, the 2x2 system the free-region "
+        "ODE inverts; Gent's (I1-3)/Jm; contact angle against the tip's end; time spent after the last "
+        "accepted point).",
+    ]
     return "\n".join(lines) + "\n"
 
 
@@ -242,10 +351,22 @@ def main():
     ap.add_argument("--time-limit", type=float, default=None, help="seconds per curve (default 300; quick 60)")
     ap.add_argument("--grace", type=float, default=120.0, help="extra seconds before a worker is killed")
     ap.add_argument("--out", default=None, help="basename in benchmarks/results (default stability[-quick])")
+    ap.add_argument("--rebuild", action="store_true",
+                    help="only rewrite the Markdown (and diagnoses) from the existing JSON")
     ap.add_argument("--worker", nargs=2, help=argparse.SUPPRESS)
     args = ap.parse_args()
     if args.worker:
         worker(*args.worker)
+        return
+    if args.rebuild:
+        name = args.out or ("stability-quick" if args.quick else "stability")
+        data = json.loads((RESULTS / f"{name}.json").read_text())
+        for r in data["scenes"]:
+            if r.get("points") and "omega_c_last_frac" in r:
+                r["diagnosis"] = diagnose(r)
+        (RESULTS / f"{name}.json").write_text(json.dumps(data, indent=1, default=float))
+        (RESULTS / f"{name}.md").write_text(markdown(data["scenes"], data["meta"]))
+        print(markdown(data["scenes"], data["meta"]))
         return
 
     import numpy
