@@ -296,6 +296,10 @@ def _natural(scene, deltas, builder: _Builder, settings):
                 if nd == target:
                     builder.add(sol, i)
                 step *= 1.5
+            elif sol.status == 4 and "end of the tip" in sol.message:
+                builder.out.complete = True
+                raise _Stop(f"the contact reached the end of the tip (the indenter's cylinder) just after "
+                            f"delta = {prev.delta:.6g}")
             else:
                 step /= 2
                 if step < 1e-6:
@@ -381,6 +385,20 @@ def _adaptive(scene, builder: _Builder, settings):
         guess = _secant(sysm, cur, prev, a)
         sol = solve_from(sysm, guess, tol=st["tol"], max_nodes=_step_nodes(cur, st), bc_tol=st["bc_tol"])
         steps += 1
+        if sol.success and sol.delta > st["delta_max"]:
+            # overshot: land on delta_max exactly, with delta control, from the current point
+            land = _solve_at_delta(scene, st["delta_max"], cur, prev, st)
+            steps += 1
+            if land.success:
+                builder.add(land, steps)
+                builder.out.complete = True
+                raise _Stop(f"delta_max = {st['delta_max']:g} reached")
+            ds /= 2
+            continue
+        if not sol.success and sol.status == 4 and "end of the tip" in sol.message:
+            builder.out.complete = True
+            raise _Stop(f"the contact reached the end of the tip (the indenter's cylinder) just after "
+                        f"delta = {cur.delta:.6g}")
         if sol.success and sol.delta > 0:
             builder.add(sol, steps)
             prev, cur = cur, sol
