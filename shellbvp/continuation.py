@@ -313,6 +313,16 @@ def _natural(scene, deltas, builder: _Builder, settings):
     builder.out.stop_reason = "all requested deltas computed"
 
 
+def _land_on_delta_max(scene, cur, prev, builder, st, key):
+    """Delta-controlled solve at delta_max from the current point; ends the curve on success."""
+    sol = _solve_at_delta(scene, st["delta_max"], cur, prev, st)
+    if sol.success:
+        builder.add(sol, key)
+        builder.out.complete = True
+        raise _Stop(f"delta_max = {st['delta_max']:g} reached")
+    return sol
+
+
 def _adaptive(scene, builder: _Builder, settings):
     st = settings
     first = _first_point(scene, st["delta_start"], st)
@@ -369,13 +379,8 @@ def _adaptive(scene, builder: _Builder, settings):
         tangent = new_tangent
         Xhat = _X(cur) + ds * tangent * scale
         if Xhat[0] >= st["delta_max"]:
-            # land on delta_max exactly, with delta control
-            sol = _solve_at_delta(scene, st["delta_max"], cur, prev, st)
             steps += 1
-            if sol.success:
-                builder.add(sol, steps)
-                builder.out.complete = True
-                raise _Stop(f"delta_max = {st['delta_max']:g} reached")
+            sol = _land_on_delta_max(scene, cur, prev, builder, st, steps)
             ds /= 2
             if ds < ds_min:
                 raise _Stop(f"no solution at delta_max = {st['delta_max']:g}: {sol.message}")
@@ -385,14 +390,9 @@ def _adaptive(scene, builder: _Builder, settings):
         guess = _secant(sysm, cur, prev, a)
         sol = solve_from(sysm, guess, tol=st["tol"], max_nodes=_step_nodes(cur, st), bc_tol=st["bc_tol"])
         steps += 1
-        if sol.success and sol.delta > st["delta_max"]:
-            # overshot: land on delta_max exactly, with delta control, from the current point
-            land = _solve_at_delta(scene, st["delta_max"], cur, prev, st)
+        if sol.success and sol.delta > st["delta_max"]:  # overshot: land from the current point
             steps += 1
-            if land.success:
-                builder.add(land, steps)
-                builder.out.complete = True
-                raise _Stop(f"delta_max = {st['delta_max']:g} reached")
+            _land_on_delta_max(scene, cur, prev, builder, st, steps)
             ds /= 2
             continue
         if not sol.success and sol.status == 4 and "end of the tip" in sol.message:
