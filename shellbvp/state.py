@@ -274,7 +274,6 @@ def _diagnose(sysm: MultipointBVP, bvp, tol):
 
 def _penetration(sysm, r, z, z_tip):
     """Largest height of free-shell points above the indenter's lower surface."""
-    om = sysm.tip_grid
     A, B = sysm.tip_A, sysm.tip_B
     rho = sysm.scene.rho
     inside = r < rho * A[-1]
@@ -293,9 +292,8 @@ def _run_bvp(sysm, guess, tol, max_nodes, bc_tol):
 
 def _attach_tip(sysm):
     """Tabulated tip profile for penetration checks (A increasing up to omega_max)."""
-    om = np.linspace(0.0, sysm.scene.tip_omega_max, 401)
-    shape = sysm.model.tip_shape(om, sysm.par)
-    sysm.tip_grid, sysm.tip_A, sysm.tip_B = om, shape["A"], shape["B"]
+    shape = sysm.model.tip_shape(np.linspace(0.0, sysm.scene.tip_omega_max, 401), sysm.par)
+    sysm.tip_A, sysm.tip_B = shape["A"], shape["B"]
 
 
 def make_system(scene, control, value, eps):

@@ -43,7 +43,6 @@ class FunctionSpec:
     outputs: list
     doc: str
     shape_of: str | None = None
-    returns_dict: bool = False
     extra_doc: list = field(default_factory=list)
 
 
@@ -218,10 +217,10 @@ def function_specs(d: Derivation) -> list[FunctionSpec]:
     specs += [
         FunctionSpec("reference_shell", d.geometry_prog, [("S", (d.geometry_S,)), ("par", par)],
                      [("out", d.reference_shell)], "Reference meridian: R, Z, Phi (angle), curvatures.",
-                     "S", returns_dict=True),
+                     "S"),
         FunctionSpec("tip_shape", d.geometry_prog, [("omega", (d.geometry_omega,)), ("par", par)],
                      [("out", d.tip_shape)], "Tip profile in units of rho: A, B, phi (tangent angle).",
-                     "omega", returns_dict=True),
+                     "omega"),
     ]
     return specs
 
