@@ -4,7 +4,7 @@ Each measurement is a fresh Python process (what a user meets), median of
 ``--repeat`` runs.  Writes benchmarks/results/codegen.json and prints a
 Markdown table.
 
-    python benchmarks/codegen_timing.py [--repeat 5]
+    python benchmarks/codegen_timing.py [--repeat 5] [--quick] [--out-dir DIR]
 """
 
 import argparse
@@ -44,12 +44,17 @@ def run(scene, cache):
     return {"import_s": imp, "model_s": load, "in_process_s": total, "process_wall_s": wall}
 
 
-def main():
+def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeat", type=int, default=5)
-    args = ap.parse_args()
+    ap.add_argument("--quick", action="store_true", help="base only, one repeat (writes codegen-quick.*)")
+    ap.add_argument("--out-dir", default=None, help="write results/ under this directory (default benchmarks/)")
+    args = ap.parse_args(argv)
+    scenes = dict(list(SCENES.items())[:1]) if args.quick else SCENES
+    if args.quick:
+        args.repeat = 1
     rows = {}
-    for label, scene in SCENES.items():
+    for label, scene in scenes.items():
         cold, warm = [], []
         for _ in range(args.repeat):
             with tempfile.TemporaryDirectory() as cache:
@@ -62,13 +67,18 @@ def main():
             "warm_process_wall_s": med(warm, "process_wall_s"),
             "import_shellbvp_s": med(warm, "import_s"),
         }
-    out = Path(__file__).parent / "results" / "codegen.json"
-    out.parent.mkdir(exist_ok=True)
-    out.write_text(json.dumps({"repeat": args.repeat, "python": sys.version.split()[0], "rows": rows}, indent=2))
-    print("| structure | cold: derive+generate+load (s) | warm: load cached (s) | warm process, total (s) |")
-    print("|---|---|---|---|")
+    res = (Path(args.out_dir) if args.out_dir else Path(__file__).parent) / "results"
+    res.mkdir(parents=True, exist_ok=True)
+    name = "codegen-quick" if args.quick else "codegen"
+    (res / f"{name}.json").write_text(json.dumps({"repeat": args.repeat, "python": sys.version.split()[0],
+                                                 "rows": rows}, indent=2))
+    lines = ["| structure | cold: derive+generate+load (s) | warm: load cached (s) | warm process, total (s) |",
+             "|---|---|---|---|"]
     for label, r in rows.items():
-        print(f"| {label} | {r['cold_model_s']:.2f} | {r['warm_model_s']:.3f} | {r['warm_process_wall_s']:.2f} |")
+        lines.append(f"| {label} | {r['cold_model_s']:.2f} | {r['warm_model_s']:.3f} | "
+                     f"{r['warm_process_wall_s']:.2f} |")
+    (res / f"{name}.md").write_text("\n".join(lines) + "\n")
+    print("\n".join(lines))
 
 
 if __name__ == "__main__":

@@ -3,9 +3,10 @@
 Runs the CLI itself (a fresh process per curve, warm code cache) and writes
 benchmarks/results/preset_curves.json and .md.
 
-    python benchmarks/preset_curves.py
+    python benchmarks/preset_curves.py [--quick] [--out-dir DIR]
 """
 
+import argparse
 import json
 import subprocess
 import sys
@@ -16,11 +17,17 @@ from pathlib import Path
 import shellbvp as sb
 
 
-def main():
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--quick", action="store_true", help="base preset, smooth contact (writes preset_curves-quick.*)")
+    ap.add_argument("--out-dir", default=None, help="write results/ under this directory (default benchmarks/)")
+    args = ap.parse_args(argv)
+    presets = ("base",) if args.quick else sb.PRESETS
+    contacts = ("smooth",) if args.quick else ("smooth", "paper")
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
-        for name in sb.PRESETS:
-            for contact in ("smooth", "paper"):
+        for name in presets:
+            for contact in contacts:
                 sb.Scene.preset(name, contact=contact).model()  # warm the code cache
                 out = Path(tmp) / f"{name}-{contact}.h5"
                 t0 = time.perf_counter()
@@ -34,16 +41,17 @@ def main():
                                  valid=int(c.valid.sum()) if c else 0,
                                  energy_identity_max=float(abs(c.energy_residual[1:-1]).max()) if c and len(c) > 3 else None))
                 print(rows[-1], flush=True)
-    res = Path(__file__).parent / "results"
-    res.mkdir(exist_ok=True)
-    (res / "preset_curves.json").write_text(json.dumps(rows, indent=1))
+    res = (Path(args.out_dir) if args.out_dir else Path(__file__).parent) / "results"
+    res.mkdir(parents=True, exist_ok=True)
+    base = "preset_curves-quick" if args.quick else "preset_curves"
+    (res / f"{base}.json").write_text(json.dumps(rows, indent=1))
     lines = ["| preset | contact | time (s) | points | valid | max delta | stopped | max abs(dE/ddelta - F) |",
              "|---|---|---|---|---|---|---|---|"]
     for r in rows:
         ei = f"{r['energy_identity_max']:.2g}" if r["energy_identity_max"] is not None else ""
         lines.append(f"| {r['preset']} | {r['contact']} | {r['seconds']:.1f} | {r['points']} | {r['valid']} | "
                      f"{r['delta_max']} | {r['stop']} | {ei} |")
-    (res / "preset_curves.md").write_text("\n".join(lines) + "\n")
+    (res / f"{base}.md").write_text("\n".join(lines) + "\n")
     print("\n".join(lines))
 
 

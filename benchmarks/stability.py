@@ -351,10 +351,14 @@ def main():
     ap.add_argument("--time-limit", type=float, default=None, help="seconds per curve (default 300; quick 60)")
     ap.add_argument("--grace", type=float, default=120.0, help="extra seconds before a worker is killed")
     ap.add_argument("--out", default=None, help="basename in benchmarks/results (default stability[-quick])")
+    ap.add_argument("--out-dir", default=None, help="write results/ under this directory (default benchmarks/)")
     ap.add_argument("--rebuild", action="store_true",
                     help="only rewrite the Markdown (and diagnoses) from the existing JSON")
     ap.add_argument("--worker", nargs=2, help=argparse.SUPPRESS)
     args = ap.parse_args()
+    global RESULTS
+    if args.out_dir:
+        RESULTS = Path(args.out_dir) / "results"
     if args.worker:
         worker(*args.worker)
         return
@@ -413,7 +417,7 @@ def main():
                 scipy=scipy.__version__, shellbvp=sb.__version__, delta_max=delta_max,
                 delta_min=args.delta_min, time_limit=time_limit, total_s=total,
                 quick=args.quick, base=dict(BASE, material=list(BASE["material"])))
-    RESULTS.mkdir(exist_ok=True)
+    RESULTS.mkdir(parents=True, exist_ok=True)
     name = args.out or ("stability-quick" if args.quick else "stability")
     (RESULTS / f"{name}.json").write_text(json.dumps({"meta": meta, "scenes": rows}, indent=1, default=float))
     md = markdown(rows, meta)

@@ -4,9 +4,10 @@ Writes benchmarks/results/states.json and benchmarks/results/states.md
 (F, Sc, lambda0, ring force, min contact pressure, validity, error estimate,
 time per cold solve).
 
-    python benchmarks/states_table.py
+    python benchmarks/states_table.py [--quick] [--out-dir DIR]
 """
 
+import argparse
 import json
 import time
 from pathlib import Path
@@ -16,13 +17,19 @@ import shellbvp as sb
 DELTAS = (0.05, 0.1, 0.2, 0.3)
 
 
-def main():
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--quick", action="store_true", help="base preset, delta 0.1 and 0.3 (writes states-quick.*)")
+    ap.add_argument("--out-dir", default=None, help="write results/ under this directory (default benchmarks/)")
+    args = ap.parse_args(argv)
+    presets = ("base",) if args.quick else sb.PRESETS
+    deltas = (0.1, 0.3) if args.quick else DELTAS
     rows = []
-    for name in sb.PRESETS:
+    for name in presets:
         for contact in ("smooth", "paper"):
             scene = sb.Scene.preset(name, contact=contact)
             scene.model()  # code generation is not part of the solve time
-            for d in DELTAS:
+            for d in deltas:
                 t0 = time.perf_counter()
                 s = sb.solve(scene, delta=d)
                 rows.append(dict(preset=name, contact=contact, delta=d, success=bool(s.success),
@@ -30,9 +37,10 @@ def main():
                                  ring_force=s.get("ring_force"), pressure_min=s.get("pressure_min"),
                                  valid=bool(s.get("valid")), force_error=s.get("force_error"),
                                  nodes=s.nodes, seconds=time.perf_counter() - t0))
-    out = Path(__file__).parent / "results"
-    out.mkdir(exist_ok=True)
-    (out / "states.json").write_text(json.dumps(rows, indent=1, default=float))
+    out = (Path(args.out_dir) if args.out_dir else Path(__file__).parent) / "results"
+    out.mkdir(parents=True, exist_ok=True)
+    name = "states-quick" if args.quick else "states"
+    (out / f"{name}.json").write_text(json.dumps(rows, indent=1, default=float))
     lines = ["| preset | contact | delta | F | Sc | lambda0 | ring force | min P | valid | F error | nodes | time (s) |",
              "|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in rows:
@@ -44,7 +52,7 @@ def main():
                      f"{r['lambda0']:.4f} | {r['ring_force']:.4g} | {r['pressure_min']:.3g} | "
                      f"{'yes' if r['valid'] else 'no'} | {r['force_error']:.1e} | {r['nodes']} | "
                      f"{r['seconds']:.2f} |")
-    (out / "states.md").write_text("\n".join(lines) + "\n")
+    (out / f"{name}.md").write_text("\n".join(lines) + "\n")
     print("\n".join(lines))
 
 

@@ -1,0 +1,129 @@
+"""The benchmark driver (benchmarks/run.py) and the work–precision helpers.
+
+The fast tests check the plan and argument parsing only; the slow one runs
+``run.py --quick`` into a temporary directory (a smoke test of every step).
+"""
+
+import importlib.util
+import json
+import math
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+BENCH = Path(__file__).resolve().parent.parent / "benchmarks"
+
+
+def _load(name):
+    spec = importlib.util.spec_from_file_location(f"_bench_{name}", BENCH / f"{name}.py")
+    mod = importlib.util.module_from_spec(spec)
+    sys.path.insert(0, str(BENCH))
+    try:
+        spec.loader.exec_module(mod)
+    finally:
+        sys.path.remove(str(BENCH))
+    return mod
+
+
+@pytest.fixture(scope="module")
+def run():
+    return _load("run")
+
+
+@pytest.fixture(scope="module")
+def wp():
+    return _load("work_precision")
+
+
+def test_full_plan_regenerates_everything(run):
+    names = [s.name for s, _ in run.plan()]
+    assert names == ["work_precision", "profile", "stability", "shooting", "states_table", "preset_curves",
+                     "codegen_timing"]
+    for s, argv in run.plan():
+        assert argv[0] == sys.executable and Path(argv[1]).exists()
+        assert "--quick" not in argv
+    assert "paper_figures" in [s.name for s, _ in run.plan(figures=True)]
+
+
+def test_quick_plan_writes_separate_files(run, tmp_path):
+    steps = run.plan(quick=True, out=tmp_path)
+    names = [s.name for s, _ in steps]
+    assert "work_precision" in names and "shooting" not in names and "paper_figures" not in names
+    for s, argv in steps:
+        assert "--quick" in argv
+        assert argv[argv.index("--out-dir") + 1] == str(tmp_path)
+        assert s.quick_outputs and all("-quick" in o for o in s.quick_outputs)
+    # --out with a step that has no output option: left out rather than writing into benchmarks/
+    assert run.plan(figures=True, out=tmp_path)[-1][0].name != "paper_figures"
+    shoot = dict((s.name, a) for s, a in run.plan(out=tmp_path))["shooting"]
+    assert shoot[shoot.index("--out") + 1] == str(tmp_path / "results" / "shooting.json")
+
+
+def test_arguments(run):
+    a = run.parse_args(["--quick", "--only", "work_precision,profile", "--out", "/tmp/x"])
+    assert a.quick and a.only == ["work_precision", "profile"] and a.out == "/tmp/x"
+    assert [s.name for s, _ in run.plan(a.quick, a.only, a.figures, a.out)] == ["work_precision", "profile"]
+    with pytest.raises(ValueError, match="unknown steps"):
+        run.plan(only=["nope"])
+    assert run.main(["--only", "nope"]) == 2
+
+
+def test_list(run, capsys):
+    assert run.main(["--list", "--quick"]) == 0
+    out = capsys.readouterr().out
+    assert "work_precision.py --quick" in out and "shooting" not in out
+
+
+def test_work_precision_arguments(wp):
+    q = wp.parse_args(["--quick"])
+    assert q.presets == ["base"] and q.points == 10 and q.name == "work_precision-quick" and q.every_1e10 == 0
+    f = wp.parse_args([])
+    assert f.presets == list(wp.PRESETS) and f.points == 40 and f.tols == wp.TOLS and f.shoot == ["base"]
+    assert f.name == "work_precision"
+
+
+def test_time_at_equal_error(wp):
+    series = [(1e-3, 1.0), (1e-5, 2.0), (1e-7, 4.0)]
+    t, how = wp.time_at_error(series, 1e-4)
+    assert how == "interp" and t == pytest.approx(math.sqrt(2.0))
+    assert wp.time_at_error(series, 1e-9) == (None, "not reached")
+    assert wp.time_at_error(series, 1e-2) == (1.0, "bound")
+    # a slower run that is also less accurate never makes an error level more expensive
+    t, _ = wp.time_at_error([(1e-3, 5.0), (1e-5, 2.0)], 1e-4)
+    assert t == pytest.approx(2.0)
+
+
+def test_equal_error_both_ways(wp):
+    coll = [dict(tol=t, max_rel=e, per_point_ms=ms, all_converged=True, points=4)
+            for t, e, ms in ((1e-4, 1e-5, 10.0), (1e-6, 1e-7, 20.0))]
+    shoot = [dict(rtol=1e-6, max_rel=1e-6, max_rel_F_equal_lambda0=1e-7, per_point_ms=400.0, converged=4, points=4)]
+    ee = wp.equal_error(coll, shoot, 4)
+    (s,) = ee["shooting_points"]
+    assert s["how"] == "interp" and s["ratio"] == pytest.approx(400 / (10 * 2 ** 0.5))
+    c = {q["tol"]: q for q in ee["collocation_points"]}
+    assert c[1e-4]["how"] == "bound" and c[1e-4]["ratio"] == pytest.approx(40.0)
+    assert c[1e-6]["ratio"] is None  # shooting never got to 1e-7
+    ee = wp.equal_error(coll, shoot, 4, "max_rel_F_equal_lambda0")
+    assert ee["shooting_points"][0]["ratio"] == pytest.approx(20.0)
+
+
+@pytest.mark.slow
+def test_quick_run_smoke(tmp_path):
+    start = time.time()
+    r = subprocess.run([sys.executable, str(BENCH / "run.py"), "--quick", "--out", str(tmp_path)],
+                       capture_output=True, text=True, timeout=900)
+    assert r.returncode == 0, r.stdout[-3000:] + r.stderr[-3000:]
+    summary = json.loads((tmp_path / "results" / "run-quick.json").read_text())
+    assert all(s["returncode"] == 0 for s in summary["steps"])
+    for name in ("work_precision-quick.json", "work_precision-quick.md", "profile-quick.md",
+                 "stability-quick.json", "states-quick.json", "preset_curves-quick.json", "codegen-quick.json"):
+        assert (tmp_path / "results" / name).exists(), name
+    wp = json.loads((tmp_path / "results" / "work_precision-quick.json").read_text())
+    base = wp["presets"]["base"]
+    assert all(r["all_converged"] for r in base["natural"])
+    assert max(r["max_rel"] for r in base["natural"]) < 1e-3
+    # nothing written into the committed results
+    assert not [p.name for p in (BENCH / "results").iterdir() if p.stat().st_mtime >= start]
