@@ -23,8 +23,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .state import (SC_POINT, Solution, _default_eps, _warm_guess, make_system, richardson_error,
-                    solve, solve_from, solve_point_load, thin_mesh)
+from .liftoff import lift_off_suspected, valid_liftoff_state
+from .state import (SC_POINT, Solution, _default_eps, _warm_guess, estimate_errors, make_system, solve,
+                    solve_from, solve_point_load, thin_mesh)
 
 __all__ = ["Curve", "curve", "POINT_FIELDS"]
 
@@ -34,8 +35,9 @@ log = logging.getLogger(__name__)
 POINT_FIELDS = (
     "delta", "force", "lambda0", "Sc", "status", "valid", "max_residual", "nodes", "niter",
     "force_error", "delta_error", "energy", "ring_force", "cap_force", "pressure_min",
-    "penetration", "force_defect", "edge_legendre", "wall_time",
+    "penetration", "force_defect", "edge_legendre", "wall_time", "topology", "S1", "ring_force_inner",
 )
+_FIELD_DEFAULTS = {"topology": "cap", "S1": 0.0, "ring_force_inner": 0.0}
 
 
 @dataclass
@@ -116,7 +118,9 @@ class _Stop(Exception):
 
 
 def _record(sol: Solution):
-    row = {k: sol.get(k, np.nan) for k in POINT_FIELDS}
+    row = {k: sol.get(k, _FIELD_DEFAULTS.get(k, np.nan)) for k in POINT_FIELDS}
+    if row["topology"] == "point":
+        row["S1"] = 0.0
     row["valid"] = bool(sol.get("valid", False))
     return row
 
@@ -127,7 +131,8 @@ def _X(sol):
 
 def curve(scene, delta_max: float = 0.5, *, deltas=None, force_max=None, lambda0_max=None,
           max_steps: int = 400, delta_start=None, delta_min=None, tol: float = 1e-6,
-          max_nodes: int = 10000, ds_max=None, estimate_error: bool = True, callback=None):
+          max_nodes: int = 10000, ds_max=None, estimate_error: bool = True, callback=None,
+          topology: str = "auto"):
     """Force–displacement curve of a scene by continuation.
 
     Parameters
@@ -152,6 +157,10 @@ def curve(scene, delta_max: float = 0.5, *, deltas=None, force_max=None, lambda0
     callback : callable, optional
         ``callback(curve_so_far, solution)`` after each accepted point (progress,
         checkpoints).  It may raise ``KeyboardInterrupt`` to stop the curve.
+    topology : {"auto", "cap"}
+        ``"auto"`` (smooth model): where the single cap would pull the shell, record
+        the valid line or annular contact at that delta (``shellbvp.liftoff``);
+        ``"cap"``: single-cap states only (flagged where invalid).
 
     Returns
     -------
@@ -174,17 +183,19 @@ def curve(scene, delta_max: float = 0.5, *, deltas=None, force_max=None, lambda0
     _check_positive("delta_min", delta_min)
     ds_max = delta_max / 10 if ds_max is None else float(ds_max)
     _check_positive("ds_max", ds_max)
+    if topology not in ("auto", "cap"):
+        raise ValueError(f"topology must be 'auto' or 'cap' for a curve; got {topology!r}")
 
     settings = dict(tol=tol, max_nodes=max_nodes, delta_max=delta_max, force_max=force_max,
                     lambda0_max=lambda0_max, max_steps=max_steps, delta_start=delta_start,
                     delta_min=delta_min, ds_max=ds_max, estimate_error=estimate_error,
                     mode="deltas" if deltas is not None else "adaptive", eps=_default_eps(tol),
-                    bc_tol=1e-10)
+                    bc_tol=1e-10, topology=topology)
     from . import __version__
 
     out = Curve(scene=scene, points={k: [] for k in POINT_FIELDS}, flags=[], stop_reason="",
                 complete=False, interrupted=False, settings=settings, version=__version__)
-    builder = _Builder(out, callback, estimate_error, tol)
+    builder = _Builder(out, callback, estimate_error, settings)
     t0 = time.perf_counter()
     try:
         if deltas is not None:
@@ -196,6 +207,11 @@ def curve(scene, delta_max: float = 0.5, *, deltas=None, force_max=None, lambda0
         out.stop_reason = "interrupted"
     except _Stop as stop:
         out.stop_reason = str(stop)
+    if topology == "auto" and not out.interrupted:
+        try:
+            _locate_switches(builder, settings)
+        except KeyboardInterrupt:
+            out.interrupted = True
     builder.finish()
     settings["wall_time"] = time.perf_counter() - t0
     log.info("curve: %s in %.2f s", out.summary(), settings["wall_time"])
@@ -209,16 +225,41 @@ def _check_positive(name, v):
 
 
 class _Builder:
-    """Collects accepted points (sorted into branch order at the end)."""
+    """Collects accepted points (sorted into branch order at the end).
 
-    def __init__(self, out: Curve, callback, estimate_error, tol):
-        self.out, self.callback, self.estimate_error, self.tol = out, callback, estimate_error, tol
+    The continuation follows the single-cap branch; with ``topology="auto"`` a cap
+    point that would pull the shell is recorded as the valid line or annular state
+    at the same delta instead (found from the cap, or from the last lift-off state).
+    At the switch the two coincide (the cap's pressure and the line's excess
+    curvature vanish together), so F(delta) has no jump.
+    """
+
+    def __init__(self, out: Curve, callback, estimate_error, settings):
+        self.out, self.callback, self.estimate_error = out, callback, estimate_error
+        self.settings = settings
+        self.tol = settings["tol"]
         self.rows = []  # (order key, row, flags, solution)
+        self.last_liftoff = None
+
+    def _shown(self, sol: Solution) -> Solution:
+        st = self.settings
+        if st["topology"] != "auto" or sol.scene.contact != "smooth" or not lift_off_suspected(sol):
+            return sol
+        alt, tried = valid_liftoff_state(sol, tol=st["tol"], max_nodes=st["max_nodes"], bc_tol=st["bc_tol"],
+                                         previous=self.last_liftoff)
+        if alt is None:
+            sol.flags = list(sol.flags) + ["no valid lift-off state found (" + "; ".join(tried) + ")"]
+            return sol
+        alt.cap_state = {k: sol[k] for k in ("delta", "force", "energy", "pressure_min", "Sc")}
+        alt.cap_solution = sol
+        self.last_liftoff = alt
+        return alt
 
     def add(self, sol: Solution, key: float):
         """Accept a point; ``key`` orders points along the branch."""
-        if self.estimate_error and sol.success and sol.get("topology") != "point":
-            richardson_error(sol.system, sol, self.tol)
+        sol = self._shown(sol)
+        if self.estimate_error and sol.success:
+            estimate_errors(sol, self.tol)
         self.rows.append((key, _record(sol), "; ".join(sol.get("flags", [])), sol))
         if self.callback is not None:
             self.callback(self.snapshot(), sol)
@@ -238,9 +279,66 @@ class _Builder:
         self.out.solutions = [r[3] for r in rows]
 
 
+def _cap_of(sol):
+    """The single-cap state behind a recorded point (itself, or the cap it replaced)."""
+    if sol.get("topology") == "cap":
+        return sol
+    return sol.get("cap_solution")
+
+
+def _locate_switches(builder: _Builder, st):
+    """Add the point where the recorded topology switches from lift-off to cap (or back).
+
+    Between two neighbouring points of which one is a cap and the other a line or
+    annulus (both valid), the switch is where the cap's minimum contact pressure
+    crosses zero: found by regula falsi (Illinois) on the cap branch; the cap state
+    there (pressure >= 0 side) is added to an adaptive curve, and the switch is
+    listed in ``settings["topology_switches"]``.
+    """
+    switches = st.setdefault("topology_switches", [])
+    rows = sorted(builder.rows, key=lambda r: r[0])
+    for (k1, _, _, s1), (k2, _, _, s2) in zip(rows[:-1], rows[1:]):
+        kinds = {s1.get("topology"), s2.get("topology")}
+        if "cap" not in kinds or not kinds & {"line", "annulus"} or not (s1.get("valid") and s2.get("valid")):
+            continue
+        c1, c2 = _cap_of(s1), _cap_of(s2)
+        if c1 is None or c2 is None:
+            continue
+        a, fa, sa = c1.delta, c1.pressure_min, c1
+        b, fb, sb = c2.delta, c2.pressure_min, c2
+        if not fa * fb < 0:
+            continue
+        side = 0
+        best = sa if fa >= 0 else sb
+        for _ in range(40):
+            d = (a * fb - b * fa) / (fb - fa)
+            sol = _solve_at_delta(builder.out.scene, d, sa if abs(d - a) < abs(d - b) else sb, None, st)
+            if not sol.success:
+                break
+            f = sol.pressure_min
+            if f >= 0:
+                best = sol
+            if f * fb > 0:
+                b, fb, sb = d, f, sol
+                fa = fa / 2 if side == -1 else fa
+                side = -1
+            else:
+                a, fa, sa = d, f, sol
+                fb = fb / 2 if side == 1 else fb
+                side = 1
+            if abs(b - a) < 1e-6 * (1 + abs(d)) or abs(f) < 10 * st["tol"]:
+                break
+        frm, to = s1.get("topology"), s2.get("topology")
+        switches.append({"delta": float(best.delta), "force": float(best.force), "from": frm, "to": to,
+                         "pressure_min": float(best.pressure_min)})
+        log.info("topology switch %s -> %s at delta = %.6g", frm, to, best.delta)
+        if st["mode"] == "adaptive":  # a curve at requested depths keeps exactly those
+            builder.add(best, 0.5 * (k1 + k2))
+
+
 def _first_point(scene, delta, settings):
     sol = solve(scene, delta=delta, tol=settings["tol"], max_nodes=settings["max_nodes"],
-                estimate_error=False)
+                estimate_error=False, topology="cap")  # the branch followed is the cap's
     if not sol.success:
         raise _Stop(f"no solution at the first point delta = {delta:g}: {sol.message}")
     return sol

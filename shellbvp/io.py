@@ -1,6 +1,7 @@
 """HDF5 files of curves: atomic writes, a documented self-describing layout.
 
-Layout (format ``shellbvp-curve``, version 1)::
+Layout (format ``shellbvp-curve``, version 2; version 1 lacked topology, S1 and
+ring_force_inner, which read as a single cap)::
 
     /                       attrs: format, format_version, package_version, created (UTC ISO)
     /curve                  NXdata group; attrs:
@@ -16,7 +17,8 @@ Layout (format ``shellbvp-curve``, version 1)::
     /curve/delta            (n,) axis: pole displacement / R_L
     /curve/force            (n,) signal: indenter force / (mu H R_L)
     /curve/<field>          (n,) each of shellbvp.continuation.POINT_FIELDS, plus
-                            energy_residual (dE/ddelta - F) and flags (strings)
+                            energy_residual (dE/ddelta - F) and flags (strings);
+                            topology (strings: cap, annulus, line, point)
     /curve/profiles/point_<i>   optional (profiles=True): S, region, r, z, ... at the
                             mesh nodes of point i (see Solution.profile)
 
@@ -38,7 +40,7 @@ import numpy as np
 __all__ = ["write_curve", "read_curve", "FORMAT", "FORMAT_VERSION"]
 
 FORMAT = "shellbvp-curve"
-FORMAT_VERSION = 1
+FORMAT_VERSION = 2
 
 
 def _check_units(units):
@@ -114,7 +116,11 @@ def write_curve(curve, path, *, profiles=False, overwrite=False, units=None):
             res = curve.energy_residual
             g.attrs["energy_identity_max"] = float(np.nanmax(np.abs(res))) if np.any(np.isfinite(res)) else np.nan
             for k, v in curve.points.items():
-                g.create_dataset(k, data=np.asarray(v))
+                v = np.asarray(v)
+                if v.dtype.kind in "UO":  # strings (topology)
+                    g.create_dataset(k, data=np.array(v, dtype=object), dtype=h5py.string_dtype())
+                else:
+                    g.create_dataset(k, data=v)
             g.create_dataset("energy_residual", data=res)
             g.create_dataset("flags", data=np.array(curve.flags, dtype=object), dtype=h5py.string_dtype())
             g["delta"].attrs["long_name"] = "pole displacement delta / R_L"
@@ -140,6 +146,16 @@ def write_curve(curve, path, *, profiles=False, overwrite=False, units=None):
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise
+
+
+#: Fields added after format version 1 and their values in older files (single cap only).
+_LATER_FIELDS = {"topology": "cap", "S1": 0.0, "ring_force_inner": 0.0}
+
+
+def _missing_field(name, n):
+    if name not in _LATER_FIELDS:
+        raise KeyError(name)
+    return np.full(n, _LATER_FIELDS[name], dtype=object if name == "topology" else float)
 
 
 def read_curve(path):
@@ -170,7 +186,10 @@ def read_curve(path):
         g = f["curve"]
         try:
             scene = Scene.from_dict(json.loads(g.attrs["scene"]))
-            points = {k: g[k][()] for k in POINT_FIELDS}
+            n = g["delta"].shape[0]
+            points = {k: g[k][()] if k in g else _missing_field(k, n) for k in POINT_FIELDS}
+            points["topology"] = np.array([t.decode() if isinstance(t, bytes) else str(t)
+                                           for t in points["topology"]])
             flags = [s.decode() if isinstance(s, bytes) else str(s) for s in g["flags"][()]]
             settings = json.loads(g.attrs["settings"])
         except (KeyError, ValueError, TypeError) as exc:

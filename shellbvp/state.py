@@ -95,9 +95,10 @@ class Solution(dict):
 
     # -- fields over S ------------------------------------------------------------------
     def profile(self, points_per_interval: int = 1):
-        """Physical fields over S (contact region first, then free region).
+        """Physical fields over S, pole to rim.
 
-        Returns a dict of 1-D arrays: ``S``, ``region`` (0 contact, 1 free), ``r``, ``z``,
+        Returns a dict of 1-D arrays: ``S`` (increasing), ``region`` (0 on the indenter,
+        1 free; a lifted pole's free cap comes first), ``r``, ``z``,
         ``phi``, ``lambda_s``, ``lambda_theta``, ``kappa_s``, ``kappa_theta``, ``T_s``,
         ``T_theta``, ``M_s``, ``M_theta``, ``tau_s``, ``tau_theta``, ``Q``, ``P``,
         ``axial_force`` (F(S), the axial force carried across the circle S), ``energy_density``.
@@ -109,6 +110,10 @@ class Solution(dict):
         if points_per_interval > 1:
             t = np.unique(np.concatenate([np.linspace(a, b, points_per_interval + 1)
                                           for a, b in zip(t[:-1], t[1:])]))
+        if self.get("topology") in ("line", "annulus"):
+            from .liftoff import liftoff_profile
+
+            return liftoff_profile(self, t)
         y = self.sol(t)
         if self.get("topology") == "point":
             pf = sysm.model.free_profile(sysm.S(t), y, sysm.par)
@@ -374,10 +379,12 @@ def solve_point_load(scene, delta, *, tol=1e-6, max_nodes=10000, guess=None, bc_
 
     t0 = time.perf_counter()
     sysm = PointLoadBVP(scene, delta)
+    _attach_tip(sysm)
     x, y = _point_guess(sysm, guess) if guess is not None else _crude_point_guess(sysm)
     with np.errstate(all="ignore"):
         bvp = solve_bvp(sysm.fun, sysm.bc, x, y, fun_jac=sysm.fun_jac, bc_jac=sysm.bc_jac, tol=tol,
                         bc_tol=bc_tol, max_nodes=max_nodes)
+        sysm.tol = tol
         res = _diagnose_point(sysm, bvp)
     res.wall_time = time.perf_counter() - t0
     return res
@@ -420,9 +427,33 @@ def _diagnose_point(sysm, bvp):
     Sg = sysm.S(tg)
     e = mod.free_profile(Sg, bvp.sol(tg), par)["energy_density"]
     res.energy = 2 * np.pi * float(np.sum(wg * e * Sg * (sysm.ln_L - sysm.ln_s0)))
-    res.flags = ["point-load limit: the contact is a point (cap below 1e-30); contact pressure "
-                 "and penetration are not defined"]
+    # The point load is the limit of contact on a vanishing circle (line contact): valid
+    # when it pushes and the shell stays outside the indenter.
+    res.penetration = _penetration(sysm, pf["r"], pf["z"], res.z_tip)
+    vflags = []
+    if force < 0:
+        vflags.append(f"negative point force ({force:.3g})")
+    if res.penetration > 10 * sysm.tol:
+        vflags.append(f"the free shell passes through the indenter (by {res.penetration:.3g})")
+    res.flags = vflags
+    res.valid = not vflags
     return res
+
+
+def _point_richardson_error(sysm, res, tol, bc_tol=1e-10):
+    """Richardson estimate of a point-load state's F (delta is prescribed exactly)."""
+    x = res.x
+    x2 = np.sort(np.r_[x, 0.5 * (x[1:] + x[:-1])])
+    with np.errstate(all="ignore"):
+        fine = solve_bvp(sysm.fun, sysm.bc, x2, res.sol(x2), fun_jac=sysm.fun_jac, bc_jac=sysm.bc_jac,
+                         tol=tol / 100, bc_tol=bc_tol / 100, max_nodes=x2.size)
+    if fine.status == 2 or not np.all(np.isfinite(fine.y)):
+        res.force_error = float("nan")
+        res.flags = list(res.flags) + ["error estimate failed (Newton on the halved mesh did not converge)"]
+        return
+    G = sysm.model.free_profile(np.array([sysm.s0]), fine.y[:, :1], sysm.par)["axial_force_2pi"][0]
+    res.force_error = abs(2 * np.pi * float(G) - res.force) * 16 / 15
+    res.delta_error = 0.0
 
 
 def _default_eps(tol):
@@ -430,8 +461,11 @@ def _default_eps(tol):
     return min(1e-3, 0.1 * math.sqrt(tol))
 
 
+TOPOLOGIES = ("auto", "cap", "line", "annulus")
+
+
 def solve(scene, *, delta=None, lambda0=None, force=None, tol=1e-6, max_nodes=10000, guess=None,
-          eps=None, bc_tol=1e-10, estimate_error=True):
+          eps=None, bc_tol=1e-10, estimate_error=True, topology="auto"):
     """Solve one indentation state.
 
     Exactly one of ``delta`` (pole displacement), ``lambda0`` (pole stretch) or
@@ -452,6 +486,12 @@ def solve(scene, *, delta=None, lambda0=None, force=None, tol=1e-6, max_nodes=10
     estimate_error : bool
         Richardson error estimates ``force_error``, ``delta_error`` (one more Newton
         solve on the mesh with every interval halved; see :func:`richardson_error`).
+    topology : {"auto", "cap", "line", "annulus"}
+        Contact topology (smooth model; ``shellbvp.liftoff``).  ``"auto"``: the
+        single cap, replaced by a valid line or annular contact where the cap
+        would pull the shell (negative pressure or ring force).  ``"cap"``: the
+        cap only.  ``"line"``/``"annulus"``: that topology, started from the cap
+        state (delta or force control only), valid or not.
 
     Returns
     -------
@@ -476,6 +516,22 @@ def solve(scene, *, delta=None, lambda0=None, force=None, tol=1e-6, max_nodes=10
     eps = _default_eps(tol) if eps is None else float(eps)
     if not 0 < eps < 0.5:
         raise ValueError(f"eps (pole start zeta = eps*Sc) must be in (0, 0.5); got {eps!r}")
+    if topology not in TOPOLOGIES:
+        raise ValueError(f"topology must be one of {TOPOLOGIES}; got {topology!r}")
+    if topology != "auto" and topology != "cap" and scene.contact != "smooth":
+        raise ValueError(f"topology={topology!r} needs contact='smooth' (the variational contact line); "
+                         f"the paper's model has the single cap only")
+    if topology in ("line", "annulus") and control == "lambda0":
+        raise ValueError(f"topology={topology!r} takes delta or force control (lambda0, the stretch of a "
+                         "lifted pole, is a result there)")
+    if guess is not None and guess.get("topology") in ("line", "annulus"):
+        from .liftoff import solve_liftoff
+
+        res = solve_liftoff(scene, guess.topology, delta=delta, force=force, guess=guess, tol=tol,
+                            max_nodes=max_nodes, eps=eps, bc_tol=bc_tol, estimate_error=estimate_error)
+        if topology in ("auto", guess.topology) and res.success:
+            return res
+        guess = None  # back to the cap
 
     t0 = time.perf_counter()
     sysm = make_system(scene, control, value, eps)
@@ -486,12 +542,43 @@ def solve(scene, *, delta=None, lambda0=None, force=None, tol=1e-6, max_nodes=10
         res = _cold_delta(sysm, value, **kw)
     else:
         res = _cold_other(scene, sysm, control, value, eps, **kw)
-    if res.success and estimate_error and res.get("topology") != "point":
-        richardson_error(sysm, res, tol, bc_tol)
+    if topology != "cap" and scene.contact == "smooth" and res.get("topology") == "cap" \
+            and control != "lambda0" and res.success:
+        res = _other_topology(res, topology, kw)
+    if res.success and estimate_error:
+        estimate_errors(res, tol, bc_tol)
     else:
         res.force_error = res.delta_error = float("nan")
     res.wall_time = time.perf_counter() - t0
     return res
+
+
+def _other_topology(cap, topology, kw):
+    """Replace an invalid cap by a valid lift-off state (auto) or by the asked topology."""
+    from .liftoff import lift_off_suspected, liftoff_state, valid_liftoff_state
+
+    if topology in ("line", "annulus"):
+        return liftoff_state(cap, topology, **kw)
+    if not lift_off_suspected(cap):
+        return cap
+    alt, tried = valid_liftoff_state(cap, **kw)
+    if alt is not None:
+        alt.cap_state = {k: cap[k] for k in ("delta", "force", "energy", "pressure_min", "Sc")}
+        return alt
+    cap.flags = list(cap.flags) + ["no valid lift-off state found (" + "; ".join(tried) + ")"]
+    return cap
+
+
+def estimate_errors(res, tol, bc_tol=1e-10):
+    """Richardson error estimates of any topology (see :func:`richardson_error`)."""
+    if res.get("topology") in ("line", "annulus"):
+        from .liftoff import liftoff_richardson_error
+
+        liftoff_richardson_error(res.system, res, tol, bc_tol)
+    elif res.get("topology") == "point":
+        _point_richardson_error(res.system, res, tol, bc_tol)
+    else:
+        richardson_error(res.system, res, tol, bc_tol)
 
 
 _SC_GUESSES = (0.05, 0.2, 0.01, 0.002)

@@ -231,3 +231,179 @@ class PointLoadBVP:
         A[0:3] = self.model.point_load_jac(self.s0, ya, self.delta, self.par)[:, :N_FREE]
         B[3:6] = self.model.rim_jac(self.L, yb, self.par)
         return A, B
+
+
+class LiftOffBVP:
+    """Contact that has lifted off at the pole: a free inner cap, then contact, then free.
+
+    ``topology="annulus"``: inner free cap ``[zeta, S1]``, contact annulus
+    ``[S1, S2]``, outer free region ``[S2, L]``; ``y`` has 14 rows
+    (inner free 6, contact 2, outer free 6) and the unknowns are
+    ``p = (ln S1, ln S2)`` (+ ``delta`` under force control).  Maps:
+    ``S = S1 eps**(1-t)``, ``S = S1 (S2/S1)**t``, ``S = S2 (L/S2)**t``.
+    Conditions (16 or 17): inner pole 3 (``free_pole_res``), smooth contact
+    line at S1 5 and at S2 5, rim 3, (force 1).
+
+    ``topology="line"``: the shell touches the indenter on one circle S1 (a
+    zero-width annulus); ``y`` has 12 rows (inner free 6, outer free 6), the
+    unknowns are ``p = (ln S1, chi1)`` with ``chi1 = rho omega1/S1`` the
+    indenter point touched (+ ``delta``).  Conditions (14 or 15): pole 3; at S1
+    the shell lies on the indenter and is tangent to it (r, phi, z: 3), and
+    ``lambda_theta, phi, lambda_s, kappa_s, z`` are continuous (5) while ``rQ``
+    jumps (the ring force); rim 3; (force 1).  Unlike the annulus, kappa_s at
+    the line is free (it must not exceed the indenter's: no penetration).
+
+    ``delta`` is the indenter's displacement (the tip apex sits at
+    ``Z(0) - delta``), which is the pole displacement whenever the pole touches.
+    Both edges use the variational (smooth) contact-line conditions of SPEC 2b.
+    """
+
+    def __init__(self, scene, topology: str, control: str, value: float, eps: float):
+        if topology not in ("annulus", "line"):
+            raise ValueError(f"topology must be 'annulus' or 'line'; got {topology!r}")
+        if control not in ("delta", "force"):
+            raise ValueError(f"control must be 'delta' or 'force' for {topology} contact; got {control!r}")
+        self.scene, self.topology, self.control = scene, topology, control
+        self.model = mod = scene.model()
+        self.par = scene.parameters(mod)
+        self.value = float(value)
+        self.eps, self.ln_eps = float(eps), math.log(eps)
+        self.L = scene.shell_length
+        self.ln_L = math.log(self.L)
+        self.n_contact = N_CONTACT if topology == "annulus" else 0
+        self.n = 2 * N_FREE + self.n_contact
+        self.inner = slice(0, N_FREE)
+        self.contact = slice(N_FREE, N_FREE + self.n_contact)
+        self.outer = slice(N_FREE + self.n_contact, self.n)
+        self.k = 3 if control == "force" else 2
+        self.n_conditions = self.n + self.k
+        self._jres, self._jjac = mod.junction_smooth_res, mod.junction_smooth_jac
+
+    # -- parameters ------------------------------------------------------------------
+    def unpack(self, p):
+        """(ln S1, q, delta, F) with q = ln S2 (annulus) or chi1 (line)."""
+        if self.control == "delta":
+            return p[0], p[1], self.value, 0.0
+        return p[0], p[1], p[2], self.value
+
+    def pack(self, ln_S1, q, delta):
+        return np.array([ln_S1, q] if self.control == "delta" else [ln_S1, q, delta])
+
+    def ln_S2(self, p):
+        return p[1] if self.topology == "annulus" else p[0]
+
+    # -- maps -----------------------------------------------------------------------------
+    def S_inner(self, t, p):
+        return np.exp(p[0] + (1.0 - t) * self.ln_eps)
+
+    def S_contact(self, t, p):
+        return np.exp(p[0] + t * (self.ln_S2(p) - p[0]))
+
+    def S_outer(self, t, p):
+        b = self.ln_S2(p)
+        return np.exp(b + t * (self.ln_L - b))
+
+    # -- ODE --------------------------------------------------------------------------------
+    def fun(self, t, y, p):
+        mod, par = self.model, self.par
+        b = self.ln_S2(p)
+        f = np.empty_like(y)
+        f[self.inner] = -self.ln_eps * mod.free_rhs(self.S_inner(t, p), y[self.inner], par)
+        if self.n_contact:
+            f[self.contact] = (b - p[0]) * mod.contact_rhs(self.S_contact(t, p), y[self.contact], par)
+        f[self.outer] = (self.ln_L - b) * mod.free_rhs(self.S_outer(t, p), y[self.outer], par)
+        return f
+
+    def fun_jac(self, t, y, p):
+        mod, par = self.model, self.par
+        a, b = p[0], self.ln_S2(p)
+        n, m = self.n, t.size
+        dfdy, dfdp = np.zeros((n, n, m)), np.zeros((n, self.k, m))
+        ib = 1 if self.topology == "annulus" else 0  # column of ln S2
+        Si = self.S_inner(t, p)
+        gy, gS = mod.free_jac(Si, y[self.inner], par)
+        dfdy[self.inner, self.inner] = -self.ln_eps * gy
+        dfdp[self.inner, 0] = -self.ln_eps * gS * Si
+        if self.n_contact:
+            Sc = self.S_contact(t, p)
+            gy, gS = mod.contact_jac(Sc, y[self.contact], par)
+            g = mod.contact_rhs(Sc, y[self.contact], par)
+            dfdy[self.contact, self.contact] = (b - a) * gy
+            dfdp[self.contact, 0] = -g + (b - a) * gS * Sc * (1.0 - t)
+            dfdp[self.contact, ib] += g + (b - a) * gS * Sc * t
+        So = self.S_outer(t, p)
+        gy, gS = mod.free_jac(So, y[self.outer], par)
+        g = mod.free_rhs(So, y[self.outer], par)
+        dfdy[self.outer, self.outer] = (self.ln_L - b) * gy
+        dfdp[self.outer, ib] += -g + (self.ln_L - b) * gS * So * (1.0 - t)
+        return dfdy, dfdp
+
+    # -- conditions ---------------------------------------------------------------------------
+    def _line_contact_state(self, q, yb_inner):
+        # the indenter point touched, as a contact state (ls is not used by r, phi, z)
+        return np.array([q, yb_inner[2]])
+
+    def bc(self, ya, yb, p):
+        mod, par = self.model, self.par
+        ln_S1, q, delta, F = self.unpack(p)
+        S1 = np.exp(np.float64(ln_S1))
+        parts = [mod.free_pole_res(self.eps * S1, ya[self.inner], par)]
+        if self.topology == "annulus":
+            S2 = np.exp(np.float64(q))
+            parts += [self._jres(S1, ya[self.contact], yb[self.inner], delta, F, par),
+                      self._jres(S2, yb[self.contact], ya[self.outer], delta, F, par)]
+            yc2 = yb[self.contact]
+        else:
+            S2 = S1
+            yc2 = self._line_contact_state(q, yb[self.inner])
+            cont = ya[self.outer] - yb[self.inner]
+            parts += [self._jres(S1, yc2, yb[self.inner], delta, F, par)[:3], cont[[0, 1, 2, 3, 5]]]
+        parts.append(mod.rim_res(self.L, yb[self.outer], par))
+        if self.control == "force":
+            parts.append(mod.force_res(S2, yc2, ya[self.outer], delta, F, par))
+        return np.concatenate(parts)
+
+    def bc_jac(self, ya, yb, p):
+        mod, par = self.model, self.par
+        ln_S1, q, delta, F = self.unpack(p)
+        S1 = np.exp(np.float64(ln_S1))
+        m, n = self.n_conditions, self.n
+        A, B, P = np.zeros((m, n)), np.zeros((m, n)), np.zeros((m, self.k))
+        i0 = self.inner.start
+        o0 = self.outer.start
+        pj = mod.free_pole_jac(self.eps * S1, ya[self.inner], par)  # d/d(y, S)
+        A[0:3, i0:i0 + N_FREE] = pj[:, :N_FREE]
+        P[0:3, 0] = pj[:, N_FREE] * self.eps * S1
+        if self.topology == "annulus":
+            c0 = self.contact.start
+            S2 = np.exp(np.float64(q))
+            j1 = self._jjac(S1, ya[self.contact], yb[self.inner], delta, F, par)  # d/d(Sc, yc, yf, delta)
+            P[3:8, 0] = j1[:, 0] * S1
+            A[3:8, c0:c0 + N_CONTACT] = j1[:, 1:3]
+            B[3:8, i0:i0 + N_FREE] = j1[:, 3:9]
+            j2 = self._jjac(S2, yb[self.contact], ya[self.outer], delta, F, par)
+            P[8:13, 1] = j2[:, 0] * S2
+            B[8:13, c0:c0 + N_CONTACT] = j2[:, 1:3]
+            A[8:13, o0:o0 + N_FREE] = j2[:, 3:9]
+            jd = np.r_[j1[:, 9], j2[:, 9]]
+            S2_col, S2v, yc2 = 1, S2, yb[self.contact]
+        else:
+            yc2 = self._line_contact_state(q, yb[self.inner])
+            j1 = self._jjac(S1, yc2, yb[self.inner], delta, F, par)[:3]
+            P[3:6, 0] = j1[:, 0] * S1
+            P[3:6, 1] = j1[:, 1]  # d/d chi1
+            B[3:6, i0:i0 + N_FREE] = j1[:, 3:9]
+            B[3:6, i0 + 2] += j1[:, 2]  # the placeholder ls of the contact state
+            for row, col in enumerate((0, 1, 2, 3, 5), start=6):
+                A[row, o0 + col] = 1.0
+                B[row, i0 + col] = -1.0
+            jd = np.r_[j1[:, 9], np.zeros(8)]
+            S2_col, S2v = 0, S1
+        r0 = 3 + (10 if self.topology == "annulus" else 8)
+        B[r0:r0 + 3, o0:o0 + N_FREE] = mod.rim_jac(self.L, yb[self.outer], par)
+        if self.control == "force":
+            P[3:3 + jd.size, 2] = jd
+            fj = mod.force_jac(S2v, yc2, ya[self.outer], delta, F, par)  # d/d(Sc, yf, F)
+            P[r0 + 3, S2_col] += fj[0, 0] * S2v
+            A[r0 + 3, o0:o0 + N_FREE] = fj[0, 1:7]
+        return A, B, P

@@ -213,6 +213,15 @@ def function_specs(d: Derivation) -> list[FunctionSpec]:
                      [("dres", PL.jacobian(d.point_load_res, [*d.free_states, DELTA]))],
                      "Point-load pole conditions: d/d(y, delta), (3, 7)."),
     ]
+    # regular pole of a free cap (annular and line contact)
+    fargs = [("S", (d.free.inputs[0],)), ("y", d.free_states), ("par", par)]
+    specs += [
+        FunctionSpec("free_pole_res", d.free, fargs, [("res", d.free_pole_res)],
+                     "Regular pole of a free cap at S = zeta (3,)."),
+        FunctionSpec("free_pole_jac", d.free, fargs,
+                     [("dres", d.free.jacobian(d.free_pole_res, [*d.free_states, d.free.inputs[0]]))],
+                     "Regular pole of a free cap: d/d(y, S), (3, 7)."),
+    ]
     # geometry of the scene (guesses, plots, penetration checks)
     specs += [
         FunctionSpec("reference_shell", d.geometry_prog, [("S", (d.geometry_S,)), ("par", par)],

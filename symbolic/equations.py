@@ -31,6 +31,8 @@ Conditions (residuals; all O(1)-scaled):
 * contact line, paper model (eq. jumpeqns2): r, phi, z, Q and tau_s continuous
   (``[F] = r sin(phi)[tau_s]`` given the others; tau_s is the well-scaled form): 5;
 * force control: ``F/(2 pi)`` of the free region minus the prescribed value: 1.
+* regular pole of a free cap (lift-off topologies): isotropic stretch,
+  ``phi/S = psi kappa_s``, zero axial force: 3.
 
 Counting: 8 ODEs (2 contact + 6 free) plus k unknown parameters need 8 + k
 conditions.  The pole (2) + rim (3) + contact line (5) give 10 = 8 + 2: the
@@ -105,6 +107,7 @@ class Derivation:
         self._build_boundaries()
         self._build_geometry()
         self._build_point_load()
+        self._build_free_pole()
 
     # ------------------------------------------------------------------ shared pieces
     def _shell_steps(self, prog: Program, Svar, tag=""):
@@ -352,6 +355,22 @@ class Derivation:
             P.let("res_iso", lt - ls),
             P.let("res_zpole", z - (self.structure.shell.Z.subs(S, 0) - DELTA)),
             P.let("res_rot", phiS - o["psi"] * (ks - g_ks)),
+        ]
+
+    def _build_free_pole(self):
+        """Regular pole of a free cap (the shell lifted off the indenter there), at S = zeta.
+
+        With no force at the pole the axial force of the cap vanishes identically
+        (``G = 0`` exactly, scaled by S^2), the stretches are isotropic and
+        ``phi/S = psi kappa_s``; the last two err by O(zeta^2), like the contact pole.
+        """
+        lt, phiS, ls, ks, rQ, z = self.free_states
+        o = self.free_phys_out
+        F = self.free
+        self.free_pole_res = [
+            F.let("res_pole_iso", lt - ls),
+            F.let("res_pole_rot", phiS - o["psi"] * ks),
+            F.let("res_pole_G", o["G"] / S**2),
         ]
 
     def _build_geometry(self):

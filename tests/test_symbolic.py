@@ -231,6 +231,9 @@ def test_generated_jacobians_equal_finite_differences(name):
               _fd_jacobian(lambda v: res(v[0], v[1:3], v[3:9], v[9], 0.0, par), xj, h))
     check(mod.force_jac(0.15, yc, yf, 0.3, 0.7, par),
           _fd_jacobian(lambda v: mod.force_res(v[0], yc, v[1:7], 0.3, v[7], par), np.r_[0.15, yf, 0.7], h))
+    # regular pole of a lifted-off free cap, d/d(y, S)
+    check(mod.free_pole_jac(0.05, yf, par),
+          _fd_jacobian(lambda v: mod.free_pole_res(v[6], v[:6], par), np.r_[yf, 0.05], h))
 
 
 def test_condition_counts_close_each_control_mode():

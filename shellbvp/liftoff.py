@@ -1,0 +1,345 @@
+"""States whose contact has lifted off at the pole: annular and line contact.
+
+Where the single-cap state needs a negative contact pressure near the pole
+(the indenter would have to pull the shell), the shell leaves the indenter
+there: a free inner cap around the pole, then contact on an annulus
+``[S1, S2]`` (``topology="annulus"``) or on one circle (``"line"``, a
+zero-width annulus carrying a ring force), then the outer free region.  The
+systems are :class:`shellbvp.system.LiftOffBVP`; this module makes guesses,
+runs solve_bvp and diagnoses the result into a :class:`~shellbvp.state.Solution`
+with the same fields as a cap state, plus ``S1`` (inner edge), ``ring_force_inner``
+and ``contact_width``.  ``Sc`` is the outer contact edge.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+from scipy.integrate import solve_bvp
+
+from .state import (_GAUSS_T, _GAUSS_W, STATUS_MESSAGES, Solution, _attach_tip, _penetration,
+                    thin_mesh)
+from .system import N_CONTACT, N_FREE, LiftOffBVP
+
+__all__ = ["solve_liftoff", "make_liftoff_system", "liftoff_guess_from_cap", "liftoff_warm_guess",
+           "LIFTOFF_TOPOLOGIES", "solve_liftoff_from"]
+
+LIFTOFF_TOPOLOGIES = ("annulus", "line")
+
+
+def make_liftoff_system(scene, topology, control, value, eps):
+    sysm = LiftOffBVP(scene, topology, control, value, eps)
+    _attach_tip(sysm)
+    return sysm
+
+
+# -- guesses --------------------------------------------------------------------------------
+def _cap_states_at(cap, S):
+    """Contact states (chi, ls) of a cap solution at S inside its cap."""
+    csys = cap.system
+    t = 1.0 - (np.log(S) - cap.p[0]) / csys.ln_eps
+    return cap.sol(np.clip(t, 0.0, 1.0))[:N_CONTACT]
+
+
+def _cap_as_free(cap, S):
+    """Free-region states (lt, phiS, ls, ks, rQ, z) of a cap solution inside its cap."""
+    csys = cap.system
+    pc = csys.model.contact_profile(S, _cap_states_at(cap, S), csys.par)
+    return np.vstack([pc["lambda_theta"], pc["phi"] / S, pc["lambda_s"], pc["kappa_s"],
+                      pc["r"] * pc["Q"], pc["z"] + cap["z_tip"]])
+
+
+def _cap_free_at(cap, S):
+    csys = cap.system
+    t = (np.log(S) - cap.p[0]) / (csys.ln_L - cap.p[0])
+    return cap.sol(np.clip(t, 0.0, 1.0))[N_CONTACT:]
+
+
+def liftoff_guess_from_cap(sysm: LiftOffBVP, cap: Solution, S1_fraction: float, n: int = 81):
+    """Guess from a cap state: the pole region ``S < S1 = S1_fraction * Sc`` taken off the tip.
+
+    Annulus: contact on ``[S1, Sc]``; line: the contact circle at S1.
+    """
+    Sc = cap.Sc
+    S1 = S1_fraction * Sc
+    t = np.linspace(0.0, 1.0, n)
+    delta = cap.delta
+    if sysm.topology == "annulus":
+        p = sysm.pack(math.log(S1), math.log(Sc), delta)
+        Sin, Scont, Sout = sysm.S_inner(t, p), sysm.S_contact(t, p), sysm.S_outer(t, p)
+        y = np.vstack([_cap_as_free(cap, Sin), _cap_states_at(cap, Scont), _cap_free_at(cap, Sout)])
+    else:
+        chi1 = float(_cap_states_at(cap, np.array([S1]))[0, 0])
+        p = sysm.pack(math.log(S1), chi1, delta)
+        Sin, Sout = sysm.S_inner(t, p), sysm.S_outer(t, p)
+        outer = np.where(Sout <= Sc, _cap_as_free(cap, np.minimum(Sout, Sc)), _cap_free_at(cap, Sout))
+        y = np.vstack([_cap_as_free(cap, Sin), outer])
+    return t, y, p
+
+
+def liftoff_warm_guess(sysm: LiftOffBVP, prev: Solution, predictor=None):
+    """A neighbouring lift-off state of the same topology on its thinned mesh."""
+    x = thin_mesh(prev.x)
+    y = prev.sol(x)
+    p = sysm.pack(prev.p[0], prev.p[1], prev.delta)
+    if predictor is not None:
+        dy, dp = predictor
+        y, p = y + dy(x), p + dp
+    return x, y, p
+
+
+# -- solving --------------------------------------------------------------------------------
+def solve_liftoff(scene, topology, *, delta=None, force=None, guess, tol=1e-6, max_nodes=10000,
+                  eps=None, bc_tol=1e-10, estimate_error=False):
+    """One annular or line-contact state from a guess.
+
+    ``guess`` is a lift-off Solution of the same topology (warm start), or an
+    ``(x, y, p)`` tuple made for this system (see :func:`liftoff_guess_from_cap`).
+    Exactly one of ``delta`` (indenter displacement) or ``force`` is prescribed.
+    """
+    from .state import _default_eps
+
+    if (delta is None) == (force is None):
+        raise ValueError("give exactly one of delta or force")
+    control, value = ("delta", delta) if delta is not None else ("force", force)
+    eps = _default_eps(tol) if eps is None else eps
+    t0 = time.perf_counter()
+    sysm = make_liftoff_system(scene, topology, control, value, eps)
+    if isinstance(guess, Solution):
+        guess = liftoff_warm_guess(sysm, guess)
+    res = solve_liftoff_from(sysm, guess, tol=tol, max_nodes=max_nodes, bc_tol=bc_tol)
+    if res.success and estimate_error:
+        liftoff_richardson_error(sysm, res, tol, bc_tol)
+    res.wall_time = time.perf_counter() - t0
+    return res
+
+
+def solve_liftoff_from(sysm, guess, *, tol=1e-6, max_nodes=10000, bc_tol=1e-10):
+    x, y, p = guess
+    t0 = time.perf_counter()
+    with np.errstate(all="ignore"):
+        bvp = solve_bvp(sysm.fun, sysm.bc, x, y, p, fun_jac=sysm.fun_jac, bc_jac=sysm.bc_jac,
+                        tol=tol, bc_tol=bc_tol, max_nodes=max_nodes)
+        res = _diagnose(sysm, bvp, tol)
+    res.wall_time = time.perf_counter() - t0
+    return res
+
+
+def _edge_values(sysm, y_a, y_b, p):
+    """Force, ring forces (inner, outer) and the contact state at each edge."""
+    mod, par = sysm.model, sysm.par
+    ln_S1, q, delta, _ = sysm.unpack(p)
+    S1 = float(np.exp(np.float64(ln_S1)))
+    S2 = float(np.exp(np.float64(sysm.ln_S2(p))))
+    G_out = float(mod.free_profile(np.array([S2]), y_a[sysm.outer, None], par)["axial_force_2pi"][0])
+    G_in = float(mod.free_profile(np.array([S1]), y_b[sysm.inner, None], par)["axial_force_2pi"][0])
+    if sysm.topology == "annulus":
+        pc1 = mod.contact_profile(np.array([S1]), y_a[sysm.contact, None], par)["axial_force_2pi"][0]
+        pc2 = mod.contact_profile(np.array([S2]), y_b[sysm.contact, None], par)["axial_force_2pi"][0]
+        ring_in, ring_out = 2 * np.pi * (pc1 - G_in), 2 * np.pi * (G_out - pc2)
+    else:
+        ring_in, ring_out = 0.0, 2 * np.pi * (G_out - G_in)
+    return 2 * np.pi * G_out, float(ring_in), float(ring_out), S1, S2, float(delta)
+
+
+def _integrate(sysm, bvp, p, region):
+    x = bvp.x
+    a, b = x[:-1], x[1:]
+    t = (0.5 * (a + b)[:, None] + 0.5 * (b - a)[:, None] * _GAUSS_T[None, :]).ravel()
+    w = (0.5 * (b - a)[:, None] * _GAUSS_W[None, :]).ravel()
+    y = bvp.sol(t)
+    mod, par = sysm.model, sysm.par
+    if region == "inner":
+        S = sysm.S_inner(t, p)
+        e = mod.free_profile(S, y[sysm.inner], par)["energy_density"]
+        dlnS = -sysm.ln_eps
+    elif region == "contact":
+        S = sysm.S_contact(t, p)
+        e = mod.contact_profile(S, y[sysm.contact], par)["energy_density"]
+        dlnS = sysm.ln_S2(p) - p[0]
+    else:
+        S = sysm.S_outer(t, p)
+        e = mod.free_profile(S, y[sysm.outer], par)["energy_density"]
+        dlnS = sysm.ln_L - sysm.ln_S2(p)
+    return float(np.sum(w * e * S * dlnS))
+
+
+def _diagnose(sysm: LiftOffBVP, bvp, tol):
+    mod, par = sysm.model, sysm.par
+    p = bvp.p
+    ya, yb = bvp.y[:, 0], bvp.y[:, -1]
+    force, ring_in, ring_out, S1, S2, delta = _edge_values(sysm, ya, yb, p)
+    z_tip = float(mod.reference_shell(0.0, par)["Z"]) - delta
+    res = Solution(
+        topology=sysm.topology, status=int(bvp.status), message=bvp.message, x=bvp.x, y=bvp.y, p=p,
+        sol=bvp.sol, rms_residuals=bvp.rms_residuals, niter=int(bvp.niter), nodes=int(bvp.x.size),
+        max_residual=float(np.max(bvp.rms_residuals)) if bvp.rms_residuals.size else float("nan"),
+        delta=delta, lambda0=float(ya[2]), Sc=S2, S1=S1, contact_width=S2 - S1, force=force,
+        ring_force=ring_out, ring_force_inner=ring_in, cap_force=force - ring_out - ring_in,
+        control=sysm.control, scene=sysm.scene, system=sysm, z_tip=z_tip,
+    )
+    flags = []
+    finite = np.all(np.isfinite(bvp.y)) and np.all(np.isfinite(p)) and math.isfinite(force)
+    if not finite:
+        flags.append("non-finite state")
+    elif bvp.status == 0:
+        if not 0.0 < S1 <= S2 < sysm.L:
+            flags.append(f"contact edges S1 = {S1:.3g}, S2 = {S2:.3g} not ordered inside (0, L)")
+        if np.any(bvp.y[[0, 2, sysm.outer.start, sysm.outer.start + 2]] <= 0):
+            flags.append("non-positive stretch")
+        omega2 = (S2 * (yb[sysm.contact][0] if sysm.topology == "annulus" else p[1])) / sysm.scene.rho
+        if omega2 > sysm.scene.tip_omega_max:
+            flags.append("the contact has passed the end of the tip (the indenter's cylinder)")
+    if bvp.status == 0 and flags:
+        res.status = 4
+        res.message = STATUS_MESSAGES[4] + ": " + "; ".join(flags)
+    elif bvp.status == 0:
+        res.message = STATUS_MESSAGES[0]
+    res.success = res.status == 0
+    nan = float("nan")
+    if not finite:
+        res.update(energy=nan, pressure_min=nan, penetration=nan, force_defect=nan, edge_legendre=nan,
+                   valid=False, flags=flags)
+        return res
+
+    t = np.unique(np.r_[bvp.x, 0.5 * (bvp.x[1:] + bvp.x[:-1])])
+    y = bvp.sol(t)
+    pin = mod.free_profile(sysm.S_inner(t, p), y[sysm.inner], par)
+    pout = mod.free_profile(sysm.S_outer(t, p), y[sysm.outer], par)
+    res.force_defect = float(max(np.max(np.abs(2 * np.pi * pout["axial_force_2pi"] - force)),
+                                 np.max(np.abs(2 * np.pi * pin["axial_force_2pi"]))))
+    if sysm.topology == "annulus":
+        pc = mod.contact_profile(sysm.S_contact(t, p), y[sysm.contact], par)
+        res.pressure_min = float(np.min(pc["P"]))
+    else:
+        res.pressure_min = nan  # no area of contact
+    leg = mod.free_legendre(sysm.S_outer(np.array([0.0, 0.5]), p),
+                            bvp.sol(np.array([0.0, 0.5]))[sysm.outer], par)[0]
+    res.edge_legendre = float(leg[0] / leg[1]) if leg[1] != 0 else nan
+    res.penetration = max(_penetration(sysm, pin["r"], pin["z"], z_tip),
+                          _penetration(sysm, pout["r"], pout["z"], z_tip))
+    E = sum(_integrate(sysm, bvp, p, reg) for reg in (("inner", "contact", "outer")
+                                                        if sysm.topology == "annulus" else ("inner", "outer")))
+    pole_density = float(mod.free_profile(np.array([sysm.eps * S1]), ya[sysm.inner, None], par)
+                         ["energy_density"][0])
+    res.energy = 2 * np.pi * (E + 0.5 * pole_density * sysm.eps * S1)
+    vflags = []
+    scale = 10 * tol * (1 + abs(force))
+    if sysm.topology == "annulus" and res.pressure_min < -scale:
+        vflags.append(f"negative contact pressure on the annulus (min P = {res.pressure_min:.3g})")
+    if ring_in < -scale:
+        vflags.append(f"negative ring force ({ring_in:.3g}) at the inner contact edge")
+    if ring_out < -scale:
+        vflags.append(f"negative ring force ({ring_out:.3g}) at the outer contact edge")
+    if res.penetration > 10 * tol:
+        vflags.append(f"the free shell passes through the indenter (by {res.penetration:.3g})")
+    res.flags = flags + vflags
+    res.valid = res.success and not vflags
+    return res
+
+
+def liftoff_richardson_error(sysm, res, tol, bc_tol=1e-10):
+    """``force_error``, ``delta_error``: as :func:`shellbvp.state.richardson_error`."""
+    x = res.x
+    x2 = np.sort(np.r_[x, 0.5 * (x[1:] + x[:-1])])
+    with np.errstate(all="ignore"):
+        fine = solve_bvp(sysm.fun, sysm.bc, x2, res.sol(x2), np.array(res.p, float), fun_jac=sysm.fun_jac,
+                         bc_jac=sysm.bc_jac, tol=tol / 100, bc_tol=bc_tol / 100, max_nodes=x2.size)
+    if fine.status == 2 or not np.all(np.isfinite(fine.p)):
+        res.force_error = res.delta_error = float("nan")
+        res.flags = list(res.flags) + ["error estimate failed (Newton on the halved mesh did not converge)"]
+        return
+    force, _, _, _, _, delta = _edge_values(sysm, fine.y[:, 0], fine.y[:, -1], fine.p)
+    res.force_error = abs(force - res.force) * 16 / 15
+    res.delta_error = abs(delta - res.delta) * 16 / 15
+
+
+# -- topology selection ------------------------------------------------------------------------
+#: Below this ratio S1/S2 an annulus has reached the pole: it is the cap.
+ANNULUS_CLOSED_AT_POLE = 1e-4
+
+
+#: Below this contact radius a lifted-off state is taken as its point-load limit.
+POINT_LIMIT_SC = 1e-8
+
+
+def lift_off_suspected(cap: Solution) -> bool:
+    """The cap state asks the indenter to pull: negative pressure or ring force."""
+    return bool(cap.success and cap.get("topology") == "cap"
+                and (cap.pressure_min < 0 or cap.ring_force < 0))
+
+
+def liftoff_state(cap: Solution, topology: str, *, tol=1e-6, max_nodes=10000, bc_tol=1e-10,
+                  previous: Solution | None = None):
+    """The ``topology`` state at the cap's delta (or force), from ``previous`` or from the cap.
+
+    Returns a Solution (check ``success`` and ``valid``).  An annulus whose inner edge
+    runs to the pole is the cap itself: it is returned as a failure saying so.
+    """
+    control = "force" if cap.control == "force" else "delta"
+    value = cap.force if control == "force" else cap.delta
+    sysm = make_liftoff_system(cap.scene, topology, control, value, cap.system.eps)
+    # The cap is the better guess (the lift-off state is close to it near the switch and
+    # its contact edge is where the cap's is); a neighbour of the same topology is the
+    # fallback.  A node budget of a few times the cap's makes hopeless starts fail fast.
+    kw = dict(tol=tol, max_nodes=int(min(max_nodes, max(2000, 4 * cap.nodes))), bc_tol=bc_tol)
+    res = None
+    for frac in ((0.9, 0.5) if topology == "line" else (0.5, 0.9)):
+        res = solve_liftoff_from(sysm, liftoff_guess_from_cap(sysm, cap, frac), **kw)
+        if res.success:
+            break
+    if not res.success and previous is not None and previous.get("topology") == topology:
+        res = solve_liftoff_from(sysm, liftoff_warm_guess(sysm, previous), **kw)
+    if topology == "annulus" and math.isfinite(res.S1) and res.S1 < ANNULUS_CLOSED_AT_POLE * res.Sc:
+        res.status, res.success, res.valid = 4, False, False
+        res.message = (f"{STATUS_MESSAGES[4]}: the annulus reaches the pole (S1/S2 = {res.S1 / res.Sc:.2g}): "
+                       "the state is the single cap")
+    return res
+
+
+def valid_liftoff_state(cap: Solution, *, tol=1e-6, max_nodes=10000, bc_tol=1e-10, previous=None):
+    """A valid line or annular state where the cap is invalid; (state or None, what was tried).
+
+    A contact radius below ``POINT_LIMIT_SC`` is taken as its point-load limit
+    (exponentially close; a line that small strains double precision in its inner cap).
+    """
+    tried = []
+    if cap.Sc < POINT_LIMIT_SC and cap.control == "delta":
+        from .state import solve_point_load
+
+        res = solve_point_load(cap.scene, cap.delta, tol=tol, max_nodes=max_nodes, guess=cap, bc_tol=bc_tol)
+        if res.success and res.valid:
+            return res, tried
+        tried.append("point load: " + (res.message if not res.success else "; ".join(res.flags)))
+    order = ("line", "annulus")
+    if previous is not None and previous.get("topology") in order:
+        order = (previous.topology,) + tuple(t for t in order if t != previous.topology)
+    for topology in order:
+        res = liftoff_state(cap, topology, tol=tol, max_nodes=max_nodes, bc_tol=bc_tol, previous=previous)
+        if res.success and res.valid:
+            return res, tried
+        why = res.message if not res.success else "; ".join(res.flags)
+        tried.append(f"{topology}: {why}")
+    return None, tried
+
+
+def liftoff_profile(sol: Solution, t):
+    """Fields over S of a lift-off state (see :meth:`Solution.profile`)."""
+    sysm, p = sol.system, sol.p
+    mod, par = sysm.model, sysm.par
+    y = sol.sol(t)
+    parts = [(np.ones(t.size), mod.free_profile(sysm.S_inner(t, p), y[sysm.inner], par), sysm.S_inner(t, p))]
+    if sysm.topology == "annulus":
+        pc = mod.contact_profile(sysm.S_contact(t, p), y[sysm.contact], par)
+        pc["z"] = pc["z"] + sol["z_tip"]
+        parts.append((np.zeros(t.size), pc, sysm.S_contact(t, p)))
+    parts.append((np.ones(t.size), mod.free_profile(sysm.S_outer(t, p), y[sysm.outer], par), sysm.S_outer(t, p)))
+    out = {"S": np.concatenate([S for _, _, S in parts]),
+           "region": np.concatenate([reg for reg, _, _ in parts]).astype(int)}
+    for key in parts[-1][1]:
+        vals = np.concatenate([np.broadcast_to(pr[key], t.shape) for _, pr, _ in parts])
+        out["axial_force" if key == "axial_force_2pi" else key] = (
+            2 * np.pi * vals if key == "axial_force_2pi" else vals)
+    return out

@@ -1,0 +1,161 @@
+"""Lift-off at the pole: line and annular contact (issue 7).
+
+Where the single cap would need a negative contact pressure, the shell leaves
+the indenter around the pole.  These tests check the stacked systems, that
+the states found are valid (pushing ring forces, no penetration), that they
+satisfy the energy identity F = dE/ddelta, and that curves switch topology
+without a jump in F(delta).
+"""
+
+import numpy as np
+import pytest
+
+import shellbvp as sb
+from shellbvp.liftoff import liftoff_state
+from shellbvp.state import solve_point_load
+from shellbvp.system import LiftOffBVP
+
+
+def _fd(f, x, h=1e-7):
+    cols = []
+    for j in range(x.size):
+        e = np.zeros(x.size)
+        e[j] = h
+        cols.append((f(x + e) - f(x - e)) / (2 * h))
+    return np.stack(cols, axis=-1)
+
+
+@pytest.mark.parametrize("topology", ["annulus", "line"])
+@pytest.mark.parametrize("control", ["delta", "force"])
+def test_liftoff_jacobians_equal_finite_differences(topology, control):
+    sysm = LiftOffBVP(sb.Scene.preset("base"), topology, control, 0.1, 1e-3)
+    rng = np.random.default_rng(1)
+    t = np.linspace(0, 1, 4)
+    y = 0.5 + 0.3 * rng.random((sysm.n, t.size))
+    p = np.r_[np.log(0.05), np.log(0.15) if topology == "annulus" else 0.9, [0.1] if control == "force" else []]
+    dfdy, dfdp = sysm.fun_jac(t, y, p)
+    rel = lambda a, b: np.max(np.abs(a - b)) / (1 + np.max(np.abs(b)))  # noqa: E731
+    for k in range(t.size):
+        assert rel(dfdy[:, :, k], _fd(lambda v: sysm.fun(t[k:k + 1], v[:, None], p)[:, 0], y[:, k])) < 1e-6
+        assert rel(dfdp[:, :, k], _fd(lambda v: sysm.fun(t[k:k + 1], y[:, k:k + 1], v)[:, 0], p)) < 1e-6
+    ya, yb = y[:, 0], y[:, -1]
+    A, B, P = sysm.bc_jac(ya, yb, p)
+    assert sysm.bc(ya, yb, p).size == sysm.n + sysm.k == A.shape[0]
+    assert rel(A, _fd(lambda v: sysm.bc(v, yb, p), ya)) < 1e-6
+    assert rel(B, _fd(lambda v: sysm.bc(ya, v, p), yb)) < 1e-6
+    assert rel(P, _fd(lambda v: sysm.bc(ya, yb, v), p)) < 1e-6
+
+
+def _energy_slope(scene, delta, h=1e-3, tol=1e-8):
+    """dE/ddelta by Richardson-extrapolated central differences (error O(h^4))."""
+    E = {k: sb.solve(scene, delta=delta + k * h, tol=tol, estimate_error=False) for k in (-2, -1, 1, 2)}
+    for s in E.values():
+        assert s.success and s.valid, s.flags
+    d1 = (E[1].energy - E[-1].energy) / (2 * h)
+    d2 = (E[2].energy - E[-2].energy) / (4 * h)
+    return (4 * d1 - d2) / 3, {s.topology for s in E.values()}
+
+
+@pytest.mark.parametrize("preset, delta", [("base", 0.05), ("dome", 0.1)])
+def test_lifted_pole_state_is_valid_and_energy_consistent(preset, delta):
+    scene = sb.Scene.preset(preset)
+    cap = sb.solve(scene, delta=delta, topology="cap")
+    assert cap.success and not cap.valid and cap.pressure_min < 0  # the cap would pull the shell
+    sol = sb.solve(scene, delta=delta, tol=1e-8)
+    assert sol.success and sol.valid, sol.flags
+    assert sol.topology == "line"
+    assert sol.ring_force > 0 and sol.ring_force == pytest.approx(sol.force, rel=1e-6)
+    assert sol.penetration <= 0
+    # the inner cap carries no force: its axial force vanishes along it
+    assert sol.force_defect < 1e-6
+    # the energy identity F = dE/ddelta, to the finite-difference and solver accuracy
+    slope, kinds = _energy_slope(scene, delta)
+    assert kinds == {"line"}
+    assert abs(slope - sol.force) < 1e-8 + 10 * sol.force_error
+    # the lifted state differs from the invalid cap by a small, measured amount
+    assert sol.cap_state["force"] == pytest.approx(cap.force, rel=1e-6)
+    assert sol.energy <= cap.energy + 1e-9
+
+
+def test_lifted_pole_profile_is_ordered_and_off_the_indenter():
+    scene = sb.Scene.preset("base")
+    sol = sb.solve(scene, delta=0.1)
+    prof = sol.profile()
+    assert np.all(np.diff(prof["S"]) >= 0)
+    assert np.all(prof["region"] == 1)  # line contact: free on both sides
+    inner = prof["S"] <= sol.S1
+    tip = sol.system.model.tip_shape(np.linspace(0, 1.5, 2001), sol.system.par)
+    surface = sol.z_tip + scene.rho * np.interp(prof["r"][inner] / scene.rho, tip["A"], tip["B"])
+    assert np.all(prof["z"][inner] <= surface + 1e-7)  # below the indenter: lifted off, not through it
+    assert np.max(surface - prof["z"][inner]) > 1e-8   # and really off it somewhere
+
+
+def test_valid_cap_is_kept_and_annulus_search_returns_the_cap():
+    scene = sb.Scene.preset("base")
+    sol = sb.solve(scene, delta=0.2)
+    assert sol.topology == "cap" and sol.valid
+    ann = liftoff_state(sol, "annulus")
+    assert not ann.success and "reaches the pole" in ann.message
+    line = liftoff_state(sol, "line")
+    assert not line.valid and any("passes through the indenter" in f for f in line.flags)
+
+
+def test_topology_argument_is_checked():
+    scene = sb.Scene.preset("base")
+    with pytest.raises(ValueError, match="topology"):
+        sb.solve(scene, delta=0.1, topology="ring")
+    with pytest.raises(ValueError, match="contact='smooth'"):
+        sb.solve(sb.Scene.preset("base", contact="paper"), delta=0.1, topology="line")
+    with pytest.raises(ValueError, match="lambda0"):
+        sb.solve(scene, lambda0=1.0, topology="line")
+    with pytest.raises(ValueError, match="topology"):
+        sb.curve(scene, topology="line")
+
+
+def test_force_control_finds_the_lifted_state():
+    scene = sb.Scene.preset("base")
+    ref = sb.solve(scene, delta=0.08)
+    sol = sb.solve(scene, force=ref.force)
+    assert sol.topology == "line" and sol.valid
+    assert sol.delta == pytest.approx(0.08, abs=1e-7)
+
+
+def test_base_curve_switches_from_line_to_cap_without_a_jump(tmp_path):
+    scene = sb.Scene.preset("base")
+    c = sb.curve(scene, delta_max=0.2)
+    assert c.complete and np.all(c.valid), c.flags
+    kinds = list(c.topology)
+    assert kinds[0] == "point" and kinds[-1] == "cap" and "line" in kinds
+    (switch,) = [s for s in c.settings["topology_switches"] if s["from"] == "line"]
+    assert 0.09 < switch["delta"] < 0.13 and abs(switch["pressure_min"]) < 1e-3
+    # at the switch the line state and the cap coincide
+    i = int(np.argmin(np.abs(c.delta - switch["delta"])))
+    cap = c.solutions[i]
+    line = liftoff_state(cap, "line")
+    assert line.success
+    assert line.force == pytest.approx(cap.force, abs=1e-7)
+    # F(delta) is smooth across: the energy identity holds through the switch
+    assert np.nanmax(np.abs(c.energy_residual)) < 2e-3
+    path = tmp_path / "c.h5"
+    c.to_hdf5(path)
+    back = sb.read_curve(path)
+    assert list(back.topology) == kinds
+    np.testing.assert_array_equal(back.S1, c.S1)
+
+
+def test_dome_curve_is_valid_at_every_point():
+    c = sb.curve(sb.Scene.preset("dome"), delta_max=0.3)
+    assert c.complete and np.all(c.valid), c.flags
+    assert set(c.topology) <= {"point", "line"}
+    assert np.all(c.force > 0) and np.all(np.diff(c.force) > 0)
+    # point -> line: the point-load limit and the smallest line contact agree
+    i = list(c.topology).index("line")
+    point = solve_point_load(sb.Scene.preset("dome"), float(c.delta[i]))
+    assert point.force == pytest.approx(c.force[i], rel=1e-5)
+
+
+@pytest.mark.slow
+def test_energy_identity_through_the_switch_on_a_fine_grid():
+    c = sb.curve(sb.Scene.preset("base"), deltas=np.linspace(0.09, 0.14, 26), tol=1e-8)
+    assert set(c.topology) == {"line", "cap"} and np.all(c.valid)
+    assert np.nanmax(np.abs(c.energy_residual)) < 5e-5
