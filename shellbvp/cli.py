@@ -114,11 +114,13 @@ def _cmd_curve(args):
     t0 = time.perf_counter()
     c = sb.curve(scene, args.delta_max, deltas=deltas, force_max=args.force_max,
                  lambda0_max=args.lambda0_max, max_steps=args.max_steps, tol=args.tol,
-                 max_nodes=args.max_nodes, callback=callback)
+                 max_nodes=args.max_nodes, callback=callback, topology=args.topology)
     if sys.stderr.isatty() and not args.quiet:
         sys.stderr.write("\n")
     write_curve(c, out, profiles=args.profiles, overwrite=True, units=units)
     print(f"wrote {out}: {c.summary()} in {time.perf_counter() - t0:.1f} s")
+    if len(c):
+        print(f"  contact topologies along the curve: {c.topology_summary()}")
     if c.interrupted:
         print("shellbvp: interrupted; the file holds the finished points (complete = False)", file=sys.stderr)
         return 130
@@ -135,11 +137,12 @@ def _cmd_solve(args):
              if v is not None}
     if not given:
         given = {"delta": 0.2}
-    sol = sb.solve(scene, tol=args.tol, max_nodes=args.max_nodes, **given)
-    keys = ("success", "status", "message", "delta", "force", "lambda0", "Sc", "ring_force", "cap_force",
+    sol = sb.solve(scene, tol=args.tol, max_nodes=args.max_nodes, topology=args.topology, **given)
+    keys = ("success", "status", "message", "topology", "delta", "force", "lambda0", "S1", "Sc",
+            "ring_force", "ring_force_inner", "cap_force",
             "pressure_min", "penetration", "valid", "flags", "energy", "force_defect", "force_error",
             "delta_error", "nodes", "niter", "max_residual", "wall_time")
-    out = {k: sol.get(k) for k in keys}
+    out = {k: sol.get(k, 0.0 if k in ("S1", "ring_force_inner") else None) for k in keys}
     out = {k: (float(v) if isinstance(v, (np.floating,)) else v) for k, v in out.items()}
     if args.profiles and sol.success:
         out["profile"] = {k: np.asarray(v).tolist() for k, v in sol.profile().items()}
@@ -147,7 +150,7 @@ def _cmd_solve(args):
         print(json.dumps(out, default=float))
     else:
         for k in keys:
-            print(f"{k:>14s}: {out[k]}")
+            print(f"{k:>16s}: {out[k]}")
         if args.profiles and sol.success:
             prof = sol.profile()
             cols = ("S", "region", "r", "z", "lambda_s", "lambda_theta", "kappa_s", "kappa_theta",
@@ -182,7 +185,20 @@ def _cmd_fit(args):
 
     data = example_data_path() if args.example else args.data
     disp, force = sb.read_force_csv(data, columns=columns, units=units)
-    res = sb.fit(scene, disp, force, R_L=R_L, fit_offset=not args.no_offset, tol=args.tol)
+    bounds = {}
+    for name, text in (("beta", args.beta_range), ("alpha", args.alpha_range)):
+        if text is not None:
+            parts = text.split(",")
+            try:
+                bounds[f"{name}_bounds"] = tuple(float(v) for v in parts)
+            except ValueError:
+                raise ValueError(f"--{name}-range must be two numbers LOW,HIGH; got {text!r}") from None
+            if len(parts) != 2:
+                raise ValueError(f"--{name}-range must be two numbers LOW,HIGH; got {text!r}")
+            if not (args.fit_beta if name == "beta" else args.fit_alpha):
+                raise ValueError(f"--{name}-range needs --fit-{name}")
+    res = sb.fit(scene, disp, force, R_L=R_L, fit_offset=not args.no_offset, fit_beta=args.fit_beta,
+                 fit_alpha=args.fit_alpha, weights=args.weights, tol=args.tol, **bounds)
     out = res.to_dict()
     if args.json:
         print(json.dumps(out))
@@ -192,7 +208,15 @@ def _cmd_fit(args):
         if not args.no_offset:
             o1, o2 = res.offset_ci95
             print(f"offset = {res.offset * 1e3:.4g} mm   95% CI [{o1 * 1e3:.4g}, {o2 * 1e3:.4g}] mm")
-        print(f"rms residual = {res.residual_rms * 1e3:.4g} mN over {res.n} points; R_L = {R_L * 1e3:.4g} mm")
+        for name in ("beta", "alpha"):
+            if name in res.fitted:
+                v, (c1, c2) = getattr(res, name), getattr(res, name + "_ci95")
+                print(f"{name:<6s} = {v:.4g}   95% CI [{c1:.4g}, {c2:.4g}] (profile likelihood; "
+                      f"{res.curves_computed} model curves)")
+        print(f"rms residual = {res.residual_rms * 1e3:.4g} mN over {res.n} points; R_L = {R_L * 1e3:.4g} mm; "
+              f"{res.weights} weights")
+        if res.message and "; " in res.message:
+            print("note: " + res.message.split("; ", 1)[1])
     if args.output:
         res.curve.to_hdf5(args.output, overwrite=args.force, units={"R_L": R_L, "mu_H": res.mu_H})
     return 0 if res.success else 1
@@ -236,10 +260,12 @@ def _cmd_info(args):
     if np.any(np.isfinite(res)):
         print(f"energy identity: max |dE/ddelta - F| = {np.nanmax(np.abs(res)):.3g}")
     if len(c):
-        print(f"{'delta':>10s} {'force':>12s} {'lambda0':>9s} {'Sc':>10s} {'status':>6s} {'valid':>5s}")
+        print(f"topology:  {c.topology_summary()}")
+        print(f"{'delta':>10s} {'force':>12s} {'lambda0':>9s} {'S1':>10s} {'Sc':>10s} {'topology':>8s} "
+              f"{'status':>6s} {'valid':>5s}")
         for i in range(len(c)):
-            print(f"{c.delta[i]:10.5f} {c.force[i]:12.6g} {c.lambda0[i]:9.5f} {c.Sc[i]:10.4g} "
-                  f"{int(c.status[i]):6d} {str(bool(c.valid[i])):>5s}")
+            print(f"{c.delta[i]:10.5f} {c.force[i]:12.6g} {c.lambda0[i]:9.5f} {c.S1[i]:10.4g} {c.Sc[i]:10.4g} "
+                  f"{c.topology[i]:>8s} {int(c.status[i]):6d} {str(bool(c.valid[i])):>5s}")
     return 0
 
 
@@ -270,6 +296,9 @@ def build_parser():
     c.add_argument("-o", "--output", help="output file (default <preset>.h5)")
     c.add_argument("--force", action="store_true", help="replace an existing output file")
     c.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
+    c.add_argument("--topology", choices=("auto", "cap"), default="auto",
+                   help="auto (default): where the single contact cap would pull the shell, use the valid "
+                        "lifted-off (line or annular) contact; cap: single cap only, flagged where invalid")
     c.set_defaults(func=_cmd_curve)
     s = sub.add_parser("solve", help="solve one state and print it")
     _scene_options(s)
@@ -279,6 +308,9 @@ def build_parser():
     g.add_argument("--load", type=float, help="indenter force F (force control)")
     s.add_argument("--profiles", action="store_true", help="print the fields over S")
     s.add_argument("--json", action="store_true", help="print JSON")
+    s.add_argument("--topology", choices=("auto", "cap", "line", "annulus"), default="auto",
+                   help="contact topology (default auto: the cap, or a valid lifted-off state where the cap "
+                        "would pull the shell)")
     s.set_defaults(func=_cmd_solve)
     f = sub.add_parser("fit", help="fit mu*H (and the contact point) to measured force-displacement data")
     f.add_argument("data", nargs="?", help="CSV file: displacement and force columns")
@@ -289,6 +321,15 @@ def build_parser():
     f.add_argument("--columns", help="displacement,force columns by name or 0-based index (default 0,1)")
     f.add_argument("--units", help="units of the two columns, e.g. mm,mN (default: from the header)")
     f.add_argument("--no-offset", action="store_true", dest="no_offset", help="do not fit the contact point")
+    f.add_argument("--fit-beta", action="store_true", dest="fit_beta",
+                   help="also fit beta (starting from the scene's; a few more model curves)")
+    f.add_argument("--fit-alpha", action="store_true", dest="fit_alpha",
+                   help="also fit the Mooney-Rivlin alpha (starting from the scene's)")
+    f.add_argument("--beta-range", dest="beta_range", help="search range of --fit-beta, LOW,HIGH (default 1e-4,1)")
+    f.add_argument("--alpha-range", dest="alpha_range", help="search range of --fit-alpha, LOW,HIGH (default 0,1)")
+    f.add_argument("--weights", choices=("uniform", "relative", "mixed"),
+                   help="noise model: uniform (same force noise everywhere), relative (noise proportional "
+                        "to the force) or mixed (both, estimated; the default)")
     f.add_argument("--json", action="store_true")
     f.add_argument("-o", "--output", help="write the fitted model curve (HDF5, with SI columns)")
     f.add_argument("--force", action="store_true", help="replace an existing output file")

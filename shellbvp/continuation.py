@@ -95,6 +95,15 @@ class Curve:
 
         write_curve(self, path, profiles=profiles, overwrite=overwrite, units=units)
 
+    def topology_summary(self) -> str:
+        """Runs of contact topology along the curve, e.g. 'point x2, line x6, cap x27'."""
+        import itertools
+
+        runs = [f"{k} x{len(list(g))}" for k, g in itertools.groupby(self.points["topology"])]
+        switches = self.settings.get("topology_switches") or []
+        where = "; ".join(f"{s['from']} -> {s['to']} at delta = {s['delta']:.6g}" for s in switches)
+        return ", ".join(runs) + (f" (switch {where})" if where else "")
+
     def summary(self) -> str:
         n = len(self)
         if n == 0:

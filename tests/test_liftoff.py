@@ -159,3 +159,28 @@ def test_energy_identity_through_the_switch_on_a_fine_grid():
     c = sb.curve(sb.Scene.preset("base"), deltas=np.linspace(0.09, 0.14, 26), tol=1e-8)
     assert set(c.topology) == {"line", "cap"} and np.all(c.valid)
     assert np.nanmax(np.abs(c.energy_residual)) < 5e-5
+
+
+def _cli(*args, cwd=None):
+    import subprocess
+    import sys
+
+    return subprocess.run([sys.executable, "-m", "shellbvp", *args], capture_output=True, text=True, cwd=cwd,
+                          timeout=600)
+
+
+def test_cli_reports_the_topology(tmp_path):
+    import json
+
+    r = _cli("solve", "--preset", "dome", "--delta", "0.1", "--json")
+    assert r.returncode == 0, r.stderr
+    out = json.loads(r.stdout)
+    assert out["topology"] == "line" and out["valid"] and out["S1"] == out["Sc"] > 0
+    r = _cli("solve", "--preset", "dome", "--delta", "0.1", "--topology", "cap", "--json")
+    out = json.loads(r.stdout)
+    assert out["topology"] == "cap" and not out["valid"]
+    r = _cli("curve", "--preset", "dome", "--delta-max", "0.1", "-o", "d.h5", cwd=tmp_path)
+    assert r.returncode == 0, r.stderr
+    assert "contact topologies along the curve: point x" in r.stdout and "line x" in r.stdout
+    c = sb.read_curve(tmp_path / "d.h5")
+    assert np.all(c.valid) and set(c.topology) == {"point", "line"}
