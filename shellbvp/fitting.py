@@ -1,12 +1,33 @@
-"""Fit mu*H (and a displacement origin) to a measured force–displacement curve.
+"""Fit mu*H (a displacement origin, and optionally beta or alpha) to a measured curve.
 
 The model force scales linearly in mu*H (``F_SI = mu_H R_L F(delta)``), so
-one model curve serves the whole fit: it is computed once on a grid of depths
-and interpolated (monotone cubic) in delta.  The unknowns are ``mu_H`` and,
-optionally, the origin offset ``d0`` of the displacement (real contact points
-are uncertain): ``F_i = mu_H R_L F((d_i - d0)/R_L)`` for ``d_i > d0``, 0 before.
-Least squares (scipy.optimize.least_squares, analytic Jacobian) with 95 %
-confidence intervals from the linearised covariance and Student's t.
+one model curve serves a fit of mu*H and the contact point: it is computed
+once on a grid of depths and interpolated (monotone cubic) in delta.  The
+unknowns are ``mu_H`` and, optionally, the origin offset ``d0`` of the
+displacement (real contact points are uncertain):
+``F_i = mu_H R_L F((d_i - d0)/R_L)`` for ``d_i > d0``, 0 before.
+
+beta (bending stiffness) and the Mooney–Rivlin alpha change the *shape* of
+the curve.  Fitting one of them uses a few model curves at trial values
+(nodes; log-spaced for beta, by 0.2 for alpha) on a common delta grid and
+interpolates F across them (cubic spline in ``ln beta`` or ``alpha`` at every
+grid depth).  The parameter is estimated by minimising the profiled residual
+(mu*H and d0 refitted at each trial value); nodes are added where the
+minimum or the interval reaches the edge of the nodes, and a last curve is
+computed at the estimate (the interpolation error there is reported).  Its
+95 % interval is the profile-likelihood interval
+``RSS(theta) <= RSS_min (1 + F_{1,n-p}(0.95)/(n-p))``.
+
+Noise models (``weights``), all by iteratively reweighted least squares with
+the weights from the current model force F_i: ``"uniform"`` (homoscedastic:
+the same force noise at every point), ``"relative"`` (noise proportional to
+the force: residuals divided by ``max(|F_i|, floor * max|F_data|)``) and
+``"mixed"`` (the default: ``sigma_i^2 = a^2 + b^2 F_i^2``, an additive floor
+plus a proportional part, both estimated from the squared residuals by
+non-negative least squares -- it covers either kind of noise and anything
+between).  Intervals of mu*H and d0 come from the
+linearised covariance (with beta or alpha as a third column when fitted) and
+Student's t.  ``benchmarks/fit_coverage.py`` measures their coverage.
 """
 
 from __future__ import annotations
@@ -14,15 +35,27 @@ from __future__ import annotations
 import csv
 import io
 import math
+from collections import OrderedDict
 from dataclasses import dataclass, field
 
 import numpy as np
 from scipy import optimize, stats
-from scipy.interpolate import PchipInterpolator
+from scipy.interpolate import CubicSpline, PchipInterpolator
 
 from .units import unit_factor
 
-__all__ = ["FitResult", "fit", "read_force_csv", "example_data_path"]
+__all__ = ["FitResult", "fit", "read_force_csv", "example_data_path", "WEIGHTS", "DEFAULT_WEIGHTS"]
+
+#: Noise models of :func:`fit`.
+WEIGHTS = ("uniform", "relative", "mixed")
+#: The default noise model (chosen by the coverage measured in benchmarks/fit_coverage.py).
+DEFAULT_WEIGHTS = "mixed"
+#: Depths of every model curve (equally spaced up to delta_max).
+N_DEPTHS = 40
+#: Default search ranges of the shape parameters.
+BETA_BOUNDS = (1e-4, 1.0)
+ALPHA_BOUNDS = (0.0, 1.0)
+_MAX_CURVES = 14
 
 
 def example_data_path():
@@ -43,14 +76,31 @@ class FitResult:
     mu_H_ci95 : (float, float)
     offset, offset_ci95 : float, (float, float)
         Displacement origin d0 in m (0 and (0, 0) when not fitted).
+    beta, alpha : float
+        Bending stiffness and Mooney–Rivlin alpha of the fitted model (the
+        scene's values unless fitted; alpha is None for other materials).
+    beta_ci95, alpha_ci95 : (float, float) or None
+        Profile-likelihood 95 % intervals (None when not fitted).  A side that
+        reached the search bound is the bound (see ``message``).
+    fitted : tuple of str
+        The fitted parameters ("mu_H", "offset", "beta" | "alpha").
+    weights : str
+        The noise model, "uniform", "relative" or "mixed".
     residual_rms : float
-        Root-mean-square force residual, N.
+        Root-mean-square force residual, N (unweighted).
     n : int
         Number of data points used.
     success : bool
     message : str
     curve : Curve
-        The model curve (nondimensional) the fit used.
+        The model curve (nondimensional) at the fitted parameters.
+    scene : Scene
+        The scene of that curve (fitted beta or alpha).
+    curves_computed : int
+        Model curves computed for this fit (cached ones not counted).
+    interpolation_error : float or None
+        With beta or alpha fitted: max |F_interpolated - F_curve| / max |F| at
+        the estimate before its own curve was added (None otherwise).
     R_L : float
     """
 
@@ -65,48 +115,217 @@ class FitResult:
     R_L: float
     curve: object = field(repr=False, default=None)
     _model: object = field(repr=False, default=None)
+    beta: float = None
+    beta_ci95: tuple = None
+    alpha: float = None
+    alpha_ci95: tuple = None
+    fitted: tuple = ("mu_H", "offset")
+    weights: str = DEFAULT_WEIGHTS
+    scene: object = field(repr=False, default=None)
+    curves_computed: int = 0
+    interpolation_error: float = None
 
     def model_force(self, displacement):
         """Fitted model force (N) at displacements (m)."""
         return self._model(np.asarray(displacement, float), self.mu_H, self.offset)
 
     def to_dict(self):
+        ci = (lambda v: None if v is None else [float(x) for x in v])
         return {"mu_H": self.mu_H, "mu_H_ci95": list(self.mu_H_ci95), "offset": self.offset,
-                "offset_ci95": list(self.offset_ci95), "residual_rms": self.residual_rms, "n": self.n,
-                "success": self.success, "message": self.message, "R_L": self.R_L,
-                "units": {"mu_H": "N/m (= um*MPa)", "offset": "m", "residual_rms": "N", "R_L": "m"}}
+                "offset_ci95": list(self.offset_ci95), "beta": self.beta, "beta_ci95": ci(self.beta_ci95),
+                "alpha": self.alpha, "alpha_ci95": ci(self.alpha_ci95), "fitted": list(self.fitted),
+                "weights": self.weights, "residual": self.residual_rms, "residual_rms": self.residual_rms,
+                "n": self.n, "success": self.success, "message": self.message, "R_L": self.R_L,
+                "curves_computed": self.curves_computed, "interpolation_error": self.interpolation_error,
+                "units": {"mu_H": "N/m (= um*MPa)", "offset": "m", "residual": "N (rms)",
+                          "residual_rms": "N", "R_L": "m", "beta": "1 (B/(mu R_L^2))", "alpha": "1"}}
 
 
-def _model_curve(scene, delta_max, tol):
+# -- model curves ------------------------------------------------------------------------------
+_CACHE: OrderedDict = OrderedDict()
+_CACHE_SIZE = 32
+
+
+def _model_curve(scene, deltas, tol, counter=None):
+    """The curve of ``scene`` at ``deltas`` (memoised per process: repeated fits reuse it)."""
     from .continuation import curve
 
-    n = 40
-    deltas = delta_max * np.arange(1, n + 1) / n
+    try:
+        key = (scene, tuple(float(x) for x in deltas), float(tol))
+        hash(key)
+    except TypeError:
+        key = None
+    if key is not None and key in _CACHE:
+        _CACHE.move_to_end(key)
+        return _CACHE[key]
     c = curve(scene, deltas=deltas, tol=tol, estimate_error=False)
-    if len(c) < 3:
-        raise RuntimeError(f"the model curve could not be computed ({c.stop_reason})")
-    d = np.r_[0.0, c.delta]
-    F = np.r_[0.0, c.force]
-    return c, PchipInterpolator(d, F, extrapolate=False)
+    if counter is not None:
+        counter[0] += 1
+    c.solutions = []  # profiles are not needed here; keep the cache small
+    if key is not None:
+        _CACHE[key] = c
+        while len(_CACHE) > _CACHE_SIZE:
+            _CACHE.popitem(last=False)
+    return c
 
 
-def fit(scene, displacement, force, *, R_L, fit_offset=True, delta_max=None, tol=1e-6, loss="linear"):
-    """Least-squares fit of mu*H (and the displacement origin) to measured data.
+class _Shape:
+    """Nondimensional force F(delta; theta) from model curves at nodes theta_k on one delta grid.
+
+    Without a shape parameter there is one node (theta None) and the curve may
+    end early (the model is NaN beyond it).  With one, every node must reach
+    ``need`` (the deepest datum); F is a cubic spline across the nodes at each
+    depth and a monotone cubic (PCHIP) in delta.
+    """
+
+    def __init__(self, scene_at, grid, tol, need, counter):
+        self.scene_at, self.grid, self.tol, self.need, self.counter = scene_at, grid, tol, need, counter
+        self.nodes = {}  # theta -> curve
+        self._spline = None
+
+    def add(self, theta):
+        """Compute the node curve at theta; False if it does not reach the data."""
+        c = _model_curve(self.scene_at(theta), self.grid, self.tol, self.counter)
+        if len(c) < 3:
+            raise RuntimeError(f"the model curve could not be computed ({c.stop_reason})")
+        if theta is not None and c.delta[-1] < self.need * (1 - 1e-12):
+            return False
+        self.nodes[theta] = c
+        self._spline = None
+        return True
+
+    @property
+    def thetas(self):
+        return sorted(self.nodes)
+
+    def _table(self):
+        if self._spline is None:
+            th = self.thetas
+            m = min(len(self.nodes[t]) for t in th)
+            rows = np.array([np.r_[0.0, self.nodes[t].force[:m]] for t in th])
+            self.top = float(self.grid[m - 1])
+            self.x = np.r_[0.0, self.grid[:m]]
+            self._spline = rows[0] if len(th) == 1 else CubicSpline(th, rows, axis=0)
+        return self._spline
+
+    def at(self, theta):
+        """(F, dF/ddelta, top): PCHIP of F in delta at theta."""
+        sp = self._table()
+        vals = sp if isinstance(sp, np.ndarray) else sp(theta)
+        P = PchipInterpolator(self.x, vals, extrapolate=False)
+        return P, P.derivative(), self.top
+
+
+# -- least squares at a fixed shape ------------------------------------------------------------
+class _Model:
+    def __init__(self, d, f, R_L, fit_offset, loss):
+        self.d, self.f, self.R_L, self.fit_offset, self.loss = d, f, R_L, fit_offset, loss
+        self.big = 1e3 * (np.max(np.abs(f)) + 1)
+
+    @staticmethod
+    def shape(P, top, x):  # nondimensional model force, 0 before contact, NaN beyond the curve
+        x = np.asarray(x, float)
+        out = np.where(x <= 0, 0.0, P(np.clip(x, 0, top)))
+        return np.where(x > top, np.nan, out)
+
+    def force(self, P, top, disp, mu_H, d0):
+        return mu_H * self.R_L * self.shape(P, top, (disp - d0) / self.R_L)
+
+    def fit(self, P, dP, top, w, start=None):
+        """Weighted least squares of (mu_H, d0) at a fixed shape: (params, weighted RSS, weighted J)."""
+        d, f, R_L, fo = self.d, self.f, self.R_L, self.fit_offset
+
+        def unpack(p):
+            return (p[0], p[1]) if fo else (p[0], 0.0)
+
+        def residual(p):
+            r = self.force(P, top, d, *unpack(p)) - f
+            return w * np.nan_to_num(r, nan=self.big)
+
+        def jac(p):
+            mu_H, d0 = unpack(p)
+            x = (d - d0) / R_L
+            ds = np.where((x > 0) & (x <= top), dP(np.clip(x, 0, top)), 0.0)
+            cols = [R_L * np.nan_to_num(self.shape(P, top, x))]
+            if fo:
+                cols.append(-mu_H * np.nan_to_num(ds))
+            return w[:, None] * np.stack(cols, axis=1)
+
+        if start is None:
+            s0 = w * np.nan_to_num(self.shape(P, top, d / R_L))
+            mu0 = float(np.dot(s0, w * f) / max(np.dot(s0, s0), 1e-300) / R_L)
+            start = [mu0 if mu0 > 0 else 1.0, 0.0] if fo else [mu0 if mu0 > 0 else 1.0]
+        start = list(start)
+        scale = [abs(start[0]) or 1.0, 0.01 * R_L] if fo else [abs(start[0]) or 1.0]
+        res = optimize.least_squares(residual, start, jac=jac, x_scale=scale, loss=self.loss, method="trf")
+        r = residual(res.x)
+        return res, float(np.dot(r, r)), jac(res.x)
+
+
+def _weights(kind, model_force, f, floor, w_prev):
+    """Weights 1/sigma_i of the noise model, from the current model force (IRLS)."""
+    if kind == "uniform":
+        return np.ones_like(f)
+    m = np.abs(np.nan_to_num(model_force))
+    fmax = np.max(np.abs(f))
+    if kind == "relative":
+        return 1.0 / np.maximum(m, floor * fmax)
+    # mixed: sigma^2 = a^2 + b^2 F^2, (a^2, b^2) >= 0 by least squares on the squared residuals
+    # (each row scaled by the previous sigma^2: squared residuals have variance ~ sigma^4)
+    r2 = (np.nan_to_num(model_force) - f) ** 2
+    s2_prev = 1.0 / w_prev ** 2
+    A = np.column_stack([np.ones_like(m), (m / fmax) ** 2]) / s2_prev[:, None]
+    coef, _ = optimize.nnls(A, r2 / s2_prev)
+    s2 = coef[0] + coef[1] * (m / fmax) ** 2
+    if not np.any(s2 > 0):
+        return np.ones_like(f)
+    s2 = np.maximum(s2, 1e-6 * np.max(s2))
+    return 1.0 / np.sqrt(s2 / np.max(s2))
+
+
+def _check_bounds(name, bounds, lo_ok, hi_ok, value):
+    try:
+        lo, hi = (float(v) for v in bounds)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name}_bounds must be two numbers (low, high); got {bounds!r}") from None
+    if not (math.isfinite(lo) and math.isfinite(hi) and lo_ok(lo) and hi_ok(hi) and lo < hi):
+        raise ValueError(f"{name}_bounds must satisfy the valid range of {name} with low < high; got {bounds!r}")
+    if not lo <= value <= hi:
+        raise ValueError(f"the scene's {name} = {value:g} (the start of the fit) must lie within "
+                         f"{name}_bounds = ({lo:g}, {hi:g})")
+    return lo, hi
+
+
+def fit(scene, displacement, force, *, R_L, fit_offset=True, fit_beta=False, fit_alpha=False,
+        weights=None, floor=0.05, beta_bounds=BETA_BOUNDS, alpha_bounds=ALPHA_BOUNDS, delta_max=None,
+        tol=1e-6, loss="linear"):
+    """Least-squares fit of mu*H (the displacement origin, and beta or alpha) to measured data.
 
     Parameters
     ----------
     scene : Scene
-        Shape, indenter, material and beta (nondimensional).
+        Shape, indenter, material and beta (nondimensional); with ``fit_beta``
+        or ``fit_alpha`` its value is the start of the search.
     displacement, force : array_like
         Measured indenter displacement (m, > 0 into the shell) and force (N).
     R_L : float
         Rim radius of the sample (m).
     fit_offset : bool
         Also fit the origin of the displacement (contact point).
+    fit_beta, fit_alpha : bool
+        Also fit beta (within ``beta_bounds``) or the Mooney–Rivlin alpha
+        (within ``alpha_bounds``, subset of [0, 1]); one of them at most.
+    weights : {"uniform", "relative", "mixed"}, optional
+        Noise model: the same force noise at every point, noise proportional
+        to the force, or both (``sigma^2 = a^2 + b^2 F^2``, a and b estimated);
+        default :data:`DEFAULT_WEIGHTS` ("mixed", see benchmarks/fit_coverage.py).
+    floor : float
+        With relative weights, forces below ``floor * max|force|`` are weighted
+        as if they were that large (near the contact point F -> 0); in (0, 1].
     delta_max : float, optional
-        Largest depth of the model curve (default: 1.2 x the largest measured depth/R_L).
+        Largest depth of the model curves (default: 1.2 x the largest measured depth/R_L).
     tol : float
-        Collocation tolerance of the model curve.
+        Collocation tolerance of the model curves.
     loss : str
         scipy.optimize.least_squares loss ('linear', or 'soft_l1' to damp outliers).
 
@@ -114,71 +333,250 @@ def fit(scene, displacement, force, *, R_L, fit_offset=True, delta_max=None, tol
     -------
     FitResult
     """
+    from .materials import MooneyRivlin
+
+    weights = DEFAULT_WEIGHTS if weights is None else weights
+    if weights not in WEIGHTS:
+        raise ValueError(f"weights must be one of {WEIGHTS}; got {weights!r}")
+    if not (isinstance(floor, (int, float)) and 0 < floor <= 1):
+        raise ValueError(f"floor (of relative weights, fraction of max |force|) must be in (0, 1]; got {floor!r}")
+    if fit_beta and fit_alpha:
+        raise ValueError("fit_beta and fit_alpha: fit one of beta, alpha at a time (each changes the curve's "
+                         "shape only weakly; together with mu*H they are not identifiable from one curve)")
     d = np.asarray(displacement, float).ravel()
     f = np.asarray(force, float).ravel()
     if d.shape != f.shape:
         raise ValueError(f"displacement and force must have the same length; got {d.size} and {f.size}")
     keep = np.isfinite(d) & np.isfinite(f)
     d, f = d[keep], f[keep]
-    if d.size < 3:
-        raise ValueError(f"need at least 3 finite data points; got {d.size}")
+    k = 1 + bool(fit_offset) + bool(fit_beta or fit_alpha)
+    if d.size < max(3, k + 2):
+        raise ValueError(f"need at least {max(3, k + 2)} finite data points; got {d.size}")
     if not (isinstance(R_L, (int, float)) and math.isfinite(R_L) and R_L > 0):
         raise ValueError(f"R_L (rim radius, m) must be a finite number > 0; got {R_L!r}")
     if np.max(d) <= 0:
         raise ValueError("displacement must reach positive values (indentation into the shell)")
+    if fit_beta:
+        lo, hi = _check_bounds("beta", beta_bounds, lambda v: v > 0, lambda v: True, scene.beta)
+        name, bounds = "beta", (math.log(lo), math.log(hi))
+        step, theta0 = math.log(2.0), math.log(scene.beta)
+        scene_at = (lambda th: scene.replace(beta=math.exp(th)))
+    elif fit_alpha:
+        if not isinstance(scene.material, MooneyRivlin):
+            raise ValueError(f"fit_alpha needs a Mooney-Rivlin material (alpha); the scene's material is "
+                             f"{scene.material.family}")
+        name, bounds = "alpha", _check_bounds("alpha", alpha_bounds, lambda v: v >= 0, lambda v: v <= 1,
+                                              scene.material.alpha)
+        step, theta0 = 0.2, float(scene.material.alpha)
+        scene_at = (lambda th: scene.replace(material=MooneyRivlin(float(min(max(th, 0.0), 1.0)))))
+    else:
+        name = None
     dm = 1.2 * np.max(d) / R_L if delta_max is None else float(delta_max)
-    c, F = _model_curve(scene, dm, tol)
-    dF = F.derivative()
-    top = c.delta[-1]
+    if not (math.isfinite(dm) and dm > 0):
+        raise ValueError(f"delta_max must be > 0; got {delta_max!r}")
+    grid = dm * np.arange(1, N_DEPTHS + 1) / N_DEPTHS
+    counter = [0]
+    mdl = _Model(d, f, R_L, fit_offset, loss)
+    notes = []
 
-    def shape(x):  # nondimensional model force, 0 before contact, NaN beyond the curve
-        x = np.asarray(x, float)
-        out = np.where(x <= 0, 0.0, F(np.clip(x, 0, top)))
-        return np.where(x > top, np.nan, out)
+    def irls(P, dP, top):
+        """Fit at a fixed shape, iteratively reweighted: the weights from the model force."""
+        w = np.ones_like(f)
+        res, rss, J = mdl.fit(P, dP, top, w)
+        for it in range(8):
+            if weights == "uniform":
+                break
+            w_new = _weights(weights, mdl.force(P, top, d, *_unpack(res.x, fit_offset)), f, floor, w)
+            change = np.max(np.abs(w_new / w - 1)) if it > 0 else np.inf
+            w = w_new
+            res, rss, J = mdl.fit(P, dP, top, w, start=res.x)
+            if change < 1e-6:
+                break
+        return res, rss, J, w
 
-    def model(disp, mu_H, d0):
-        return mu_H * R_L * shape((disp - d0) / R_L)
+    if name is None:
+        shape = _Shape(lambda th: scene, grid, tol, np.max(d) / R_L, counter)
+        shape.add(None)
+        P, dP, top = shape.at(None)
+        res, rss, J, w = irls(P, dP, top)
+        theta_hat, theta_ci, interp_err, fit_scene, c = None, None, None, scene, shape.nodes[None]
+        model_P = (P, top)
+    else:
+        shape = _Shape(scene_at, grid, tol, np.max(d) / R_L, counter)
+        lim = [bounds[0], bounds[1]]  # shrinks where node curves do not reach the data
+        if not shape.add(theta0):
+            raise RuntimeError(f"the model curve at the scene's {name} does not reach the deepest data point "
+                               f"(delta = {np.max(d) / R_L:.3g}); {shape.scene_at(theta0)!r}")
 
-    def residual(p):
-        mu_H, d0 = (p[0], p[1]) if fit_offset else (p[0], 0.0)
-        r = model(d, mu_H, d0) - f
-        return np.nan_to_num(r, nan=1e3 * (np.max(np.abs(f)) + 1))
+        def extend(side):
+            """Add the next node beyond the nodes on side -1 (low) or +1 (high); False at the limit."""
+            th = shape.thetas
+            edge = th[0] if side < 0 else th[-1]
+            if (edge <= lim[0] + 1e-12) if side < 0 else (edge >= lim[1] - 1e-12):
+                return False
+            if counter[0] >= _MAX_CURVES:
+                notes.append(f"stopped adding model curves at {_MAX_CURVES}")
+                return False
+            new = edge + side * step
+            if side < 0:
+                new = lim[0] if new < lim[0] + 0.25 * step else new
+            else:
+                new = lim[1] if new > lim[1] - 0.25 * step else new
+            if shape.add(new):
+                return True
+            # this curve ends before the data: the range ends between edge and new
+            lim[0 if side < 0 else 1] = edge
+            notes.append(f"model curves at {name} = {_show(name, new)} end before the deepest data point; "
+                         f"searched {name} up to {_show(name, edge)}")
+            return False
 
-    def jac(p):
-        mu_H, d0 = (p[0], p[1]) if fit_offset else (p[0], 0.0)
-        x = (d - d0) / R_L
-        s = shape(x)
-        ds = np.where((x > 0) & (x <= top), dF(np.clip(x, 0, top)), 0.0)
-        cols = [R_L * np.nan_to_num(s)]
-        if fit_offset:
-            cols.append(-mu_H * np.nan_to_num(ds))
-        return np.stack(cols, axis=1)
+        extend(-1)
+        extend(+1)
+        w = irls(*shape.at(theta0))[3]  # the noise model's weights at the start value
+        state = {"start": None}
 
-    # mu_H at d0 = 0 from the linear least-squares formula as the start
-    s0 = np.nan_to_num(shape(d / R_L))
-    mu0 = float(np.dot(s0, f) / max(np.dot(s0, s0), 1e-300) / R_L)
-    if not mu0 > 0:
-        mu0 = 1.0
-    p0 = [mu0, 0.0] if fit_offset else [mu0]
-    scale = [mu0, 0.01 * R_L] if fit_offset else [mu0]
-    res = optimize.least_squares(residual, p0, jac=jac, x_scale=scale, loss=loss, method="trf")
-    J = jac(res.x)
-    n, k = d.size, len(res.x)
-    rss = float(np.sum(residual(res.x) ** 2))
+        def profile(theta):
+            P, dP, top = shape.at(theta)
+            res, rss, J = mdl.fit(P, dP, top, w, start=state["start"])
+            return rss, res
+
+        def estimate():
+            while True:
+                th = shape.thetas
+                vals = [profile(t)[0] for t in th]
+                i = int(np.argmin(vals))
+                if i == 0 and extend(-1):
+                    continue
+                if i == len(th) - 1 and extend(+1):
+                    continue
+                a, b = th[max(i - 1, 0)], th[min(i + 1, len(th) - 1)]
+                if a == b:
+                    return th[i]
+                r = optimize.minimize_scalar(lambda t: profile(t)[0], bounds=(a, b), method="bounded",
+                                             options={"xatol": 1e-5 * step})
+                return float(r.x) if r.fun <= vals[i] else th[i]
+
+        theta_hat = estimate()
+        for it in range(8):
+            if weights == "uniform":
+                break
+            rss, res = profile(theta_hat)
+            P, dP, top = shape.at(theta_hat)
+            w_new = _weights(weights, mdl.force(P, top, d, *_unpack(res.x, fit_offset)), f, floor, w)
+            change = np.max(np.abs(w_new / w - 1)) if it > 0 else np.inf
+            w = w_new
+            theta_hat = estimate()
+            if change < 1e-6:
+                break
+        # the curve at the estimate itself: measures the interpolation error, then joins the nodes.
+        # The estimate moves onto that node when the node's profiled RSS is within 1 % of the
+        # interval's likelihood-ratio margin of the minimum (indistinguishable from it; the
+        # reported curve is then the fitted one); otherwise one more curve at the new estimate.
+        n_par = k
+        dof = max(d.size - n_par, 1)
+        margin = stats.f.ppf(0.95, 1, dof) / dof  # thr = RSS_min (1 + margin)
+        interp_err = None
+        for _ in range(3):
+            rss_hat = profile(theta_hat)[0]
+            near = min(shape.thetas, key=lambda t: abs(t - theta_hat))
+            if profile(near)[0] - rss_hat <= 0.01 * margin * rss_hat:
+                theta_hat = near
+                break
+            P_old, _, top_old = shape.at(theta_hat)
+            if not shape.add(theta_hat):
+                break
+            ce = shape.nodes[theta_hat]
+            m = min(len(ce), int(np.sum(grid <= top_old + 1e-15)))
+            err = float(np.max(np.abs(P_old(ce.delta[:m]) - ce.force[:m])) / np.max(np.abs(ce.force[:m])))
+            interp_err = err if interp_err is None else interp_err  # the first one: before any exact curve
+            theta_hat = estimate()
+        interp_err = 0.0 if interp_err is None else interp_err
+        rss_min, res = profile(theta_hat)
+        thr = rss_min * (1 + margin)
+
+        def crossing(side):
+            while True:
+                th = shape.thetas
+                pts = [t for t in th if (t < theta_hat if side < 0 else t > theta_hat)]
+                pts = pts[::-1] if side < 0 else pts
+                inner = theta_hat
+                for t in pts:
+                    if profile(t)[0] > thr:
+                        return float(optimize.brentq(lambda u: profile(u)[0] - thr, min(inner, t), max(inner, t),
+                                                     xtol=1e-6 * step)), False
+                    inner = t
+                if not extend(side):
+                    return (th[0] if side < 0 else th[-1]), True
+
+        (c_lo, open_lo), (c_hi, open_hi) = crossing(-1), crossing(+1)
+        if open_lo or open_hi:
+            notes.append(f"the 95% interval of {name} reaches the end of the searched range "
+                         f"({_show(name, lim[0])}, {_show(name, lim[1])}); {name} is not determined "
+                         f"by the data on that side")
+        theta_ci = (c_lo, c_hi)
+        theta_hat_final = theta_hat
+        P, dP, top = shape.at(theta_hat_final)
+        res, rss, J = mdl.fit(P, dP, top, w, start=res.x)
+        # the shape parameter's column of the Jacobian (finite differences across the interpolated curves)
+        # (central; one-sided at the end of the nodes)
+        h = 1e-4 * step
+        ths = [min(max(t, shape.thetas[0]), shape.thetas[-1]) for t in (theta_hat - h, theta_hat + h)]
+        Fp = [mdl.force(*_drop(shape.at(t)), d, *_unpack(res.x, fit_offset)) for t in ths]
+        col = w * np.nan_to_num((Fp[1] - Fp[0]) / (ths[1] - ths[0]))
+        J = np.column_stack([J, col])
+        near = min(shape.thetas, key=lambda t: abs(t - theta_hat))
+        c = shape.nodes[near]
+        fit_scene = shape.scene_at(near)
+        model_P = (P, top)
+    # intervals of mu_H, d0 (Wald, t), from the weighted Jacobian
+    n = d.size
     dof = max(n - k, 1)
     try:
         cov = np.linalg.inv(J.T @ J) * rss / dof
         half = stats.t.ppf(0.975, dof) * np.sqrt(np.diag(cov))
     except np.linalg.LinAlgError:
-        half = np.full(k, np.nan)
+        half = np.full(J.shape[1], np.nan)
     mu_H = float(res.x[0])
     d0 = float(res.x[1]) if fit_offset else 0.0
     off_ci = (d0 - half[1], d0 + half[1]) if fit_offset else (0.0, 0.0)
     off_ci = tuple(float(v) for v in off_ci)
+    P, top = model_P
+
+    def model(disp, mu_H, d0):
+        return mu_H * R_L * _Model.shape(P, top, (disp - d0) / R_L)
+
+    resid = model(d, mu_H, d0) - f
+    fitted = ("mu_H",) + (("offset",) if fit_offset else ()) + ((name,) if name else ())
+    mat = fit_scene.material
+    alpha = float(mat.alpha) if isinstance(mat, MooneyRivlin) else None
+    beta = float(fit_scene.beta)
+    beta_ci = alpha_ci = None
+    if name == "beta":
+        beta = float(math.exp(theta_hat))
+        beta_ci = tuple(float(math.exp(v)) for v in theta_ci)
+    elif name == "alpha":
+        alpha = float(theta_hat)
+        alpha_ci = tuple(float(v) for v in theta_ci)
+    message = "; ".join([str(res.message)] + notes)
+    ok = bool(res.success and mu_H > 0 and np.all(np.isfinite(resid)))
     return FitResult(mu_H=mu_H, mu_H_ci95=(float(mu_H - half[0]), float(mu_H + half[0])), offset=d0,
-                     offset_ci95=off_ci,
-                     residual_rms=math.sqrt(rss / n), n=n, success=bool(res.success and mu_H > 0),
-                     message=res.message, R_L=float(R_L), curve=c, _model=model)
+                     offset_ci95=off_ci, residual_rms=float(np.sqrt(np.mean(np.nan_to_num(resid, nan=mdl.big) ** 2))),
+                     n=n, success=ok, message=message, R_L=float(R_L), curve=c, _model=model,
+                     beta=beta, beta_ci95=beta_ci, alpha=alpha, alpha_ci95=alpha_ci, fitted=fitted,
+                     weights=weights, scene=fit_scene, curves_computed=counter[0],
+                     interpolation_error=interp_err)
+
+
+def _unpack(p, fit_offset):
+    return (p[0], p[1]) if fit_offset else (p[0], 0.0)
+
+
+def _drop(pdt):
+    return pdt[0], pdt[2]
+
+
+def _show(name, theta):
+    return f"{math.exp(theta):.3g}" if name == "beta" else f"{theta:.3g}"
 
 
 def read_force_csv(path, *, columns=None, units=None):

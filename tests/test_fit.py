@@ -38,6 +38,90 @@ def test_fit_recovers_mu_H_and_offset_within_interval_and_2_percent(model):
     assert r.offset_ci95[0] < D0 < r.offset_ci95[1]
 
 
+def test_noise_models_under_proportional_noise(model):
+    """2 % proportional noise: mixed and relative weights cover 52 with a narrower interval than uniform."""
+    disp, force = synthetic(model, 40, seed=3)
+    width = {}
+    for w in ("uniform", "relative", "mixed"):
+        r = sb.fit(model[0], disp, force, R_L=R_L, weights=w)
+        assert r.weights == w and r.success
+        assert r.mu_H_ci95[0] < MU_H < r.mu_H_ci95[1], (w, r.mu_H, r.mu_H_ci95)
+        width[w] = r.mu_H_ci95[1] - r.mu_H_ci95[0]
+    assert width["mixed"] < 0.8 * width["uniform"] and width["relative"] < 0.8 * width["uniform"], width
+    assert sb.fit(model[0], disp, force, R_L=R_L).weights == sb.fitting.DEFAULT_WEIGHTS == "mixed"
+
+
+def test_mixed_weights_follow_additive_noise(model):
+    """Additive noise: the mixed model's weights come out nearly uniform, the relative model's do not."""
+    scene, c = model
+    idx = np.linspace(0, len(c) - 1, 40).astype(int)
+    F = MU_H * R_L * c.force[idx]
+    rng = np.random.default_rng(11)
+    force = F + 0.02 * F.max() * rng.standard_normal(F.size)
+    disp = R_L * c.delta[idx] + D0
+    fits = {w: sb.fit(scene, disp, force, R_L=R_L, weights=w) for w in ("uniform", "mixed")}
+    lo, hi = fits["mixed"].mu_H_ci95
+    assert lo < MU_H < hi
+    wu, wm = (fits[w].mu_H_ci95[1] - fits[w].mu_H_ci95[0] for w in ("uniform", "mixed"))
+    assert abs(wm / wu - 1) < 0.25, (wu, wm)
+
+
+def test_fit_shape_parameter_options_are_validated():
+    scene = sb.Scene.preset("fit")
+    d, f = np.linspace(1e-5, 1e-4, 10), np.linspace(1e-4, 1e-3, 10)
+    cases = [
+        (dict(fit_beta=True, fit_alpha=True), "one of beta, alpha"),
+        (dict(fit_beta=True, beta_bounds=(0.0, 1.0)), "beta_bounds"),
+        (dict(fit_beta=True, beta_bounds=(1e-3, 5e-3)), r"scene's beta = 0\.01"),
+        (dict(fit_beta=True, beta_bounds="wide"), "beta_bounds"),
+        (dict(fit_alpha=True, alpha_bounds=(0.2, 1.5)), "alpha_bounds"),
+        (dict(fit_alpha=True, alpha_bounds=(0.5, 1.0)), r"scene's alpha = 0\.1"),
+        (dict(weights="poisson"), "weights must be one of"),
+        (dict(floor=0.0), "floor"),
+    ]
+    for kwargs, match in cases:
+        with pytest.raises(ValueError, match=match):
+            sb.fit(scene, d, f, R_L=R_L, **kwargs)
+    with pytest.raises(ValueError, match="fit_alpha needs a Mooney-Rivlin material"):
+        sb.fit(scene.replace(material=sb.Gent(1.0)), d, f, R_L=R_L, fit_alpha=True)
+    with pytest.raises(ValueError, match="at least 5"):
+        sb.fit(scene, d[:4], f[:4], R_L=R_L, fit_beta=True)
+
+
+@pytest.mark.parametrize("argv,match", [
+    (["--fit-beta", "--fit-alpha"], "one of beta, alpha"),
+    (["--beta-range", "1e-3,0.1"], "--beta-range needs --fit-beta"),
+    (["--fit-beta", "--beta-range", "1e-3"], "--beta-range must be two numbers"),
+    (["--fit-alpha", "--gent-jm", "1"], "Mooney-Rivlin"),
+    (["--weights", "poisson"], "invalid choice"),
+])
+def test_fit_cli_shape_options_errors(argv, match):
+    r = subprocess.run([sys.executable, "-m", "shellbvp", "fit", "--example", "--preset", "fit", "--radius", "0.3mm",
+                        *argv], capture_output=True, text=True, env=dict(os.environ), timeout=600)
+    assert r.returncode == 2 and match in r.stderr, r.stderr
+    assert len(r.stderr.strip().splitlines()) == 1
+
+
+def test_fit_beta_recovers_known_beta_within_interval():
+    """Data at beta = 0.02 (preset fit, 2 % proportional noise); the fit starts from the preset's 0.01."""
+    truth = sb.Scene.preset("fit", beta=0.02)
+    c = sb.curve(truth, deltas=np.linspace(0.01, 0.45, 40), estimate_error=False)
+    rng = np.random.default_rng(3)
+    disp = R_L * c.delta + D0
+    force = MU_H * R_L * c.force * (1 + 0.02 * rng.standard_normal(len(c)))
+    r = sb.fit(sb.Scene.preset("fit"), disp, force, R_L=R_L, fit_beta=True)
+    assert r.success and r.fitted == ("mu_H", "offset", "beta")
+    assert r.beta_ci95[0] < 0.02 < r.beta_ci95[1], (r.beta, r.beta_ci95)
+    assert r.beta_ci95[0] > 0.01 / 4 and r.beta_ci95[1] < 0.04, r.beta_ci95  # informative, not the search range
+    assert r.mu_H_ci95[0] < MU_H < r.mu_H_ci95[1], (r.mu_H, r.mu_H_ci95)
+    assert r.offset_ci95[0] < D0 < r.offset_ci95[1]
+    assert r.interpolation_error < 2e-3 and r.curves_computed <= 6
+    assert r.curve.scene.beta == pytest.approx(r.beta, rel=1e-3) and r.scene == r.curve.scene
+    # beta fitted widens mu*H's interval against the fit at the (wrong) start value 0.01
+    fixed = sb.fit(sb.Scene.preset("fit"), disp, force, R_L=R_L)
+    assert fixed.mu_H_ci95[1] - fixed.mu_H_ci95[0] < r.mu_H_ci95[1] - r.mu_H_ci95[0]
+
+
 def test_interval_shrinks_with_more_data(model):
     widths = []
     for n in (10, 80):
@@ -107,6 +191,9 @@ def test_fit_cli_with_csv(model, tmp_path):
     assert r.returncode == 0, r.stderr
     out = json.loads(r.stdout)
     assert abs(out["mu_H"] - MU_H) < 0.02 * MU_H and out["mu_H_ci95"][0] < out["mu_H"] < out["mu_H_ci95"][1]
+    assert out["residual"] > 0 and out["offset"] > 0 and out["weights"] == "mixed"
+    assert out["beta"] == 0.01 and out["beta_ci95"] is None and out["alpha"] == pytest.approx(0.1)
+    assert out["fitted"] == ["mu_H", "offset"]
     assert sb.read_curve(tmp_path / "fit.h5").scene == sb.Scene.preset("fit")
 
 
