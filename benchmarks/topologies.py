@@ -4,7 +4,9 @@ For every preset (smooth contact): the state at delta = 0.05, 0.1, 0.2 with
 ``topology="auto"`` (a valid line or annular contact where the single cap
 would pull the shell) against the cap-only state, and the curve to
 delta = 0.5 with the topology of each point, the switches and the energy
-identity.  Writes benchmarks/results/topologies.{json,md}.
+identity; and one scene outside the presets (base with rho = 0.3, gamma = 3)
+whose curve passes through a finite annulus.  Writes
+benchmarks/results/topologies.{json,md}.
 
     python benchmarks/topologies.py [--quick] [--out-dir DIR]
 """
@@ -33,9 +35,11 @@ def main(argv=None):
     ap.add_argument("--out-dir", default=None, help="write results/ under this directory (default benchmarks/)")
     args = ap.parse_args(argv)
     presets = ("base",) if args.quick else sb.PRESETS
+    scenes = {name: sb.Scene.preset(name) for name in presets}
+    if not args.quick:  # a large indenter in a prolate shell: line, then a finite annulus, then the cap
+        scenes["base rho=0.3 gamma=3"] = sb.Scene.preset("base", rho=0.3, gamma=3.0)
     states, curves = [], []
-    for name in presets:
-        scene = sb.Scene.preset(name)
+    for name, scene in scenes.items():
         scene.model()
         for d in DELTAS:
             cap = sb.solve(scene, delta=d, topology="cap", tol=1e-8)
@@ -67,11 +71,11 @@ def main(argv=None):
                      f"| {r['S1']:.3g} | {r['Sc']:.3g} | {r['cap_force']:.8f} | {r['force'] - r['cap_force']:.2e} "
                      f"| {r['energy_change']:.2e} | {r['cap_pressure_min']:.3g} | {'yes' if r['valid'] else 'no'} |")
     lines += ["", "Curves (`shellbvp curve --preset NAME`, delta to 0.5):", "",
-              "| preset | points | valid | topologies along the curve | switch (line -> cap) at delta "
+              "| preset | points | valid | topologies along the curve | switches at delta "
               "| max abs(dE/ddelta - F) | time (s) | stopped |",
               "|---|---|---|---|---|---|---|---|"]
     for r in curves:
-        sw = ", ".join(f"{s['delta']:.5f}" for s in r["switches"]) or "none"
+        sw = ", ".join(f"{s['from']} -> {s['to']} {s['delta']:.5f}" for s in r["switches"]) or "none"
         lines.append(f"| {r['preset']} | {r['points']} | {r['valid']} | {r['topologies']} | {sw} | "
                      f"{r['energy_identity_max']:.1e} | {r['seconds']:.1f} | {r['stop_reason']} |")
     (out / f"{stem}.md").write_text("\n".join(lines) + "\n")

@@ -295,54 +295,101 @@ def _cap_of(sol):
     return sol.get("cap_solution")
 
 
-def _locate_switches(builder: _Builder, st):
-    """Add the point where the recorded topology switches from lift-off to cap (or back).
+def _regula_falsi(a, fa, sa, b, fb, sb, solve_at, tol):
+    """Root of f(delta) between a and b (Illinois); returns the last state with f >= 0."""
+    best = sa if fa >= 0 else sb
+    side = 0
+    for _ in range(40):
+        d = (a * fb - b * fa) / (fb - fa)
+        sol, f = solve_at(d, sa if abs(d - a) < abs(d - b) else sb)
+        if sol is None:
+            break
+        if f >= 0:
+            best = sol
+        if f * fb > 0:
+            b, fb, sb = d, f, sol
+            fa = fa / 2 if side == -1 else fa
+            side = -1
+        else:
+            a, fa, sa = d, f, sol
+            fb = fb / 2 if side == 1 else fb
+            side = 1
+        if abs(b - a) < 1e-6 * (1 + abs(d)) or abs(f) < 10 * tol:
+            break
+    return best
 
-    Between two neighbouring points of which one is a cap and the other a line or
-    annulus (both valid), the switch is where the cap's minimum contact pressure
-    crosses zero: found by regula falsi (Illinois) on the cap branch; the cap state
-    there (pressure >= 0 side) is added to an adaptive curve, and the switch is
-    listed in ``settings["topology_switches"]``.
+
+def _locate_switches(builder: _Builder, st):
+    """Add the point where the recorded topology switches between neighbouring points.
+
+    cap <-> line or annulus: where the cap's minimum contact pressure crosses zero
+    (the cap state there, pressure >= 0 side).  line <-> annulus: where the line's
+    curvature excess over the indenter crosses zero (the line state there).  Both by
+    regula falsi (Illinois); the point is added to an adaptive curve, and every switch
+    is listed in ``settings["topology_switches"]``.
     """
+    from .liftoff import solve_liftoff
+
+    scene = builder.out.scene
     switches = st.setdefault("topology_switches", [])
     rows = sorted(builder.rows, key=lambda r: r[0])
+
+    def cap_at(d, near):
+        sol = _solve_at_delta(scene, d, near, None, st)
+        return (sol, sol.pressure_min) if sol.success else (None, None)
+
+    def line_at(d, near):
+        sol = solve_liftoff(scene, "line", delta=d, guess=near, tol=st["tol"], max_nodes=st["max_nodes"],
+                            bc_tol=st["bc_tol"])
+        return (sol, -sol.curvature_excess) if sol.success else (None, None)
+
     for (k1, _, _, s1), (k2, _, _, s2) in zip(rows[:-1], rows[1:]):
-        kinds = {s1.get("topology"), s2.get("topology")}
-        if "cap" not in kinds or not kinds & {"line", "annulus"} or not (s1.get("valid") and s2.get("valid")):
-            continue
-        c1, c2 = _cap_of(s1), _cap_of(s2)
-        if c1 is None or c2 is None:
-            continue
-        a, fa, sa = c1.delta, c1.pressure_min, c1
-        b, fb, sb = c2.delta, c2.pressure_min, c2
-        if not fa * fb < 0:
-            continue
-        side = 0
-        best = sa if fa >= 0 else sb
-        for _ in range(40):
-            d = (a * fb - b * fa) / (fb - fa)
-            sol = _solve_at_delta(builder.out.scene, d, sa if abs(d - a) < abs(d - b) else sb, None, st)
-            if not sol.success:
-                break
-            f = sol.pressure_min
-            if f >= 0:
-                best = sol
-            if f * fb > 0:
-                b, fb, sb = d, f, sol
-                fa = fa / 2 if side == -1 else fa
-                side = -1
-            else:
-                a, fa, sa = d, f, sol
-                fb = fb / 2 if side == 1 else fb
-                side = 1
-            if abs(b - a) < 1e-6 * (1 + abs(d)) or abs(f) < 10 * st["tol"]:
-                break
         frm, to = s1.get("topology"), s2.get("topology")
-        switches.append({"delta": float(best.delta), "force": float(best.force), "from": frm, "to": to,
-                         "pressure_min": float(best.pressure_min)})
-        log.info("topology switch %s -> %s at delta = %.6g", frm, to, best.delta)
-        if st["mode"] == "adaptive":  # a curve at requested depths keeps exactly those
-            builder.add(best, 0.5 * (k1 + k2))
+        if not (s1.get("valid") and s2.get("valid")) or frm == to:
+            continue
+        if "cap" in (frm, to) and {frm, to} & {"line", "annulus"}:
+            e1, e2, f, solve_at = _cap_of(s1), _cap_of(s2), "pressure_min", cap_at
+        elif {frm, to} == {"line", "annulus"}:
+            line = s1 if frm == "line" else s2
+            e1 = e2 = None
+            ends = [(line.delta, -line.curvature_excess, line)]
+            other = s2 if frm == "line" else s1
+            shadow = liftoff_state_line(other, st)
+            if shadow is None:
+                continue
+            ends.append((shadow.delta, -shadow.curvature_excess, shadow))
+            ends.sort(key=lambda e: e[0])
+            (a, fa, sa), (b, fb, sb) = ends
+            if not fa * fb < 0:
+                continue
+            best = _regula_falsi(a, fa, sa, b, fb, sb, line_at, st["tol"])
+            _add_switch(builder, st, switches, best, frm, to, k1, k2, "curvature_excess")
+            continue
+        else:
+            continue
+        if e1 is None or e2 is None or not e1[f] * e2[f] < 0:
+            continue
+        best = _regula_falsi(e1.delta, e1[f], e1, e2.delta, e2[f], e2, solve_at, st["tol"])
+        _add_switch(builder, st, switches, best, frm, to, k1, k2, f)
+
+
+def liftoff_state_line(sol, st):
+    """The line state at a lift-off point's delta (from its cap), or None."""
+    from .liftoff import liftoff_state
+
+    cap = _cap_of(sol)
+    if cap is None:
+        return None
+    line = liftoff_state(cap, "line", tol=st["tol"], max_nodes=st["max_nodes"], bc_tol=st["bc_tol"])
+    return line if line.success and "curvature_excess" in line else None
+
+
+def _add_switch(builder, st, switches, best, frm, to, k1, k2, criterion):
+    switches.append({"delta": float(best.delta), "force": float(best.force), "from": frm, "to": to,
+                     "criterion": criterion, "value": float(best[criterion])})
+    log.info("topology switch %s -> %s at delta = %.6g", frm, to, best.delta)
+    if st["mode"] == "adaptive":  # a curve at requested depths keeps exactly those
+        builder.add(best, 0.5 * (k1 + k2))
 
 
 def _first_point(scene, delta, settings):

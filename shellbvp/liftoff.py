@@ -235,6 +235,14 @@ def _diagnose(sysm: LiftOffBVP, bvp, tol):
         vflags.append(f"negative ring force ({ring_out:.3g}) at the outer contact edge")
     if res.penetration > 10 * tol:
         vflags.append(f"the free shell passes through the indenter (by {res.penetration:.3g})")
+    if sysm.topology == "line":
+        # Touching on a circle, the shell must not bend more tightly than the indenter there
+        # (else it passes through it next to the line: the contact becomes an annulus).
+        tip = mod.contact_profile(np.array([S1]), np.array([[p[1]], [yb[2]]]), par)["kappa_s"][0]
+        res.curvature_excess = float(yb[3] - tip)
+        if res.curvature_excess > 10 * tol * max(1.0, abs(tip)):
+            vflags.append(f"the shell bends more tightly than the indenter at the contact line "
+                          f"(kappa_s exceeds the tip's by {res.curvature_excess:.3g}): the contact is an annulus")
     res.flags = flags + vflags
     res.valid = res.success and not vflags
     return res

@@ -127,7 +127,7 @@ def test_base_curve_switches_from_line_to_cap_without_a_jump(tmp_path):
     kinds = list(c.topology)
     assert kinds[0] == "point" and kinds[-1] == "cap" and "line" in kinds
     (switch,) = [s for s in c.settings["topology_switches"] if s["from"] == "line"]
-    assert 0.09 < switch["delta"] < 0.13 and abs(switch["pressure_min"]) < 1e-3
+    assert 0.09 < switch["delta"] < 0.13 and switch["criterion"] == "pressure_min" and abs(switch["value"]) < 1e-3
     # at the switch the line state and the cap coincide
     i = int(np.argmin(np.abs(c.delta - switch["delta"])))
     cap = c.solutions[i]
@@ -184,3 +184,47 @@ def test_cli_reports_the_topology(tmp_path):
     assert "contact topologies along the curve: point x" in r.stdout and "line x" in r.stdout
     c = sb.read_curve(tmp_path / "d.h5")
     assert np.all(c.valid) and set(c.topology) == {"point", "line"}
+
+
+# A large indenter in a prolate shell: the pole lifts while an outer band is pressed --
+# line contact, then a finite annulus, then the cap.
+ANNULAR = dict(rho=0.3, gamma=3.0)
+
+
+def test_finite_annulus_is_valid_and_energy_consistent():
+    scene = sb.Scene.preset("base", **ANNULAR)
+    cap = sb.solve(scene, delta=0.1, topology="cap")
+    assert cap.success and cap.pressure_min < 0
+    line = sb.solve(scene, delta=0.1, topology="line")
+    assert line.success and not line.valid and line.curvature_excess > 0  # bends through the tip
+    sol = sb.solve(scene, delta=0.1, tol=1e-8)
+    assert sol.topology == "annulus" and sol.valid, sol.flags
+    assert 0 < sol.S1 < 0.8 * sol.Sc                     # a finite annulus, away from the pole
+    assert sol.pressure_min > 0 and sol.ring_force > 0 and sol.ring_force_inner > 0
+    assert sol.penetration <= 0
+    assert sol.force == pytest.approx(sol.ring_force + sol.ring_force_inner + sol.cap_force, abs=1e-12)
+    prof = sol.profile()
+    on = prof["region"] == 0
+    assert prof["S"][on].min() == pytest.approx(sol.S1) and np.all(prof["P"][on] >= 0)
+    slope, kinds = _energy_slope(scene, 0.1)
+    assert kinds == {"annulus"}
+    assert abs(slope - sol.force) < 1e-8 + 10 * sol.force_error
+    assert sol.energy < cap.energy  # lifting off lowers the energy at fixed delta
+
+
+def test_curve_passes_line_annulus_cap_without_a_jump():
+    c = sb.curve(sb.Scene.preset("base", **ANNULAR), delta_max=0.15)
+    assert c.complete and np.all(c.valid), c.flags
+    runs = [k for i, k in enumerate(c.topology) if i == 0 or k != c.topology[i - 1]]
+    assert runs == ["line", "annulus", "cap"]
+    sw = {(s["from"], s["to"]): s for s in c.settings["topology_switches"]}
+    assert sw[("line", "annulus")]["criterion"] == "curvature_excess"
+    assert sw[("annulus", "cap")]["criterion"] == "pressure_min"
+    assert sw[("line", "annulus")]["delta"] < sw[("annulus", "cap")]["delta"]
+    ann = c.topology == "annulus"
+    assert np.all(c.pressure_min[ann] >= 0) and np.all(c.ring_force_inner[ann] >= 0)
+    # near the switch the annulus opens from the line: it is narrow there
+    first = np.nonzero(ann)[0][0]
+    assert c.Sc[first] - c.S1[first] < 0.5 * (c.Sc[first] - c.S1[np.nonzero(ann)[0][-1]])
+    assert np.all(np.diff(c.force) > 0)
+    assert np.nanmax(np.abs(c.energy_residual)) < 2e-3
