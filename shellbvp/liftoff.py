@@ -292,7 +292,7 @@ def liftoff_state(cap: Solution, topology: str, *, tol=1e-6, max_nodes=10000, bc
     # The cap is the better guess (the lift-off state is close to it near the switch and
     # its contact edge is where the cap's is); a neighbour of the same topology is the
     # fallback.  A node budget of a few times the cap's makes hopeless starts fail fast.
-    kw = dict(tol=tol, max_nodes=int(min(max_nodes, max(2000, 4 * cap.nodes))), bc_tol=bc_tol)
+    kw = dict(tol=tol, max_nodes=int(min(max_nodes, max(1000, 3 * cap.nodes))), bc_tol=bc_tol)
     res = None
     for frac in ((0.9, 0.5) if topology == "line" else (0.5, 0.9)):
         res = solve_liftoff_from(sysm, liftoff_guess_from_cap(sysm, cap, frac), **kw)
@@ -324,13 +324,25 @@ def valid_liftoff_state(cap: Solution, *, tol=1e-6, max_nodes=10000, bc_tol=1e-1
     order = ("line", "annulus")
     if previous is not None and previous.get("topology") in order:
         order = (previous.topology,) + tuple(t for t in order if t != previous.topology)
+    line_too_curved = False
     for topology in order:
+        if topology == "annulus" and not (line_too_curved or _pressed_somewhere(cap)):
+            # an annulus needs a pressed band: where the whole cap pulls and the line is not
+            # bent through the tip, Newton only walks its inner edge to the pole (seconds)
+            tried.append("annulus: not tried (the cap pulls everywhere)")
+            continue
         res = liftoff_state(cap, topology, tol=tol, max_nodes=max_nodes, bc_tol=bc_tol, previous=previous)
         if res.success and res.valid:
             return res, tried
+        line_too_curved |= topology == "line" and res.get("curvature_excess", -1.0) > 0
         why = res.message if not res.success else "; ".join(res.flags)
         tried.append(f"{topology}: {why}")
     return None, tried
+
+
+def _pressed_somewhere(cap):
+    prof = cap.profile()
+    return bool(np.max(prof["P"][prof["region"] == 0]) > 0)
 
 
 def liftoff_profile(sol: Solution, t):
