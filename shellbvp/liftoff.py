@@ -91,19 +91,21 @@ def liftoff_warm_guess(sysm: LiftOffBVP, prev: Solution, predictor=None):
 
 
 # -- solving --------------------------------------------------------------------------------
-def solve_liftoff(scene, topology, *, delta=None, force=None, guess, tol=1e-6, max_nodes=10000,
-                  eps=None, bc_tol=1e-10, estimate_error=False):
+def solve_liftoff(scene, topology, *, delta=None, force=None, lambda0=None, guess, tol=1e-6,
+                  max_nodes=10000, eps=None, bc_tol=1e-10, estimate_error=False):
     """One annular or line-contact state from a guess.
 
     ``guess`` is a lift-off Solution of the same topology (warm start), or an
     ``(x, y, p)`` tuple made for this system (see :func:`liftoff_guess_from_cap`).
-    Exactly one of ``delta`` (indenter displacement) or ``force`` is prescribed.
+    Exactly one of ``delta`` (indenter displacement), ``force`` or ``lambda0`` (the
+    stretch at the lifted pole) is prescribed.
     """
     from .state import _default_eps
 
-    if (delta is None) == (force is None):
-        raise ValueError("give exactly one of delta or force")
-    control, value = ("delta", delta) if delta is not None else ("force", force)
+    given = [(k, v) for k, v in (("delta", delta), ("force", force), ("lambda0", lambda0)) if v is not None]
+    if len(given) != 1:
+        raise ValueError("give exactly one of delta, force or lambda0")
+    (control, value), = given
     eps = _default_eps(tol) if eps is None else eps
     t0 = time.perf_counter()
     sysm = make_liftoff_system(scene, topology, control, value, eps)
@@ -286,8 +288,8 @@ def liftoff_state(cap: Solution, topology: str, *, tol=1e-6, max_nodes=10000, bc
     Returns a Solution (check ``success`` and ``valid``).  An annulus whose inner edge
     runs to the pole is the cap itself: it is returned as a failure saying so.
     """
-    control = "force" if cap.control == "force" else "delta"
-    value = cap.force if control == "force" else cap.delta
+    control = cap.control if cap.control in ("force", "lambda0") else "delta"
+    value = {"force": cap.force, "lambda0": cap.lambda0, "delta": cap.delta}[control]
     sysm = make_liftoff_system(cap.scene, topology, control, value, cap.system.eps)
     # The cap is the better guess (the lift-off state is close to it near the switch and
     # its contact edge is where the cap's is); a neighbour of the same topology is the

@@ -491,7 +491,7 @@ def solve(scene, *, delta=None, lambda0=None, force=None, tol=1e-6, max_nodes=10
         single cap, replaced by a valid line or annular contact where the cap
         would pull the shell (negative pressure or ring force).  ``"cap"``: the
         cap only.  ``"line"``/``"annulus"``: that topology, started from the cap
-        state (delta or force control only), valid or not.
+        state, valid or not.  With a lifted pole, ``lambda0`` is the stretch there.
 
     Returns
     -------
@@ -521,14 +521,11 @@ def solve(scene, *, delta=None, lambda0=None, force=None, tol=1e-6, max_nodes=10
     if topology != "auto" and topology != "cap" and scene.contact != "smooth":
         raise ValueError(f"topology={topology!r} needs contact='smooth' (the variational contact line); "
                          f"the paper's model has the single cap only")
-    if topology in ("line", "annulus") and control == "lambda0":
-        raise ValueError(f"topology={topology!r} takes delta or force control (lambda0, the stretch of a "
-                         "lifted pole, is a result there)")
     if guess is not None and guess.get("topology") in ("line", "annulus"):
         from .liftoff import solve_liftoff
 
-        res = solve_liftoff(scene, guess.topology, delta=delta, force=force, guess=guess, tol=tol,
-                            max_nodes=max_nodes, eps=eps, bc_tol=bc_tol, estimate_error=estimate_error)
+        res = solve_liftoff(scene, guess.topology, delta=delta, force=force, lambda0=lambda0, guess=guess,
+                            tol=tol, max_nodes=max_nodes, eps=eps, bc_tol=bc_tol, estimate_error=estimate_error)
         if topology in ("auto", guess.topology) and res.success:
             return res
         guess = None  # back to the cap
@@ -542,8 +539,7 @@ def solve(scene, *, delta=None, lambda0=None, force=None, tol=1e-6, max_nodes=10
         res = _cold_delta(sysm, value, **kw)
     else:
         res = _cold_other(scene, sysm, control, value, eps, **kw)
-    if topology != "cap" and scene.contact == "smooth" and res.get("topology") == "cap" \
-            and control != "lambda0" and res.success:
+    if topology != "cap" and scene.contact == "smooth" and res.get("topology") == "cap" and res.success:
         res = _other_topology(res, topology, kw)
     if res.success and estimate_error:
         estimate_errors(res, tol, bc_tol)

@@ -239,10 +239,10 @@ class LiftOffBVP:
     ``topology="annulus"``: inner free cap ``[zeta, S1]``, contact annulus
     ``[S1, S2]``, outer free region ``[S2, L]``; ``y`` has 14 rows
     (inner free 6, contact 2, outer free 6) and the unknowns are
-    ``p = (ln S1, ln S2)`` (+ ``delta`` under force control).  Maps:
+    ``p = (ln S1, ln S2)`` (+ ``delta`` under force or lambda0 control).  Maps:
     ``S = S1 eps**(1-t)``, ``S = S1 (S2/S1)**t``, ``S = S2 (L/S2)**t``.
     Conditions (16 or 17): inner pole 3 (``free_pole_res``), smooth contact
-    line at S1 5 and at S2 5, rim 3, (force 1).
+    line at S1 5 and at S2 5, rim 3, (force or lambda0 1: the stretch at the lifted pole).
 
     ``topology="line"``: the shell touches the indenter on one circle S1 (a
     zero-width annulus); ``y`` has 12 rows (inner free 6, outer free 6), the
@@ -250,7 +250,7 @@ class LiftOffBVP:
     indenter point touched (+ ``delta``).  Conditions (14 or 15): pole 3; at S1
     the shell lies on the indenter and is tangent to it (r, phi, z: 3), and
     ``lambda_theta, phi, lambda_s, kappa_s, z`` are continuous (5) while ``rQ``
-    jumps (the ring force); rim 3; (force 1).  Unlike the annulus, kappa_s at
+    jumps (the ring force); rim 3; (force or lambda0 1).  Unlike the annulus, kappa_s at
     the line is free (it must not exceed the indenter's: no penetration).
 
     ``delta`` is the indenter's displacement (the tip apex sits at
@@ -261,8 +261,9 @@ class LiftOffBVP:
     def __init__(self, scene, topology: str, control: str, value: float, eps: float):
         if topology not in ("annulus", "line"):
             raise ValueError(f"topology must be 'annulus' or 'line'; got {topology!r}")
-        if control not in ("delta", "force"):
-            raise ValueError(f"control must be 'delta' or 'force' for {topology} contact; got {control!r}")
+        if control not in ("delta", "force", "lambda0"):
+            raise ValueError(f"control must be 'delta', 'force' or 'lambda0' for {topology} contact; "
+                             f"got {control!r}")
         self.scene, self.topology, self.control = scene, topology, control
         self.model = mod = scene.model()
         self.par = scene.parameters(mod)
@@ -275,7 +276,7 @@ class LiftOffBVP:
         self.inner = slice(0, N_FREE)
         self.contact = slice(N_FREE, N_FREE + self.n_contact)
         self.outer = slice(N_FREE + self.n_contact, self.n)
-        self.k = 3 if control == "force" else 2
+        self.k = 2 if control == "delta" else 3
         self.n_conditions = self.n + self.k
         self._jres, self._jjac = mod.junction_smooth_res, mod.junction_smooth_jac
 
@@ -284,7 +285,7 @@ class LiftOffBVP:
         """(ln S1, q, delta, F) with q = ln S2 (annulus) or chi1 (line)."""
         if self.control == "delta":
             return p[0], p[1], self.value, 0.0
-        return p[0], p[1], p[2], self.value
+        return p[0], p[1], p[2], self.value if self.control == "force" else 0.0
 
     def pack(self, ln_S1, q, delta):
         return np.array([ln_S1, q] if self.control == "delta" else [ln_S1, q, delta])
@@ -361,6 +362,8 @@ class LiftOffBVP:
         parts.append(mod.rim_res(self.L, yb[self.outer], par))
         if self.control == "force":
             parts.append(mod.force_res(S2, yc2, ya[self.outer], delta, F, par))
+        elif self.control == "lambda0":  # the stretch at the lifted pole
+            parts.append([ya[self.inner.start + 2] - self.value])
         return np.concatenate(parts)
 
     def bc_jac(self, ya, yb, p):
@@ -401,9 +404,12 @@ class LiftOffBVP:
             S2_col, S2v = 0, S1
         r0 = 3 + (10 if self.topology == "annulus" else 8)
         B[r0:r0 + 3, o0:o0 + N_FREE] = mod.rim_jac(self.L, yb[self.outer], par)
-        if self.control == "force":
+        if self.control != "delta":
             P[3:3 + jd.size, 2] = jd
+        if self.control == "force":
             fj = mod.force_jac(S2v, yc2, ya[self.outer], delta, F, par)  # d/d(Sc, yf, F)
             P[r0 + 3, S2_col] += fj[0, 0] * S2v
             A[r0 + 3, o0:o0 + N_FREE] = fj[0, 1:7]
+        elif self.control == "lambda0":
+            A[r0 + 3, i0 + 2] = 1.0
         return A, B, P

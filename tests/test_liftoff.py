@@ -26,13 +26,13 @@ def _fd(f, x, h=1e-7):
 
 
 @pytest.mark.parametrize("topology", ["annulus", "line"])
-@pytest.mark.parametrize("control", ["delta", "force"])
+@pytest.mark.parametrize("control", ["delta", "force", "lambda0"])
 def test_liftoff_jacobians_equal_finite_differences(topology, control):
     sysm = LiftOffBVP(sb.Scene.preset("base"), topology, control, 0.1, 1e-3)
     rng = np.random.default_rng(1)
     t = np.linspace(0, 1, 4)
     y = 0.5 + 0.3 * rng.random((sysm.n, t.size))
-    p = np.r_[np.log(0.05), np.log(0.15) if topology == "annulus" else 0.9, [0.1] if control == "force" else []]
+    p = np.r_[np.log(0.05), np.log(0.15) if topology == "annulus" else 0.9, [0.1] if control != "delta" else []]
     dfdy, dfdp = sysm.fun_jac(t, y, p)
     rel = lambda a, b: np.max(np.abs(a - b)) / (1 + np.max(np.abs(b)))  # noqa: E731
     for k in range(t.size):
@@ -106,18 +106,20 @@ def test_topology_argument_is_checked():
         sb.solve(scene, delta=0.1, topology="ring")
     with pytest.raises(ValueError, match="contact='smooth'"):
         sb.solve(sb.Scene.preset("base", contact="paper"), delta=0.1, topology="line")
-    with pytest.raises(ValueError, match="lambda0"):
-        sb.solve(scene, lambda0=1.0, topology="line")
     with pytest.raises(ValueError, match="topology"):
         sb.curve(scene, topology="line")
 
 
-def test_force_control_finds_the_lifted_state():
+def test_force_and_lambda0_control_find_the_lifted_state():
     scene = sb.Scene.preset("base")
     ref = sb.solve(scene, delta=0.08)
+    assert ref.topology == "line"
     sol = sb.solve(scene, force=ref.force)
     assert sol.topology == "line" and sol.valid
     assert sol.delta == pytest.approx(0.08, abs=1e-7)
+    lifted = sb.solve(scene, lambda0=ref.lambda0, topology="line")  # the stretch at the lifted pole
+    assert lifted.success and lifted.valid
+    assert lifted.delta == pytest.approx(0.08, abs=1e-6) and lifted.force == pytest.approx(ref.force, rel=1e-6)
 
 
 def test_base_curve_switches_from_line_to_cap_without_a_jump(tmp_path):
