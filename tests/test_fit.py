@@ -102,6 +102,50 @@ def test_fit_cli_shape_options_errors(argv, match):
     assert len(r.stderr.strip().splitlines()) == 1
 
 
+class _FakeCurve:
+    """A model curve of closed form whose shape depends on beta and alpha (fast tests of the fit logic)."""
+
+    def __init__(self, scene, deltas):
+        self.scene, self.delta = scene, np.asarray(deltas, float)
+        b, a = scene.beta, scene.material.alpha
+        self.force = self.delta ** (1.3 + 20 * b - 0.4 * a) * (1 + b)
+        self.stop_reason, self.solutions = "closed form", []
+
+    def __len__(self):
+        return self.delta.size
+
+
+@pytest.mark.parametrize("name,truth,start", [("beta", 0.02, 0.01), ("alpha", 0.6, 0.1)])
+def test_fit_shape_parameter_logic_on_closed_form_curves(monkeypatch, name, truth, start):
+    """Nodes, interpolation across them, profile interval: recovers the parameter of a known curve family."""
+    calls = []
+
+    def fake(scene, deltas, tol, counter=None):
+        calls.append(scene)
+        if counter is not None:
+            counter[0] += 1
+        return _FakeCurve(scene, deltas)
+
+    monkeypatch.setattr(sb.fitting, "_model_curve", fake)
+    mat = (lambda a: sb.MooneyRivlin(a))
+    scene0 = sb.Scene.preset("fit", **({"beta": start} if name == "beta" else {"material": mat(start)}))
+    true_scene = scene0.replace(**({"beta": truth} if name == "beta" else {"material": mat(truth)}))
+    x = np.linspace(0.01, 0.4, 40)
+    rng = np.random.default_rng(0)
+    force = MU_H * R_L * _FakeCurve(true_scene, x).force * (1 + 0.02 * rng.standard_normal(x.size))
+    r = sb.fit(scene0, R_L * x + D0, force, R_L=R_L, **{f"fit_{name}": True})
+    lo, hi = getattr(r, name + "_ci95")
+    assert lo < truth < hi and hi - lo < 0.5 * truth, (getattr(r, name), lo, hi)
+    assert r.mu_H_ci95[0] < MU_H < r.mu_H_ci95[1] and r.offset_ci95[0] < D0 < r.offset_ci95[1]
+    assert r.fitted == ("mu_H", "offset", name) and r.success
+    assert r.curves_computed == len(calls) <= 8 and r.interpolation_error < 1e-3
+    fitted_value = r.scene.beta if name == "beta" else r.scene.material.alpha
+    assert fitted_value == pytest.approx(getattr(r, name), rel=1e-9)  # the reported curve is the fitted one
+    # the data decide: a clearly wrong value lies outside the interval
+    assert not lo < start < hi
+
+
+@pytest.mark.slow
 def test_fit_beta_recovers_known_beta_within_interval():
     """Data at beta = 0.02 (preset fit, 2 % proportional noise); the fit starts from the preset's 0.01."""
     truth = sb.Scene.preset("fit", beta=0.02)
