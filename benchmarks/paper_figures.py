@@ -3,9 +3,13 @@
 Writes PNGs to benchmarks/figures/: each F-delta figure draws the variational
 ("smooth", solid) and the paper's ("paper", dashed) contact-line model.
 
-    python benchmarks/paper_figures.py
+    python benchmarks/paper_figures.py [--only beta_xi,rho,gamma,material,profiles,hemisphere_beta01,fit]
+
+The scenes of each figure are in FAMILIES (benchmarks/fit_models.py checks the
+paper's claims on the same scenes).
 """
 
+import argparse
 import time
 from pathlib import Path
 
@@ -15,14 +19,37 @@ import shellbvp as sb
 from shellbvp.plotting import plot_fit, plot_profiles, require_matplotlib
 
 OUT = Path(__file__).parent / "figures"
+FIGURES = ("beta_xi", "rho", "gamma", "material", "profiles", "hemisphere_beta01", "fit")
+DELTA_MAX = 0.5
 
 
-def family(ax, scenes, labels, title, delta_max=0.5):
+def families():
+    """Panel name -> [(scene, label)]: the curves of each F-delta panel."""
+    base = sb.Scene.preset("base")
+    betas, rhos, gammas = (1e-3, 1e-2, 1e-1), (0.1, 0.2, 1 / 3, 0.5), (0.0, 0.5, 1.0, 2.0, 2.5, 3.0)
+    alphas, jms = (0.0, 0.1, 0.5), (0.4, 1.0, 97.2)
+    return {
+        "beta_xi0": [(base.replace(beta=b, xi=0), f"beta = {b:g}") for b in betas],
+        "beta_xi1": [(base.replace(beta=b, xi=1), f"beta = {b:g}") for b in betas],
+        "rho": [(base.replace(rho=r), f"rho = {r:.3g}") for r in rhos],
+        "gamma": [(base.replace(gamma=g), f"gamma = {g:g}") for g in gammas],
+        "alpha": [(base.replace(material=sb.MooneyRivlin(a)), f"Mooney-Rivlin alpha = {a:g}") for a in alphas],
+        "gent": [(base.replace(material=sb.Gent(j)), f"Gent Jm = {j:g}") for j in jms],
+        "hemisphere_beta01": [(base.replace(beta=0.1), "hemisphere, beta = 0.1")],
+    }
+
+
+def model_curve(scene, contact, delta_max=DELTA_MAX):
+    """The curve drawn for a scene and contact model (adaptive, to delta_max)."""
+    return sb.curve(scene.replace(contact=contact), delta_max=delta_max, estimate_error=False)
+
+
+def family(ax, members, title, delta_max=DELTA_MAX):
     plt = require_matplotlib()
     colors = plt.rcParams["axes.prop_cycle"].by_key()["color"]
-    for i, (scene, label) in enumerate(zip(scenes, labels)):
+    for i, (scene, label) in enumerate(members):
         for contact, style in (("smooth", "-"), ("paper", "--")):
-            c = sb.curve(scene.replace(contact=contact), delta_max=delta_max, estimate_error=False)
+            c = model_curve(scene, contact, delta_max)
             ax.plot(c.delta, c.force, style, color=colors[i % len(colors)],
                     label=f"{label}" if contact == "smooth" else None)
             print(f"  {title}: {label} {contact}: {c.summary()}", flush=True)
@@ -33,54 +60,8 @@ def family(ax, scenes, labels, title, delta_max=0.5):
     ax.legend(fontsize=7)
 
 
-def main():
-    plt = require_matplotlib()
-    OUT.mkdir(exist_ok=True)
-    t0 = time.perf_counter()
-    base = sb.Scene.preset("base")
-
-    fig, axes = plt.subplots(1, 2, figsize=(11, 4.2))
-    for ax, xi in zip(axes, (0, 1)):
-        betas = (1e-3, 1e-2, 1e-1)
-        family(ax, [base.replace(beta=b, xi=xi) for b in betas], [f"beta = {b:g}" for b in betas],
-               f"varying beta, xi = {xi}")
-    fig.tight_layout()
-    fig.savefig(OUT / "beta_xi.png", dpi=120)
-
-    fig, ax = plt.subplots(figsize=(6, 4.2))
-    rhos = (0.1, 0.2, 1 / 3, 0.5)
-    family(ax, [base.replace(rho=r) for r in rhos], [f"rho = {r:.3g}" for r in rhos], "varying rho")
-    fig.tight_layout()
-    fig.savefig(OUT / "rho.png", dpi=120)
-
-    fig, ax = plt.subplots(figsize=(6, 4.2))
-    gammas = (0.0, 0.5, 1.0, 2.0, 2.5, 3.0)
-    family(ax, [base.replace(gamma=g) for g in gammas], [f"gamma = {g:g}" for g in gammas], "varying gamma")
-    fig.tight_layout()
-    fig.savefig(OUT / "gamma.png", dpi=120)
-
-    fig, axes = plt.subplots(1, 2, figsize=(11, 4.2))
-    alphas = (0.0, 0.1, 0.5)
-    family(axes[0], [base.replace(material=sb.MooneyRivlin(a)) for a in alphas],
-           [f"Mooney-Rivlin alpha = {a:g}" for a in alphas], "varying Mooney-Rivlin alpha")
-    jms = (0.4, 1.0, 97.2)
-    family(axes[1], [base.replace(material=sb.Gent(j)) for j in jms], [f"Gent Jm = {j:g}" for j in jms],
-           "varying Gent Jm")
-    fig.tight_layout()
-    fig.savefig(OUT / "material.png", dpi=120)
-
-    fig, axes = plt.subplots(1, 2, figsize=(11, 5))
-    plot_profiles(sb.Scene.preset("prolate2"), [0.1, 0.3, 0.5], ax=axes[0])
-    plot_profiles(sb.Scene.preset("dome"), [0.1, 0.3, 0.5], ax=axes[1])
-    fig.tight_layout()
-    fig.savefig(OUT / "profiles.png", dpi=120)
-
-    fig, ax = plt.subplots(figsize=(6, 4.2))
-    family(ax, [base.replace(beta=0.1)], ["hemisphere, beta = 0.1"], "shell on the hemisphere (paper: vs membrane)")
-    fig.tight_layout()
-    fig.savefig(OUT / "hemisphere_beta01.png", dpi=120)
-
-    # the fit figure with synthetic Lepidium-like data
+def fit_figure(plt):
+    """The fit figure with synthetic Lepidium-like data (seed 0, 50 points, 2 % proportional noise)."""
     scene = sb.Scene.preset("fit")
     R_L, mu_H, d0 = 0.3e-3, 52.0, 0.01e-3
     c = sb.curve(scene, deltas=np.linspace(0.01, 0.45, 50), estimate_error=False)
@@ -88,13 +69,70 @@ def main():
     disp = R_L * c.delta + d0
     force = mu_H * R_L * c.force * (1 + 0.02 * rng.standard_normal(c.delta.size))
     res = sb.fit(scene, disp, force, R_L=R_L)
-    print(f"  synthetic fit: mu*H = {res.mu_H:.4g} N/m, 95% CI {res.mu_H_ci95}, offset {res.offset:.3g} m")
+    print(f"  synthetic fit: mu*H = {res.mu_H:.4g} N/m, 95% CI {res.mu_H_ci95}, offset {res.offset:.3g} m, "
+          f"{res.weights} weights")
     fig, ax = plt.subplots(figsize=(6, 4.2))
     plot_fit(res, disp, force, ax=ax)
     ax.set_title(f"synthetic Lepidium-like data: mu*H = {res.mu_H:.3g} "
-                 f"[{res.mu_H_ci95[0]:.3g}, {res.mu_H_ci95[1]:.3g}] N/m (true 52)", fontsize=8)
+                 f"[{res.mu_H_ci95[0]:.3g}, {res.mu_H_ci95[1]:.3g}] N/m (true 52; {res.weights} weights)",
+                 fontsize=8)
     fig.tight_layout()
     fig.savefig(OUT / "fit.png", dpi=120)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--only", help="comma-separated figures: " + ",".join(FIGURES))
+    args = ap.parse_args()
+    only = set(FIGURES if not args.only else args.only.split(","))
+    if only - set(FIGURES):
+        ap.error(f"unknown figures {sorted(only - set(FIGURES))}; choose from {FIGURES}")
+    plt = require_matplotlib()
+    OUT.mkdir(exist_ok=True)
+    t0 = time.perf_counter()
+    fam = families()
+
+    if "beta_xi" in only:
+        fig, axes = plt.subplots(1, 2, figsize=(11, 4.2))
+        for ax, xi in zip(axes, (0, 1)):
+            family(ax, fam[f"beta_xi{xi}"], f"varying beta, xi = {xi}")
+        fig.tight_layout()
+        fig.savefig(OUT / "beta_xi.png", dpi=120)
+
+    if "rho" in only:
+        fig, ax = plt.subplots(figsize=(6, 4.2))
+        family(ax, fam["rho"], "varying rho")
+        fig.tight_layout()
+        fig.savefig(OUT / "rho.png", dpi=120)
+
+    if "gamma" in only:
+        fig, ax = plt.subplots(figsize=(6, 4.2))
+        family(ax, fam["gamma"], "varying gamma")
+        fig.tight_layout()
+        fig.savefig(OUT / "gamma.png", dpi=120)
+
+    if "material" in only:
+        fig, axes = plt.subplots(1, 2, figsize=(11, 4.2))
+        family(axes[0], fam["alpha"], "varying Mooney-Rivlin alpha")
+        family(axes[1], fam["gent"], "varying Gent Jm")
+        fig.tight_layout()
+        fig.savefig(OUT / "material.png", dpi=120)
+
+    if "profiles" in only:
+        fig, axes = plt.subplots(1, 2, figsize=(11, 5))
+        plot_profiles(sb.Scene.preset("prolate2"), [0.1, 0.3, 0.5], ax=axes[0])
+        plot_profiles(sb.Scene.preset("dome"), [0.1, 0.3, 0.5], ax=axes[1])
+        fig.tight_layout()
+        fig.savefig(OUT / "profiles.png", dpi=120)
+
+    if "hemisphere_beta01" in only:
+        fig, ax = plt.subplots(figsize=(6, 4.2))
+        family(ax, fam["hemisphere_beta01"], "shell on the hemisphere (paper: vs membrane)")
+        fig.tight_layout()
+        fig.savefig(OUT / "hemisphere_beta01.png", dpi=120)
+
+    if "fit" in only:
+        fit_figure(plt)
     plt.close("all")
     print(f"figures in {OUT} ({time.perf_counter() - t0:.0f} s)")
 
