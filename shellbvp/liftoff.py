@@ -268,7 +268,7 @@ def liftoff_richardson_error(sysm, res, tol, bc_tol=1e-10):
 
 # -- topology selection ------------------------------------------------------------------------
 #: Below this ratio S1/S2 an annulus has reached the pole: it is the cap.
-ANNULUS_CLOSED_AT_POLE = 1e-4
+ANNULUS_CLOSED_AT_POLE = 1e-3
 
 
 #: Below this contact radius a lifted-off state is taken as its point-load limit.
@@ -294,7 +294,7 @@ def liftoff_state(cap: Solution, topology: str, *, tol=1e-6, max_nodes=10000, bc
     # The cap is the better guess (the lift-off state is close to it near the switch and
     # its contact edge is where the cap's is); a neighbour of the same topology is the
     # fallback.  A node budget of a few times the cap's makes hopeless starts fail fast.
-    kw = dict(tol=tol, max_nodes=int(min(max_nodes, max(1000, 3 * cap.nodes))), bc_tol=bc_tol)
+    kw = dict(tol=tol, max_nodes=int(min(max_nodes, max(2000, 4 * cap.nodes))), bc_tol=bc_tol)
     res = None
     for frac in ((0.9, 0.5) if topology == "line" else (0.5, 0.9)):
         res = solve_liftoff_from(sysm, liftoff_guess_from_cap(sysm, cap, frac), **kw)
