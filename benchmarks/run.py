@@ -66,6 +66,8 @@ STEPS = (
     Step("preset_curves", "preset_curves.py", [], ["--quick"],
          ["results/preset_curves.json", "results/preset_curves.md"],
          ["results/preset_curves-quick.json", "results/preset_curves-quick.md"]),
+    Step("topologies", "topologies.py", [], ["--quick"], ["results/topologies.json", "results/topologies.md"],
+         ["results/topologies-quick.json", "results/topologies-quick.md"]),
     Step("codegen_timing", "codegen_timing.py", ["--repeat", "3"], ["--quick"],
          ["results/codegen.json", "results/codegen.md"], ["results/codegen-quick.json", "results/codegen-quick.md"]),
     Step("paper_figures", "paper_figures.py", [], None, ["figures/*.png"], out_flag=None, optional=True),

@@ -193,6 +193,7 @@ def worker(spec_path, out_path):
         cap = lambda s: s.get("topology", "cap") != "point"  # noqa: E731
         row["point_load_points"] = int(sum(not cap(s) for s in sols))
         row["curve"]["topology"] = [s.get("topology", "cap") for s in sols]
+        row["topologies"] = c.topology_summary() if hasattr(c, "topology_summary") else ""
         if "edge_legendre" in p:
             row["curve"]["edge_legendre"] = [float(v) for v in p["edge_legendre"]]
         omega_c = [float(s.Sc * s.y[0, -1] / scene.rho) if cap(s) else 0.0 for s in sols]
@@ -304,16 +305,16 @@ def markdown(rows, meta):
         f"time limit {meta['time_limit']:.0f} s per curve; total {meta['total_s']:.0f} s.",
         "",
         "| scene | contact | delta reached | max F | stopped | complete | points | max nodes | time (s) "
-        "| max F error | min P | invalid | F < 0 at delta | max \\|dE/dδ − F\\| | at the last point |",
-        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|",
+        "| max F error | min P | invalid | F < 0 at delta | max \\|dE/dδ − F\\| | contact topologies | at the last point |",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     for r in rows:
         if r.get("skipped"):
-            lines.append(f"| {r['id']} | {r['contact']} | skipped: {r['skipped'][:50]} |" + " |" * 12)
+            lines.append(f"| {r['id']} | {r['contact']} | skipped: {r['skipped'][:50]} |" + " |" * 13)
             continue
         if not r.get("points"):
             lines.append(f"| {r['id']} | {r['contact']} | — | | {short_reason(r)} | no | 0 | | "
-                         f"{r['wall_time']:.1f} | | | | | | |")
+                         f"{r['wall_time']:.1f} | | | | | | | |")
             continue
         neg = ("" if not r["F_negative"] else
                f"{r['F_negative_delta'][0]:.3g}–{r['F_negative_delta'][1]:.3g}")
@@ -324,14 +325,15 @@ def markdown(rows, meta):
             f"| {r['id']} | {r['contact']} | {r['delta_min']:.3g}–{r['delta_max']:.4g} | {r['force_max']:.4g} "
             f"| {short_reason(r)} | {'yes' if r['complete'] else 'no'} | {r['points']} | {r['nodes_max']} "
             f"| {r['wall_time']:.1f} | {fe} | {g(r['pressure_min'])} | {r['invalid']} | {neg or 'no'} "
-            f"| {g(r['energy_residual_max'], '.1e')} | {r.get('diagnosis', '')} |")
+            f"| {g(r['energy_residual_max'], '.1e')} | {r.get('topologies', '')} | {r.get('diagnosis', '')} |")
     lines += [
         "",
         "delta reached: smallest and largest delta on the curve (the small-delta leg aims at delta_min; "
         "the upward leg at delta_max or the cylinder). max F error: largest Richardson estimate. "
-        "min P: smallest contact pressure over all points (the huge negative values are exponentially "
-        "small caps at small delta, P ~ 1/Sc^2; single-cap topology, issue 7). invalid: points with "
-        "valid = False. max |dE/dδ − F|: Curve.energy_residual (finite differences along the curve; "
+        "min P: smallest contact pressure over all points (of the states recorded: where the cap would "
+        "pull, the valid line or annular contact replaces it; a line has no contact area). invalid: points "
+        "with valid = False (with the paper's contact model, which has the single cap only, the small-delta "
+        "caps that pull). contact topologies: runs along the curve and the located switches. max |dE/dδ − F|: Curve.energy_residual (finite differences along the curve; "
         "~1e-3 for the smooth model is the differencing error at this point spacing, O(0.1-1) for the "
         "paper model and for xi = 0 is real). at the last point: automatic diagnosis of the last point "
         "(det of d(tau_s, M_s)/d(lambda_s, kappa_s) at the contact line, the 2x2 system the free-region "

@@ -31,7 +31,8 @@ def _runs(values):
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--quick", action="store_true", help="base preset only (writes topologies-quick.*)")
+    ap.add_argument("--quick", action="store_true",
+                    help="base preset, delta 0.05, curve to 0.15 (writes topologies-quick.*)")
     ap.add_argument("--out-dir", default=None, help="write results/ under this directory (default benchmarks/)")
     args = ap.parse_args(argv)
     presets = ("base",) if args.quick else sb.PRESETS
@@ -41,7 +42,7 @@ def main(argv=None):
     states, curves = [], []
     for name, scene in scenes.items():
         scene.model()
-        for d in DELTAS:
+        for d in ((0.05,) if args.quick else DELTAS):
             cap = sb.solve(scene, delta=d, topology="cap", tol=1e-8)
             t0 = time.perf_counter()
             auto = sb.solve(scene, delta=d, tol=1e-8)
@@ -52,7 +53,7 @@ def main(argv=None):
                                energy_change=auto.get("energy", np.nan) - cap.get("energy", np.nan),
                                seconds=time.perf_counter() - t0))
         t0 = time.perf_counter()
-        c = sb.curve(scene)
+        c = sb.curve(scene, delta_max=0.15 if args.quick else 0.5)
         curves.append(dict(preset=name, points=len(c), valid=int(np.sum(c.valid)), topologies=_runs(c.topology),
                            switches=c.settings.get("topology_switches", []), stop_reason=c.stop_reason,
                            energy_identity_max=float(np.nanmax(np.abs(c.energy_residual))),
@@ -70,7 +71,7 @@ def main(argv=None):
         lines.append(f"| {r['preset']} | {r['delta']} | {r['topology']} | {r['force']:.8f} | {r['force_error']:.1e} "
                      f"| {r['S1']:.3g} | {r['Sc']:.3g} | {r['cap_force']:.8f} | {r['force'] - r['cap_force']:.2e} "
                      f"| {r['energy_change']:.2e} | {r['cap_pressure_min']:.3g} | {'yes' if r['valid'] else 'no'} |")
-    lines += ["", "Curves (`shellbvp curve --preset NAME`, delta to 0.5):", "",
+    lines += ["", f"Curves (`shellbvp curve --preset NAME`, delta to {0.15 if args.quick else 0.5}):", "",
               "| preset | points | valid | topologies along the curve | switches at delta "
               "| max abs(dE/ddelta - F) | time (s) | stopped |",
               "|---|---|---|---|---|---|---|---|"]
