@@ -15,10 +15,23 @@ from .scene import PRESETS, Scene
 from .state import STATUS_MESSAGES, Solution, solve
 from .continuation import Curve, curve
 from .io import read_curve
-from .fitting import FitResult, fit, read_force_csv
 from .units import Dimensions, beta_from_thickness, parse_quantity
 
 __version__ = "0.1.0.dev0"
+
+_LAZY = {"fit": "fitting", "FitResult": "fitting", "read_force_csv": "fitting"}
+
+
+def __getattr__(name):
+    # Fitting pulls in scipy.optimize and friends (a third of the import time): load it
+    # on first use, so that solving and curves start faster.
+    if name in _LAZY:
+        import importlib
+
+        value = getattr(importlib.import_module(f".{_LAZY[name]}", __name__), name)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 __all__ = [
     "Scene",
