@@ -188,15 +188,16 @@ def worker(spec_path, out_path):
                                                    "flags": list(c.flags)},
         )
         # Diagnostics of the first and the last point of the branch (in delta).
-        # (point-load states, topology "point", have no contact region: no cap angle, no Sc+)
+        # (only single-cap states have the cap angle and Sc+ used here; point-load, line and
+        # annulus states are skipped)
         sols = c.solutions
-        cap = lambda s: s.get("topology", "cap") != "point"  # noqa: E731
-        row["point_load_points"] = int(sum(not cap(s) for s in sols))
+        cap = lambda s: s.get("topology", "cap") == "cap"  # noqa: E731
+        row["point_load_points"] = int(sum(s.get("topology") == "point" for s in sols))
         row["curve"]["topology"] = [s.get("topology", "cap") for s in sols]
         row["topologies"] = c.topology_summary() if hasattr(c, "topology_summary") else ""
         if "edge_legendre" in p:
             row["curve"]["edge_legendre"] = [float(v) for v in p["edge_legendre"]]
-        omega_c = [float(s.Sc * s.y[0, -1] / scene.rho) if cap(s) else 0.0 for s in sols]
+        omega_c = [float(s.Sc * s.y[0, -1] / scene.rho) if cap(s) else float("nan") for s in sols]
         row["curve"]["omega_c"] = omega_c
         last = sols[int(np.argmax(d))]
         row["omega_c_last_frac"] = omega_c[int(np.argmax(d))] / scene.tip_omega_max
@@ -206,7 +207,7 @@ def worker(spec_path, out_path):
                 d0 = free_det(sols[caps[0]])
                 d1 = free_det(last)
             row.update(det_first=d0[0], det_last=d1[0], det_last_min=d1[1], det_last_min_at=d1[2])
-        if spec["overrides"].get("material", ("",))[0] == "gent":
+        if spec["overrides"].get("material", ("",))[0] == "gent" and cap(last):
             with np.errstate(all="ignore"):
                 row["gent_ratio_last"] = gent_ratio(last, spec["overrides"]["material"][1])
         row["diagnosis"] = diagnose(row)
