@@ -33,6 +33,7 @@ def main(argv=None):
                 t0 = time.perf_counter()
                 s = sb.solve(scene, delta=d)
                 rows.append(dict(preset=name, contact=contact, delta=d, success=bool(s.success),
+                                 topology=s.get("topology", "cap"),
                                  status=s.status, force=s.force, Sc=float(s.Sc), lambda0=s.lambda0,
                                  ring_force=s.get("ring_force"), pressure_min=s.get("pressure_min"),
                                  valid=bool(s.get("valid")), force_error=s.get("force_error"),
@@ -41,14 +42,15 @@ def main(argv=None):
     out.mkdir(parents=True, exist_ok=True)
     name = "states-quick" if args.quick else "states"
     (out / f"{name}.json").write_text(json.dumps(rows, indent=1, default=float))
-    lines = ["| preset | contact | delta | F | Sc | lambda0 | ring force | min P | valid | F error | nodes | time (s) |",
-             "|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    lines = ["| preset | contact | delta | topology | F | Sc | lambda0 | ring force | min P | valid | F error | nodes "
+             "| time (s) |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in rows:
         if not r["success"]:
             lines.append(f"| {r['preset']} | {r['contact']} | {r['delta']} | failed (status {r['status']}) "
-                         f"| | | | | | | | {r['seconds']:.2f} |")
+                         f"| | | | | | | | | {r['seconds']:.2f} |")
             continue
-        lines.append(f"| {r['preset']} | {r['contact']} | {r['delta']} | {r['force']:.6f} | {r['Sc']:.3g} | "
+        lines.append(f"| {r['preset']} | {r['contact']} | {r['delta']} | {r['topology']} | {r['force']:.6f} | {r['Sc']:.3g} | "
                      f"{r['lambda0']:.4f} | {r['ring_force']:.4g} | {r['pressure_min']:.3g} | "
                      f"{'yes' if r['valid'] else 'no'} | {r['force_error']:.1e} | {r['nodes']} | "
                      f"{r['seconds']:.2f} |")
