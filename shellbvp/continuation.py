@@ -345,35 +345,27 @@ def _locate_switches(builder: _Builder, st):
 
     for (k1, _, _, s1), (k2, _, _, s2) in zip(rows[:-1], rows[1:]):
         frm, to = s1.get("topology"), s2.get("topology")
+        pair = {frm, to}
         if not (s1.get("valid") and s2.get("valid")) or frm == to:
             continue
-        if "cap" in (frm, to) and {frm, to} & {"line", "annulus"}:
-            e1, e2, f, solve_at = _cap_of(s1), _cap_of(s2), "pressure_min", cap_at
-        elif {frm, to} == {"line", "annulus"}:
-            line = s1 if frm == "line" else s2
-            e1 = e2 = None
-            ends = [(line.delta, -line.curvature_excess, line)]
-            other = s2 if frm == "line" else s1
-            shadow = liftoff_state_line(other, st)
-            if shadow is None:
-                continue
-            ends.append((shadow.delta, -shadow.curvature_excess, shadow))
-            ends.sort(key=lambda e: e[0])
-            (a, fa, sa), (b, fb, sb) = ends
-            if not fa * fb < 0:
-                continue
-            best = _regula_falsi(a, fa, sa, b, fb, sb, line_at, st["tol"])
-            _add_switch(builder, st, switches, best, frm, to, k1, k2, "curvature_excess")
-            continue
+        if "cap" in pair and pair & {"line", "annulus"}:
+            ends, criterion, sign, solve_at = [_cap_of(s1), _cap_of(s2)], "pressure_min", 1.0, cap_at
+        elif pair == {"line", "annulus"}:
+            ends = [s if s.get("topology") == "line" else _line_state_at(s, st) for s in (s1, s2)]
+            criterion, sign, solve_at = "curvature_excess", -1.0, line_at
         else:
             continue
-        if e1 is None or e2 is None or not e1[f] * e2[f] < 0:
+        if any(e is None for e in ends):
             continue
-        best = _regula_falsi(e1.delta, e1[f], e1, e2.delta, e2[f], e2, solve_at, st["tol"])
-        _add_switch(builder, st, switches, best, frm, to, k1, k2, f)
+        e1, e2 = sorted(ends, key=lambda e: e.delta)
+        f1, f2 = sign * e1[criterion], sign * e2[criterion]
+        if not f1 * f2 < 0:
+            continue
+        best = _regula_falsi(e1.delta, f1, e1, e2.delta, f2, e2, solve_at, st["tol"])
+        _add_switch(builder, st, switches, best, frm, to, k1, k2, criterion)
 
 
-def liftoff_state_line(sol, st):
+def _line_state_at(sol, st):
     """The line state at a lift-off point's delta (from its cap), or None."""
     from .liftoff import liftoff_state
 

@@ -7,8 +7,14 @@ there: a free inner cap around the pole, then contact on an annulus
 zero-width annulus carrying a ring force), then the outer free region.  The
 systems are :class:`shellbvp.system.LiftOffBVP`; this module makes guesses,
 runs solve_bvp and diagnoses the result into a :class:`~shellbvp.state.Solution`
-with the same fields as a cap state, plus ``S1`` (inner edge), ``ring_force_inner``
-and ``contact_width``.  ``Sc`` is the outer contact edge.
+with the same fields as a cap state, plus ``S1`` (inner edge), ``ring_force_inner``,
+``contact_width`` and, for a line, ``curvature_excess`` (kappa_s at the line minus the
+tip's: > 0 means the shell bends through the tip and the contact is an annulus).
+``Sc`` is the outer contact edge.
+
+Topology selection (:func:`valid_liftoff_state`) starts from an invalid cap: the line
+first (or the topology of the previous point), then the annulus where a pressed band
+is possible, and the point-load limit for contact circles below ``POINT_LIMIT_SC``.
 """
 
 from __future__ import annotations
@@ -23,10 +29,9 @@ from .state import (_GAUSS_T, _GAUSS_W, STATUS_MESSAGES, Solution, _attach_tip, 
                     thin_mesh)
 from .system import N_CONTACT, N_FREE, LiftOffBVP
 
-__all__ = ["solve_liftoff", "make_liftoff_system", "liftoff_guess_from_cap", "liftoff_warm_guess",
-           "LIFTOFF_TOPOLOGIES", "solve_liftoff_from"]
-
-LIFTOFF_TOPOLOGIES = ("annulus", "line")
+__all__ = ["solve_liftoff", "solve_liftoff_from", "make_liftoff_system", "liftoff_guess_from_cap",
+           "liftoff_warm_guess", "liftoff_state", "valid_liftoff_state", "lift_off_suspected",
+           "liftoff_richardson_error", "liftoff_profile"]
 
 
 def make_liftoff_system(scene, topology, control, value, eps):
@@ -79,15 +84,10 @@ def liftoff_guess_from_cap(sysm: LiftOffBVP, cap: Solution, S1_fraction: float, 
     return t, y, p
 
 
-def liftoff_warm_guess(sysm: LiftOffBVP, prev: Solution, predictor=None):
+def liftoff_warm_guess(sysm: LiftOffBVP, prev: Solution):
     """A neighbouring lift-off state of the same topology on its thinned mesh."""
     x = thin_mesh(prev.x)
-    y = prev.sol(x)
-    p = sysm.pack(prev.p[0], prev.p[1], prev.delta)
-    if predictor is not None:
-        dy, dp = predictor
-        y, p = y + dy(x), p + dp
-    return x, y, p
+    return x, prev.sol(x), sysm.pack(prev.p[0], prev.p[1], prev.delta)
 
 
 # -- solving --------------------------------------------------------------------------------
@@ -130,7 +130,7 @@ def solve_liftoff_from(sysm, guess, *, tol=1e-6, max_nodes=10000, bc_tol=1e-10):
 
 
 def _edge_values(sysm, y_a, y_b, p):
-    """Force, ring forces (inner, outer) and the contact state at each edge."""
+    """(F, inner ring force, outer ring force, S1, S2, delta) of a lift-off state."""
     mod, par = sysm.model, sysm.par
     ln_S1, q, delta, _ = sysm.unpack(p)
     S1 = float(np.exp(np.float64(ln_S1)))
