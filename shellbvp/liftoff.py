@@ -23,9 +23,7 @@ import math
 import time
 
 import numpy as np
-from scipy.integrate import solve_bvp
-
-from .state import (_GAUSS_T, _GAUSS_W, STATUS_MESSAGES, Solution, _attach_tip, _penetration,
+from .state import (_GAUSS_T, _GAUSS_W, STATUS_MESSAGES, Solution, _attach_tip, _penetration, solve_bvp,
                     thin_mesh)
 from .system import N_CONTACT, N_FREE, LiftOffBVP
 

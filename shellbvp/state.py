@@ -13,7 +13,6 @@ import math
 import time
 
 import numpy as np
-from scipy.integrate import solve_bvp
 
 from .system import N_CONTACT, MultipointBVP
 
@@ -33,6 +32,14 @@ STATUS_MESSAGES = {
 }
 
 _GAUSS_T, _GAUSS_W = np.polynomial.legendre.leggauss(4)
+
+
+def solve_bvp(*args, **kwargs):
+    """scipy.integrate.solve_bvp, imported on first use: scipy.integrate is most of the
+    import time of shellbvp, and reading files or loading a model does not need it."""
+    from scipy.integrate import solve_bvp as _solve_bvp
+
+    return _solve_bvp(*args, **kwargs)
 
 
 class Solution(dict):
