@@ -23,8 +23,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .liftoff import lift_off_suspected, valid_liftoff_state
-from .state import (SC_POINT, Solution, _default_eps, _warm_guess, estimate_errors, make_system, solve,
+from .liftoff import replace_invalid_cap
+from .state import (SC_POINT, Solution, _default_eps, _warm_guess, make_system, richardson_error, solve,
                     solve_from, solve_point_load, thin_mesh)
 
 __all__ = ["Curve", "curve", "POINT_FIELDS"]
@@ -37,7 +37,9 @@ POINT_FIELDS = (
     "force_error", "delta_error", "energy", "ring_force", "cap_force", "pressure_min",
     "penetration", "force_defect", "edge_legendre", "wall_time", "topology", "S1", "ring_force_inner",
 )
-_FIELD_DEFAULTS = {"topology": "cap", "S1": 0.0, "ring_force_inner": 0.0}
+#: Fields a single-cap state does not carry, with their cap values (also what files of
+#: format version 1, which predate them, read as).
+CAP_FIELD_DEFAULTS = {"topology": "cap", "S1": 0.0, "ring_force_inner": 0.0}
 
 
 @dataclass
@@ -127,7 +129,7 @@ class _Stop(Exception):
 
 
 def _record(sol: Solution):
-    row = {k: sol.get(k, _FIELD_DEFAULTS.get(k, np.nan)) for k in POINT_FIELDS}
+    row = {k: sol.get(k, CAP_FIELD_DEFAULTS.get(k, np.nan)) for k in POINT_FIELDS}
     if row["topology"] == "point":
         row["S1"] = 0.0
     row["valid"] = bool(sol.get("valid", False))
@@ -252,23 +254,19 @@ class _Builder:
 
     def _shown(self, sol: Solution) -> Solution:
         st = self.settings
-        if st["topology"] != "auto" or sol.scene.contact != "smooth" or not lift_off_suspected(sol):
+        if st["topology"] != "auto" or sol.scene.contact != "smooth":
             return sol
-        alt, tried = valid_liftoff_state(sol, tol=st["tol"], max_nodes=st["max_nodes"], bc_tol=st["bc_tol"],
-                                         previous=self.last_liftoff)
-        if alt is None:
-            sol.flags = list(sol.flags) + ["no valid lift-off state found (" + "; ".join(tried) + ")"]
-            return sol
-        alt.cap_state = {k: sol[k] for k in ("delta", "force", "energy", "pressure_min", "Sc")}
-        alt.cap_solution = sol
-        self.last_liftoff = alt
-        return alt
+        shown = replace_invalid_cap(sol, tol=st["tol"], max_nodes=st["max_nodes"], bc_tol=st["bc_tol"],
+                                    previous=self.last_liftoff)
+        if shown is not sol:
+            self.last_liftoff = shown
+        return shown
 
     def add(self, sol: Solution, key: float):
         """Accept a point; ``key`` orders points along the branch."""
         sol = self._shown(sol)
         if self.estimate_error and sol.success:
-            estimate_errors(sol, self.tol)
+            richardson_error(sol.system, sol, self.tol)
         self.rows.append((key, _record(sol), "; ".join(sol.get("flags", [])), sol))
         if self.callback is not None:
             self.callback(self.snapshot(), sol)

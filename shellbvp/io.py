@@ -148,14 +148,13 @@ def write_curve(curve, path, *, profiles=False, overwrite=False, units=None):
         raise
 
 
-#: Fields added after format version 1 and their values in older files (single cap only).
-_LATER_FIELDS = {"topology": "cap", "S1": 0.0, "ring_force_inner": 0.0}
-
-
 def _missing_field(name, n):
-    if name not in _LATER_FIELDS:
+    """A field added after format version 1, as an older (single-cap) file reads it."""
+    from .continuation import CAP_FIELD_DEFAULTS
+
+    if name not in CAP_FIELD_DEFAULTS:
         raise KeyError(name)
-    return np.full(n, _LATER_FIELDS[name], dtype=object if name == "topology" else float)
+    return np.full(n, CAP_FIELD_DEFAULTS[name], dtype=object if name == "topology" else float)
 
 
 def read_curve(path):

@@ -23,13 +23,13 @@ import math
 import time
 
 import numpy as np
-from .state import (_GAUSS_T, _GAUSS_W, STATUS_MESSAGES, Solution, _attach_tip, _penetration, solve_bvp,
-                    thin_mesh)
+from .state import (STATUS_MESSAGES, Solution, _attach_tip, _penetration, gauss_points, richardson_error,
+                    set_status, solve_bvp, thin_mesh)
 from .system import N_CONTACT, N_FREE, LiftOffBVP
 
 __all__ = ["solve_liftoff", "solve_liftoff_from", "make_liftoff_system", "liftoff_guess_from_cap",
            "liftoff_warm_guess", "liftoff_state", "valid_liftoff_state", "lift_off_suspected",
-           "liftoff_richardson_error", "liftoff_profile"]
+           "replace_invalid_cap", "liftoff_profile"]
 
 
 def make_liftoff_system(scene, topology, control, value, eps):
@@ -111,7 +111,7 @@ def solve_liftoff(scene, topology, *, delta=None, force=None, lambda0=None, gues
         guess = liftoff_warm_guess(sysm, guess)
     res = solve_liftoff_from(sysm, guess, tol=tol, max_nodes=max_nodes, bc_tol=bc_tol)
     if res.success and estimate_error:
-        liftoff_richardson_error(sysm, res, tol, bc_tol)
+        richardson_error(sysm, res, tol, bc_tol)
     res.wall_time = time.perf_counter() - t0
     return res
 
@@ -127,50 +127,25 @@ def solve_liftoff_from(sysm, guess, *, tol=1e-6, max_nodes=10000, bc_tol=1e-10):
     return res
 
 
-def _edge_values(sysm, y_a, y_b, p):
-    """(F, inner ring force, outer ring force, S1, S2, delta) of a lift-off state."""
-    mod, par = sysm.model, sysm.par
-    ln_S1, q, delta, _ = sysm.unpack(p)
-    S1 = float(np.exp(np.float64(ln_S1)))
-    S2 = float(np.exp(np.float64(sysm.ln_S2(p))))
-    G_out = float(mod.free_profile(np.array([S2]), y_a[sysm.outer, None], par)["axial_force_2pi"][0])
-    G_in = float(mod.free_profile(np.array([S1]), y_b[sysm.inner, None], par)["axial_force_2pi"][0])
-    if sysm.topology == "annulus":
-        pc1 = mod.contact_profile(np.array([S1]), y_a[sysm.contact, None], par)["axial_force_2pi"][0]
-        pc2 = mod.contact_profile(np.array([S2]), y_b[sysm.contact, None], par)["axial_force_2pi"][0]
-        ring_in, ring_out = 2 * np.pi * (pc1 - G_in), 2 * np.pi * (G_out - pc2)
-    else:
-        ring_in, ring_out = 0.0, 2 * np.pi * (G_out - G_in)
-    return 2 * np.pi * G_out, float(ring_in), float(ring_out), S1, S2, float(delta)
-
-
-def _integrate(sysm, bvp, p, region):
-    x = bvp.x
-    a, b = x[:-1], x[1:]
-    t = (0.5 * (a + b)[:, None] + 0.5 * (b - a)[:, None] * _GAUSS_T[None, :]).ravel()
-    w = (0.5 * (b - a)[:, None] * _GAUSS_W[None, :]).ravel()
+def _energy(sysm, bvp, p):
+    """Int U R Psi dS over the inner cap, the annulus (if any) and the outer region."""
+    t, w = gauss_points(bvp.x)
     y = bvp.sol(t)
     mod, par = sysm.model, sysm.par
-    if region == "inner":
-        S = sysm.S_inner(t, p)
-        e = mod.free_profile(S, y[sysm.inner], par)["energy_density"]
-        dlnS = -sysm.ln_eps
-    elif region == "contact":
-        S = sysm.S_contact(t, p)
-        e = mod.contact_profile(S, y[sysm.contact], par)["energy_density"]
-        dlnS = sysm.ln_S2(p) - p[0]
-    else:
-        S = sysm.S_outer(t, p)
-        e = mod.free_profile(S, y[sysm.outer], par)["energy_density"]
-        dlnS = sysm.ln_L - sysm.ln_S2(p)
-    return float(np.sum(w * e * S * dlnS))
+    Si, So = sysm.S_inner(t, p), sysm.S_outer(t, p)
+    e = (mod.free_profile(Si, y[sysm.inner], par)["energy_density"] * Si * (-sysm.ln_eps)
+         + mod.free_profile(So, y[sysm.outer], par)["energy_density"] * So * (sysm.ln_L - sysm.ln_S2(p)))
+    if sysm.topology == "annulus":
+        Sc = sysm.S_contact(t, p)
+        e = e + mod.contact_profile(Sc, y[sysm.contact], par)["energy_density"] * Sc * (sysm.ln_S2(p) - p[0])
+    return float(np.sum(w * e))
 
 
 def _diagnose(sysm: LiftOffBVP, bvp, tol):
     mod, par = sysm.model, sysm.par
     p = bvp.p
     ya, yb = bvp.y[:, 0], bvp.y[:, -1]
-    force, ring_in, ring_out, S1, S2, delta = _edge_values(sysm, ya, yb, p)
+    force, ring_in, ring_out, S1, S2, delta = sysm.edge_values(ya, yb, p)
     z_tip = float(mod.reference_shell(0.0, par)["Z"]) - delta
     res = Solution(
         topology=sysm.topology, status=int(bvp.status), message=bvp.message, x=bvp.x, y=bvp.y, p=p,
@@ -192,12 +167,7 @@ def _diagnose(sysm: LiftOffBVP, bvp, tol):
         omega2 = (S2 * (yb[sysm.contact][0] if sysm.topology == "annulus" else p[1])) / sysm.scene.rho
         if omega2 > sysm.scene.tip_omega_max:
             flags.append("the contact has passed the end of the tip (the indenter's cylinder)")
-    if bvp.status == 0 and flags:
-        res.status = 4
-        res.message = STATUS_MESSAGES[4] + ": " + "; ".join(flags)
-    elif bvp.status == 0:
-        res.message = STATUS_MESSAGES[0]
-    res.success = res.status == 0
+    set_status(res, bvp, flags)
     nan = float("nan")
     if not finite:
         res.update(energy=nan, pressure_min=nan, penetration=nan, force_defect=nan, edge_legendre=nan,
@@ -220,8 +190,7 @@ def _diagnose(sysm: LiftOffBVP, bvp, tol):
     res.edge_legendre = float(leg[0] / leg[1]) if leg[1] != 0 else nan
     res.penetration = max(_penetration(sysm, pin["r"], pin["z"], z_tip),
                           _penetration(sysm, pout["r"], pout["z"], z_tip))
-    E = sum(_integrate(sysm, bvp, p, reg) for reg in (("inner", "contact", "outer")
-                                                        if sysm.topology == "annulus" else ("inner", "outer")))
+    E = _energy(sysm, bvp, p)
     pole_density = float(mod.free_profile(np.array([sysm.eps * S1]), ya[sysm.inner, None], par)
                          ["energy_density"][0])
     res.energy = 2 * np.pi * (E + 0.5 * pole_density * sysm.eps * S1)
@@ -246,22 +215,6 @@ def _diagnose(sysm: LiftOffBVP, bvp, tol):
     res.flags = flags + vflags
     res.valid = res.success and not vflags
     return res
-
-
-def liftoff_richardson_error(sysm, res, tol, bc_tol=1e-10):
-    """``force_error``, ``delta_error``: as :func:`shellbvp.state.richardson_error`."""
-    x = res.x
-    x2 = np.sort(np.r_[x, 0.5 * (x[1:] + x[:-1])])
-    with np.errstate(all="ignore"):
-        fine = solve_bvp(sysm.fun, sysm.bc, x2, res.sol(x2), np.array(res.p, float), fun_jac=sysm.fun_jac,
-                         bc_jac=sysm.bc_jac, tol=tol / 100, bc_tol=bc_tol / 100, max_nodes=x2.size)
-    if fine.status == 2 or not np.all(np.isfinite(fine.p)):
-        res.force_error = res.delta_error = float("nan")
-        res.flags = list(res.flags) + ["error estimate failed (Newton on the halved mesh did not converge)"]
-        return
-    force, _, _, _, _, delta = _edge_values(sysm, fine.y[:, 0], fine.y[:, -1], fine.p)
-    res.force_error = abs(force - res.force) * 16 / 15
-    res.delta_error = abs(delta - res.delta) * 16 / 15
 
 
 # -- topology selection ------------------------------------------------------------------------
@@ -367,6 +320,21 @@ def valid_liftoff_state(cap: Solution, *, tol=1e-6, max_nodes=10000, bc_tol=1e-1
         why = res.message if not res.success else "; ".join(res.flags)
         tried.append(f"{topology}: {why}")
     return None, tried
+
+
+def replace_invalid_cap(cap: Solution, *, tol=1e-6, max_nodes=10000, bc_tol=1e-10, previous=None):
+    """The state to report for a cap state: itself if it does not pull, else the valid
+    lift-off state (with ``cap_state``/``cap_solution`` kept), else the cap flagged with
+    what was tried."""
+    if not lift_off_suspected(cap):
+        return cap
+    alt, tried = valid_liftoff_state(cap, tol=tol, max_nodes=max_nodes, bc_tol=bc_tol, previous=previous)
+    if alt is None:
+        cap.flags = list(cap.flags) + ["no valid lift-off state found (" + "; ".join(tried) + ")"]
+        return cap
+    alt.cap_state = {k: cap[k] for k in ("delta", "force", "energy", "pressure_min", "Sc")}
+    alt.cap_solution = cap
+    return alt
 
 
 def _pressed_somewhere(cap):

@@ -190,24 +190,36 @@ def _state_params(sol):
     return sol.p[0], sol["lambda0"], sol["delta"], sol["force"]
 
 
-def _integrate(sysm, sol, ln_Sc, region):
-    """Int over a region of f(S) dS with Gauss points on each mesh interval."""
-    x = sol.x
+def gauss_points(x):
+    """Gauss-Legendre points (4 per mesh interval) and weights on t, for energy integrals."""
     a, b = x[:-1], x[1:]
-    tm = 0.5 * (a + b)[:, None] + 0.5 * (b - a)[:, None] * _GAUSS_T[None, :]
-    w = 0.5 * (b - a)[:, None] * _GAUSS_W[None, :]
-    t = tm.ravel()
-    y = sol.sol(t)
+    t = (0.5 * (a + b)[:, None] + 0.5 * (b - a)[:, None] * _GAUSS_T[None, :]).ravel()
+    w = (0.5 * (b - a)[:, None] * _GAUSS_W[None, :]).ravel()
+    return t, w
+
+
+def _cap_energy(sysm, bvp, ln_Sc):
+    """Int U R Psi dS over the contact and free regions (both mapped on the same t)."""
+    t, w = gauss_points(bvp.x)
+    y = bvp.sol(t)
     mod, par = sysm.model, sysm.par
-    if region == "contact":
-        S = sysm.S_contact(t, ln_Sc)
-        e = mod.contact_profile(S, y[:N_CONTACT], par)["energy_density"]
-        jac = S * (-sysm.ln_eps)
-    else:
-        S = sysm.S_free(t, ln_Sc)
-        e = mod.free_profile(S, y[N_CONTACT:], par)["energy_density"]
-        jac = S * (sysm.ln_L - ln_Sc)
-    return float(np.sum(w.ravel() * e * jac))
+    Sc_t, Sf_t = sysm.S_contact(t, ln_Sc), sysm.S_free(t, ln_Sc)
+    e = (mod.contact_profile(Sc_t, y[:N_CONTACT], par)["energy_density"] * Sc_t * (-sysm.ln_eps)
+         + mod.free_profile(Sf_t, y[N_CONTACT:], par)["energy_density"] * Sf_t * (sysm.ln_L - ln_Sc))
+    return float(np.sum(w * e))
+
+
+def set_status(res, bvp, flags, converged_note=""):
+    """status, message and success of a diagnosed state: a converged run whose state
+    breaks an admissibility check (``flags``) gets status 4."""
+    if bvp.status == 0 and flags:
+        res.status = 4
+        res.message = STATUS_MESSAGES[4] + ": " + "; ".join(flags)
+    elif bvp.status == 0:
+        res.message = STATUS_MESSAGES[0] + converged_note
+    elif not res.message:
+        res.message = STATUS_MESSAGES.get(bvp.status, "")
+    res.success = res.status == 0
 
 
 def _diagnose(sysm: MultipointBVP, bvp, tol):
@@ -242,14 +254,7 @@ def _diagnose(sysm: MultipointBVP, bvp, tol):
             flags.append(f"collapsed state with delta = {delta:.3g} < 0")
         if omega_c > sysm.scene.tip_omega_max:
             flags.append("the contact has passed the end of the tip (the indenter's cylinder)")
-    if bvp.status == 0 and flags:
-        res.status = 4
-        res.message = STATUS_MESSAGES[4] + ": " + "; ".join(flags)
-    elif bvp.status == 0:
-        res.message = STATUS_MESSAGES[0]
-    elif not res.message:
-        res.message = STATUS_MESSAGES.get(bvp.status, "")
-    res.success = res.status == 0
+    set_status(res, bvp, flags)
     if not finite:
         res.update(energy=float("nan"), pressure_min=float("nan"), penetration=float("nan"),
                    force_defect=float("nan"), valid=False, flags=flags)
@@ -268,7 +273,7 @@ def _diagnose(sysm: MultipointBVP, bvp, tol):
     res.edge_legendre = float(leg[0] / leg[1]) if leg[1] != 0 else float("nan")
     res.pressure_min = float(np.min(pc["P"]))
     res.penetration = _penetration(sysm, pf["r"], pf["z"], res.z_tip)
-    res.energy = 2 * np.pi * (_integrate(sysm, bvp, ln_Sc, "contact") + _integrate(sysm, bvp, ln_Sc, "free")
+    res.energy = 2 * np.pi * (_cap_energy(sysm, bvp, ln_Sc)
                               + 0.5 * float(pc["energy_density"][0]) * sysm.S_contact(0.0, ln_Sc))
     vflags = []
     scale = 10 * tol
@@ -325,32 +330,29 @@ def solve_from(sysm, guess, *, tol=1e-6, max_nodes=10000, bc_tol=None):
 
 
 def richardson_error(sysm, res, tol, bc_tol=1e-10):
-    """Set ``force_error`` and ``delta_error`` by Richardson extrapolation.
+    """Set ``force_error`` and ``delta_error`` by Richardson extrapolation (any topology).
 
     The collocation solution (Lobatto IIIA, order 4) is recomputed on the
     converged mesh with every interval halved, without further refinement
     (``max_nodes`` pins the mesh; Newton converges to tol/100 and bc_tol/100, so the
     coarse solve's iteration and boundary errors are included); the error of
     the coarse value is then ``|X_h - X_h/2| * 16/15``.  Costs one Newton
-    solve on twice the nodes.
+    solve on twice the nodes.  ``sysm.end_values`` gives (F, delta) of a solution.
     """
     x = res.x
     x2 = np.sort(np.r_[x, 0.5 * (x[1:] + x[:-1])])
-    ln_Sc, lambda0, delta, _ = _state_params(res)
-    guess = (x2, res.sol(x2), sysm.pack(ln_Sc, lambda0, delta))
+    p = np.asarray(res.p, float)
     with np.errstate(all="ignore"):
-        fine = solve_bvp(sysm.fun, sysm.bc, *guess, fun_jac=sysm.fun_jac, bc_jac=sysm.bc_jac,
-                         tol=tol / 100, bc_tol=bc_tol / 100, max_nodes=x2.size)
-    if fine.status == 2 or not np.all(np.isfinite(fine.p)):
-        res.force_error = res.delta_error = float("nan")
-        res.flags = list(res.flags) + ["error estimate failed (Newton on the halved mesh did not converge)"]
-        return
-    f_ln_Sc, _, f_delta, _ = sysm.unpack(fine.p)
-    ring, cap = sysm.model.contact_line_forces(np.exp(f_ln_Sc), fine.y[:N_CONTACT, -1],
-                                               fine.y[N_CONTACT:, 0], f_delta, sysm.unpack(fine.p)[3],
-                                               sysm.par)
-    res.force_error = abs(float(ring[0] + cap[0]) - res.force) * 16 / 15
-    res.delta_error = abs(float(f_delta) - res.delta) * 16 / 15
+        fine = solve_bvp(sysm.fun, sysm.bc, x2, res.sol(x2), p if p.size else None, fun_jac=sysm.fun_jac,
+                         bc_jac=sysm.bc_jac, tol=tol / 100, bc_tol=bc_tol / 100, max_nodes=x2.size)
+        if fine.status == 2 or not np.all(np.isfinite(fine.y)) \
+                or (fine.p is not None and not np.all(np.isfinite(fine.p))):
+            res.force_error = res.delta_error = float("nan")
+            res.flags = list(res.flags) + ["error estimate failed (Newton on the halved mesh did not converge)"]
+            return
+        force, delta = sysm.end_values(fine.y[:, 0], fine.y[:, -1], fine.p)
+    res.force_error = abs(force - res.force) * 16 / 15
+    res.delta_error = abs(delta - res.delta) * 16 / 15
 
 
 #: Caps smaller than this are replaced by the point-load limit (their own equations
@@ -416,11 +418,7 @@ def _diagnose_point(sysm, bvp):
         flags.append("non-finite state")
     elif bvp.status == 0 and np.any(bvp.y[[0, 2]] <= 0):
         flags.append("non-positive stretch")
-    if bvp.status == 0 and flags:
-        res.status, res.message = 4, STATUS_MESSAGES[4] + ": " + "; ".join(flags)
-    elif bvp.status == 0:
-        res.message = STATUS_MESSAGES[0] + " (point-load limit: the contact cap is exponentially small)"
-    res.success = res.status == 0
+    set_status(res, bvp, flags, " (point-load limit: the contact cap is exponentially small)")
     res.update(pressure_min=nan, penetration=nan, valid=False, force_error=nan, delta_error=0.0)
     if not res.success or flags:
         res.update(energy=nan, force_defect=nan, flags=flags)
@@ -428,9 +426,7 @@ def _diagnose_point(sysm, bvp):
     t = np.unique(np.r_[bvp.x, 0.5 * (bvp.x[1:] + bvp.x[:-1])])
     pf = mod.free_profile(sysm.S(t), bvp.sol(t), par)
     res.force_defect = float(np.max(np.abs(2 * np.pi * pf["axial_force_2pi"] - force)))
-    a, b = bvp.x[:-1], bvp.x[1:]
-    tg = (0.5 * (a + b)[:, None] + 0.5 * (b - a)[:, None] * _GAUSS_T[None, :]).ravel()
-    wg = (0.5 * (b - a)[:, None] * _GAUSS_W[None, :]).ravel()
+    tg, wg = gauss_points(bvp.x)
     Sg = sysm.S(tg)
     e = mod.free_profile(Sg, bvp.sol(tg), par)["energy_density"]
     res.energy = 2 * np.pi * float(np.sum(wg * e * Sg * (sysm.ln_L - sysm.ln_s0)))
@@ -445,22 +441,6 @@ def _diagnose_point(sysm, bvp):
     res.flags = vflags
     res.valid = not vflags
     return res
-
-
-def _point_richardson_error(sysm, res, tol, bc_tol=1e-10):
-    """Richardson estimate of a point-load state's F (delta is prescribed exactly)."""
-    x = res.x
-    x2 = np.sort(np.r_[x, 0.5 * (x[1:] + x[:-1])])
-    with np.errstate(all="ignore"):
-        fine = solve_bvp(sysm.fun, sysm.bc, x2, res.sol(x2), fun_jac=sysm.fun_jac, bc_jac=sysm.bc_jac,
-                         tol=tol / 100, bc_tol=bc_tol / 100, max_nodes=x2.size)
-    if fine.status == 2 or not np.all(np.isfinite(fine.y)):
-        res.force_error = float("nan")
-        res.flags = list(res.flags) + ["error estimate failed (Newton on the halved mesh did not converge)"]
-        return
-    G = sysm.model.free_profile(np.array([sysm.s0]), fine.y[:, :1], sysm.par)["axial_force_2pi"][0]
-    res.force_error = abs(2 * np.pi * float(G) - res.force) * 16 / 15
-    res.delta_error = 0.0
 
 
 def _default_eps(tol):
@@ -549,7 +529,7 @@ def solve(scene, *, delta=None, lambda0=None, force=None, tol=1e-6, max_nodes=10
     if topology != "cap" and scene.contact == "smooth" and res.get("topology") == "cap" and res.success:
         res = _other_topology(res, topology, kw)
     if res.success and estimate_error:
-        estimate_errors(res, tol, bc_tol)
+        richardson_error(res.system, res, tol, bc_tol)
     else:
         res.force_error = res.delta_error = float("nan")
     res.wall_time = time.perf_counter() - t0
@@ -558,30 +538,11 @@ def solve(scene, *, delta=None, lambda0=None, force=None, tol=1e-6, max_nodes=10
 
 def _other_topology(cap, topology, kw):
     """Replace an invalid cap by a valid lift-off state (auto) or by the asked topology."""
-    from .liftoff import lift_off_suspected, liftoff_state, valid_liftoff_state
+    from .liftoff import liftoff_state, replace_invalid_cap
 
     if topology in ("line", "annulus"):
         return liftoff_state(cap, topology, **kw)
-    if not lift_off_suspected(cap):
-        return cap
-    alt, tried = valid_liftoff_state(cap, **kw)
-    if alt is not None:
-        alt.cap_state = {k: cap[k] for k in ("delta", "force", "energy", "pressure_min", "Sc")}
-        return alt
-    cap.flags = list(cap.flags) + ["no valid lift-off state found (" + "; ".join(tried) + ")"]
-    return cap
-
-
-def estimate_errors(res, tol, bc_tol=1e-10):
-    """Richardson error estimates of any topology (see :func:`richardson_error`)."""
-    if res.get("topology") in ("line", "annulus"):
-        from .liftoff import liftoff_richardson_error
-
-        liftoff_richardson_error(res.system, res, tol, bc_tol)
-    elif res.get("topology") == "point":
-        _point_richardson_error(res.system, res, tol, bc_tol)
-    else:
-        richardson_error(res.system, res, tol, bc_tol)
+    return replace_invalid_cap(cap, **kw)
 
 
 _SC_GUESSES = (0.05, 0.2, 0.01, 0.002)

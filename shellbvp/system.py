@@ -187,6 +187,14 @@ class MultipointBVP:
         return A, B, P
 
 
+    def end_values(self, ya, yb, p):
+        """(F, delta) of a solution given its end states and unknowns."""
+        ln_Sc, _, delta, F = self.unpack(p)
+        ring, cap = self.model.contact_line_forces(np.exp(ln_Sc), yb[:N_CONTACT], ya[N_CONTACT:], delta, F,
+                                                   self.par)
+        return float(ring[0] + cap[0]), float(delta)
+
+
 class PointLoadBVP:
     """The point-load limit of the smooth model: the free region alone, delta prescribed.
 
@@ -225,6 +233,11 @@ class PointLoadBVP:
     def bc(self, ya, yb, p=None):
         return np.concatenate([self.model.point_load_res(self.s0, ya, self.delta, self.par),
                                self.model.rim_res(self.L, yb, self.par)])
+
+    def end_values(self, ya, yb, p=None):
+        """(F, delta): the axial force at the pole start and the prescribed delta."""
+        G = self.model.free_profile(np.array([self.s0]), ya[:, None], self.par)["axial_force_2pi"][0]
+        return 2 * np.pi * float(G), self.delta
 
     def bc_jac(self, ya, yb, p=None):
         A, B = np.zeros((N_FREE, N_FREE)), np.zeros((N_FREE, N_FREE))
@@ -413,3 +426,24 @@ class LiftOffBVP:
         elif self.control == "lambda0":
             A[r0 + 3, i0 + 2] = 1.0
         return A, B, P
+
+    def edge_values(self, ya, yb, p):
+        """(F, inner ring force, outer ring force, S1, S2, delta) of a solution."""
+        mod, par = self.model, self.par
+        ln_S1, _, delta, _ = self.unpack(p)
+        S1 = float(np.exp(np.float64(ln_S1)))
+        S2 = float(np.exp(np.float64(self.ln_S2(p))))
+        G_out = float(mod.free_profile(np.array([S2]), ya[self.outer, None], par)["axial_force_2pi"][0])
+        G_in = float(mod.free_profile(np.array([S1]), yb[self.inner, None], par)["axial_force_2pi"][0])
+        if self.topology == "annulus":
+            pc1 = mod.contact_profile(np.array([S1]), ya[self.contact, None], par)["axial_force_2pi"][0]
+            pc2 = mod.contact_profile(np.array([S2]), yb[self.contact, None], par)["axial_force_2pi"][0]
+            ring_in, ring_out = 2 * np.pi * (pc1 - G_in), 2 * np.pi * (G_out - pc2)
+        else:
+            ring_in, ring_out = 0.0, 2 * np.pi * (G_out - G_in)
+        return 2 * np.pi * G_out, float(ring_in), float(ring_out), S1, S2, float(delta)
+
+    def end_values(self, ya, yb, p):
+        """(F, delta) of a solution."""
+        values = self.edge_values(ya, yb, p)
+        return values[0], values[5]
