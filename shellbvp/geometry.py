@@ -1,8 +1,9 @@
 """Shell and indenter-tip shapes a scene can use.
 
 The built-in spheroid (``R = sin S, Z = -gamma cos S``) and sphere tip are
-described by name; user shapes carry SymPy formulas (validated on
-construction by ``symbolic.geometry``) and get code generated for them.
+described by name; user shapes carry formulas (parsed without evaluating
+code by ``symbolic.formula`` and validated by ``symbolic.geometry``), stored
+as plain text, and get code generated for them.
 """
 
 from __future__ import annotations
@@ -67,14 +68,15 @@ class UserShell:
 
     kind = "user"
 
-    def __init__(self, R, Z, L="pi/2"):
+    def __init__(self, R, Z, L="pi/2", *, legacy_srepr: bool = False):
         import sympy as sp
 
         from symbolic import geometry as sg
+        from symbolic.formula import formula_text
 
-        self.geometry = sg.user_shell(R, Z, L)
-        self._desc = {"kind": "user", "R": sp.srepr(self.geometry.R), "Z": sp.srepr(self.geometry.Z),
-                      "L": sp.srepr(self.geometry.L)}
+        self.geometry = sg.user_shell(R, Z, L, legacy_srepr=legacy_srepr)
+        self._desc = {"kind": "user", "R": formula_text(self.geometry.R), "Z": formula_text(self.geometry.Z),
+                      "L": formula_text(self.geometry.L)}
         ks, kt = self.geometry.curvatures()
         self._pole_kt = float(sp.limit(kt, sg.S, 0, "+"))
 
@@ -99,13 +101,14 @@ class UserTip:
 
     kind = "user"
 
-    def __init__(self, A, B):
+    def __init__(self, A, B, *, legacy_srepr: bool = False):
         import sympy as sp
 
         from symbolic import geometry as sg
+        from symbolic.formula import formula_text
 
-        self.geometry = sg.user_tip(A, B)
-        self._desc = {"kind": "user", "A": sp.srepr(self.geometry.A), "B": sp.srepr(self.geometry.B)}
+        self.geometry = sg.user_tip(A, B, legacy_srepr=legacy_srepr)
+        self._desc = {"kind": "user", "A": formula_text(self.geometry.A), "B": formula_text(self.geometry.B)}
         w = sg.OMEGA
         dA0 = sp.diff(self.geometry.A, w).subs(w, 0)
         ddB0 = sp.diff(self.geometry.B, w, 2).subs(w, 0)

@@ -6,7 +6,7 @@ ring_force_inner, which read as a single cap)::
     /                       attrs: format, format_version, package_version, created (UTC ISO)
     /curve                  NXdata group; attrs:
                               NX_class = "NXdata", signal = "force", axes = ["delta"],
-                              scene (JSON: rebuilds the Scene exactly, user formulas as srepr),
+                              scene (JSON: rebuilds the Scene exactly, user formulas as plain text),
                               scene_<key> (gamma, rho, beta, xi, contact, material_family, ...:
                               the same, readable at a glance),
                               settings (JSON: solver and continuation settings),

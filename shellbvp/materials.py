@@ -73,7 +73,8 @@ class StrainEnergy(Material):
     ----------
     W : str or sympy expression
         In the symbols ``lambda_s`` and ``lambda_theta`` (shear modulus 1 in the
-        nondimensionalisation).  Checked on construction: symmetric,
+        nondimensionalisation), parsed without evaluating code
+        (``symbolic.formula``: numbers, + - * / **, sin, exp, log, sqrt, ...).  Checked on construction: symmetric,
         ``W(1,1) = 0``, stress-free at (1,1), positive small-strain shear
         modulus (reported as ``shear_modulus``; it should be 1, or forces are in
         units of that modulus times mu).
@@ -83,25 +84,18 @@ class StrainEnergy(Material):
 
     family = "user"
 
-    def __init__(self, W, name: str = "user"):
-        import sympy as sp
-
+    def __init__(self, W, name: str = "user", *, legacy_srepr: bool = False):
         from symbolic import materials as sm
+        from symbolic.formula import formula_text, parse_formula
 
-        try:
-            expr = sp.sympify(W, locals={"lambda_s": sm.LS, "lambda_theta": sm.LT})
-        except (sp.SympifyError, SyntaxError, TypeError) as exc:
-            raise ValueError(f"W: cannot parse {W!r} ({exc})") from None
-        expr = expr.xreplace({s: {"lambda_s": sm.LS, "lambda_theta": sm.LT}.get(s.name, s)
-                              for s in expr.free_symbols})
+        expr = parse_formula(W, {"lambda_s": sm.LS, "lambda_theta": sm.LT}, name="W", legacy_srepr=legacy_srepr)
         self.shear_modulus = float(sm.check_energy(expr, name="W"))
         self.W = expr
-        self.name = name
+        self.name = str(name)
+        self._text = formula_text(expr)
 
     def description(self):
-        import sympy as sp
-
-        return {"family": "user", "W": sp.srepr(self.W)}
+        return {"family": "user", "W": self._text}
 
     def __repr__(self):
         return f"StrainEnergy({str(self.W)!r}, name={self.name!r})"

@@ -7,6 +7,11 @@ the ``symbolic/`` sources and the SymPy version.  Cached modules live in ``$SHEL
 atomically (temporary file + rename) and checked on load (their ``KEY`` must
 match), so a concurrent or interrupted writer never leaves a module that is
 used half-written.  A warm load imports neither SymPy nor the derivation.
+
+Cached modules are code that is imported, so a cache directory or file that
+another user owns or may write is never imported from: the module is
+regenerated, into a private temporary directory if the directory itself is
+not trusted (a warning says so).
 """
 
 from __future__ import annotations
@@ -15,6 +20,7 @@ import importlib.metadata
 import importlib.util
 import logging
 import os
+import stat
 import sys
 import tempfile
 import time
@@ -22,10 +28,12 @@ from pathlib import Path
 
 from symbolic.version import CODEGEN_VERSION, description_key, source_fingerprint
 
-__all__ = ["cache_dir", "structure_description", "description_key", "load_module", "module_path"]
+__all__ = ["cache_dir", "structure_description", "description_key", "load_module", "module_path",
+           "untrusted_reason"]
 
 log = logging.getLogger(__name__)
 _loaded: dict[str, object] = {}
+_private: Path | None = None  # this process's own cache when the shared one is not to be trusted
 
 
 def cache_dir() -> Path:
@@ -66,15 +74,37 @@ def _import_file(path: Path, key: str):
     return mod
 
 
+def untrusted_reason(path: Path) -> str | None:
+    """Why a cached file or directory must not be imported from, or None.
+
+    Generated modules are code that gets imported: a file or directory that
+    another user owns or may write could hold anything.
+    """
+    try:
+        st = path.stat()
+    except OSError as exc:
+        return f"cannot stat it ({exc.strerror})"
+    if hasattr(os, "getuid") and st.st_uid != os.getuid():
+        return f"it belongs to another user (uid {st.st_uid})"
+    if st.st_mode & (stat.S_IWGRP | stat.S_IWOTH):
+        return f"it is writable by other users (mode {stat.filemode(st.st_mode)})"
+    return None
+
+
+def _private_dir() -> Path:
+    global _private
+    if _private is None:
+        _private = Path(tempfile.mkdtemp(prefix="shellbvp-"))  # 0700, ours
+    return _private
+
+
 def _write_atomic(path: Path, text: str) -> None:
-    path.parent.mkdir(parents=True, exist_ok=True)
+    path.parent.mkdir(mode=0o700, parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=path.name + ".", suffix=".tmp")
     try:
         with os.fdopen(fd, "w") as fh:
             fh.write(text)
-        mask = os.umask(0)
-        os.umask(mask)
-        os.chmod(tmp, 0o666 & ~mask)  # mkstemp makes 0600
+        os.chmod(tmp, 0o644)  # mkstemp makes 0600; never group- or world-writable
         os.replace(tmp, path)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
@@ -90,6 +120,12 @@ def load_module(desc: dict, *, regenerate: bool = False):
     if not regenerate and key in _loaded:
         return _loaded[key]
     path = module_path(desc)
+    if path.parent.exists() and (why := untrusted_reason(path.parent)):
+        log.warning("not using the code cache %s: %s; generating into a private directory", path.parent, why)
+        path = _private_dir() / path.name
+    elif path.exists() and (why := untrusted_reason(path)):
+        log.warning("not importing the cached module %s: %s; regenerating it", path, why)
+        regenerate = True
     mod = None
     if path.exists() and not regenerate:
         try:
@@ -106,7 +142,7 @@ def load_module(desc: dict, *, regenerate: bool = False):
             _write_atomic(path, src)
         except OSError as exc:  # read-only cache: keep the module in a private temp dir
             log.warning("cannot write the code cache %s (%s); using a temporary directory", path, exc)
-            path = Path(tempfile.mkdtemp(prefix="shellbvp-")) / path.name
+            path = _private_dir() / path.name
             _write_atomic(path, src)
         mod = _import_file(path, key)
     _loaded[key] = mod

@@ -110,7 +110,7 @@ class Scene:
 
     # -- serialisation -------------------------------------------------------------
     def to_dict(self) -> dict:
-        """Plain data that rebuilds this scene exactly (user formulas as srepr)."""
+        """Plain data that rebuilds this scene exactly (user formulas as plain text)."""
         return {
             "gamma": self.gamma, "rho": self.rho, "beta": self.beta, "xi": self.xi,
             "contact": self.contact,
@@ -120,27 +120,56 @@ class Scene:
 
     @classmethod
     def from_dict(cls, d: dict) -> "Scene":
+        """The scene of :meth:`to_dict` data (e.g. read from a file).
+
+        Formulas are parsed by the whitelist of ``symbolic.formula`` (plain
+        text, or the srepr text of files from before plain text): data from a
+        file never runs as code.  Malformed data raises ``ValueError`` naming
+        the field.
+        """
         from .geometry import UserShell, UserTip
         from .materials import NeoHookean, StrainEnergy
 
-        m = dict(d["material"])
-        family = m.pop("family")
+        def field(data, key, kind, where):
+            if not isinstance(data, dict) or key not in data:
+                raise ValueError(f"scene data{' ' + where.rstrip('.') if where else ''} has no {key!r}")
+            value = data[key]
+            if not isinstance(value, kind) or isinstance(value, bool) and bool not in kind:
+                raise ValueError(f"scene data: {where}{key} must be {what[kind]}; got {value!r}")
+            return value
+
+        number, text = (int, float), (str,)
+        what = {number: "a number", text: "text", (dict,): "a mapping", (int,): "an integer"}
+        m = field(d, "material", (dict,), "")
+        family = field(m, "family", text, "material.")
         if family == "mooney-rivlin":
-            material = MooneyRivlin(m["alpha"])
+            material = MooneyRivlin(field(m, "alpha", number, "material."))
         elif family == "neo-hookean":
             material = NeoHookean()
         elif family == "gent":
-            material = Gent(m["Jm"])
+            material = Gent(field(m, "Jm", number, "material."))
         elif family == "user":
-            import sympy as sp
-
-            material = StrainEnergy(sp.sympify(m["W"]))
+            material = StrainEnergy(field(m, "W", text, "material."), legacy_srepr=True)
         else:
-            raise ValueError(f"unknown material family {family!r} in scene data")
-        shell = Spheroid() if d["shell"]["kind"] == "spheroid" else _user_shell(d["shell"])
-        tip = SphereTip() if d["tip"]["kind"] == "sphere" else _user_tip(d["tip"])
-        return cls(gamma=d["gamma"], rho=d["rho"], beta=d["beta"], material=material, xi=int(d["xi"]),
-                   contact=d["contact"], shell=shell, tip=tip)
+            raise ValueError(f"scene data: unknown material family {family!r}")
+        sh, tp = field(d, "shell", (dict,), ""), field(d, "tip", (dict,), "")
+        kind = field(sh, "kind", text, "shell.")
+        if kind == "spheroid":
+            shell = Spheroid()
+        elif kind == "user":
+            shell = UserShell(*(field(sh, k, text, "shell.") for k in "RZL"), legacy_srepr=True)
+        else:
+            raise ValueError(f"scene data: unknown shell kind {kind!r}")
+        kind = field(tp, "kind", text, "tip.")
+        if kind == "sphere":
+            tip = SphereTip()
+        elif kind == "user":
+            tip = UserTip(*(field(tp, k, text, "tip.") for k in "AB"), legacy_srepr=True)
+        else:
+            raise ValueError(f"scene data: unknown tip kind {kind!r}")
+        return cls(gamma=field(d, "gamma", number, ""), rho=field(d, "rho", number, ""),
+                   beta=field(d, "beta", number, ""), material=material, xi=field(d, "xi", (int,), ""),
+                   contact=field(d, "contact", text, ""), shell=shell, tip=tip)
 
     def to_json(self) -> str:
         import json
@@ -179,18 +208,6 @@ class Scene:
         if isinstance(self.shell, Spheroid):
             return math.pi / 2
         return float(self.shell.geometry.L)
-
-
-def _user_shell(desc):
-    import sympy as sp
-
-    return UserShell(sp.sympify(desc["R"]), sp.sympify(desc["Z"]), sp.sympify(desc["L"]))
-
-
-def _user_tip(desc):
-    import sympy as sp
-
-    return UserTip(sp.sympify(desc["A"]), sp.sympify(desc["B"]))
 
 
 PRESETS = {

@@ -2,8 +2,10 @@
 
 The description is what ``shellbvp`` hashes into the cache key, so it must
 say everything the generated code depends on, and nothing else (continuous
-parameters are run-time arguments).  User formulas travel as ``sympy.srepr``
-strings, which rebuild the exact expression.
+parameters are run-time arguments).  User formulas travel as plain text
+(``formula.formula_text``), read back by the whitelist parser
+``formula.parse_formula``; descriptions of older versions held ``srepr`` text,
+which the parser's legacy mode reads.
 """
 
 from __future__ import annotations
@@ -12,6 +14,7 @@ import sympy as sp
 
 from . import codegen, geometry, materials
 from .equations import Structure, derive
+from .formula import parse_formula
 from .version import canonical_json
 
 __all__ = ["structure_from_description", "generate_source"]
@@ -20,10 +23,9 @@ ALPHA = sp.Symbol("alpha", positive=True)
 JM = sp.Symbol("Jm", positive=True)
 
 
-def _expr(text: str, *syms):
-    """Rebuild an expression from its srepr (or plain) text; rename onto our symbols."""
-    e = sp.sympify(text)
-    return e.xreplace({s: t for t in syms for s in e.free_symbols if s.name == t.name})
+def _expr(text: str, name: str, *syms):
+    """Rebuild an expression from its stored text (never evaluated as code)."""
+    return parse_formula(text, {s.name: s for s in syms}, name=name, legacy_srepr=True)
 
 
 def structure_from_description(desc: dict) -> Structure:
@@ -36,20 +38,20 @@ def structure_from_description(desc: dict) -> Structure:
     elif family == "gent":
         W, mpar = materials.gent(JM), (JM,)
     elif family == "user":
-        W, mpar = _expr(mat["W"], materials.LS, materials.LT), ()
+        W, mpar = _expr(mat["W"], "W", materials.LS, materials.LT), ()
     else:
         raise ValueError(f"unknown material family {family!r}")
     sh = desc["shell"]
     if sh["kind"] == "spheroid":
         shell = geometry.spheroid()
     else:
-        shell = geometry.user_shell(_expr(sh["R"], geometry.S), _expr(sh["Z"], geometry.S),
-                                    _expr(sh["L"]))
+        shell = geometry.user_shell(_expr(sh["R"], "R(S)", geometry.S), _expr(sh["Z"], "Z(S)", geometry.S),
+                                    _expr(sh["L"], "L"))
     tp = desc["tip"]
     if tp["kind"] == "sphere":
         tip = geometry.sphere_tip()
     else:
-        tip = geometry.user_tip(_expr(tp["A"], geometry.OMEGA), _expr(tp["B"], geometry.OMEGA))
+        tip = geometry.user_tip(_expr(tp["A"], "A(omega)", geometry.OMEGA), _expr(tp["B"], "B(omega)", geometry.OMEGA))
     return Structure(W=W, material_params=mpar, shell=shell, tip=tip, xi=int(desc["xi"]))
 
 

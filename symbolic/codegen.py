@@ -58,7 +58,7 @@ def _flatten(outputs):
             flat.extend(val.values())
         else:
             flat.extend(sp.Matrix(val))
-    return [sp.sympify(e) for e in flat]
+    return [sp.sympify(e, strict=True) for e in flat]  # expressions, never text
 
 
 def _function_source(spec: FunctionSpec) -> str:

@@ -52,7 +52,7 @@ class Program:
         vanish from the expressions that use them.  ``always=True`` is for names
         that later assignments refer to by symbol (see :meth:`extend`).
         """
-        expr = sp.sympify(expr)
+        expr = sp.sympify(expr, strict=True)
         if not always and (expr.is_Number or expr.is_Symbol):
             return expr
         sym = sp.Symbol(name)
@@ -123,7 +123,7 @@ class Program:
         """
         if wrt not in self.inputs:
             raise ValueError(f"can only differentiate with respect to inputs, not {wrt}")
-        target = sp.sympify(target)
+        target = sp.sympify(target, strict=True)
         if target.is_Number:
             return sp.S.Zero
         if target in self._index:
@@ -161,7 +161,7 @@ class Program:
     # -- evaluation (tests, reference values) ------------------------------------------
     def expand(self, expr):
         """``expr`` with every assigned name replaced by its expression (recursively)."""
-        expr = sp.sympify(expr)
+        expr = sp.sympify(expr, strict=True)
         steps = self._step_symbols_of(expr)
         while steps:
             expr = expr.xreplace({s: self._expr[s] for s in steps})
@@ -173,7 +173,7 @@ class Program:
         needed: set[sp.Symbol] = set()
         stack = []
         for e in exprs:
-            stack.extend(self._step_symbols_of(sp.sympify(e)))
+            stack.extend(self._step_symbols_of(sp.sympify(e, strict=True)))
         while stack:
             s = stack.pop()
             if s in needed:

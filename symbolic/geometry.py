@@ -16,6 +16,8 @@ from dataclasses import dataclass
 
 import sympy as sp
 
+from .formula import parse_formula
+
 __all__ = ["S", "OMEGA", "GAMMA", "ShellGeometry", "TipGeometry", "spheroid", "user_shell",
            "sphere_tip", "user_tip"]
 
@@ -84,28 +86,18 @@ def spheroid() -> ShellGeometry:
     return ShellGeometry(R=sp.sin(S), Z=-GAMMA * sp.cos(S), L=sp.pi / 2, params=(GAMMA,))
 
 
-def _parse(expr, var, name, allowed=()):
-    try:
-        e = sp.sympify(expr, locals={var.name: var, "pi": sp.pi})
-    except (sp.SympifyError, TypeError, SyntaxError) as exc:
-        raise ValueError(f"{name}: cannot parse {expr!r} as a SymPy expression ({exc})") from None
-    # Map same-named symbols (e.g. a plain Symbol('S')) onto ours.
-    e = e.xreplace({s: var for s in e.free_symbols if s.name == var.name})
-    extra = e.free_symbols - {var} - set(allowed)
-    if extra:
-        raise ValueError(f"{name} may only depend on {var.name}; it also contains {sorted(map(str, extra))}")
-    return e
-
-
-def user_shell(R, Z, L) -> ShellGeometry:
+def user_shell(R, Z, L, *, legacy_srepr: bool = False) -> ShellGeometry:
     """Any smooth meridian with ``R(0) = 0``, ``Z'(0) = 0``, ``R > 0`` on (0, L].
 
+    Formulas are text (or SymPy expressions) read by ``formula.parse_formula``.
     Rescaled so that ``R(L) = 1`` and ``Z(L) = 0``.
     """
-    R = _parse(R, S, "R(S)")
-    Z = _parse(Z, S, "Z(S)")
-    L = sp.nsimplify(sp.sympify(L)) if not isinstance(L, sp.Basic) else L
-    if not (L.is_number and float(L) > 0):
+    R = parse_formula(R, {"S": S}, name="R(S)", legacy_srepr=legacy_srepr)
+    Z = parse_formula(Z, {"S": S}, name="Z(S)", legacy_srepr=legacy_srepr)
+    exact = isinstance(L, sp.Basic)
+    L = parse_formula(L, {}, name="L", legacy_srepr=legacy_srepr)
+    L = L if exact else sp.nsimplify(L)
+    if not (L.is_number and L.is_extended_real and float(L) > 0):
         raise ValueError(f"L must be a positive number; got {L}")
     if sp.simplify(R.subs(S, 0)) != 0:
         raise ValueError(f"R(0) must be 0 (the pole is on the axis); got {R.subs(S, 0)}")
@@ -122,10 +114,10 @@ def sphere_tip() -> TipGeometry:
     return TipGeometry(A=sp.sin(OMEGA), B=1 - sp.cos(OMEGA), phi=OMEGA)
 
 
-def user_tip(A, B) -> TipGeometry:
+def user_tip(A, B, *, legacy_srepr: bool = False) -> TipGeometry:
     """Any smooth tip with ``A(0) = 0``, ``B(0) = 0``, ``B'(0) = 0``, ``A'(0) > 0``."""
-    A = _parse(A, OMEGA, "A(omega)")
-    B = _parse(B, OMEGA, "B(omega)")
+    A = parse_formula(A, {"omega": OMEGA}, name="A(omega)", legacy_srepr=legacy_srepr)
+    B = parse_formula(B, {"omega": OMEGA}, name="B(omega)", legacy_srepr=legacy_srepr)
     if sp.simplify(A.subs(OMEGA, 0)) != 0:
         raise ValueError("A(0) must be 0 (tip on the axis)")
     if sp.simplify(B.subs(OMEGA, 0)) != 0:

@@ -75,7 +75,7 @@ def check_energy(W, ls=LS, lt=LT, name="W"):
     is symmetric in them, vanishes and is stress-free at ``(1, 1)``, and has
     a positive small-strain shear modulus.
     """
-    W = sp.sympify(W)
+    W = sp.sympify(W, strict=True)  # an expression already: text goes through formula.parse_formula
     extra = W.free_symbols - {ls, lt}
     if extra:
         raise ValueError(

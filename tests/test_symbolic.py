@@ -111,7 +111,7 @@ def test_user_energy_validation():
         sb.StrainEnergy("(lambda_s - 1)**2 + 2*(lambda_theta - 1)**2")
     with pytest.raises(ValueError, match="vanish"):
         sb.StrainEnergy("(lambda_s - 1)**2 + (lambda_theta - 1)**2 + 1")
-    with pytest.raises(ValueError, match="only"):
+    with pytest.raises(ValueError, match=r"'c' \(unknown name\)"):
         sb.StrainEnergy("c*(lambda_s - 1)**2 + c*(lambda_theta - 1)**2")
     stiff = sb.StrainEnergy("lambda_s**2 + lambda_theta**2 + 1/(lambda_s*lambda_theta)**2 - 3")
     assert stiff.shear_modulus == pytest.approx(2.0)
