@@ -1,0 +1,479 @@
+r"""Contact configurations as data: a chain of regions and junctions, assembled into ONE
+multipoint BVP for ``scipy.integrate.solve_bvp``.
+
+The stacked layout (the one place it is defined)
+------------------------------------------------
+A configuration is an ordered list of regions ``k = 0 .. n-1`` from the pole to
+the rim, each of a kind (``"free"``: 6 states ``(lt, phiS, ls, ks, rQ, z)``;
+``"contact"``, the shell on the tip: 2 states ``(chi, ls)``; see
+``symbolic.equations``) on ``[S_a, S_b]``.  Every region is mapped
+geometrically onto the same ``t in [0, 1]``,
+
+    ``S_k(t) = exp(a_k + t (b_k - a_k))``,  ``a_k = ln S_a``, ``b_k = ln S_b``,
+
+so that ``dy/dt = (b_k - a_k) g_k(S, y)`` with ``g = S dy/dS`` from the
+generated code, and tiny caps stay well conditioned.  ``y`` stacks the
+regions' states in chain order (rows ``offset[k] : offset[k] + size[k]``);
+``y[:, 0]`` holds every region's start and ``y[:, -1]`` every region's end.
+
+Each end is a :class:`Point` with ``ln S = ln_offset + p[unknown]`` (or a
+fixed value): a pole start ``zeta = eps * Sc`` is the point ``Sc`` shifted by
+``ln eps``.  The unknown parameters ``p`` are, in this order, the
+configuration's own unknowns (``ln Sc``; ``ln S1, ln S2``; ``ln S1, chi1``),
+then ``lambda0`` where a contact cap reaches the pole and lambda0 is not
+prescribed, then ``delta`` unless it is prescribed.
+
+Conditions are the junctions' rows in chain order (pole, contact edges or
+lines, rim), then the control's row: the force at the last contact edge
+(``force``), the stretch at a lifted pole (``lambda0`` without a contact
+pole), or the pseudo-arclength condition (``arclength``,
+``sum_i t_i (X_i - Xhat_i)/s_i = 0`` over ``X = (delta, lambda0, F)``; its
+value is the tuple ``(Xhat, t, s)``).
+
+:func:`cap_chain`, :func:`point_chain`, :func:`annulus_chain` and
+:func:`line_chain` declare today's configurations; :class:`ChainBVP`
+assembles any chain into ``fun``, ``fun_jac``, ``bc``, ``bc_jac`` (analytic,
+from the generated Jacobians), end values, energy and profile.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = ["Point", "Region", "ContactPole", "FreePole", "PointPole", "Edge", "Line", "Rim", "Chain",
+           "ChainBVP", "cap_chain", "point_chain", "annulus_chain", "line_chain", "CONTROLS", "SIZES",
+           "FREE_STATES", "CONTACT_STATES"]
+
+CONTROLS = ("delta", "lambda0", "force", "arclength")
+FREE_STATES = ("lt", "phiS", "ls", "ks", "rQ", "z")
+CONTACT_STATES = ("chi", "ls")
+SIZES = {"free": len(FREE_STATES), "contact": len(CONTACT_STATES)}
+_LS = FREE_STATES.index("ls")
+# states continuous across a line contact (rQ jumps: the ring force)
+_LINE_CONTINUOUS = [FREE_STATES.index(s) for s in ("lt", "phiS", "ls", "ks", "z")]
+
+
+# -- declarations ---------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class Point:
+    """A point on the S axis: ``ln S = ln_offset + p[unknown]``, or ``ln S = ln_offset`` if fixed."""
+
+    name: str
+    unknown: str | None = None
+    ln_offset: float = 0.0
+
+
+@dataclass(frozen=True)
+class Region:
+    kind: str  # "free" | "contact"
+    start: Point
+    end: Point
+
+
+@dataclass(frozen=True)
+class ContactPole:
+    """Regular pole of a contact cap (region ``k`` starts at zeta): 2 rows, uses lambda0."""
+
+    k: int
+    rows = 2
+
+
+@dataclass(frozen=True)
+class FreePole:
+    """Regular pole of a free cap (region ``k`` starts at zeta): 3 rows."""
+
+    k: int
+    rows = 3
+
+
+@dataclass(frozen=True)
+class PointPole:
+    """Point-load pole of the free region ``k`` at its start s0: 3 rows, uses delta."""
+
+    k: int
+    rows = 3
+
+
+@dataclass(frozen=True)
+class Edge:
+    """Contact edge between contact region ``kc`` and free region ``kf`` (adjacent): 5 rows.
+
+    ``model`` is ``"smooth"`` (variational) or ``"paper"``; see SPEC section 2b.
+    """
+
+    kc: int
+    kf: int
+    model: str = "smooth"
+    rows = 5
+
+
+@dataclass(frozen=True)
+class Line:
+    """Line contact between free regions ``k`` and ``k + 1`` at the indenter point ``chi1``: 8 rows.
+
+    r, phi, z on the tip (3 rows, the smooth junction's first three);
+    lt, phiS, ls, ks, z continuous (5); rQ jumps (the ring force).
+    """
+
+    k: int
+    rows = 8
+
+
+@dataclass(frozen=True)
+class Rim:
+    """Simply supported rim at the end of region ``k``: 3 rows."""
+
+    k: int
+    rows = 3
+
+
+@dataclass(frozen=True)
+class Chain:
+    """A contact configuration: regions pole to rim, junctions, unknowns of its own."""
+
+    name: str
+    regions: tuple
+    junctions: tuple
+    unknowns: tuple  # configuration unknowns (before lambda0, delta)
+
+    def layout(self) -> str:
+        """A table of the stacked layout (rows, S ranges, junction rows)."""
+        lines, row = [f"{self.name}: y rows, t in [0, 1]"], 0
+        for k, reg in enumerate(self.regions):
+            n = SIZES[reg.kind]
+            states = FREE_STATES if reg.kind == "free" else CONTACT_STATES
+            lines.append(f"  y[{row}:{row + n}]  region {k} {reg.kind:<7s} S in [{reg.start.name}, {reg.end.name}]"
+                         f"  ({', '.join(states)})")
+            row += n
+        lines.append("conditions:")
+        r = 0
+        for j in self.junctions:
+            lines.append(f"  [{r}:{r + j.rows}]  {type(j).__name__}{_fields(j)}")
+            r += j.rows
+        return "\n".join(lines)
+
+
+def _fields(j):
+    return "(" + ", ".join(f"{k}={v!r}" for k, v in j.__dict__.items()) + ")"
+
+
+def cap_chain(eps: float, L: float, model: str = "smooth") -> Chain:
+    """Single contact cap: contact [zeta, Sc], free [Sc, L]; unknown ln Sc."""
+    Sc = Point("Sc", "ln_Sc")
+    return Chain("cap", (Region("contact", Point("zeta", "ln_Sc", math.log(eps)), Sc),
+                         Region("free", Sc, Point("L", None, math.log(L)))),
+                 (ContactPole(0), Edge(0, 1, model), Rim(1)), ("ln_Sc",))
+
+
+def point_chain(s0: float, L: float) -> Chain:
+    """Point-load limit: the free region on [s0, L] alone."""
+    return Chain("point", (Region("free", Point("s0", None, math.log(s0)), Point("L", None, math.log(L))),),
+                 (PointPole(0), Rim(0)), ())
+
+
+def annulus_chain(eps: float, L: float) -> Chain:
+    """Lifted pole, contact on an annulus: free [zeta, S1], contact [S1, S2], free [S2, L]."""
+    S1, S2 = Point("S1", "ln_S1"), Point("S2", "ln_S2")
+    return Chain("annulus", (Region("free", Point("zeta", "ln_S1", math.log(eps)), S1), Region("contact", S1, S2),
+                             Region("free", S2, Point("L", None, math.log(L)))),
+                 (FreePole(0), Edge(1, 0), Edge(1, 2), Rim(2)), ("ln_S1", "ln_S2"))
+
+
+def line_chain(eps: float, L: float) -> Chain:
+    """Lifted pole, contact on one circle S1: free [zeta, S1], free [S1, L]; unknowns ln S1, chi1."""
+    S1 = Point("S1", "ln_S1")
+    return Chain("line", (Region("free", Point("zeta", "ln_S1", math.log(eps)), S1),
+                          Region("free", S1, Point("L", None, math.log(L)))),
+                 (FreePole(0), Line(0), Rim(1)), ("ln_S1", "chi1"))
+
+
+# -- the assembler -------------------------------------------------------------------------------
+class ChainBVP:
+    """fun, fun_jac, bc, bc_jac of one chain, scene, control mode and prescribed value.
+
+    Parameters
+    ----------
+    scene : Scene
+    chain : Chain
+    control : {"delta", "lambda0", "force", "arclength"}
+    value : float, or (Xhat, tangent, scale) for ``"arclength"``
+    model : module, optional
+        The scene's generated module (loaded if not given).
+    """
+
+    def __init__(self, scene, chain: Chain, control: str, value, model=None):
+        if control not in CONTROLS:
+            raise ValueError(f"control must be one of {CONTROLS}; got {control!r}")
+        self.scene, self.chain, self.control = scene, chain, control
+        self.model = mod = model if model is not None else scene.model()
+        self.par = scene.parameters(mod)
+        self.regions = chain.regions
+        self.sizes = [SIZES[r.kind] for r in chain.regions]
+        self.offsets = np.cumsum([0, *self.sizes])[:-1].tolist()
+        self.n = int(sum(self.sizes))
+        kinds = {type(j) for j in chain.junctions}
+        self.has_contact_pole = ContactPole in kinds
+        if control == "arclength" and not self.has_contact_pole:
+            raise ValueError(f"arclength control needs a contact cap at the pole; {chain.name} has none")
+        if control in ("force", "arclength") and not any(isinstance(j, (Edge, Line)) for j in chain.junctions):
+            raise ValueError(f"{control} control needs contact; the {chain.name} configuration has only delta")
+        if control == "lambda0" and not any(isinstance(j, (ContactPole, FreePole)) for j in chain.junctions):
+            raise ValueError(f"lambda0 control needs a regular pole; the {chain.name} configuration has none")
+        names = list(chain.unknowns)
+        if self.has_contact_pole and control != "lambda0":
+            names.append("lambda0")
+        if control != "delta":
+            names.append("delta")
+        self.unknowns = tuple(names)
+        self.k = len(names)
+        self.col = {name: i for i, name in enumerate(names)}
+        self.value = float("nan")
+        if control == "arclength":
+            self.arc_point, self.arc_tangent, self.arc_scale = (np.asarray(v, float) for v in value)
+        else:
+            self.value = float(value)
+        self.junctions = list(chain.junctions)
+        self.extra = None
+        if control == "force":
+            self.extra = "force"
+        elif control == "lambda0" and not self.has_contact_pole:
+            self.extra = "pole_stretch"
+        elif control == "arclength":
+            self.extra = "arclength"
+        self.force_at = next((j for j in reversed(self.junctions) if isinstance(j, (Edge, Line))), None)
+        self.n_conditions = sum(j.rows for j in self.junctions) + (self.extra is not None)
+
+    # -- quantities -----------------------------------------------------------------------------
+    def quantities(self, p) -> dict:
+        """Every quantity by name: the unknowns from ``p``, the prescribed one, F (0 unless prescribed)."""
+        q = {name: p[i] for i, name in enumerate(self.unknowns)}
+        q.setdefault("F", self.value if self.control == "force" else 0.0)
+        if self.control in ("delta", "lambda0"):
+            q.setdefault(self.control, self.value)
+        q.setdefault("lambda0", float("nan"))
+        return q
+
+    def pack(self, **values) -> np.ndarray:
+        """``p`` from named values (extra names, e.g. a prescribed delta, are ignored)."""
+        return np.array([values[name] for name in self.unknowns], float)
+
+    def ln_S(self, point: Point, p) -> float:
+        return point.ln_offset + (p[self.col[point.unknown]] if point.unknown else 0.0)
+
+    def S_point(self, point: Point, p) -> float:
+        return float(np.exp(np.float64(self.ln_S(point, p))))
+
+    def rows(self, k) -> slice:
+        return slice(self.offsets[k], self.offsets[k] + self.sizes[k])
+
+    def S(self, k, t, p):
+        """S on region ``k`` at ``t``."""
+        a, b = self.ln_S(self.regions[k].start, p), self.ln_S(self.regions[k].end, p)
+        return np.exp(a + t * (b - a))
+
+    def _rhs(self, k):
+        return self.model.free_rhs if self.regions[k].kind == "free" else self.model.contact_rhs
+
+    def _jac(self, k):
+        return self.model.free_jac if self.regions[k].kind == "free" else self.model.contact_jac
+
+    # -- ODE ------------------------------------------------------------------------------------
+    def fun(self, t, y, p=None):
+        f = np.empty_like(y)
+        for k, reg in enumerate(self.regions):
+            a, b = self.ln_S(reg.start, p), self.ln_S(reg.end, p)
+            rows = self.rows(k)
+            f[rows] = (b - a) * self._rhs(k)(np.exp(a + t * (b - a)), y[rows], self.par)
+        return f
+
+    def fun_jac(self, t, y, p=None):
+        n, m = self.n, t.size
+        dfdy = np.zeros((n, n, m))
+        dfdp = np.zeros((n, self.k, m)) if self.k else None
+        for k, reg in enumerate(self.regions):
+            a, b = self.ln_S(reg.start, p), self.ln_S(reg.end, p)
+            rows = self.rows(k)
+            S = np.exp(a + t * (b - a))
+            gy, gS = self._jac(k)(S, y[rows], self.par)
+            dfdy[rows, rows] = (b - a) * gy
+            if dfdp is None:
+                continue
+            # d/da and d/db of (b - a) g(exp(a + t (b - a)), y)
+            g = None
+            for point, dS_dln, sign in ((reg.start, 1.0 - t, -1.0), (reg.end, t, 1.0)):
+                if point.unknown is None:
+                    continue
+                if g is None:
+                    g = self._rhs(k)(S, y[rows], self.par)
+                dfdp[rows, self.col[point.unknown]] += sign * g + (b - a) * gS * S * dS_dln
+        return (dfdy, dfdp) if dfdp is not None else dfdy
+
+    # -- conditions -------------------------------------------------------------------------------
+    def _edge_states(self, j: Edge, ya, yb):
+        """(point, yc, yf, contact state at start?, free state at start?) of an edge."""
+        rc, rf = self.rows(j.kc), self.rows(j.kf)
+        if j.kc < j.kf:
+            return self.regions[j.kc].end, yb[rc], ya[rf], False, True
+        return self.regions[j.kc].start, ya[rc], yb[rf], True, False
+
+    def _line_states(self, j: Line, ya, yb, q):
+        yin = yb[self.rows(j.k)]
+        return self.regions[j.k].end, np.array([q["chi1"], yin[_LS]]), yin, ya[self.rows(j.k + 1)]
+
+    def bc(self, ya, yb, p=None):
+        mod, par = self.model, self.par
+        q = self.quantities(p)
+        parts = []
+        for j in self.junctions:
+            if isinstance(j, ContactPole):
+                y0 = ya[self.rows(j.k)]
+                parts.append(mod.pole_res(y0[0], y0[1], q["lambda0"], par))
+            elif isinstance(j, FreePole):
+                parts.append(mod.free_pole_res(self.S_point(self.regions[j.k].start, p), ya[self.rows(j.k)], par))
+            elif isinstance(j, PointPole):
+                parts.append(mod.point_load_res(self.S_point(self.regions[j.k].start, p), ya[self.rows(j.k)],
+                                                q["delta"], par))
+            elif isinstance(j, Edge):
+                point, yc, yf, _, _ = self._edge_states(j, ya, yb)
+                res = getattr(mod, f"junction_{j.model}_res")
+                parts.append(res(self.S_point(point, p), yc, yf, q["delta"], q["F"], par))
+            elif isinstance(j, Line):
+                point, yc, yin, yout = self._line_states(j, ya, yb, q)
+                on_tip = mod.junction_smooth_res(self.S_point(point, p), yc, yin, q["delta"], q["F"], par)[:3]
+                parts += [on_tip, (yout - yin)[_LINE_CONTINUOUS]]
+            elif isinstance(j, Rim):
+                parts.append(mod.rim_res(self.S_point(self.regions[j.k].end, p), yb[self.rows(j.k)], par))
+        if self.extra == "force":
+            S, yc, yf = self._force_args(ya, yb, p, q)
+            parts.append(mod.force_res(S, yc, yf, q["delta"], q["F"], par))
+        elif self.extra == "pole_stretch":
+            parts.append([ya[self.rows(0)][_LS] - self.value])
+        elif self.extra == "arclength":
+            S, yc, yf = self._force_args(ya, yb, p, q)
+            force = 2 * np.pi * mod.force_res(S, yc, yf, q["delta"], 0.0, par)[0]
+            X = np.array([q["delta"], q["lambda0"], force])
+            parts.append([np.sum(self.arc_tangent * (X - self.arc_point) / self.arc_scale)])
+        return np.concatenate(parts)
+
+    def _force_args(self, ya, yb, p, q):
+        j = self.force_at
+        if isinstance(j, Edge):
+            point, yc, yf, _, _ = self._edge_states(j, ya, yb)
+        else:
+            point, yc, _, yf = self._line_states(j, ya, yb, q)
+        return self.S_point(point, p), yc, yf
+
+    def _add_p(self, P, rows, name, values):
+        if name is not None and name in self.col:
+            P[rows, self.col[name]] += values
+
+    def bc_jac(self, ya, yb, p=None):
+        mod, par = self.model, self.par
+        q = self.quantities(p)
+        m, n = self.n_conditions, self.n
+        A, B = np.zeros((m, n)), np.zeros((m, n))
+        P = np.zeros((m, self.k)) if self.k else None
+        r = 0
+        for j in self.junctions:
+            rows = slice(r, r + j.rows)
+            if isinstance(j, ContactPole):
+                o = self.offsets[j.k]
+                y0 = ya[self.rows(j.k)]
+                pj = mod.pole_jac(y0[0], y0[1], q["lambda0"], par)  # d/d(chi, ls, lambda0)
+                A[rows, o:o + 2] = pj[:, :2]
+                self._add_p(P, rows, "lambda0", pj[:, 2])
+            elif isinstance(j, (FreePole, PointPole)):
+                point = self.regions[j.k].start
+                S = self.S_point(point, p)
+                if isinstance(j, FreePole):
+                    pj = mod.free_pole_jac(S, ya[self.rows(j.k)], par)  # d/d(y, S)
+                    self._add_p(P, rows, point.unknown, pj[:, 6] * S)
+                else:
+                    pj = mod.point_load_jac(S, ya[self.rows(j.k)], q["delta"], par)  # d/d(y, delta)
+                    self._add_p(P, rows, "delta", pj[:, 6])
+                A[rows, self.rows(j.k)] = pj[:, :6]
+            elif isinstance(j, Edge):
+                point, yc, yf, c_at_a, f_at_a = self._edge_states(j, ya, yb)
+                S = self.S_point(point, p)
+                jj = getattr(mod, f"junction_{j.model}_jac")(S, yc, yf, q["delta"], q["F"], par)
+                (A if c_at_a else B)[rows, self.rows(j.kc)] = jj[:, 1:3]
+                (A if f_at_a else B)[rows, self.rows(j.kf)] = jj[:, 3:9]
+                self._add_p(P, rows, point.unknown, jj[:, 0] * S)
+                self._add_p(P, rows, "delta", jj[:, 9])
+            elif isinstance(j, Line):
+                point, yc, yin, yout = self._line_states(j, ya, yb, q)
+                S = self.S_point(point, p)
+                on = slice(r, r + 3)
+                jj = mod.junction_smooth_jac(S, yc, yin, q["delta"], q["F"], par)[:3]
+                self._add_p(P, on, point.unknown, jj[:, 0] * S)
+                self._add_p(P, on, "chi1", jj[:, 1])
+                self._add_p(P, on, "delta", jj[:, 9])
+                i0, o0 = self.offsets[j.k], self.offsets[j.k + 1]
+                B[on, i0:i0 + 6] = jj[:, 3:9]
+                B[on, i0 + _LS] += jj[:, 2]  # ls of the contact state is the inner region's
+                for row, c in enumerate(_LINE_CONTINUOUS, start=r + 3):
+                    A[row, o0 + c] = 1.0
+                    B[row, i0 + c] = -1.0
+            elif isinstance(j, Rim):
+                B[rows, self.rows(j.k)] = mod.rim_jac(self.S_point(self.regions[j.k].end, p),
+                                                      yb[self.rows(j.k)], par)
+            r += j.rows
+        if self.extra in ("force", "arclength"):
+            w = 1.0 if self.extra == "force" else 2 * np.pi * self.arc_tangent[2] / self.arc_scale[2]
+            F = q["F"] if self.extra == "force" else 0.0
+            j = self.force_at
+            S, yc, yf = self._force_args(ya, yb, p, q)
+            fj = w * mod.force_jac(S, yc, yf, q["delta"], F, par)  # d/d(Sc, yf, F)
+            kf = j.kf if isinstance(j, Edge) else j.k + 1
+            f_at_a = isinstance(j, Line) or self._edge_states(j, ya, yb)[4]
+            point = self._edge_states(j, ya, yb)[0] if isinstance(j, Edge) else self.regions[j.k].end
+            (A if f_at_a else B)[r, self.rows(kf)] = fj[0, 1:7]
+            self._add_p(P, r, point.unknown, fj[0, 0] * S)
+            if self.extra == "arclength":
+                w3 = self.arc_tangent / self.arc_scale  # weights of (delta, lambda0, F)
+                self._add_p(P, r, "lambda0", w3[1])
+                self._add_p(P, r, "delta", w3[0])
+        elif self.extra == "pole_stretch":
+            A[r, self.offsets[0] + _LS] = 1.0
+        return (A, B, P) if P is not None else (A, B)
+
+    # -- values of a solution -----------------------------------------------------------------------
+    def end_values(self, ya, yb, p=None):
+        """(F, delta): F is the axial force at the start of the region that ends at the rim
+        (a first integral of a free region, so the indenter's force)."""
+        k = len(self.regions) - 1
+        S = self.S_point(self.regions[k].start, p)
+        G = self.model.free_profile(np.array([S]), ya[self.rows(k), None], self.par)["axial_force_2pi"][0]
+        return 2 * np.pi * float(G), float(self.quantities(p)["delta"])
+
+    def region_profiles(self, t, y, p):
+        """[(k, S, fields)] of every region on ``t``: the generated ``*_profile`` dicts."""
+        out = []
+        for k, reg in enumerate(self.regions):
+            S = self.S(k, t, p)
+            prof = self.model.free_profile if reg.kind == "free" else self.model.contact_profile
+            out.append((k, S, prof(S, y[self.rows(k)], self.par)))
+        return out
+
+    def energy(self, sol, x, p) -> float:
+        """``E = 2 pi Int U R Psi dS`` over every region (Gauss-Legendre on each mesh interval),
+        plus the leading term ``zeta U(zeta)/2`` of each pole disc ``[0, zeta]``."""
+        from .quadrature import gauss_points
+
+        t, w = gauss_points(x)
+        y = sol(t)
+        total = 0.0
+        for k, S, fields in self.region_profiles(t, y, p):
+            reg = self.regions[k]
+            width = self.ln_S(reg.end, p) - self.ln_S(reg.start, p)
+            total += float(np.sum(w * fields["energy_density"] * S)) * width
+        for j in self.junctions:
+            if isinstance(j, (ContactPole, FreePole)):
+                zeta = self.S_point(self.regions[j.k].start, p)
+                prof = self.model.free_profile if self.regions[j.k].kind == "free" else self.model.contact_profile
+                density = prof(np.array([zeta]), sol(np.array([0.0]))[self.rows(j.k)], self.par)["energy_density"]
+                total += 0.5 * float(density[0]) * zeta
+        return 2 * np.pi * total

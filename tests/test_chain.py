@@ -1,0 +1,102 @@
+"""Contact configurations as chains of regions and junctions, assembled by one class (issue 12).
+
+Every chain and control mode: analytic fun_jac and bc_jac against central
+differences (the point-load chain included); the assembled system against the
+hand-written classes it replaces; layout tables from the declaration.
+"""
+
+import numpy as np
+import pytest
+
+import shellbvp as sb
+from shellbvp import chain as ch
+
+EPS = 1e-3
+CHAINS = {"cap": lambda L, contact: ch.cap_chain(EPS, L, contact),
+          "annulus": lambda L, contact: ch.annulus_chain(EPS, L),
+          "line": lambda L, contact: ch.line_chain(EPS, L),
+          "point": lambda L, contact: ch.point_chain(1e-12, L)}
+CASES = [("cap", c, m) for c in ("smooth", "paper") for m in ("delta", "lambda0", "force", "arclength")] + \
+        [(k, "smooth", m) for k in ("annulus", "line") for m in ("delta", "lambda0", "force")] + \
+        [("point", "smooth", "delta")]
+ARC = (np.array([0.2, 1.0, 0.4]), np.array([0.6, 0.0, 0.8]), np.array([1.0, 0.5, 2.0]))
+
+
+def central_difference(f, x, h=1e-7):
+    cols = []
+    for j in range(x.size):
+        e = np.zeros(x.size)
+        e[j] = h
+        cols.append((f(x + e) - f(x - e)) / (2 * h))
+    return np.stack(cols, axis=-1)
+
+
+def system(kind, contact, control):
+    scene = sb.Scene.preset("base", contact=contact)
+    value = ARC if control == "arclength" else 0.3
+    return ch.ChainBVP(scene, CHAINS[kind](scene.shell_length, contact), control, value)
+
+
+def state(sysm, rng):
+    t = np.linspace(0.0, 1.0, 4)
+    y = 0.5 + 0.3 * rng.random((sysm.n, t.size))
+    values = dict(ln_Sc=np.log(0.1), ln_S1=np.log(0.05), ln_S2=np.log(0.15), chi1=0.9, lambda0=1.02, delta=0.3)
+    return t, y, sysm.pack(**values)
+
+
+@pytest.mark.parametrize("kind, contact, control", CASES)
+def test_analytic_jacobians_equal_central_differences(kind, contact, control):
+    sysm = system(kind, contact, control)
+    t, y, p = state(sysm, np.random.default_rng(2))
+    rel = lambda a, b: np.max(np.abs(a - b)) / (1 + np.max(np.abs(b)))  # noqa: E731
+    jac = sysm.fun_jac(t, y, p)
+    dfdy, dfdp = jac if sysm.k else (jac, None)
+    for k in range(t.size):
+        assert rel(dfdy[:, :, k], central_difference(lambda v: sysm.fun(t[k:k + 1], v[:, None], p)[:, 0],
+                                                     y[:, k])) < 1e-6
+        if sysm.k:
+            assert rel(dfdp[:, :, k], central_difference(lambda v: sysm.fun(t[k:k + 1], y[:, k:k + 1], v)[:, 0],
+                                                         p)) < 1e-6
+    ya, yb = y[:, 0], y[:, -1]
+    A, B, *P = sysm.bc_jac(ya, yb, p)
+    assert sysm.bc(ya, yb, p).size == sysm.n + sysm.k == sysm.n_conditions == A.shape[0]
+    assert rel(A, central_difference(lambda v: sysm.bc(v, yb, p), ya)) < 1e-6
+    assert rel(B, central_difference(lambda v: sysm.bc(ya, v, p), yb)) < 1e-6
+    if sysm.k:
+        assert rel(P[0], central_difference(lambda v: sysm.bc(ya, yb, v), p)) < 1e-6
+
+
+@pytest.mark.parametrize("kind, contact, control", CASES)
+def test_assembled_system_equals_the_hand_written_one(kind, contact, control):
+    from shellbvp.system import LiftOffBVP, MultipointBVP, PointLoadBVP
+
+    new = system(kind, contact, control)
+    scene, value = new.scene, (ARC if control == "arclength" else 0.3)
+    old = {"cap": lambda: MultipointBVP(scene, control, value, EPS),
+           "annulus": lambda: LiftOffBVP(scene, "annulus", control, value, EPS),
+           "line": lambda: LiftOffBVP(scene, "line", control, value, EPS),
+           "point": lambda: PointLoadBVP(scene, value)}[kind]()
+    t, y, p = state(new, np.random.default_rng(3))
+    args = (t, y, p) if new.k else (t, y)
+    ends = (y[:, 0], y[:, -1], p) if new.k else (y[:, 0], y[:, -1])
+    pairs = [(new.fun(t, y, p), old.fun(*args)), (new.bc(y[:, 0], y[:, -1], p), old.bc(*ends)),
+             (np.array(new.end_values(y[:, 0], y[:, -1], p)), np.array(old.end_values(*ends)))]
+    nj, oj = new.fun_jac(t, y, p), old.fun_jac(*args)
+    pairs += list(zip(nj, oj)) if new.k else [(nj, oj)]
+    pairs += list(zip(new.bc_jac(y[:, 0], y[:, -1], p), old.bc_jac(*ends)))
+    for a, b in pairs:
+        np.testing.assert_allclose(a, b, rtol=1e-13, atol=1e-13 * (1 + np.max(np.abs(b))))
+
+
+def test_layout_table_is_generated_from_the_declaration():
+    text = ch.annulus_chain(EPS, 1.5).layout()
+    assert "y[0:6]  region 0 free" in text and "y[6:8]  region 1 contact" in text and "y[8:14]" in text
+    assert "[3:8]  Edge(kc=1, kf=0" in text and "[13:16]  Rim(k=2)" in text
+
+
+def test_control_the_chain_cannot_take_is_refused():
+    scene = sb.Scene.preset("base")
+    with pytest.raises(ValueError, match="only delta"):
+        ch.ChainBVP(scene, ch.point_chain(1e-12, scene.shell_length), "force", 0.3)
+    with pytest.raises(ValueError, match="arclength"):
+        ch.ChainBVP(scene, ch.line_chain(EPS, scene.shell_length), "arclength", ARC)
