@@ -100,3 +100,24 @@ def test_control_the_chain_cannot_take_is_refused():
         ch.ChainBVP(scene, ch.point_chain(1e-12, scene.shell_length), "force", 0.3)
     with pytest.raises(ValueError, match="arclength"):
         ch.ChainBVP(scene, ch.line_chain(EPS, scene.shell_length), "arclength", ARC)
+
+
+# -- regression: the states of the hand-written classes (commit 1109cdf), to 1e-10 ---------------------
+def _reference():
+    import json
+    from pathlib import Path
+
+    data = json.loads((Path(__file__).parent / "data" / "regression_states.json").read_text())
+    return data["states"]
+
+
+@pytest.mark.parametrize("ref", _reference(), ids=lambda r: f"{r['preset']}-{r['contact']}-{r['control']}"
+                         f"{r['value']}-{r['topology']}")
+def test_states_equal_those_before_the_assembler(ref):
+    """benchmarks/regression_reference.py wrote these at 1109cdf, before the chain assembler."""
+    scene = sb.Scene.preset(ref["preset"], contact=ref["contact"])
+    s = sb.solve(scene, **{ref["control"]: ref["value"]}, topology=ref["topology"], tol=1e-8, estimate_error=False)
+    assert s.success == ref["success"] and s.topology == ref["result_topology"], s.message
+    for key in ("force", "delta", "lambda0", "Sc", "energy"):
+        assert s[key] == pytest.approx(ref[key], rel=1e-10, abs=1e-14, nan_ok=True), key
+    assert s.get("S1", s.Sc) == pytest.approx(ref["S1"], rel=1e-10, abs=1e-14)
