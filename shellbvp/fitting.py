@@ -34,6 +34,7 @@ from __future__ import annotations
 
 import codecs
 import csv
+import logging
 import math
 import re
 from collections import OrderedDict
@@ -44,6 +45,8 @@ from scipy import optimize, stats
 from scipy.interpolate import CubicSpline, PchipInterpolator
 
 from .units import unit_factor
+
+log = logging.getLogger(__name__)
 
 __all__ = ["FitResult", "fit", "read_force_csv", "example_data_path", "WEIGHTS", "DEFAULT_WEIGHTS",
            "FIT_STATUS", "FIT_WARNINGS", "PLAUSIBLE_MU_H", "runs_test"]
@@ -427,7 +430,7 @@ def runs_test(residual):
     return runs, float(stats.norm.cdf((runs + 0.5 - mean) / math.sqrt(var))) if var > 0 else 1.0
 
 
-def _check_result(res_ok, mu_H, mu_ci, off_ci, resid_ok, disp, wresid):
+def _check_result(res_ok, mu_H, mu_ci, off_ci, resid_ok, disp, resid):
     """Status and warnings of a fitted result (see :data:`FIT_STATUS`, :data:`FIT_WARNINGS`)."""
     warnings = []
     if not res_ok:
@@ -442,10 +445,10 @@ def _check_result(res_ok, mu_H, mu_ci, off_ci, resid_ok, disp, wresid):
         status = 5
     else:
         status = 0
-    if wresid.size >= RUNS_MIN_POINTS and np.all(np.isfinite(wresid)):
-        runs, p = runs_test(wresid[np.argsort(disp, kind="stable")])
+    if resid.size >= RUNS_MIN_POINTS and np.all(np.isfinite(resid)):  # signs only: weights do not matter
+        runs, p = runs_test(resid[np.argsort(disp, kind="stable")])
         if p < RUNS_P:
-            warnings.append(("residual_runs", f"the residuals' signs form {runs} runs over {wresid.size} points "
+            warnings.append(("residual_runs", f"the residuals' signs form {runs} runs over {resid.size} points "
                              f"(runs test p = {p:.2g} < {RUNS_P:g}): a pattern the noise model does not explain; "
                              "the model (scene, contact point, weights) does not follow the data"))
     lo, hi = PLAUSIBLE_MU_H
@@ -504,6 +507,22 @@ def fit(scene, displacement, force, *, R_L, fit_offset=True, fit_beta=False, fit
     Returns
     -------
     FitResult
+        ``status`` (:data:`FIT_STATUS`) 0 only when the solver converged, mu*H > 0
+        and the 95 % intervals of mu*H and the offset are finite with mu*H's
+        narrower than mu*H itself.  ``warnings``: a residual sign pattern the
+        noise model does not explain (:func:`runs_test`, p < :data:`RUNS_P`, at
+        least :data:`RUNS_MIN_POINTS` points), mu*H outside :data:`PLAUSIBLE_MU_H`,
+        a shape parameter's interval at its search bound.
+
+    Raises
+    ------
+    ValueError
+        For arguments out of range and for data the fit cannot use, before any
+        model curve is computed: infinite values, fewer than ``max(3, p + 2)``
+        distinct displacements (p fitted parameters), a force that does not
+        increase with displacement (Spearman, one-sided p >= :data:`TREND_P`),
+        data too shallow for the model curve to start (one solve at its first
+        depth); and, once the curve is computed, data deeper than it reaches.
     """
     from .materials import MooneyRivlin
 
@@ -724,8 +743,10 @@ def fit(scene, displacement, force, *, R_L, fit_offset=True, fit_beta=False, fit
         alpha_ci = tuple(float(v) for v in theta_ci)
     mu_ci = (float(mu_H - half[0]), float(mu_H + half[0]))
     status, checks = _check_result(bool(res.success), mu_H, mu_ci, off_ci if fit_offset else (0.0, 0.0),
-                                   bool(np.all(np.isfinite(resid))), d, w * resid)
+                                   bool(np.all(np.isfinite(resid))), d, resid)
     found = notes + checks
+    for _, text in found:
+        log.info("fit: warning: %s", text)
     message = f"{FIT_STATUS[status]} (least squares: {res.message})"
     return FitResult(mu_H=mu_H, mu_H_ci95=mu_ci, offset=d0,
                      offset_ci95=off_ci, residual_rms=float(np.sqrt(np.mean(np.nan_to_num(resid, nan=mdl.big) ** 2))),
