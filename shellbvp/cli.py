@@ -8,6 +8,11 @@
     shellbvp presets                                                 the built-in scenes
 
 Invalid input exits with status 2 and a one-line message naming the parameter.
+``fit`` exits 0 when the fit succeeded (warnings allowed, printed as ``warning: ...``
+lines and listed under ``warnings`` in ``--json``), 1 when the fit ran but failed its
+checks (``success`` false, ``status`` one of ``shellbvp.fitting.FIT_STATUS``), 2 on bad
+input (data the fit cannot use included); with ``--json`` stdout is one JSON document
+in every case.
 """
 
 from __future__ import annotations
@@ -162,14 +167,29 @@ def _cmd_solve(args):
 
 
 def _cmd_fit(args):
+    """``shellbvp fit``: exit 0 (fit succeeded; warnings allowed), 1 (the fit ran but failed its
+    checks) or 2 (bad input: a ValueError, one line on stderr).  With ``--json`` stdout holds
+    exactly one JSON document in every case."""
+    try:
+        return _fit_and_report(args)
+    except ValueError as exc:
+        if args.json:
+            print(json.dumps({"success": False, "status": None, "exit_status": 2, "message": str(exc),
+                              "warnings": [], "warning_codes": []}))
+        raise
+
+
+def _fit_and_report(args):
+    import dataclasses
+
     import shellbvp as sb
 
     from .units import parse_quantity
 
     scene = _scene(args)
     R_L = parse_quantity(args.radius, "length", default_unit="m")
-    if not R_L > 0:
-        raise ValueError(f"--radius must be a length > 0 (e.g. 0.3mm); got {args.radius!r}")
+    if not (math.isfinite(R_L) and R_L > 0):
+        raise ValueError(f"--radius must be a finite length > 0 (e.g. 0.3mm); got {args.radius!r}")
     units = None
     if args.units:
         parts = [u.strip() for u in args.units.split(",")]
@@ -200,9 +220,12 @@ def _cmd_fit(args):
     res = sb.fit(scene, disp, force, R_L=R_L, fit_offset=not args.no_offset, fit_beta=args.fit_beta,
                  fit_alpha=args.fit_alpha, weights=args.weights, tol=args.tol, **bounds)
     out = res.to_dict()
+    out["exit_status"] = 0 if res.success else 1
     if args.json:
-        print(json.dumps(out))
+        print(json.dumps(out, allow_nan=False))
     else:
+        if not res.success:
+            print(f"fit failed (status {res.status}): {res.message}")
         lo, hi = res.mu_H_ci95
         print(f"mu*H   = {res.mu_H:.4g} N/m (um*MPa)   95% CI [{lo:.4g}, {hi:.4g}]")
         if not args.no_offset:
@@ -215,10 +238,16 @@ def _cmd_fit(args):
                       f"{res.curves_computed} model curves)")
         print(f"rms residual = {res.residual_rms * 1e3:.4g} mN over {res.n} points; R_L = {R_L * 1e3:.4g} mm; "
               f"{res.weights} weights")
-        if res.message and "; " in res.message:
-            print("note: " + res.message.split("; ", 1)[1])
+        for text in res.warnings:
+            print(f"warning: {text}")
     if args.output:
-        res.curve.to_hdf5(args.output, overwrite=args.force, units={"R_L": R_L, "mu_H": res.mu_H})
+        if not res.success:
+            print(f"shellbvp: not writing {args.output}: the fit failed its checks", file=sys.stderr)
+        else:  # the file carries the fit's outcome (settings["fit"], read back by read_curve)
+            record = {k: out[k] for k in ("mu_H", "mu_H_ci95", "offset", "offset_ci95", "fitted", "weights",
+                                          "status", "message", "warnings", "warning_codes", "n", "R_L")}
+            curve = dataclasses.replace(res.curve, settings={**res.curve.settings, "fit": record})
+            curve.to_hdf5(args.output, overwrite=args.force, units={"R_L": R_L, "mu_H": res.mu_H})
     return 0 if res.success else 1
 
 
@@ -312,7 +341,11 @@ def build_parser():
                    help="contact topology (default auto: the cap, or a valid lifted-off state where the cap "
                         "would pull the shell)")
     s.set_defaults(func=_cmd_solve)
-    f = sub.add_parser("fit", help="fit mu*H (and the contact point) to measured force-displacement data")
+    f = sub.add_parser("fit", help="fit mu*H (and the contact point) to measured force-displacement data",
+                       description="Fit mu*H (and the contact point) to measured force-displacement data. "
+                       "Exit status: 0 the fit succeeded (warnings, if any, printed as 'warning: ...'); "
+                       "1 the fit ran but failed its checks (e.g. an interval not finite or wider than mu*H); "
+                       "2 bad input (one-line message).")
     f.add_argument("data", nargs="?", help="CSV file: displacement and force columns")
     f.add_argument("--example", action="store_true",
                    help="use the synthetic Lepidium-like data shipped with shellbvp (README)")

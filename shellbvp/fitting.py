@@ -32,9 +32,11 @@ Student's t.  ``benchmarks/fit_coverage.py`` measures their coverage.
 
 from __future__ import annotations
 
+import codecs
 import csv
-import io
+import logging
 import math
+import re
 from collections import OrderedDict
 from dataclasses import dataclass, field
 
@@ -44,7 +46,10 @@ from scipy.interpolate import CubicSpline, PchipInterpolator
 
 from .units import unit_factor
 
-__all__ = ["FitResult", "fit", "read_force_csv", "example_data_path", "WEIGHTS", "DEFAULT_WEIGHTS"]
+log = logging.getLogger(__name__)
+
+__all__ = ["FitResult", "fit", "read_force_csv", "example_data_path", "WEIGHTS", "DEFAULT_WEIGHTS",
+           "FIT_STATUS", "FIT_WARNINGS", "PLAUSIBLE_MU_H", "runs_test"]
 
 #: Noise models of :func:`fit`.
 WEIGHTS = ("uniform", "relative", "mixed")
@@ -56,6 +61,33 @@ N_DEPTHS = 40
 BETA_BOUNDS = (1e-4, 1.0)
 ALPHA_BOUNDS = (0.0, 1.0)
 _MAX_CURVES = 14
+
+#: Outcomes of a fit that ran (``FitResult.status``); ``success`` is ``status == 0``.
+#: Data the fit cannot use at all raise ``ValueError`` before any model curve is computed.
+FIT_STATUS = {
+    0: "the fit converged and passed its checks",
+    1: "the least-squares solver did not converge",
+    2: "the fitted mu*H is not positive",
+    3: "the model force is not finite at every data point",
+    4: "a 95 % interval (mu*H or the offset) is not finite",
+    5: "the 95 % interval of mu*H is wider than mu*H itself: the data do not determine mu*H",
+}
+#: Kinds of warning (``FitResult.warning_codes``; the texts are in ``FitResult.warnings``).
+FIT_WARNINGS = {
+    "residual_runs": "the residuals' signs form long runs (runs test): the model does not follow the data",
+    "implausible_mu_H": "mu*H is far outside the values of soft shells (PLAUSIBLE_MU_H): check the units",
+    "search_range": "a shape parameter's interval or search reached the end of its range",
+    "max_curves": "the number of model curves reached its limit",
+}
+#: mu*H (N/m) of soft shells, from red-cell membranes (~1e-5) to thick rubber (~1e4); a fit
+#: outside this range gets a warning (a header in kN for data in mN gives 1e6 x the truth).
+PLAUSIBLE_MU_H = (1e-6, 1e5)
+#: One-sided p-value below which the force counts as not increasing with depth (Spearman).
+TREND_P = 0.01
+#: One-sided p-value of the runs test below which the residual pattern is a warning, and the
+#: least number of points for the test.
+RUNS_P = 1e-3
+RUNS_MIN_POINTS = 10
 
 
 def example_data_path():
@@ -90,8 +122,19 @@ class FitResult:
         Root-mean-square force residual, N (unweighted).
     n : int
         Number of data points used.
+    status : int
+        Outcome, a key of :data:`FIT_STATUS` (0: converged and passed the checks
+        on the result: finite intervals, mu*H's narrower than mu*H).
     success : bool
+        ``status == 0``.
     message : str
+        ``FIT_STATUS[status]`` with details (the solver's message).
+    warnings : list of str
+        Findings that do not fail the fit but need a look (a residual pattern
+        the noise model does not explain, an implausible mu*H, a shape
+        parameter's interval at its search bound).
+    warning_codes : list of str
+        The kind of each warning, keys of :data:`FIT_WARNINGS` (same order).
     curve : Curve
         The model curve (nondimensional) at the fitted parameters.
     scene : Scene
@@ -110,7 +153,7 @@ class FitResult:
     offset_ci95: tuple
     residual_rms: float
     n: int
-    success: bool
+    status: int
     message: str
     R_L: float
     curve: object = field(repr=False, default=None)
@@ -124,19 +167,31 @@ class FitResult:
     scene: object = field(repr=False, default=None)
     curves_computed: int = 0
     interpolation_error: float = None
+    warnings: list = field(default_factory=list)
+    warning_codes: list = field(default_factory=list)
+
+    @property
+    def success(self):
+        """True when the fit converged and passed its checks (``status == 0``)."""
+        return self.status == 0
 
     def model_force(self, displacement):
         """Fitted model force (N) at displacements (m)."""
         return self._model(np.asarray(displacement, float), self.mu_H, self.offset)
 
     def to_dict(self):
-        ci = (lambda v: None if v is None else [float(x) for x in v])
-        return {"mu_H": self.mu_H, "mu_H_ci95": list(self.mu_H_ci95), "offset": self.offset,
-                "offset_ci95": list(self.offset_ci95), "beta": self.beta, "beta_ci95": ci(self.beta_ci95),
-                "alpha": self.alpha, "alpha_ci95": ci(self.alpha_ci95), "fitted": list(self.fitted),
-                "weights": self.weights, "residual": self.residual_rms, "residual_rms": self.residual_rms,
-                "n": self.n, "success": self.success, "message": self.message, "R_L": self.R_L,
-                "curves_computed": self.curves_computed, "interpolation_error": self.interpolation_error,
+        """A JSON-ready dict (non-finite numbers as None, so the JSON is strict)."""
+        def num(v):
+            return None if v is None or not math.isfinite(v) else float(v)
+
+        ci = (lambda v: None if v is None else [num(x) for x in v])
+        return {"mu_H": num(self.mu_H), "mu_H_ci95": ci(self.mu_H_ci95), "offset": num(self.offset),
+                "offset_ci95": ci(self.offset_ci95), "beta": num(self.beta), "beta_ci95": ci(self.beta_ci95),
+                "alpha": num(self.alpha), "alpha_ci95": ci(self.alpha_ci95), "fitted": list(self.fitted),
+                "weights": self.weights, "residual": num(self.residual_rms), "residual_rms": num(self.residual_rms),
+                "n": self.n, "success": self.success, "status": self.status, "message": self.message,
+                "warnings": list(self.warnings), "warning_codes": list(self.warning_codes), "R_L": self.R_L,
+                "curves_computed": self.curves_computed, "interpolation_error": num(self.interpolation_error),
                 "units": {"mu_H": "N/m (= um*MPa)", "offset": "m", "residual": "N (rms)",
                           "residual_rms": "N", "R_L": "m", "beta": "1 (B/(mu R_L^2))", "alpha": "1"}}
 
@@ -158,6 +213,7 @@ def _model_curve(scene, deltas, tol, counter=None):
     if key is not None and key in _CACHE:
         _CACHE.move_to_end(key)
         return _CACHE[key]
+    _check_model_start(scene, float(deltas[0]), tol)
     c = curve(scene, deltas=deltas, tol=tol, estimate_error=False)
     if counter is not None:
         counter[0] += 1
@@ -169,13 +225,38 @@ def _model_curve(scene, deltas, tol, counter=None):
     return c
 
 
+def _check_model_start(scene, delta, tol):
+    """ValueError unless the model curve can start at its shallowest depth ``delta`` (one solve).
+
+    A curve at requested depths starts from a single contact cap; at depths where
+    the scene's contact is the point-load limit (far shallower than the shell's
+    size) it cannot start, so data that shallow are reported before the curve.
+    """
+    from .state import solve
+
+    sol = solve(scene, delta=delta, tol=tol, estimate_error=False, topology="cap")
+    if not (sol.success and sol.get("topology") == "cap"):
+        why = (sol.message if not sol.success else "the contact there is the point-load limit (the contact cap "
+               "is exponentially small), from which the model curve cannot start")
+        raise ValueError(f"the model curve cannot start at its shallowest depth delta = {delta:.3g} "
+                         f"(1/{N_DEPTHS} of delta_max = 1.2 x the deepest data depth / R_L): {why}. "
+                         f"Check the displacement units and the rim radius R_L (--radius): data this shallow "
+                         f"against R_L do not determine mu*H with this scene")
+
+
+def _beyond_message(c, need):
+    return (f"the data reach delta = {need:.4g} (deepest displacement / R_L) but the model curve ends at "
+            f"delta = {c.delta[-1]:.4g} ({c.stop_reason}): the model cannot explain the deepest points; "
+            f"fit the data up to delta = {c.delta[-1]:.4g} x R_L, or check the units and R_L (--radius)")
+
+
 class _Shape:
     """Nondimensional force F(delta; theta) from model curves at nodes theta_k on one delta grid.
 
-    Without a shape parameter there is one node (theta None) and the curve may
-    end early (the model is NaN beyond it).  With one, every node must reach
-    ``need`` (the deepest datum); F is a cubic spline across the nodes at each
-    depth and a monotone cubic (PCHIP) in delta.
+    Every node must reach ``need`` (the deepest datum): without a shape
+    parameter (one node, theta None) a curve that ends before it is a
+    ValueError; with one, ``add`` returns False.  F is a cubic spline across
+    the nodes at each depth and a monotone cubic (PCHIP) in delta.
     """
 
     def __init__(self, scene_at, grid, tol, need, counter):
@@ -187,9 +268,12 @@ class _Shape:
         """Compute the node curve at theta; False if it does not reach the data."""
         c = _model_curve(self.scene_at(theta), self.grid, self.tol, self.counter)
         if len(c) < 3:
-            raise RuntimeError(f"the model curve could not be computed ({c.stop_reason})")
-        if theta is not None and c.delta[-1] < self.need * (1 - 1e-12):
-            return False
+            raise ValueError(f"the model curve of this scene could not be computed to the data's depths "
+                             f"({c.stop_reason})")
+        if c.delta[-1] < self.need * (1 - 1e-12):
+            if theta is not None:
+                return False
+            raise ValueError(_beyond_message(c, self.need))
         self.nodes[theta] = c
         self._spline = None
         return True
@@ -283,6 +367,97 @@ def _weights(kind, model_force, f, floor, w_prev):
     return 1.0 / np.sqrt(s2 / np.max(s2))
 
 
+def _check_data(d, f, k):
+    """Checks of the data before any model curve; returns the finite rows, or raises ValueError.
+
+    ``k`` is the number of fitted parameters.  NaN rows are dropped (missing
+    values); infinite values, too few distinct displacements and a force that
+    does not increase with depth are errors.
+    """
+    if d.shape != f.shape:
+        raise ValueError(f"displacement and force must have the same length; got {d.size} and {f.size}")
+    for name, v in (("displacement", d), ("force", f)):
+        bad = np.flatnonzero(np.isinf(v))
+        if bad.size:
+            raise ValueError(f"{name} must be finite; got {v[bad[0]]} at index {bad[0]} "
+                             f"({bad.size} infinite values)")
+    keep = np.isfinite(d) & np.isfinite(f)
+    d, f = d[keep], f[keep]
+    need = max(3, k + 2)
+    if d.size < need:
+        raise ValueError(f"need at least {need} finite data points; got {d.size}")
+    distinct = np.unique(d).size
+    if distinct < need:
+        raise ValueError(f"displacement: need at least {need} distinct values to fit {k} parameters; got "
+                         f"{distinct} (the data are {d.size} points at {distinct} depth(s))")
+    if np.max(d) <= 0:
+        raise ValueError("displacement must reach positive values (indentation into the shell)")
+    if np.ptp(f) == 0:
+        raise ValueError(f"force is constant ({f[0]:g} N at every point): it must increase with the depth "
+                         "of indentation")
+    rho, p = stats.spearmanr(d, f, alternative="greater")
+    if not p < TREND_P:
+        raise ValueError(f"force does not increase with displacement (Spearman rank correlation {rho:.2f}, "
+                         f"one-sided p = {p:.2g}, needed < {TREND_P:g}): these data show no indentation "
+                         "response to fit (check the columns and their order with --columns)")
+    return d, f
+
+
+def runs_test(residual):
+    """One-sided Wald–Wolfowitz runs test for too few runs of signs (a systematic misfit).
+
+    Parameters
+    ----------
+    residual : array_like
+        Residuals in the order of the data (by displacement); zeros are skipped.
+
+    Returns
+    -------
+    runs : int
+        Number of runs of equal sign.
+    p : float
+        P(so few runs or fewer) for independent signs (normal approximation).
+    """
+    sgn = np.sign(np.asarray(residual, float))
+    sgn = sgn[sgn != 0]
+    n1, n2 = int(np.sum(sgn > 0)), int(np.sum(sgn < 0))
+    n = n1 + n2
+    runs = 1 + int(np.sum(sgn[1:] != sgn[:-1])) if n else 0
+    if n1 == 0 or n2 == 0:
+        return runs, float(0.5 ** max(n - 1, 0))  # every sign the same
+    mean = 2.0 * n1 * n2 / n + 1
+    var = (mean - 1) * (mean - 2) / (n - 1)
+    return runs, float(stats.norm.cdf((runs + 0.5 - mean) / math.sqrt(var))) if var > 0 else 1.0
+
+
+def _check_result(res_ok, mu_H, mu_ci, off_ci, resid_ok, disp, resid):
+    """Status and warnings of a fitted result (see :data:`FIT_STATUS`, :data:`FIT_WARNINGS`)."""
+    warnings = []
+    if not res_ok:
+        status = 1
+    elif not mu_H > 0:
+        status = 2
+    elif not resid_ok:
+        status = 3
+    elif not all(math.isfinite(v) for v in (*mu_ci, *off_ci)):
+        status = 4
+    elif mu_ci[1] - mu_ci[0] > mu_H:
+        status = 5
+    else:
+        status = 0
+    if resid.size >= RUNS_MIN_POINTS and np.all(np.isfinite(resid)):  # signs only: weights do not matter
+        runs, p = runs_test(resid[np.argsort(disp, kind="stable")])
+        if p < RUNS_P:
+            warnings.append(("residual_runs", f"the residuals' signs form {runs} runs over {resid.size} points "
+                             f"(runs test p = {p:.2g} < {RUNS_P:g}): a pattern the noise model does not explain; "
+                             "the model (scene, contact point, weights) does not follow the data"))
+    lo, hi = PLAUSIBLE_MU_H
+    if status != 2 and math.isfinite(mu_H) and not lo <= mu_H <= hi:
+        warnings.append(("implausible_mu_H", f"mu*H = {mu_H:.3g} N/m is far outside the range of soft shells "
+                         f"({lo:g} to {hi:g} N/m): check the units of the data (header or --units) and R_L"))
+    return status, warnings
+
+
 def _check_bounds(name, bounds, lo_ok, hi_ok, value):
     try:
         lo, hi = (float(v) for v in bounds)
@@ -332,6 +507,22 @@ def fit(scene, displacement, force, *, R_L, fit_offset=True, fit_beta=False, fit
     Returns
     -------
     FitResult
+        ``status`` (:data:`FIT_STATUS`) 0 only when the solver converged, mu*H > 0
+        and the 95 % intervals of mu*H and the offset are finite with mu*H's
+        narrower than mu*H itself.  ``warnings``: a residual sign pattern the
+        noise model does not explain (:func:`runs_test`, p < :data:`RUNS_P`, at
+        least :data:`RUNS_MIN_POINTS` points), mu*H outside :data:`PLAUSIBLE_MU_H`,
+        a shape parameter's interval at its search bound.
+
+    Raises
+    ------
+    ValueError
+        For arguments out of range and for data the fit cannot use, before any
+        model curve is computed: infinite values, fewer than ``max(3, p + 2)``
+        distinct displacements (p fitted parameters), a force that does not
+        increase with displacement (Spearman, one-sided p >= :data:`TREND_P`),
+        data too shallow for the model curve to start (one solve at its first
+        depth); and, once the curve is computed, data deeper than it reaches.
     """
     from .materials import MooneyRivlin
 
@@ -345,17 +536,10 @@ def fit(scene, displacement, force, *, R_L, fit_offset=True, fit_beta=False, fit
                          "shape only weakly; together with mu*H they are not identifiable from one curve)")
     d = np.asarray(displacement, float).ravel()
     f = np.asarray(force, float).ravel()
-    if d.shape != f.shape:
-        raise ValueError(f"displacement and force must have the same length; got {d.size} and {f.size}")
-    keep = np.isfinite(d) & np.isfinite(f)
-    d, f = d[keep], f[keep]
     k = 1 + bool(fit_offset) + bool(fit_beta or fit_alpha)
-    if d.size < max(3, k + 2):
-        raise ValueError(f"need at least {max(3, k + 2)} finite data points; got {d.size}")
+    d, f = _check_data(d, f, k)
     if not (isinstance(R_L, (int, float)) and math.isfinite(R_L) and R_L > 0):
         raise ValueError(f"R_L (rim radius, m) must be a finite number > 0; got {R_L!r}")
-    if np.max(d) <= 0:
-        raise ValueError("displacement must reach positive values (indentation into the shell)")
     if fit_beta:
         lo, hi = _check_bounds("beta", beta_bounds, lambda v: v > 0, lambda v: True, scene.beta)
         name, bounds = "beta", (math.log(lo), math.log(hi))
@@ -405,8 +589,8 @@ def fit(scene, displacement, force, *, R_L, fit_offset=True, fit_beta=False, fit
         shape = _Shape(scene_at, grid, tol, np.max(d) / R_L, counter)
         lim = [bounds[0], bounds[1]]  # shrinks where node curves do not reach the data
         if not shape.add(theta0):
-            raise RuntimeError(f"the model curve at the scene's {name} does not reach the deepest data point "
-                               f"(delta = {np.max(d) / R_L:.3g}); {shape.scene_at(theta0)!r}")
+            raise ValueError(f"the model curve at the scene's {name} ends before the deepest data point "
+                             f"(delta = {np.max(d) / R_L:.4g}): fit shallower data, or check the units and R_L")
 
         def extend(side):
             """Add the next node beyond the nodes on side -1 (low) or +1 (high); False at the limit."""
@@ -415,7 +599,7 @@ def fit(scene, displacement, force, *, R_L, fit_offset=True, fit_beta=False, fit
             if (edge <= lim[0] + 1e-12) if side < 0 else (edge >= lim[1] - 1e-12):
                 return False
             if counter[0] >= _MAX_CURVES:
-                notes.append(f"stopped adding model curves at {_MAX_CURVES}")
+                notes.append(("max_curves", f"stopped adding model curves at {_MAX_CURVES}"))
                 return False
             new = edge + side * step
             if side < 0:
@@ -426,8 +610,8 @@ def fit(scene, displacement, force, *, R_L, fit_offset=True, fit_beta=False, fit
                 return True
             # this curve ends before the data: the range ends between edge and new
             lim[0 if side < 0 else 1] = edge
-            notes.append(f"model curves at {name} = {_show(name, new)} end before the deepest data point; "
-                         f"searched {name} up to {_show(name, edge)}")
+            notes.append(("search_range", f"model curves at {name} = {_show(name, new)} end before the deepest "
+                          f"data point; searched {name} up to {_show(name, edge)}"))
             return False
 
         extend(-1)
@@ -510,9 +694,9 @@ def fit(scene, displacement, force, *, R_L, fit_offset=True, fit_beta=False, fit
 
         (c_lo, open_lo), (c_hi, open_hi) = crossing(-1), crossing(+1)
         if open_lo or open_hi:
-            notes.append(f"the 95% interval of {name} reaches the end of the searched range "
-                         f"({_show(name, lim[0])}, {_show(name, lim[1])}); {name} is not determined "
-                         f"by the data on that side")
+            notes.append(("search_range", f"the 95% interval of {name} reaches the end of the searched range "
+                          f"({_show(name, lim[0])}, {_show(name, lim[1])}); {name} is not determined "
+                          f"by the data on that side"))
         theta_ci = (c_lo, c_hi)
         theta_hat_final = theta_hat
         P, dP, top = shape.at(theta_hat_final)
@@ -557,14 +741,20 @@ def fit(scene, displacement, force, *, R_L, fit_offset=True, fit_beta=False, fit
     elif name == "alpha":
         alpha = float(theta_hat)
         alpha_ci = tuple(float(v) for v in theta_ci)
-    message = "; ".join([str(res.message)] + notes)
-    ok = bool(res.success and mu_H > 0 and np.all(np.isfinite(resid)))
-    return FitResult(mu_H=mu_H, mu_H_ci95=(float(mu_H - half[0]), float(mu_H + half[0])), offset=d0,
+    mu_ci = (float(mu_H - half[0]), float(mu_H + half[0]))
+    status, checks = _check_result(bool(res.success), mu_H, mu_ci, off_ci if fit_offset else (0.0, 0.0),
+                                   bool(np.all(np.isfinite(resid))), d, resid)
+    found = notes + checks
+    for _, text in found:
+        log.info("fit: warning: %s", text)
+    message = f"{FIT_STATUS[status]} (least squares: {res.message})"
+    return FitResult(mu_H=mu_H, mu_H_ci95=mu_ci, offset=d0,
                      offset_ci95=off_ci, residual_rms=float(np.sqrt(np.mean(np.nan_to_num(resid, nan=mdl.big) ** 2))),
-                     n=n, success=ok, message=message, R_L=float(R_L), curve=c, _model=model,
+                     n=n, status=status, message=message, R_L=float(R_L), curve=c, _model=model,
                      beta=beta, beta_ci95=beta_ci, alpha=alpha, alpha_ci95=alpha_ci, fitted=fitted,
                      weights=weights, scene=fit_scene, curves_computed=counter[0],
-                     interpolation_error=interp_err)
+                     interpolation_error=interp_err, warnings=[t for _, t in found],
+                     warning_codes=[code for code, _ in found])
 
 
 def _unpack(p, fit_offset):
@@ -579,41 +769,90 @@ def _show(name, theta):
     return f"{math.exp(theta):.3g}" if name == "beta" else f"{theta:.3g}"
 
 
+#: A number as a CSV should write it: ASCII digits, optional sign, decimal point and exponent
+#: (Python's float() also takes "5_0", "inf", "1e999" and non-ASCII digits; a CSV should not).
+_NUMBER = re.compile(r"[-+]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][-+]?[0-9]+)?")
+_BOMS = ((codecs.BOM_UTF32_LE, "utf-32"), (codecs.BOM_UTF32_BE, "utf-32"), (codecs.BOM_UTF8, "utf-8-sig"),
+         (codecs.BOM_UTF16_LE, "utf-16"), (codecs.BOM_UTF16_BE, "utf-16"))
+
+
+def _decode(raw, path):
+    """Text of a CSV file: a BOM's encoding, else UTF-8, else UTF-16 (no BOM), else cp1252/Latin-1."""
+    for bom, enc in _BOMS:
+        if raw.startswith(bom):
+            try:
+                return raw.decode(enc)
+            except UnicodeDecodeError as exc:
+                raise ValueError(f"{path}: cannot decode as {enc} (its byte-order mark says so): {exc.reason} "
+                                 f"at byte {exc.start}") from None
+    tries = ["utf-8"]
+    if len(raw) >= 4 and raw.count(b"\x00") >= len(raw) // 4:  # ASCII text in UTF-16 without a BOM
+        tries += ["utf-16-le" if raw[1::2].count(0) > raw[0::2].count(0) else "utf-16-be"]
+    for enc in tries + ["cp1252", "latin-1"]:
+        try:
+            text = raw.decode(enc)
+        except UnicodeDecodeError:
+            continue
+        if not re.search(r"[\x00-\x08\x0b\x0c\x0e-\x1f\x7f]", text):  # control characters: not this encoding
+            return text
+    raise ValueError(f"{path}: not a text file in a known encoding (tried UTF-8, UTF-16, Windows-1252, Latin-1; "
+                     "it holds control characters): save it as CSV text, e.g. UTF-8")
+
+
+def _number(s, decimal_comma):
+    """float of a CSV cell: "" and "nan" are NaN; anything but a plain finite number is None."""
+    t = s.strip()
+    if decimal_comma:
+        t = t.replace(",", ".")
+    if not t or t.lower() == "nan":
+        return math.nan
+    if not _NUMBER.fullmatch(t):
+        return None
+    v = float(t)
+    return v if math.isfinite(v) else None
+
+
 def read_force_csv(path, *, columns=None, units=None):
     """Read displacement and force columns from an instrument's CSV file.
 
     Accepts a header or none, comma, semicolon or tab delimiters, columns by
     name or 0-based index (default: the first two), units in the header
-    (``"Displacement (mm)"``, ``"force [mN]"``) or by ``units=("mm", "mN")``,
-    descending or repeated displacements and NaN/empty rows (dropped).
+    (``"Displacement (mm)"``, ``"force [mN]"``, ``"µm"`` or ``"μm"``) or by
+    ``units=("mm", "mN")``, descending or repeated displacements and NaN/empty
+    rows (dropped), ``#`` comment lines.  Encodings: a byte-order mark's
+    (UTF-8, UTF-16, UTF-32), else UTF-8, UTF-16 or Windows-1252/Latin-1.
+    Numbers must be plain decimals (``1.5``, ``-2e-3``; with ``;`` delimiters
+    also ``1,5``); ``5_0``, ``inf`` or ``1e999`` are errors.
     Returns ``(displacement_m, force_N)`` sorted by displacement.
-    Raises ValueError naming the line of a malformed row.
+    Raises ValueError naming the line (counted in the file, comments included)
+    of a malformed row.
     """
     try:
-        text = open(path, newline="", encoding="utf-8-sig").read()
+        with open(path, "rb") as fh:
+            raw = fh.read()
     except OSError as exc:
         raise ValueError(f"{path}: cannot read ({exc.strerror})") from None
-    lines = [ln for ln in text.splitlines() if ln.strip() and not ln.lstrip().startswith("#")]
-    if not lines:
+    text = _decode(raw, path)
+    numbered = [(i, ln) for i, ln in enumerate(text.splitlines(), start=1)
+                if ln.strip() and not ln.lstrip().startswith("#")]
+    if not numbered:
         raise ValueError(f"{path}: no data")
+    lines = [ln for _, ln in numbered]
     try:
         dialect = csv.Sniffer().sniff("\n".join(lines[:20]), delimiters=",;\t")
         delim = dialect.delimiter
     except csv.Error:
         delim = "," if "," in lines[0] else (";" if ";" in lines[0] else "\t")
-    rows = list(csv.reader(io.StringIO("\n".join(lines)), delimiter=delim))
+    rows = [next(csv.reader([ln], delimiter=delim), []) for ln in lines]
+    line_no = [i for i, _ in numbered]
 
     def is_number(s):
-        try:
-            float(s.replace(",", ".") if delim == ";" else s)
-            return True
-        except ValueError:
-            return s.strip().lower() in ("nan", "")
+        return _number(s, delim == ";") is not None
 
     header = None
     if not all(is_number(c) for c in rows[0]):
         header = [h.strip() for h in rows[0]]
-        rows = rows[1:]
+        rows, line_no = rows[1:], line_no[1:]
     if columns is None:
         cols = (0, 1)
     else:
@@ -634,29 +873,25 @@ def read_force_csv(path, *, columns=None, units=None):
     if units is None and header is not None:
         for i, col in enumerate(cols):
             if col < len(header):
-                import re
-
                 m = re.search(r"[\(\[]\s*([^\)\]]+?)\s*[\)\]]", header[col])
                 if m:
-                    unit_names[i] = m.group(1)
+                    unit_names[i] = m.group(1).replace("\u03bc", "\u00b5")  # Greek mu -> micro sign
     if unit_names[0] is None or unit_names[1] is None:
         raise ValueError(f"{path}: units unknown; give them in the header, e.g. 'displacement (mm)', "
                          "or with --units mm,mN")
     fd, ff = unit_factor(unit_names[0], "length"), unit_factor(unit_names[1], "force")
     disp, frc = [], []
-    first_line = 2 if header is not None else 1
-    for n, row in enumerate(rows, start=first_line):
+    for n, row in zip(line_no, rows):
         if all(not c.strip() for c in row):
             continue
         try:
             a, b = (row[c].strip() for c in cols)
         except IndexError:
             raise ValueError(f"{path}: line {n} has {len(row)} columns; need column {max(cols)}") from None
-        try:
-            va = float(a.replace(",", ".") if delim == ";" else a) if a else float("nan")
-            vb = float(b.replace(",", ".") if delim == ";" else b) if b else float("nan")
-        except ValueError:
-            raise ValueError(f"{path}: line {n}: cannot read {a!r}, {b!r} as numbers") from None
+        va, vb = _number(a, delim == ";"), _number(b, delim == ";")
+        if va is None or vb is None:
+            raise ValueError(f"{path}: line {n}: cannot read {a!r}, {b!r} as numbers (plain finite decimals "
+                             "such as 1.5 or -2e-3; empty or nan for a missing value)")
         disp.append(va * fd)
         frc.append(vb * ff)
     d, f = np.array(disp), np.array(frc)
