@@ -37,6 +37,8 @@ from pathlib import Path
 
 import numpy as np
 
+from .paths import check_output_path
+
 __all__ = ["write_curve", "read_curve", "FORMAT", "FORMAT_VERSION"]
 
 FORMAT = "shellbvp-curve"
@@ -84,12 +86,8 @@ def write_curve(curve, path, *, profiles=False, overwrite=False, units=None):
     dims = _check_units(units)
     if path.exists() and not overwrite:
         raise FileExistsError(f"{path} exists; pass overwrite=True (CLI: --force) to replace it")
-    parent = path.parent if str(path.parent) else Path(".")
-    if not parent.is_dir():
-        raise ValueError(f"output directory {parent} does not exist")
-    if not os.access(parent, os.W_OK):
-        raise ValueError(f"output directory {parent} is not writable")
-    fd, tmp = tempfile.mkstemp(dir=parent, prefix=f".{path.name}.", suffix=".tmp")
+    check_output_path(path, overwrite=True)
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
     os.close(fd)
     try:
         with h5py.File(tmp, "w") as f:

@@ -119,3 +119,127 @@ def test_solve_with_a_point_load_guess_starts_cold():
     point = solve_point_load(scene, 1e-3)
     sol = sb.solve(scene, delta=0.1, guess=point, topology="cap", estimate_error=False)
     assert sol.success and sol.topology == "cap"
+
+
+# -- output paths ---------------------------------------------------------------------------------
+
+@pytest.mark.parametrize("command", [["curve", "--delta-max", "0.1"], ["fit", "--example", "--radius", "0.3mm"],
+                                     ["plot", "in.h5"]])
+@pytest.mark.parametrize("output,words", [
+    (".", ["is a directory"]),
+    ("sub", ["sub is a directory"]),
+    ("nonexistent/x.h5", ["directory nonexistent", "does not exist"]),
+    ("/proc/x.h5", ["/proc", "not writable"]),
+    ("", ["empty"]),
+    ("in.h5/x.h5", ["in.h5", "not a directory"]),
+])
+def test_bad_output_paths_are_refused_before_any_work(tmp_path, command, output, words):
+    (tmp_path / "sub").mkdir()
+    (tmp_path / "in.h5").write_bytes(b"")  # plot would fail on reading it: the path is checked first
+    t0 = time.perf_counter()
+    r = run(*command, "-o", output, cwd=tmp_path)
+    one_line_error(r, *words)
+    assert time.perf_counter() - t0 < 20  # import only: no curve, no fit
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["in.h5", "sub"]  # nothing left behind
+
+
+@pytest.mark.skipif(os.geteuid() == 0, reason="root writes into a mode-555 directory")
+def test_unwritable_directory_is_refused(tmp_path):
+    ro = tmp_path / "ro"
+    ro.mkdir()
+    ro.chmod(0o555)
+    try:
+        one_line_error(run("curve", "-o", "ro/x.h5", cwd=tmp_path), "ro", "not writable")
+    finally:
+        ro.chmod(0o755)
+
+
+def test_check_output_path_api(tmp_path):
+    from shellbvp.paths import check_output_path, partial_path
+
+    target = tmp_path / "a.h5"
+    assert check_output_path(target, overwrite=False) == target
+    target.write_bytes(b"old")
+    with pytest.raises(ValueError, match="exists; use --force"):
+        check_output_path(target, overwrite=False)
+    assert check_output_path(str(target), overwrite=True) == target
+    assert partial_path(target) == tmp_path / "a.h5.partial"
+    with pytest.raises(ValueError, match="is a directory"):
+        check_output_path(str(tmp_path) + os.sep, overwrite=True)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a.h5"]  # the write probe is removed
+
+
+def test_points_and_delta_max_limits_on_the_command_line(tmp_path):
+    one_line_error(run("curve", "--points", "1000000000", "-o", "p.h5", cwd=tmp_path), "--points", "[2, 100000]")
+    one_line_error(run("curve", "--delta-max", "1e-300", "-o", "p.h5", cwd=tmp_path), "delta_max = 1e-300",
+                   "[1e-06, 2.142]")
+    assert not list(tmp_path.iterdir())
+
+
+# -- --force and checkpoints -------------------------------------------------------------------------
+
+@pytest.fixture
+def old_file(tmp_path):
+    path = tmp_path / "X.h5"
+    sb.curve(sb.Scene.preset("base"), deltas=[0.1, 0.12], estimate_error=False).to_hdf5(path)
+    return path, path.read_bytes()
+
+
+def _start_curve_and_wait_for_checkpoint(tmp_path, *extra):
+    env = dict(os.environ, SHELLBVP_CHECKPOINT_SECONDS="0")
+    proc = subprocess.Popen([sys.executable, "-m", "shellbvp", "curve", "--force", "-o", "X.h5", "-q", *extra],
+                            cwd=tmp_path, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    partial = tmp_path / "X.h5.partial"
+    deadline = time.monotonic() + 120
+    while not partial.exists():
+        assert proc.poll() is None, proc.communicate()
+        assert time.monotonic() < deadline, "no checkpoint within 120 s"
+        time.sleep(0.05)
+    return proc, partial
+
+
+def test_killed_run_leaves_the_old_file_intact_and_a_labelled_checkpoint(tmp_path, old_file):
+    path, before = old_file
+    proc, partial = _start_curve_and_wait_for_checkpoint(tmp_path, "--delta-max", "0.5")
+    proc.kill()  # SIGKILL: nothing runs after it
+    proc.communicate()
+    assert path.read_bytes() == before
+    old = sb.read_curve(path)
+    assert old.complete and list(old.delta) == [0.1, 0.12]
+    ck = sb.read_curve(partial)
+    assert ck.stop_reason == "running" and not ck.complete and not ck.interrupted and len(ck) >= 1
+    info = run("info", "X.h5.partial", cwd=tmp_path)
+    assert info.returncode == 0 and "running" in info.stdout and "complete:  False" in info.stdout
+
+
+def test_sigint_writes_the_final_file_labelled_interrupted(tmp_path, old_file):
+    import signal
+
+    path, before = old_file
+    proc, partial = _start_curve_and_wait_for_checkpoint(tmp_path, "--delta-max", "0.5")
+    n_checkpoint = len(sb.read_curve(partial))
+    proc.send_signal(signal.SIGINT)
+    out, err = proc.communicate(timeout=120)
+    assert proc.returncode == 130, (out, err)
+    assert "Traceback" not in err and "interrupted" in err
+    c = sb.read_curve(path)
+    assert c.interrupted and not c.complete and c.stop_reason == "interrupted"
+    assert len(c) >= n_checkpoint and c.delta[0] != 0.1  # the new run's points, not the old file's
+    assert not partial.exists()
+
+
+def test_finished_run_replaces_the_file_and_removes_the_checkpoint(tmp_path, old_file):
+    path, before = old_file
+    env = dict(os.environ, SHELLBVP_CHECKPOINT_SECONDS="0")
+    r = subprocess.run([sys.executable, "-m", "shellbvp", "curve", "--force", "-o", "X.h5", "--points", "3",
+                        "--delta-max", "0.15"], cwd=tmp_path, env=env, capture_output=True, text=True,
+                       timeout=300)
+    assert r.returncode == 0, r.stderr
+    c = sb.read_curve(path)
+    assert c.complete and c.stop_reason == "all requested deltas computed"
+    np.testing.assert_allclose(c.delta, [0.05, 0.1, 0.15])
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["X.h5"]
+    # a leftover checkpoint is somebody's finished work: replaced only with --force
+    (tmp_path / "Y.h5.partial").write_bytes(b"points")
+    r = run("curve", "-o", "Y.h5", cwd=tmp_path)
+    one_line_error(r, "Y.h5.partial exists", "--force")
