@@ -146,6 +146,23 @@ def _cmd_curve(args):
     return 0 if c.complete else 1
 
 
+def _strict_json(value):
+    """NaN and inf as null (JSON has neither; jq, JavaScript and most parsers refuse them)."""
+    import numpy as np
+
+    if isinstance(value, dict):
+        return {k: _strict_json(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_strict_json(v) for v in value]
+    if isinstance(value, (bool, np.bool_)):
+        return bool(value)
+    if isinstance(value, (int, np.integer)):
+        return int(value)
+    if isinstance(value, (float, np.floating)):
+        return float(value) if math.isfinite(value) else None
+    return value
+
+
 def _cmd_solve(args):
     import numpy as np
 
@@ -166,7 +183,7 @@ def _cmd_solve(args):
     if args.profiles and sol.success:
         out["profile"] = {k: np.asarray(v).tolist() for k, v in sol.profile().items()}
     if args.json:
-        print(json.dumps(out, default=float))
+        print(json.dumps(_strict_json(out), allow_nan=False))
     else:
         for k in keys:
             print(f"{k:>16s}: {out[k]}")

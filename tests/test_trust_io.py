@@ -36,7 +36,11 @@ def test_overflowing_jacobian_never_reaches_lapack_and_json_is_one_document():
     r = run("solve", "--gamma", "99.9999999", "--rho", "0.01", "--beta", "1e-4", "--xi", "0", "--neo-hookean",
             "--delta", "0.0184286", "--tol", "1e-3", "--json")
     assert "illegal value" not in r.stdout + r.stderr
-    out = json.loads(r.stdout)  # exactly one document: nothing before or after it
+    def refuse(token):
+        raise AssertionError(f"{token} is not JSON")
+
+    out = json.loads(r.stdout, parse_constant=refuse)  # one strict document: nothing before or after it
+    assert out["force"] is None and out["delta"] == 0.0184286  # no state: NaN -> null
     assert r.returncode == 1 and not out["success"] and out["status"] != 0
     assert "overflowed" in out["message"]
 
@@ -243,3 +247,96 @@ def test_finished_run_replaces_the_file_and_removes_the_checkpoint(tmp_path, old
     (tmp_path / "Y.h5.partial").write_bytes(b"points")
     r = run("curve", "-o", "Y.h5", cwd=tmp_path)
     one_line_error(r, "Y.h5.partial exists", "--force")
+
+
+# -- malformed files -----------------------------------------------------------------------------------
+
+@pytest.fixture(scope="module")
+def good_file(tmp_path_factory):
+    path = tmp_path_factory.mktemp("good") / "good.h5"
+    sb.curve(sb.Scene.preset("base"), deltas=[0.1, 0.12, 0.14], estimate_error=False).to_hdf5(path)
+    return path
+
+
+def _replace(name, data, **kw):
+    def edit(f):
+        del f["curve"][name]
+        f["curve"].create_dataset(name, data=data, **kw)
+    return edit
+
+
+def _strings(values):
+    import h5py
+
+    return _replace("force", np.array(values, dtype=object), dtype=h5py.string_dtype())
+
+
+TAMPERED = {
+    "no_stop_reason": (lambda f: f["curve"].attrs.__delitem__("stop_reason"), "attribute stop_reason missing"),
+    "no_complete": (lambda f: f["curve"].attrs.__delitem__("complete"), "attribute complete missing"),
+    "no_interrupted": (lambda f: f["curve"].attrs.__delitem__("interrupted"), "attribute interrupted missing"),
+    "complete_text": (lambda f: f["curve"].attrs.__setitem__("complete", "yes"), "complete must be a boolean"),
+    "stop_reason_number": (lambda f: f["curve"].attrs.__setitem__("stop_reason", 3.0),
+                           "stop_reason must be a string"),
+    "version_array": (lambda f: f.attrs.__setitem__("format_version", np.array([2, 2])),
+                      "format_version must be a scalar integer"),
+    "version_float": (lambda f: f.attrs.__setitem__("format_version", 2.5), "format_version must be a scalar integer"),
+    "version_missing": (lambda f: f.attrs.__delitem__("format_version"), "format_version attribute missing"),
+    "version_newer": (lambda f: f.attrs.__setitem__("format_version", 99), "format version 99"),
+    "scalar_delta": (_replace("delta", 0.1), "delta must be a 1-D array; got shape ()"),
+    "short_force": (_replace("force", [0.1, 0.2]), "force must be a 1-D array of 3 values"),
+    "force_2d": (_replace("force", np.zeros((3, 2))), "force must be a 1-D array of 3 values"),
+    "force_strings": (_strings(["a", "b", "c"]), "force must hold numbers; got strings"),
+    "no_lambda0": (lambda f: f["curve"].__delitem__("lambda0"), "dataset lambda0 missing"),
+    "no_flags": (lambda f: f["curve"].__delitem__("flags"), "dataset flags missing"),
+    "status_fraction": (_replace("status", [0.5, 0.0, 0.0]), "status must hold integers"),
+    "topology_numbers": (_replace("topology", [1, 2, 3]), "topology must hold strings"),
+    "scene_not_json": (lambda f: f["curve"].attrs.__setitem__("scene", "{nope"), "attribute scene is not valid JSON"),
+    "scene_incomplete": (lambda f: f["curve"].attrs.__setitem__("scene", '{"gamma": 1}'),
+                         "attribute scene does not describe a scene"),
+    "settings_list": (lambda f: f["curve"].attrs.__setitem__("settings", "[1, 2]"),
+                      "attribute settings must be a JSON object"),
+}
+
+
+@pytest.mark.parametrize("name", sorted(TAMPERED))
+def test_read_curve_names_what_is_wrong_with_a_tampered_file(tmp_path, good_file, name):
+    import shutil
+
+    import h5py
+
+    edit, message = TAMPERED[name]
+    path = tmp_path / f"{name}.h5"
+    shutil.copy(good_file, path)
+    with h5py.File(path, "r+") as f:
+        edit(f)
+    with pytest.raises(ValueError) as err:
+        sb.read_curve(path)
+    text = str(err.value)
+    assert text.startswith(f"{path}: ") and message in text and "\n" not in text, text
+
+
+def test_info_answers_every_tampered_file_in_one_line(tmp_path, good_file):
+    import shutil
+
+    import h5py
+
+    for name in ("no_stop_reason", "version_array", "scalar_delta", "short_force", "force_strings"):
+        edit, message = TAMPERED[name]
+        path = tmp_path / f"{name}.h5"
+        shutil.copy(good_file, path)
+        with h5py.File(path, "r+") as f:
+            edit(f)
+        one_line_error(run("info", path.name, cwd=tmp_path), path.name, message)
+    r = run("info", str(good_file))
+    assert r.returncode == 0 and "complete:  True" in r.stdout
+
+
+def test_an_untouched_file_reads_back_with_its_types(good_file):
+    c = sb.read_curve(good_file)
+    assert c.complete and not c.interrupted and c.stop_reason == "all requested deltas computed"
+    assert c.status.dtype.kind == "i" and c.valid.dtype == bool and c.delta.dtype == float
+    assert set(c.topology) <= {"cap", "line", "annulus"} and len(c.topology) == len(c.flags) == 3
+    again = sb.curve(sb.Scene.preset("base"), deltas=[0.1, 0.12, 0.14], estimate_error=False)
+    assert list(c.topology) == list(again.topology) and c.flags == again.flags
+    np.testing.assert_array_equal(c.force, again.force)
