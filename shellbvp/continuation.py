@@ -523,9 +523,8 @@ def _adaptive(scene, builder: _Builder, settings):
         # the cap is below double precision there: no (delta, lambda0, F) branch to follow
         # until it comes back; natural continuation in delta instead (point-load limit or cap)
         grid = np.linspace(first.delta, st["delta_max"], 11)
-        _natural(scene, grid, builder, st, first=first, key0=steps)
-        raise _Stop(builder.out.stop_reason.replace("all requested deltas computed",
-                                                    f"delta_max = {st['delta_max']:g} reached"))
+        _natural(scene, grid, builder, st, first=first, key0=steps)  # complete, or raises _Stop
+        raise _Stop(f"delta_max = {st['delta_max']:g} reached")
     scale = np.array([1.0, 1.0, 1.0])
     cur = first
     if below is None:  # need a second point for the tangent

@@ -115,7 +115,7 @@ def write_curve(curve, path, *, profiles=False, overwrite=False, units=None):
             g.attrs["energy_identity_max"] = float(np.nanmax(np.abs(res))) if np.any(np.isfinite(res)) else np.nan
             for k, v in curve.points.items():
                 v = np.asarray(v)
-                if v.dtype.kind in "UO":  # strings (topology)
+                if v.dtype.kind in "UO" or k in _STRING_FIELDS:  # strings (topology; also when empty)
                     g.create_dataset(k, data=np.array(v, dtype=object), dtype=h5py.string_dtype())
                 else:
                     g.create_dataset(k, data=v)
@@ -214,10 +214,9 @@ def _field(g, name, n):
         raise ValueError(f"{name} must be a 1-D array of {n} values (one per delta); got shape {d.shape}")
     v = d[()]
     if name in _STRING_FIELDS:
-        if v.dtype.kind not in "OSU":
+        if v.dtype.kind not in "OSU" and n:  # files of empty curves stored an empty float array
             raise ValueError(f"{name} must hold strings; got {v.dtype}")
-        return np.array([t.decode("utf-8", "replace") if isinstance(t, bytes) else str(t) for t in v],
-                        dtype=str if n else "<U1")
+        return np.array([t.decode("utf-8", "replace") if isinstance(t, bytes) else str(t) for t in v], dtype=str)
     if v.dtype.kind not in "fiub":
         raise ValueError(f"{name} must hold numbers; got {'strings' if v.dtype.kind in 'OSU' else v.dtype}")
     if name in _INTEGER_FIELDS:
@@ -250,7 +249,7 @@ def _points(g):
             points[k] = _missing_field(k, n)
         else:
             raise ValueError(f"dataset {k} missing")
-    points["topology"] = np.asarray(points["topology"], dtype=str) if n else np.array([], dtype=str)
+    points["topology"] = np.asarray(points["topology"], dtype=str)
     unknown = sorted(set(points["topology"]) - set(_TOPOLOGIES))
     if unknown:
         raise ValueError(f"topology must be one of {_TOPOLOGIES}; got {unknown[0]!r}")

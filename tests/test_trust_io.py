@@ -340,3 +340,13 @@ def test_an_untouched_file_reads_back_with_its_types(good_file):
     again = sb.curve(sb.Scene.preset("base"), deltas=[0.1, 0.12, 0.14], estimate_error=False)
     assert list(c.topology) == list(again.topology) and c.flags == again.flags
     np.testing.assert_array_equal(c.force, again.force)
+
+
+def test_a_curve_without_points_round_trips(tmp_path):
+    c = sb.curve(sb.Scene.preset("base"), deltas=[0.1], max_nodes=10, estimate_error=False)
+    assert len(c) == 0 and not c.complete and "no solution" in c.stop_reason
+    c.to_hdf5(tmp_path / "e.h5")
+    back = sb.read_curve(tmp_path / "e.h5")
+    assert len(back) == 0 and back.stop_reason == c.stop_reason and not back.complete
+    r = run("info", "e.h5", cwd=tmp_path)
+    assert r.returncode == 0 and "0 points" in r.stdout
