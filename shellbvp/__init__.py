@@ -12,7 +12,7 @@ Quick use::
 from .geometry import SphereTip, Spheroid, UserShell, UserTip
 from .materials import Gent, MooneyRivlin, NeoHookean, StrainEnergy
 from .scene import PRESETS, Scene
-from .state import STATUS_MESSAGES, Solution, solve
+from .state import STATUS_MESSAGES, Solution, delta_bounds, solve
 from .continuation import Curve, curve
 from .io import read_curve
 from .units import Dimensions, beta_from_thickness, parse_quantity
@@ -36,6 +36,7 @@ def __getattr__(name):
 __all__ = [
     "Scene",
     "solve",
+    "delta_bounds",
     "curve",
     "Curve",
     "read_curve",

@@ -21,6 +21,7 @@ import argparse
 import json
 import logging
 import math
+import os
 import sys
 import time
 
@@ -62,6 +63,19 @@ def _scene(args):
     return sb.Scene.preset(args.preset, **over)
 
 
+def _checkpoint_seconds():
+    """Seconds between checkpoints of a running curve (to ``X.h5.partial``): 5, or
+    ``SHELLBVP_CHECKPOINT_SECONDS`` (0: after every point)."""
+    text = os.environ.get("SHELLBVP_CHECKPOINT_SECONDS", "5")
+    try:
+        value = float(text)
+    except ValueError:
+        value = -1.0
+    if not (math.isfinite(value) and value >= 0):
+        raise ValueError(f"SHELLBVP_CHECKPOINT_SECONDS must be a number of seconds >= 0; got {text!r}")
+    return value
+
+
 def _progress(enabled):
     start = time.perf_counter()
 
@@ -76,11 +90,24 @@ def _progress(enabled):
     return show
 
 
+MAX_POINTS = 100_000  # --points: each is a solve (~0.05-0.5 s); more is a typo, not a curve
+
+
 def _cmd_curve(args):
+    import dataclasses
+
     import shellbvp as sb
 
     from .io import write_curve
+    from .paths import check_output_path, partial_path
 
+    out = check_output_path(args.output if args.output is not None else f"{args.preset}.h5",
+                            overwrite=args.force)
+    partial = partial_path(out)
+    if partial.exists() and not args.force:
+        raise ValueError(f"{partial} exists (the checkpoint of an unfinished run; `shellbvp info` reads "
+                         f"it); use --force to replace it")
+    check_output_path(partial, overwrite=True)
     scene = _scene(args)
     units = None
     if (args.radius is None) != (args.mu_h is None):
@@ -89,31 +116,22 @@ def _cmd_curve(args):
         units = {"R_L": args.radius, "mu_H": args.mu_h}
     deltas = None
     if args.points is not None:
-        if args.points < 2:
-            raise ValueError(f"--points must be >= 2; got {args.points}")
+        if not 2 <= args.points <= MAX_POINTS:
+            raise ValueError(f"--points must be in [2, {MAX_POINTS}]; got {args.points}")
         if not (math.isfinite(args.delta_max) and args.delta_max > 0):
             raise ValueError(f"--delta-max must be a finite number > 0; got {args.delta_max}")
         deltas = [args.delta_max * (i + 1) / args.points for i in range(args.points)]
-    out = args.output or f"{args.preset}.h5"
-    from pathlib import Path
 
-    if Path(out).exists() and not args.force:
-        raise ValueError(f"output {out} exists; use --force to replace it")
-    parent = Path(out).parent
-    if not parent.is_dir():
-        raise ValueError(f"output directory {parent} does not exist")
-    import os
-
-    if not os.access(parent, os.W_OK):
-        raise ValueError(f"output directory {parent} is not writable")
-
+    every = _checkpoint_seconds()
     show = _progress(sys.stderr.isatty() and not args.quiet)
     last = [time.perf_counter()]
 
     def callback(curve, sol):
         show(curve, sol)
-        if time.perf_counter() - last[0] > 5.0:  # checkpoint: no finished work is lost
-            write_curve(curve, out, overwrite=True, units=units)
+        if time.perf_counter() - last[0] >= every:
+            # checkpoint: no finished work is lost, and the old output stays intact until the end
+            running = dataclasses.replace(curve, stop_reason="running", complete=False, interrupted=False)
+            write_curve(running, partial, overwrite=True, units=units)
             last[0] = time.perf_counter()
 
     t0 = time.perf_counter()
@@ -123,6 +141,7 @@ def _cmd_curve(args):
     if sys.stderr.isatty() and not args.quiet:
         sys.stderr.write("\n")
     write_curve(c, out, profiles=args.profiles, overwrite=True, units=units)
+    partial.unlink(missing_ok=True)
     print(f"wrote {out}: {c.summary()} in {time.perf_counter() - t0:.1f} s")
     if len(c):
         print(f"  contact topologies along the curve: {c.topology_summary()}")
@@ -130,6 +149,23 @@ def _cmd_curve(args):
         print("shellbvp: interrupted; the file holds the finished points (complete = False)", file=sys.stderr)
         return 130
     return 0 if c.complete else 1
+
+
+def _strict_json(value):
+    """NaN and inf as null (JSON has neither; jq, JavaScript and most parsers refuse them)."""
+    import numpy as np
+
+    if isinstance(value, dict):
+        return {k: _strict_json(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_strict_json(v) for v in value]
+    if isinstance(value, (bool, np.bool_)):
+        return bool(value)
+    if isinstance(value, (int, np.integer)):
+        return int(value)
+    if isinstance(value, (float, np.floating)):
+        return float(value) if math.isfinite(value) else None
+    return value
 
 
 def _cmd_solve(args):
@@ -152,7 +188,7 @@ def _cmd_solve(args):
     if args.profiles and sol.success:
         out["profile"] = {k: np.asarray(v).tolist() for k, v in sol.profile().items()}
     if args.json:
-        print(json.dumps(out, default=float))
+        print(json.dumps(_strict_json(out), allow_nan=False))
     else:
         for k in keys:
             print(f"{k:>16s}: {out[k]}")
@@ -184,7 +220,11 @@ def _fit_and_report(args):
 
     import shellbvp as sb
 
+    from .paths import check_output_path
     from .units import parse_quantity
+
+    if args.output is not None:
+        check_output_path(args.output, overwrite=args.force)
 
     scene = _scene(args)
     R_L = parse_quantity(args.radius, "length", default_unit="m")
@@ -253,8 +293,10 @@ def _fit_and_report(args):
 
 def _cmd_plot(args):
     from .io import read_curve
+    from .paths import check_output_path
     from .plotting import plot_curves, plot_profiles, require_matplotlib
 
+    check_output_path(args.output, overwrite=True)  # a figure is cheap to redraw: replaced
     plt = require_matplotlib()
     curves = [read_curve(f) for f in args.files]
     deltas = [float(v) for v in args.profiles.split(",")] if args.profiles else []

@@ -24,8 +24,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .liftoff import replace_invalid_cap
-from .state import (SC_POINT, Solution, _default_eps, _warm_guess, make_system, richardson_error, solve,
-                    solve_from, solve_point_load, thin_mesh)
+from .state import (SC_POINT, Solution, _default_eps, _warm_guess, check_delta, check_tol, make_system,
+                    richardson_error, solve, solve_from, solve_point_load, thin_mesh)
 
 __all__ = ["Curve", "curve", "POINT_FIELDS"]
 
@@ -178,6 +178,8 @@ def curve(scene, delta_max: float = 0.5, *, deltas=None, force_max=None, lambda0
     Curve
     """
     _check_positive("delta_max", delta_max)
+    check_tol(tol)
+    check_delta("delta_max", delta_max, scene, tol)
     for name, v in (("force_max", force_max), ("lambda0_max", lambda0_max)):
         if v is not None:
             _check_positive(name, v)
@@ -188,10 +190,14 @@ def curve(scene, delta_max: float = 0.5, *, deltas=None, force_max=None, lambda0
         if deltas.ndim != 1 or deltas.size == 0 or not np.all(np.isfinite(deltas)) or np.any(deltas <= 0):
             raise ValueError("deltas must be a non-empty 1-D sequence of finite numbers > 0")
         deltas = np.unique(deltas)
-    delta_start = min(0.05, delta_max / 4) if delta_start is None else float(delta_start)
+        check_delta("deltas", deltas[0], scene, tol)
+        check_delta("deltas", deltas[-1], scene, tol)
+    delta_start = max(tol, min(0.05, delta_max / 4)) if delta_start is None else float(delta_start)
     _check_positive("delta_start", delta_start)
-    delta_min = delta_max / 100 if delta_min is None else float(delta_min)
+    check_delta("delta_start", delta_start, scene, tol)
+    delta_min = max(tol, delta_max / 100) if delta_min is None else float(delta_min)
     _check_positive("delta_min", delta_min)
+    check_delta("delta_min", delta_min, scene, tol)
     ds_max = delta_max / 10 if ds_max is None else float(ds_max)
     _check_positive("ds_max", ds_max)
     if topology not in ("auto", "cap"):
@@ -400,13 +406,25 @@ def _stop_rule(sol, settings):
 
 def _solve_at_delta(scene, delta, prev, prev2, settings):
     """Delta-controlled solve warm-started from prev with a secant predictor from prev2."""
+    if prev.get("topology") == "point":
+        return _step_from_point(scene, delta, prev, settings)
     sysm = make_system(scene, "delta", delta, settings["eps"])
     guess = _warm_guess(sysm, prev)
-    if prev2 is not None and prev2.delta != prev.delta:
+    if prev2 is not None and prev2.delta != prev.delta and prev2.get("topology") != "point":
         a = (delta - prev.delta) / (prev.delta - prev2.delta)
         guess = _secant(sysm, prev, prev2, a)
     return solve_from(sysm, guess, tol=settings["tol"], max_nodes=_step_nodes(prev, settings),
                       bc_tol=settings["bc_tol"])
+
+
+def _step_from_point(scene, delta, prev, settings):
+    """A step from a point-load state (no cap to warm-start from).  Deeper, the cap may
+    come back within double precision: a cold solve finds the cap there, or the point-load
+    limit again; shallower, the point-load limit from ``prev``."""
+    if delta > prev.delta:
+        return solve(scene, delta=delta, tol=settings["tol"], max_nodes=settings["max_nodes"],
+                     bc_tol=settings["bc_tol"], estimate_error=False, topology="cap")
+    return solve_point_load(scene, delta, tol=settings["tol"], max_nodes=settings["max_nodes"], guess=prev)
 
 
 def _step_nodes(prev, settings):
@@ -425,11 +443,15 @@ def _secant(sysm, cur, prev, a):
     return x, y, sysm.pack(ln_Sc, lambda0, delta)
 
 
-def _natural(scene, deltas, builder: _Builder, settings):
+def _natural(scene, deltas, builder: _Builder, settings, first=None, key0=0):
+    """Natural continuation through ``deltas`` (from ``first``, already recorded, if given)."""
     prev2 = None
-    prev = _first_point(scene, float(deltas[0]), settings)
-    builder.add(prev, 0)
-    for i, target in enumerate(deltas[1:], 1):
+    if first is None:
+        prev = _first_point(scene, float(deltas[0]), settings)
+        builder.add(prev, key0)
+    else:
+        prev = first
+    for i, target in enumerate(deltas[1:], key0 + 1):
         d = prev.delta
         step = target - d
         while prev.delta < target:
@@ -446,7 +468,7 @@ def _natural(scene, deltas, builder: _Builder, settings):
                             f"delta = {prev.delta:.6g}")
             else:
                 step /= 2
-                if step < 1e-6:
+                if step < min(1e-6, 1e-3 * target):
                     raise _Stop(f"no solution near delta = {nd:.6g}: {sol.message}")
         rule = _stop_rule(prev, settings)
         if rule:
@@ -497,6 +519,12 @@ def _adaptive(scene, builder: _Builder, settings):
                 log.info("small-delta leg stopped at delta = %.4g: %s", d, sol.message)
                 break
     # Leg 2: pseudo-arclength upwards from the first point.
+    if first.get("topology") == "point":
+        # the cap is below double precision there: no (delta, lambda0, F) branch to follow
+        # until it comes back; natural continuation in delta instead (point-load limit or cap)
+        grid = np.linspace(first.delta, st["delta_max"], 11)
+        _natural(scene, grid, builder, st, first=first, key0=steps)  # complete, or raises _Stop
+        raise _Stop(f"delta_max = {st['delta_max']:g} reached")
     scale = np.array([1.0, 1.0, 1.0])
     cur = first
     if below is None:  # need a second point for the tangent

@@ -37,6 +37,8 @@ from pathlib import Path
 
 import numpy as np
 
+from .paths import check_output_path
+
 __all__ = ["write_curve", "read_curve", "FORMAT", "FORMAT_VERSION"]
 
 FORMAT = "shellbvp-curve"
@@ -84,12 +86,8 @@ def write_curve(curve, path, *, profiles=False, overwrite=False, units=None):
     dims = _check_units(units)
     if path.exists() and not overwrite:
         raise FileExistsError(f"{path} exists; pass overwrite=True (CLI: --force) to replace it")
-    parent = path.parent if str(path.parent) else Path(".")
-    if not parent.is_dir():
-        raise ValueError(f"output directory {parent} does not exist")
-    if not os.access(parent, os.W_OK):
-        raise ValueError(f"output directory {parent} is not writable")
-    fd, tmp = tempfile.mkstemp(dir=parent, prefix=f".{path.name}.", suffix=".tmp")
+    check_output_path(path, overwrite=True)
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
     os.close(fd)
     try:
         with h5py.File(tmp, "w") as f:
@@ -117,7 +115,7 @@ def write_curve(curve, path, *, profiles=False, overwrite=False, units=None):
             g.attrs["energy_identity_max"] = float(np.nanmax(np.abs(res))) if np.any(np.isfinite(res)) else np.nan
             for k, v in curve.points.items():
                 v = np.asarray(v)
-                if v.dtype.kind in "UO":  # strings (topology)
+                if v.dtype.kind in "UO" or k in _STRING_FIELDS:  # strings (topology; also when empty)
                     g.create_dataset(k, data=np.array(v, dtype=object), dtype=h5py.string_dtype())
                 else:
                     g.create_dataset(k, data=v)
@@ -152,20 +150,133 @@ def _missing_field(name, n):
     """A field added after format version 1, as an older (single-cap) file reads it."""
     from .continuation import CAP_FIELD_DEFAULTS
 
-    if name not in CAP_FIELD_DEFAULTS:
-        raise KeyError(name)
     return np.full(n, CAP_FIELD_DEFAULTS[name], dtype=object if name == "topology" else float)
+
+
+#: Fields stored as strings; every other point field is numeric.
+_STRING_FIELDS = ("topology", "flags")
+#: Integer-valued fields (an empty curve stores them as float).
+_INTEGER_FIELDS = ("status", "nodes", "niter")
+_TOPOLOGIES = ("cap", "line", "annulus", "point")
+
+
+def _format_version(f):
+    v = f.attrs.get("format_version")
+    if v is None:
+        raise ValueError("format_version attribute missing")
+    a = np.asarray(v)
+    if a.shape != () or a.dtype.kind not in "iu":
+        raise ValueError(f"format_version must be a scalar integer; got {a.dtype} of shape {a.shape}")
+    version = int(a)
+    if not 1 <= version <= FORMAT_VERSION:
+        raise ValueError(f"format version {version} is not one this shellbvp reads (1..{FORMAT_VERSION})")
+    return version
+
+
+def _text_attr(g, name):
+    if name not in g.attrs:
+        raise ValueError(f"attribute {name} missing")
+    v = g.attrs[name]
+    if isinstance(v, bytes):
+        v = v.decode("utf-8", "replace")
+    if not isinstance(v, str):
+        raise ValueError(f"attribute {name} must be a string; got {type(v).__name__}")
+    return v
+
+
+def _bool_attr(g, name):
+    if name not in g.attrs:
+        raise ValueError(f"attribute {name} missing")
+    a = np.asarray(g.attrs[name])
+    if a.shape != () or a.dtype.kind not in "biu" or int(a) not in (0, 1):
+        raise ValueError(f"attribute {name} must be a boolean; got {a.dtype} {a.tolist()!r}")
+    return bool(a)
+
+
+def _json_attr(g, name):
+    try:
+        v = json.loads(_text_attr(g, name))
+    except json.JSONDecodeError as exc:
+        raise ValueError(f"attribute {name} is not valid JSON ({exc})") from None
+    if not isinstance(v, dict):
+        raise ValueError(f"attribute {name} must be a JSON object; got {type(v).__name__}")
+    return v
+
+
+def _field(g, name, n):
+    """Dataset ``name`` as a 1-D array of length ``n`` (strings or numbers as the field is)."""
+    import h5py
+
+    d = g[name]
+    if not isinstance(d, h5py.Dataset):
+        raise ValueError(f"{name} must be a dataset; got a group")
+    if d.ndim != 1 or d.shape[0] != n:
+        raise ValueError(f"{name} must be a 1-D array of {n} values (one per delta); got shape {d.shape}")
+    v = d[()]
+    if name in _STRING_FIELDS:
+        if v.dtype.kind not in "OSU" and n:  # files of empty curves stored an empty float array
+            raise ValueError(f"{name} must hold strings; got {v.dtype}")
+        return np.array([t.decode("utf-8", "replace") if isinstance(t, bytes) else str(t) for t in v], dtype=str)
+    if v.dtype.kind not in "fiub":
+        raise ValueError(f"{name} must hold numbers; got {'strings' if v.dtype.kind in 'OSU' else v.dtype}")
+    if name in _INTEGER_FIELDS:
+        if not np.all(np.isfinite(v)) or np.any(v != np.round(v)):
+            raise ValueError(f"{name} must hold integers")
+        return v.astype(int)
+    if name == "valid":
+        if not np.all((v == 0) | (v == 1)):
+            raise ValueError("valid must hold booleans")
+        return v.astype(bool)
+    return v.astype(float)
+
+
+def _points(g):
+    """Every point field (and flags), checked; fields added after version 1 default to a cap's."""
+    import h5py
+
+    from .continuation import CAP_FIELD_DEFAULTS, POINT_FIELDS
+
+    if "delta" not in g or not isinstance(g["delta"], h5py.Dataset):
+        raise ValueError("dataset delta missing")
+    if g["delta"].ndim != 1:
+        raise ValueError(f"delta must be a 1-D array; got shape {g['delta'].shape}")
+    n = g["delta"].shape[0]
+    points = {}
+    for k in POINT_FIELDS:
+        if k in g:
+            points[k] = _field(g, k, n)
+        elif k in CAP_FIELD_DEFAULTS:
+            points[k] = _missing_field(k, n)
+        else:
+            raise ValueError(f"dataset {k} missing")
+    points["topology"] = np.asarray(points["topology"], dtype=str)
+    unknown = sorted(set(points["topology"]) - set(_TOPOLOGIES))
+    if unknown:
+        raise ValueError(f"topology must be one of {_TOPOLOGIES}; got {unknown[0]!r}")
+    if not np.all(np.isfinite(points["delta"])):
+        raise ValueError("delta must be finite")
+    if "flags" not in g:
+        raise ValueError("dataset flags missing")
+    flags = list(_field(g, "flags", n))
+    return points, flags
+
+
+def _check_settings(settings):
+    for s in settings.get("topology_switches", []) or []:
+        if not (isinstance(s, dict) and {"from", "to"} <= s.keys() and isinstance(s.get("delta"), (int, float))):
+            raise ValueError("settings.topology_switches must list {delta, from, to} objects")
 
 
 def read_curve(path):
     """Read a curve written by :func:`write_curve`.
 
     Raises ``ValueError`` with a one-line reason for a missing, corrupt or
-    foreign file.
+    foreign file, naming the attribute or dataset that is missing or malformed
+    (every point field a 1-D array of one number, or string, per delta).
     """
     import h5py
 
-    from .continuation import POINT_FIELDS, Curve
+    from .continuation import Curve
     from .scene import Scene
 
     path = Path(path)
@@ -176,24 +287,26 @@ def read_curve(path):
     except OSError as exc:
         raise ValueError(f"{path}: not a readable HDF5 file ({exc})") from None
     with f:
-        if f.attrs.get("format") != FORMAT or "curve" not in f:
+        fmt = f.attrs.get("format")
+        fmt = fmt.decode("utf-8", "replace") if isinstance(fmt, bytes) else fmt
+        if not isinstance(fmt, str) or fmt != FORMAT or not isinstance(f.get("curve"), h5py.Group):
             raise ValueError(f"{path}: not a shellbvp curve file (format attribute missing or different)")
-        version = int(f.attrs.get("format_version", -1))
-        if version > FORMAT_VERSION:
-            raise ValueError(f"{path}: format version {version} is newer than this shellbvp reads "
-                             f"({FORMAT_VERSION})")
-        g = f["curve"]
         try:
-            scene = Scene.from_dict(json.loads(g.attrs["scene"]))
-            n = g["delta"].shape[0]
-            points = {k: g[k][()] if k in g else _missing_field(k, n) for k in POINT_FIELDS}
-            points["topology"] = np.array([t.decode() if isinstance(t, bytes) else str(t)
-                                           for t in points["topology"]])
-            flags = [s.decode() if isinstance(s, bytes) else str(s) for s in g["flags"][()]]
-            settings = json.loads(g.attrs["settings"])
-        except (KeyError, ValueError, TypeError) as exc:
-            raise ValueError(f"{path}: incomplete or corrupt curve ({exc})") from None
-        points["valid"] = points["valid"].astype(bool)
-        return Curve(scene=scene, points=points, flags=flags, stop_reason=str(g.attrs["stop_reason"]),
-                     complete=bool(g.attrs["complete"]), interrupted=bool(g.attrs["interrupted"]),
-                     settings=settings, version=str(f.attrs.get("package_version", "")))
+            _format_version(f)
+            g = f["curve"]
+            try:
+                scene = Scene.from_dict(_json_attr(g, "scene"))
+            except (KeyError, TypeError, AttributeError) as exc:
+                raise ValueError(f"attribute scene does not describe a scene ({type(exc).__name__}: "
+                                 f"{exc})") from None
+            settings = _json_attr(g, "settings")
+            _check_settings(settings)
+            points, flags = _points(g)
+            curve = Curve(scene=scene, points=points, flags=flags, stop_reason=_text_attr(g, "stop_reason"),
+                          complete=_bool_attr(g, "complete"), interrupted=_bool_attr(g, "interrupted"),
+                          settings=settings, version=str(f.attrs.get("package_version", "")))
+        except ValueError as exc:
+            raise ValueError(f"{path}: {exc}") from None
+        except (KeyError, TypeError, OSError) as exc:  # h5py's own errors on a damaged file
+            raise ValueError(f"{path}: incomplete or corrupt curve ({type(exc).__name__}: {exc})") from None
+        return curve

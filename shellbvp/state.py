@@ -16,7 +16,7 @@ import numpy as np
 
 from .system import N_CONTACT, MultipointBVP
 
-__all__ = ["Solution", "solve", "STATUS_MESSAGES"]
+__all__ = ["Solution", "solve", "STATUS_MESSAGES", "delta_bounds"]
 
 log = logging.getLogger(__name__)
 
@@ -34,12 +34,69 @@ STATUS_MESSAGES = {
 _GAUSS_T, _GAUSS_W = np.polynomial.legendre.leggauss(4)
 
 
-def solve_bvp(*args, **kwargs):
-    """scipy.integrate.solve_bvp, imported on first use: scipy.integrate is most of the
-    import time of shellbvp, and reading files or loading a model does not need it."""
+class _NonFinite(Exception):
+    """Raised inside solve_bvp by a Jacobian with NaN or inf entries (see :func:`solve_bvp`)."""
+
+
+def _finite_jacobian(jac, what):
+    """``jac`` that refuses to hand non-finite entries to solve_bvp's sparse LU."""
+    def checked(*args):
+        out = jac(*args)
+        for block in (out if isinstance(out, tuple) else (out,)):
+            if block is not None and not np.all(np.isfinite(block)):
+                raise _NonFinite(what)
+        return out
+
+    return checked
+
+
+class _NoSolution:
+    """Interpolant of a run that produced no state: NaN everywhere."""
+
+    def __init__(self, n):
+        self.n = n
+
+    def __call__(self, t):
+        t = np.asarray(t, float)
+        return np.full((self.n,) + t.shape, np.nan)
+
+
+def _failed_run(x, y, p, status, message):
+    """A solve_bvp-like result of a run stopped before (or instead of) a LAPACK call."""
+    from scipy.optimize import OptimizeResult
+
+    x = np.asarray(x, float)
+    n = np.shape(y)[0]
+    p = None if p is None else np.full(np.shape(p), np.nan)
+    return OptimizeResult(sol=_NoSolution(n), p=p, x=x, y=np.full((n, x.size), np.nan),
+                          yp=np.full((n, x.size), np.nan), rms_residuals=np.full(max(x.size - 1, 0), np.nan),
+                          niter=0, status=status, message=message, success=False)
+
+
+def solve_bvp(fun, bc, x, y, p=None, *, fun_jac, bc_jac, **kwargs):
+    """scipy.integrate.solve_bvp, imported on first use (scipy.integrate is most of the
+    import time of shellbvp, and reading files or loading a model does not need it),
+    with a guard on what reaches its linear algebra.
+
+    A guess with NaN/inf or a mesh that is not strictly increasing, and a Jacobian
+    that overflows during Newton (a state far outside the model's domain, e.g. an
+    extreme scene), end the run with status 2 instead: solve_bvp would pass such a
+    matrix to SuperLU, whose BLAS calls then print ``** On entry to DGEMV parameter
+    number 2 had an illegal value`` on stdout (Fortran, not Python) and return garbage.
+    """
     from scipy.integrate import solve_bvp as _solve_bvp
 
-    return _solve_bvp(*args, **kwargs)
+    xa = np.asarray(x, float)
+    if xa.ndim != 1 or xa.size < 2 or not np.all(np.isfinite(xa)) or not np.all(np.diff(xa) > 0):
+        return _failed_run(x, y, p, 2, "degenerate mesh (not strictly increasing and finite): no solve")
+    if not np.all(np.isfinite(y)) or (p is not None and not np.all(np.isfinite(p))):
+        return _failed_run(x, y, p, 2, "the initial guess has NaN or inf entries: no solve")
+    try:
+        return _solve_bvp(fun, bc, x, y, p, fun_jac=_finite_jacobian(fun_jac, "fun_jac"),
+                          bc_jac=_finite_jacobian(bc_jac, "bc_jac"), **kwargs)
+    except _NonFinite as exc:
+        return _failed_run(x, y, p, 2, f"the Jacobian ({exc}) overflowed to NaN/inf during Newton: the "
+                                       f"iterate left the model's domain (no solve of the collocation system)")
 
 
 class Solution(dict):
@@ -450,6 +507,49 @@ def _default_eps(tol):
 
 TOPOLOGIES = ("auto", "cap", "line", "annulus")
 
+#: Mean meridional stretch taken as beyond reach (see :func:`delta_bounds`).
+MEAN_STRETCH_LIMIT = 2.0
+
+
+def delta_bounds(scene, tol: float) -> tuple[float, float]:
+    """The pole displacements ``(low, high)`` for which a state is computed.
+
+    ``low = tol``: the states are O(1)-scaled and solve_bvp's tolerance is
+    absolute for them, so a displacement below ``tol`` is in the solver's noise
+    (measured on the base scene at tol 1e-6, point-load limit F/delta -> 1.2625:
+    within 0.03 % at delta = 10 tol, 7 % off at delta = tol (and ``force_error``
+    says so), of either sign at tol/100).
+
+    ``high = Z(0) - Z(L) + 2 l`` (l the reference meridian's length, Z(0) the pole's
+    and Z(L) the rim's height): the deformed meridian joins the pole, at height
+    ``Z(0) - delta``, to the fixed rim, so it is at least as long as their height
+    difference ``Z(L) - Z(0) + delta``; beyond ``high`` its mean stretch would
+    exceed 2 (doubled in length even hanging straight down).  Every branch of the
+    presets ends (convexity at the contact edge, or the tip's end) below delta = 1,
+    well short of it (the dome: 4.14, the base hemisphere: 2.14, a flat plate: 2).
+    """
+    mod = scene.model()
+    S = np.linspace(0.0, scene.shell_length, 4001)
+    ref = mod.reference_shell(S, scene.parameters(mod))
+    R, Z = np.broadcast_to(ref["R"], S.shape), np.broadcast_to(ref["Z"], S.shape)
+    length = float(np.sum(np.hypot(np.diff(R), np.diff(Z))))
+    return float(tol), float(Z[0] - Z[-1] + MEAN_STRETCH_LIMIT * length)
+
+
+def check_tol(tol):
+    """ValueError unless ``tol`` (solve_bvp's tolerance) is a number in [1e-12, 1e-1]."""
+    if isinstance(tol, bool) or not (isinstance(tol, (int, float, np.floating)) and 1e-12 <= tol <= 1e-1):
+        raise ValueError(f"tol must be in [1e-12, 1e-1]; got {tol!r}")
+
+
+def check_delta(name, value, scene, tol):
+    """ValueError naming ``name`` unless ``value`` is within :func:`delta_bounds`."""
+    low, high = delta_bounds(scene, tol)
+    if not low <= value <= high:
+        raise ValueError(f"{name} = {value:g} is outside [{low:g}, {high:.4g}] for this scene: below tol "
+                         f"= {low:g} a displacement is in the solver's noise (loosen tol for smaller ones), "
+                         f"above {high:.4g} the meridian would be more than doubled in length")
+
 
 def solve(scene, *, delta=None, lambda0=None, force=None, tol=1e-6, max_nodes=10000, guess=None,
           eps=None, bc_tol=1e-10, estimate_error=True, topology="auto"):
@@ -496,8 +596,7 @@ def solve(scene, *, delta=None, lambda0=None, force=None, tol=1e-6, max_nodes=10
         raise ValueError(f"delta must be > 0 (delta = 0 is the undeformed shell); got {value!r}")
     if control == "lambda0" and value <= 0:
         raise ValueError(f"lambda0 (pole stretch) must be > 0; got {value!r}")
-    if not (isinstance(tol, (int, float)) and 1e-12 <= tol <= 1e-1):
-        raise ValueError(f"tol must be in [1e-12, 1e-1]; got {tol!r}")
+    check_tol(tol)
     if not (isinstance(max_nodes, (int, np.integer)) and max_nodes >= 10):
         raise ValueError(f"max_nodes must be an integer >= 10; got {max_nodes!r}")
     eps = _default_eps(tol) if eps is None else float(eps)
@@ -505,6 +604,8 @@ def solve(scene, *, delta=None, lambda0=None, force=None, tol=1e-6, max_nodes=10
         raise ValueError(f"eps (pole start zeta = eps*Sc) must be in (0, 0.5); got {eps!r}")
     if topology not in TOPOLOGIES:
         raise ValueError(f"topology must be one of {TOPOLOGIES}; got {topology!r}")
+    if control == "delta":
+        check_delta("delta", value, scene, tol)
     if topology != "auto" and topology != "cap" and scene.contact != "smooth":
         raise ValueError(f"topology={topology!r} needs contact='smooth' (the variational contact line); "
                          f"the paper's model has the single cap only")
@@ -516,6 +617,9 @@ def solve(scene, *, delta=None, lambda0=None, force=None, tol=1e-6, max_nodes=10
         if topology in ("auto", guess.topology) and res.success:
             return res
         guess = None  # back to the cap
+
+    if guess is not None and guess.get("topology") == "point":
+        guess = None  # a point-load state has no cap to start from: cold start (it finds the limit again)
 
     t0 = time.perf_counter()
     sysm = make_system(scene, control, value, eps)

@@ -1,0 +1,62 @@
+"""Output paths checked before any work is done (the CLI's ``-o`` of curve, fit and plot)."""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from pathlib import Path
+
+__all__ = ["check_output_path", "partial_path"]
+
+
+def partial_path(path) -> Path:
+    """The checkpoint file of ``path``: ``X.h5`` -> ``X.h5.partial`` (same directory)."""
+    path = Path(path)
+    return path.with_name(path.name + ".partial")
+
+
+def check_output_path(path, *, overwrite: bool) -> Path:
+    """Check that a file can be written at ``path``, before computing what goes in it.
+
+    Parameters
+    ----------
+    path : str or Path
+    overwrite : bool
+        An existing file may be replaced.
+
+    Returns
+    -------
+    Path
+
+    Raises
+    ------
+    ValueError
+        One line naming the path and what is wrong: empty, a directory, a parent
+        that does not exist or is not a directory, a directory where no file can
+        be created (probed by creating and removing a temporary file there:
+        ``os.access`` says yes on read-only mounts, ``/proc`` and for root),
+        or an existing file without ``overwrite``.
+    """
+    text = os.fspath(path)
+    if not text.strip():
+        raise ValueError("the output path is empty")
+    if text.endswith(os.sep) or os.path.isdir(text):
+        raise ValueError(f"output {text} is a directory; give a file name")
+    out = Path(text)
+    parent = out.parent
+    if not parent.exists():
+        raise ValueError(f"output directory {parent} does not exist")
+    if not parent.is_dir():
+        raise ValueError(f"output directory {parent} is not a directory")
+    if out.exists() and not overwrite:
+        raise ValueError(f"output {out} exists; use --force to replace it")
+    if not os.access(parent, os.W_OK | os.X_OK):
+        raise ValueError(f"output directory {parent} is not writable")
+    try:
+        fd, probe = tempfile.mkstemp(dir=parent, prefix=f".{out.name}.", suffix=".probe")
+    except OSError as exc:
+        raise ValueError(f"output directory {parent} is not writable (creating a file there: "
+                         f"{exc.strerror or exc})") from None
+    os.close(fd)
+    os.unlink(probe)
+    return out  # files are written to a temporary file there and renamed over ``out``

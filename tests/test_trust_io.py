@@ -1,0 +1,352 @@
+"""Issue #11, sections 3 and 4: output paths, checkpoints, LAPACK noise, malformed files,
+extreme values -- each gets an answer (a status or a one-line ValueError), never a traceback."""
+
+import json
+import os
+import subprocess
+import sys
+import time
+
+import numpy as np
+import pytest
+
+import shellbvp as sb
+from shellbvp.state import delta_bounds, solve_point_load
+
+
+def run(*args, cwd=None, timeout=300):
+    return subprocess.run([sys.executable, "-m", "shellbvp", *args], capture_output=True, text=True,
+                          cwd=cwd, env=dict(os.environ), timeout=timeout)
+
+
+def one_line_error(r, *words):
+    assert r.returncode == 2, (r.stdout, r.stderr)
+    lines = r.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("shellbvp: error: "), r.stderr
+    for w in words:
+        assert w in lines[0], lines[0]
+    return lines[0]
+
+
+# -- LAPACK/BLAS messages ---------------------------------------------------------------------
+
+def test_overflowing_jacobian_never_reaches_lapack_and_json_is_one_document():
+    """The extreme scene's Newton iterates overflow; SuperLU used to get a NaN matrix and its
+    BLAS printed '** On entry to DGEMV parameter number 2 had an illegal value' on stdout."""
+    r = run("solve", "--gamma", "99.9999999", "--rho", "0.01", "--beta", "1e-4", "--xi", "0", "--neo-hookean",
+            "--delta", "0.0184286", "--tol", "1e-3", "--json")
+    assert "illegal value" not in r.stdout + r.stderr
+    def refuse(token):
+        raise AssertionError(f"{token} is not JSON")
+
+    out = json.loads(r.stdout, parse_constant=refuse)  # one strict document: nothing before or after it
+    assert out["force"] is None and out["delta"] == 0.0184286  # no state: NaN -> null
+    assert r.returncode == 1 and not out["success"] and out["status"] != 0
+    assert "overflowed" in out["message"]
+
+
+def test_guard_returns_status_2_for_a_nan_guess():
+    sol = sb.solve(sb.Scene.preset("base"), delta=0.1, estimate_error=False)
+    sysm = sol.system
+    from shellbvp.state import solve_bvp
+
+    y = sol.y.copy()
+    y[3, 5] = np.nan
+    bvp = solve_bvp(sysm.fun, sysm.bc, sol.x, y, sol.p, fun_jac=sysm.fun_jac, bc_jac=sysm.bc_jac, tol=1e-6)
+    assert bvp.status == 2 and not bvp.success and "NaN" in bvp.message
+    assert np.all(np.isnan(bvp.sol(np.array([0.2, 0.7]))))
+    x = sol.x.copy()
+    x[3] = x[2]  # degenerate mesh: scipy would raise ValueError (read as bad user input)
+    bvp = solve_bvp(sysm.fun, sysm.bc, x, sol.y, sol.p, fun_jac=sysm.fun_jac, bc_jac=sysm.bc_jac, tol=1e-6)
+    assert bvp.status == 2 and "mesh" in bvp.message
+
+
+# -- extreme values -----------------------------------------------------------------------------
+
+@pytest.mark.parametrize("kwargs,name", [
+    (dict(deltas=[1e-300, 2e-300]), "deltas"),
+    (dict(delta_max=1e-300), "delta_max"),
+    (dict(delta_max=0.5, delta_min=1e-9), "delta_min"),
+    (dict(delta_max=5.0), "delta_max"),
+])
+def test_curve_refuses_depths_outside_the_range_at_once(kwargs, name):
+    scene = sb.Scene.preset("base")
+    low, high = delta_bounds(scene, 1e-6)
+    t0 = time.perf_counter()
+    with pytest.raises(ValueError, match=name) as err:
+        sb.curve(scene, **kwargs)
+    assert time.perf_counter() - t0 < 2.0
+    assert f"[{low:g}, {high:.4g}]" in str(err.value)
+
+
+def test_delta_bound_is_the_doubled_meridian():
+    """high = Z(0) - Z(L) + 2 l: the dome's pole starts 1 above the rim, the bowl's 1 below,
+    a hemisphere's meridian is pi/2 long; a flat plate's (R = sin S) 1."""
+    assert delta_bounds(sb.Scene.preset("dome"), 1e-6)[1] == pytest.approx(1 + np.pi, rel=1e-6)
+    assert delta_bounds(sb.Scene.preset("base"), 1e-6)[1] == pytest.approx(np.pi - 1, rel=1e-6)
+    assert delta_bounds(sb.Scene.preset("flat"), 1e-6)[1] == pytest.approx(2.0, rel=1e-6)
+    assert delta_bounds(sb.Scene.preset("base"), 1e-8)[0] == 1e-8
+
+
+def test_solve_dome_paper_at_delta_5_is_refused_at_once():
+    scene = sb.Scene.preset("dome", contact="paper")
+    t0 = time.perf_counter()
+    with pytest.raises(ValueError, match=r"delta = 5 is outside \[1e-06, 4.142\]"):
+        sb.solve(scene, delta=5.0)
+    assert time.perf_counter() - t0 < 2.0
+    with pytest.raises(ValueError, match="delta = 1e-300"):
+        sb.solve(scene, delta=1e-300)
+
+
+def test_curve_from_point_load_states_goes_up_without_index_error():
+    """delta_max = 1e-3 on the base scene: every state is the point-load limit (the cap is
+    below 1e-30), so the upward leg cannot follow a cap branch; it used to fail with an
+    IndexError in state._state_params (a point state has no ln Sc)."""
+    c = sb.curve(sb.Scene.preset("base"), delta_max=1e-3, estimate_error=False)
+    assert c.complete and c.delta[-1] == pytest.approx(1e-3) and "delta_max" in c.stop_reason
+    assert np.all(np.diff(c.delta) > 0) and np.all(c.status == 0)
+    assert set(c.topology) == {"point"}
+    # the point-load limit F/delta -> 1.2625 (README), the same whichever way it is reached
+    direct = solve_point_load(sb.Scene.preset("base"), 1e-3)
+    assert c.force[-1] == pytest.approx(direct.force, rel=1e-5)
+
+
+def test_natural_curve_from_a_point_state_reaches_the_cap_again():
+    c = sb.curve(sb.Scene.preset("base"), deltas=[1e-4, 0.05, 0.1], topology="cap", estimate_error=False)
+    assert c.complete and list(c.topology) == ["point", "cap", "cap"]
+    ref = sb.solve(sb.Scene.preset("base"), delta=0.1, topology="cap", estimate_error=False)
+    assert c.force[-1] == pytest.approx(ref.force, abs=1e-7)
+
+
+def test_solve_with_a_point_load_guess_starts_cold():
+    scene = sb.Scene.preset("base")
+    point = solve_point_load(scene, 1e-3)
+    sol = sb.solve(scene, delta=0.1, guess=point, topology="cap", estimate_error=False)
+    assert sol.success and sol.topology == "cap"
+
+
+# -- output paths ---------------------------------------------------------------------------------
+
+@pytest.mark.parametrize("command", [["curve", "--delta-max", "0.1"], ["fit", "--example", "--radius", "0.3mm"],
+                                     ["plot", "in.h5"]])
+@pytest.mark.parametrize("output,words", [
+    (".", ["is a directory"]),
+    ("sub", ["sub is a directory"]),
+    ("nonexistent/x.h5", ["directory nonexistent", "does not exist"]),
+    ("/proc/x.h5", ["/proc", "not writable"]),
+    ("", ["empty"]),
+    ("in.h5/x.h5", ["in.h5", "not a directory"]),
+])
+def test_bad_output_paths_are_refused_before_any_work(tmp_path, command, output, words):
+    (tmp_path / "sub").mkdir()
+    (tmp_path / "in.h5").write_bytes(b"")  # plot would fail on reading it: the path is checked first
+    t0 = time.perf_counter()
+    r = run(*command, "-o", output, cwd=tmp_path)
+    one_line_error(r, *words)
+    assert time.perf_counter() - t0 < 20  # import only: no curve, no fit
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["in.h5", "sub"]  # nothing left behind
+
+
+@pytest.mark.skipif(os.geteuid() == 0, reason="root writes into a mode-555 directory")
+def test_unwritable_directory_is_refused(tmp_path):
+    ro = tmp_path / "ro"
+    ro.mkdir()
+    ro.chmod(0o555)
+    try:
+        one_line_error(run("curve", "-o", "ro/x.h5", cwd=tmp_path), "ro", "not writable")
+    finally:
+        ro.chmod(0o755)
+
+
+def test_check_output_path_api(tmp_path):
+    from shellbvp.paths import check_output_path, partial_path
+
+    target = tmp_path / "a.h5"
+    assert check_output_path(target, overwrite=False) == target
+    target.write_bytes(b"old")
+    with pytest.raises(ValueError, match="exists; use --force"):
+        check_output_path(target, overwrite=False)
+    assert check_output_path(str(target), overwrite=True) == target
+    assert partial_path(target) == tmp_path / "a.h5.partial"
+    with pytest.raises(ValueError, match="is a directory"):
+        check_output_path(str(tmp_path) + os.sep, overwrite=True)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a.h5"]  # the write probe is removed
+
+
+def test_points_and_delta_max_limits_on_the_command_line(tmp_path):
+    one_line_error(run("curve", "--points", "1000000000", "-o", "p.h5", cwd=tmp_path), "--points", "[2, 100000]")
+    one_line_error(run("curve", "--delta-max", "1e-300", "-o", "p.h5", cwd=tmp_path), "delta_max = 1e-300",
+                   "[1e-06, 2.142]")
+    assert not list(tmp_path.iterdir())
+
+
+# -- --force and checkpoints -------------------------------------------------------------------------
+
+@pytest.fixture
+def old_file(tmp_path):
+    path = tmp_path / "X.h5"
+    sb.curve(sb.Scene.preset("base"), deltas=[0.1, 0.12], estimate_error=False).to_hdf5(path)
+    return path, path.read_bytes()
+
+
+def _start_curve_and_wait_for_checkpoint(tmp_path, *extra):
+    env = dict(os.environ, SHELLBVP_CHECKPOINT_SECONDS="0")
+    proc = subprocess.Popen([sys.executable, "-m", "shellbvp", "curve", "--force", "-o", "X.h5", "-q", *extra],
+                            cwd=tmp_path, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    partial = tmp_path / "X.h5.partial"
+    deadline = time.monotonic() + 120
+    while not partial.exists():
+        assert proc.poll() is None, proc.communicate()
+        assert time.monotonic() < deadline, "no checkpoint within 120 s"
+        time.sleep(0.05)
+    return proc, partial
+
+
+def test_killed_run_leaves_the_old_file_intact_and_a_labelled_checkpoint(tmp_path, old_file):
+    path, before = old_file
+    proc, partial = _start_curve_and_wait_for_checkpoint(tmp_path, "--delta-max", "0.5")
+    proc.kill()  # SIGKILL: nothing runs after it
+    proc.communicate()
+    assert path.read_bytes() == before
+    old = sb.read_curve(path)
+    assert old.complete and list(old.delta) == [0.1, 0.12]
+    ck = sb.read_curve(partial)
+    assert ck.stop_reason == "running" and not ck.complete and not ck.interrupted and len(ck) >= 1
+    info = run("info", "X.h5.partial", cwd=tmp_path)
+    assert info.returncode == 0 and "running" in info.stdout and "complete:  False" in info.stdout
+
+
+def test_sigint_writes_the_final_file_labelled_interrupted(tmp_path, old_file):
+    import signal
+
+    path, before = old_file
+    proc, partial = _start_curve_and_wait_for_checkpoint(tmp_path, "--delta-max", "0.5")
+    n_checkpoint = len(sb.read_curve(partial))
+    proc.send_signal(signal.SIGINT)
+    out, err = proc.communicate(timeout=120)
+    assert proc.returncode == 130, (out, err)
+    assert "Traceback" not in err and "interrupted" in err
+    c = sb.read_curve(path)
+    assert c.interrupted and not c.complete and c.stop_reason == "interrupted"
+    assert len(c) >= n_checkpoint and c.delta[0] != 0.1  # the new run's points, not the old file's
+    assert not partial.exists()
+
+
+def test_finished_run_replaces_the_file_and_removes_the_checkpoint(tmp_path, old_file):
+    path, before = old_file
+    env = dict(os.environ, SHELLBVP_CHECKPOINT_SECONDS="0")
+    r = subprocess.run([sys.executable, "-m", "shellbvp", "curve", "--force", "-o", "X.h5", "--points", "3",
+                        "--delta-max", "0.15"], cwd=tmp_path, env=env, capture_output=True, text=True,
+                       timeout=300)
+    assert r.returncode == 0, r.stderr
+    c = sb.read_curve(path)
+    assert c.complete and c.stop_reason == "all requested deltas computed"
+    np.testing.assert_allclose(c.delta, [0.05, 0.1, 0.15])
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["X.h5"]
+    # a leftover checkpoint is somebody's finished work: replaced only with --force
+    (tmp_path / "Y.h5.partial").write_bytes(b"points")
+    r = run("curve", "-o", "Y.h5", cwd=tmp_path)
+    one_line_error(r, "Y.h5.partial exists", "--force")
+
+
+# -- malformed files -----------------------------------------------------------------------------------
+
+@pytest.fixture(scope="module")
+def good_file(tmp_path_factory):
+    path = tmp_path_factory.mktemp("good") / "good.h5"
+    sb.curve(sb.Scene.preset("base"), deltas=[0.1, 0.12, 0.14], estimate_error=False).to_hdf5(path)
+    return path
+
+
+def _replace(name, data, **kw):
+    def edit(f):
+        del f["curve"][name]
+        f["curve"].create_dataset(name, data=data, **kw)
+    return edit
+
+
+def _strings(values):
+    import h5py
+
+    return _replace("force", np.array(values, dtype=object), dtype=h5py.string_dtype())
+
+
+TAMPERED = {
+    "no_stop_reason": (lambda f: f["curve"].attrs.__delitem__("stop_reason"), "attribute stop_reason missing"),
+    "no_complete": (lambda f: f["curve"].attrs.__delitem__("complete"), "attribute complete missing"),
+    "no_interrupted": (lambda f: f["curve"].attrs.__delitem__("interrupted"), "attribute interrupted missing"),
+    "complete_text": (lambda f: f["curve"].attrs.__setitem__("complete", "yes"), "complete must be a boolean"),
+    "stop_reason_number": (lambda f: f["curve"].attrs.__setitem__("stop_reason", 3.0),
+                           "stop_reason must be a string"),
+    "version_array": (lambda f: f.attrs.__setitem__("format_version", np.array([2, 2])),
+                      "format_version must be a scalar integer"),
+    "version_float": (lambda f: f.attrs.__setitem__("format_version", 2.5), "format_version must be a scalar integer"),
+    "version_missing": (lambda f: f.attrs.__delitem__("format_version"), "format_version attribute missing"),
+    "version_newer": (lambda f: f.attrs.__setitem__("format_version", 99), "format version 99"),
+    "scalar_delta": (_replace("delta", 0.1), "delta must be a 1-D array; got shape ()"),
+    "short_force": (_replace("force", [0.1, 0.2]), "force must be a 1-D array of 3 values"),
+    "force_2d": (_replace("force", np.zeros((3, 2))), "force must be a 1-D array of 3 values"),
+    "force_strings": (_strings(["a", "b", "c"]), "force must hold numbers; got strings"),
+    "no_lambda0": (lambda f: f["curve"].__delitem__("lambda0"), "dataset lambda0 missing"),
+    "no_flags": (lambda f: f["curve"].__delitem__("flags"), "dataset flags missing"),
+    "status_fraction": (_replace("status", [0.5, 0.0, 0.0]), "status must hold integers"),
+    "topology_numbers": (_replace("topology", [1, 2, 3]), "topology must hold strings"),
+    "scene_not_json": (lambda f: f["curve"].attrs.__setitem__("scene", "{nope"), "attribute scene is not valid JSON"),
+    "scene_incomplete": (lambda f: f["curve"].attrs.__setitem__("scene", '{"gamma": 1}'),
+                         "attribute scene does not describe a scene"),
+    "settings_list": (lambda f: f["curve"].attrs.__setitem__("settings", "[1, 2]"),
+                      "attribute settings must be a JSON object"),
+}
+
+
+@pytest.mark.parametrize("name", sorted(TAMPERED))
+def test_read_curve_names_what_is_wrong_with_a_tampered_file(tmp_path, good_file, name):
+    import shutil
+
+    import h5py
+
+    edit, message = TAMPERED[name]
+    path = tmp_path / f"{name}.h5"
+    shutil.copy(good_file, path)
+    with h5py.File(path, "r+") as f:
+        edit(f)
+    with pytest.raises(ValueError) as err:
+        sb.read_curve(path)
+    text = str(err.value)
+    assert text.startswith(f"{path}: ") and message in text and "\n" not in text, text
+
+
+def test_info_answers_every_tampered_file_in_one_line(tmp_path, good_file):
+    import shutil
+
+    import h5py
+
+    for name in ("no_stop_reason", "version_array", "scalar_delta", "short_force", "force_strings"):
+        edit, message = TAMPERED[name]
+        path = tmp_path / f"{name}.h5"
+        shutil.copy(good_file, path)
+        with h5py.File(path, "r+") as f:
+            edit(f)
+        one_line_error(run("info", path.name, cwd=tmp_path), path.name, message)
+    r = run("info", str(good_file))
+    assert r.returncode == 0 and "complete:  True" in r.stdout
+
+
+def test_an_untouched_file_reads_back_with_its_types(good_file):
+    c = sb.read_curve(good_file)
+    assert c.complete and not c.interrupted and c.stop_reason == "all requested deltas computed"
+    assert c.status.dtype.kind == "i" and c.valid.dtype == bool and c.delta.dtype == float
+    assert set(c.topology) <= {"cap", "line", "annulus"} and len(c.topology) == len(c.flags) == 3
+    again = sb.curve(sb.Scene.preset("base"), deltas=[0.1, 0.12, 0.14], estimate_error=False)
+    assert list(c.topology) == list(again.topology) and c.flags == again.flags
+    np.testing.assert_array_equal(c.force, again.force)
+
+
+def test_a_curve_without_points_round_trips(tmp_path):
+    c = sb.curve(sb.Scene.preset("base"), deltas=[0.1], max_nodes=10, estimate_error=False)
+    assert len(c) == 0 and not c.complete and "no solution" in c.stop_reason
+    c.to_hdf5(tmp_path / "e.h5")
+    back = sb.read_curve(tmp_path / "e.h5")
+    assert len(back) == 0 and back.stop_reason == c.stop_reason and not back.complete
+    r = run("info", "e.h5", cwd=tmp_path)
+    assert r.returncode == 0 and "0 points" in r.stdout
