@@ -294,8 +294,11 @@ def read_curve(path):
         try:
             _format_version(f)
             g = f["curve"]
+            scene_data = _json_attr(g, "scene")
             try:
-                scene = Scene.from_dict(_json_attr(g, "scene"))
+                scene = Scene.from_dict(scene_data)
+            except ValueError as exc:  # Scene.from_dict names the field or formula
+                raise ValueError(f"attribute scene does not describe a scene: {exc}") from None
             except (KeyError, TypeError, AttributeError) as exc:
                 raise ValueError(f"attribute scene does not describe a scene ({type(exc).__name__}: "
                                  f"{exc})") from None
