@@ -4,7 +4,7 @@ Profiles the base curve at tol 1e-6 (natural continuation at the 40 depths of th
 work–precision study, ``estimate_error=False``; and the adaptive curve) after a warm-up
 run, and splits the time into categories: the generated model code (right-hand sides,
 Jacobians, boundary/junction conditions, profiles), solve_bvp's internals (sparse LU,
-Jacobian assembly, the rest of its Python), shellbvp's glue (system.py), diagnostics
+Jacobian assembly, the rest of its Python), shellbvp's glue (chain.py), diagnostics
 (state.py) and continuation.  Time in builtins and NumPy/SciPy helpers is attributed to
 the categories of their callers (in proportion to the callers' cumulative time).  It also
 times single calls of the generated functions against the number of nodes, to show how
@@ -41,7 +41,7 @@ CATEGORIES = (
     "solve_bvp: sparse LU (SuperLU factorise + solve)",
     "solve_bvp: global Jacobian assembly (sparse COO -> CSC)",
     "solve_bvp: other (collocation residuals, mesh refinement, splines)",
-    "shellbvp glue (system.py: fun, fun_jac, bc, bc_jac)",
+    "shellbvp glue (chain.py: fun, fun_jac, bc, bc_jac)",
     "shellbvp diagnostics (state.py: _diagnose, energy, guesses)",
     "continuation logic (continuation.py)",
     "other",
@@ -64,7 +64,7 @@ def _category(key):
         return CATEGORIES[5]
     if "scipy/integrate/_bvp.py" in path or "scipy/interpolate" in path:
         return CATEGORIES[6]
-    if path.endswith("shellbvp/system.py"):
+    if path.endswith("shellbvp/chain.py"):
         return CATEGORIES[7]
     if path.endswith("shellbvp/state.py"):
         return CATEGORIES[8]
@@ -138,9 +138,9 @@ def profile_curve(make, repeat):
         newton_solves=_calls(st, "scipy/integrate/_bvp.py", "solve_newton"),
         jacobians=_calls(st, "scipy/integrate/_bvp.py", "construct_global_jac"),
         lu_factorisations=_calls(st, "", "splu"),
-        fun=_calls(st, "shellbvp/system.py", "fun"),
-        fun_jac=_calls(st, "shellbvp/system.py", "fun_jac"),
-        bc=_calls(st, "shellbvp/system.py", "bc"),
+        fun=_calls(st, "shellbvp/chain.py", "fun"),
+        fun_jac=_calls(st, "shellbvp/chain.py", "fun_jac"),
+        bc=_calls(st, "shellbvp/chain.py", "bc"),
         free_rhs=_calls(st, "model_", "free_rhs"),
         contact_rhs=_calls(st, "model_", "contact_rhs"),
     )
@@ -168,7 +168,7 @@ def per_call(repeat=5):
     for m in (30, 300, 3000):
         t = np.linspace(0.0, 1.0, m)
         y = r.sol(t)
-        Sf, Sc = sysm.S_free(t, p[0]), sysm.S_contact(t, p[0])
+        Sc, Sf = sysm.S(0, t, p), sysm.S(1, t, p)
         fns = dict(free_rhs=lambda: mod.free_rhs(Sf, y[2:], par),
                    contact_rhs=lambda: mod.contact_rhs(Sc, y[:2], par),
                    free_jac=lambda: mod.free_jac(Sf, y[2:], par),

@@ -2,7 +2,7 @@ r"""Shooting: the paper's own method, as an independent peer for the benchmarks.
 
 This re-solves the indentation problem with ``lambda0`` (the pole stretch)
 prescribed, the way the paper did (its section 3), and shares nothing with
-``shellbvp``'s collocation machinery (``shellbvp.system`` / ``shellbvp.state``)
+``shellbvp``'s collocation machinery (``shellbvp.chain`` / ``shellbvp.state``)
 except the generated equations: the right-hand sides ``g = S dy/dS`` of both
 regions, their Jacobians and the pole, contact-line and rim conditions.
 

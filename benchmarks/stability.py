@@ -91,12 +91,10 @@ def free_det(sol):
     """
     import numpy as np
 
-    from shellbvp.system import N_CONTACT
-
     sysm = sol["system"]
     mod, par = sysm.model, sysm.par
-    S = sysm.S_free(sol.x, sol.p[0])
-    y = sol.y[N_CONTACT:]
+    S = sysm.S(1, sol.x, sol.p)
+    y = sol.y[sysm.rows(1)]
     cols = [mod.FREE_STATES.index("ls"), mod.FREE_STATES.index("ks")]
     J = np.zeros((2, 2, S.size))
     for j, k in enumerate(cols):

@@ -138,6 +138,7 @@ class Chain:
     regions: tuple
     junctions: tuple
     unknowns: tuple  # configuration unknowns (before lambda0, delta)
+    eps: float | None = None  # pole start zeta = eps * (first contact or lift-off edge), if a regular pole
 
     def layout(self) -> str:
         """A table of the stacked layout (rows, S ranges, junction rows)."""
@@ -165,7 +166,7 @@ def cap_chain(eps: float, L: float, model: str = "smooth") -> Chain:
     Sc = Point("Sc", "ln_Sc")
     return Chain("cap", (Region("contact", Point("zeta", "ln_Sc", math.log(eps)), Sc),
                          Region("free", Sc, Point("L", None, math.log(L)))),
-                 (ContactPole(0), Edge(0, 1, model), Rim(1)), ("ln_Sc",))
+                 (ContactPole(0), Edge(0, 1, model), Rim(1)), ("ln_Sc",), eps)
 
 
 def point_chain(s0: float, L: float) -> Chain:
@@ -179,7 +180,7 @@ def annulus_chain(eps: float, L: float) -> Chain:
     S1, S2 = Point("S1", "ln_S1"), Point("S2", "ln_S2")
     return Chain("annulus", (Region("free", Point("zeta", "ln_S1", math.log(eps)), S1), Region("contact", S1, S2),
                              Region("free", S2, Point("L", None, math.log(L)))),
-                 (FreePole(0), Edge(1, 0), Edge(1, 2), Rim(2)), ("ln_S1", "ln_S2"))
+                 (FreePole(0), Edge(1, 0), Edge(1, 2), Rim(2)), ("ln_S1", "ln_S2"), eps)
 
 
 def line_chain(eps: float, L: float) -> Chain:
@@ -187,7 +188,7 @@ def line_chain(eps: float, L: float) -> Chain:
     S1 = Point("S1", "ln_S1")
     return Chain("line", (Region("free", Point("zeta", "ln_S1", math.log(eps)), S1),
                           Region("free", S1, Point("L", None, math.log(L)))),
-                 (FreePole(0), Line(0), Rim(1)), ("ln_S1", "chi1"))
+                 (FreePole(0), Line(0), Rim(1)), ("ln_S1", "chi1"), eps)
 
 
 # -- the assembler -------------------------------------------------------------------------------
@@ -273,6 +274,23 @@ class ChainBVP:
         """S on region ``k`` at ``t``."""
         a, b = self.ln_S(self.regions[k].start, p), self.ln_S(self.regions[k].end, p)
         return np.exp(a + t * (b - a))
+
+    def t_of(self, k, S, p):
+        """The t at which region ``k`` reaches ``S`` (outside the region: outside [0, 1])."""
+        a, b = self.ln_S(self.regions[k].start, p), self.ln_S(self.regions[k].end, p)
+        return (np.log(S) - a) / (b - a)
+
+    @property
+    def topology(self) -> str:
+        return self.chain.name
+
+    @property
+    def eps(self):
+        return self.chain.eps
+
+    @property
+    def L(self) -> float:
+        return self.S_point(self.regions[-1].end, None)
 
     def _rhs(self, k):
         return self.model.free_rhs if self.regions[k].kind == "free" else self.model.contact_rhs
@@ -456,6 +474,26 @@ class ChainBVP:
             S = self.S(k, t, p)
             prof = self.model.free_profile if reg.kind == "free" else self.model.contact_profile
             out.append((k, S, prof(S, y[self.rows(k)], self.par)))
+        return out
+
+    def profile(self, t, y, p, z_tip: float) -> dict:
+        """Fields over S, pole to rim, on ``t`` for every region (see ``Solution.profile``):
+        ``S``, ``region`` (0 on the indenter, 1 free) and the generated profile fields
+        (``axial_force`` = 2 pi times the generated ``axial_force_2pi``)."""
+        parts = self.region_profiles(t, y, p)
+        out = {"S": np.concatenate([S for _, S, _ in parts]),
+               "region": np.concatenate([np.full(t.size, int(self.regions[k].kind == "free")) for k, _, _ in parts])}
+        keys = next(fields for k, _, fields in parts if self.regions[k].kind == "free")  # contact adds omega
+        for key in keys:
+            vals = []
+            for k, _, fields in parts:
+                v = np.broadcast_to(fields[key], t.shape)
+                if key == "z" and self.regions[k].kind == "contact":
+                    v = v + z_tip  # the generated contact z is measured from the tip's apex
+                vals.append(v)
+            vals = np.concatenate(vals)
+            out["axial_force" if key == "axial_force_2pi" else key] = (
+                2 * np.pi * vals if key == "axial_force_2pi" else vals)
         return out
 
     def energy(self, sol, x, p) -> float:

@@ -440,7 +440,7 @@ def _secant(sysm, cur, prev, a):
     X = np.array([cur.p[0], cur.lambda0, cur.delta])
     Xp = np.array([prev.p[0], prev.lambda0, prev.delta])
     ln_Sc, lambda0, delta = X + a * (X - Xp)
-    return x, y, sysm.pack(ln_Sc, lambda0, delta)
+    return x, y, sysm.pack(ln_Sc=ln_Sc, lambda0=lambda0, delta=delta)
 
 
 def _natural(scene, deltas, builder: _Builder, settings, first=None, key0=0):

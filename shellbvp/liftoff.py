@@ -5,7 +5,7 @@ Where the single-cap state needs a negative contact pressure near the pole
 there: a free inner cap around the pole, then contact on an annulus
 ``[S1, S2]`` (``topology="annulus"``) or on one circle (``"line"``, a
 zero-width annulus carrying a ring force), then the outer free region.  The
-systems are :class:`shellbvp.system.LiftOffBVP`; this module makes guesses,
+systems are the chains ``annulus_chain`` and ``line_chain`` of :mod:`shellbvp.chain`; this module makes guesses,
 runs solve_bvp and diagnoses the result into a :class:`~shellbvp.state.Solution`
 with the same fields as a cap state, plus ``S1`` (inner edge), ``ring_force_inner``,
 ``contact_width`` and, for a line, ``curvature_excess`` (kappa_s at the line minus the
@@ -23,17 +23,22 @@ import math
 import time
 
 import numpy as np
-from .state import (STATUS_MESSAGES, Solution, _attach_tip, _penetration, gauss_points, richardson_error,
-                    set_status, solve_bvp, thin_mesh)
-from .system import N_CONTACT, N_FREE, LiftOffBVP
+from .chain import ChainBVP, annulus_chain, line_chain
+from .state import (STATUS_MESSAGES, Solution, _attach_tip, _penetration, richardson_error, set_status, solve_bvp,
+                    thin_mesh)
 
 __all__ = ["solve_liftoff", "solve_liftoff_from", "make_liftoff_system", "liftoff_guess_from_cap",
            "liftoff_warm_guess", "liftoff_state", "valid_liftoff_state", "lift_off_suspected",
-           "replace_invalid_cap", "liftoff_profile"]
+           "replace_invalid_cap"]
 
 
 def make_liftoff_system(scene, topology, control, value, eps):
-    sysm = LiftOffBVP(scene, topology, control, value, eps)
+    if topology not in ("annulus", "line"):
+        raise ValueError(f"topology must be 'annulus' or 'line'; got {topology!r}")
+    if control not in ("delta", "force", "lambda0"):
+        raise ValueError(f"control must be 'delta', 'force' or 'lambda0' for {topology} contact; got {control!r}")
+    chain = (annulus_chain if topology == "annulus" else line_chain)(eps, scene.shell_length)
+    sysm = ChainBVP(scene, chain, control, value)
     _attach_tip(sysm)
     return sysm
 
@@ -42,8 +47,7 @@ def make_liftoff_system(scene, topology, control, value, eps):
 def _cap_states_at(cap, S):
     """Contact states (chi, ls) of a cap solution at S inside its cap."""
     csys = cap.system
-    t = 1.0 - (np.log(S) - cap.p[0]) / csys.ln_eps
-    return cap.sol(np.clip(t, 0.0, 1.0))[:N_CONTACT]
+    return cap.sol(np.clip(csys.t_of(0, S, cap.p), 0.0, 1.0))[csys.rows(0)]
 
 
 def _cap_as_free(cap, S):
@@ -56,11 +60,10 @@ def _cap_as_free(cap, S):
 
 def _cap_free_at(cap, S):
     csys = cap.system
-    t = (np.log(S) - cap.p[0]) / (csys.ln_L - cap.p[0])
-    return cap.sol(np.clip(t, 0.0, 1.0))[N_CONTACT:]
+    return cap.sol(np.clip(csys.t_of(1, S, cap.p), 0.0, 1.0))[csys.rows(1)]
 
 
-def liftoff_guess_from_cap(sysm: LiftOffBVP, cap: Solution, S1_fraction: float, n: int = 81):
+def liftoff_guess_from_cap(sysm: ChainBVP, cap: Solution, S1_fraction: float, n: int = 81):
     """Guess from a cap state: the pole region ``S < S1 = S1_fraction * Sc`` taken off the tip.
 
     Annulus: contact on ``[S1, Sc]``; line: the contact circle at S1.
@@ -70,22 +73,23 @@ def liftoff_guess_from_cap(sysm: LiftOffBVP, cap: Solution, S1_fraction: float, 
     t = np.linspace(0.0, 1.0, n)
     delta = cap.delta
     if sysm.topology == "annulus":
-        p = sysm.pack(math.log(S1), math.log(Sc), delta)
-        Sin, Scont, Sout = sysm.S_inner(t, p), sysm.S_contact(t, p), sysm.S_outer(t, p)
+        p = sysm.pack(ln_S1=math.log(S1), ln_S2=math.log(Sc), delta=delta)
+        Sin, Scont, Sout = sysm.S(0, t, p), sysm.S(1, t, p), sysm.S(2, t, p)
         y = np.vstack([_cap_as_free(cap, Sin), _cap_states_at(cap, Scont), _cap_free_at(cap, Sout)])
     else:
         chi1 = float(_cap_states_at(cap, np.array([S1]))[0, 0])
-        p = sysm.pack(math.log(S1), chi1, delta)
-        Sin, Sout = sysm.S_inner(t, p), sysm.S_outer(t, p)
+        p = sysm.pack(ln_S1=math.log(S1), chi1=chi1, delta=delta)
+        Sin, Sout = sysm.S(0, t, p), sysm.S(1, t, p)
         outer = np.where(Sout <= Sc, _cap_as_free(cap, np.minimum(Sout, Sc)), _cap_free_at(cap, Sout))
         y = np.vstack([_cap_as_free(cap, Sin), outer])
     return t, y, p
 
 
-def liftoff_warm_guess(sysm: LiftOffBVP, prev: Solution):
+def liftoff_warm_guess(sysm: ChainBVP, prev: Solution):
     """A neighbouring lift-off state of the same topology on its thinned mesh."""
     x = thin_mesh(prev.x)
-    return x, prev.sol(x), sysm.pack(prev.p[0], prev.p[1], prev.delta)
+    q = dict(zip(prev.system.unknowns, prev.p), delta=prev.delta)
+    return x, prev.sol(x), sysm.pack(**q)
 
 
 # -- solving --------------------------------------------------------------------------------
@@ -127,25 +131,33 @@ def solve_liftoff_from(sysm, guess, *, tol=1e-6, max_nodes=10000, bc_tol=1e-10):
     return res
 
 
-def _energy(sysm, bvp, p):
-    """Int U R Psi dS over the inner cap, the annulus (if any) and the outer region."""
-    t, w = gauss_points(bvp.x)
-    y = bvp.sol(t)
+def _edge_values(sysm, ya, yb, p):
+    """(F, inner ring force, outer ring force, S1, S2, delta): ring forces are the jumps of 2 pi G
+    (the axial force) across each contact edge."""
     mod, par = sysm.model, sysm.par
-    Si, So = sysm.S_inner(t, p), sysm.S_outer(t, p)
-    e = (mod.free_profile(Si, y[sysm.inner], par)["energy_density"] * Si * (-sysm.ln_eps)
-         + mod.free_profile(So, y[sysm.outer], par)["energy_density"] * So * (sysm.ln_L - sysm.ln_S2(p)))
+    q = sysm.quantities(p)
+    S1 = float(np.exp(np.float64(q["ln_S1"])))
+    S2 = float(np.exp(np.float64(q["ln_S2"]))) if sysm.topology == "annulus" else S1
+    outer, inner = len(sysm.regions) - 1, 0
+
+    def G(prof, S, y):
+        return float(prof(np.array([S]), y[:, None], par)["axial_force_2pi"][0])
+
+    G_out = G(mod.free_profile, S2, ya[sysm.rows(outer)])
+    G_in = G(mod.free_profile, S1, yb[sysm.rows(inner)])
     if sysm.topology == "annulus":
-        Sc = sysm.S_contact(t, p)
-        e = e + mod.contact_profile(Sc, y[sysm.contact], par)["energy_density"] * Sc * (sysm.ln_S2(p) - p[0])
-    return float(np.sum(w * e))
+        pc1, pc2 = G(mod.contact_profile, S1, ya[sysm.rows(1)]), G(mod.contact_profile, S2, yb[sysm.rows(1)])
+        ring_in, ring_out = 2 * np.pi * (pc1 - G_in), 2 * np.pi * (G_out - pc2)
+    else:
+        ring_in, ring_out = 0.0, 2 * np.pi * (G_out - G_in)
+    return 2 * np.pi * G_out, float(ring_in), float(ring_out), S1, S2, float(q["delta"])
 
 
-def _diagnose(sysm: LiftOffBVP, bvp, tol):
+def _diagnose(sysm: ChainBVP, bvp, tol):
     mod, par = sysm.model, sysm.par
     p = bvp.p
     ya, yb = bvp.y[:, 0], bvp.y[:, -1]
-    force, ring_in, ring_out, S1, S2, delta = sysm.edge_values(ya, yb, p)
+    force, ring_in, ring_out, S1, S2, delta = _edge_values(sysm, ya, yb, p)
     z_tip = float(mod.reference_shell(0.0, par)["Z"]) - delta
     res = Solution(
         topology=sysm.topology, status=int(bvp.status), message=bvp.message, x=bvp.x, y=bvp.y, p=p,
@@ -162,9 +174,10 @@ def _diagnose(sysm: LiftOffBVP, bvp, tol):
     elif bvp.status == 0:
         if not 0.0 < S1 <= S2 < sysm.L:
             flags.append(f"contact edges S1 = {S1:.3g}, S2 = {S2:.3g} not ordered inside (0, L)")
-        if np.any(bvp.y[[0, 2, sysm.outer.start, sysm.outer.start + 2]] <= 0):
+        o = sysm.offsets[-1]
+        if np.any(bvp.y[[0, 2, o, o + 2]] <= 0):
             flags.append("non-positive stretch")
-        omega2 = (S2 * (yb[sysm.contact][0] if sysm.topology == "annulus" else p[1])) / sysm.scene.rho
+        omega2 = (S2 * (yb[sysm.rows(1)][0] if sysm.topology == "annulus" else p[1])) / sysm.scene.rho
         if omega2 > sysm.scene.tip_omega_max:
             flags.append("the contact has passed the end of the tip (the indenter's cylinder)")
     set_status(res, bvp, flags)
@@ -176,24 +189,20 @@ def _diagnose(sysm: LiftOffBVP, bvp, tol):
 
     t = np.unique(np.r_[bvp.x, 0.5 * (bvp.x[1:] + bvp.x[:-1])])
     y = bvp.sol(t)
-    pin = mod.free_profile(sysm.S_inner(t, p), y[sysm.inner], par)
-    pout = mod.free_profile(sysm.S_outer(t, p), y[sysm.outer], par)
+    profiles = [fields for _, _, fields in sysm.region_profiles(t, y, p)]
+    pin, pout = profiles[0], profiles[-1]
     res.force_defect = float(max(np.max(np.abs(2 * np.pi * pout["axial_force_2pi"] - force)),
                                  np.max(np.abs(2 * np.pi * pin["axial_force_2pi"]))))
     if sysm.topology == "annulus":
-        pc = mod.contact_profile(sysm.S_contact(t, p), y[sysm.contact], par)
-        res.pressure_min = float(np.min(pc["P"]))
+        res.pressure_min = float(np.min(profiles[1]["P"]))
     else:
         res.pressure_min = nan  # no area of contact
-    leg = mod.free_legendre(sysm.S_outer(np.array([0.0, 0.5]), p),
-                            bvp.sol(np.array([0.0, 0.5]))[sysm.outer], par)[0]
+    t_leg = np.array([0.0, 0.5])
+    leg = mod.free_legendre(sysm.S(len(sysm.regions) - 1, t_leg, p), bvp.sol(t_leg)[sysm.rows(-1)], par)[0]
     res.edge_legendre = float(leg[0] / leg[1]) if leg[1] != 0 else nan
     res.penetration = max(_penetration(sysm, pin["r"], pin["z"], z_tip),
                           _penetration(sysm, pout["r"], pout["z"], z_tip))
-    E = _energy(sysm, bvp, p)
-    pole_density = float(mod.free_profile(np.array([sysm.eps * S1]), ya[sysm.inner, None], par)
-                         ["energy_density"][0])
-    res.energy = 2 * np.pi * (E + 0.5 * pole_density * sysm.eps * S1)
+    res.energy = sysm.energy(bvp.sol, bvp.x, p)
     vflags = []
     scale = 10 * tol * (1 + abs(force))
     if sysm.topology == "annulus" and res.pressure_min < -scale:
@@ -340,23 +349,3 @@ def replace_invalid_cap(cap: Solution, *, tol=1e-6, max_nodes=10000, bc_tol=1e-1
 def _pressed_somewhere(cap):
     prof = cap.profile()
     return bool(np.max(prof["P"][prof["region"] == 0]) > 0)
-
-
-def liftoff_profile(sol: Solution, t):
-    """Fields over S of a lift-off state (see :meth:`Solution.profile`)."""
-    sysm, p = sol.system, sol.p
-    mod, par = sysm.model, sysm.par
-    y = sol.sol(t)
-    parts = [(np.ones(t.size), mod.free_profile(sysm.S_inner(t, p), y[sysm.inner], par), sysm.S_inner(t, p))]
-    if sysm.topology == "annulus":
-        pc = mod.contact_profile(sysm.S_contact(t, p), y[sysm.contact], par)
-        pc["z"] = pc["z"] + sol["z_tip"]
-        parts.append((np.zeros(t.size), pc, sysm.S_contact(t, p)))
-    parts.append((np.ones(t.size), mod.free_profile(sysm.S_outer(t, p), y[sysm.outer], par), sysm.S_outer(t, p)))
-    out = {"S": np.concatenate([S for _, _, S in parts]),
-           "region": np.concatenate([reg for reg, _, _ in parts]).astype(int)}
-    for key in parts[-1][1]:
-        vals = np.concatenate([np.broadcast_to(pr[key], t.shape) for _, pr, _ in parts])
-        out["axial_force" if key == "axial_force_2pi" else key] = (
-            2 * np.pi * vals if key == "axial_force_2pi" else vals)
-    return out

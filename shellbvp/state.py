@@ -14,7 +14,8 @@ import time
 
 import numpy as np
 
-from .system import N_CONTACT, MultipointBVP
+from .chain import ChainBVP, cap_chain, point_chain
+from .quadrature import gauss_points
 
 __all__ = ["Solution", "solve", "STATUS_MESSAGES", "delta_bounds"]
 
@@ -30,8 +31,6 @@ STATUS_MESSAGES = {
     4: "converged to an inadmissible state (see message): start from a neighbouring solution",
     5: "no initial guess converged (crude guesses and continuation from small delta)",
 }
-
-_GAUSS_T, _GAUSS_W = np.polynomial.legendre.leggauss(4)
 
 
 class _NonFinite(Exception):
@@ -115,7 +114,7 @@ class Solution(dict):
         Pole displacement, indenter force F (> 0 pushing), pole stretch, contact circle.
     x, y, p, sol, rms_residuals, niter
         solve_bvp's mesh on t in [0, 1], stacked states (8, m) (layout in
-        ``shellbvp.system``), unknown parameters, interpolant, residuals, iterations.
+        ``shellbvp.chain``), unknown parameters, interpolant, residuals, iterations.
     nodes : int
     max_residual : float
         Largest relative collocation residual.
@@ -174,39 +173,15 @@ class Solution(dict):
         if points_per_interval > 1:
             t = np.unique(np.concatenate([np.linspace(a, b, points_per_interval + 1)
                                           for a, b in zip(t[:-1], t[1:])]))
-        if self.get("topology") in ("line", "annulus"):
-            from .liftoff import liftoff_profile
-
-            return liftoff_profile(self, t)
-        y = self.sol(t)
-        if self.get("topology") == "point":
-            pf = sysm.model.free_profile(sysm.S(t), y, sysm.par)
-            out = {"S": sysm.S(t), "region": np.ones(t.size, int)}
-            for key, v in pf.items():
-                out["axial_force" if key == "axial_force_2pi" else key] = (
-                    2 * np.pi * v if key == "axial_force_2pi" else v)
-            return out
-        ln_Sc = self.p[0]
-        mod, par = sysm.model, sysm.par
-        Sc_t, Sf_t = sysm.S_contact(t, ln_Sc), sysm.S_free(t, ln_Sc)
-        pc = mod.contact_profile(Sc_t, y[:N_CONTACT], par)
-        pf = mod.free_profile(Sf_t, y[N_CONTACT:], par)
-        pc["z"] = pc["z"] + self["z_tip"]
-        out = {"S": np.concatenate([Sc_t, Sf_t]),
-               "region": np.concatenate([np.zeros(t.size, int), np.ones(t.size, int)])}
-        for key in pf:
-            if key == "axial_force_2pi":
-                out["axial_force"] = 2 * np.pi * np.concatenate([pc[key], pf[key]])
-            else:
-                out[key] = np.concatenate([pc[key], pf[key]])
-        return out
+        return sysm.profile(t, self.sol(t), self.p, self["z_tip"])
 
 
-def _undeformed_guess(sysm: MultipointBVP, ln_Sc, lambda0, delta, n=41):
+def _undeformed_guess(sysm: ChainBVP, ln_Sc, lambda0, delta, n=41):
     """Crude start: the reference shell moved down by delta, a small cap at stretch lambda0."""
     mod, par, L = sysm.model, sysm.par, sysm.L
     t = np.linspace(0.0, 1.0, n)
-    Sf = sysm.S_free(t, ln_Sc)
+    p = sysm.pack(ln_Sc=ln_Sc, lambda0=lambda0, delta=delta)
+    Sf = sysm.S(1, t, p)
     ref = mod.reference_shell(Sf, par)
     chi0 = -mod.pole_res(0.0, 0.0, 1.0, par)[0]  # chi at the pole for lambda0 = 1
     Sc = np.exp(ln_Sc)
@@ -221,7 +196,7 @@ def _undeformed_guess(sysm: MultipointBVP, ln_Sc, lambda0, delta, n=41):
         np.zeros(n),
         ref["Z"] - delta * (1.0 - w),
     ])
-    return t, y, sysm.pack(ln_Sc, lambda0, delta)
+    return t, y, p
 
 
 def thin_mesh(x, keep_every: int = 3):
@@ -230,40 +205,16 @@ def thin_mesh(x, keep_every: int = 3):
     return x[idx]
 
 
-def _warm_guess(sysm: MultipointBVP, prev: "Solution", predictor=None):
-    """Previous solution on a thinned mesh; optional predicted (y, p) shift."""
+def _warm_guess(sysm: ChainBVP, prev: "Solution", predictor=None):
+    """Previous cap solution on a thinned mesh; optional predicted (y, p) shift."""
     x = thin_mesh(prev.x)
     y = prev.sol(x)
-    ln_Sc, lambda0, delta, _ = _state_params(prev)
-    p = sysm.pack(ln_Sc, lambda0, delta)
+    p = sysm.pack(ln_Sc=prev.p[0], lambda0=prev.lambda0, delta=prev.delta)
     if predictor is not None:
         dy, dp = predictor
         y = y + dy(x)
         p = p + dp
     return x, y, p
-
-
-def _state_params(sol):
-    return sol.p[0], sol["lambda0"], sol["delta"], sol["force"]
-
-
-def gauss_points(x):
-    """Gauss-Legendre points (4 per mesh interval) and weights on t, for energy integrals."""
-    a, b = x[:-1], x[1:]
-    t = (0.5 * (a + b)[:, None] + 0.5 * (b - a)[:, None] * _GAUSS_T[None, :]).ravel()
-    w = (0.5 * (b - a)[:, None] * _GAUSS_W[None, :]).ravel()
-    return t, w
-
-
-def _cap_energy(sysm, bvp, ln_Sc):
-    """Int U R Psi dS over the contact and free regions (both mapped on the same t)."""
-    t, w = gauss_points(bvp.x)
-    y = bvp.sol(t)
-    mod, par = sysm.model, sysm.par
-    Sc_t, Sf_t = sysm.S_contact(t, ln_Sc), sysm.S_free(t, ln_Sc)
-    e = (mod.contact_profile(Sc_t, y[:N_CONTACT], par)["energy_density"] * Sc_t * (-sysm.ln_eps)
-         + mod.free_profile(Sf_t, y[N_CONTACT:], par)["energy_density"] * Sf_t * (sysm.ln_L - ln_Sc))
-    return float(np.sum(w * e))
 
 
 def set_status(res, bvp, flags, converged_note=""):
@@ -279,13 +230,14 @@ def set_status(res, bvp, flags, converged_note=""):
     res.success = res.status == 0
 
 
-def _diagnose(sysm: MultipointBVP, bvp, tol):
+def _diagnose(sysm: ChainBVP, bvp, tol):
     """Turn solve_bvp's result into a Solution with the model's diagnostics."""
     mod, par = sysm.model, sysm.par
-    ln_Sc, lambda0, delta, F_pres = sysm.unpack(bvp.p)
+    q = sysm.quantities(bvp.p)
+    ln_Sc, lambda0, delta, F_pres = q["ln_Sc"], q["lambda0"], q["delta"], q["F"]
     Sc = np.exp(ln_Sc)
     ya, yb = bvp.y[:, 0], bvp.y[:, -1]
-    yc, yf = yb[:N_CONTACT], ya[N_CONTACT:]
+    yc, yf = yb[sysm.rows(0)], ya[sysm.rows(1)]
     ring, cap = mod.contact_line_forces(Sc, yc, yf, delta, F_pres, par)
     force = float(ring[0] + cap[0])
     res = Solution(
@@ -320,18 +272,16 @@ def _diagnose(sysm: MultipointBVP, bvp, tol):
     # Diagnostics on nodes and midpoints.
     t = np.unique(np.r_[bvp.x, 0.5 * (bvp.x[1:] + bvp.x[:-1])])
     y = bvp.sol(t)
-    pc = mod.contact_profile(sysm.S_contact(t, ln_Sc), y[:N_CONTACT], par)
-    pf = mod.free_profile(sysm.S_free(t, ln_Sc), y[N_CONTACT:], par)
+    (_, _, pc), (_, _, pf) = sysm.region_profiles(t, y, bvp.p)
     res.force_defect = float(np.max(np.abs(2 * np.pi * pf["axial_force_2pi"] - force)))
     # Legendre condition at the contact edge relative to mid-region: -> 0 where the smooth
     # branch ends (the free equations become singular at Sc+).
-    leg = mod.free_legendre(sysm.S_free(np.array([0.0, 0.5]), ln_Sc), bvp.sol(np.array([0.0, 0.5]))[N_CONTACT:],
-                            par)[0]
+    t_leg = np.array([0.0, 0.5])
+    leg = mod.free_legendre(sysm.S(1, t_leg, bvp.p), bvp.sol(t_leg)[sysm.rows(1)], par)[0]
     res.edge_legendre = float(leg[0] / leg[1]) if leg[1] != 0 else float("nan")
     res.pressure_min = float(np.min(pc["P"]))
     res.penetration = _penetration(sysm, pf["r"], pf["z"], res.z_tip)
-    res.energy = 2 * np.pi * (_cap_energy(sysm, bvp, ln_Sc)
-                              + 0.5 * float(pc["energy_density"][0]) * sysm.S_contact(0.0, ln_Sc))
+    res.energy = sysm.energy(bvp.sol, bvp.x, bvp.p)
     vflags = []
     scale = 10 * tol
     if res.pressure_min < -scale * (1 + abs(force)):
@@ -371,7 +321,8 @@ def _attach_tip(sysm):
 
 
 def make_system(scene, control, value, eps):
-    sysm = MultipointBVP(scene, control, value, eps)
+    """The single-cap system (``shellbvp.chain.cap_chain``) of a scene, control and value."""
+    sysm = ChainBVP(scene, cap_chain(eps, scene.shell_length, scene.contact), control, value)
     _attach_tip(sysm)
     return sysm
 
@@ -415,6 +366,8 @@ def richardson_error(sysm, res, tol, bc_tol=1e-10):
 #: Caps smaller than this are replaced by the point-load limit (their own equations
 #: leave double precision near Sc ~ 1e-75; the difference is exponentially small).
 SC_POINT = 1e-30
+#: Start of the point-load state's free region (truncation error O(s0^2 ln^2 s0)).
+POINT_S0 = 1e-12
 
 
 def _point_guess(sysm, prev):
@@ -423,28 +376,32 @@ def _point_guess(sysm, prev):
         x = thin_mesh(prev.x)
         return x, prev.sol(x)
     x = np.linspace(0.0, 1.0, 61)
-    S = sysm.S(x)
-    ln_Sc = prev.p[0]
-    tp = np.clip((np.log(S) - ln_Sc) / (sysm.ln_L - ln_Sc), 0.0, 1.0)
-    return x, prev.sol(tp)[N_CONTACT:]
+    cap = prev.system
+    tp = np.clip(cap.t_of(1, sysm.S(0, x, None), prev.p), 0.0, 1.0)
+    return x, prev.sol(tp)[cap.rows(1)]
 
 
 def _crude_point_guess(sysm):
     x = np.linspace(0.0, 1.0, 61)
-    S = sysm.S(x)
+    S = sysm.S(0, x, None)
     ref = sysm.model.reference_shell(S, sysm.par)
     lam = 0.95
     y = np.vstack([np.full(x.size, lam), ref["Phi"] / S, np.full(x.size, lam), ref["kappa_s"],
-                   np.zeros(x.size), ref["Z"] - sysm.delta * (1 - (S - S[0]) / (S[-1] - S[0]))])
+                   np.zeros(x.size), ref["Z"] - sysm.value * (1 - (S - S[0]) / (S[-1] - S[0]))])
     return x, y
 
 
 def solve_point_load(scene, delta, *, tol=1e-6, max_nodes=10000, guess=None, bc_tol=1e-10):
-    """The point-load limit of the smooth model at pole displacement ``delta`` (see PointLoadBVP)."""
-    from .system import PointLoadBVP
+    """The point-load limit of the smooth model at pole displacement ``delta``.
 
+    When the contact cap is exponentially small (``Sc`` below ~1e-30, which
+    happens as delta -> 0) the cap's own equations leave double precision and
+    the state is the point-load solution to exponential accuracy: the free
+    region alone on ``[s0, L]`` with the point-load pole conditions
+    (``shellbvp.chain.point_chain``).
+    """
     t0 = time.perf_counter()
-    sysm = PointLoadBVP(scene, delta)
+    sysm = ChainBVP(scene, point_chain(POINT_S0, scene.shell_length), "delta", delta)
     _attach_tip(sysm)
     x, y = _point_guess(sysm, guess) if guess is not None else _crude_point_guess(sysm)
     with np.errstate(all="ignore"):
@@ -460,15 +417,15 @@ def _diagnose_point(sysm, bvp):
     mod, par = sysm.model, sysm.par
     nan = float("nan")
     ya = bvp.y[:, 0]
-    force = 2 * np.pi * float(mod.free_profile(np.array([sysm.s0]), ya[:, None], par)["axial_force_2pi"][0])
+    force, delta = sysm.end_values(ya, bvp.y[:, -1])
     res = Solution(
         topology="point", status=int(bvp.status), message=bvp.message, x=bvp.x, y=bvp.y, p=np.array([]),
         sol=bvp.sol, rms_residuals=bvp.rms_residuals, niter=int(bvp.niter), nodes=int(bvp.x.size),
         max_residual=float(np.max(bvp.rms_residuals)) if bvp.rms_residuals.size else nan,
         # lambda0 is not defined in this limit: the stretches vary like ln^2 S near a point force.
-        delta=sysm.delta, lambda0=float("nan"), Sc=0.0, force=force, ring_force=force, cap_force=0.0,
+        delta=delta, lambda0=float("nan"), Sc=0.0, force=force, ring_force=force, cap_force=0.0,
         control="delta", scene=sysm.scene, system=sysm,
-        z_tip=float(mod.reference_shell(0.0, par)["Z"]) - sysm.delta,
+        z_tip=float(mod.reference_shell(0.0, par)["Z"]) - delta,
     )
     flags = []
     if not (np.all(np.isfinite(bvp.y)) and math.isfinite(force)):
@@ -481,12 +438,9 @@ def _diagnose_point(sysm, bvp):
         res.update(energy=nan, force_defect=nan, flags=flags)
         return res
     t = np.unique(np.r_[bvp.x, 0.5 * (bvp.x[1:] + bvp.x[:-1])])
-    pf = mod.free_profile(sysm.S(t), bvp.sol(t), par)
+    (_, _, pf), = sysm.region_profiles(t, bvp.sol(t), None)
     res.force_defect = float(np.max(np.abs(2 * np.pi * pf["axial_force_2pi"] - force)))
-    tg, wg = gauss_points(bvp.x)
-    Sg = sysm.S(tg)
-    e = mod.free_profile(Sg, bvp.sol(tg), par)["energy_density"]
-    res.energy = 2 * np.pi * float(np.sum(wg * e * Sg * (sysm.ln_L - sysm.ln_s0)))
+    res.energy = sysm.energy(bvp.sol, bvp.x, None)
     # The point load is the limit of contact on a vanishing circle (line contact): valid
     # when it pushes and the shell stays outside the indenter.
     res.penetration = _penetration(sysm, pf["r"], pf["z"], res.z_tip)

@@ -12,7 +12,8 @@ import numpy as np
 import pytest
 
 import shellbvp as sb
-from shellbvp.system import CONTROLS, N, MultipointBVP
+from shellbvp.chain import CONTROLS
+from shellbvp.state import make_system
 
 
 @pytest.fixture(scope="module")
@@ -27,9 +28,10 @@ def test_layout_counts_states_parameters_and_conditions(control, contact):
     scene = sb.Scene.preset("base", contact=contact)
     value = {"delta": 0.2, "lambda0": 1.0, "force": 0.3,
              "arclength": ([0.2, 1.0, 0.3], [0.6, 0.0, 0.8], [1.0, 1.0, 1.0])}[control]
-    sysm = MultipointBVP(scene, control, value, 1e-4)
-    p = sysm.pack(math.log(0.05), 1.0, 0.2)
+    sysm = make_system(scene, control, value, 1e-4)
+    p = sysm.pack(ln_Sc=math.log(0.05), lambda0=1.0, delta=0.2)
     ya = yb = np.array([1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 0.0, -0.5])
+    N = sysm.n
     assert N == 8
     assert p.size == sysm.k == (3 if control in ("force", "arclength") else 2)
     assert sysm.bc(ya, yb, p).size == sysm.n_conditions == N + sysm.k
@@ -42,10 +44,11 @@ def test_multipoint_jacobians_equal_finite_differences(base):
     for control in CONTROLS:
         value = {"delta": 0.2, "lambda0": sol.lambda0, "force": sol.force,
                  "arclength": ([0.2, sol.lambda0, sol.force], [0.6, 0.0, 0.8], [1.0, 0.5, 2.0])}[control]
-        sysm = MultipointBVP(base, control, value, 1e-4)
+        sysm = make_system(base, control, value, 1e-4)
+        N = sysm.n
         t = np.linspace(0, 1, 7)
         y = sol.sol(t) * (1 + 0.01 * np.sin(np.arange(N))[:, None])
-        p = sysm.pack(math.log(sol.Sc) + 0.1, sol.lambda0 * 1.01, 0.19)
+        p = sysm.pack(ln_Sc=math.log(sol.Sc) + 0.1, lambda0=sol.lambda0 * 1.01, delta=0.19)
         dfdy, dfdp = sysm.fun_jac(t, y, p)
         h = 1e-7
         for j in range(N):
