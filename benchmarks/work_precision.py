@@ -82,12 +82,17 @@ class Counter:
         self.fun = self.jac = self.calls = self.niter = 0
 
     def __enter__(self):
-        import shellbvp.state as st
+        import shellbvp.liftoff
+        import shellbvp.pointload
+        import shellbvp.solution
+        import shellbvp.state
 
-        self._st, self._orig = st, st.solve_bvp
-        counter, orig = self, st.solve_bvp
+        # every module that calls the guarded solve_bvp (bound at import)
+        self._modules = [shellbvp.solution, shellbvp.state, shellbvp.pointload, shellbvp.liftoff]
+        self._orig = orig = shellbvp.solution.solve_bvp
+        counter = self
 
-        def counted(fun, bc, x, y, p=None, S=None, fun_jac=None, bc_jac=None, **kw):
+        def counted(fun, bc, x, y, p=None, *, fun_jac=None, bc_jac=None, **kw):
             def f(*a):
                 counter.fun += 1
                 return fun(*a)
@@ -97,15 +102,17 @@ class Counter:
                 return fun_jac(*a)
 
             counter.calls += 1
-            r = orig(f, bc, x, y, p, S, fun_jac=j if fun_jac is not None else None, bc_jac=bc_jac, **kw)
+            r = orig(f, bc, x, y, p, fun_jac=j if fun_jac is not None else None, bc_jac=bc_jac, **kw)
             counter.niter += int(r.niter)
             return r
 
-        st.solve_bvp = counted
+        for m in self._modules:
+            m.solve_bvp = counted
         return self
 
     def __exit__(self, *exc):
-        self._st.solve_bvp = self._orig
+        for m in self._modules:
+            m.solve_bvp = self._orig
 
     def as_dict(self):
         return dict(bvp_runs=self.calls, bvp_niter=self.niter, jacobians=self.jac // 2, rhs_evals=self.fun)

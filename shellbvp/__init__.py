@@ -12,12 +12,13 @@ Quick use::
 from .geometry import SphereTip, Spheroid, UserShell, UserTip
 from .materials import Gent, MooneyRivlin, NeoHookean, StrainEnergy
 from .scene import PRESETS, Scene
-from .state import STATUS_MESSAGES, Solution, delta_bounds, solve
-from .continuation import Curve, curve
-from .io import read_curve
+from .solution import STATUS_MESSAGES, Solution
+from .state import delta_bounds, solve
+from .continuation import curve
+from .io import Curve, read_curve
 from .units import Dimensions, beta_from_thickness, parse_quantity
 
-__version__ = "0.1.0.dev0"
+from .version import __version__  # noqa: F401  (sb.__version__)
 
 _LAZY = {"fit": "fitting", "FitResult": "fitting", "read_force_csv": "fitting"}
 

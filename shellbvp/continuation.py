@@ -19,121 +19,22 @@ from __future__ import annotations
 import logging
 import math
 import time
-from dataclasses import dataclass, field
 
 import numpy as np
 
+from .io import POINT_FIELDS, Curve, point_record
 from .liftoff import replace_invalid_cap
-from .state import (SC_POINT, Solution, _default_eps, _warm_guess, check_delta, check_tol, make_system,
-                    richardson_error, solve, solve_from, solve_point_load, thin_mesh)
+from .pointload import SC_POINT, solve_point_load
+from .solution import Solution, default_eps, richardson_error, thin_mesh
+from .state import check_delta, check_tol, make_system, solve, solve_from, warm_guess
+from .version import __version__ as VERSION
 
-__all__ = ["Curve", "curve", "POINT_FIELDS"]
+__all__ = ["curve"]
 
 log = logging.getLogger(__name__)
 
-#: Per-point fields of a curve (arrays of the Curve and datasets of its HDF5 file).
-POINT_FIELDS = (
-    "delta", "force", "lambda0", "Sc", "status", "valid", "max_residual", "nodes", "niter",
-    "force_error", "delta_error", "energy", "ring_force", "cap_force", "pressure_min",
-    "penetration", "force_defect", "edge_legendre", "wall_time", "topology", "S1", "ring_force_inner",
-)
-#: Fields a single-cap state does not carry, with their cap values (also what files of
-#: format version 1, which predate them, read as).
-CAP_FIELD_DEFAULTS = {"topology": "cap", "S1": 0.0, "ring_force_inner": 0.0}
-
-
-@dataclass
-class Curve:
-    """A force–displacement curve: per-point arrays and how it was made.
-
-    Attributes
-    ----------
-    scene : Scene
-    delta, force, lambda0, Sc, ... : ndarray
-        One entry per point (see ``POINT_FIELDS``), in the order computed along
-        the branch (increasing delta unless the branch folds back).
-    energy_residual : ndarray
-        ``dE/ddelta - F`` at each point, dE/ddelta by finite differences of the
-        energies along the curve (second order on the non-uniform grid): ~0 for
-        the smooth contact model, finite for the paper's.
-    flags : list of str
-        Per point, "; "-joined validity flags ("" when valid).
-    stop_reason : str
-    complete : bool
-        The stopping rule was reached (False: failure or interruption).
-    interrupted : bool
-    settings : dict
-        Solver and continuation settings.
-    solutions : list of Solution
-        In memory only (profiles); not stored unless ``to_hdf5(profiles=True)``.
-    """
-
-    scene: object
-    points: dict
-    flags: list
-    stop_reason: str
-    complete: bool
-    interrupted: bool
-    settings: dict
-    solutions: list = field(default_factory=list, repr=False)
-    version: str = ""
-
-    def __getattr__(self, name):
-        points = self.__dict__.get("points", {})
-        if name in points:
-            return points[name]
-        raise AttributeError(name)
-
-    def __len__(self):
-        return len(self.points["delta"])
-
-    @property
-    def energy_residual(self):
-        return energy_residual(self.points["delta"], self.points["energy"], self.points["force"])
-
-    def to_hdf5(self, path, *, profiles: bool = False, overwrite: bool = False, units=None):
-        """Write the curve to an HDF5 file atomically (see ``shellbvp.io``)."""
-        from .io import write_curve
-
-        write_curve(self, path, profiles=profiles, overwrite=overwrite, units=units)
-
-    def topology_summary(self) -> str:
-        """Runs of contact topology along the curve, e.g. 'point x2, line x6, cap x27'."""
-        import itertools
-
-        runs = [f"{k} x{len(list(g))}" for k, g in itertools.groupby(self.points["topology"])]
-        switches = self.settings.get("topology_switches") or []
-        where = "; ".join(f"{s['from']} -> {s['to']} at delta = {s['delta']:.6g}" for s in switches)
-        return ", ".join(runs) + (f" (switch {where})" if where else "")
-
-    def summary(self) -> str:
-        n = len(self)
-        if n == 0:
-            return f"0 points ({self.stop_reason})"
-        d, F = self.points["delta"], self.points["force"]
-        nvalid = int(np.sum(self.points["valid"]))
-        return (f"{n} points, delta {d.min():.4g}..{d.max():.4g}, F {F.min():.4g}..{F.max():.4g}, "
-                f"{nvalid} valid; stopped: {self.stop_reason}")
-
-
-def energy_residual(delta, energy, force):
-    """dE/ddelta - F along a curve (np.gradient, second order, non-uniform spacing)."""
-    delta, energy, force = (np.asarray(a, float) for a in (delta, energy, force))
-    if delta.size < 3 or np.any(np.diff(delta) == 0):
-        return np.full(delta.shape, np.nan)
-    return np.gradient(energy, delta, edge_order=2) - force
-
-
 class _Stop(Exception):
     pass
-
-
-def _record(sol: Solution):
-    row = {k: sol.get(k, CAP_FIELD_DEFAULTS.get(k, np.nan)) for k in POINT_FIELDS}
-    if row["topology"] == "point":
-        row["S1"] = 0.0
-    row["valid"] = bool(sol.get("valid", False))
-    return row
 
 
 def _X(sol):
@@ -206,12 +107,11 @@ def curve(scene, delta_max: float = 0.5, *, deltas=None, force_max=None, lambda0
     settings = dict(tol=tol, max_nodes=max_nodes, delta_max=delta_max, force_max=force_max,
                     lambda0_max=lambda0_max, max_steps=max_steps, delta_start=delta_start,
                     delta_min=delta_min, ds_max=ds_max, estimate_error=estimate_error,
-                    mode="deltas" if deltas is not None else "adaptive", eps=_default_eps(tol),
+                    mode="deltas" if deltas is not None else "adaptive", eps=default_eps(tol),
                     bc_tol=1e-10, topology=topology)
-    from . import __version__
 
     out = Curve(scene=scene, points={k: [] for k in POINT_FIELDS}, flags=[], stop_reason="",
-                complete=False, interrupted=False, settings=settings, version=__version__)
+                complete=False, interrupted=False, settings=settings, version=VERSION)
     builder = _Builder(out, callback, estimate_error, settings)
     t0 = time.perf_counter()
     try:
@@ -273,7 +173,7 @@ class _Builder:
         sol = self._shown(sol)
         if self.estimate_error and sol.success:
             richardson_error(sol.system, sol, self.tol)
-        self.rows.append((key, _record(sol), "; ".join(sol.get("flags", [])), sol))
+        self.rows.append((key, point_record(sol), "; ".join(sol.get("flags", [])), sol))
         if self.callback is not None:
             self.callback(self.snapshot(), sol)
 
@@ -409,7 +309,7 @@ def _solve_at_delta(scene, delta, prev, prev2, settings):
     if prev.get("topology") == "point":
         return _step_from_point(scene, delta, prev, settings)
     sysm = make_system(scene, "delta", delta, settings["eps"])
-    guess = _warm_guess(sysm, prev)
+    guess = warm_guess(sysm, prev)
     if prev2 is not None and prev2.delta != prev.delta and prev2.get("topology") != "point":
         a = (delta - prev.delta) / (prev.delta - prev2.delta)
         guess = _secant(sysm, prev, prev2, a)

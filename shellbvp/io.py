@@ -1,4 +1,6 @@
-"""HDF5 files of curves: atomic writes, a documented self-describing layout.
+"""Curves as records: the per-point schema, :class:`Curve`, and its HDF5 file
+(atomic writes, a documented self-describing layout).  The continuation
+algorithm (``shellbvp.continuation``) fills a Curve; this module owns its shape.
 
 Layout (format ``shellbvp-curve``, version 2; version 1 lacked topology, S1 and
 ring_force_inner, which read as a single cap)::
@@ -16,7 +18,7 @@ ring_force_inner, which read as a single cap)::
                               R_L_m, mu_H_N_per_m (then delta_m, force_N datasets exist)
     /curve/delta            (n,) axis: pole displacement / R_L
     /curve/force            (n,) signal: indenter force / (mu H R_L)
-    /curve/<field>          (n,) each of shellbvp.continuation.POINT_FIELDS, plus
+    /curve/<field>          (n,) each of POINT_FIELDS, plus
                             energy_residual (dE/ddelta - F) and flags (strings);
                             topology (strings: cap, annulus, line, point)
     /curve/profiles/point_<i>   optional (profiles=True): S, region, r, z, ... at the
@@ -33,16 +35,118 @@ import datetime as _dt
 import json
 import os
 import tempfile
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
 from .paths import check_output_path
+from .version import __version__
 
-__all__ = ["write_curve", "read_curve", "FORMAT", "FORMAT_VERSION"]
+__all__ = ["Curve", "POINT_FIELDS", "CAP_FIELD_DEFAULTS", "point_record", "energy_residual", "write_curve",
+           "read_curve", "FORMAT", "FORMAT_VERSION"]
 
 FORMAT = "shellbvp-curve"
 FORMAT_VERSION = 2
+
+#: Per-point fields of a curve (arrays of the Curve and datasets of its HDF5 file).
+POINT_FIELDS = (
+    "delta", "force", "lambda0", "Sc", "status", "valid", "max_residual", "nodes", "niter",
+    "force_error", "delta_error", "energy", "ring_force", "cap_force", "pressure_min",
+    "penetration", "force_defect", "edge_legendre", "wall_time", "topology", "S1", "ring_force_inner",
+)
+#: Fields a single-cap state does not carry, with their cap values (also what files of
+#: format version 1, which predate them, read as).
+CAP_FIELD_DEFAULTS = {"topology": "cap", "S1": 0.0, "ring_force_inner": 0.0}
+
+
+@dataclass
+class Curve:
+    """A force–displacement curve: per-point arrays and how it was made.
+
+    Attributes
+    ----------
+    scene : Scene
+    delta, force, lambda0, Sc, ... : ndarray
+        One entry per point (see ``POINT_FIELDS``), in the order computed along
+        the branch (increasing delta unless the branch folds back).
+    energy_residual : ndarray
+        ``dE/ddelta - F`` at each point, dE/ddelta by finite differences of the
+        energies along the curve (second order on the non-uniform grid): ~0 for
+        the smooth contact model, finite for the paper's.
+    flags : list of str
+        Per point, "; "-joined validity flags ("" when valid).
+    stop_reason : str
+    complete : bool
+        The stopping rule was reached (False: failure or interruption).
+    interrupted : bool
+    settings : dict
+        Solver and continuation settings.
+    solutions : list of Solution
+        In memory only (profiles); not stored unless ``to_hdf5(profiles=True)``.
+    """
+
+    scene: object
+    points: dict
+    flags: list
+    stop_reason: str
+    complete: bool
+    interrupted: bool
+    settings: dict
+    solutions: list = field(default_factory=list, repr=False)
+    version: str = ""
+
+    def __getattr__(self, name):
+        points = self.__dict__.get("points", {})
+        if name in points:
+            return points[name]
+        raise AttributeError(name)
+
+    def __len__(self):
+        return len(self.points["delta"])
+
+    @property
+    def energy_residual(self):
+        return energy_residual(self.points["delta"], self.points["energy"], self.points["force"])
+
+    def to_hdf5(self, path, *, profiles: bool = False, overwrite: bool = False, units=None):
+        """Write the curve to an HDF5 file atomically (see :func:`write_curve`)."""
+        write_curve(self, path, profiles=profiles, overwrite=overwrite, units=units)
+
+    def topology_summary(self) -> str:
+        """Runs of contact topology along the curve, e.g. 'point x2, line x6, cap x27'."""
+        import itertools
+
+        runs = [f"{k} x{len(list(g))}" for k, g in itertools.groupby(self.points["topology"])]
+        switches = self.settings.get("topology_switches") or []
+        where = "; ".join(f"{s['from']} -> {s['to']} at delta = {s['delta']:.6g}" for s in switches)
+        return ", ".join(runs) + (f" (switch {where})" if where else "")
+
+    def summary(self) -> str:
+        n = len(self)
+        if n == 0:
+            return f"0 points ({self.stop_reason})"
+        d, F = self.points["delta"], self.points["force"]
+        nvalid = int(np.sum(self.points["valid"]))
+        return (f"{n} points, delta {d.min():.4g}..{d.max():.4g}, F {F.min():.4g}..{F.max():.4g}, "
+                f"{nvalid} valid; stopped: {self.stop_reason}")
+
+
+def energy_residual(delta, energy, force):
+    """dE/ddelta - F along a curve (np.gradient, second order, non-uniform spacing)."""
+    delta, energy, force = (np.asarray(a, float) for a in (delta, energy, force))
+    if delta.size < 3 or np.any(np.diff(delta) == 0):
+        return np.full(delta.shape, np.nan)
+    return np.gradient(energy, delta, edge_order=2) - force
+
+
+def point_record(sol) -> dict:
+    """One point of a curve from a Solution: every POINT_FIELDS value (cap defaults where absent)."""
+    row = {k: sol.get(k, CAP_FIELD_DEFAULTS.get(k, np.nan)) for k in POINT_FIELDS}
+    if row["topology"] == "point":
+        row["S1"] = 0.0
+    row["valid"] = bool(sol.get("valid", False))
+    return row
 
 
 def _check_units(units):
@@ -80,7 +184,6 @@ def write_curve(curve, path, *, profiles=False, overwrite=False, units=None):
     """
     import h5py
 
-    from . import __version__
 
     path = Path(path)
     dims = _check_units(units)
@@ -148,7 +251,6 @@ def write_curve(curve, path, *, profiles=False, overwrite=False, units=None):
 
 def _missing_field(name, n):
     """A field added after format version 1, as an older (single-cap) file reads it."""
-    from .continuation import CAP_FIELD_DEFAULTS
 
     return np.full(n, CAP_FIELD_DEFAULTS[name], dtype=object if name == "topology" else float)
 
@@ -234,7 +336,6 @@ def _points(g):
     """Every point field (and flags), checked; fields added after version 1 default to a cap's."""
     import h5py
 
-    from .continuation import CAP_FIELD_DEFAULTS, POINT_FIELDS
 
     if "delta" not in g or not isinstance(g["delta"], h5py.Dataset):
         raise ValueError("dataset delta missing")
@@ -276,7 +377,6 @@ def read_curve(path):
     """
     import h5py
 
-    from .continuation import Curve
     from .scene import Scene
 
     path = Path(path)

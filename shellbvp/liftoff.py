@@ -23,9 +23,20 @@ import math
 import time
 
 import numpy as np
+
 from .chain import ChainBVP, annulus_chain, line_chain
-from .state import (STATUS_MESSAGES, Solution, _attach_tip, _penetration, richardson_error, set_status, solve_bvp,
-                    thin_mesh)
+from .pointload import solve_point_load
+from .solution import (
+    STATUS_MESSAGES,
+    Solution,
+    attach_tip_table,
+    default_eps,
+    penetration,
+    richardson_error,
+    set_status,
+    solve_bvp,
+    thin_mesh,
+)
 
 __all__ = ["solve_liftoff", "solve_liftoff_from", "make_liftoff_system", "liftoff_guess_from_cap",
            "liftoff_warm_guess", "liftoff_state", "valid_liftoff_state", "lift_off_suspected",
@@ -39,7 +50,7 @@ def make_liftoff_system(scene, topology, control, value, eps):
         raise ValueError(f"control must be 'delta', 'force' or 'lambda0' for {topology} contact; got {control!r}")
     chain = (annulus_chain if topology == "annulus" else line_chain)(eps, scene.shell_length)
     sysm = ChainBVP(scene, chain, control, value)
-    _attach_tip(sysm)
+    attach_tip_table(sysm)
     return sysm
 
 
@@ -102,13 +113,11 @@ def solve_liftoff(scene, topology, *, delta=None, force=None, lambda0=None, gues
     Exactly one of ``delta`` (indenter displacement), ``force`` or ``lambda0`` (the
     stretch at the lifted pole) is prescribed.
     """
-    from .state import _default_eps
-
     given = [(k, v) for k, v in (("delta", delta), ("force", force), ("lambda0", lambda0)) if v is not None]
     if len(given) != 1:
         raise ValueError("give exactly one of delta, force or lambda0")
     (control, value), = given
-    eps = _default_eps(tol) if eps is None else eps
+    eps = default_eps(tol) if eps is None else eps
     t0 = time.perf_counter()
     sysm = make_liftoff_system(scene, topology, control, value, eps)
     if isinstance(guess, Solution):
@@ -200,8 +209,8 @@ def _diagnose(sysm: ChainBVP, bvp, tol):
     t_leg = np.array([0.0, 0.5])
     leg = mod.free_legendre(sysm.S(len(sysm.regions) - 1, t_leg, p), bvp.sol(t_leg)[sysm.rows(-1)], par)[0]
     res.edge_legendre = float(leg[0] / leg[1]) if leg[1] != 0 else nan
-    res.penetration = max(_penetration(sysm, pin["r"], pin["z"], z_tip),
-                          _penetration(sysm, pout["r"], pout["z"], z_tip))
+    res.penetration = max(penetration(sysm, pin["r"], pin["z"], z_tip),
+                          penetration(sysm, pout["r"], pout["z"], z_tip))
     res.energy = sysm.energy(bvp.sol, bvp.x, p)
     vflags = []
     scale = 10 * tol * (1 + abs(force))
@@ -306,8 +315,6 @@ def valid_liftoff_state(cap: Solution, *, tol=1e-6, max_nodes=10000, bc_tol=1e-1
     """
     tried = []
     if cap.Sc < POINT_LIMIT_SC and cap.control == "delta":
-        from .state import solve_point_load
-
         res = solve_point_load(cap.scene, cap.delta, tol=tol, max_nodes=max_nodes, guess=cap, bc_tol=bc_tol)
         if res.success and res.valid:
             return res, tried

@@ -14,167 +14,24 @@ import time
 
 import numpy as np
 
-from .chain import ChainBVP, cap_chain, point_chain
-from .quadrature import gauss_points
+from .chain import ChainBVP, cap_chain
+from .pointload import SC_POINT, solve_point_load
+from .solution import (
+    STATUS_MESSAGES,
+    Solution,
+    attach_tip_table,
+    default_eps,
+    penetration,
+    richardson_error,
+    set_status,
+    solve_bvp,
+    thin_mesh,
+)
 
-__all__ = ["Solution", "solve", "STATUS_MESSAGES", "delta_bounds"]
+__all__ = ["solve", "solve_from", "make_system", "warm_guess", "delta_bounds", "check_delta", "check_tol",
+           "TOPOLOGIES"]
 
 log = logging.getLogger(__name__)
-
-STATUS_MESSAGES = {
-    0: "converged",
-    1: "the maximum number of mesh nodes was exceeded: raise max_nodes or loosen tol, or start "
-       "from a neighbouring solution (guess=)",
-    2: "a singular Jacobian was met: the guess is too far from a solution; start from a "
-       "neighbouring solution (guess=) or use sb.curve",
-    3: "solve_bvp could not satisfy the boundary conditions to bc_tol",
-    4: "converged to an inadmissible state (see message): start from a neighbouring solution",
-    5: "no initial guess converged (crude guesses and continuation from small delta)",
-}
-
-
-class _NonFinite(Exception):
-    """Raised inside solve_bvp by a Jacobian with NaN or inf entries (see :func:`solve_bvp`)."""
-
-
-def _finite_jacobian(jac, what):
-    """``jac`` that refuses to hand non-finite entries to solve_bvp's sparse LU."""
-    def checked(*args):
-        out = jac(*args)
-        for block in (out if isinstance(out, tuple) else (out,)):
-            if block is not None and not np.all(np.isfinite(block)):
-                raise _NonFinite(what)
-        return out
-
-    return checked
-
-
-class _NoSolution:
-    """Interpolant of a run that produced no state: NaN everywhere."""
-
-    def __init__(self, n):
-        self.n = n
-
-    def __call__(self, t):
-        t = np.asarray(t, float)
-        return np.full((self.n,) + t.shape, np.nan)
-
-
-def _failed_run(x, y, p, status, message):
-    """A solve_bvp-like result of a run stopped before (or instead of) a LAPACK call."""
-    from scipy.optimize import OptimizeResult
-
-    x = np.asarray(x, float)
-    n = np.shape(y)[0]
-    p = None if p is None else np.full(np.shape(p), np.nan)
-    return OptimizeResult(sol=_NoSolution(n), p=p, x=x, y=np.full((n, x.size), np.nan),
-                          yp=np.full((n, x.size), np.nan), rms_residuals=np.full(max(x.size - 1, 0), np.nan),
-                          niter=0, status=status, message=message, success=False)
-
-
-def solve_bvp(fun, bc, x, y, p=None, *, fun_jac, bc_jac, **kwargs):
-    """scipy.integrate.solve_bvp, imported on first use (scipy.integrate is most of the
-    import time of shellbvp, and reading files or loading a model does not need it),
-    with a guard on what reaches its linear algebra.
-
-    A guess with NaN/inf or a mesh that is not strictly increasing, and a Jacobian
-    that overflows during Newton (a state far outside the model's domain, e.g. an
-    extreme scene), end the run with status 2 instead: solve_bvp would pass such a
-    matrix to SuperLU, whose BLAS calls then print ``** On entry to DGEMV parameter
-    number 2 had an illegal value`` on stdout (Fortran, not Python) and return garbage.
-    """
-    from scipy.integrate import solve_bvp as _solve_bvp
-
-    xa = np.asarray(x, float)
-    if xa.ndim != 1 or xa.size < 2 or not np.all(np.isfinite(xa)) or not np.all(np.diff(xa) > 0):
-        return _failed_run(x, y, p, 2, "degenerate mesh (not strictly increasing and finite): no solve")
-    if not np.all(np.isfinite(y)) or (p is not None and not np.all(np.isfinite(p))):
-        return _failed_run(x, y, p, 2, "the initial guess has NaN or inf entries: no solve")
-    try:
-        return _solve_bvp(fun, bc, x, y, p, fun_jac=_finite_jacobian(fun_jac, "fun_jac"),
-                          bc_jac=_finite_jacobian(bc_jac, "bc_jac"), **kwargs)
-    except _NonFinite as exc:
-        return _failed_run(x, y, p, 2, f"the Jacobian ({exc}) overflowed to NaN/inf during Newton: the "
-                                       f"iterate left the model's domain (no solve of the collocation system)")
-
-
-class Solution(dict):
-    """Result of :func:`solve` (a dict with attribute access, like OptimizeResult).
-
-    Attributes
-    ----------
-    success : bool
-        Converged to an admissible state (``status == 0``).
-    status : int
-        0 converged; 1 too many nodes; 2 singular Jacobian; 3 boundary conditions
-        not met to ``bc_tol``; 4 inadmissible (delta < 0, cap beyond the tip, ...);
-        5 no guess converged.  See ``STATUS_MESSAGES``.
-    message : str
-    delta, force, lambda0, Sc : float
-        Pole displacement, indenter force F (> 0 pushing), pole stretch, contact circle.
-    x, y, p, sol, rms_residuals, niter
-        solve_bvp's mesh on t in [0, 1], stacked states (8, m) (layout in
-        ``shellbvp.chain``), unknown parameters, interpolant, residuals, iterations.
-    nodes : int
-    max_residual : float
-        Largest relative collocation residual.
-    energy : float
-        ``E = 2 pi Int U R Psi dS`` (F = dE/ddelta for the smooth model).
-    ring_force, cap_force : float
-        Axial force of the ring at Sc (jump of Q) and of the pressure on the cap;
-        ``force = ring_force + cap_force``.  For ``contact="paper"`` the ring force is ~0.
-    pressure_min : float
-        Minimum contact pressure over the cap (< 0: the shell would pull the indenter).
-    edge_legendre : float
-        det d(tau_s, M_s)/d(lambda_s, kappa_s) at Sc+ relative to mid-region; it goes to 0
-        where the energy loses convexity at the contact edge and the branch ends.
-    penetration : float
-        Largest height of the free shell above the indenter's surface (> 0: it passes
-        through the indenter).
-    valid : bool
-        pressure_min >= 0, ring_force >= 0, no penetration, contact on the tip.
-    flags : list of str
-        Why the state is not valid (empty when valid).
-    force_defect : float
-        max |F(S) - F| over the free region (F is a first integral there).
-    force_error, delta_error : float
-        Richardson error estimates (halved mesh; NaN if not estimated).
-    wall_time : float
-        Seconds.
-    """
-
-    def __getattr__(self, name):
-        try:
-            return self[name]
-        except KeyError:
-            raise AttributeError(name) from None
-
-    __setattr__ = dict.__setitem__
-
-    def __repr__(self):
-        keys = ("success", "status", "delta", "force", "lambda0", "Sc", "nodes", "valid")
-        inner = ", ".join(f"{k}={self.get(k)!r}" for k in keys)
-        return f"Solution({inner})"
-
-    # -- fields over S ------------------------------------------------------------------
-    def profile(self, points_per_interval: int = 1):
-        """Physical fields over S, pole to rim.
-
-        Returns a dict of 1-D arrays: ``S`` (increasing), ``region`` (0 on the indenter,
-        1 free; a lifted pole's free cap comes first), ``r``, ``z``,
-        ``phi``, ``lambda_s``, ``lambda_theta``, ``kappa_s``, ``kappa_theta``, ``T_s``,
-        ``T_theta``, ``M_s``, ``M_theta``, ``tau_s``, ``tau_theta``, ``Q``, ``P``,
-        ``axial_force`` (F(S), the axial force carried across the circle S), ``energy_density``.
-        For a point-load state (``topology == "point"``) there is no contact region.
-        ``points_per_interval > 1`` adds points between mesh nodes (from the interpolant).
-        """
-        sysm = self["system"]
-        t = self.x
-        if points_per_interval > 1:
-            t = np.unique(np.concatenate([np.linspace(a, b, points_per_interval + 1)
-                                          for a, b in zip(t[:-1], t[1:])]))
-        return sysm.profile(t, self.sol(t), self.p, self["z_tip"])
-
 
 def _undeformed_guess(sysm: ChainBVP, ln_Sc, lambda0, delta, n=41):
     """Crude start: the reference shell moved down by delta, a small cap at stretch lambda0."""
@@ -199,13 +56,7 @@ def _undeformed_guess(sysm: ChainBVP, ln_Sc, lambda0, delta, n=41):
     return t, y, p
 
 
-def thin_mesh(x, keep_every: int = 3):
-    """Every ``keep_every``-th node plus the ends (solve_bvp only ever adds nodes)."""
-    idx = np.unique(np.r_[np.arange(0, x.size, keep_every), x.size - 1])
-    return x[idx]
-
-
-def _warm_guess(sysm: ChainBVP, prev: "Solution", predictor=None):
+def warm_guess(sysm: ChainBVP, prev: "Solution", predictor=None):
     """Previous cap solution on a thinned mesh; optional predicted (y, p) shift."""
     x = thin_mesh(prev.x)
     y = prev.sol(x)
@@ -215,19 +66,6 @@ def _warm_guess(sysm: ChainBVP, prev: "Solution", predictor=None):
         y = y + dy(x)
         p = p + dp
     return x, y, p
-
-
-def set_status(res, bvp, flags, converged_note=""):
-    """status, message and success of a diagnosed state: a converged run whose state
-    breaks an admissibility check (``flags``) gets status 4."""
-    if bvp.status == 0 and flags:
-        res.status = 4
-        res.message = STATUS_MESSAGES[4] + ": " + "; ".join(flags)
-    elif bvp.status == 0:
-        res.message = STATUS_MESSAGES[0] + converged_note
-    elif not res.message:
-        res.message = STATUS_MESSAGES.get(bvp.status, "")
-    res.success = res.status == 0
 
 
 def _diagnose(sysm: ChainBVP, bvp, tol):
@@ -280,7 +118,7 @@ def _diagnose(sysm: ChainBVP, bvp, tol):
     leg = mod.free_legendre(sysm.S(1, t_leg, bvp.p), bvp.sol(t_leg)[sysm.rows(1)], par)[0]
     res.edge_legendre = float(leg[0] / leg[1]) if leg[1] != 0 else float("nan")
     res.pressure_min = float(np.min(pc["P"]))
-    res.penetration = _penetration(sysm, pf["r"], pf["z"], res.z_tip)
+    res.penetration = penetration(sysm, pf["r"], pf["z"], res.z_tip)
     res.energy = sysm.energy(bvp.sol, bvp.x, bvp.p)
     vflags = []
     scale = 10 * tol
@@ -296,17 +134,6 @@ def _diagnose(sysm: ChainBVP, bvp, tol):
     return res
 
 
-def _penetration(sysm, r, z, z_tip):
-    """Largest height of free-shell points above the indenter's lower surface."""
-    A, B = sysm.tip_A, sysm.tip_B
-    rho = sysm.scene.rho
-    inside = r < rho * A[-1]
-    if not np.any(inside):
-        return -np.inf
-    surface = z_tip + rho * np.interp(r[inside] / rho, A, B)
-    return float(np.max(z[inside] - surface))
-
-
 def _run_bvp(sysm, guess, tol, max_nodes, bc_tol):
     x, y, p = guess
     with np.errstate(all="ignore"):
@@ -314,16 +141,10 @@ def _run_bvp(sysm, guess, tol, max_nodes, bc_tol):
                          tol=tol, bc_tol=bc_tol, max_nodes=max_nodes)
 
 
-def _attach_tip(sysm):
-    """Tabulated tip profile for penetration checks (A increasing up to omega_max)."""
-    shape = sysm.model.tip_shape(np.linspace(0.0, sysm.scene.tip_omega_max, 401), sysm.par)
-    sysm.tip_A, sysm.tip_B = shape["A"], shape["B"]
-
-
 def make_system(scene, control, value, eps):
     """The single-cap system (``shellbvp.chain.cap_chain``) of a scene, control and value."""
     sysm = ChainBVP(scene, cap_chain(eps, scene.shell_length, scene.contact), control, value)
-    _attach_tip(sysm)
+    attach_tip_table(sysm)
     return sysm
 
 
@@ -335,128 +156,6 @@ def solve_from(sysm, guess, *, tol=1e-6, max_nodes=10000, bc_tol=None):
         res = _diagnose(sysm, bvp, tol)
     res.wall_time = time.perf_counter() - t0
     return res
-
-
-def richardson_error(sysm, res, tol, bc_tol=1e-10):
-    """Set ``force_error`` and ``delta_error`` by Richardson extrapolation (any topology).
-
-    The collocation solution (Lobatto IIIA, order 4) is recomputed on the
-    converged mesh with every interval halved, without further refinement
-    (``max_nodes`` pins the mesh; Newton converges to tol/100 and bc_tol/100, so the
-    coarse solve's iteration and boundary errors are included); the error of
-    the coarse value is then ``|X_h - X_h/2| * 16/15``.  Costs one Newton
-    solve on twice the nodes.  ``sysm.end_values`` gives (F, delta) of a solution.
-    """
-    x = res.x
-    x2 = np.sort(np.r_[x, 0.5 * (x[1:] + x[:-1])])
-    p = np.asarray(res.p, float)
-    with np.errstate(all="ignore"):
-        fine = solve_bvp(sysm.fun, sysm.bc, x2, res.sol(x2), p if p.size else None, fun_jac=sysm.fun_jac,
-                         bc_jac=sysm.bc_jac, tol=tol / 100, bc_tol=bc_tol / 100, max_nodes=x2.size)
-        if fine.status == 2 or not np.all(np.isfinite(fine.y)) \
-                or (fine.p is not None and not np.all(np.isfinite(fine.p))):
-            res.force_error = res.delta_error = float("nan")
-            res.flags = list(res.flags) + ["error estimate failed (Newton on the halved mesh did not converge)"]
-            return
-        force, delta = sysm.end_values(fine.y[:, 0], fine.y[:, -1], fine.p)
-    res.force_error = abs(force - res.force) * 16 / 15
-    res.delta_error = abs(delta - res.delta) * 16 / 15
-
-
-#: Caps smaller than this are replaced by the point-load limit (their own equations
-#: leave double precision near Sc ~ 1e-75; the difference is exponentially small).
-SC_POINT = 1e-30
-#: Start of the point-load state's free region (truncation error O(s0^2 ln^2 s0)).
-POINT_S0 = 1e-12
-
-
-def _point_guess(sysm, prev):
-    """Free states for the point-load problem from a cap or point solution."""
-    if prev.get("topology") == "point":
-        x = thin_mesh(prev.x)
-        return x, prev.sol(x)
-    x = np.linspace(0.0, 1.0, 61)
-    cap = prev.system
-    tp = np.clip(cap.t_of(1, sysm.S(0, x, None), prev.p), 0.0, 1.0)
-    return x, prev.sol(tp)[cap.rows(1)]
-
-
-def _crude_point_guess(sysm):
-    x = np.linspace(0.0, 1.0, 61)
-    S = sysm.S(0, x, None)
-    ref = sysm.model.reference_shell(S, sysm.par)
-    lam = 0.95
-    y = np.vstack([np.full(x.size, lam), ref["Phi"] / S, np.full(x.size, lam), ref["kappa_s"],
-                   np.zeros(x.size), ref["Z"] - sysm.value * (1 - (S - S[0]) / (S[-1] - S[0]))])
-    return x, y
-
-
-def solve_point_load(scene, delta, *, tol=1e-6, max_nodes=10000, guess=None, bc_tol=1e-10):
-    """The point-load limit of the smooth model at pole displacement ``delta``.
-
-    When the contact cap is exponentially small (``Sc`` below ~1e-30, which
-    happens as delta -> 0) the cap's own equations leave double precision and
-    the state is the point-load solution to exponential accuracy: the free
-    region alone on ``[s0, L]`` with the point-load pole conditions
-    (``shellbvp.chain.point_chain``).
-    """
-    t0 = time.perf_counter()
-    sysm = ChainBVP(scene, point_chain(POINT_S0, scene.shell_length), "delta", delta)
-    _attach_tip(sysm)
-    x, y = _point_guess(sysm, guess) if guess is not None else _crude_point_guess(sysm)
-    with np.errstate(all="ignore"):
-        bvp = solve_bvp(sysm.fun, sysm.bc, x, y, fun_jac=sysm.fun_jac, bc_jac=sysm.bc_jac, tol=tol,
-                        bc_tol=bc_tol, max_nodes=max_nodes)
-        sysm.tol = tol
-        res = _diagnose_point(sysm, bvp)
-    res.wall_time = time.perf_counter() - t0
-    return res
-
-
-def _diagnose_point(sysm, bvp):
-    mod, par = sysm.model, sysm.par
-    nan = float("nan")
-    ya = bvp.y[:, 0]
-    force, delta = sysm.end_values(ya, bvp.y[:, -1])
-    res = Solution(
-        topology="point", status=int(bvp.status), message=bvp.message, x=bvp.x, y=bvp.y, p=np.array([]),
-        sol=bvp.sol, rms_residuals=bvp.rms_residuals, niter=int(bvp.niter), nodes=int(bvp.x.size),
-        max_residual=float(np.max(bvp.rms_residuals)) if bvp.rms_residuals.size else nan,
-        # lambda0 is not defined in this limit: the stretches vary like ln^2 S near a point force.
-        delta=delta, lambda0=float("nan"), Sc=0.0, force=force, ring_force=force, cap_force=0.0,
-        control="delta", scene=sysm.scene, system=sysm,
-        z_tip=float(mod.reference_shell(0.0, par)["Z"]) - delta,
-    )
-    flags = []
-    if not (np.all(np.isfinite(bvp.y)) and math.isfinite(force)):
-        flags.append("non-finite state")
-    elif bvp.status == 0 and np.any(bvp.y[[0, 2]] <= 0):
-        flags.append("non-positive stretch")
-    set_status(res, bvp, flags, " (point-load limit: the contact cap is exponentially small)")
-    res.update(pressure_min=nan, penetration=nan, valid=False, force_error=nan, delta_error=0.0)
-    if not res.success or flags:
-        res.update(energy=nan, force_defect=nan, flags=flags)
-        return res
-    t = np.unique(np.r_[bvp.x, 0.5 * (bvp.x[1:] + bvp.x[:-1])])
-    (_, _, pf), = sysm.region_profiles(t, bvp.sol(t), None)
-    res.force_defect = float(np.max(np.abs(2 * np.pi * pf["axial_force_2pi"] - force)))
-    res.energy = sysm.energy(bvp.sol, bvp.x, None)
-    # The point load is the limit of contact on a vanishing circle (line contact): valid
-    # when it pushes and the shell stays outside the indenter.
-    res.penetration = _penetration(sysm, pf["r"], pf["z"], res.z_tip)
-    vflags = []
-    if force < 0:
-        vflags.append(f"negative point force ({force:.3g})")
-    if res.penetration > 10 * sysm.tol:
-        vflags.append(f"the free shell passes through the indenter (by {res.penetration:.3g})")
-    res.flags = vflags
-    res.valid = not vflags
-    return res
-
-
-def _default_eps(tol):
-    # Pole start zeta = eps*Sc: the truncated series errs by O(eps^2) relative.
-    return min(1e-3, 0.1 * math.sqrt(tol))
 
 
 TOPOLOGIES = ("auto", "cap", "line", "annulus")
@@ -553,7 +252,7 @@ def solve(scene, *, delta=None, lambda0=None, force=None, tol=1e-6, max_nodes=10
     check_tol(tol)
     if not (isinstance(max_nodes, (int, np.integer)) and max_nodes >= 10):
         raise ValueError(f"max_nodes must be an integer >= 10; got {max_nodes!r}")
-    eps = _default_eps(tol) if eps is None else float(eps)
+    eps = default_eps(tol) if eps is None else float(eps)
     if not 0 < eps < 0.5:
         raise ValueError(f"eps (pole start zeta = eps*Sc) must be in (0, 0.5); got {eps!r}")
     if topology not in TOPOLOGIES:
@@ -579,7 +278,7 @@ def solve(scene, *, delta=None, lambda0=None, force=None, tol=1e-6, max_nodes=10
     sysm = make_system(scene, control, value, eps)
     kw = dict(tol=tol, max_nodes=max_nodes, bc_tol=bc_tol)
     if guess is not None:
-        res = solve_from(sysm, _warm_guess(sysm, guess), **kw)
+        res = solve_from(sysm, warm_guess(sysm, guess), **kw)
     elif control == "delta":
         res = _cold_delta(sysm, value, **kw)
     else:
@@ -616,7 +315,7 @@ def _loose(kw):
 def _tighten(sysm, res, **kw):
     if not res.success or kw["tol"] >= _CRUDE_TOL:
         return res
-    return solve_from(sysm, _warm_guess(sysm, res), **kw)
+    return solve_from(sysm, warm_guess(sysm, res), **kw)
 
 
 def _cold_delta(sysm, delta, **kw):
@@ -664,7 +363,7 @@ def _continue_in_delta(scene, eps, target, starts=(0.1, 0.05), **kw):
             nxt = solve_point_load(scene, nd, tol=kw["tol"], max_nodes=kw["max_nodes"], guess=res)
         else:
             sysm = make_system(scene, "delta", nd, eps)
-            nxt = solve_from(sysm, _warm_guess(sysm, res), **kw)
+            nxt = solve_from(sysm, warm_guess(sysm, res), **kw)
             if not up and scene.contact == "smooth" and (not nxt.success or nxt.Sc < SC_POINT) \
                     and res.Sc < 1e-8:
                 # the cap is leaving double precision: continue with its point-load limit
@@ -711,7 +410,7 @@ def _cold_other(scene, sysm, control, value, eps, **kw):
             return _failure(5, f"{control} = {value:g} was not reached on the branch for delta up to "
                                f"{d:.3g} ({key} there: {cur[key]:.4g})")
         dsys = make_system(scene, "delta", nd, eps)
-        nxt = solve_from(dsys, _warm_guess(dsys, cur), **lk)
+        nxt = solve_from(dsys, warm_guess(dsys, cur), **lk)
         if nxt.success:
             prev, cur, d = cur, nxt, nd
             step = min(1.5 * step, 0.05)
@@ -724,4 +423,4 @@ def _cold_other(scene, sysm, control, value, eps, **kw):
                 return _failure(5, f"continuation in delta towards {control} = {value:g} stalled at "
                                    f"delta = {d:.3g}")
     start = min((prev, cur), key=lambda s: abs(s[key] - value))
-    return solve_from(sysm, _warm_guess(sysm, start), **kw)
+    return solve_from(sysm, warm_guess(sysm, start), **kw)

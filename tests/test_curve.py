@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import shellbvp as sb
-from shellbvp.continuation import POINT_FIELDS
+from shellbvp.io import POINT_FIELDS
 
 
 @pytest.fixture(scope="module")

@@ -36,7 +36,7 @@ def payloads(marker):
         f"(lambda: open('{m}', 'w'))()",
         f"[open('{m}', 'w') for _ in (1,)]",
         f"S.__class__.__init__.__globals__['__builtins__']['open']('{m}', 'w')",
-        f"().__class__.__bases__[0].__subclasses__()",
+        "().__class__.__bases__[0].__subclasses__()",
         f"getattr(__builtins__, 'open')('{m}', 'w')",
         f"sin(S) + __import__('os').system('touch {m}')",
         f"Symbol('S').func.__globals__['os'].system('touch {m}')",

@@ -68,7 +68,6 @@ def test_plausible_scenes_solve_or_report(gamma, rho, beta, alpha, delta, contac
 # -- issue 11: payloads, malformed CSVs, tampered files ---------------------------------------------------
 # SHELLBVP_FUZZ_SCALE=20 multiplies every example count below (the long run; default 1, under a minute).
 import io as _io
-import json
 import os
 import string
 from contextlib import redirect_stderr, redirect_stdout

@@ -12,7 +12,7 @@ import pytest
 
 import shellbvp as sb
 from shellbvp.liftoff import liftoff_state
-from shellbvp.state import solve_point_load
+from shellbvp.pointload import solve_point_load
 
 
 def _energy_slope(scene, delta, h=1e-3, tol=1e-8):

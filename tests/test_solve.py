@@ -178,7 +178,7 @@ def test_flat_plate_tends_to_the_kirchhoff_point_load_stiffness():
 
 def test_point_load_limit_agrees_with_a_small_cap(base):
     """Where a cap is tiny but representable, the point-load limit gives the same F."""
-    from shellbvp.state import solve_point_load
+    from shellbvp.pointload import solve_point_load
 
     cap = sb.solve(base, delta=0.01, tol=1e-8, estimate_error=False)
     assert cap.success and cap.Sc < 1e-10

@@ -11,7 +11,8 @@ import numpy as np
 import pytest
 
 import shellbvp as sb
-from shellbvp.state import delta_bounds, solve_point_load
+from shellbvp.pointload import solve_point_load
+from shellbvp.state import delta_bounds
 
 
 def run(*args, cwd=None, timeout=300):
@@ -48,7 +49,7 @@ def test_overflowing_jacobian_never_reaches_lapack_and_json_is_one_document():
 def test_guard_returns_status_2_for_a_nan_guess():
     sol = sb.solve(sb.Scene.preset("base"), delta=0.1, estimate_error=False)
     sysm = sol.system
-    from shellbvp.state import solve_bvp
+    from shellbvp.solution import solve_bvp
 
     y = sol.y.copy()
     y[3, 5] = np.nan

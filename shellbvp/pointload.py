@@ -1,0 +1,116 @@
+"""The point-load limit of the smooth model: the free region alone, delta prescribed.
+
+When the contact cap is exponentially small (``Sc`` below ~1e-30, which happens
+as delta -> 0) the cap's own equations leave double precision and the state is
+the point-load solution to exponential accuracy (``shellbvp.chain.point_chain``).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+
+from .chain import ChainBVP, point_chain
+from .solution import (
+    Solution,
+    attach_tip_table,
+    penetration,
+    set_status,
+    solve_bvp,
+    thin_mesh,
+)
+
+__all__ = ["solve_point_load", "SC_POINT", "POINT_S0"]
+
+
+#: Caps smaller than this are replaced by the point-load limit (their own equations
+#: leave double precision near Sc ~ 1e-75; the difference is exponentially small).
+SC_POINT = 1e-30
+#: Start of the point-load state's free region (truncation error O(s0^2 ln^2 s0)).
+POINT_S0 = 1e-12
+
+
+def _point_guess(sysm, prev):
+    """Free states for the point-load problem from a cap or point solution."""
+    if prev.get("topology") == "point":
+        x = thin_mesh(prev.x)
+        return x, prev.sol(x)
+    x = np.linspace(0.0, 1.0, 61)
+    cap = prev.system
+    tp = np.clip(cap.t_of(1, sysm.S(0, x, None), prev.p), 0.0, 1.0)
+    return x, prev.sol(tp)[cap.rows(1)]
+
+
+def _crude_point_guess(sysm):
+    x = np.linspace(0.0, 1.0, 61)
+    S = sysm.S(0, x, None)
+    ref = sysm.model.reference_shell(S, sysm.par)
+    lam = 0.95
+    y = np.vstack([np.full(x.size, lam), ref["Phi"] / S, np.full(x.size, lam), ref["kappa_s"],
+                   np.zeros(x.size), ref["Z"] - sysm.value * (1 - (S - S[0]) / (S[-1] - S[0]))])
+    return x, y
+
+
+def solve_point_load(scene, delta, *, tol=1e-6, max_nodes=10000, guess=None, bc_tol=1e-10):
+    """The point-load limit of the smooth model at pole displacement ``delta``.
+
+    When the contact cap is exponentially small (``Sc`` below ~1e-30, which
+    happens as delta -> 0) the cap's own equations leave double precision and
+    the state is the point-load solution to exponential accuracy: the free
+    region alone on ``[s0, L]`` with the point-load pole conditions
+    (``shellbvp.chain.point_chain``).
+    """
+    t0 = time.perf_counter()
+    sysm = ChainBVP(scene, point_chain(POINT_S0, scene.shell_length), "delta", delta)
+    attach_tip_table(sysm)
+    x, y = _point_guess(sysm, guess) if guess is not None else _crude_point_guess(sysm)
+    with np.errstate(all="ignore"):
+        bvp = solve_bvp(sysm.fun, sysm.bc, x, y, fun_jac=sysm.fun_jac, bc_jac=sysm.bc_jac, tol=tol,
+                        bc_tol=bc_tol, max_nodes=max_nodes)
+        sysm.tol = tol
+        res = _diagnose_point(sysm, bvp)
+    res.wall_time = time.perf_counter() - t0
+    return res
+
+
+def _diagnose_point(sysm, bvp):
+    mod, par = sysm.model, sysm.par
+    nan = float("nan")
+    ya = bvp.y[:, 0]
+    force, delta = sysm.end_values(ya, bvp.y[:, -1])
+    res = Solution(
+        topology="point", status=int(bvp.status), message=bvp.message, x=bvp.x, y=bvp.y, p=np.array([]),
+        sol=bvp.sol, rms_residuals=bvp.rms_residuals, niter=int(bvp.niter), nodes=int(bvp.x.size),
+        max_residual=float(np.max(bvp.rms_residuals)) if bvp.rms_residuals.size else nan,
+        # lambda0 is not defined in this limit: the stretches vary like ln^2 S near a point force.
+        delta=delta, lambda0=float("nan"), Sc=0.0, force=force, ring_force=force, cap_force=0.0,
+        control="delta", scene=sysm.scene, system=sysm,
+        z_tip=float(mod.reference_shell(0.0, par)["Z"]) - delta,
+    )
+    flags = []
+    if not (np.all(np.isfinite(bvp.y)) and math.isfinite(force)):
+        flags.append("non-finite state")
+    elif bvp.status == 0 and np.any(bvp.y[[0, 2]] <= 0):
+        flags.append("non-positive stretch")
+    set_status(res, bvp, flags, " (point-load limit: the contact cap is exponentially small)")
+    res.update(pressure_min=nan, penetration=nan, valid=False, force_error=nan, delta_error=0.0)
+    if not res.success or flags:
+        res.update(energy=nan, force_defect=nan, flags=flags)
+        return res
+    t = np.unique(np.r_[bvp.x, 0.5 * (bvp.x[1:] + bvp.x[:-1])])
+    (_, _, pf), = sysm.region_profiles(t, bvp.sol(t), None)
+    res.force_defect = float(np.max(np.abs(2 * np.pi * pf["axial_force_2pi"] - force)))
+    res.energy = sysm.energy(bvp.sol, bvp.x, None)
+    # The point load is the limit of contact on a vanishing circle (line contact): valid
+    # when it pushes and the shell stays outside the indenter.
+    res.penetration = penetration(sysm, pf["r"], pf["z"], res.z_tip)
+    vflags = []
+    if force < 0:
+        vflags.append(f"negative point force ({force:.3g})")
+    if res.penetration > 10 * sysm.tol:
+        vflags.append(f"the free shell passes through the indenter (by {res.penetration:.3g})")
+    res.flags = vflags
+    res.valid = not vflags
+    return res

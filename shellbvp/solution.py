@@ -1,0 +1,245 @@
+"""What every contact configuration shares: the result object, statuses, the guarded
+solve_bvp call, error estimates and the checks against the indenter.
+
+:class:`Solution` is built by each configuration's diagnosis (``state`` for the cap,
+``pointload``, ``liftoff``); it never raises for a state that does not converge
+(``success=False``, a ``status`` from :data:`STATUS_MESSAGES` and a ``message``).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+__all__ = ["STATUS_MESSAGES", "Solution", "solve_bvp", "set_status", "thin_mesh", "richardson_error",
+           "penetration", "attach_tip_table", "default_eps"]
+
+
+STATUS_MESSAGES = {
+    0: "converged",
+    1: "the maximum number of mesh nodes was exceeded: raise max_nodes or loosen tol, or start "
+       "from a neighbouring solution (guess=)",
+    2: "a singular Jacobian was met: the guess is too far from a solution; start from a "
+       "neighbouring solution (guess=) or use sb.curve",
+    3: "solve_bvp could not satisfy the boundary conditions to bc_tol",
+    4: "converged to an inadmissible state (see message): start from a neighbouring solution",
+    5: "no initial guess converged (crude guesses and continuation from small delta)",
+}
+
+
+class _NonFinite(Exception):
+    """Raised inside solve_bvp by a Jacobian with NaN or inf entries (see :func:`solve_bvp`)."""
+
+
+def _finite_jacobian(jac, what):
+    """``jac`` that refuses to hand non-finite entries to solve_bvp's sparse LU."""
+    def checked(*args):
+        out = jac(*args)
+        for block in (out if isinstance(out, tuple) else (out,)):
+            if block is not None and not np.all(np.isfinite(block)):
+                raise _NonFinite(what)
+        return out
+
+    return checked
+
+
+class _NoSolution:
+    """Interpolant of a run that produced no state: NaN everywhere."""
+
+    def __init__(self, n):
+        self.n = n
+
+    def __call__(self, t):
+        t = np.asarray(t, float)
+        return np.full((self.n,) + t.shape, np.nan)
+
+
+def _failed_run(x, y, p, status, message):
+    """A solve_bvp-like result of a run stopped before (or instead of) a LAPACK call."""
+    from scipy.optimize import OptimizeResult
+
+    x = np.asarray(x, float)
+    n = np.shape(y)[0]
+    p = None if p is None else np.full(np.shape(p), np.nan)
+    return OptimizeResult(sol=_NoSolution(n), p=p, x=x, y=np.full((n, x.size), np.nan),
+                          yp=np.full((n, x.size), np.nan), rms_residuals=np.full(max(x.size - 1, 0), np.nan),
+                          niter=0, status=status, message=message, success=False)
+
+
+def solve_bvp(fun, bc, x, y, p=None, *, fun_jac, bc_jac, **kwargs):
+    """scipy.integrate.solve_bvp, imported on first use (scipy.integrate is most of the
+    import time of shellbvp, and reading files or loading a model does not need it),
+    with a guard on what reaches its linear algebra.
+
+    A guess with NaN/inf or a mesh that is not strictly increasing, and a Jacobian
+    that overflows during Newton (a state far outside the model's domain, e.g. an
+    extreme scene), end the run with status 2 instead: solve_bvp would pass such a
+    matrix to SuperLU, whose BLAS calls then print ``** On entry to DGEMV parameter
+    number 2 had an illegal value`` on stdout (Fortran, not Python) and return garbage.
+    """
+    from scipy.integrate import solve_bvp as _solve_bvp
+
+    xa = np.asarray(x, float)
+    if xa.ndim != 1 or xa.size < 2 or not np.all(np.isfinite(xa)) or not np.all(np.diff(xa) > 0):
+        return _failed_run(x, y, p, 2, "degenerate mesh (not strictly increasing and finite): no solve")
+    if not np.all(np.isfinite(y)) or (p is not None and not np.all(np.isfinite(p))):
+        return _failed_run(x, y, p, 2, "the initial guess has NaN or inf entries: no solve")
+    try:
+        return _solve_bvp(fun, bc, x, y, p, fun_jac=_finite_jacobian(fun_jac, "fun_jac"),
+                          bc_jac=_finite_jacobian(bc_jac, "bc_jac"), **kwargs)
+    except _NonFinite as exc:
+        return _failed_run(x, y, p, 2, f"the Jacobian ({exc}) overflowed to NaN/inf during Newton: the "
+                                       f"iterate left the model's domain (no solve of the collocation system)")
+
+
+
+class Solution(dict):
+    """Result of :func:`solve` (a dict with attribute access, like OptimizeResult).
+
+    Attributes
+    ----------
+    success : bool
+        Converged to an admissible state (``status == 0``).
+    status : int
+        0 converged; 1 too many nodes; 2 singular Jacobian; 3 boundary conditions
+        not met to ``bc_tol``; 4 inadmissible (delta < 0, cap beyond the tip, ...);
+        5 no guess converged.  See ``STATUS_MESSAGES``.
+    message : str
+    delta, force, lambda0, Sc : float
+        Pole displacement, indenter force F (> 0 pushing), pole stretch, contact circle.
+    x, y, p, sol, rms_residuals, niter
+        solve_bvp's mesh on t in [0, 1], stacked states (8, m) (layout in
+        ``shellbvp.chain``), unknown parameters, interpolant, residuals, iterations.
+    nodes : int
+    max_residual : float
+        Largest relative collocation residual.
+    energy : float
+        ``E = 2 pi Int U R Psi dS`` (F = dE/ddelta for the smooth model).
+    ring_force, cap_force : float
+        Axial force of the ring at Sc (jump of Q) and of the pressure on the cap;
+        ``force = ring_force + cap_force``.  For ``contact="paper"`` the ring force is ~0.
+    pressure_min : float
+        Minimum contact pressure over the cap (< 0: the shell would pull the indenter).
+    edge_legendre : float
+        det d(tau_s, M_s)/d(lambda_s, kappa_s) at Sc+ relative to mid-region; it goes to 0
+        where the energy loses convexity at the contact edge and the branch ends.
+    penetration : float
+        Largest height of the free shell above the indenter's surface (> 0: it passes
+        through the indenter).
+    valid : bool
+        pressure_min >= 0, ring_force >= 0, no penetration, contact on the tip.
+    flags : list of str
+        Why the state is not valid (empty when valid).
+    force_defect : float
+        max |F(S) - F| over the free region (F is a first integral there).
+    force_error, delta_error : float
+        Richardson error estimates (halved mesh; NaN if not estimated).
+    wall_time : float
+        Seconds.
+    """
+
+    def __getattr__(self, name):
+        try:
+            return self[name]
+        except KeyError:
+            raise AttributeError(name) from None
+
+    __setattr__ = dict.__setitem__
+
+    def __repr__(self):
+        keys = ("success", "status", "delta", "force", "lambda0", "Sc", "nodes", "valid")
+        inner = ", ".join(f"{k}={self.get(k)!r}" for k in keys)
+        return f"Solution({inner})"
+
+    # -- fields over S ------------------------------------------------------------------
+    def profile(self, points_per_interval: int = 1):
+        """Physical fields over S, pole to rim.
+
+        Returns a dict of 1-D arrays: ``S`` (increasing), ``region`` (0 on the indenter,
+        1 free; a lifted pole's free cap comes first), ``r``, ``z``,
+        ``phi``, ``lambda_s``, ``lambda_theta``, ``kappa_s``, ``kappa_theta``, ``T_s``,
+        ``T_theta``, ``M_s``, ``M_theta``, ``tau_s``, ``tau_theta``, ``Q``, ``P``,
+        ``axial_force`` (F(S), the axial force carried across the circle S), ``energy_density``.
+        For a point-load state (``topology == "point"``) there is no contact region.
+        ``points_per_interval > 1`` adds points between mesh nodes (from the interpolant).
+        """
+        sysm = self["system"]
+        t = self.x
+        if points_per_interval > 1:
+            t = np.unique(np.concatenate([np.linspace(a, b, points_per_interval + 1)
+                                          for a, b in zip(t[:-1], t[1:])]))
+        return sysm.profile(t, self.sol(t), self.p, self["z_tip"])
+
+
+
+def thin_mesh(x, keep_every: int = 3):
+    """Every ``keep_every``-th node plus the ends (solve_bvp only ever adds nodes)."""
+    idx = np.unique(np.r_[np.arange(0, x.size, keep_every), x.size - 1])
+    return x[idx]
+
+
+
+def set_status(res, bvp, flags, converged_note=""):
+    """status, message and success of a diagnosed state: a converged run whose state
+    breaks an admissibility check (``flags``) gets status 4."""
+    if bvp.status == 0 and flags:
+        res.status = 4
+        res.message = STATUS_MESSAGES[4] + ": " + "; ".join(flags)
+    elif bvp.status == 0:
+        res.message = STATUS_MESSAGES[0] + converged_note
+    elif not res.message:
+        res.message = STATUS_MESSAGES.get(bvp.status, "")
+    res.success = res.status == 0
+
+
+
+def penetration(sysm, r, z, z_tip):
+    """Largest height of free-shell points above the indenter's lower surface."""
+    A, B = sysm.tip_A, sysm.tip_B
+    rho = sysm.scene.rho
+    inside = r < rho * A[-1]
+    if not np.any(inside):
+        return -np.inf
+    surface = z_tip + rho * np.interp(r[inside] / rho, A, B)
+    return float(np.max(z[inside] - surface))
+
+
+
+def attach_tip_table(sysm):
+    """Tabulated tip profile for penetration checks (A increasing up to omega_max)."""
+    shape = sysm.model.tip_shape(np.linspace(0.0, sysm.scene.tip_omega_max, 401), sysm.par)
+    sysm.tip_A, sysm.tip_B = shape["A"], shape["B"]
+
+
+
+def richardson_error(sysm, res, tol, bc_tol=1e-10):
+    """Set ``force_error`` and ``delta_error`` by Richardson extrapolation (any topology).
+
+    The collocation solution (Lobatto IIIA, order 4) is recomputed on the
+    converged mesh with every interval halved, without further refinement
+    (``max_nodes`` pins the mesh; Newton converges to tol/100 and bc_tol/100, so the
+    coarse solve's iteration and boundary errors are included); the error of
+    the coarse value is then ``|X_h - X_h/2| * 16/15``.  Costs one Newton
+    solve on twice the nodes.  ``sysm.end_values`` gives (F, delta) of a solution.
+    """
+    x = res.x
+    x2 = np.sort(np.r_[x, 0.5 * (x[1:] + x[:-1])])
+    p = np.asarray(res.p, float)
+    with np.errstate(all="ignore"):
+        fine = solve_bvp(sysm.fun, sysm.bc, x2, res.sol(x2), p if p.size else None, fun_jac=sysm.fun_jac,
+                         bc_jac=sysm.bc_jac, tol=tol / 100, bc_tol=bc_tol / 100, max_nodes=x2.size)
+        if fine.status == 2 or not np.all(np.isfinite(fine.y)) \
+                or (fine.p is not None and not np.all(np.isfinite(fine.p))):
+            res.force_error = res.delta_error = float("nan")
+            res.flags = list(res.flags) + ["error estimate failed (Newton on the halved mesh did not converge)"]
+            return
+        force, delta = sysm.end_values(fine.y[:, 0], fine.y[:, -1], fine.p)
+    res.force_error = abs(force - res.force) * 16 / 15
+    res.delta_error = abs(delta - res.delta) * 16 / 15
+
+
+
+def default_eps(tol):
+    # Pole start zeta = eps*Sc: the truncated series errs by O(eps^2) relative.
+    return min(1e-3, 0.1 * math.sqrt(tol))

@@ -1,0 +1,75 @@
+"""The package's architecture as its imports show it (issue 12): no import cycle inside
+``shellbvp/`` (function-level imports included) and no private name imported from
+another module -- what two modules share lives in a third, under a public name."""
+
+import ast
+from pathlib import Path
+
+PKG = Path(__file__).resolve().parents[1] / "shellbvp"
+
+
+def imports_of(path):
+    """(module imported, names) for every ``from .x import ...`` / ``from . import x`` in a file."""
+    tree = ast.parse(path.read_text())
+    for node in ast.walk(tree):
+        if isinstance(node, ast.ImportFrom) and node.level == 1:
+            if node.module:
+                yield node.module.split(".")[0], [a.name for a in node.names]
+            else:  # from . import x: x is a module or a name of __init__
+                for a in node.names:
+                    yield (a.name if (PKG / f"{a.name}.py").exists() else "__init__"), [a.name]
+        elif isinstance(node, ast.ImportFrom) and node.module and node.module.startswith("shellbvp"):
+            parts = node.module.split(".")
+            yield (parts[1] if len(parts) > 1 else "__init__"), [a.name for a in node.names]
+        elif isinstance(node, ast.Import):
+            for a in node.names:
+                if a.name.startswith("shellbvp"):
+                    parts = a.name.split(".")
+                    yield (parts[1] if len(parts) > 1 else "__init__"), []
+
+
+def graph():
+    return {p.stem: {m for m, _ in imports_of(p)} - {p.stem} for p in PKG.glob("*.py")}
+
+
+def test_no_import_cycle_inside_the_package():
+    g = graph()
+    # the package's __init__ and the CLI sit on top: nothing below may import them
+    for top in ("__init__", "cli", "__main__"):
+        users = sorted(m for m, deps in g.items() if top in deps and m not in ("__init__", "cli", "__main__"))
+        assert not users, f"{users} import {top}, which imports them back"
+    state, stack, cycles = {}, [], []
+
+    def visit(m):
+        state[m] = "open"
+        stack.append(m)
+        for d in sorted(g.get(m, ())):
+            if d in ("__init__",) or d not in g:
+                continue
+            if state.get(d) == "open":
+                cycles.append(stack[stack.index(d):] + [d])
+            elif d not in state:
+                visit(d)
+        stack.pop()
+        state[m] = "done"
+
+    for m in sorted(g):
+        if m not in state and m not in ("__init__", "cli", "__main__"):
+            visit(m)
+    assert not cycles, " ; ".join(" -> ".join(c) for c in cycles)
+
+
+def test_no_private_name_is_imported_from_another_module():
+    bad = [(p.name, m, n) for p in PKG.glob("*.py") for m, names in imports_of(p) for n in names
+           if n.startswith("_") and not n.startswith("__")]
+    assert not bad, bad
+
+
+def test_the_cycle_check_can_fail(tmp_path, monkeypatch):
+    """The walker sees function-level imports: a module importing its importer is a cycle."""
+    pkg = tmp_path / "shellbvp"
+    pkg.mkdir()
+    (pkg / "a.py").write_text("from .b import x\n")
+    (pkg / "b.py").write_text("def f():\n    from .a import y\n")
+    monkeypatch.setattr(__import__(__name__), "PKG", pkg)
+    assert graph() == {"a": {"b"}, "b": {"a"}}
