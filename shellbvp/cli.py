@@ -33,20 +33,37 @@ class _Parser(argparse.ArgumentParser):
         self.exit(2, f"shellbvp: error: {message}\n")
 
 
+def _number(text):
+    """argparse type: a plain finite number (float() would also take 5_0, inf, nan, 1e999)."""
+    from .units import plain_number
+
+    try:
+        return plain_number(text, "the value")
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+
+
+def _numbers(text, name):
+    """Comma-separated plain finite numbers of an option."""
+    from .units import plain_number
+
+    return [plain_number(v, name) for v in text.split(",")]
+
+
 def _scene_options(p):
     g = p.add_argument_group("scene (overrides of the preset)")
     g.add_argument("--preset", default="base", help="built-in scene (see `shellbvp presets`; default base)")
-    g.add_argument("--gamma", type=float, help="spheroid aspect parameter (< 1/rho; >0 bowl, <0 dome)")
-    g.add_argument("--rho", type=float, help="indenter radius / rim radius (> 0)")
-    g.add_argument("--beta", type=float, help="bending stiffness B/(mu R_L^2) (> 0)")
+    g.add_argument("--gamma", type=_number, help="spheroid aspect parameter (< 1/rho; >0 bowl, <0 dome)")
+    g.add_argument("--rho", type=_number, help="indenter radius / rim radius (> 0)")
+    g.add_argument("--beta", type=_number, help="bending stiffness B/(mu R_L^2) (> 0)")
     m = g.add_mutually_exclusive_group()
-    m.add_argument("--alpha", type=float, help="Mooney-Rivlin alpha in [0, 1]")
-    m.add_argument("--gent-jm", type=float, dest="gent_jm", help="Gent model with this Jm (> 0)")
+    m.add_argument("--alpha", type=_number, help="Mooney-Rivlin alpha in [0, 1]")
+    m.add_argument("--gent-jm", type=_number, dest="gent_jm", help="Gent model with this Jm (> 0)")
     m.add_argument("--neo-hookean", action="store_true", help="neo-Hookean material")
     g.add_argument("--xi", type=int, choices=(0, 1), help="1: full generalised tensions; 0: first approximation")
     g.add_argument("--contact", choices=("smooth", "paper"), help="contact-line model (default smooth)")
     s = p.add_argument_group("solver")
-    s.add_argument("--tol", type=float, default=1e-6, help="collocation tolerance (default 1e-6)")
+    s.add_argument("--tol", type=_number, default=1e-6, help="collocation tolerance (default 1e-6)")
     s.add_argument("--max-nodes", type=int, default=10000, dest="max_nodes")
 
 
@@ -250,7 +267,7 @@ def _fit_and_report(args):
         if text is not None:
             parts = text.split(",")
             try:
-                bounds[f"{name}_bounds"] = tuple(float(v) for v in parts)
+                bounds[f"{name}_bounds"] = tuple(_numbers(text, f"--{name}-range"))
             except ValueError:
                 raise ValueError(f"--{name}-range must be two numbers LOW,HIGH; got {text!r}") from None
             if len(parts) != 2:
@@ -299,7 +316,7 @@ def _cmd_plot(args):
     check_output_path(args.output, overwrite=True)  # a figure is cheap to redraw: replaced
     plt = require_matplotlib()
     curves = [read_curve(f) for f in args.files]
-    deltas = [float(v) for v in args.profiles.split(",")] if args.profiles else []
+    deltas = _numbers(args.profiles, "--profiles") if args.profiles else []
     ncol = 2 if deltas else 1
     fig, axes = plt.subplots(1, ncol, figsize=(6 * ncol, 4.8), squeeze=False)
     plot_curves(curves, ax=axes[0, 0])
@@ -356,14 +373,14 @@ def build_parser():
     sub = p.add_subparsers(dest="command", parser_class=_Parser)
     c = sub.add_parser("curve", help="compute a force-displacement curve into an HDF5 file")
     _scene_options(c)
-    c.add_argument("--delta-max", type=float, default=0.5, dest="delta_max", help="largest pole displacement (default 0.5)")
+    c.add_argument("--delta-max", type=_number, default=0.5, dest="delta_max", help="largest pole displacement (default 0.5)")
     c.add_argument("--points", type=int, help="N equally spaced depths up to delta-max (default: adaptive)")
-    c.add_argument("--force-max", type=float, dest="force_max", help="stop at this force")
-    c.add_argument("--lambda0-max", type=float, dest="lambda0_max", help="stop at this pole stretch")
+    c.add_argument("--force-max", type=_number, dest="force_max", help="stop at this force")
+    c.add_argument("--lambda0-max", type=_number, dest="lambda0_max", help="stop at this pole stretch")
     c.add_argument("--max-steps", type=int, default=400, dest="max_steps")
     c.add_argument("--profiles", action="store_true", help="store each point's profiles")
-    c.add_argument("--radius", type=float, help="rim radius R_L in m (with --muH: SI columns)")
-    c.add_argument("--muH", type=float, dest="mu_h", help="mu*H in N/m")
+    c.add_argument("--radius", type=_number, help="rim radius R_L in m (with --muH: SI columns)")
+    c.add_argument("--muH", type=_number, dest="mu_h", help="mu*H in N/m")
     c.add_argument("-o", "--output", help="output file (default <preset>.h5)")
     c.add_argument("--force", action="store_true", help="replace an existing output file")
     c.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
@@ -374,9 +391,9 @@ def build_parser():
     s = sub.add_parser("solve", help="solve one state and print it")
     _scene_options(s)
     g = s.add_mutually_exclusive_group()
-    g.add_argument("--delta", type=float, help="pole displacement (default 0.2)")
-    g.add_argument("--lambda0", type=float, help="pole stretch")
-    g.add_argument("--load", type=float, help="indenter force F (force control)")
+    g.add_argument("--delta", type=_number, help="pole displacement (default 0.2)")
+    g.add_argument("--lambda0", type=_number, help="pole stretch")
+    g.add_argument("--load", type=_number, help="indenter force F (force control)")
     s.add_argument("--profiles", action="store_true", help="print the fields over S")
     s.add_argument("--json", action="store_true", help="print JSON")
     s.add_argument("--topology", choices=("auto", "cap", "line", "annulus"), default="auto",

@@ -44,7 +44,7 @@ import numpy as np
 from scipy import optimize, stats
 from scipy.interpolate import CubicSpline, PchipInterpolator
 
-from .units import unit_factor
+from .units import PLAIN_NUMBER, unit_factor
 
 log = logging.getLogger(__name__)
 
@@ -769,9 +769,6 @@ def _show(name, theta):
     return f"{math.exp(theta):.3g}" if name == "beta" else f"{theta:.3g}"
 
 
-#: A number as a CSV should write it: ASCII digits, optional sign, decimal point and exponent
-#: (Python's float() also takes "5_0", "inf", "1e999" and non-ASCII digits; a CSV should not).
-_NUMBER = re.compile(r"[-+]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][-+]?[0-9]+)?")
 _BOMS = ((codecs.BOM_UTF32_LE, "utf-32"), (codecs.BOM_UTF32_BE, "utf-32"), (codecs.BOM_UTF8, "utf-8-sig"),
          (codecs.BOM_UTF16_LE, "utf-16"), (codecs.BOM_UTF16_BE, "utf-16"))
 
@@ -806,7 +803,7 @@ def _number(s, decimal_comma):
         t = t.replace(",", ".")
     if not t or t.lower() == "nan":
         return math.nan
-    if not _NUMBER.fullmatch(t):
+    if not PLAIN_NUMBER.fullmatch(t):
         return None
     v = float(t)
     return v if math.isfinite(v) else None

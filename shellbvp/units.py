@@ -12,7 +12,12 @@ import math
 import re
 from dataclasses import dataclass
 
-__all__ = ["Dimensions", "parse_quantity", "unit_factor", "beta_from_thickness", "LENGTH_UNITS", "FORCE_UNITS"]
+__all__ = ["Dimensions", "parse_quantity", "unit_factor", "beta_from_thickness", "plain_number", "PLAIN_NUMBER",
+           "LENGTH_UNITS", "FORCE_UNITS"]
+
+#: A number as a person or a CSV writes it: ASCII digits, optional sign, decimal point and
+#: exponent.  Python's float() also takes "5_0", "inf", "nan", "1e999" and non-ASCII digits.
+PLAIN_NUMBER = re.compile(r"[-+]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][-+]?[0-9]+)?")
 
 LENGTH_UNITS = {"m": 1.0, "mm": 1e-3, "um": 1e-6, "µm": 1e-6, "micron": 1e-6, "nm": 1e-9, "cm": 1e-2}
 FORCE_UNITS = {"N": 1.0, "mN": 1e-3, "uN": 1e-6, "µN": 1e-6, "nN": 1e-9, "kN": 1e3}
@@ -27,12 +32,20 @@ def unit_factor(unit: str, kind: str) -> float:
     return table[u]
 
 
+def plain_number(text: str, name: str = "value") -> float:
+    """A finite float from plain decimal text; ValueError naming ``name`` otherwise."""
+    t = str(text).strip()
+    if not PLAIN_NUMBER.fullmatch(t) or not math.isfinite(v := float(t)):
+        raise ValueError(f"{name} must be a plain finite number (e.g. 0.25 or 1e-3); got {text!r}")
+    return v
+
+
 def parse_quantity(text, kind: str = "length", default_unit: str | None = None) -> float:
     """'0.3mm' -> 3e-4 (SI); a bare number takes ``default_unit`` (else SI)."""
     if isinstance(text, (int, float)):
         v = float(text)
         return v * (unit_factor(default_unit, kind) if default_unit else 1.0)
-    m = re.fullmatch(r"\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*([A-Za-zµ]*)\s*", str(text))
+    m = re.fullmatch(r"\s*([-+]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][-+]?[0-9]+)?)\s*([A-Za-zµ]*)\s*", str(text))
     if not m:
         raise ValueError(f"cannot read {text!r} as a {kind} (e.g. 0.3mm)")
     value, unit = float(m.group(1)), m.group(2)

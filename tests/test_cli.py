@@ -86,3 +86,18 @@ def test_info_rejects_foreign_and_corrupt_files(tmp_path):
     for name in ("foreign.h5", "corrupt.h5"):
         r = run("info", name, cwd=tmp_path)
         assert r.returncode == 2 and name in r.stderr and "Traceback" not in r.stderr
+
+
+@pytest.mark.parametrize("argv", [["solve", "--gamma", "5_0"], ["solve", "--delta", "inf"], ["solve", "--rho", "nan"],
+                                  ["curve", "--delta-max", "1e999"], ["solve", "--beta", "１"],
+                                  ["fit", "--example", "--radius", "0.3mm", "--fit-beta", "--beta-range", "5_0,1"]])
+def test_numbers_python_reads_but_a_person_would_not_write_are_refused(argv, capsys):
+    from shellbvp.cli import main
+
+    try:
+        code = main(argv)
+    except SystemExit as exc:  # argparse's own error exit
+        code = exc.code
+    err = capsys.readouterr().err
+    assert code == 2 and err.startswith("shellbvp: error:") and "Traceback" not in err
+    assert "plain finite number" in err or "two numbers" in err, err
