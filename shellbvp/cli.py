@@ -29,8 +29,18 @@ __all__ = ["main"]
 
 
 class _Parser(argparse.ArgumentParser):
+    json_errors = False  # set by main when --json was asked for: errors are JSON on stdout too
+
     def error(self, message):  # one line, exit 2 (argparse's own convention)
+        if _Parser.json_errors:
+            _print_json_error(message)
         self.exit(2, f"shellbvp: error: {message}\n")
+
+
+def _print_json_error(message):
+    """The one JSON document of a --json run that stopped on bad input (exit status 2)."""
+    print(json.dumps({"success": False, "status": None, "exit_status": 2, "message": str(message),
+                      "warnings": [], "warning_codes": []}))
 
 
 def _number(text):
@@ -222,17 +232,7 @@ def _cmd_solve(args):
 def _cmd_fit(args):
     """``shellbvp fit``: exit 0 (fit succeeded; warnings allowed), 1 (the fit ran but failed its
     checks) or 2 (bad input: a ValueError, one line on stderr).  With ``--json`` stdout holds
-    exactly one JSON document in every case."""
-    try:
-        return _fit_and_report(args)
-    except ValueError as exc:
-        if args.json:
-            print(json.dumps({"success": False, "status": None, "exit_status": 2, "message": str(exc),
-                              "warnings": [], "warning_codes": []}))
-        raise
-
-
-def _fit_and_report(args):
+    exactly one JSON document in every case (errors: see :func:`main`)."""
     import dataclasses
 
     import shellbvp as sb
@@ -445,6 +445,7 @@ def main(argv=None):
     argv = sys.argv[1:] if argv is None else list(argv)
     if not argv:
         argv = ["curve"]  # the quick start: the base preset into base.h5
+    _Parser.json_errors = "--json" in argv
     args = parser.parse_args(argv)
     if args.command is None:
         args = parser.parse_args(["curve", *argv])
@@ -453,6 +454,8 @@ def main(argv=None):
     try:
         return args.func(args)
     except (ValueError, FileExistsError) as exc:
+        if getattr(args, "json", False):
+            _print_json_error(exc)
         print(f"shellbvp: error: {exc}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:

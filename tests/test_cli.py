@@ -101,3 +101,17 @@ def test_numbers_python_reads_but_a_person_would_not_write_are_refused(argv, cap
     err = capsys.readouterr().err
     assert code == 2 and err.startswith("shellbvp: error:") and "Traceback" not in err
     assert "plain finite number" in err or "two numbers" in err, err
+
+
+@pytest.mark.parametrize("argv", [["fit", "--json", "--example", "--radius"], ["solve", "--json", "--delta", "5"],
+                                  ["solve", "--json", "--delta", "5_0"], ["solve", "--json", "--bogus"]])
+def test_json_runs_print_one_json_document_on_bad_input_too(argv, capsys):
+    from shellbvp.cli import main
+
+    try:
+        code = main(argv)
+    except SystemExit as exc:
+        code = exc.code
+    out = capsys.readouterr().out
+    doc = json.loads(out)  # exactly one document: json.loads refuses trailing text
+    assert code == 2 and doc["exit_status"] == 2 and doc["success"] is False and doc["message"]
