@@ -5,7 +5,9 @@ The stacked layout (the one place it is defined)
 ------------------------------------------------
 A configuration is an ordered list of regions ``k = 0 .. n-1`` from the pole to
 the rim, each of a kind (``"free"``: 6 states ``(lt, phiS, ls, ks, rQ, z)``;
-``"contact"``, the shell on the tip: 2 states ``(chi, ls)``; see
+``"contact"``, the shell on the tip, and ``"cylinder"``, the shell on the
+indenter's cylinder: 2 states ``(chi, ls)``, ``chi = rho omega/S`` with omega
+running on past the tip's end ``omega_max`` along the cylinder; see
 ``symbolic.equations``) on ``[S_a, S_b]``.  Every region is mapped
 geometrically onto the same ``t in [0, 1]``,
 
@@ -43,14 +45,17 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["Point", "Region", "ContactPole", "FreePole", "PointPole", "Edge", "Line", "Rim", "Chain",
-           "ChainBVP", "cap_chain", "point_chain", "annulus_chain", "line_chain", "CONTROLS", "SIZES",
-           "FREE_STATES", "CONTACT_STATES"]
+__all__ = ["Point", "Region", "ContactPole", "FreePole", "PointPole", "Edge", "TipEnd", "Line", "Rim", "Chain",
+           "ChainBVP", "cap_chain", "point_chain", "annulus_chain", "line_chain", "cylinder_chain", "CONTROLS",
+           "SIZES", "FREE_STATES", "CONTACT_STATES", "CONTACT_KINDS", "REGION_CODES"]
 
 CONTROLS = ("delta", "lambda0", "force", "arclength")
 FREE_STATES = ("lt", "phiS", "ls", "ks", "rQ", "z")
 CONTACT_STATES = ("chi", "ls")
-SIZES = {"free": len(FREE_STATES), "contact": len(CONTACT_STATES)}
+SIZES = {"free": len(FREE_STATES), "contact": len(CONTACT_STATES), "cylinder": len(CONTACT_STATES)}
+CONTACT_KINDS = ("contact", "cylinder")  # the shell on the tip; on the indenter's cylinder r = rho A(omega_max)
+#: ``region`` codes of profiles: 0 on the tip, 1 free, 2 on the cylinder
+REGION_CODES = {"contact": 0, "free": 1, "cylinder": 2}
 _LS = FREE_STATES.index("ls")
 # states continuous across a line contact (rQ jumps: the ring force)
 _LINE_CONTINUOUS = [FREE_STATES.index(s) for s in ("lt", "phiS", "ls", "ks", "z")]
@@ -68,7 +73,7 @@ class Point:
 
 @dataclass(frozen=True)
 class Region:
-    kind: str  # "free" | "contact"
+    kind: str  # "free" | "contact" (on the tip) | "cylinder" (on the indenter's side)
     start: Point
     end: Point
 
@@ -108,6 +113,18 @@ class Edge:
     kf: int
     model: str = "smooth"
     rows = 5
+
+
+@dataclass(frozen=True)
+class TipEnd:
+    """The shell passes from the tip (region ``k``) onto the cylinder (region ``k + 1``): 3 rows.
+
+    omega = omega_max at the end of one and the start of the other, and
+    ``[lambda_s dU/dlambda_s - U] = 0`` (``symbolic.equations.Derivation._build_tip_end``).
+    """
+
+    k: int
+    rows = 3
 
 
 @dataclass(frozen=True)
@@ -173,6 +190,15 @@ def point_chain(s0: float, L: float) -> Chain:
     """Point-load limit: the free region on [s0, L] alone."""
     return Chain("point", (Region("free", Point("s0", None, math.log(s0)), Point("L", None, math.log(L))),),
                  (PointPole(0), Rim(0)), ())
+
+
+def cylinder_chain(eps: float, L: float, model: str = "smooth") -> Chain:
+    """Contact running past the tip's end onto the cylinder: tip [zeta, S*], cylinder [S*, Sc],
+    free [Sc, L]; unknowns ln S*, ln Sc."""
+    Se, Sc = Point("S*", "ln_Send"), Point("Sc", "ln_Sc")
+    return Chain("cap+cylinder", (Region("contact", Point("zeta", "ln_Send", math.log(eps)), Se),
+                                  Region("cylinder", Se, Sc), Region("free", Sc, Point("L", None, math.log(L)))),
+                 (ContactPole(0), TipEnd(0), Edge(1, 2, model), Rim(2)), ("ln_Send", "ln_Sc"), eps)
 
 
 def annulus_chain(eps: float, L: float) -> Chain:
@@ -293,10 +319,16 @@ class ChainBVP:
         return self.S_point(self.regions[-1].end, None)
 
     def _rhs(self, k):
-        return self.model.free_rhs if self.regions[k].kind == "free" else self.model.contact_rhs
+        return getattr(self.model, f"{self.regions[k].kind}_rhs")
 
     def _jac(self, k):
-        return self.model.free_jac if self.regions[k].kind == "free" else self.model.contact_jac
+        return getattr(self.model, f"{self.regions[k].kind}_jac")
+
+    def _edge_function(self, j, what):
+        """junction_[cyl_]<model>_<what> or force_[cyl_]<what> of an edge's contact kind."""
+        prefix = "cyl_" if self.regions[j.kc].kind == "cylinder" else ""
+        return getattr(self.model, f"junction_{prefix}{j.model}_{what}" if what in ("res", "jac")
+                       else f"force_{prefix}{what[6:]}")
 
     # -- ODE ------------------------------------------------------------------------------------
     def fun(self, t, y, p=None):
@@ -356,8 +388,10 @@ class ChainBVP:
                                                 q["delta"], par))
             elif isinstance(j, Edge):
                 point, yc, yf, _, _ = self._edge_states(j, ya, yb)
-                res = getattr(mod, f"junction_{j.model}_res")
-                parts.append(res(self.S_point(point, p), yc, yf, q["delta"], q["F"], par))
+                parts.append(self._edge_function(j, "res")(self.S_point(point, p), yc, yf, q["delta"], q["F"], par))
+            elif isinstance(j, TipEnd):
+                parts.append(mod.tip_end_res(self.S_point(self.regions[j.k].end, p), yb[self.rows(j.k)],
+                                             ya[self.rows(j.k + 1)], par))
             elif isinstance(j, Line):
                 point, yc, yin, yout = self._line_states(j, ya, yb, q)
                 on_tip = mod.junction_smooth_res(self.S_point(point, p), yc, yin, q["delta"], q["F"], par)[:3]
@@ -366,15 +400,21 @@ class ChainBVP:
                 parts.append(mod.rim_res(self.S_point(self.regions[j.k].end, p), yb[self.rows(j.k)], par))
         if self.extra == "force":
             S, yc, yf = self._force_args(ya, yb, p, q)
-            parts.append(mod.force_res(S, yc, yf, q["delta"], q["F"], par))
+            parts.append(self._force_function("res")(S, yc, yf, q["delta"], q["F"], par))
         elif self.extra == "pole_stretch":
             parts.append([ya[self.rows(0)][_LS] - self.value])
         elif self.extra == "arclength":
             S, yc, yf = self._force_args(ya, yb, p, q)
-            force = 2 * np.pi * mod.force_res(S, yc, yf, q["delta"], 0.0, par)[0]
+            force = 2 * np.pi * self._force_function("res")(S, yc, yf, q["delta"], 0.0, par)[0]
             X = np.array([q["delta"], q["lambda0"], force])
             parts.append([np.sum(self.arc_tangent * (X - self.arc_point) / self.arc_scale)])
         return np.concatenate(parts)
+
+    def _force_function(self, what):
+        j = self.force_at
+        if isinstance(j, Edge):
+            return self._edge_function(j, "force_" + what)
+        return getattr(self.model, f"force_{what}")
 
     def _force_args(self, ya, yb, p, q):
         j = self.force_at
@@ -416,7 +456,7 @@ class ChainBVP:
             elif isinstance(j, Edge):
                 point, yc, yf, c_at_a, f_at_a = self._edge_states(j, ya, yb)
                 S = self.S_point(point, p)
-                jj = getattr(mod, f"junction_{j.model}_jac")(S, yc, yf, q["delta"], q["F"], par)
+                jj = self._edge_function(j, "jac")(S, yc, yf, q["delta"], q["F"], par)
                 (A if c_at_a else B)[rows, self.rows(j.kc)] = jj[:, 1:3]
                 (A if f_at_a else B)[rows, self.rows(j.kf)] = jj[:, 3:9]
                 self._add_p(P, rows, point.unknown, jj[:, 0] * S)
@@ -435,6 +475,13 @@ class ChainBVP:
                 for row, c in enumerate(_LINE_CONTINUOUS, start=r + 3):
                     A[row, o0 + c] = 1.0
                     B[row, i0 + c] = -1.0
+            elif isinstance(j, TipEnd):
+                point = self.regions[j.k].end
+                S = self.S_point(point, p)
+                ej = mod.tip_end_jac(S, yb[self.rows(j.k)], ya[self.rows(j.k + 1)], par)  # d/d(S, yt, yw)
+                B[rows, self.rows(j.k)] = ej[:, 1:3]
+                A[rows, self.rows(j.k + 1)] = ej[:, 3:5]
+                self._add_p(P, rows, point.unknown, ej[:, 0] * S)
             elif isinstance(j, Rim):
                 B[rows, self.rows(j.k)] = mod.rim_jac(self.S_point(self.regions[j.k].end, p),
                                                       yb[self.rows(j.k)], par)
@@ -444,7 +491,7 @@ class ChainBVP:
             F = q["F"] if self.extra == "force" else 0.0
             j = self.force_at
             S, yc, yf = self._force_args(ya, yb, p, q)
-            fj = w * mod.force_jac(S, yc, yf, q["delta"], F, par)  # d/d(Sc, yf, F)
+            fj = w * self._force_function("jac")(S, yc, yf, q["delta"], F, par)  # d/d(Sc, yf, F)
             kf = j.kf if isinstance(j, Edge) else j.k + 1
             f_at_a = isinstance(j, Line) or self._edge_states(j, ya, yb)[4]
             point = self._edge_states(j, ya, yb)[0] if isinstance(j, Edge) else self.regions[j.k].end
@@ -472,8 +519,7 @@ class ChainBVP:
         out = []
         for k, reg in enumerate(self.regions):
             S = self.S(k, t, p)
-            prof = self.model.free_profile if reg.kind == "free" else self.model.contact_profile
-            out.append((k, S, prof(S, y[self.rows(k)], self.par)))
+            out.append((k, S, getattr(self.model, f"{reg.kind}_profile")(S, y[self.rows(k)], self.par)))
         return out
 
     def profile(self, t, y, p, z_tip: float) -> dict:
@@ -482,13 +528,13 @@ class ChainBVP:
         (``axial_force`` = 2 pi times the generated ``axial_force_2pi``)."""
         parts = self.region_profiles(t, y, p)
         out = {"S": np.concatenate([S for _, S, _ in parts]),
-               "region": np.concatenate([np.full(t.size, int(self.regions[k].kind == "free")) for k, _, _ in parts])}
+               "region": np.concatenate([np.full(t.size, REGION_CODES[self.regions[k].kind]) for k, _, _ in parts])}
         keys = next(fields for k, _, fields in parts if self.regions[k].kind == "free")  # contact adds omega
         for key in keys:
             vals = []
             for k, _, fields in parts:
                 v = np.broadcast_to(fields[key], t.shape)
-                if key == "z" and self.regions[k].kind == "contact":
+                if key == "z" and self.regions[k].kind in CONTACT_KINDS:
                     v = v + z_tip  # the generated contact z is measured from the tip's apex
                 vals.append(v)
             vals = np.concatenate(vals)
@@ -511,7 +557,7 @@ class ChainBVP:
         for j in self.junctions:
             if isinstance(j, (ContactPole, FreePole)):
                 zeta = self.S_point(self.regions[j.k].start, p)
-                prof = self.model.free_profile if self.regions[j.k].kind == "free" else self.model.contact_profile
+                prof = getattr(self.model, f"{self.regions[j.k].kind}_profile")
                 density = prof(np.array([zeta]), sol(np.array([0.0]))[self.rows(j.k)], self.par)["energy_density"]
                 total += 0.5 * float(density[0]) * zeta
         return 2 * np.pi * total

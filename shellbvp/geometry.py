@@ -8,6 +8,8 @@ as plain text, and get code generated for them.
 
 from __future__ import annotations
 
+import math
+
 __all__ = ["Spheroid", "SphereTip", "UserShell", "UserTip"]
 
 
@@ -115,14 +117,10 @@ class UserTip:
         self._apex = float(ddB0 / dA0**2)
         if self._apex <= 0:
             raise ValueError(f"tip apex curvature B''(0)/A'(0)^2 must be > 0 (a convex tip); got {self._apex}")
-        # The tip ends where A' first vanishes (it meets the cylinder r = rho A there).
-        import numpy as np
-
-        dA = sp.lambdify(w, sp.diff(self.geometry.A, w), "numpy")
-        grid = np.linspace(1e-6, 2 * np.pi, 20001)
-        vals = np.broadcast_to(dA(grid), grid.shape)
-        sign_change = np.nonzero(np.diff(np.sign(vals)) != 0)[0]
-        self.omega_max = float(grid[sign_change[0]]) if sign_change.size else float(grid[-1])
+        # The tip ends where A' first vanishes (it meets the cylinder r = rho A there); a tip
+        # whose A' never vanishes is followed up to omega = 2 pi.
+        end = self.geometry.omega_max
+        self.omega_max = float(end) if end is not None else 2 * math.pi
 
     def description(self):
         return dict(self._desc)

@@ -195,14 +195,22 @@ def set_status(res, bvp, flags, converged_note=""):
 
 
 def penetration(sysm, r, z, z_tip):
-    """Largest height of free-shell points above the indenter's lower surface."""
+    """How far free-shell points reach into the indenter (tip and cylinder above it).
+
+    For a point above the tip's surface and inside the cylinder ``r < rho A(omega_max)``,
+    the depth is the smaller of its height above the tip surface and its distance from
+    the cylinder wall; for points outside, the (negative) height above the tip surface.
+    Returns the largest value (> 0: the shell passes through the indenter), -inf if no
+    point lies inside the cylinder's radius.
+    """
     A, B = sysm.tip_A, sysm.tip_B
     rho = sysm.scene.rho
     inside = r < rho * A[-1]
     if not np.any(inside):
         return -np.inf
-    surface = z_tip + rho * np.interp(r[inside] / rho, A, B)
-    return float(np.max(z[inside] - surface))
+    height = z[inside] - (z_tip + rho * np.interp(r[inside] / rho, A, B))
+    depth = np.where(height > 0, np.minimum(height, rho * A[-1] - r[inside]), height)
+    return float(np.max(depth))
 
 
 

@@ -158,7 +158,7 @@ def solve_from(sysm, guess, *, tol=1e-6, max_nodes=10000, bc_tol=None):
     return res
 
 
-TOPOLOGIES = ("auto", "cap", "line", "annulus")
+TOPOLOGIES = ("auto", "cap", "line", "annulus", "cap+cylinder")
 
 #: Mean meridional stretch taken as beyond reach (see :func:`delta_bounds`).
 MEAN_STRETCH_LIMIT = 2.0
@@ -226,12 +226,16 @@ def solve(scene, *, delta=None, lambda0=None, force=None, tol=1e-6, max_nodes=10
     estimate_error : bool
         Richardson error estimates ``force_error``, ``delta_error`` (one more Newton
         solve on the mesh with every interval halved; see :func:`richardson_error`).
-    topology : {"auto", "cap", "line", "annulus"}
-        Contact topology (smooth model; ``shellbvp.liftoff``).  ``"auto"``: the
-        single cap, replaced by a valid line or annular contact where the cap
-        would pull the shell (negative pressure or ring force).  ``"cap"``: the
-        cap only.  ``"line"``/``"annulus"``: that topology, started from the cap
-        state, valid or not.  With a lifted pole, ``lambda0`` is the stretch there.
+    topology : {"auto", "cap", "line", "annulus", "cap+cylinder"}
+        Contact configuration (``shellbvp.chain``).  ``"auto"``: the single cap,
+        replaced by a valid line or annular contact where the cap would pull the
+        shell (negative pressure or ring force; smooth model; ``shellbvp.liftoff``),
+        or by contact running onto the indenter's cylinder where the cap passes the
+        tip's end or its free shell passes through the indenter near it
+        (``shellbvp.cylinder``; both contact models).  ``"cap"``: the cap only.
+        ``"line"``/``"annulus"``/``"cap+cylinder"``: that configuration, started
+        from the cap state, valid or not.  With a lifted pole, ``lambda0`` is the
+        stretch there.
 
     Returns
     -------
@@ -259,7 +263,7 @@ def solve(scene, *, delta=None, lambda0=None, force=None, tol=1e-6, max_nodes=10
         raise ValueError(f"topology must be one of {TOPOLOGIES}; got {topology!r}")
     if control == "delta":
         check_delta("delta", value, scene, tol)
-    if topology != "auto" and topology != "cap" and scene.contact != "smooth":
+    if topology in ("line", "annulus") and scene.contact != "smooth":
         raise ValueError(f"topology={topology!r} needs contact='smooth' (the variational contact line); "
                          f"the paper's model has the single cap only")
     if guess is not None and guess.get("topology") in ("line", "annulus"):
@@ -268,6 +272,15 @@ def solve(scene, *, delta=None, lambda0=None, force=None, tol=1e-6, max_nodes=10
         res = solve_liftoff(scene, guess.topology, delta=delta, force=force, lambda0=lambda0, guess=guess,
                             tol=tol, max_nodes=max_nodes, eps=eps, bc_tol=bc_tol, estimate_error=estimate_error)
         if topology in ("auto", guess.topology) and res.success:
+            return res
+        guess = None  # back to the cap
+
+    if guess is not None and guess.get("topology") == "cap+cylinder":
+        from .cylinder import cylinder_state
+
+        res = cylinder_state(guess, control=control, value=value, tol=tol, max_nodes=max_nodes, bc_tol=bc_tol,
+                             estimate_error=estimate_error)
+        if topology in ("auto", "cap+cylinder") and res.success:
             return res
         guess = None  # back to the cap
 
@@ -283,7 +296,10 @@ def solve(scene, *, delta=None, lambda0=None, force=None, tol=1e-6, max_nodes=10
         res = _cold_delta(sysm, value, **kw)
     else:
         res = _cold_other(scene, sysm, control, value, eps, **kw)
-    if topology != "cap" and scene.contact == "smooth" and res.get("topology") == "cap" and res.success:
+    if topology in ("auto", "cap+cylinder") and res.get("topology") == "cap":
+        res = _onto_cylinder(res, topology, kw)
+    if topology not in ("cap", "cap+cylinder") and scene.contact == "smooth" and res.get("topology") == "cap" \
+            and res.success:
         res = _other_topology(res, topology, kw)
     if res.success and estimate_error:
         richardson_error(res.system, res, tol, bc_tol)
@@ -291,6 +307,24 @@ def solve(scene, *, delta=None, lambda0=None, force=None, tol=1e-6, max_nodes=10
         res.force_error = res.delta_error = float("nan")
     res.wall_time = time.perf_counter() - t0
     return res
+
+
+def _onto_cylinder(cap, topology, kw):
+    """The cap+cylinder state where asked, or (auto) where the cap passes the tip's end or its
+    free shell passes through the indenter near it and the cylinder state is valid."""
+    from .cylinder import cylinder_state, cylinder_suspected
+
+    if cap.get("system") is None or cap.scene.model().OMEGA_MAX is None \
+            or not (topology == "cap+cylinder" or cylinder_suspected(cap)):
+        return cap
+    if not (cap.success or (cap.status == 4 and "end of the tip" in cap.message)):
+        return cap
+    alt = cylinder_state(cap, **kw)
+    if topology == "cap+cylinder" or (alt.success and alt.valid):
+        alt.cap_solution = cap
+        return alt
+    cap.flags = list(cap.flags) + [f"no valid cap+cylinder state ({alt.message if not alt.success else '; '.join(alt.flags)})"]
+    return cap
 
 
 def _other_topology(cap, topology, kw):
@@ -400,7 +434,10 @@ def _cold_other(scene, sysm, control, value, eps, **kw):
         return _failure(5, STATUS_MESSAGES[5])
     prev = None
     attempts = 0
-    while prev is None or (prev[key] - value) * (cur[key] - value) > 0:
+    def bracketed():  # a point-load state's lambda0 is NaN: it brackets nothing
+        return prev is not None and (prev[key] - value) * (cur[key] - value) <= 0
+
+    while not bracketed():
         attempts += 1
         if attempts > _MARCH_MAX_SOLVES:
             return _failure(5, f"{control} = {value:g} was not bracketed within {_MARCH_MAX_SOLVES} "
@@ -410,7 +447,9 @@ def _cold_other(scene, sysm, control, value, eps, **kw):
             return _failure(5, f"{control} = {value:g} was not reached on the branch for delta up to "
                                f"{d:.3g} ({key} there: {cur[key]:.4g})")
         dsys = make_system(scene, "delta", nd, eps)
-        nxt = solve_from(dsys, warm_guess(dsys, cur), **lk)
+        # a point-load state has no cap to warm-start from: a cold solve finds the cap or the limit again
+        nxt = _cold_delta(dsys, nd, **lk) if cur.get("topology") == "point" else solve_from(
+            dsys, warm_guess(dsys, cur), **lk)
         if nxt.success:
             prev, cur, d = cur, nxt, nd
             step = min(1.5 * step, 0.05)

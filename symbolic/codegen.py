@@ -132,10 +132,11 @@ def function_specs(d: Derivation) -> list[FunctionSpec]:
 
     par = tuple(d.params)
     specs = []
-    for region, prog, states, rhs, profile in (
-        ("free", d.free, d.free_states, d.free_rhs, d.free_profile),
-        ("contact", d.contact, d.contact_states, d.contact_rhs, d.contact_profile),
-    ):
+    regions = [("free", d.free, d.free_states, d.free_rhs, d.free_profile),
+               ("contact", d.contact, d.contact_states, d.contact_rhs, d.contact_profile)]
+    if d.has_cylinder:
+        regions.append(("cylinder", d.cylinder, d.cylinder_states, d.cylinder_rhs, d.cylinder_profile))
+    for region, prog, states, rhs, profile in regions:
         n = len(states)
         args = [("S", (sp.Symbol("S"),)), ("y", states), ("par", par)]
         # S is declared positive in geometry; find the program's own S.
@@ -178,31 +179,46 @@ def function_specs(d: Derivation) -> list[FunctionSpec]:
         FunctionSpec("rim_jac_par", d.free, rargs, [("dres", d.free.jacobian(d.rim_res, par))],
                      f"Rim conditions: d/dpar (3, {len(par)})."),
     ]
-    # contact line
-    J = d.junction
-    Sc = d.junction_inputs[0]
-    yc = d.junction_inputs[1:3]
-    yf = d.junction_inputs[3:]
-    jargs = [("Sc", (Sc,)), ("yc", yc), ("yf", yf), ("delta", (DELTA,)), ("F", (FORCE,)), ("par", par)]
-    wrt = [Sc, *yc, *yf, DELTA]
-    for model, res in d.junction_res.items():
+    # contact lines: tip | free and, where the tip has an end, cylinder | free (prefix cyl_)
+    edges = [("", "tip", d.junction, d.junction_inputs, d.junction_res, d.force_res)]
+    if d.has_cylinder:
+        edges.append(("cyl_", "cylinder", d.cyl_junction, d.cyl_junction_inputs, d.cyl_junction_res,
+                      d.cyl_force_res))
+    for prefix, where, J, inputs, residuals, force_res in edges:
+        Sc, yc, yf = inputs[0], inputs[1:3], inputs[3:]
+        jargs = [("Sc", (Sc,)), ("yc", yc), ("yf", yf), ("delta", (DELTA,)), ("F", (FORCE,)), ("par", par)]
+        wrt = [Sc, *yc, *yf, DELTA]
+        for model, res in residuals.items():
+            specs += [
+                FunctionSpec(f"junction_{prefix}{model}_res", J, jargs, [("res", res)],
+                             f"Contact-line conditions ({where} | free), {model} model (5,)."),
+                FunctionSpec(f"junction_{prefix}{model}_jac", J, jargs, [("dres", J.jacobian(res, wrt))],
+                             f"Contact-line conditions ({where} | free), {model} model: "
+                             "d/d(Sc, yc, yf, delta), (5, 10)."),
+                FunctionSpec(f"junction_{prefix}{model}_jac_par", J, jargs, [("dres", J.jacobian(res, par))],
+                             f"Contact-line conditions ({where} | free), {model} model: d/dpar (5, {len(par)})."),
+            ]
         specs += [
-            FunctionSpec(f"junction_{model}_res", J, jargs, [("res", res)],
-                         f"Contact-line conditions, {model} model (5,)."),
-            FunctionSpec(f"junction_{model}_jac", J, jargs, [("dres", J.jacobian(res, wrt))],
-                         f"Contact-line conditions, {model} model: d/d(Sc, yc, yf, delta), (5, 10)."),
-            FunctionSpec(f"junction_{model}_jac_par", J, jargs, [("dres", J.jacobian(res, par))],
-                         f"Contact-line conditions, {model} model: d/dpar (5, {len(par)})."),
+            FunctionSpec(f"force_{prefix}res", J, jargs, [("res", [force_res])],
+                         f"Force control at a {where} edge: F/(2 pi) of the free region minus the "
+                         "prescribed F/(2 pi), (1,)."),
+            FunctionSpec(f"force_{prefix}jac", J, jargs, [("dres", J.jacobian([force_res], [Sc, *yf, FORCE]))],
+                         f"Force control at a {where} edge: d/d(Sc, yf, F), (1, 8)."),
         ]
-    specs += [
-        FunctionSpec("force_res", J, jargs, [("res", [d.force_res])],
-                     "Force control: F/(2 pi) of the free region minus the prescribed F/(2 pi), (1,)."),
-        FunctionSpec("force_jac", J, jargs, [("dres", J.jacobian([d.force_res], [Sc, *yf, FORCE]))],
-                     "Force control: d/d(Sc, yf, F), (1, 8)."),
-        FunctionSpec("contact_line_forces", J, jargs,
-                     [("ring", [d.ring_force]), ("cap", [d.cap_force])],
-                     "Axial force of the ring at Sc (jump of Q) and of the pressure on the cap."),
-    ]
+        if not prefix:
+            specs.append(FunctionSpec("contact_line_forces", J, jargs,
+                                      [("ring", [d.ring_force]), ("cap", [d.cap_force])],
+                                      "Axial force of the ring at Sc (jump of Q) and of the pressure on the cap."))
+    if d.has_cylinder:
+        E, (SS, *ye) = d.tip_end, d.tip_end_inputs
+        eargs = [("S_end", (SS,)), ("yt", tuple(ye[:2])), ("yw", tuple(ye[2:])), ("par", par)]
+        specs += [
+            FunctionSpec("tip_end_res", E, eargs, [("res", d.tip_end_res)],
+                         "Tip | cylinder junction at S = S* (tip end state yt, cylinder start state yw): "
+                         "omega = omega_max on both sides and [lambda_s U_ls - U] = 0, (3,)."),
+            FunctionSpec("tip_end_jac", E, eargs, [("dres", E.jacobian(d.tip_end_res, [SS, *ye]))],
+                         "Tip | cylinder junction: d/d(S, yt, yw), (3, 5)."),
+        ]
     # point-load limit: pole conditions of the free region alone
     PL = d.point_load
     plargs = [("S", (PL.inputs[0],)), ("y", d.free_states), ("delta", (DELTA,)), ("par", par)]
@@ -256,6 +272,7 @@ def module_source(d: Derivation, description: str) -> str:
         f"PARAMS = {tuple(par)!r}",
         f"FREE_STATES = {FREE_STATES!r}",
         f"CONTACT_STATES = {CONTACT_STATES!r}",
+        f"OMEGA_MAX = {float(d.structure.tip.omega_max)!r}" if d.has_cylinder else "OMEGA_MAX = None",
         "",
     ]
     body = [_function_source(s) for s in function_specs(d)]

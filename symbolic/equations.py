@@ -48,7 +48,7 @@ from dataclasses import dataclass
 import sympy as sp
 
 from .dag import Program
-from .geometry import OMEGA, S, ShellGeometry, TipGeometry
+from .geometry import OMEGA, S, ShellGeometry, TipGeometry, cylinder_of
 from .materials import LS, LT
 
 __all__ = [
@@ -101,10 +101,24 @@ class Derivation:
         self.structure = st
         self.params = st.params
         self._build_free_physical()
-        self._build_contact_physical()
+        self.contact_phys, self.contact_phys_out = self._contact_physical(st.tip)
         self._build_free_scaled()
-        self._build_contact_scaled()
+        self.contact, self.contact_states, self.contact_rhs, self.contact_profile = self._contact_scaled(
+            self.contact_phys, self.contact_phys_out)
         self._build_boundaries()
+        (self.junction, self.junction_inputs, self.junction_res, self.force_res, self.ring_force,
+         self.cap_force) = self._edge(self.contact, self.contact_profile, self.contact_phys_out)
+        # The indenter's cylinder r = rho A(omega_max): the same contact equations on the
+        # continuation of the tip past its end (kappa_s = 0), its edge to a free region, and
+        # the junction where the shell passes from the tip onto it.
+        self.has_cylinder = st.tip.omega_max is not None
+        if self.has_cylinder:
+            self.cylinder_phys, self.cylinder_phys_out = self._contact_physical(cylinder_of(st.tip))
+            self.cylinder, self.cylinder_states, self.cylinder_rhs, self.cylinder_profile = self._contact_scaled(
+                self.cylinder_phys, self.cylinder_phys_out)
+            (self.cyl_junction, self.cyl_junction_inputs, self.cyl_junction_res, self.cyl_force_res, _,
+             _) = self._edge(self.cylinder, self.cylinder_profile, self.cylinder_phys_out)
+            self._build_tip_end()
         self._build_geometry()
         self._build_point_load()
         self._build_free_pole()
@@ -146,8 +160,8 @@ class Derivation:
         U_ = prog.let(f"U{tag}", W + BETA / 2 * m**2)
         return dict(m=m, T_s=T_s, T_t=T_t, M_s=M_s, M_t=M_t, tau_s=tau_s, tau_t=tau_t, W=W, U=U_)
 
-    def _tip_steps(self, prog: Program, omega, tag=""):
-        d = self.structure.tip.derived()
+    def _tip_steps(self, prog: Program, omega, tip, tag=""):
+        d = tip.derived()
         sub = {OMEGA: omega}
         return {k: prog.let(f"tip_{k}{tag}", v.xreplace(sub)) for k, v in d.items()}
 
@@ -225,7 +239,7 @@ class Derivation:
         }
 
     # ------------------------------------------------------------------ contact region
-    def _build_contact_physical(self):
+    def _contact_physical(self, tip: TipGeometry):
         """Contact region over (S, omega, ls): r, z on the tip, omega(S) unknown.
 
         With Q eliminated by the moment balance, the tangential balance
@@ -236,7 +250,7 @@ class Derivation:
         omega, ls = sp.symbols("omega ls")
         C = Program([S, omega, ls, *self.params])
         g = self._shell_steps(C, S)
-        t = self._tip_steps(C, omega)
+        t = self._tip_steps(C, omega, tip)
         r = C.let("r", RHO * t["A"])
         lt = C.let("lt", r / g["R"])
         ks = C.let("ks", t["rho_ks"] / RHO)
@@ -259,23 +273,20 @@ class Derivation:
         # P from the normal balance; (rQ)' is a total derivative along the solution.
         drQ = C.derivative(rQ, S) + C.derivative(rQ, omega) * domega + C.derivative(rQ, ls) * dls
         P = C.let("P", ks * c["tau_s"] + kt * c["tau_t"] - drQ / (r * psi))
-        self.contact_phys = C
-        self.contact_phys_out = dict(c, **g, tip=t, r=r, dr=dr, lt=lt, ks=ks, kt=kt, psi=psi,
-                                     domega=domega, dls=dls, rQ=rQ, Q=Q, G=G, P=P)
+        return C, dict(c, **g, tip=t, r=r, dr=dr, lt=lt, ks=ks, kt=kt, psi=psi,
+                       domega=domega, dls=dls, rQ=rQ, Q=Q, G=G, P=P)
 
-    def _build_contact_scaled(self):
+    def _contact_scaled(self, phys: Program, o: dict):
+        """(program, states, rhs, profile) of a contact region in the scaled states (chi, ls)."""
         ys = sp.symbols(" ".join(CONTACT_STATES))
         chi, ls = ys
         P = Program([S, *ys, *self.params])
         P.let("omega", S * chi / RHO, always=True)
-        P.extend(self.contact_phys, skip_defined=True)
-        o = self.contact_phys_out
+        P.extend(phys, skip_defined=True)
         g = [ls * o["Psi"] / o["tip"]["G"] - chi, S * o["dls"]]
-        self.contact = P
-        self.contact_states = ys
-        self.contact_rhs = [P.let(f"g_{n}", e) for n, e in zip(CONTACT_STATES, g)]
+        rhs = [P.let(f"g_{n}", e) for n, e in zip(CONTACT_STATES, g)]
         t = o["tip"]
-        self.contact_profile = {
+        profile = {
             "r": o["r"], "z": RHO * t["B"], "phi": t["phi"], "lambda_s": ls, "lambda_theta": o["lt"],
             "kappa_s": o["ks"], "kappa_theta": o["kt"], "T_s": o["T_s"], "T_theta": o["T_t"],
             "M_s": o["M_s"], "M_theta": o["M_t"], "tau_s": o["tau_s"], "tau_theta": o["tau_t"],
@@ -283,6 +294,7 @@ class Derivation:
             "energy_density": o["U"] * o["R"] * o["Psi"], "omega": sp.Symbol("omega"),
         }
         # note: profile z is relative to the tip apex; the solver adds z_tip.
+        return P, ys, rhs, profile
 
     # ------------------------------------------------------------------ conditions
     def _build_boundaries(self):
@@ -304,15 +316,22 @@ class Derivation:
         self.rim_res = [F.let("res_lt", lt - 1), F.let("res_m", self.free_phys_out["m"]),
                         F.let("res_z", z)]
 
-        # Contact line: contact end (chi_c, ls_c) and free start (suffix _f) at S = Sc.
+
+    def _edge(self, contact: Program, contact_profile: dict, contact_out: dict):
+        """Contact-line programs between a contact region (tip or cylinder) and a free one.
+
+        Returns ``(program, inputs (Sc, yc, yf), {model: residuals}, force residual,
+        ring force, cap force)``: contact end (chi_c, ls_c) and free start (suffix _f) at S = Sc.
+        """
+        sh = self.structure.shell
         yc = sp.symbols("chi_c ls_c")
         yf = sp.symbols(" ".join(n + "_f" for n in FREE_STATES))
         J = Program([SC, *yc, *yf, DELTA, FORCE, *self.params])
-        cprog, cmap = self.contact.renamed("_c", {S: SC}, keep=self.params)
+        cprog, cmap = contact.renamed("_c", {S: SC}, keep=self.params)
         fprog, fmap = self.free.renamed("_f", {S: SC}, keep=self.params)
         J.extend(cprog)
         J.extend(fprog)
-        oc = {k: v.xreplace(cmap) for k, v in self.contact_profile.items()}
+        oc = {k: v.xreplace(cmap) for k, v in contact_profile.items()}
         of = {k: v.xreplace(fmap) for k, v in self.free_profile.items()}
         z_tip = sh.Z.subs(S, 0) - DELTA
         lt_f, phiS_f, ls_f, ks_f, rQ_f, z_f = yf
@@ -321,19 +340,50 @@ class Derivation:
             J.let("res_phi", phiS_f - oc["phi"] / SC),
             J.let("res_z", z_f - (z_tip + oc["z"])),
         ]
-        self.junction = J
-        self.junction_inputs = (SC, *yc, *yf)
-        self.junction_res = {
+        res = {
             "smooth": common + [J.let("res_ls", ls_f - oc["lambda_s"]),
                                 J.let("res_ks", ks_f - oc["kappa_s"])],
-            "paper": common + [J.let("res_Q", rQ_f - self.contact_phys_out["rQ"].xreplace(cmap)),
+            "paper": common + [J.let("res_Q", rQ_f - contact_out["rQ"].xreplace(cmap)),
                                J.let("res_tau", of["tau_s"] - oc["tau_s"])],
         }
-        self.force_res = J.let("res_F", of["axial_force_2pi"] - FORCE / (2 * sp.pi))
+        force = J.let("res_F", of["axial_force_2pi"] - FORCE / (2 * sp.pi))
         # Total axial force of the ring at the contact edge (Q jumps there) and of the cap.
-        self.ring_force = J.let("ring_force", 2 * sp.pi * (of["axial_force_2pi"] - oc["axial_force_2pi"]))
-        self.cap_force = J.let("cap_force", 2 * sp.pi * oc["axial_force_2pi"])
+        ring = J.let("ring_force", 2 * sp.pi * (of["axial_force_2pi"] - oc["axial_force_2pi"]))
+        cap = J.let("cap_force", 2 * sp.pi * oc["axial_force_2pi"])
+        return J, (SC, *yc, *yf), res, force, ring, cap
 
+    def _build_tip_end(self):
+        """Where the shell passes from the tip onto the cylinder, at an unknown S = S*.
+
+        omega reaches omega_max from both sides (2 conditions, as chi = rho omega_max/S*), and
+        the Weierstrass-Erdmann (refraction) condition of E = 2 pi Int U R Psi dS across the
+        line omega = omega_max, where U jumps with the indenter's kappa_s: the Hamiltonian
+        ``R Psi (lambda_s dU/dlambda_s - U)`` is continuous (``[lambda_s U_ls - U] = 0``, R Psi
+        being continuous); lambda_s may jump, and with it the tension (the kink of the indenter's
+        curvature carries it, like the contact edge's ring force).  1 condition.
+        """
+        w0 = self.structure.tip.omega_max
+        SS = sp.Symbol("S_end", positive=True)
+        yt = sp.symbols("chi_t ls_t")
+        yw = sp.symbols("chi_w ls_w")
+        E = Program([SS, *yt, *yw, *self.params])
+        tprog, tmap = self.contact.renamed("_t", {S: SS, self.contact_states[0]: yt[0],
+                                                  self.contact_states[1]: yt[1]}, keep=self.params)
+        wprog, wmap = self.cylinder.renamed("_w", {S: SS, self.cylinder_states[0]: yw[0],
+                                                   self.cylinder_states[1]: yw[1]}, keep=self.params)
+        E.extend(tprog)
+        E.extend(wprog)
+
+        def eshelby(out, ls, mapping, prog):
+            U = out["U"].xreplace(mapping)
+            return ls * prog.derivative(U, ls) - U
+
+        H_t = E.let("H_t", eshelby(self.contact_phys_out, yt[1], tmap, E))
+        H_w = E.let("H_w", eshelby(self.cylinder_phys_out, yw[1], wmap, E))
+        self.tip_end = E
+        self.tip_end_inputs = (SS, *yt, *yw)
+        self.tip_end_res = [E.let("res_end_t", yt[0] - RHO * w0 / SS), E.let("res_end_w", yw[0] - RHO * w0 / SS),
+                            E.let("res_end_H", H_t - H_w)]
 
     def _build_point_load(self):
         """Pole conditions of the point-load limit (cap -> 0, smooth model), at S = s0.

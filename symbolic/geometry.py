@@ -60,6 +60,7 @@ class TipGeometry:
     A: sp.Expr
     B: sp.Expr
     phi: sp.Expr
+    omega_max: sp.Expr | None = None  # where A' first vanishes: the tip meets its cylinder (None: never)
 
     def derived(self):
         """Dict of tip expressions in omega: A, B, dA, dB, G=|(A',B')|,
@@ -111,7 +112,7 @@ def user_shell(R, Z, L, *, legacy_srepr: bool = False) -> ShellGeometry:
 
 def sphere_tip() -> TipGeometry:
     """Sphere of radius rho: ``A = sin omega``, ``B = 1 - cos omega``, phi = omega."""
-    return TipGeometry(A=sp.sin(OMEGA), B=1 - sp.cos(OMEGA), phi=OMEGA)
+    return TipGeometry(A=sp.sin(OMEGA), B=1 - sp.cos(OMEGA), phi=OMEGA, omega_max=sp.pi / 2)
 
 
 def user_tip(A, B, *, legacy_srepr: bool = False) -> TipGeometry:
@@ -127,4 +128,38 @@ def user_tip(A, B, *, legacy_srepr: bool = False) -> TipGeometry:
     dA0 = sp.diff(A, OMEGA).subs(OMEGA, 0)
     if not (dA0.is_number and float(dA0) > 0):
         raise ValueError(f"A'(0) must be positive; got {dA0}")
-    return TipGeometry(A=A, B=B, phi=sp.atan2(sp.diff(B, OMEGA), sp.diff(A, OMEGA)))
+    return TipGeometry(A=A, B=B, phi=sp.atan2(sp.diff(B, OMEGA), sp.diff(A, OMEGA)), omega_max=tip_end(A))
+
+
+def tip_end(A, omega_limit=2 * sp.pi):
+    """The first omega > 0 where A'(omega) = 0 (the tip meets the cylinder r = rho A there),
+    exact where SymPy solves it, else to 30 digits; None if A' keeps its sign up to ``omega_limit``."""
+    import numpy as np
+
+    dA = sp.diff(A, OMEGA)
+    f = sp.lambdify(OMEGA, dA, "mpmath")
+    grid = np.linspace(1e-6, float(omega_limit), 20001)
+    vals = np.array([float(f(w)) for w in grid[::20]])  # coarse scan, then refine the bracket
+    change = np.nonzero(np.diff(np.sign(vals)) != 0)[0]
+    if not change.size:
+        return None
+    lo, hi = grid[::20][change[0]], grid[::20][change[0] + 1]
+    roots = sp.solveset(dA, OMEGA, sp.Interval(lo, hi))
+    if isinstance(roots, sp.FiniteSet) and roots:
+        return min(roots, key=float)
+    import mpmath
+
+    with mpmath.workdps(30):
+        return sp.Float(mpmath.findroot(f, (lo, hi), solver="anderson"), 30)
+
+
+def cylinder_of(tip: TipGeometry) -> TipGeometry:
+    """The indenter's cylinder as the continuation of the tip past its end, in the same
+    parameter: ``A = A(omega_max)``, ``B = B(omega_max) + (omega - omega_max)`` (unit speed,
+    tangent vertical, kappa_s = 0, kappa_theta = 1/(rho A(omega_max)))."""
+    if tip.omega_max is None:
+        raise ValueError("this tip has no end where it meets a cylinder (A' never vanishes)")
+    w0 = tip.omega_max
+    return TipGeometry(A=sp.simplify(tip.A.subs(OMEGA, w0)) + 0 * OMEGA,
+                       B=sp.simplify(tip.B.subs(OMEGA, w0)) + (OMEGA - w0), phi=sp.pi / 2 + 0 * OMEGA,
+                       omega_max=None)

@@ -17,10 +17,12 @@ EPS = 1e-3
 CHAINS = {"cap": lambda L, contact: ch.cap_chain(EPS, L, contact),
           "annulus": lambda L, contact: ch.annulus_chain(EPS, L),
           "line": lambda L, contact: ch.line_chain(EPS, L),
-          "point": lambda L, contact: ch.point_chain(1e-12, L)}
+          "point": lambda L, contact: ch.point_chain(1e-12, L),
+          "cylinder": lambda L, contact: ch.cylinder_chain(EPS, L, contact)}
 CASES = [("cap", c, m) for c in ("smooth", "paper") for m in ("delta", "lambda0", "force", "arclength")] + \
         [(k, "smooth", m) for k in ("annulus", "line") for m in ("delta", "lambda0", "force")] + \
-        [("point", "smooth", "delta")]
+        [("point", "smooth", "delta")] + \
+        [("cylinder", c, m) for c in ("smooth", "paper") for m in ("delta", "lambda0", "force", "arclength")]
 ARC = (np.array([0.2, 1.0, 0.4]), np.array([0.6, 0.0, 0.8]), np.array([1.0, 0.5, 2.0]))
 
 
@@ -42,7 +44,8 @@ def system(kind, contact, control):
 def state(sysm, rng):
     t = np.linspace(0.0, 1.0, 4)
     y = 0.5 + 0.3 * rng.random((sysm.n, t.size))
-    values = dict(ln_Sc=np.log(0.1), ln_S1=np.log(0.05), ln_S2=np.log(0.15), chi1=0.9, lambda0=1.02, delta=0.3)
+    values = dict(ln_Sc=np.log(0.1), ln_S1=np.log(0.05), ln_S2=np.log(0.15), ln_Send=np.log(0.07), chi1=0.9,
+                  lambda0=1.02, delta=0.3)
     return t, y, sysm.pack(**values)
 
 

@@ -1,0 +1,148 @@
+"""One diagnosis for every contact configuration: a solve_bvp result -> a :class:`Solution`.
+
+Reads the chain's declaration (``shellbvp.chain``): the force is the axial force of the
+region that ends at the rim; every contact edge (tip or cylinder) and line carries a ring
+force, the jump of the axial force across it (``ring_force`` at the outermost edge,
+``ring_force_inner`` at the innermost of several) and a normal ring force
+``-2 pi r [Q]`` (``edge_forces``, all edges, pole to rim) that must push; every contact
+region a pressure (``pressure_min``); no free region may pass through the indenter.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .chain import FREE_STATES, ContactPole, Edge, FreePole, Line, TipEnd
+from .solution import Solution, penetration, set_status
+
+__all__ = ["diagnose"]
+
+_LS, _LT = FREE_STATES.index("ls"), FREE_STATES.index("lt")
+
+
+def _edges(sysm):
+    """(S point, inner region, outer region) of each contact edge and line, pole to rim."""
+    out = []
+    for j in sysm.junctions:
+        if isinstance(j, Edge):
+            inner, outer = min(j.kc, j.kf), max(j.kc, j.kf)
+            out.append((sysm.regions[inner].end, inner, outer))
+        elif isinstance(j, Line):
+            out.append((sysm.regions[j.k].end, j.k, j.k + 1))
+    return out
+
+
+def _at(sysm, k, S, y):
+    prof = getattr(sysm.model, f"{sysm.regions[k].kind}_profile")
+    return prof(np.array([S]), y[sysm.rows(k), None], sysm.par)
+
+
+def _omega_range(sysm, k, fields):
+    return float(np.min(fields["omega"])), float(np.max(fields["omega"]))
+
+
+def diagnose(sysm, bvp, tol) -> Solution:
+    """The Solution of a solve_bvp run of ``sysm`` (a ChainBVP) with the model's checks.
+
+    Status 4 (inadmissible) for edges out of order, non-positive stretches, delta < 0, a
+    tip contact past the tip's end or a cylinder contact below it; ``valid`` also needs
+    pressures and ring forces that push and no penetration (``flags`` say what failed).
+    """
+    nan = float("nan")
+    p = bvp.p
+    q = sysm.quantities(p) if sysm.k else sysm.quantities(None)
+    ya, yb = bvp.y[:, 0], bvp.y[:, -1]
+    force, delta = sysm.end_values(ya, yb, p)
+    mod, par = sysm.model, sysm.par
+    first = sysm.chain.junctions[0]
+    lambda0 = (q["lambda0"] if isinstance(first, ContactPole)
+               else ya[sysm.rows(0)][_LS] if isinstance(first, FreePole) else nan)
+    edges = _edges(sysm)
+    S_edges = [sysm.S_point(pt, p) for pt, _, _ in edges] or [0.0]
+    res = Solution(
+        topology=sysm.topology, status=int(bvp.status), message=bvp.message, x=bvp.x, y=bvp.y, p=p, sol=bvp.sol,
+        rms_residuals=bvp.rms_residuals, niter=int(bvp.niter), nodes=int(bvp.x.size),
+        max_residual=float(np.max(bvp.rms_residuals)) if bvp.rms_residuals.size else nan,
+        delta=float(delta), lambda0=float(lambda0), Sc=S_edges[-1], S1=S_edges[0], force=float(force),
+        control=sysm.control, scene=sysm.scene, system=sysm,
+        z_tip=float(mod.reference_shell(0.0, par)["Z"]) - float(delta),
+    )
+    tip_end = next((j for j in sysm.junctions if isinstance(j, TipEnd)), None)
+    if tip_end is not None:
+        res.S_end = sysm.S_point(sysm.regions[tip_end.k].end, p)
+        res.S1 = res.S_end
+    flags = []
+    finite = bool(np.all(np.isfinite(bvp.y)) and (p is None or np.all(np.isfinite(p))) and math.isfinite(force))
+    if not finite:
+        flags.append("non-finite state")
+    elif bvp.status == 0:
+        bounds = [sysm.S_point(r.start, p) for r in sysm.regions] + [sysm.L]
+        if not (bounds[0] > 0 and np.all(np.diff(bounds) > 0)):
+            flags.append("region boundaries not ordered inside (0, L): " + ", ".join(f"{b:.3g}" for b in bounds))
+        stretches = [bvp.y[sysm.offsets[k] + (_LS if r.kind == "free" else 1)] for k, r in enumerate(sysm.regions)]
+        stretches += [bvp.y[sysm.offsets[k] + _LT] for k, r in enumerate(sysm.regions) if r.kind == "free"]
+        if (math.isfinite(lambda0) and lambda0 <= 0) or any(np.any(s <= 0) for s in stretches):
+            flags.append("non-positive stretch")
+        if delta < 0:
+            flags.append(f"collapsed state with delta = {delta:.3g} < 0")
+    set_status(res, bvp, flags)
+    if not finite:
+        res.update(energy=nan, pressure_min=nan, penetration=nan, force_defect=nan, edge_legendre=nan,
+                   ring_force=nan, ring_force_inner=nan, cap_force=nan, edge_forces=[], valid=False, flags=flags)
+        return res
+
+    t = np.unique(np.r_[bvp.x, 0.5 * (bvp.x[1:] + bvp.x[:-1])])
+    parts = sysm.region_profiles(t, bvp.sol(t), p)
+    # ring forces: jumps of the axial force (2 pi G) and of r Q across each edge, outer minus inner
+    axial, normal = [], []
+    for pt, inner, outer in edges:
+        S = sysm.S_point(pt, p)
+        fi, fo = _at(sysm, inner, S, yb), _at(sysm, outer, S, ya)
+        axial.append(2 * np.pi * float(fo["axial_force_2pi"][0] - fi["axial_force_2pi"][0]))
+        normal.append(-2 * np.pi * float(fo["r"][0] * fo["Q"][0] - fi["r"][0] * fi["Q"][0]))
+    res.ring_force = axial[-1] if axial else float(force)
+    res.ring_force_inner = axial[0] if len(axial) > 1 else 0.0
+    res.edge_forces = normal
+    res.cap_force = float(force) - sum(axial)
+    contact = [(k, f) for k, _, f in parts if sysm.regions[k].kind != "free"]
+    res.pressure_min = min((float(np.min(f["P"])) for _, f in contact), default=nan)
+    free = [(k, f) for k, _, f in parts if sysm.regions[k].kind == "free"]
+    defect = 0.0
+    for k, f in free:
+        G = 2 * np.pi * f["axial_force_2pi"]
+        ref = 0.0 if (k == 0 and isinstance(first, FreePole)) else G[0]
+        defect = max(defect, float(np.max(np.abs(G - ref))))
+    res.force_defect = defect
+    res.penetration = max(penetration(sysm, f["r"], f["z"], res.z_tip) for _, f in free)
+    last = len(sysm.regions) - 1
+    t_leg = np.array([0.0, 0.5])
+    leg = mod.free_legendre(sysm.S(last, t_leg, p), bvp.sol(t_leg)[sysm.rows(last)], par)[0]
+    res.edge_legendre = float(leg[0] / leg[1]) if leg[1] != 0 else nan
+    res.energy = sysm.energy(bvp.sol, bvp.x, p)
+
+    admissible, vflags = [], []
+    omega_max = sysm.scene.tip_omega_max
+    for k, f in contact:
+        lo, hi = _omega_range(sysm, k, f)
+        if sysm.regions[k].kind == "contact" and hi > omega_max * (1 + 1e-9):
+            admissible.append("the contact has passed the end of the tip (the indenter's cylinder)")
+        if sysm.regions[k].kind == "cylinder" and lo < omega_max * (1 - 1e-9):
+            admissible.append("the contact on the cylinder runs back onto the tip")
+    if admissible and bvp.status == 0:
+        set_status(res, bvp, flags + admissible)
+        flags = flags + admissible
+    scale = 10 * tol * (1 + abs(force))
+    for k, f in contact:
+        where = "the cylinder" if sysm.regions[k].kind == "cylinder" else "the tip"
+        if float(np.min(f["P"])) < -scale:
+            vflags.append(f"negative contact pressure on {where} (min P = {float(np.min(f['P'])):.3g})")
+    for (pt, _, _), N in zip(edges, normal):
+        if N < -scale:
+            vflags.append(f"negative ring force ({N:.3g}) at the contact edge {pt.name}")
+    if res.penetration > 10 * tol:
+        vflags.append(f"the free shell passes through the indenter (by {res.penetration:.3g})")
+    res.flags = flags + vflags
+    res.valid = res.success and not vflags
+    return res
