@@ -456,7 +456,7 @@ def main(argv=None):
     except (ValueError, FileExistsError) as exc:
         if getattr(args, "json", False):
             _print_json_error(exc)
-        print(f"shellbvp: error: {exc}", file=sys.stderr)
+        print(f"shellbvp: error: {' '.join(str(exc).split())}", file=sys.stderr)  # one line, always
         return 2
     except KeyboardInterrupt:
         print("shellbvp: interrupted", file=sys.stderr)

@@ -889,6 +889,9 @@ def read_force_csv(path, *, columns=None, units=None):
         if va is None or vb is None:
             raise ValueError(f"{path}: line {n}: cannot read {a!r}, {b!r} as numbers (plain finite decimals "
                              "such as 1.5 or -2e-3; empty or nan for a missing value)")
+        if math.isinf(va * fd) or math.isinf(vb * ff):
+            raise ValueError(f"{path}: line {n}: {a!r}, {b!r} overflow when converted to metres and newtons "
+                             f"({unit_names[0]}, {unit_names[1]})")
         disp.append(va * fd)
         frc.append(vb * ff)
     d, f = np.array(disp), np.array(frc)

@@ -74,13 +74,17 @@ class UserShell:
         import sympy as sp
 
         from symbolic import geometry as sg
-        from symbolic.formula import formula_text
+        from symbolic.formula import evaluation_errors, formula_text
 
-        self.geometry = sg.user_shell(R, Z, L, legacy_srepr=legacy_srepr)
-        self._desc = {"kind": "user", "R": formula_text(self.geometry.R), "Z": formula_text(self.geometry.Z),
-                      "L": formula_text(self.geometry.L)}
-        ks, kt = self.geometry.curvatures()
-        self._pole_kt = float(sp.limit(kt, sg.S, 0, "+"))
+        with evaluation_errors("shell"):
+            self.geometry = sg.user_shell(R, Z, L, legacy_srepr=legacy_srepr)
+            self._desc = {"kind": "user", "R": formula_text(self.geometry.R), "Z": formula_text(self.geometry.Z),
+                          "L": formula_text(self.geometry.L)}
+            ks, kt = self.geometry.curvatures()
+            pole_kt = sp.limit(kt, sg.S, 0, "+")
+        if not (pole_kt.is_real and pole_kt.is_finite):
+            raise ValueError(f"shell: the pole curvature kappa_theta(0) must be finite; got {pole_kt}")
+        self._pole_kt = float(pole_kt)
 
     def description(self):
         return dict(self._desc)
@@ -107,14 +111,18 @@ class UserTip:
         import sympy as sp
 
         from symbolic import geometry as sg
-        from symbolic.formula import formula_text
+        from symbolic.formula import evaluation_errors, formula_text
 
-        self.geometry = sg.user_tip(A, B, legacy_srepr=legacy_srepr)
-        self._desc = {"kind": "user", "A": formula_text(self.geometry.A), "B": formula_text(self.geometry.B)}
-        w = sg.OMEGA
-        dA0 = sp.diff(self.geometry.A, w).subs(w, 0)
-        ddB0 = sp.diff(self.geometry.B, w, 2).subs(w, 0)
-        self._apex = float(ddB0 / dA0**2)
+        with evaluation_errors("tip"):
+            self.geometry = sg.user_tip(A, B, legacy_srepr=legacy_srepr)
+            self._desc = {"kind": "user", "A": formula_text(self.geometry.A), "B": formula_text(self.geometry.B)}
+            w = sg.OMEGA
+            dA0 = sp.diff(self.geometry.A, w).subs(w, 0)
+            ddB0 = sp.diff(self.geometry.B, w, 2).subs(w, 0)
+            apex = ddB0 / dA0**2
+        if not (apex.is_real and apex.is_finite):
+            raise ValueError(f"tip apex curvature B''(0)/A'(0)^2 must be a finite number; got {apex}")
+        self._apex = float(apex)
         if self._apex <= 0:
             raise ValueError(f"tip apex curvature B''(0)/A'(0)^2 must be > 0 (a convex tip); got {self._apex}")
         # The tip ends where A' first vanishes (it meets the cylinder r = rho A there); a tip

@@ -382,10 +382,12 @@ def read_curve(path):
     path = Path(path)
     if not path.exists():
         raise ValueError(f"{path}: no such file")
+    if path.is_dir():
+        raise ValueError(f"{path}: is a directory, not a curve file")
     try:
         f = h5py.File(path, "r")
     except OSError as exc:
-        raise ValueError(f"{path}: not a readable HDF5 file ({exc})") from None
+        raise ValueError(f"{path}: not a readable HDF5 file ({' '.join(str(exc).split())})") from None
     with f:
         fmt = f.attrs.get("format")
         fmt = fmt.decode("utf-8", "replace") if isinstance(fmt, bytes) else fmt

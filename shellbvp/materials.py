@@ -39,7 +39,7 @@ class MooneyRivlin(Material):
 
     def validate(self):
         a = self.alpha
-        if not (isinstance(a, (int, float)) and math.isfinite(a) and 0.0 <= a <= 1.0):
+        if isinstance(a, bool) or not (isinstance(a, (int, float)) and math.isfinite(a) and 0.0 <= a <= 1.0):
             raise ValueError(f"alpha (Mooney-Rivlin) must be in [0, 1]; got {a!r}")
 
 
@@ -62,7 +62,7 @@ class Gent(Material):
 
     def validate(self):
         j = self.Jm
-        if not (isinstance(j, (int, float)) and math.isfinite(j) and j > 0):
+        if isinstance(j, bool) or not (isinstance(j, (int, float)) and math.isfinite(j) and j > 0):
             raise ValueError(f"Jm (Gent) must be a finite number > 0; got {j!r}")
 
 
@@ -86,10 +86,11 @@ class StrainEnergy(Material):
 
     def __init__(self, W, name: str = "user", *, legacy_srepr: bool = False):
         from symbolic import materials as sm
-        from symbolic.formula import formula_text, parse_formula
+        from symbolic.formula import evaluation_errors, formula_text, parse_formula
 
-        expr = parse_formula(W, {"lambda_s": sm.LS, "lambda_theta": sm.LT}, name="W", legacy_srepr=legacy_srepr)
-        self.shear_modulus = float(sm.check_energy(expr, name="W"))
+        with evaluation_errors("W"):
+            expr = parse_formula(W, {"lambda_s": sm.LS, "lambda_theta": sm.LT}, name="W", legacy_srepr=legacy_srepr)
+            self.shear_modulus = float(sm.check_energy(expr, name="W"))
         self.W = expr
         self.name = str(name)
         self._text = formula_text(expr)

@@ -25,12 +25,13 @@ with literal arguments), still through the same whitelist.
 from __future__ import annotations
 
 import ast
+import contextlib
 import math
 
 import sympy as sp
 from sympy.printing.str import StrPrinter
 
-__all__ = ["FUNCTIONS", "MAX_LENGTH", "parse_formula", "formula_text"]
+__all__ = ["FUNCTIONS", "MAX_LENGTH", "parse_formula", "formula_text", "evaluation_errors"]
 
 #: Functions a formula may call: name -> (SymPy function, number of arguments).
 FUNCTIONS = {
@@ -208,6 +209,17 @@ class _Builder:
         if fname in ("Add", "Mul") and vals:
             return sp.Add(*vals) if fname == "Add" else sp.Mul(*vals)
         self.fail(node)
+
+
+@contextlib.contextmanager
+def evaluation_errors(name: str):
+    """Turn what SymPy/mpmath raise on a formula's numbers (``exp(exp(exp(exp(1000))))``
+    overflows mpmath's integers; deep nesting recurses) into a ValueError naming it."""
+    try:
+        yield
+    except (ArithmeticError, RecursionError) as exc:
+        raise ValueError(f"{name}: the formula's numbers cannot be evaluated ({type(exc).__name__}: "
+                         f"{' '.join(str(exc).split())[:100]})") from None
 
 
 class _PlainPrinter(StrPrinter):

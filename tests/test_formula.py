@@ -230,3 +230,27 @@ def test_cache_directory_writable_by_others_is_not_used(tmp_path, monkeypatch, c
     assert "not using the code cache" in caplog.text
     assert not any(cache.iterdir())  # nothing written to, nothing read from the shared directory
     assert model.untrusted_reason(__import__("pathlib").Path(mod.__file__).parent) is None
+
+
+@pytest.mark.parametrize("W", [
+    "((1-0.1)*(lambda_s**2+lambda_theta**2+1/(lambda_s*lambda_theta)**2-3)"
+    " + 0.1*(1/lambda_s**2+1/lambda_theta**2+lambda_s**2*lambda_theta**2-3))/2",  # Mooney-Rivlin 0.1
+    "-97.2/2*log(1-(lambda_s**2+lambda_theta**2+1/(lambda_s*lambda_theta)**2-3)/97.2)",  # Gent 97.2
+])
+def test_built_in_energies_written_out_with_decimals_are_accepted(W):
+    """W(1, 1) of these is 2e-16 and -1e-14 in floating point: zero to rounding, accepted."""
+    assert sb.StrainEnergy(W).shear_modulus == pytest.approx(1.0, rel=1e-12)
+
+
+@pytest.mark.parametrize("W, what", [("(lambda_s - 1)**2 + (lambda_theta - 1)**2 + 1e-6", "vanish"),
+                                     ("0.5*(lambda_s**2 + lambda_theta**2 + 1/(lambda_s*lambda_theta)**2 - 3.001)",
+                                      "vanish"),
+                                     ("(lambda_s - 1)**2 + 2.0*(lambda_theta - 1)**2", "symmetric")])
+def test_small_but_real_defects_of_decimal_energies_are_still_refused(W, what):
+    with pytest.raises(ValueError, match=what):
+        sb.StrainEnergy(W)
+
+
+def test_numbers_too_large_to_evaluate_are_a_value_error():
+    with pytest.raises(ValueError, match="cannot be evaluated"):
+        sb.StrainEnergy("exp(exp(exp(exp(1000))))")

@@ -351,3 +351,21 @@ def test_a_curve_without_points_round_trips(tmp_path):
     assert len(back) == 0 and back.stop_reason == c.stop_reason and not back.complete
     r = run("info", "e.h5", cwd=tmp_path)
     assert r.returncode == 0 and "0 points" in r.stdout
+
+
+def test_a_directory_is_not_a_curve_file(tmp_path):
+    with pytest.raises(ValueError, match="is a directory"):
+        sb.read_curve(tmp_path)
+
+
+def test_csv_numbers_that_overflow_in_si_units_name_their_line(tmp_path):
+    path = tmp_path / "big.csv"
+    path.write_text("# a comment\nd (um),F (kN)\n1,1\n2,1e308\n3,2\n4,3\n")
+    with pytest.raises(ValueError, match="line 4: .*overflow"):
+        sb.read_force_csv(path)
+
+
+@pytest.mark.parametrize("material", [lambda: sb.MooneyRivlin(True), lambda: sb.Gent(True)])
+def test_booleans_are_not_material_parameters(material):
+    with pytest.raises(ValueError, match="alpha|Jm"):
+        sb.Scene.preset("base", material=material())
