@@ -46,7 +46,8 @@ from dataclasses import dataclass
 import numpy as np
 
 __all__ = ["Point", "Region", "ContactPole", "FreePole", "PointPole", "Edge", "TipEnd", "Line", "Rim", "Chain",
-           "ChainBVP", "cap_chain", "point_chain", "annulus_chain", "line_chain", "cylinder_chain", "CONTROLS",
+           "ChainBVP", "cap_chain", "point_chain", "annulus_chain", "line_chain", "cylinder_chain",
+           "cap_line_cylinder_chain", "cap_band_cylinder_chain", "CONTROLS",
            "SIZES", "FREE_STATES", "CONTACT_STATES", "CONTACT_KINDS", "REGION_CODES"]
 
 CONTROLS = ("delta", "lambda0", "force", "arclength")
@@ -131,11 +132,13 @@ class TipEnd:
 class Line:
     """Line contact between free regions ``k`` and ``k + 1`` at the indenter point ``chi1``: 8 rows.
 
-    r, phi, z on the tip (3 rows, the smooth junction's first three);
-    lt, phiS, ls, ks, z continuous (5); rQ jumps (the ring force).
+    r, phi, z on the indenter (3 rows, the smooth junction's first three; ``on`` the tip,
+    ``"contact"``, or the cylinder, ``"cylinder"``); lt, phiS, ls, ks, z continuous (5);
+    rQ jumps (the ring force).
     """
 
     k: int
+    on: str = "contact"
     rows = 8
 
 
@@ -199,6 +202,26 @@ def cylinder_chain(eps: float, L: float, model: str = "smooth") -> Chain:
     return Chain("cap+cylinder", (Region("contact", Point("zeta", "ln_Send", math.log(eps)), Se),
                                   Region("cylinder", Se, Sc), Region("free", Sc, Point("L", None, math.log(L)))),
                  (ContactPole(0), TipEnd(0), Edge(1, 2, model), Rim(2)), ("ln_Send", "ln_Sc"), eps)
+
+
+def cap_line_cylinder_chain(eps: float, L: float, model: str = "smooth") -> Chain:
+    """A cap on the tip and the free shell touching the cylinder on one circle S1: tip
+    [zeta, Sc], free [Sc, S1], free [S1, L]; unknowns ln Sc, ln S1, chi1 (the wall point touched)."""
+    Sc, S1 = Point("Sc", "ln_Sc"), Point("S1", "ln_S1")
+    return Chain("cap+line(cylinder)", (Region("contact", Point("zeta", "ln_Sc", math.log(eps)), Sc),
+                                        Region("free", Sc, S1), Region("free", S1, Point("L", None, math.log(L)))),
+                 (ContactPole(0), Edge(0, 1, model), Line(1, "cylinder"), Rim(2)), ("ln_Sc", "ln_S1", "chi1"), eps)
+
+
+def cap_band_cylinder_chain(eps: float, L: float, model: str = "smooth") -> Chain:
+    """A cap on the tip and a band of contact on the cylinder: tip [zeta, Sc], free [Sc, S1],
+    cylinder [S1, S2], free [S2, L]; unknowns ln Sc, ln S1, ln S2."""
+    Sc, S1, S2 = Point("Sc", "ln_Sc"), Point("S1", "ln_S1"), Point("S2", "ln_S2")
+    return Chain("cap+band(cylinder)", (Region("contact", Point("zeta", "ln_Sc", math.log(eps)), Sc),
+                                        Region("free", Sc, S1), Region("cylinder", S1, S2),
+                                        Region("free", S2, Point("L", None, math.log(L)))),
+                 (ContactPole(0), Edge(0, 1, model), Edge(2, 1, model), Edge(2, 3, model), Rim(3)),
+                 ("ln_Sc", "ln_S1", "ln_S2"), eps)
 
 
 def annulus_chain(eps: float, L: float) -> Chain:
@@ -394,7 +417,7 @@ class ChainBVP:
                                              ya[self.rows(j.k + 1)], par))
             elif isinstance(j, Line):
                 point, yc, yin, yout = self._line_states(j, ya, yb, q)
-                on_tip = mod.junction_smooth_res(self.S_point(point, p), yc, yin, q["delta"], q["F"], par)[:3]
+                on_tip = self._line_function(j, "res")(self.S_point(point, p), yc, yin, q["delta"], q["F"], par)[:3]
                 parts += [on_tip, (yout - yin)[_LINE_CONTINUOUS]]
             elif isinstance(j, Rim):
                 parts.append(mod.rim_res(self.S_point(self.regions[j.k].end, p), yb[self.rows(j.k)], par))
@@ -409,6 +432,9 @@ class ChainBVP:
             X = np.array([q["delta"], q["lambda0"], force])
             parts.append([np.sum(self.arc_tangent * (X - self.arc_point) / self.arc_scale)])
         return np.concatenate(parts)
+
+    def _line_function(self, j, what):
+        return getattr(self.model, f"junction_{'cyl_' if j.on == 'cylinder' else ''}smooth_{what}")
 
     def _force_function(self, what):
         j = self.force_at
@@ -465,7 +491,7 @@ class ChainBVP:
                 point, yc, yin, yout = self._line_states(j, ya, yb, q)
                 S = self.S_point(point, p)
                 on = slice(r, r + 3)
-                jj = mod.junction_smooth_jac(S, yc, yin, q["delta"], q["F"], par)[:3]
+                jj = self._line_function(j, "jac")(S, yc, yin, q["delta"], q["F"], par)[:3]
                 self._add_p(P, on, point.unknown, jj[:, 0] * S)
                 self._add_p(P, on, "chi1", jj[:, 1])
                 self._add_p(P, on, "delta", jj[:, 9])

@@ -23,6 +23,7 @@ import time
 import numpy as np
 
 from .io import POINT_FIELDS, Curve, point_record
+from .cylinder import best_wall_state, wall_contact_suspected, wall_state
 from .liftoff import replace_invalid_cap
 from .pointload import SC_POINT, solve_point_load
 from .solution import Solution, default_eps, richardson_error, thin_mesh
@@ -157,15 +158,26 @@ class _Builder:
         self.tol = settings["tol"]
         self.rows = []  # (order key, row, flags, solution)
         self.last_liftoff = None
+        self.last_wall = None  # the last state with contact on the indenter's cylinder
 
     def _shown(self, sol: Solution) -> Solution:
         st = self.settings
-        if st["topology"] != "auto" or sol.scene.contact != "smooth":
+        if st["topology"] != "auto":
             return sol
-        shown = replace_invalid_cap(sol, tol=st["tol"], max_nodes=st["max_nodes"], bc_tol=st["bc_tol"],
-                                    previous=self.last_liftoff)
-        if shown is not sol:
-            self.last_liftoff = shown
+        kw = dict(tol=st["tol"], max_nodes=st["max_nodes"], bc_tol=st["bc_tol"])
+        shown = sol
+        if sol.scene.contact == "smooth":
+            shown = replace_invalid_cap(sol, previous=self.last_liftoff, **kw)
+            if shown is not sol:
+                self.last_liftoff = shown
+        if shown.get("topology") == "cap" and wall_contact_suspected(shown):
+            wall = None
+            if self.last_wall is not None:
+                wall = best_wall_state(self.last_wall, control="delta", value=shown.delta, **kw)
+            wall = wall or best_wall_state(shown, **kw)
+            if wall is not None:
+                wall.cap_solution = shown
+                self.last_wall = shown = wall
         return shown
 
     def add(self, sol: Solution, key: float):
@@ -199,7 +211,7 @@ def _cap_of(sol):
     return sol.get("cap_solution")
 
 
-def _regula_falsi(a, fa, sa, b, fb, sb, solve_at, tol):
+def _regula_falsi(a, fa, sa, b, fb, sb, solve_at):
     """Root of f(delta) between a and b (Illinois); returns the last state with f >= 0."""
     best = sa if fa >= 0 else sb
     side = 0
@@ -218,7 +230,7 @@ def _regula_falsi(a, fa, sa, b, fb, sb, solve_at, tol):
             a, fa, sa = d, f, sol
             fb = fb / 2 if side == 1 else fb
             side = 1
-        if abs(b - a) < 1e-6 * (1 + abs(d)) or abs(f) < 10 * tol:
+        if abs(b - a) < 1e-7 * (1 + abs(d)) or f == 0:  # on delta: criteria have very different slopes
             break
     return best
 
@@ -247,6 +259,15 @@ def _locate_switches(builder: _Builder, st):
                             bc_tol=st["bc_tol"])
         return (sol, -sol.curvature_excess) if sol.success else (None, None)
 
+    def cap_touch_at(d, near):  # the cap whose free shell just touches the cylinder
+        sol = _solve_at_delta(scene, d, near, None, st)
+        return (sol, min(sol.wall_gap, 1.0)) if sol.success else (None, None)  # inf: nothing above the tip end
+
+    def wall_line_at(d, near):
+        sol = wall_state(near, "cap+line(cylinder)", control="delta", value=d, tol=st["tol"],
+                         max_nodes=st["max_nodes"], bc_tol=st["bc_tol"])
+        return (sol, -sol.curvature_excess) if sol.success and "curvature_excess" in sol else (None, None)
+
     for (k1, _, _, s1), (k2, _, _, s2) in zip(rows[:-1], rows[1:]):
         frm, to = s1.get("topology"), s2.get("topology")
         pair = {frm, to}
@@ -257,16 +278,28 @@ def _locate_switches(builder: _Builder, st):
         elif pair == {"line", "annulus"}:
             ends = [s if s.get("topology") == "line" else _line_state_at(s, st) for s in (s1, s2)]
             criterion, sign, solve_at = "curvature_excess", -1.0, line_at
+        elif pair == {"cap", "cap+line(cylinder)"}:
+            ends, criterion, sign, solve_at = [_cap_of(s1), _cap_of(s2)], "wall_gap", 1.0, cap_touch_at
+        elif pair == {"cap+line(cylinder)", "cap+band(cylinder)"}:
+            ends = [s if s.get("topology") == "cap+line(cylinder)" else
+                    _wall_line_at(s, st) for s in (s1, s2)]
+            criterion, sign, solve_at = "curvature_excess", -1.0, wall_line_at
         else:
             continue
         if any(e is None for e in ends):
             continue
         e1, e2 = sorted(ends, key=lambda e: e.delta)
-        f1, f2 = sign * e1[criterion], sign * e2[criterion]
+        f1, f2 = (sign * (min(e[criterion], 1.0) if criterion == "wall_gap" else e[criterion]) for e in (e1, e2))
         if not f1 * f2 < 0:
             continue
-        best = _regula_falsi(e1.delta, f1, e1, e2.delta, f2, e2, solve_at, st["tol"])
+        best = _regula_falsi(e1.delta, f1, e1, e2.delta, f2, e2, solve_at)
         _add_switch(builder, st, switches, best, frm, to, k1, k2, criterion)
+
+
+def _wall_line_at(sol, st):
+    """The cap+line(cylinder) state at a band point's delta (from the band), or None."""
+    line = wall_state(sol, "cap+line(cylinder)", tol=st["tol"], max_nodes=st["max_nodes"], bc_tol=st["bc_tol"])
+    return line if line.success and "curvature_excess" in line else None
 
 
 def _line_state_at(sol, st):
@@ -284,7 +317,8 @@ def _add_switch(builder, st, switches, best, frm, to, k1, k2, criterion):
     switches.append({"delta": float(best.delta), "force": float(best.force), "from": frm, "to": to,
                      "criterion": criterion, "value": float(best[criterion])})
     log.info("topology switch %s -> %s at delta = %.6g", frm, to, best.delta)
-    if st["mode"] == "adaptive":  # a curve at requested depths keeps exactly those
+    already = any(abs(r[3].delta - best.delta) <= 1e-12 * (1 + best.delta) for r in builder.rows)
+    if st["mode"] == "adaptive" and not already:  # a curve at requested depths keeps exactly those
         builder.add(best, 0.5 * (k1 + k2))
 
 
@@ -363,9 +397,9 @@ def _natural(scene, deltas, builder: _Builder, settings, first=None, key0=0):
                     builder.add(sol, i)
                 step *= 1.5
             elif sol.status == 4 and "end of the tip" in sol.message:
-                builder.out.complete = True
-                raise _Stop(f"the contact reached the end of the tip (the indenter's cylinder) just after "
-                            f"delta = {prev.delta:.6g}")
+                _wall_leg(scene, builder, settings, sol, i, deltas=[d for d in deltas if d > prev.delta],
+                          reason=f"the contact reached the end of the tip (the indenter's cylinder) just after "
+                                 f"delta = {prev.delta:.6g}")
             else:
                 step /= 2
                 if step < min(1e-6, 1e-3 * target):
@@ -373,10 +407,52 @@ def _natural(scene, deltas, builder: _Builder, settings, first=None, key0=0):
         rule = _stop_rule(prev, settings)
         if rule:
             raise _Stop(rule)
-        if prev.Sc * prev.y[0, -1] / scene.rho > scene.tip_omega_max:
-            raise _Stop("the contact reached the end of the tip (the indenter's cylinder)")
+        if prev.get("topology") == "cap" and prev.Sc * prev.y[0, -1] / scene.rho > scene.tip_omega_max:
+            _wall_leg(scene, builder, settings, prev, i, deltas=[d for d in deltas if d > prev.delta],
+                      reason="the contact reached the end of the tip (the indenter's cylinder)")
     builder.out.complete = True
     builder.out.stop_reason = "all requested deltas computed"
+
+
+def _wall_leg(scene, builder, st, last_cap, key, *, reason, deltas=None):
+    """Past the cap's branch (its contact at the tip's end): follow the configurations with
+    contact on the indenter's cylinder by natural continuation in delta (the valid one of
+    lowest energy at each depth, from the last such state), to delta_max or through the
+    remaining ``deltas``.  Raises _Stop at the end, with ``reason`` if no wall state is found."""
+    kw = dict(tol=st["tol"], max_nodes=st["max_nodes"], bc_tol=st["bc_tol"])
+    if st["topology"] != "auto" or scene.model().OMEGA_MAX is None:
+        builder.out.complete = True
+        raise _Stop(reason)
+    tried = []
+    prev = builder.last_wall or best_wall_state(last_cap, tried=tried, **kw)
+    if prev is None:
+        builder.out.complete = True
+        raise _Stop(f"{reason}; no valid contact with the cylinder ({'; '.join(tried)})")
+    targets = list(deltas) if deltas is not None else None
+    d_end = st["delta_max"] if targets is None else (targets[-1] if targets else prev.delta)
+    step = max(1e-3, (d_end - prev.delta) / 20)
+    while prev.delta < d_end * (1 - 1e-12):
+        rule = _stop_rule(prev, st)
+        if rule:
+            builder.out.complete = True
+            raise _Stop(rule)
+        nxt_target = min(d_end, prev.delta + step) if targets is None else min(
+            min(t for t in targets if t > prev.delta), prev.delta + step)
+        tried = []
+        sol = best_wall_state(prev, control="delta", value=nxt_target, tried=tried, **kw)
+        if sol is None:
+            step /= 2
+            if step < 1e-5 * (1 + prev.delta):
+                raise _Stop(f"no valid contact configuration beyond delta = {prev.delta:.6g} "
+                            f"({'; '.join(tried)})")
+            continue
+        key += 1
+        builder.last_wall = prev = sol
+        if targets is None or any(abs(sol.delta - t) < 1e-12 for t in targets):
+            builder.add(sol, key)
+        step *= 1.5
+    builder.out.complete = True
+    raise _Stop(f"delta_max = {st['delta_max']:g} reached" if targets is None else "all requested deltas computed")
 
 
 def _land_on_delta_max(scene, cur, prev, builder, st, key):
@@ -468,15 +544,15 @@ def _adaptive(scene, builder: _Builder, settings):
             ds /= 2
             continue
         if not sol.success and sol.status == 4 and "end of the tip" in sol.message:
-            builder.out.complete = True
-            raise _Stop(f"the contact reached the end of the tip (the indenter's cylinder) just after "
-                        f"delta = {cur.delta:.6g}")
+            _wall_leg(scene, builder, st, sol, steps,
+                      reason=f"the contact reached the end of the tip (the indenter's cylinder) just after "
+                             f"delta = {cur.delta:.6g}")
         if sol.success and sol.delta > 0:
             builder.add(sol, steps)
             prev, cur = cur, sol
             if sol.y[0, -1] * sol.Sc / scene.rho > scene.tip_omega_max:
-                builder.out.complete = True
-                raise _Stop("the contact reached the end of the tip (the indenter's cylinder)")
+                _wall_leg(scene, builder, st, sol, steps,
+                          reason="the contact reached the end of the tip (the indenter's cylinder)")
             # adapt: Newton effort and turning of the branch
             grow = 1.5 if sol.niter <= 3 else (1.0 if sol.niter <= 6 else 0.6)
             if turn > 0.3:

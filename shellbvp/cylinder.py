@@ -1,15 +1,25 @@
-"""Contact that runs past the tip's end onto the indenter's cylinder (``"cap+cylinder"``).
+"""Contact with the indenter's cylinder: the shell that meets the indenter's side.
 
-Deep enough, or with an indenter large for the shell, the contact reaches the end
-of the tip (omega_max, where the tip meets its cylinder r = rho A(omega_max)); a
-single cap there either passes the tip's end or leaves a free shell that passes
-through the cylinder.  The state is then the chain of
-:func:`shellbvp.chain.cylinder_chain`: the shell on the tip up to S*, on the
-cylinder from S* to Sc, free beyond.  At S* omega = omega_max and the
-refraction condition ``[lambda_s dU/dlambda_s - U] = 0`` holds (lambda_s jumps
-where the indenter's meridional curvature does); at Sc the edge conditions of
-the scene's contact model.  This module makes guesses from a cap state or a
-neighbouring cylinder state, solves, and diagnoses (``shellbvp.diagnosis``).
+A large indenter, or a deep one, brings the free shell beyond the tip's contact
+edge against the indenter's cylinder ``r = rho A(omega_max)``.  As it goes deeper
+the shell passes through three configurations (``shellbvp.chain``), each
+following on from the one before without a jump in F:
+
+``cap+line(cylinder)``
+    the free shell touches the wall on one circle (a ring force), while the shell
+    there bends away from the wall;
+``cap+band(cylinder)``
+    the circle has become a band of contact on the wall, with a free gap between
+    it and the cap on the tip;
+``cap+cylinder``
+    the gap has closed: the contact runs from the tip onto the wall, passing the
+    tip's end at S*, where omega = omega_max and ``[lambda_s dU/dlambda_s - U] = 0``
+    (lambda_s jumps where the indenter's meridional curvature does).
+
+Where several are valid at one depth the state of lower energy is the state
+(SPEC section 7).  This module makes guesses (from a cap state or from a
+neighbouring configuration), solves and diagnoses (``shellbvp.diagnosis``), and
+chooses.
 """
 
 from __future__ import annotations
@@ -19,75 +29,177 @@ import time
 
 import numpy as np
 
-from .chain import ChainBVP, cylinder_chain
+from .chain import ChainBVP, cap_band_cylinder_chain, cap_line_cylinder_chain, cylinder_chain
 from .diagnosis import diagnose
 from .solution import Solution, attach_tip_table, richardson_error, solve_bvp, thin_mesh
 
-__all__ = ["make_cylinder_system", "cylinder_guess_from_cap", "cylinder_warm_guess", "solve_cylinder_from",
-           "cylinder_state", "cylinder_suspected", "TOPOLOGY"]
+__all__ = ["WALL_TOPOLOGIES", "make_wall_system", "wall_contact_suspected", "solve_wall_from", "wall_state",
+           "best_wall_state", "transfer_guess"]
 
-TOPOLOGY = "cap+cylinder"
+#: The configurations with contact on the cylinder, in the order they follow each other as
+#: the indenter goes deeper, and their chains.
+WALL_TOPOLOGIES = {"cap+line(cylinder)": cap_line_cylinder_chain, "cap+band(cylinder)": cap_band_cylinder_chain,
+                   "cap+cylinder": cylinder_chain}
 #: A cap whose contact edge has reached this fraction of the tip's end, and whose free shell
-#: passes through the indenter, is tried as contact running onto the cylinder.
+#: passes through the indenter, is tried against the wall configurations.
 NEAR_TIP_END = 0.7
-#: (S*/Sc, Sc'/Sc) of the guesses made from a cap state: the tip end a little inside the cap's
-#: edge, the cylinder contact reaching a little beyond it.
-_GUESS_SPLITS = ((0.97, 1.15), (0.9, 1.3), (0.99, 1.05))
+_BAND_HALF_WIDTH = 0.02  # relative half width of a band grown from a line
+_CAP_SPLITS = ((0.97, 1.15), (0.9, 1.3), (0.99, 1.05))  # (S*/Sc, Sc'/Sc) of cap+cylinder guesses from a cap
 
 
-def make_cylinder_system(scene, control, value, eps):
+def make_wall_system(scene, topology, control, value, eps):
     if scene.model().OMEGA_MAX is None:
-        raise ValueError("this tip has no end where it meets a cylinder (A' never vanishes): no cylinder contact")
-    sysm = ChainBVP(scene, cylinder_chain(eps, scene.shell_length, scene.contact), control, value)
+        raise ValueError("this tip has no end where it meets a cylinder (A' never vanishes): no wall contact")
+    if topology not in WALL_TOPOLOGIES:
+        raise ValueError(f"topology must be one of {tuple(WALL_TOPOLOGIES)}; got {topology!r}")
+    sysm = ChainBVP(scene, WALL_TOPOLOGIES[topology](eps, scene.shell_length, scene.contact), control, value)
     attach_tip_table(sysm)
     return sysm
 
 
 def _cap_omega(cap):
-    """omega at the cap's contact edge."""
     csys = cap.system
     return float(cap.Sc * cap.y[csys.rows(0), -1][0] / cap.scene.rho)
 
 
-def cylinder_suspected(cap: Solution) -> bool:
+def wall_contact_suspected(cap: Solution) -> bool:
     """A converged cap that passed the tip's end, or whose free shell passes through the
     indenter with its contact edge near the tip's end."""
-    if cap.get("topology") != "cap" or not math.isfinite(cap.get("penetration", float("nan"))) \
-            and cap.get("status") != 4:
+    if cap.get("topology") != "cap" or cap.get("system") is None or cap.scene.model().OMEGA_MAX is None:
         return False
     passed = cap.get("status") == 4 and "end of the tip" in cap.get("message", "")
-    near = (cap.get("success") and cap.get("penetration", -1.0) > 0
-            and _cap_omega(cap) > NEAR_TIP_END * cap.scene.tip_omega_max)
-    return bool(passed or near)
+    near = bool(cap.get("success") and cap.get("penetration", -1.0) > 0
+                and _cap_omega(cap) > NEAR_TIP_END * cap.scene.tip_omega_max)
+    return passed or near
 
 
-def cylinder_guess_from_cap(sysm: ChainBVP, cap: Solution, end_fraction: float, edge_fraction: float,
-                            n: int = 81):
-    """Guess from a cap state: the tip contact up to ``S* = end_fraction * Sc`` (its omega
-    stretched to reach omega_max there), the cylinder on ``[S*, edge_fraction * Sc]``, the free
-    region of the cap beyond."""
-    csys, rho, w0 = cap.system, cap.scene.rho, cap.scene.tip_omega_max
-    Se, Sc = end_fraction * cap.Sc, edge_fraction * cap.Sc
+# -- guesses --------------------------------------------------------------------------------------
+def _fields_at(sol, S):
+    """Physical fields of a solution at the points S (each from the region that holds it)."""
+    sysm = sol.system
+    out = None
+    for k, reg in enumerate(sysm.regions):
+        t = sysm.t_of(k, S, sol.p)
+        inside = (t >= 0) & (t <= 1) if k < len(sysm.regions) - 1 else (t >= 0)
+        if k == 0:
+            inside = inside | (t < 0)
+        if out is not None:
+            inside = inside & ~out["set"]
+        if not np.any(inside):
+            continue
+        prof = getattr(sysm.model, f"{reg.kind}_profile")(S[inside], sol.sol(np.clip(t[inside], 0, 1))[sysm.rows(k)],
+                                                           sysm.par)
+        if out is None:
+            out = {key: np.full(S.shape, np.nan) for key in (*prof, "omega")}
+            out["set"] = np.zeros(S.shape, bool)
+        for key, v in prof.items():
+            out[key][inside] = v
+        if reg.kind != "free":
+            out["z"][inside] = out["z"][inside] + sol["z_tip"]
+        out["set"] |= inside
+    return out
+
+
+def _free_states(f, S):
+    return np.vstack([f["lambda_theta"], f["phi"] / S, f["lambda_s"], f["kappa_s"], f["r"] * f["Q"], f["z"]])
+
+
+def _wall_omega(sysm, z, z_tip):
+    """omega of the wall point at height z (the cylinder continues the tip at unit speed)."""
+    mod, par = sysm.model, sysm.par
+    w0 = mod.OMEGA_MAX
+    z_end = z_tip + sysm.scene.rho * float(mod.tip_shape(np.array([w0]), par)["B"][0])
+    return w0 + np.maximum(z - z_end, 0.0) / sysm.scene.rho
+
+
+def transfer_guess(sysm: ChainBVP, source: Solution, n: int = 101, **unknowns):
+    """Guess for ``sysm`` from a solution of another configuration: the target's unknowns as
+    given (``ln_Sc=..., chi1=...``; lambda0 and delta from the source), the states at every
+    target S from the source's fields there (free states from its profile; on the tip or the
+    wall omega from the source where it is in contact, else from the shell's height)."""
+    rho = sysm.scene.rho
+    values = dict(unknowns, lambda0=source.lambda0, delta=source.delta)
+    p = sysm.pack(**values)
     t = np.linspace(0.0, 1.0, n)
-    p = sysm.pack(ln_Send=math.log(Se), ln_Sc=math.log(Sc), lambda0=cap.lambda0, delta=cap.delta)
-    S0, S1, S2 = sysm.S(0, t, p), sysm.S(1, t, p), sysm.S(2, t, p)
-    y0 = cap.sol(np.clip(csys.t_of(0, S0, cap.p), 0.0, 1.0))[csys.rows(0)]
-    omega_end = Se * y0[0, -1] / rho
-    y0[0] = y0[0] * (w0 / omega_end) ** ((S0 / Se) ** 2)  # omega -> omega_max at S*, unchanged at the pole
-    ls_end = y0[1, -1]
-    y1 = np.vstack([rho * (w0 + (S1 - Se) * ls_end / rho) / S1, np.full(n, ls_end)])
-    y2 = cap.sol(np.clip(csys.t_of(1, S2, cap.p), 0.0, 1.0))[csys.rows(1)]
-    return t, np.vstack([y0, y1, y2]), p
+    blocks = []
+    for k, reg in enumerate(sysm.regions):
+        S = sysm.S(k, t, p)
+        f = _fields_at(source, S)
+        if reg.kind == "free":
+            blocks.append(_free_states(f, S))
+            continue
+        omega = f["omega"]
+        if reg.kind == "cylinder":
+            omega = np.where(np.isfinite(omega) & (omega >= sysm.model.OMEGA_MAX), omega,
+                             _wall_omega(sysm, f["z"], source["z_tip"]))
+            omega = np.maximum.accumulate(omega)
+        elif not np.all(np.isfinite(omega)):
+            omega = np.where(np.isfinite(omega), omega, sysm.model.OMEGA_MAX)
+        end = [j for j in sysm.junctions if type(j).__name__ == "TipEnd" and j.k == k]
+        if end:  # the tip contact must reach omega_max at S*
+            w_end = omega[-1]
+            omega = omega * (sysm.model.OMEGA_MAX / w_end) ** ((S / S[-1]) ** 2)
+        blocks.append(np.vstack([rho * omega / S, f["lambda_s"]]))
+    return t, np.vstack(blocks), p
 
 
-def cylinder_warm_guess(sysm: ChainBVP, prev: Solution):
-    """A neighbouring cap+cylinder state on its thinned mesh."""
-    x = thin_mesh(prev.x)
-    q = dict(zip(prev.system.unknowns, prev.p), lambda0=prev.lambda0, delta=prev.delta)
-    return x, prev.sol(x), sysm.pack(**q)
+def _touch_point(cap):
+    """(S, omega on the wall) where a cap's free shell comes nearest the wall from inside."""
+    sysm = cap.system
+    t = np.linspace(0.0, 1.0, 801)
+    S = sysm.S(1, t, cap.p)
+    f = sysm.model.free_profile(S, cap.sol(t)[sysm.rows(1)], sysm.par)
+    above = f["z"] > cap["z_tip"] + cap.scene.rho  # above the tip's end (sphere: B(omega_max) = 1)
+    gap = np.where(above, f["r"] - cap.scene.rho * sysm.tip_A[-1], np.inf)
+    i = int(np.argmin(gap))
+    return float(S[i]), float(_wall_omega(sysm, f["z"][i:i + 1], cap["z_tip"])[0])
 
 
-def solve_cylinder_from(sysm, guess, *, tol=1e-6, max_nodes=10000, bc_tol=1e-10):
+def _guesses(sysm, start):
+    """Guesses for ``sysm`` from ``start`` (a cap, or a wall state of this or a neighbouring
+    configuration), best first."""
+    topo, src = sysm.topology, start.get("topology")
+    if src == topo:
+        x = thin_mesh(start.x)
+        q = dict(zip(start.system.unknowns, start.p), lambda0=start.lambda0, delta=start.delta)
+        return [(x, start.sol(x), sysm.pack(**q))]
+    out = []
+    if src == "cap":
+        Sc = start.Sc
+        if topo == "cap+cylinder":
+            return [transfer_guess(sysm, start, ln_Send=math.log(a * Sc), ln_Sc=math.log(b * Sc))
+                    for a, b in _CAP_SPLITS]
+        S1, w1 = _touch_point(start)
+        if topo == "cap+line(cylinder)":
+            out.append(transfer_guess(sysm, start, ln_Sc=math.log(Sc), ln_S1=math.log(S1),
+                                      chi1=start.scene.rho * w1 / S1))
+        else:  # band
+            out.append(transfer_guess(sysm, start, ln_Sc=math.log(Sc), ln_S1=math.log(S1 * (1 - _BAND_HALF_WIDTH)),
+                                      ln_S2=math.log(S1 * (1 + _BAND_HALF_WIDTH))))
+    elif src == "cap+line(cylinder)" and topo == "cap+band(cylinder)":
+        q = dict(zip(start.system.unknowns, start.p))
+        S1 = math.exp(q["ln_S1"])
+        out.append(transfer_guess(sysm, start, ln_Sc=q["ln_Sc"], ln_S1=math.log(S1 * (1 - _BAND_HALF_WIDTH)),
+                                  ln_S2=math.log(S1 * (1 + _BAND_HALF_WIDTH))))
+    elif src == "cap+band(cylinder)" and topo == "cap+cylinder":
+        q = dict(zip(start.system.unknowns, start.p))
+        Sc, S1, S2 = (math.exp(q[k]) for k in ("ln_Sc", "ln_S1", "ln_S2"))
+        out.append(transfer_guess(sysm, start, ln_Send=math.log(0.5 * (Sc + S1)), ln_Sc=math.log(S2)))
+    elif src == "cap+band(cylinder)" and topo == "cap+line(cylinder)":
+        q = dict(zip(start.system.unknowns, start.p))
+        S1 = math.sqrt(math.exp(q["ln_S1"] + q["ln_S2"]))
+        w1 = float(_fields_at(start, np.array([S1]))["omega"][0])
+        out.append(transfer_guess(sysm, start, ln_Sc=q["ln_Sc"], ln_S1=math.log(S1), chi1=start.scene.rho * w1 / S1))
+    elif src == "cap+cylinder" and topo == "cap+band(cylinder)":
+        q = dict(zip(start.system.unknowns, start.p))
+        Se, Sc = math.exp(q["ln_Send"]), math.exp(q["ln_Sc"])
+        out.append(transfer_guess(sysm, start, ln_Sc=math.log(0.98 * Se), ln_S1=math.log(1.02 * Se),
+                                  ln_S2=math.log(Sc)))
+    return out
+
+
+# -- solving and choosing ---------------------------------------------------------------------------
+def solve_wall_from(sysm, guess, *, tol=1e-6, max_nodes=10000, bc_tol=1e-10):
     x, y, p = guess
     t0 = time.perf_counter()
     with np.errstate(all="ignore"):
@@ -98,28 +210,67 @@ def solve_cylinder_from(sysm, guess, *, tol=1e-6, max_nodes=10000, bc_tol=1e-10)
     return res
 
 
-def cylinder_state(start: Solution, *, control=None, value=None, tol=1e-6, max_nodes=10000, bc_tol=1e-10,
-                   estimate_error=False):
-    """The cap+cylinder state at ``start``'s delta (or the given control and value), from a cap
-    state (a few splits are tried) or a neighbouring cap+cylinder state (warm start).
-
-    Returns a Solution (check ``success`` and ``valid``).
-    """
+def _control_of(start, control, value):
     if control is None:
         control = start.control if start.control in ("force", "lambda0") else "delta"
         value = {"force": start.force, "lambda0": start.lambda0, "delta": start.delta}[control]
+    return control, value
+
+
+def wall_state(start: Solution, topology: str, *, control=None, value=None, tol=1e-6, max_nodes=10000,
+               bc_tol=1e-10, estimate_error=False):
+    """The ``topology`` state (one of WALL_TOPOLOGIES) at ``start``'s delta (or the given control
+    and value), from a cap state or a wall state; the first guess that converges.  Returns a
+    Solution (check ``success`` and ``valid``), a failure if no guess can be made."""
+    control, value = _control_of(start, control, value)
     t0 = time.perf_counter()
-    sysm = make_cylinder_system(start.scene, control, value, start.system.eps)
+    sysm = make_wall_system(start.scene, topology, control, value, start.system.eps)
     kw = dict(tol=tol, max_nodes=max_nodes, bc_tol=bc_tol)
-    if start.get("topology") == TOPOLOGY:
-        res = solve_cylinder_from(sysm, cylinder_warm_guess(sysm, start), **kw)
-    else:
-        res = None
-        for end, edge in _GUESS_SPLITS:
-            res = solve_cylinder_from(sysm, cylinder_guess_from_cap(sysm, start, end, edge), **kw)
-            if res.success:
-                break
-    if res.success and estimate_error:
+    res = None
+    for guess in _guesses(sysm, start):
+        res = solve_wall_from(sysm, guess, **kw)
+        if res.success:
+            break
+    if res is None:
+        nan = float("nan")
+        res = Solution(status=5, success=False, valid=False, flags=[], topology=topology, delta=nan, force=nan,
+                       lambda0=nan, Sc=nan, energy=nan, message=f"no guess for {topology} from a "
+                       f"{start.get('topology')} state")
+    elif res.success and estimate_error:
         richardson_error(sysm, res, tol, bc_tol)
     res.wall_time = time.perf_counter() - t0
     return res
+
+
+def _neighbours(topology):
+    names = list(WALL_TOPOLOGIES)
+    if topology not in names:
+        return names
+    i = names.index(topology)
+    return [names[i]] + names[i + 1:i + 2] + names[max(i - 1, 0):i]
+
+
+def best_wall_state(start: Solution, *, control=None, value=None, tol=1e-6, max_nodes=10000, bc_tol=1e-10,
+                    tried=None):
+    """The valid wall configuration of lowest energy at ``start``'s depth, or None.
+
+    From a cap every configuration is tried; from a wall state its own configuration, the
+    next deeper one and the one before.  ``tried`` (a list) collects what was tried and why
+    it was not taken.
+    """
+    tried = [] if tried is None else tried
+    order = list(WALL_TOPOLOGIES) if start.get("topology") == "cap" else _neighbours(start.topology)
+    valid = []
+    for topology in order:
+        res = wall_state(start, topology, control=control, value=value, tol=tol, max_nodes=max_nodes,
+                         bc_tol=bc_tol)
+        if res.success and res.valid:
+            valid.append(res)
+        else:
+            tried.append(f"{topology}: {res.message if not res.success else '; '.join(res.flags)}")
+    if not valid:
+        return None
+    best = min(valid, key=lambda r: r.energy)
+    best.candidates = {r.topology: r.energy for r in valid}
+    return best
+

@@ -15,7 +15,7 @@ import math
 import numpy as np
 
 from .chain import FREE_STATES, ContactPole, Edge, FreePole, Line, TipEnd
-from .solution import Solution, penetration, set_status
+from .solution import Solution, penetration, set_status, wall_gap
 
 __all__ = ["diagnose"]
 
@@ -37,6 +37,11 @@ def _edges(sysm):
 def _at(sysm, k, S, y):
     prof = getattr(sysm.model, f"{sysm.regions[k].kind}_profile")
     return prof(np.array([S]), y[sysm.rows(k), None], sysm.par)
+
+
+def _at_kind(sysm, kind, S, y):
+    prof = getattr(sysm.model, f"{kind}_profile")
+    return prof(np.array([S]), y[:, None], sysm.par)
 
 
 def _omega_range(sysm, k, fields):
@@ -116,6 +121,7 @@ def diagnose(sysm, bvp, tol) -> Solution:
         defect = max(defect, float(np.max(np.abs(G - ref))))
     res.force_defect = defect
     res.penetration = max(penetration(sysm, f["r"], f["z"], res.z_tip) for _, f in free)
+    res.wall_gap = min(wall_gap(sysm, f["r"], f["z"], res.z_tip) for _, f in free)
     last = len(sysm.regions) - 1
     t_leg = np.array([0.0, 0.5])
     leg = mod.free_legendre(sysm.S(last, t_leg, p), bvp.sol(t_leg)[sysm.rows(last)], par)[0]
@@ -143,6 +149,17 @@ def diagnose(sysm, bvp, tol) -> Solution:
             vflags.append(f"negative ring force ({N:.3g}) at the contact edge {pt.name}")
     if res.penetration > 10 * tol:
         vflags.append(f"the free shell passes through the indenter (by {res.penetration:.3g})")
+    for j in sysm.junctions:
+        if isinstance(j, Line):
+            # touching on a circle, the shell must not bend more tightly than the indenter there
+            # (else it passes through it next to the line: the contact is a band)
+            S = sysm.S_point(sysm.regions[j.k].end, p)
+            yin = yb[sysm.rows(j.k)]
+            on = _at_kind(sysm, j.on, S, np.array([q["chi1"], yin[_LS]]))
+            res.curvature_excess = float(yin[FREE_STATES.index("ks")] - on["kappa_s"][0])
+            if res.curvature_excess > 10 * tol * max(1.0, abs(float(on["kappa_s"][0]))):
+                vflags.append(f"the shell bends more tightly than the indenter at the contact line "
+                              f"(kappa_s exceeds the indenter's by {res.curvature_excess:.3g}): the contact is a band")
     res.flags = flags + vflags
     res.valid = res.success and not vflags
     return res

@@ -13,7 +13,7 @@ import math
 import numpy as np
 
 __all__ = ["STATUS_MESSAGES", "Solution", "solve_bvp", "set_status", "thin_mesh", "richardson_error",
-           "penetration", "attach_tip_table", "default_eps"]
+           "penetration", "wall_gap", "attach_tip_table", "default_eps"]
 
 
 STATUS_MESSAGES = {
@@ -212,6 +212,18 @@ def penetration(sysm, r, z, z_tip):
     depth = np.where(height > 0, np.minimum(height, rho * A[-1] - r[inside]), height)
     return float(np.max(depth))
 
+
+
+def wall_gap(sysm, r, z, z_tip):
+    """Smallest horizontal distance from the indenter's cylinder ``r = rho A(omega_max)`` of the
+    free-shell points above the tip's end (negative: through the wall); inf if none is above.
+    It crosses zero where the free shell first touches the indenter's side."""
+    A, B = sysm.tip_A, sysm.tip_B
+    rho = sysm.scene.rho
+    above = z > z_tip + rho * B[-1]
+    if not np.any(above):
+        return float("inf")
+    return float(np.min(r[above] - rho * A[-1]))
 
 
 def attach_tip_table(sysm):

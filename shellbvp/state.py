@@ -26,6 +26,7 @@ from .solution import (
     set_status,
     solve_bvp,
     thin_mesh,
+    wall_gap,
 )
 
 __all__ = ["solve", "solve_from", "make_system", "warm_guess", "delta_bounds", "check_delta", "check_tol",
@@ -119,6 +120,7 @@ def _diagnose(sysm: ChainBVP, bvp, tol):
     res.edge_legendre = float(leg[0] / leg[1]) if leg[1] != 0 else float("nan")
     res.pressure_min = float(np.min(pc["P"]))
     res.penetration = penetration(sysm, pf["r"], pf["z"], res.z_tip)
+    res.wall_gap = wall_gap(sysm, pf["r"], pf["z"], res.z_tip)
     res.energy = sysm.energy(bvp.sol, bvp.x, bvp.p)
     vflags = []
     scale = 10 * tol
@@ -158,10 +160,11 @@ def solve_from(sysm, guess, *, tol=1e-6, max_nodes=10000, bc_tol=None):
     return res
 
 
-TOPOLOGIES = ("auto", "cap", "line", "annulus", "cap+cylinder")
+TOPOLOGIES = ("auto", "cap", "line", "annulus", "cap+line(cylinder)", "cap+band(cylinder)", "cap+cylinder")
+_WALL = ("cap+line(cylinder)", "cap+band(cylinder)", "cap+cylinder")
 
 #: Mean meridional stretch taken as beyond reach (see :func:`delta_bounds`).
-MEAN_STRETCH_LIMIT = 2.0
+MEAN_STRETCH_LIMIT = 2.5
 
 
 def delta_bounds(scene, tol: float) -> tuple[float, float]:
@@ -173,13 +176,13 @@ def delta_bounds(scene, tol: float) -> tuple[float, float]:
     within 0.03 % at delta = 10 tol, 7 % off at delta = tol (and ``force_error``
     says so), of either sign at tol/100).
 
-    ``high = Z(0) - Z(L) + 2 l`` (l the reference meridian's length, Z(0) the pole's
+    ``high = Z(0) - Z(L) + 2.5 l`` (l the reference meridian's length, Z(0) the pole's
     and Z(L) the rim's height): the deformed meridian joins the pole, at height
     ``Z(0) - delta``, to the fixed rim, so it is at least as long as their height
     difference ``Z(L) - Z(0) + delta``; beyond ``high`` its mean stretch would
-    exceed 2 (doubled in length even hanging straight down).  Every branch of the
-    presets ends (convexity at the contact edge, or the tip's end) below delta = 1,
-    well short of it (the dome: 4.14, the base hemisphere: 2.14, a flat plate: 2).
+    exceed 2.5 even hanging straight down (``MEAN_STRETCH_LIMIT``).  The dome: 4.93
+    (delta = 5 is refused at once), the base hemisphere: 2.93 (a wide indenter,
+    rho = 0.6, pushes it to delta = 2.5 with every state valid), a flat plate: 2.5.
     """
     mod = scene.model()
     S = np.linspace(0.0, scene.shell_length, 4001)
@@ -226,15 +229,16 @@ def solve(scene, *, delta=None, lambda0=None, force=None, tol=1e-6, max_nodes=10
     estimate_error : bool
         Richardson error estimates ``force_error``, ``delta_error`` (one more Newton
         solve on the mesh with every interval halved; see :func:`richardson_error`).
-    topology : {"auto", "cap", "line", "annulus", "cap+cylinder"}
+    topology : {"auto", "cap", "line", "annulus", "cap+line(cylinder)", "cap+band(cylinder)", "cap+cylinder"}
         Contact configuration (``shellbvp.chain``).  ``"auto"``: the single cap,
         replaced by a valid line or annular contact where the cap would pull the
         shell (negative pressure or ring force; smooth model; ``shellbvp.liftoff``),
-        or by contact running onto the indenter's cylinder where the cap passes the
-        tip's end or its free shell passes through the indenter near it
-        (``shellbvp.cylinder``; both contact models).  ``"cap"``: the cap only.
-        ``"line"``/``"annulus"``/``"cap+cylinder"``: that configuration, started
-        from the cap state, valid or not.  With a lifted pole, ``lambda0`` is the
+        or by the valid configuration of lowest energy with contact on the
+        indenter's cylinder (a line, a band, or the contact running onto it;
+        ``shellbvp.cylinder``; both contact models) where the cap passes the tip's
+        end or its free shell passes through the indenter near it.  ``"cap"``: the
+        cap only.  Any other: that configuration, started from the cap state (or
+        from ``guess``), valid or not.  With a lifted pole, ``lambda0`` is the
         stretch there.
 
     Returns
@@ -275,12 +279,17 @@ def solve(scene, *, delta=None, lambda0=None, force=None, tol=1e-6, max_nodes=10
             return res
         guess = None  # back to the cap
 
-    if guess is not None and guess.get("topology") == "cap+cylinder":
-        from .cylinder import cylinder_state
+    if guess is not None and guess.get("topology") in _WALL:
+        from .cylinder import best_wall_state, wall_state
 
-        res = cylinder_state(guess, control=control, value=value, tol=tol, max_nodes=max_nodes, bc_tol=bc_tol,
-                             estimate_error=estimate_error)
-        if topology in ("auto", "cap+cylinder") and res.success:
+        t0 = time.perf_counter()
+        kw = dict(control=control, value=value, tol=tol, max_nodes=max_nodes, bc_tol=bc_tol)
+        res = best_wall_state(guess, **kw) if topology == "auto" else (
+            wall_state(guess, topology, **kw) if topology in _WALL else None)
+        if res is not None and res.success:
+            if estimate_error:
+                richardson_error(res.system, res, tol, bc_tol)
+            res.wall_time = time.perf_counter() - t0
             return res
         guess = None  # back to the cap
 
@@ -296,9 +305,9 @@ def solve(scene, *, delta=None, lambda0=None, force=None, tol=1e-6, max_nodes=10
         res = _cold_delta(sysm, value, **kw)
     else:
         res = _cold_other(scene, sysm, control, value, eps, **kw)
-    if topology in ("auto", "cap+cylinder") and res.get("topology") == "cap":
-        res = _onto_cylinder(res, topology, kw)
-    if topology not in ("cap", "cap+cylinder") and scene.contact == "smooth" and res.get("topology") == "cap" \
+    if (topology == "auto" or topology in _WALL) and res.get("topology") == "cap":
+        res = _onto_wall(res, topology, kw)
+    if topology in ("auto", "line", "annulus") and scene.contact == "smooth" and res.get("topology") == "cap" \
             and res.success:
         res = _other_topology(res, topology, kw)
     if res.success and estimate_error:
@@ -309,22 +318,29 @@ def solve(scene, *, delta=None, lambda0=None, force=None, tol=1e-6, max_nodes=10
     return res
 
 
-def _onto_cylinder(cap, topology, kw):
-    """The cap+cylinder state where asked, or (auto) where the cap passes the tip's end or its
-    free shell passes through the indenter near it and the cylinder state is valid."""
-    from .cylinder import cylinder_state, cylinder_suspected
+def _onto_wall(cap, topology, kw):
+    """The asked wall configuration, or (auto) the valid one of lowest energy where the cap
+    passes the tip's end or its free shell passes through the indenter near it
+    (``shellbvp.cylinder``); else the cap, with what was tried in its flags."""
+    from .cylinder import best_wall_state, wall_contact_suspected, wall_state
 
-    if cap.get("system") is None or cap.scene.model().OMEGA_MAX is None \
-            or not (topology == "cap+cylinder" or cylinder_suspected(cap)):
+    if cap.get("system") is None or cap.scene.model().OMEGA_MAX is None:
         return cap
     if not (cap.success or (cap.status == 4 and "end of the tip" in cap.message)):
         return cap
-    alt = cylinder_state(cap, **kw)
-    if topology == "cap+cylinder" or (alt.success and alt.valid):
+    if topology in _WALL:
+        alt = wall_state(cap, topology, **kw)
         alt.cap_solution = cap
         return alt
-    cap.flags = list(cap.flags) + [f"no valid cap+cylinder state ({alt.message if not alt.success else '; '.join(alt.flags)})"]
-    return cap
+    if not wall_contact_suspected(cap):
+        return cap
+    tried = []
+    alt = best_wall_state(cap, tried=tried, **kw)
+    if alt is None:
+        cap.flags = list(cap.flags) + ["no valid contact with the indenter's cylinder (" + "; ".join(tried) + ")"]
+        return cap
+    alt.cap_solution = cap
+    return alt
 
 
 def _other_topology(cap, topology, kw):

@@ -18,11 +18,14 @@ CHAINS = {"cap": lambda L, contact: ch.cap_chain(EPS, L, contact),
           "annulus": lambda L, contact: ch.annulus_chain(EPS, L),
           "line": lambda L, contact: ch.line_chain(EPS, L),
           "point": lambda L, contact: ch.point_chain(1e-12, L),
-          "cylinder": lambda L, contact: ch.cylinder_chain(EPS, L, contact)}
+          "cylinder": lambda L, contact: ch.cylinder_chain(EPS, L, contact),
+          "wall_line": lambda L, contact: ch.cap_line_cylinder_chain(EPS, L, contact),
+          "wall_band": lambda L, contact: ch.cap_band_cylinder_chain(EPS, L, contact)}
 CASES = [("cap", c, m) for c in ("smooth", "paper") for m in ("delta", "lambda0", "force", "arclength")] + \
         [(k, "smooth", m) for k in ("annulus", "line") for m in ("delta", "lambda0", "force")] + \
         [("point", "smooth", "delta")] + \
-        [("cylinder", c, m) for c in ("smooth", "paper") for m in ("delta", "lambda0", "force", "arclength")]
+        [(k, c, m) for k in ("cylinder", "wall_line", "wall_band") for c in ("smooth", "paper")
+         for m in ("delta", "lambda0", "force", "arclength")]
 ARC = (np.array([0.2, 1.0, 0.4]), np.array([0.6, 0.0, 0.8]), np.array([1.0, 0.5, 2.0]))
 
 

@@ -14,7 +14,7 @@ import sympy as sp
 from scipy.integrate import solve_ivp
 
 import shellbvp as sb
-from shellbvp.cylinder import cylinder_state, cylinder_suspected
+from shellbvp.cylinder import wall_contact_suspected, wall_state
 
 SCENE = sb.Scene.preset("fit", beta=1e-3)
 
@@ -86,12 +86,12 @@ def test_tip_end_condition_is_the_jump_of_lambda_s_dU_dlambda_s_minus_U():
         assert res[2] == pytest.approx(expect, rel=1e-12, abs=1e-13), gamma
 
 
-def test_cap_passing_through_the_side_is_replaced_by_contact_on_the_cylinder(state):
+def test_cap_passing_through_the_side_is_replaced_by_contact_with_the_wall(state):
     cap = sb.solve(SCENE, delta=1.25, topology="cap", tol=1e-8, estimate_error=False)
-    assert cap.success and not cap.valid and cylinder_suspected(cap)
+    assert cap.success and not cap.valid and wall_contact_suspected(cap)
     assert any("passes through the indenter" in f for f in cap.flags)
     auto = sb.solve(SCENE, delta=1.25, tol=1e-8, estimate_error=False)
-    assert auto.topology == "cap+cylinder" and auto.valid
+    assert auto.topology != "cap" and auto.valid  # a wall configuration (the line here: lower energy)
     assert state.success and state.valid, state.flags
     assert 0 < state.S_end < state.Sc < SCENE.shell_length
     assert state.pressure_min > 0 and state.edge_forces[0] > 0
@@ -148,7 +148,82 @@ def test_force_is_the_derivative_of_the_energy_on_the_cylinder_branch(state):
 @pytest.mark.parametrize("control", ["force", "lambda0"])
 def test_other_controls_reach_the_same_cylinder_state(state, control):
     value = state[control]
-    s = cylinder_state(state, control=control, value=value, tol=1e-8)
+    s = wall_state(state, "cap+cylinder", control=control, value=value, tol=1e-8)
     assert s.success and s.topology == "cap+cylinder"
     assert s.delta == pytest.approx(state.delta, abs=1e-7)
     assert s.force == pytest.approx(state.force, rel=1e-7)
+
+
+# -- the shell that meets the indenter's side: line, band, and the sequence along a curve ---------------
+@pytest.mark.parametrize("delta, expected", [(1.2, "cap+line(cylinder)"), (1.35, "cap+band(cylinder)")])
+def test_the_valid_wall_configuration_of_lowest_energy_is_the_state(delta, expected):
+    s = sb.solve(SCENE, delta=delta, tol=1e-8, estimate_error=False)
+    assert s.topology == expected and s.valid, (s.topology, s.flags)
+    others = {k: v for k, v in s.candidates.items() if k != expected}
+    assert others and all(e > s.energy for e in others.values()), s.candidates
+    assert s.pressure_min > 0 and all(f > 0 for f in s.edge_forces)
+    if expected == "cap+line(cylinder)":
+        assert s.curvature_excess < 0  # the shell bends away from the wall at the line
+
+
+@pytest.mark.parametrize("delta, topology", [(1.2, "cap+line(cylinder)"), (1.35, "cap+band(cylinder)")])
+def test_force_is_the_derivative_of_the_energy_touching_the_wall(delta, topology):
+    base = sb.solve(SCENE, delta=delta, topology=topology, tol=1e-8, estimate_error=False)
+    assert base.success and base.topology == topology
+    h = 2e-3
+    E = {}
+    for k in (-2, -1, 1, 2):
+        s = sb.solve(SCENE, delta=delta + k * h, topology=topology, guess=base, tol=1e-8, estimate_error=False)
+        assert s.success and s.topology == topology, s.message
+        E[k] = s.energy
+    d1, d2 = (E[1] - E[-1]) / (2 * h), (E[2] - E[-2]) / (4 * h)
+    assert (4 * d1 - d2) / 3 == pytest.approx(base.force, abs=1e-7)
+
+
+@pytest.fixture(scope="module")
+def wall_curve():
+    return sb.curve(SCENE, delta_max=2.0)
+
+
+def test_curve_goes_on_past_the_tip_end_with_every_point_valid(wall_curve):
+    """Issue 12: this curve was invalid from delta 1.14 (the shell through the indenter's side)
+    and stopped at 1.32 (the contact at the tip's end)."""
+    c = wall_curve
+    assert c.complete and c.delta[-1] == pytest.approx(2.0) and np.all(c.valid), c.flags
+    assert list(dict.fromkeys(c.topology.tolist())) == ["cap", "cap+line(cylinder)", "cap+band(cylinder)"]
+    assert np.all(c.force_error < 1e-6)
+
+
+def test_switches_are_located_where_their_criteria_change_sign(wall_curve):
+    """cap -> line: the cap's free shell reaches the wall (wall_gap crosses 0); line -> band:
+    the shell at the line bends as tightly as the wall (curvature excess crosses 0).  Each is
+    checked on both sides of the located delta, 1e-4 away."""
+    sw = {(s["from"], s["to"]): s for s in wall_curve.settings["topology_switches"]}
+    touch = sw[("cap", "cap+line(cylinder)")]["delta"]
+    assert 1.1 < touch < 1.15
+    gaps = [sb.solve(SCENE, delta=touch + h, topology="cap", estimate_error=False).wall_gap for h in (-1e-4, 1e-4)]
+    assert gaps[0] > 0 > gaps[1], gaps
+    band = sw[("cap+line(cylinder)", "cap+band(cylinder)")]["delta"]
+    line = sb.solve(SCENE, delta=band, topology="cap+line(cylinder)", estimate_error=False)
+    excess = [sb.solve(SCENE, delta=band + h, topology="cap+line(cylinder)", guess=line,
+                       estimate_error=False).curvature_excess for h in (-1e-4, 1e-4)]
+    assert excess[0] < 0 < excess[1], excess
+
+
+def test_force_is_continuous_where_the_shell_meets_the_wall(wall_curve):
+    """At the located switch the cap and the line state coincide: the same F (no snap)."""
+    sw = next(s for s in wall_curve.settings["topology_switches"] if s["to"] == "cap+line(cylinder)")
+    cap = sb.solve(SCENE, delta=sw["delta"], topology="cap", tol=1e-8, estimate_error=False)
+    line = sb.solve(SCENE, delta=sw["delta"] + 1e-3, topology="cap+line(cylinder)", tol=1e-8,
+                    estimate_error=False)
+    assert line.success
+    slope = (line.force - cap.force) / 1e-3  # a finite slope: F continuous across the switch
+    assert 0 < slope < 5 * (cap.force / cap.delta)
+
+
+@pytest.mark.slow
+def test_wide_indenter_on_a_hemisphere_to_delta_2_5():
+    """Issue 12's first scene: gamma 1, rho 0.6, to delta 2.5 (10 of 45 points invalid before)."""
+    c = sb.curve(sb.Scene.preset("base", rho=0.6), delta_max=2.5)
+    assert c.complete and np.all(c.valid), c.flags
+    assert "cap+band(cylinder)" in set(c.topology)

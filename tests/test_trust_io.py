@@ -80,19 +80,19 @@ def test_curve_refuses_depths_outside_the_range_at_once(kwargs, name):
     assert f"[{low:g}, {high:.4g}]" in str(err.value)
 
 
-def test_delta_bound_is_the_doubled_meridian():
-    """high = Z(0) - Z(L) + 2 l: the dome's pole starts 1 above the rim, the bowl's 1 below,
+def test_delta_bound_is_the_meridian_stretched_2_5_times():
+    """high = Z(0) - Z(L) + 2.5 l: the dome's pole starts 1 above the rim, the bowl's 1 below,
     a hemisphere's meridian is pi/2 long; a flat plate's (R = sin S) 1."""
-    assert delta_bounds(sb.Scene.preset("dome"), 1e-6)[1] == pytest.approx(1 + np.pi, rel=1e-6)
-    assert delta_bounds(sb.Scene.preset("base"), 1e-6)[1] == pytest.approx(np.pi - 1, rel=1e-6)
-    assert delta_bounds(sb.Scene.preset("flat"), 1e-6)[1] == pytest.approx(2.0, rel=1e-6)
+    assert delta_bounds(sb.Scene.preset("dome"), 1e-6)[1] == pytest.approx(1 + 1.25 * np.pi, rel=1e-6)
+    assert delta_bounds(sb.Scene.preset("base"), 1e-6)[1] == pytest.approx(1.25 * np.pi - 1, rel=1e-6)
+    assert delta_bounds(sb.Scene.preset("flat"), 1e-6)[1] == pytest.approx(2.5, rel=1e-6)
     assert delta_bounds(sb.Scene.preset("base"), 1e-8)[0] == 1e-8
 
 
 def test_solve_dome_paper_at_delta_5_is_refused_at_once():
     scene = sb.Scene.preset("dome", contact="paper")
     t0 = time.perf_counter()
-    with pytest.raises(ValueError, match=r"delta = 5 is outside \[1e-06, 4.142\]"):
+    with pytest.raises(ValueError, match=r"delta = 5 is outside \[1e-06, 4.927\]"):
         sb.solve(scene, delta=5.0)
     assert time.perf_counter() - t0 < 2.0
     with pytest.raises(ValueError, match="delta = 1e-300"):
@@ -177,7 +177,7 @@ def test_check_output_path_api(tmp_path):
 def test_points_and_delta_max_limits_on_the_command_line(tmp_path):
     one_line_error(run("curve", "--points", "1000000000", "-o", "p.h5", cwd=tmp_path), "--points", "[2, 100000]")
     one_line_error(run("curve", "--delta-max", "1e-300", "-o", "p.h5", cwd=tmp_path), "delta_max = 1e-300",
-                   "[1e-06, 2.142]")
+                   "[1e-06, 2.927]")
     assert not list(tmp_path.iterdir())
 
 
