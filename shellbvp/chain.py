@@ -296,6 +296,18 @@ class ChainBVP:
         self.force_at = next((j for j in reversed(self.junctions) if isinstance(j, (Edge, Line))), None)
         self.n_conditions = sum(j.rows for j in self.junctions) + (self.extra is not None)
 
+    def __repr__(self):
+        return f"ChainBVP({self.control}={self.value:g})\n{self.chain.layout()}"
+
+    # pickling: the generated module is code, not data; it is loaded again (from the code
+    # cache) by the scene on unpickling, so results can travel between processes
+    def __getstate__(self):
+        return {k: v for k, v in self.__dict__.items() if k != "model"}
+
+    def __setstate__(self, state):
+        self.__dict__.update(state)
+        self.model = self.scene.model()
+
     # -- quantities -----------------------------------------------------------------------------
     def quantities(self, p) -> dict:
         """Every quantity by name: the unknowns from ``p``, the prescribed one, F (0 unless prescribed)."""

@@ -52,6 +52,9 @@ def make_wall_system(scene, topology, control, value, eps):
         raise ValueError("this tip has no end where it meets a cylinder (A' never vanishes): no wall contact")
     if topology not in WALL_TOPOLOGIES:
         raise ValueError(f"topology must be one of {tuple(WALL_TOPOLOGIES)}; got {topology!r}")
+    if scene.contact == "paper" and topology != "cap+cylinder":
+        raise ValueError(f"topology={topology!r} needs contact='smooth': the paper's contact model has the single "
+                         "cap only, which may run onto the cylinder ('cap+cylinder')")
     sysm = ChainBVP(scene, WALL_TOPOLOGIES[topology](eps, scene.shell_length, scene.contact), control, value)
     attach_tip_table(sysm)
     return sysm
@@ -260,6 +263,8 @@ def best_wall_state(start: Solution, *, control=None, value=None, tol=1e-6, max_
     """
     tried = [] if tried is None else tried
     order = list(WALL_TOPOLOGIES) if start.get("topology") == "cap" else _neighbours(start.topology)
+    if start.scene.contact == "paper":
+        order = [t for t in order if t == "cap+cylinder"]
     valid = []
     for topology in order:
         res = wall_state(start, topology, control=control, value=value, tol=tol, max_nodes=max_nodes,

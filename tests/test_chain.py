@@ -109,3 +109,26 @@ def test_states_equal_those_before_the_assembler(ref):
     for key in ("force", "delta", "lambda0", "Sc", "energy"):
         assert s[key] == pytest.approx(ref[key], rel=1e-10, abs=1e-14, nan_ok=True), key
     assert s.get("S1", s.Sc) == pytest.approx(ref["S1"], rel=1e-10, abs=1e-14)
+
+
+def test_results_round_trip_through_pickle():
+    """A Solution holds its system but not the generated module (code): it is loaded again from
+    the code cache on unpickling, so results can be returned by worker processes."""
+    import pickle
+
+    for scene, delta in ((sb.Scene.preset("base"), 0.3), (sb.Scene.preset("base"), 0.05),
+                         (sb.Scene.preset("flat"), 0.01)):
+        s = sb.solve(scene, delta=delta)
+        back = pickle.loads(pickle.dumps(s))
+        assert back.topology == s.topology and back.force == s.force and back.scene == s.scene
+        np.testing.assert_array_equal(back.profile()["z"], s.profile()["z"])
+    c = sb.curve(sb.Scene.preset("base"), deltas=[0.1, 0.2])
+    back = pickle.loads(pickle.dumps(c))
+    np.testing.assert_array_equal(back.force, c.force)
+    assert back.solutions[1].profile()["r"].size == c.solutions[1].profile()["r"].size
+
+
+def test_repr_shows_the_layout():
+    scene = sb.Scene.preset("base")
+    text = repr(ch.ChainBVP(scene, ch.cap_chain(EPS, scene.shell_length), "delta", 0.2))
+    assert "ChainBVP(delta=0.2)" in text and "ContactPole(k=0)" in text and "y[2:8]  region 1 free" in text
