@@ -9,15 +9,14 @@ Quick use::
     c.to_hdf5("base.h5")
 """
 
+from .continuation import curve
 from .geometry import SphereTip, Spheroid, UserShell, UserTip
+from .io import Curve, read_curve
 from .materials import Gent, MooneyRivlin, NeoHookean, StrainEnergy
 from .scene import PRESETS, Scene
 from .solution import STATUS_MESSAGES, Solution
 from .state import delta_bounds, solve
-from .continuation import curve
-from .io import Curve, read_curve
 from .units import Dimensions, beta_from_thickness, parse_quantity
-
 from .version import __version__  # noqa: F401  (sb.__version__)
 
 _LAZY = {"fit": "fitting", "FitResult": "fitting", "read_force_csv": "fitting"}

@@ -22,8 +22,8 @@ import time
 
 import numpy as np
 
-from .io import POINT_FIELDS, Curve, point_record
 from .cylinder import best_wall_state, wall_contact_suspected, wall_state
+from .io import POINT_FIELDS, Curve, point_record
 from .liftoff import replace_invalid_cap
 from .pointload import SC_POINT, solve_point_load
 from .solution import Solution, default_eps, richardson_error, thin_mesh

@@ -29,7 +29,12 @@ import time
 
 import numpy as np
 
-from .chain import ChainBVP, cap_band_cylinder_chain, cap_line_cylinder_chain, cylinder_chain
+from .chain import (
+    ChainBVP,
+    cap_band_cylinder_chain,
+    cap_line_cylinder_chain,
+    cylinder_chain,
+)
 from .diagnosis import diagnose
 from .solution import Solution, attach_tip_table, richardson_error, solve_bvp, thin_mesh
 

@@ -14,10 +14,10 @@ import math
 
 import numpy as np
 
-from .chain import FREE_STATES, ContactPole, Edge, FreePole, Line, TipEnd
+from .chain import FREE_STATES, ContactPole, Edge, FreePole, Line, PointPole, TipEnd
 from .solution import Solution, penetration, set_status, wall_gap
 
-__all__ = ["diagnose"]
+__all__ = ["diagnose", "STATE_NUMBERS"]
 
 _LS, _LT = FREE_STATES.index("ls"), FREE_STATES.index("lt")
 
@@ -48,7 +48,7 @@ def _omega_range(sysm, k, fields):
     return float(np.min(fields["omega"])), float(np.max(fields["omega"]))
 
 
-def diagnose(sysm, bvp, tol) -> Solution:
+def diagnose(sysm, bvp, tol, converged_note: str = "") -> Solution:
     """The Solution of a solve_bvp run of ``sysm`` (a ChainBVP) with the model's checks.
 
     Status 4 (inadmissible) for edges out of order, non-positive stretches, delta < 0, a
@@ -67,7 +67,8 @@ def diagnose(sysm, bvp, tol) -> Solution:
     edges = _edges(sysm)
     S_edges = [sysm.S_point(pt, p) for pt, _, _ in edges] or [0.0]
     res = Solution(
-        topology=sysm.topology, status=int(bvp.status), message=bvp.message, x=bvp.x, y=bvp.y, p=p, sol=bvp.sol,
+        topology=sysm.topology, status=int(bvp.status), message=bvp.message, x=bvp.x, y=bvp.y,
+        p=p if p is not None else np.empty(0), sol=bvp.sol,
         rms_residuals=bvp.rms_residuals, niter=int(bvp.niter), nodes=int(bvp.x.size),
         max_residual=float(np.max(bvp.rms_residuals)) if bvp.rms_residuals.size else nan,
         delta=float(delta), lambda0=float(lambda0), Sc=S_edges[-1], S1=S_edges[0], force=float(force),
@@ -92,11 +93,11 @@ def diagnose(sysm, bvp, tol) -> Solution:
             flags.append("non-positive stretch")
         if delta < 0:
             flags.append(f"collapsed state with delta = {delta:.3g} < 0")
-    set_status(res, bvp, flags)
+    set_status(res, bvp, flags, converged_note)
     if not finite:
         res.update(energy=nan, pressure_min=nan, penetration=nan, force_defect=nan, edge_legendre=nan,
                    ring_force=nan, ring_force_inner=nan, cap_force=nan, edge_forces=[], valid=False, flags=flags)
-        return res
+        return _without_iterate_numbers(res)
 
     t = np.unique(np.r_[bvp.x, 0.5 * (bvp.x[1:] + bvp.x[:-1])])
     parts = sysm.region_profiles(t, bvp.sol(t), p)
@@ -107,10 +108,10 @@ def diagnose(sysm, bvp, tol) -> Solution:
         fi, fo = _at(sysm, inner, S, yb), _at(sysm, outer, S, ya)
         axial.append(2 * np.pi * float(fo["axial_force_2pi"][0] - fi["axial_force_2pi"][0]))
         normal.append(-2 * np.pi * float(fo["r"][0] * fo["Q"][0] - fi["r"][0] * fi["Q"][0]))
-    res.ring_force = axial[-1] if axial else float(force)
+    res.ring_force = axial[-1] if axial else float(force)  # no edge: a point force
     res.ring_force_inner = axial[0] if len(axial) > 1 else 0.0
     res.edge_forces = normal
-    res.cap_force = float(force) - sum(axial)
+    res.cap_force = float(force) - sum(axial) if axial else 0.0
     contact = [(k, f) for k, _, f in parts if sysm.regions[k].kind != "free"]
     res.pressure_min = min((float(np.min(f["P"])) for _, f in contact), default=nan)
     free = [(k, f) for k, _, f in parts if sysm.regions[k].kind == "free"]
@@ -136,9 +137,18 @@ def diagnose(sysm, bvp, tol) -> Solution:
             admissible.append("the contact has passed the end of the tip (the indenter's cylinder)")
         if sysm.regions[k].kind == "cylinder" and lo < omega_max * (1 - 1e-9):
             admissible.append("the contact on the cylinder runs back onto the tip")
+    for j in sysm.junctions:
+        if isinstance(j, Line):
+            w = q["chi1"] * sysm.S_point(sysm.regions[j.k].end, p) / sysm.scene.rho
+            if j.on == "contact" and w > omega_max * (1 + 1e-9):
+                admissible.append("the contact has passed the end of the tip (the indenter's cylinder)")
+            if j.on == "cylinder" and w < omega_max * (1 - 1e-9):
+                admissible.append("the contact line on the cylinder runs back onto the tip")
     if admissible and bvp.status == 0:
-        set_status(res, bvp, flags + admissible)
+        set_status(res, bvp, flags + admissible, converged_note)
         flags = flags + admissible
+    if isinstance(first, PointPole) and force < 0:
+        vflags.append(f"negative point force ({force:.3g})")
     scale = 10 * tol * (1 + abs(force))
     for k, f in contact:
         where = "the cylinder" if sysm.regions[k].kind == "cylinder" else "the tip"
@@ -159,7 +169,27 @@ def diagnose(sysm, bvp, tol) -> Solution:
             res.curvature_excess = float(yin[FREE_STATES.index("ks")] - on["kappa_s"][0])
             if res.curvature_excess > 10 * tol * max(1.0, abs(float(on["kappa_s"][0]))):
                 vflags.append(f"the shell bends more tightly than the indenter at the contact line "
-                              f"(kappa_s exceeds the indenter's by {res.curvature_excess:.3g}): the contact is a band")
+                              f"(kappa_s exceeds the indenter's by {res.curvature_excess:.3g}): the contact is "
+                              f"{'a band' if j.on == 'cylinder' else 'an annulus'}")
     res.flags = flags + vflags
     res.valid = res.success and not vflags
+    return _without_iterate_numbers(res)
+
+
+#: The numbers of a state; a run that did not converge reports them as NaN, all but the
+#: prescribed one (its ``y``, ``x`` and ``p`` stay: the last iterate, for inspection).
+STATE_NUMBERS = ("delta", "force", "lambda0", "Sc", "S1", "S_end", "energy", "ring_force", "ring_force_inner",
+                 "cap_force", "pressure_min", "penetration", "wall_gap", "force_defect", "edge_legendre",
+                 "curvature_excess")
+
+
+def _without_iterate_numbers(res):
+    if res.status in (0, 4):  # converged (admissible or not)
+        return res
+    prescribed = res.get("control")  # the prescribed delta, lambda0 or force is known all the same
+    for key in STATE_NUMBERS:
+        if key in res and key != prescribed:
+            res[key] = float("nan")
+    res.edge_forces = [float("nan")] * len(res.get("edge_forces", []))
+    res.valid = False
     return res

@@ -25,15 +25,14 @@ import time
 import numpy as np
 
 from .chain import ChainBVP, annulus_chain, line_chain
+from .diagnosis import diagnose
 from .pointload import solve_point_load
 from .solution import (
     STATUS_MESSAGES,
     Solution,
     attach_tip_table,
     default_eps,
-    penetration,
     richardson_error,
-    set_status,
     solve_bvp,
     thin_mesh,
 )
@@ -135,103 +134,8 @@ def solve_liftoff_from(sysm, guess, *, tol=1e-6, max_nodes=10000, bc_tol=1e-10):
     with np.errstate(all="ignore"):
         bvp = solve_bvp(sysm.fun, sysm.bc, x, y, p, fun_jac=sysm.fun_jac, bc_jac=sysm.bc_jac,
                         tol=tol, bc_tol=bc_tol, max_nodes=max_nodes)
-        res = _diagnose(sysm, bvp, tol)
+        res = diagnose(sysm, bvp, tol)
     res.wall_time = time.perf_counter() - t0
-    return res
-
-
-def _edge_values(sysm, ya, yb, p):
-    """(F, inner ring force, outer ring force, S1, S2, delta): ring forces are the jumps of 2 pi G
-    (the axial force) across each contact edge."""
-    mod, par = sysm.model, sysm.par
-    q = sysm.quantities(p)
-    S1 = float(np.exp(np.float64(q["ln_S1"])))
-    S2 = float(np.exp(np.float64(q["ln_S2"]))) if sysm.topology == "annulus" else S1
-    outer, inner = len(sysm.regions) - 1, 0
-
-    def G(prof, S, y):
-        return float(prof(np.array([S]), y[:, None], par)["axial_force_2pi"][0])
-
-    G_out = G(mod.free_profile, S2, ya[sysm.rows(outer)])
-    G_in = G(mod.free_profile, S1, yb[sysm.rows(inner)])
-    if sysm.topology == "annulus":
-        pc1, pc2 = G(mod.contact_profile, S1, ya[sysm.rows(1)]), G(mod.contact_profile, S2, yb[sysm.rows(1)])
-        ring_in, ring_out = 2 * np.pi * (pc1 - G_in), 2 * np.pi * (G_out - pc2)
-    else:
-        ring_in, ring_out = 0.0, 2 * np.pi * (G_out - G_in)
-    return 2 * np.pi * G_out, float(ring_in), float(ring_out), S1, S2, float(q["delta"])
-
-
-def _diagnose(sysm: ChainBVP, bvp, tol):
-    mod, par = sysm.model, sysm.par
-    p = bvp.p
-    ya, yb = bvp.y[:, 0], bvp.y[:, -1]
-    force, ring_in, ring_out, S1, S2, delta = _edge_values(sysm, ya, yb, p)
-    z_tip = float(mod.reference_shell(0.0, par)["Z"]) - delta
-    res = Solution(
-        topology=sysm.topology, status=int(bvp.status), message=bvp.message, x=bvp.x, y=bvp.y, p=p,
-        sol=bvp.sol, rms_residuals=bvp.rms_residuals, niter=int(bvp.niter), nodes=int(bvp.x.size),
-        max_residual=float(np.max(bvp.rms_residuals)) if bvp.rms_residuals.size else float("nan"),
-        delta=delta, lambda0=float(ya[2]), Sc=S2, S1=S1, contact_width=S2 - S1, force=force,
-        ring_force=ring_out, ring_force_inner=ring_in, cap_force=force - ring_out - ring_in,
-        control=sysm.control, scene=sysm.scene, system=sysm, z_tip=z_tip,
-    )
-    flags = []
-    finite = np.all(np.isfinite(bvp.y)) and np.all(np.isfinite(p)) and math.isfinite(force)
-    if not finite:
-        flags.append("non-finite state")
-    elif bvp.status == 0:
-        if not 0.0 < S1 <= S2 < sysm.L:
-            flags.append(f"contact edges S1 = {S1:.3g}, S2 = {S2:.3g} not ordered inside (0, L)")
-        o = sysm.offsets[-1]
-        if np.any(bvp.y[[0, 2, o, o + 2]] <= 0):
-            flags.append("non-positive stretch")
-        omega2 = (S2 * (yb[sysm.rows(1)][0] if sysm.topology == "annulus" else p[1])) / sysm.scene.rho
-        if omega2 > sysm.scene.tip_omega_max:
-            flags.append("the contact has passed the end of the tip (the indenter's cylinder)")
-    set_status(res, bvp, flags)
-    nan = float("nan")
-    if not finite:
-        res.update(energy=nan, pressure_min=nan, penetration=nan, force_defect=nan, edge_legendre=nan,
-                   valid=False, flags=flags)
-        return res
-
-    t = np.unique(np.r_[bvp.x, 0.5 * (bvp.x[1:] + bvp.x[:-1])])
-    y = bvp.sol(t)
-    profiles = [fields for _, _, fields in sysm.region_profiles(t, y, p)]
-    pin, pout = profiles[0], profiles[-1]
-    res.force_defect = float(max(np.max(np.abs(2 * np.pi * pout["axial_force_2pi"] - force)),
-                                 np.max(np.abs(2 * np.pi * pin["axial_force_2pi"]))))
-    if sysm.topology == "annulus":
-        res.pressure_min = float(np.min(profiles[1]["P"]))
-    else:
-        res.pressure_min = nan  # no area of contact
-    t_leg = np.array([0.0, 0.5])
-    leg = mod.free_legendre(sysm.S(len(sysm.regions) - 1, t_leg, p), bvp.sol(t_leg)[sysm.rows(-1)], par)[0]
-    res.edge_legendre = float(leg[0] / leg[1]) if leg[1] != 0 else nan
-    res.penetration = max(penetration(sysm, pin["r"], pin["z"], z_tip),
-                          penetration(sysm, pout["r"], pout["z"], z_tip))
-    res.energy = sysm.energy(bvp.sol, bvp.x, p)
-    vflags = []
-    scale = 10 * tol * (1 + abs(force))
-    if sysm.topology == "annulus" and res.pressure_min < -scale:
-        vflags.append(f"negative contact pressure on the annulus (min P = {res.pressure_min:.3g})")
-    if ring_in < -scale:
-        vflags.append(f"negative ring force ({ring_in:.3g}) at the inner contact edge")
-    if ring_out < -scale:
-        vflags.append(f"negative ring force ({ring_out:.3g}) at the outer contact edge")
-    if res.penetration > 10 * tol:
-        vflags.append(f"the free shell passes through the indenter (by {res.penetration:.3g})")
-    if sysm.topology == "line":
-        # Touching on a circle, the shell must not bend more tightly than the indenter there
-        # (else it passes through it next to the line: the contact becomes an annulus).
-        tip = mod.contact_profile(np.array([S1]), np.array([[p[1]], [yb[2]]]), par)["kappa_s"][0]
-        res.curvature_excess = float(yb[3] - tip)
-        if res.curvature_excess > 10 * tol * max(1.0, abs(tip)):
-            vflags.append(f"the shell bends more tightly than the indenter at the contact line "
-                          f"(kappa_s exceeds the tip's by {res.curvature_excess:.3g}): the contact is an annulus")
-    res.flags = flags + vflags
-    res.valid = res.success and not vflags
     return res
 
 
@@ -280,13 +184,19 @@ def liftoff_state(cap: Solution, topology: str, *, tol=1e-6, max_nodes=10000, bc
     res = good[0] if good else (closed[0] if closed else tries[-1])
     if _closed_at_pole(res):
         res.status, res.success, res.valid = 4, False, False
-        res.message = (f"{STATUS_MESSAGES[4]}: the annulus reaches the pole (S1/S2 = {res.S1 / res.Sc:.2g}): "
-                       "the state is the single cap")
+        res.message = (f"{STATUS_MESSAGES[4]}: the annulus reaches the pole (S1/S2 = "
+                       f"{math.exp(res.p[0] - res.p[1]):.2g}): the state is the single cap")
     return res
 
 
 def _closed_at_pole(res):
-    return res.topology == "annulus" and math.isfinite(res.S1) and res.S1 < ANNULUS_CLOSED_AT_POLE * res.Sc
+    """The annulus's inner edge has run to the pole: S1/S2 below ANNULUS_CLOSED_AT_POLE, read
+    from the unknowns (ln S1, ln S2) -- of the converged state, or of the last iterate of a run
+    that did not converge (Newton walking ln S1 down is how such a run fails)."""
+    if res.get("topology") != "annulus" or res.get("p") is None or len(res.p) < 2:
+        return False
+    ratio = math.exp(min(0.0, float(res.p[0]) - float(res.p[1])))
+    return bool(math.isfinite(res.p[0]) and math.isfinite(res.p[1]) and ratio < ANNULUS_CLOSED_AT_POLE)
 
 
 #: The probe of an annulus: loose and small, so that one that runs to the pole is seen fast.

@@ -7,17 +7,14 @@ the point-load solution to exponential accuracy (``shellbvp.chain.point_chain``)
 
 from __future__ import annotations
 
-import math
 import time
 
 import numpy as np
 
 from .chain import ChainBVP, point_chain
+from .diagnosis import diagnose
 from .solution import (
-    Solution,
     attach_tip_table,
-    penetration,
-    set_status,
     solve_bvp,
     thin_mesh,
 )
@@ -69,48 +66,6 @@ def solve_point_load(scene, delta, *, tol=1e-6, max_nodes=10000, guess=None, bc_
     with np.errstate(all="ignore"):
         bvp = solve_bvp(sysm.fun, sysm.bc, x, y, fun_jac=sysm.fun_jac, bc_jac=sysm.bc_jac, tol=tol,
                         bc_tol=bc_tol, max_nodes=max_nodes)
-        sysm.tol = tol
-        res = _diagnose_point(sysm, bvp)
+        res = diagnose(sysm, bvp, tol, " (point-load limit: the contact cap is exponentially small)")
     res.wall_time = time.perf_counter() - t0
-    return res
-
-
-def _diagnose_point(sysm, bvp):
-    mod, par = sysm.model, sysm.par
-    nan = float("nan")
-    ya = bvp.y[:, 0]
-    force, delta = sysm.end_values(ya, bvp.y[:, -1])
-    res = Solution(
-        topology="point", status=int(bvp.status), message=bvp.message, x=bvp.x, y=bvp.y, p=np.array([]),
-        sol=bvp.sol, rms_residuals=bvp.rms_residuals, niter=int(bvp.niter), nodes=int(bvp.x.size),
-        max_residual=float(np.max(bvp.rms_residuals)) if bvp.rms_residuals.size else nan,
-        # lambda0 is not defined in this limit: the stretches vary like ln^2 S near a point force.
-        delta=delta, lambda0=float("nan"), Sc=0.0, force=force, ring_force=force, cap_force=0.0,
-        control="delta", scene=sysm.scene, system=sysm,
-        z_tip=float(mod.reference_shell(0.0, par)["Z"]) - delta,
-    )
-    flags = []
-    if not (np.all(np.isfinite(bvp.y)) and math.isfinite(force)):
-        flags.append("non-finite state")
-    elif bvp.status == 0 and np.any(bvp.y[[0, 2]] <= 0):
-        flags.append("non-positive stretch")
-    set_status(res, bvp, flags, " (point-load limit: the contact cap is exponentially small)")
-    res.update(pressure_min=nan, penetration=nan, valid=False, force_error=nan, delta_error=0.0)
-    if not res.success or flags:
-        res.update(energy=nan, force_defect=nan, flags=flags)
-        return res
-    t = np.unique(np.r_[bvp.x, 0.5 * (bvp.x[1:] + bvp.x[:-1])])
-    (_, _, pf), = sysm.region_profiles(t, bvp.sol(t), None)
-    res.force_defect = float(np.max(np.abs(2 * np.pi * pf["axial_force_2pi"] - force)))
-    res.energy = sysm.energy(bvp.sol, bvp.x, None)
-    # The point load is the limit of contact on a vanishing circle (line contact): valid
-    # when it pushes and the shell stays outside the indenter.
-    res.penetration = penetration(sysm, pf["r"], pf["z"], res.z_tip)
-    vflags = []
-    if force < 0:
-        vflags.append(f"negative point force ({force:.3g})")
-    if res.penetration > 10 * sysm.tol:
-        vflags.append(f"the free shell passes through the indenter (by {res.penetration:.3g})")
-    res.flags = vflags
-    res.valid = not vflags
     return res

@@ -15,18 +15,16 @@ import time
 import numpy as np
 
 from .chain import ChainBVP, cap_chain
+from .diagnosis import diagnose
 from .pointload import SC_POINT, solve_point_load
 from .solution import (
     STATUS_MESSAGES,
     Solution,
     attach_tip_table,
     default_eps,
-    penetration,
     richardson_error,
-    set_status,
     solve_bvp,
     thin_mesh,
-    wall_gap,
 )
 
 __all__ = ["solve", "solve_from", "make_system", "warm_guess", "delta_bounds", "check_delta", "check_tol",
@@ -69,73 +67,6 @@ def warm_guess(sysm: ChainBVP, prev: "Solution", predictor=None):
     return x, y, p
 
 
-def _diagnose(sysm: ChainBVP, bvp, tol):
-    """Turn solve_bvp's result into a Solution with the model's diagnostics."""
-    mod, par = sysm.model, sysm.par
-    q = sysm.quantities(bvp.p)
-    ln_Sc, lambda0, delta, F_pres = q["ln_Sc"], q["lambda0"], q["delta"], q["F"]
-    Sc = np.exp(ln_Sc)
-    ya, yb = bvp.y[:, 0], bvp.y[:, -1]
-    yc, yf = yb[sysm.rows(0)], ya[sysm.rows(1)]
-    ring, cap = mod.contact_line_forces(Sc, yc, yf, delta, F_pres, par)
-    force = float(ring[0] + cap[0])
-    res = Solution(
-        topology="cap",
-        status=int(bvp.status), message=bvp.message, x=bvp.x, y=bvp.y, p=bvp.p, sol=bvp.sol,
-        rms_residuals=bvp.rms_residuals, niter=int(bvp.niter), nodes=int(bvp.x.size),
-        max_residual=float(np.max(bvp.rms_residuals)) if bvp.rms_residuals.size else float("nan"),
-        delta=float(delta), lambda0=float(lambda0), Sc=Sc, force=force,
-        ring_force=float(ring[0]), cap_force=float(cap[0]), control=sysm.control,
-        scene=sysm.scene, system=sysm, z_tip=float(mod.reference_shell(0.0, par)["Z"]) - float(delta),
-    )
-    flags = []
-    finite = np.all(np.isfinite(bvp.y)) and np.all(np.isfinite(bvp.p)) and math.isfinite(force)
-    omega_c = Sc * yc[0] / sysm.scene.rho
-    if not finite:
-        flags.append("non-finite state")
-    elif bvp.status == 0:
-        if not 0.0 < Sc < sysm.L:
-            flags.append(f"contact circle Sc = {Sc:.3g} outside (0, L)")
-        if lambda0 <= 0 or np.any(bvp.y[[1, 2, 4]] <= 0):
-            flags.append("non-positive stretch")
-        if delta < 0:
-            flags.append(f"collapsed state with delta = {delta:.3g} < 0")
-        if omega_c > sysm.scene.tip_omega_max:
-            flags.append("the contact has passed the end of the tip (the indenter's cylinder)")
-    set_status(res, bvp, flags)
-    if not finite:
-        res.update(energy=float("nan"), pressure_min=float("nan"), penetration=float("nan"),
-                   force_defect=float("nan"), valid=False, flags=flags)
-        return res
-
-    # Diagnostics on nodes and midpoints.
-    t = np.unique(np.r_[bvp.x, 0.5 * (bvp.x[1:] + bvp.x[:-1])])
-    y = bvp.sol(t)
-    (_, _, pc), (_, _, pf) = sysm.region_profiles(t, y, bvp.p)
-    res.force_defect = float(np.max(np.abs(2 * np.pi * pf["axial_force_2pi"] - force)))
-    # Legendre condition at the contact edge relative to mid-region: -> 0 where the smooth
-    # branch ends (the free equations become singular at Sc+).
-    t_leg = np.array([0.0, 0.5])
-    leg = mod.free_legendre(sysm.S(1, t_leg, bvp.p), bvp.sol(t_leg)[sysm.rows(1)], par)[0]
-    res.edge_legendre = float(leg[0] / leg[1]) if leg[1] != 0 else float("nan")
-    res.pressure_min = float(np.min(pc["P"]))
-    res.penetration = penetration(sysm, pf["r"], pf["z"], res.z_tip)
-    res.wall_gap = wall_gap(sysm, pf["r"], pf["z"], res.z_tip)
-    res.energy = sysm.energy(bvp.sol, bvp.x, bvp.p)
-    vflags = []
-    scale = 10 * tol
-    if res.pressure_min < -scale * (1 + abs(force)):
-        vflags.append(f"negative contact pressure (min P = {res.pressure_min:.3g}): the shell would "
-                      "lift off the indenter inside the cap")
-    if res.ring_force < -scale * (1 + abs(force)):
-        vflags.append(f"negative ring force ({res.ring_force:.3g}) at the contact edge")
-    if res.penetration > scale:
-        vflags.append(f"the free shell passes through the indenter (by {res.penetration:.3g})")
-    res.flags = flags + vflags
-    res.valid = res.success and not vflags
-    return res
-
-
 def _run_bvp(sysm, guess, tol, max_nodes, bc_tol):
     x, y, p = guess
     with np.errstate(all="ignore"):
@@ -155,7 +86,7 @@ def solve_from(sysm, guess, *, tol=1e-6, max_nodes=10000, bc_tol=None):
     t0 = time.perf_counter()
     bvp = _run_bvp(sysm, guess, tol, max_nodes, bc_tol if bc_tol is not None else 1e-10)
     with np.errstate(all="ignore"):  # diagnostics of a failed run may overflow; flagged instead
-        res = _diagnose(sysm, bvp, tol)
+        res = diagnose(sysm, bvp, tol)
     res.wall_time = time.perf_counter() - t0
     return res
 

@@ -132,3 +132,17 @@ def test_repr_shows_the_layout():
     scene = sb.Scene.preset("base")
     text = repr(ch.ChainBVP(scene, ch.cap_chain(EPS, scene.shell_length), "delta", 0.2))
     assert "ChainBVP(delta=0.2)" in text and "ContactPole(k=0)" in text and "y[2:8]  region 1 free" in text
+
+
+def test_a_run_that_does_not_converge_reports_nan_numbers_not_its_last_iterate():
+    from shellbvp.state import make_system, solve_from, warm_guess
+
+    scene = sb.Scene.preset("base")
+    good = sb.solve(scene, delta=0.2, estimate_error=False)
+    sysm = make_system(scene, "delta", 0.6, good.system.eps)  # far from the guess, few nodes allowed
+    bad = solve_from(sysm, warm_guess(sysm, good), tol=1e-10, max_nodes=20)
+    assert not bad.success and bad.status not in (0, 4) and bad.message
+    assert bad.delta == 0.6  # prescribed: known
+    for key in ("force", "lambda0", "Sc", "energy", "ring_force", "pressure_min"):
+        assert np.isnan(bad[key]), key
+    assert not bad.valid and bad.y.shape[0] == sysm.n  # the last iterate stays for inspection
