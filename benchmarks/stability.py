@@ -265,11 +265,16 @@ def short_reason(r):
     if r.get("interrupted"):
         return f"time limit ({r['time_limit']:.0f} s)"
     s = r["stop_reason"]
+    if "end of the tip" in s and "no valid contact with the cylinder" in s:
+        return "contact reached the cylinder; no valid state on it"
     if "end of the tip" in s and "inadmissible" in s:
         m = re.match(r"continuation failed near delta = ([-\d.e+]+)", s)
-        return f"failed at delta {float(m.group(1)):.4g}: contact passed the cylinder (no landing)"
+        if m:
+            return f"failed at delta {float(m.group(1)):.4g}: contact passed the cylinder (no landing)"
     if "end of the tip" in s:
         return "contact reached the cylinder"
+    if s.startswith("no valid contact configuration beyond"):
+        return s[:60]
     if s.startswith("delta_max"):
         return "delta_max reached"
     m = re.match(r"continuation failed near delta = ([-\d.e+]+): (.*)", s)

@@ -48,7 +48,7 @@ import numpy as np
 __all__ = ["Point", "Region", "ContactPole", "FreePole", "PointPole", "Edge", "TipEnd", "Line", "Rim", "Chain",
            "ChainBVP", "cap_chain", "point_chain", "annulus_chain", "line_chain", "cylinder_chain",
            "cap_line_cylinder_chain", "cap_band_cylinder_chain", "CONTROLS",
-           "SIZES", "FREE_STATES", "CONTACT_STATES", "CONTACT_KINDS", "REGION_CODES"]
+           "SIZES", "FREE_STATES", "CONTACT_STATES", "CONTACT_KINDS", "REGION_CODES", "CONFIGURATION_NAMES"]
 
 CONTROLS = ("delta", "lambda0", "force", "arclength")
 FREE_STATES = ("lt", "phiS", "ls", "ks", "rQ", "z")
@@ -179,6 +179,10 @@ class Chain:
 
 def _fields(j):
     return "(" + ", ".join(f"{k}={v!r}" for k, v in j.__dict__.items()) + ")"
+
+
+#: Every configuration's name (``Solution.topology``, a curve's per-point ``topology``).
+CONFIGURATION_NAMES = ("cap", "point", "line", "annulus", "cap+line(cylinder)", "cap+band(cylinder)", "cap+cylinder")
 
 
 def cap_chain(eps: float, L: float, model: str = "smooth") -> Chain:

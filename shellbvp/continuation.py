@@ -263,6 +263,10 @@ def _locate_switches(builder: _Builder, st):
         sol = _solve_at_delta(scene, d, near, None, st)
         return (sol, min(sol.wall_gap, 1.0)) if sol.success else (None, None)  # inf: nothing above the tip end
 
+    def cap_end_at(d, near):  # the cap whose contact edge is at the tip's end
+        sol = _solve_at_delta(scene, d, near, None, st)
+        return (sol, sol.tip_end_margin) if sol.status in (0, 4) else (None, None)
+
     def wall_line_at(d, near):
         sol = wall_state(near, "cap+line(cylinder)", control="delta", value=d, tol=st["tol"],
                          max_nodes=st["max_nodes"], bc_tol=st["bc_tol"])
@@ -278,8 +282,14 @@ def _locate_switches(builder: _Builder, st):
         elif pair == {"line", "annulus"}:
             ends = [s if s.get("topology") == "line" else _line_state_at(s, st) for s in (s1, s2)]
             criterion, sign, solve_at = "curvature_excess", -1.0, line_at
-        elif pair == {"cap", "cap+line(cylinder)"}:
-            ends, criterion, sign, solve_at = [_cap_of(s1), _cap_of(s2)], "wall_gap", 1.0, cap_touch_at
+        elif "cap" in pair and pair & {"cap+line(cylinder)", "cap+band(cylinder)", "cap+cylinder"}:
+            ends = [_cap_of(s1), _cap_of(s2)]
+            if any(e is None for e in ends):
+                continue
+            if all(math.isfinite(e.get("wall_gap", math.inf)) for e in ends):  # the shell reaches the wall
+                criterion, sign, solve_at = "wall_gap", 1.0, cap_touch_at
+            else:  # the contact reaches the tip's end
+                criterion, sign, solve_at = "tip_end_margin", 1.0, cap_end_at
         elif pair == {"cap+line(cylinder)", "cap+band(cylinder)"}:
             ends = [s if s.get("topology") == "cap+line(cylinder)" else
                     _wall_line_at(s, st) for s in (s1, s2)]
@@ -421,14 +431,20 @@ def _wall_leg(scene, builder, st, last_cap, key, *, reason, deltas=None):
     remaining ``deltas``.  Raises _Stop at the end, with ``reason`` if no wall state is found."""
     kw = dict(tol=st["tol"], max_nodes=st["max_nodes"], bc_tol=st["bc_tol"])
     if st["topology"] != "auto" or scene.model().OMEGA_MAX is None:
-        builder.out.complete = True
+        builder.out.complete = True  # the cap's branch ends at the tip's end: the end asked for
         raise _Stop(reason)
     tried = []
-    prev = builder.last_wall or best_wall_state(last_cap, tried=tried, **kw)
-    if prev is None:
-        builder.out.complete = True
-        raise _Stop(f"{reason}; no valid contact with the cylinder ({'; '.join(tried)})")
     targets = list(deltas) if deltas is not None else None
+    prev = builder.last_wall
+    if prev is None:
+        prev = best_wall_state(last_cap, tried=tried, **kw)
+        if prev is None:  # not a physical end: a configuration that is missing or not found
+            raise _Stop(f"{reason}; no valid contact with the cylinder ({'; '.join(tried)})")
+        prev.cap_solution = last_cap  # the cap past the tip's end: where the switch is located from
+        builder.last_wall = prev
+        if targets is None:
+            key += 1
+            builder.add(prev, key)
     d_end = st["delta_max"] if targets is None else (targets[-1] if targets else prev.delta)
     step = max(1e-3, (d_end - prev.delta) / 20)
     while prev.delta < d_end * (1 - 1e-12):

@@ -71,14 +71,15 @@ def diagnose(sysm, bvp, tol, converged_note: str = "") -> Solution:
         p=p if p is not None else np.empty(0), sol=bvp.sol,
         rms_residuals=bvp.rms_residuals, niter=int(bvp.niter), nodes=int(bvp.x.size),
         max_residual=float(np.max(bvp.rms_residuals)) if bvp.rms_residuals.size else nan,
-        delta=float(delta), lambda0=float(lambda0), Sc=S_edges[-1], S1=S_edges[0], force=float(force),
+        delta=float(delta), lambda0=float(lambda0), Sc=S_edges[-1], force=float(force), edge_S=S_edges,
+        # where the contact starts from the pole's side: the pole itself, or a lifted pole's first edge
+        S1=S_edges[0] if isinstance(first, FreePole) else 0.0,
         control=sysm.control, scene=sysm.scene, system=sysm,
         z_tip=float(mod.reference_shell(0.0, par)["Z"]) - float(delta),
     )
     tip_end = next((j for j in sysm.junctions if isinstance(j, TipEnd)), None)
     if tip_end is not None:
         res.S_end = sysm.S_point(sysm.regions[tip_end.k].end, p)
-        res.S1 = res.S_end
     flags = []
     finite = bool(np.all(np.isfinite(bvp.y)) and (p is None or np.all(np.isfinite(p))) and math.isfinite(force))
     if not finite:
@@ -131,6 +132,8 @@ def diagnose(sysm, bvp, tol, converged_note: str = "") -> Solution:
 
     admissible, vflags = [], []
     omega_max = sysm.scene.tip_omega_max
+    on_tip = [_omega_range(sysm, k, f)[1] for k, f in contact if sysm.regions[k].kind == "contact"]
+    res.tip_end_margin = omega_max - max(on_tip) if on_tip else float("nan")  # < 0: past the tip's end
     for k, f in contact:
         lo, hi = _omega_range(sysm, k, f)
         if sysm.regions[k].kind == "contact" and hi > omega_max * (1 + 1e-9):
@@ -180,7 +183,7 @@ def diagnose(sysm, bvp, tol, converged_note: str = "") -> Solution:
 #: prescribed one (its ``y``, ``x`` and ``p`` stay: the last iterate, for inspection).
 STATE_NUMBERS = ("delta", "force", "lambda0", "Sc", "S1", "S_end", "energy", "ring_force", "ring_force_inner",
                  "cap_force", "pressure_min", "penetration", "wall_gap", "force_defect", "edge_legendre",
-                 "curvature_excess")
+                 "curvature_excess", "tip_end_margin")
 
 
 def _without_iterate_numbers(res):

@@ -20,7 +20,7 @@ ring_force_inner, which read as a single cap)::
     /curve/force            (n,) signal: indenter force / (mu H R_L)
     /curve/<field>          (n,) each of POINT_FIELDS, plus
                             energy_residual (dE/ddelta - F) and flags (strings);
-                            topology (strings: cap, annulus, line, point)
+                            topology (strings: shellbvp.chain.CONFIGURATION_NAMES)
     /curve/profiles/point_<i>   optional (profiles=True): S, region, r, z, ... at the
                             mesh nodes of point i (see Solution.profile)
 
@@ -40,6 +40,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .chain import CONFIGURATION_NAMES
 from .paths import check_output_path
 from .version import __version__
 
@@ -259,7 +260,6 @@ def _missing_field(name, n):
 _STRING_FIELDS = ("topology", "flags")
 #: Integer-valued fields (an empty curve stores them as float).
 _INTEGER_FIELDS = ("status", "nodes", "niter")
-_TOPOLOGIES = ("cap", "line", "annulus", "point")
 
 
 def _format_version(f):
@@ -351,9 +351,9 @@ def _points(g):
         else:
             raise ValueError(f"dataset {k} missing")
     points["topology"] = np.asarray(points["topology"], dtype=str)
-    unknown = sorted(set(points["topology"]) - set(_TOPOLOGIES))
+    unknown = sorted(set(points["topology"]) - set(CONFIGURATION_NAMES))
     if unknown:
-        raise ValueError(f"topology must be one of {_TOPOLOGIES}; got {unknown[0]!r}")
+        raise ValueError(f"topology must be one of {CONFIGURATION_NAMES}; got {str(unknown[0])!r}")
     if not np.all(np.isfinite(points["delta"])):
         raise ValueError("delta must be finite")
     if "flags" not in g:
