@@ -47,7 +47,8 @@ import numpy as np
 
 __all__ = ["Point", "Region", "ContactPole", "FreePole", "PointPole", "Edge", "TipEnd", "Line", "Rim", "Chain",
            "ChainBVP", "cap_chain", "point_chain", "annulus_chain", "line_chain", "cylinder_chain",
-           "cap_line_cylinder_chain", "cap_band_cylinder_chain", "CONTROLS",
+           "cap_line_cylinder_chain", "cap_band_cylinder_chain", "cap_line_tip_chain", "cap_band_tip_chain",
+           "CONTROLS",
            "SIZES", "FREE_STATES", "CONTACT_STATES", "CONTACT_KINDS", "REGION_CODES", "CONFIGURATION_NAMES"]
 
 CONTROLS = ("delta", "lambda0", "force", "arclength")
@@ -182,7 +183,8 @@ def _fields(j):
 
 
 #: Every configuration's name (``Solution.topology``, a curve's per-point ``topology``).
-CONFIGURATION_NAMES = ("cap", "point", "line", "annulus", "cap+line(cylinder)", "cap+band(cylinder)", "cap+cylinder")
+CONFIGURATION_NAMES = ("cap", "point", "line", "annulus", "cap+line(tip)", "cap+band(tip)", "cap+line(cylinder)",
+                       "cap+band(cylinder)", "cap+cylinder")
 
 
 def cap_chain(eps: float, L: float, model: str = "smooth") -> Chain:
@@ -226,6 +228,25 @@ def cap_band_cylinder_chain(eps: float, L: float, model: str = "smooth") -> Chai
                                         Region("free", S2, Point("L", None, math.log(L)))),
                  (ContactPole(0), Edge(0, 1, model), Edge(2, 1, model), Edge(2, 3, model), Rim(3)),
                  ("ln_Sc", "ln_S1", "ln_S2"), eps)
+
+
+def cap_line_tip_chain(eps: float, L: float) -> Chain:
+    """A cap and, beyond a lifted gap, a line of contact on the tip: tip [zeta, Sc], free
+    [Sc, S1], free [S1, L] with the line at S1 (on the tip); unknowns ln Sc, ln S1, chi1."""
+    Sc, S1 = Point("Sc", "ln_Sc"), Point("S1", "ln_S1")
+    return Chain("cap+line(tip)", (Region("contact", Point("zeta", "ln_Sc", math.log(eps)), Sc),
+                                   Region("free", Sc, S1), Region("free", S1, Point("L", None, math.log(L)))),
+                 (ContactPole(0), Edge(0, 1), Line(1, "contact"), Rim(2)), ("ln_Sc", "ln_S1", "chi1"), eps)
+
+
+def cap_band_tip_chain(eps: float, L: float) -> Chain:
+    """A cap and, beyond a lifted gap, a band of contact on the tip: tip [zeta, Sc], free [Sc, S1],
+    tip [S1, S2], free [S2, L]; unknowns ln Sc, ln S1, ln S2."""
+    Sc, S1, S2 = Point("Sc", "ln_Sc"), Point("S1", "ln_S1"), Point("S2", "ln_S2")
+    return Chain("cap+band(tip)", (Region("contact", Point("zeta", "ln_Sc", math.log(eps)), Sc),
+                                   Region("free", Sc, S1), Region("contact", S1, S2),
+                                   Region("free", S2, Point("L", None, math.log(L)))),
+                 (ContactPole(0), Edge(0, 1), Edge(2, 1), Edge(2, 3), Rim(3)), ("ln_Sc", "ln_S1", "ln_S2"), eps)
 
 
 def annulus_chain(eps: float, L: float) -> Chain:
@@ -329,8 +350,10 @@ class ChainBVP:
     def ln_S(self, point: Point, p) -> float:
         return point.ln_offset + (p[self.col[point.unknown]] if point.unknown else 0.0)
 
-    def S_point(self, point: Point, p) -> float:
-        return float(np.exp(np.float64(self.ln_S(point, p))))
+    def S_point(self, point: Point, p) -> np.float64:
+        # a numpy scalar, not a float: an iterate far out (S -> 0 or inf) must give inf/NaN in
+        # the generated code (IEEE), not Python's OverflowError
+        return np.exp(np.float64(self.ln_S(point, p)))
 
     def rows(self, k) -> slice:
         return slice(self.offsets[k], self.offsets[k] + self.sizes[k])

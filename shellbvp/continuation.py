@@ -277,7 +277,7 @@ def _locate_switches(builder: _Builder, st):
         pair = {frm, to}
         if not (s1.get("valid") and s2.get("valid")) or frm == to:
             continue
-        if "cap" in pair and pair & {"line", "annulus"}:
+        if "cap" in pair and pair & {"line", "annulus", "cap+line(tip)"}:
             ends, criterion, sign, solve_at = [_cap_of(s1), _cap_of(s2)], "pressure_min", 1.0, cap_at
         elif pair == {"line", "annulus"}:
             ends = [s if s.get("topology") == "line" else _line_state_at(s, st) for s in (s1, s2)]

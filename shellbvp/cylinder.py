@@ -38,7 +38,7 @@ from .chain import (
 from .diagnosis import diagnose
 from .solution import Solution, attach_tip_table, richardson_error, solve_bvp, thin_mesh
 
-__all__ = ["WALL_TOPOLOGIES", "make_wall_system", "wall_contact_suspected", "solve_wall_from", "wall_state",
+__all__ = ["WALL_TOPOLOGIES", "make_wall_system", "wall_contact_suspected", "solve_chain_from", "wall_state",
            "best_wall_state", "transfer_guess"]
 
 #: The configurations with contact on the cylinder, in the order they follow each other as
@@ -207,7 +207,7 @@ def _guesses(sysm, start):
 
 
 # -- solving and choosing ---------------------------------------------------------------------------
-def solve_wall_from(sysm, guess, *, tol=1e-6, max_nodes=10000, bc_tol=1e-10):
+def solve_chain_from(sysm, guess, *, tol=1e-6, max_nodes=10000, bc_tol=1e-10):
     x, y, p = guess
     t0 = time.perf_counter()
     with np.errstate(all="ignore"):
@@ -236,7 +236,7 @@ def wall_state(start: Solution, topology: str, *, control=None, value=None, tol=
     kw = dict(tol=tol, max_nodes=max_nodes, bc_tol=bc_tol)
     res = None
     for guess in _guesses(sysm, start):
-        res = solve_wall_from(sysm, guess, **kw)
+        res = solve_chain_from(sysm, guess, **kw)
         if res.success:
             break
     if res is None:

@@ -24,7 +24,7 @@ import time
 
 import numpy as np
 
-from .chain import ChainBVP, annulus_chain, line_chain
+from .chain import ChainBVP, annulus_chain, cap_line_tip_chain, line_chain
 from .diagnosis import diagnose
 from .pointload import solve_point_load
 from .solution import (
@@ -245,7 +245,57 @@ def valid_liftoff_state(cap: Solution, *, tol=1e-6, max_nodes=10000, bc_tol=1e-1
         line_too_curved |= topology == "line" and res.get("curvature_excess", -1.0) > 0
         why = res.message if not res.success else "; ".join(res.flags)
         tried.append(f"{topology}: {why}")
+    if _pressed_at_the_pole(cap):
+        res = second_zone_state(cap, tol=tol, max_nodes=max_nodes, bc_tol=bc_tol, previous=previous)
+        if res.success and res.valid:
+            return res, tried
+        tried.append(f"{res.topology}: {res.message if not res.success else '; '.join(res.flags)}")
     return None, tried
+
+
+#: (Sc'/S_p, S1/Sc) of second-zone guesses from a cap pressed at the pole and pulling further out
+#: (S_p: where its pressure first turns negative; the ring at the cap's old edge Sc)
+_SECOND_ZONE_SPLITS = ((1.0, 1.0), (0.9, 1.0), (0.7, 1.0), (1.0, 0.97))
+
+
+def _pressed_at_the_pole(cap):
+    prof = cap.profile()
+    P = prof["P"][prof["region"] == 0]
+    return bool(P.size and P[0] > 0 and np.min(P) < 0)
+
+
+def second_zone_state(cap: Solution, *, tol=1e-6, max_nodes=10000, bc_tol=1e-10, previous=None):
+    """Where the cap is pressed at the pole but would pull further out: the contact splits into
+    a smaller cap and, beyond a lifted gap, a line on the tip (``cap+line(tip)``) where the cap's
+    edge was; from ``previous`` (the same configuration) when given, else a few guesses from the
+    cap.  Returns a Solution (check ``success`` and ``valid``)."""
+    from .cylinder import solve_chain_from, transfer_guess
+
+    t0 = time.perf_counter()
+    control = cap.control if cap.control in ("force",) else "delta"
+    value = cap.force if control == "force" else cap.delta
+    scene, rho = cap.scene, cap.scene.rho
+    sysm = ChainBVP(scene, cap_line_tip_chain(cap.system.eps, scene.shell_length), control, value)
+    attach_tip_table(sysm)
+    kw = dict(tol=tol, max_nodes=int(min(max_nodes, max(2000, 4 * cap.nodes))), bc_tol=bc_tol)
+    guesses = []
+    if previous is not None and previous.get("topology") == sysm.topology:
+        q = dict(zip(previous.system.unknowns, previous.p))
+        guesses.append(transfer_guess(sysm, previous, ln_Sc=q["ln_Sc"], ln_S1=q["ln_S1"], chi1=q["chi1"]))
+    prof = cap.profile()
+    on = prof["region"] == 0
+    S_p = float(prof["S"][on][np.nonzero(prof["P"][on] < 0)[0][0]])
+    w_edge = float(cap.Sc * cap.y[cap.system.rows(0), -1][0] / rho)  # the indenter point at the cap's edge
+    for a, b in _SECOND_ZONE_SPLITS:
+        S1 = b * cap.Sc
+        guesses.append(transfer_guess(sysm, cap, ln_Sc=math.log(a * S_p), ln_S1=math.log(S1), chi1=rho * w_edge / cap.Sc))
+    res = None
+    for guess in guesses:
+        res = solve_chain_from(sysm, guess, **kw)
+        if res.success and res.valid:
+            break
+    res.wall_time = time.perf_counter() - t0
+    return res
 
 
 def replace_invalid_cap(cap: Solution, *, tol=1e-6, max_nodes=10000, bc_tol=1e-10, previous=None):

@@ -20,12 +20,15 @@ CHAINS = {"cap": lambda L, contact: ch.cap_chain(EPS, L, contact),
           "point": lambda L, contact: ch.point_chain(1e-12, L),
           "cylinder": lambda L, contact: ch.cylinder_chain(EPS, L, contact),
           "wall_line": lambda L, contact: ch.cap_line_cylinder_chain(EPS, L, contact),
-          "wall_band": lambda L, contact: ch.cap_band_cylinder_chain(EPS, L, contact)}
+          "wall_band": lambda L, contact: ch.cap_band_cylinder_chain(EPS, L, contact),
+          "tip_line": lambda L, contact: ch.cap_line_tip_chain(EPS, L),
+          "tip_band": lambda L, contact: ch.cap_band_tip_chain(EPS, L)}
 CASES = [("cap", c, m) for c in ("smooth", "paper") for m in ("delta", "lambda0", "force", "arclength")] + \
         [(k, "smooth", m) for k in ("annulus", "line") for m in ("delta", "lambda0", "force")] + \
         [("point", "smooth", "delta")] + \
         [(k, c, m) for k in ("cylinder", "wall_line", "wall_band") for c in ("smooth", "paper")
-         for m in ("delta", "lambda0", "force", "arclength")]
+         for m in ("delta", "lambda0", "force", "arclength")] + \
+        [(k, "smooth", m) for k in ("tip_line", "tip_band") for m in ("delta", "lambda0", "force", "arclength")]
 ARC = (np.array([0.2, 1.0, 0.4]), np.array([0.6, 0.0, 0.8]), np.array([1.0, 0.5, 2.0]))
 
 
@@ -108,7 +111,8 @@ def test_states_equal_those_before_the_assembler(ref):
         return  # e.g. an annulus closing onto the pole: a degenerate state, its numbers are not reproducible
     for key in ("force", "delta", "lambda0", "Sc", "energy"):
         assert s[key] == pytest.approx(ref[key], rel=1e-10, abs=1e-14, nan_ok=True), key
-    assert s.get("S1", s.Sc) == pytest.approx(ref["S1"], rel=1e-10, abs=1e-14)
+    if ref["result_topology"] in ("line", "annulus"):  # (the file holds Sc for a cap: it had no S1)
+        assert s.S1 == pytest.approx(ref["S1"], rel=1e-10, abs=1e-14)
 
 
 def test_results_round_trip_through_pickle():

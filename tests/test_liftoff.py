@@ -240,3 +240,20 @@ def test_format_version_1_files_read_as_single_caps(tmp_path):
     back = sb.read_curve(path)
     assert list(back.topology) == ["cap", "cap"] and np.all(back.S1 == 0)
     np.testing.assert_array_equal(back.force, c.force)
+
+
+@pytest.mark.parametrize("delta", [0.33, 0.36])
+def test_a_cap_pressed_at_the_pole_and_pulling_further_out_splits_into_a_cap_and_a_line(delta):
+    """beta = 0.1: the cap presses at the pole but pulls near its edge, and neither a lifted
+    pole's line nor an annulus is valid; the contact splits into a smaller cap and, beyond a
+    lifted gap, a line on the tip where the cap's edge was (issue 12: two contact zones)."""
+    scene = sb.Scene.preset("base", beta=0.1)
+    cap = sb.solve(scene, delta=delta, topology="cap", estimate_error=False)
+    assert cap.success and not cap.valid and cap.pressure_min < 0
+    s = sb.solve(scene, delta=delta, tol=1e-8)
+    assert s.topology == "cap+line(tip)" and s.valid, s.flags
+    assert 0 < s.edge_S[0] < s.Sc < cap.Sc * 1.1 and s.curvature_excess < 0
+    assert s.pressure_min >= 0 and all(f > 0 for f in s.edge_forces)
+    slope, kinds = _energy_slope(scene, delta)
+    assert kinds == {"cap+line(tip)"}
+    assert abs(slope - s.force) < 1e-8 + 10 * s.force_error
