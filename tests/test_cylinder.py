@@ -227,3 +227,12 @@ def test_wide_indenter_on_a_hemisphere_to_delta_2_5():
     c = sb.curve(sb.Scene.preset("base", rho=0.6), delta_max=2.5)
     assert c.complete and np.all(c.valid), c.flags
     assert "cap+band(cylinder)" in set(c.topology)
+
+
+@pytest.mark.slow
+def test_fit_scene_with_thin_wall_to_the_geometric_limit():
+    """Issue 12's second scene: gamma 2.5, rho 1/3, beta 1e-3 to the upper end of delta_bounds."""
+    hi = sb.delta_bounds(SCENE, 1e-6)[1]
+    c = sb.curve(SCENE, delta_max=0.999 * hi, estimate_error=False)
+    assert c.complete and np.all(c.valid), c.flags
+    assert c.delta[-1] == pytest.approx(0.999 * hi)
