@@ -120,6 +120,19 @@ def _progress(enabled):
 MAX_POINTS = 100_000  # --points: each is a solve (~0.05-0.5 s); more is a typo, not a curve
 
 
+def _free_default_name(preset, force):
+    """Without -o: ``<preset>.h5``, or (it exists, no --force) the first free ``<preset>-N.h5``,
+    so that running the quick start twice neither fails nor replaces the first result."""
+    from pathlib import Path
+
+    name = Path(f"{preset}.h5")
+    n = 2
+    while not force and (name.exists() or Path(f"{name}.partial").exists()):
+        name = Path(f"{preset}-{n}.h5")
+        n += 1
+    return str(name)
+
+
 def _cmd_curve(args):
     import dataclasses
 
@@ -128,7 +141,7 @@ def _cmd_curve(args):
     from .io import write_curve
     from .paths import check_output_path, partial_path
 
-    out = check_output_path(args.output if args.output is not None else f"{args.preset}.h5",
+    out = check_output_path(args.output if args.output is not None else _free_default_name(args.preset, args.force),
                             overwrite=args.force)
     partial = partial_path(out)
     if partial.exists() and not args.force:
@@ -368,8 +381,11 @@ def _cmd_presets(args):
 
 
 def build_parser():
+    from .version import __version__
+
     p = _Parser(prog="shellbvp", description="Indentation of thin curved hyperelastic shells.")
     p.add_argument("-v", "--verbose", action="store_true", help="log progress (INFO)")
+    p.add_argument("--version", action="version", version=f"shellbvp {__version__}")
     sub = p.add_subparsers(dest="command", parser_class=_Parser)
     c = sub.add_parser("curve", help="compute a force-displacement curve into an HDF5 file")
     _scene_options(c)
@@ -381,7 +397,7 @@ def build_parser():
     c.add_argument("--profiles", action="store_true", help="store each point's profiles")
     c.add_argument("--radius", type=_number, help="rim radius R_L in m (with --muH: SI columns)")
     c.add_argument("--muH", type=_number, dest="mu_h", help="mu*H in N/m")
-    c.add_argument("-o", "--output", help="output file (default <preset>.h5)")
+    c.add_argument("-o", "--output", help="output file (default <preset>.h5, or <preset>-2.h5, ... if that exists)")
     c.add_argument("--force", action="store_true", help="replace an existing output file")
     c.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
     c.add_argument("--topology", choices=("auto", "cap"), default="auto",

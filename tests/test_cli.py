@@ -24,8 +24,12 @@ def test_curve_without_arguments_writes_base_h5(tmp_path):
     c = sb.read_curve(tmp_path / "base.h5")
     assert c.complete and c.delta[-1] == pytest.approx(0.5) and c.scene == sb.Scene.preset("base")
     assert r.stderr == ""  # no progress bar when not on a terminal
-    again = run("curve", cwd=tmp_path)
-    assert again.returncode == 2 and "exists" in again.stderr and "--force" in again.stderr
+    first = (tmp_path / "base.h5").read_bytes()
+    again = run(cwd=tmp_path)  # the quick start twice: a new name, the first result kept
+    assert again.returncode == 0 and "wrote base-2.h5" in again.stdout, again.stderr
+    assert (tmp_path / "base.h5").read_bytes() == first
+    taken = run("curve", "-o", "base.h5", cwd=tmp_path)  # a name given: never replaced without --force
+    assert taken.returncode == 2 and "exists" in taken.stderr and "--force" in taken.stderr
     info = run("info", "base.h5", cwd=tmp_path)
     assert info.returncode == 0 and "delta_max = 0.5 reached" in info.stdout and "gamma=1" in info.stdout
 
@@ -115,3 +119,11 @@ def test_json_runs_print_one_json_document_on_bad_input_too(argv, capsys):
     out = capsys.readouterr().out
     doc = json.loads(out)  # exactly one document: json.loads refuses trailing text
     assert code == 2 and doc["exit_status"] == 2 and doc["success"] is False and doc["message"]
+
+
+def test_version(capsys):
+    from shellbvp.cli import main
+
+    with pytest.raises(SystemExit) as exc:
+        main(["--version"])
+    assert exc.value.code == 0 and capsys.readouterr().out.strip() == f"shellbvp {sb.__version__}"
