@@ -286,6 +286,7 @@ class ChainBVP:
         self.model = mod = model if model is not None else scene.model()
         self.par = scene.parameters(mod)
         self.regions = chain.regions
+        self._bind()
         self.sizes = [SIZES[r.kind] for r in chain.regions]
         self.offsets = np.cumsum([0, *self.sizes])[:-1].tolist()
         self.n = int(sum(self.sizes))
@@ -327,11 +328,12 @@ class ChainBVP:
     # pickling: the generated module is code, not data; it is loaded again (from the code
     # cache) by the scene on unpickling, so results can travel between processes
     def __getstate__(self):
-        return {k: v for k, v in self.__dict__.items() if k != "model"}
+        return {k: v for k, v in self.__dict__.items() if k not in ("model", "_rhs_of", "_jac_of")}
 
     def __setstate__(self, state):
         self.__dict__.update(state)
         self.model = self.scene.model()
+        self._bind()
 
     # -- quantities -----------------------------------------------------------------------------
     def quantities(self, p) -> dict:
@@ -380,17 +382,25 @@ class ChainBVP:
     def L(self) -> float:
         return self.S_point(self.regions[-1].end, None)
 
+    def _bind(self):
+        """The regions' generated right-hand sides and Jacobians, looked up once (hot path)."""
+        self._rhs_of = [getattr(self.model, f"{r.kind}_rhs") for r in self.regions]
+        self._jac_of = [getattr(self.model, f"{r.kind}_jac") for r in self.regions]
+
     def _rhs(self, k):
-        return getattr(self.model, f"{self.regions[k].kind}_rhs")
+        return self._rhs_of[k]
 
     def _jac(self, k):
-        return getattr(self.model, f"{self.regions[k].kind}_jac")
+        return self._jac_of[k]
+
+    @staticmethod
+    def _prefix(kind):
+        """Generated names of cylinder edges carry ``cyl_`` (``junction_cyl_smooth_res``)."""
+        return "cyl_" if kind == "cylinder" else ""
 
     def _edge_function(self, j, what):
-        """junction_[cyl_]<model>_<what> or force_[cyl_]<what> of an edge's contact kind."""
-        prefix = "cyl_" if self.regions[j.kc].kind == "cylinder" else ""
-        return getattr(self.model, f"junction_{prefix}{j.model}_{what}" if what in ("res", "jac")
-                       else f"force_{prefix}{what[6:]}")
+        """junction_[cyl_]<model>_<what> of an edge, by its contact region's kind."""
+        return getattr(self.model, f"junction_{self._prefix(self.regions[j.kc].kind)}{j.model}_{what}")
 
     # -- ODE ------------------------------------------------------------------------------------
     def fun(self, t, y, p=None):
@@ -461,33 +471,36 @@ class ChainBVP:
             elif isinstance(j, Rim):
                 parts.append(mod.rim_res(self.S_point(self.regions[j.k].end, p), yb[self.rows(j.k)], par))
         if self.extra == "force":
-            S, yc, yf = self._force_args(ya, yb, p, q)
+            _, S, yc, yf, _, _ = self._force_args(ya, yb, p, q)
             parts.append(self._force_function("res")(S, yc, yf, q["delta"], q["F"], par))
         elif self.extra == "pole_stretch":
             parts.append([ya[self.rows(0)][_LS] - self.value])
         elif self.extra == "arclength":
-            S, yc, yf = self._force_args(ya, yb, p, q)
+            _, S, yc, yf, _, _ = self._force_args(ya, yb, p, q)
             force = 2 * np.pi * self._force_function("res")(S, yc, yf, q["delta"], 0.0, par)[0]
             X = np.array([q["delta"], q["lambda0"], force])
             parts.append([np.sum(self.arc_tangent * (X - self.arc_point) / self.arc_scale)])
         return np.concatenate(parts)
 
     def _line_function(self, j, what):
-        return getattr(self.model, f"junction_{'cyl_' if j.on == 'cylinder' else ''}smooth_{what}")
+        return getattr(self.model, f"junction_{self._prefix(j.on)}smooth_{what}")
 
     def _force_function(self, what):
+        """force_[cyl_]<what> at the last contact edge (F of the free region beyond it)."""
         j = self.force_at
-        if isinstance(j, Edge):
-            return self._edge_function(j, "force_" + what)
-        return getattr(self.model, f"force_{what}")
+        return getattr(self.model, f"force_{self._prefix(self.regions[j.kc].kind if isinstance(j, Edge) else '')}"
+                                   f"{what}")
 
     def _force_args(self, ya, yb, p, q):
+        """(point, S, yc, yf, free region, free state at its start?) of the force condition."""
         j = self.force_at
         if isinstance(j, Edge):
-            point, yc, yf, _, _ = self._edge_states(j, ya, yb)
+            point, yc, yf, _, f_at_a = self._edge_states(j, ya, yb)
+            kf = j.kf
         else:
             point, yc, _, yf = self._line_states(j, ya, yb, q)
-        return self.S_point(point, p), yc, yf
+            kf, f_at_a = j.k + 1, True
+        return point, self.S_point(point, p), yc, yf, kf, f_at_a
 
     def _add_p(self, P, rows, name, values):
         if name is not None and name in self.col:
@@ -554,12 +567,8 @@ class ChainBVP:
         if self.extra in ("force", "arclength"):
             w = 1.0 if self.extra == "force" else 2 * np.pi * self.arc_tangent[2] / self.arc_scale[2]
             F = q["F"] if self.extra == "force" else 0.0
-            j = self.force_at
-            S, yc, yf = self._force_args(ya, yb, p, q)
+            point, S, yc, yf, kf, f_at_a = self._force_args(ya, yb, p, q)
             fj = w * self._force_function("jac")(S, yc, yf, q["delta"], F, par)  # d/d(Sc, yf, F)
-            kf = j.kf if isinstance(j, Edge) else j.k + 1
-            f_at_a = isinstance(j, Line) or self._edge_states(j, ya, yb)[4]
-            point = self._edge_states(j, ya, yb)[0] if isinstance(j, Edge) else self.regions[j.k].end
             (A if f_at_a else B)[r, self.rows(kf)] = fj[0, 1:7]
             self._add_p(P, r, point.unknown, fj[0, 0] * S)
             if self.extra == "arclength":

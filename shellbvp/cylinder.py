@@ -31,6 +31,7 @@ import numpy as np
 
 from .chain import (
     ChainBVP,
+    TipEnd,
     cap_band_cylinder_chain,
     cap_line_cylinder_chain,
     cylinder_chain,
@@ -65,19 +66,15 @@ def make_wall_system(scene, topology, control, value, eps):
     return sysm
 
 
-def _cap_omega(cap):
-    csys = cap.system
-    return float(cap.Sc * cap.y[csys.rows(0), -1][0] / cap.scene.rho)
-
-
 def wall_contact_suspected(cap: Solution) -> bool:
     """A converged cap that passed the tip's end, or whose free shell passes through the
     indenter with its contact edge near the tip's end."""
     if cap.get("topology") != "cap" or cap.get("system") is None or cap.scene.model().OMEGA_MAX is None:
         return False
     passed = cap.get("status") == 4 and "end of the tip" in cap.get("message", "")
+    omega_max = cap.scene.tip_omega_max
     near = bool(cap.get("success") and cap.get("penetration", -1.0) > 0
-                and _cap_omega(cap) > NEAR_TIP_END * cap.scene.tip_omega_max)
+                and omega_max - cap.tip_end_margin > NEAR_TIP_END * omega_max)  # the edge's omega
     return passed or near
 
 
@@ -143,8 +140,7 @@ def transfer_guess(sysm: ChainBVP, source: Solution, n: int = 101, **unknowns):
             omega = np.maximum.accumulate(omega)
         elif not np.all(np.isfinite(omega)):
             omega = np.where(np.isfinite(omega), omega, sysm.model.OMEGA_MAX)
-        end = [j for j in sysm.junctions if type(j).__name__ == "TipEnd" and j.k == k]
-        if end:  # the tip contact must reach omega_max at S*
+        if any(isinstance(j, TipEnd) and j.k == k for j in sysm.junctions):  # reach omega_max at S*
             w_end = omega[-1]
             omega = omega * (sysm.model.OMEGA_MAX / w_end) ** ((S / S[-1]) ** 2)
         blocks.append(np.vstack([rho * omega / S, f["lambda_s"]]))

@@ -34,18 +34,9 @@ def _edges(sysm):
     return out
 
 
-def _at(sysm, k, S, y):
-    prof = getattr(sysm.model, f"{sysm.regions[k].kind}_profile")
-    return prof(np.array([S]), y[sysm.rows(k), None], sysm.par)
-
-
-def _at_kind(sysm, kind, S, y):
-    prof = getattr(sysm.model, f"{kind}_profile")
-    return prof(np.array([S]), y[:, None], sysm.par)
-
-
-def _omega_range(sysm, k, fields):
-    return float(np.min(fields["omega"])), float(np.max(fields["omega"]))
+def _at(sysm, kind, S, y):
+    """The generated profile of a ``kind`` region at one point S with state y."""
+    return getattr(sysm.model, f"{kind}_profile")(np.array([S]), y[:, None], sysm.par)
 
 
 def diagnose(sysm, bvp, tol, converged_note: str = "") -> Solution:
@@ -106,7 +97,8 @@ def diagnose(sysm, bvp, tol, converged_note: str = "") -> Solution:
     axial, normal = [], []
     for pt, inner, outer in edges:
         S = sysm.S_point(pt, p)
-        fi, fo = _at(sysm, inner, S, yb), _at(sysm, outer, S, ya)
+        fi = _at(sysm, sysm.regions[inner].kind, S, yb[sysm.rows(inner)])
+        fo = _at(sysm, sysm.regions[outer].kind, S, ya[sysm.rows(outer)])
         axial.append(2 * np.pi * float(fo["axial_force_2pi"][0] - fi["axial_force_2pi"][0]))
         normal.append(-2 * np.pi * float(fo["r"][0] * fo["Q"][0] - fi["r"][0] * fi["Q"][0]))
     res.ring_force = axial[-1] if axial else float(force)  # no edge: a point force
@@ -132,10 +124,10 @@ def diagnose(sysm, bvp, tol, converged_note: str = "") -> Solution:
 
     admissible, vflags = [], []
     omega_max = sysm.scene.tip_omega_max
-    on_tip = [_omega_range(sysm, k, f)[1] for k, f in contact if sysm.regions[k].kind == "contact"]
+    on_tip = [float(np.max(f["omega"])) for k, f in contact if sysm.regions[k].kind == "contact"]
     res.tip_end_margin = omega_max - max(on_tip) if on_tip else float("nan")  # < 0: past the tip's end
     for k, f in contact:
-        lo, hi = _omega_range(sysm, k, f)
+        lo, hi = float(np.min(f["omega"])), float(np.max(f["omega"]))
         if sysm.regions[k].kind == "contact" and hi > omega_max * (1 + 1e-9):
             admissible.append("the contact has passed the end of the tip (the indenter's cylinder)")
         if sysm.regions[k].kind == "cylinder" and lo < omega_max * (1 - 1e-9):
@@ -168,7 +160,7 @@ def diagnose(sysm, bvp, tol, converged_note: str = "") -> Solution:
             # (else it passes through it next to the line: the contact is a band)
             S = sysm.S_point(sysm.regions[j.k].end, p)
             yin = yb[sysm.rows(j.k)]
-            on = _at_kind(sysm, j.on, S, np.array([q["chi1"], yin[_LS]]))
+            on = _at(sysm, j.on, S, np.array([q["chi1"], yin[_LS]]))
             res.curvature_excess = float(yin[FREE_STATES.index("ks")] - on["kappa_s"][0])
             if res.curvature_excess > 10 * tol * max(1.0, abs(float(on["kappa_s"][0]))):
                 vflags.append(f"the shell bends more tightly than the indenter at the contact line "

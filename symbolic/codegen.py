@@ -128,7 +128,7 @@ def _function_source(spec: FunctionSpec) -> str:
 
 def function_specs(d: Derivation) -> list[FunctionSpec]:
     """Every function of a structure's module."""
-    from .equations import DELTA, FORCE, LAMBDA0, SC
+    from .equations import DELTA, FORCE, LAMBDA0
 
     par = tuple(d.params)
     specs = []
@@ -205,10 +205,6 @@ def function_specs(d: Derivation) -> list[FunctionSpec]:
             FunctionSpec(f"force_{prefix}jac", J, jargs, [("dres", J.jacobian([force_res], [Sc, *yf, FORCE]))],
                          f"Force control at a {where} edge: d/d(Sc, yf, F), (1, 8)."),
         ]
-        if not prefix:
-            specs.append(FunctionSpec("contact_line_forces", J, jargs,
-                                      [("ring", [d.ring_force]), ("cap", [d.cap_force])],
-                                      "Axial force of the ring at Sc (jump of Q) and of the pressure on the cap."))
     if d.has_cylinder:
         E, (SS, *ye) = d.tip_end, d.tip_end_inputs
         eargs = [("S_end", (SS,)), ("yt", tuple(ye[:2])), ("yw", tuple(ye[2:])), ("par", par)]

@@ -106,8 +106,8 @@ class Derivation:
         self.contact, self.contact_states, self.contact_rhs, self.contact_profile = self._contact_scaled(
             self.contact_phys, self.contact_phys_out)
         self._build_boundaries()
-        (self.junction, self.junction_inputs, self.junction_res, self.force_res, self.ring_force,
-         self.cap_force) = self._edge(self.contact, self.contact_profile, self.contact_phys_out)
+        (self.junction, self.junction_inputs, self.junction_res,
+         self.force_res) = self._edge(self.contact, self.contact_profile, self.contact_phys_out)
         # The indenter's cylinder r = rho A(omega_max): the same contact equations on the
         # continuation of the tip past its end (kappa_s = 0), its edge to a free region, and
         # the junction where the shell passes from the tip onto it.
@@ -116,8 +116,8 @@ class Derivation:
             self.cylinder_phys, self.cylinder_phys_out = self._contact_physical(cylinder_of(st.tip))
             self.cylinder, self.cylinder_states, self.cylinder_rhs, self.cylinder_profile = self._contact_scaled(
                 self.cylinder_phys, self.cylinder_phys_out)
-            (self.cyl_junction, self.cyl_junction_inputs, self.cyl_junction_res, self.cyl_force_res, _,
-             _) = self._edge(self.cylinder, self.cylinder_profile, self.cylinder_phys_out)
+            (self.cyl_junction, self.cyl_junction_inputs, self.cyl_junction_res,
+             self.cyl_force_res) = self._edge(self.cylinder, self.cylinder_profile, self.cylinder_phys_out)
             self._build_tip_end()
         self._build_geometry()
         self._build_point_load()
@@ -320,8 +320,10 @@ class Derivation:
     def _edge(self, contact: Program, contact_profile: dict, contact_out: dict):
         """Contact-line programs between a contact region (tip or cylinder) and a free one.
 
-        Returns ``(program, inputs (Sc, yc, yf), {model: residuals}, force residual,
-        ring force, cap force)``: contact end (chi_c, ls_c) and free start (suffix _f) at S = Sc.
+        Returns ``(program, inputs (Sc, yc, yf), {model: residuals}, force residual)``:
+        contact end (chi_c, ls_c) and free start (suffix _f) at S = Sc.  (Ring forces are
+        the jumps of the axial force across an edge, from the regions' profiles:
+        ``shellbvp.diagnosis``.)
         """
         sh = self.structure.shell
         yc = sp.symbols("chi_c ls_c")
@@ -347,10 +349,7 @@ class Derivation:
                                J.let("res_tau", of["tau_s"] - oc["tau_s"])],
         }
         force = J.let("res_F", of["axial_force_2pi"] - FORCE / (2 * sp.pi))
-        # Total axial force of the ring at the contact edge (Q jumps there) and of the cap.
-        ring = J.let("ring_force", 2 * sp.pi * (of["axial_force_2pi"] - oc["axial_force_2pi"]))
-        cap = J.let("cap_force", 2 * sp.pi * oc["axial_force_2pi"])
-        return J, (SC, *yc, *yf), res, force, ring, cap
+        return J, (SC, *yc, *yf), res, force
 
     def _build_tip_end(self):
         """Where the shell passes from the tip onto the cylinder, at an unknown S = S*.
