@@ -27,7 +27,9 @@ from .io import POINT_FIELDS, Curve, point_record
 from .liftoff import replace_invalid_cap
 from .pointload import SC_POINT, solve_point_load
 from .solution import Solution, default_eps, richardson_error, thin_mesh
-from .state import check_delta, check_tol, make_system, solve, solve_from, warm_guess
+from .corner import LEGENDRE_WATCH, edge_model, is_corner, limit_estimate, near_limit
+from .state import check_delta, check_tol, cross_convexity_limit, make_system, solve, solve_from, system_like, \
+    warm_guess
 from .version import __version__ as VERSION
 
 __all__ = ["curve"]
@@ -273,6 +275,11 @@ def _locate_switches(builder: _Builder, st):
         return (sol, -sol.curvature_excess) if sol.success and "curvature_excess" in sol else (None, None)
 
     for (k1, _, _, s1), (k2, _, _, s2) in zip(rows[:-1], rows[1:]):
+        c1, c2 = _cap_of(s1), _cap_of(s2)
+        if c1 is not None and c2 is not None and c1.success and c2.success \
+                and (edge_model(c1), edge_model(c2)) == ("smooth", "corner"):
+            switches.append(locate_corner_switch(c1, c2, st))
+            continue
         frm, to = s1.get("topology"), s2.get("topology")
         pair = {frm, to}
         if not (s1.get("valid") and s2.get("valid")) or frm == to:
@@ -304,6 +311,68 @@ def _locate_switches(builder: _Builder, st):
             continue
         best = _regula_falsi(e1.delta, f1, e1, e2.delta, f2, e2, solve_at)
         _add_switch(builder, st, switches, best, frm, to, k1, k2, criterion)
+
+
+def locate_corner_switch(smooth, corner, st, h=0.003):
+    """Where the corner takes over from the smooth cap, located from both sides.
+
+    From the smooth side: the depth where edge_legendre reaches 0 (quadratic through smooth
+    caps at delta* - h, - 2h, - 3h, delta* first estimated linearly); from the corner side:
+    where the jump of lambda_s at the edge reaches 0 (quadratic through three corner caps h
+    apart from the first found past the limit, stepping away from it: Newton does not
+    converge stepping from a corner towards the limit).  They agree when the corner grows
+    out of the smooth branch (a continuous switch); F and E extrapolated from each side give
+    their jumps at the switch.
+    """
+    kw = dict(tol=st["tol"], max_nodes=st["max_nodes"], bc_tol=st["bc_tol"])
+    sysm = system_like(smooth, "delta", 0.98 * smooth.delta, st["eps"])
+    d0 = limit_estimate(solve_from(sysm, warm_guess(sysm, smooth), **kw), smooth)
+    d0 = d0 if d0 is not None and smooth.delta < d0 < corner.delta else 0.5 * (smooth.delta + corner.delta)
+    lo = [smooth]
+    for d in sorted((d0 - k * h for k in (1, 2, 3)), key=lambda d: abs(d - smooth.delta)):
+        sysm = system_like(lo[-1], "delta", d, st["eps"])
+        s = solve_from(sysm, warm_guess(sysm, lo[-1]), **kw)
+        if s.success and edge_model(s) == "smooth":
+            lo.append(s)
+    lo = sorted(lo[1:], key=lambda s: s.delta)
+    first = cross_convexity_limit(lo[-1], lo[0] if len(lo) > 1 else None, d0 + h, eps=st["eps"], exact=False,
+                                  **kw) if lo else None
+    hi = [first] if first is not None and is_corner(first, st["tol"]) else []
+    for k in (1, 2):
+        if hi:
+            sysm = system_like(hi[-1], "delta", hi[0].delta + k * h, st["eps"])
+            s = solve_from(sysm, warm_guess(sysm, hi[-1]), **kw)
+            if is_corner(s, st["tol"]):
+                hi.append(s)
+
+    def root(states, key):
+        x = np.array([s.delta for s in states])
+        yv = np.array([s[key] for s in states])
+        c = np.polyfit(x, yv, min(2, len(x) - 1))
+        r = np.roots(c)
+        r = r[np.isreal(r)].real
+        return float(r[np.argmin(np.abs(r - d0))]) if r.size else math.nan
+
+    def value_at(states, key, d):
+        x = np.array([s.delta for s in states])
+        return float(np.polyval(np.polyfit(x, [s[key] for s in states], min(2, len(x) - 1)), d))
+
+    d_smooth = root(lo, "edge_legendre") if len(lo) >= 2 else math.nan
+    d_corner = root(hi, "edge_jump_ls") if len(hi) >= 2 else math.nan
+    d_star = d_smooth if math.isfinite(d_smooth) else d_corner
+    f_lo, f_hi, e_lo, e_hi = (value_at(states, key, d_star) if len(states) >= 2 else math.nan
+                              for key in ("force", "energy") for states in (lo, hi))
+    if not (math.isfinite(d_smooth) and math.isfinite(d_corner)):
+        kind = "not determined (the states either side of the limit did not converge)"
+    elif abs(d_smooth - d_corner) <= 1e-2 * d_star:
+        kind = "continuous: the corner grows from a zero jump at the convexity limit"
+    else:
+        kind = "first-order: the corner appears with a finite jump"
+    log.info("switch to the corner edge at delta = %.6g (%s)", d_star, kind)
+    return {"delta": d_star, "force": f_lo, "from": "cap", "to": "cap (corner edge)", "criterion": "edge_legendre",
+            "value": 0.0, "kind": kind, "delta_from_jump": d_corner, "force_jump": f_hi - f_lo,
+            "energy_jump": e_hi - e_lo,
+            "jump_ls_after": float(corner.edge_jump_ls)}
 
 
 def _wall_line_at(sol, st):
@@ -352,13 +421,17 @@ def _solve_at_delta(scene, delta, prev, prev2, settings):
     """Delta-controlled solve warm-started from prev with a secant predictor from prev2."""
     if prev.get("topology") == "point":
         return _step_from_point(scene, delta, prev, settings)
-    sysm = make_system(scene, "delta", delta, settings["eps"])
+    sysm = system_like(prev, "delta", delta, settings["eps"])
     guess = warm_guess(sysm, prev)
-    if prev2 is not None and prev2.delta != prev.delta and prev2.get("topology") != "point":
+    if prev2 is not None and prev2.delta != prev.delta and prev2.get("topology") != "point" \
+            and edge_model(prev2) == edge_model(prev):
         a = (delta - prev.delta) / (prev.delta - prev2.delta)
         guess = _secant(sysm, prev, prev2, a)
-    return solve_from(sysm, guess, tol=settings["tol"], max_nodes=_step_nodes(prev, settings),
-                      bc_tol=settings["bc_tol"])
+    kw = dict(tol=settings["tol"], max_nodes=_step_nodes(prev, settings), bc_tol=settings["bc_tol"])
+    sol = solve_from(sysm, guess, **kw)
+    if not sol.success and delta > prev.delta and near_limit(prev):
+        sol = cross_convexity_limit(prev, prev2, delta, eps=settings["eps"], **kw) or sol
+    return sol
 
 
 def _step_from_point(scene, delta, prev, settings):
@@ -471,6 +544,15 @@ def _wall_leg(scene, builder, st, last_cap, key, *, reason, deltas=None):
     raise _Stop(f"delta_max = {st['delta_max']:g} reached" if targets is None else "all requested deltas computed")
 
 
+def _cross(cur, prev, delta, st):
+    """The corner cap at ``delta`` past the smooth cap's convexity limit (or None)."""
+    sol = cross_convexity_limit(cur, prev, delta, eps=st["eps"], tol=st["tol"], max_nodes=_step_nodes(cur, st),
+                                bc_tol=st["bc_tol"], exact=False)
+    if sol is not None:
+        log.info("past the convexity limit near delta = %.6g: corner at the contact edge", cur.delta)
+    return sol
+
+
 def _land_on_delta_max(scene, cur, prev, builder, st, key):
     """Delta-controlled solve at delta_max from the current point; ends the curve on success."""
     sol = _solve_at_delta(scene, st["delta_max"], cur, prev, st)
@@ -549,10 +631,18 @@ def _adaptive(scene, builder: _Builder, settings):
             if ds < ds_min:
                 raise _Stop(f"no solution at delta_max = {st['delta_max']:g}: {sol.message}")
             continue
-        sysm = make_system(scene, "arclength", (Xhat, tangent, scale), st["eps"])
-        a = ds / max(norm, 1e-300)
-        guess = _secant(sysm, cur, prev, a)
-        sol = solve_from(sysm, guess, tol=st["tol"], max_nodes=_step_nodes(cur, st), bc_tol=st["bc_tol"])
+        sol = None
+        if near_limit(cur):  # past the convexity limit the smooth cap ends: the corner takes over
+            d_star = limit_estimate(prev, cur)
+            if d_star is None or Xhat[0] > d_star:
+                sol = _cross(cur, prev, Xhat[0], st)
+        if sol is None:
+            sysm = system_like(cur, "arclength", (Xhat, tangent, scale), st["eps"])
+            a = ds / max(norm, 1e-300)
+            guess = _secant(sysm, cur, prev, a)
+            sol = solve_from(sysm, guess, tol=st["tol"], max_nodes=_step_nodes(cur, st), bc_tol=st["bc_tol"])
+            if not sol.success and near_limit(cur):
+                sol = _cross(cur, prev, Xhat[0], st) or sol
         steps += 1
         if sol.success and sol.delta > st["delta_max"]:  # overshot: land from the current point
             steps += 1
@@ -581,8 +671,9 @@ def _adaptive(scene, builder: _Builder, settings):
             if ds < ds_min:
                 reason = sol.message if not sol.success else "the branch turned back to delta <= 0"
                 leg = cur.get("edge_legendre", float("nan"))
-                if leg < 0.05:
+                if leg < 0.05 and edge_model(cur) == "smooth":
                     reason = (f"the energy loses convexity at the contact edge (Legendre determinant at Sc+ "
                               f"down to {leg:.2g} of its mid-region value): the free region's equations "
-                              f"become singular there and the smooth single-cap branch ends ({reason})")
+                              f"become singular there, the smooth single-cap branch ends and no corner "
+                              f"state was found ({reason})")
                 raise _Stop(f"continuation failed near delta = {cur.delta:.6g}: {reason}")

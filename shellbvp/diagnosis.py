@@ -39,6 +39,45 @@ def _at(sysm, kind, S, y):
     return getattr(sysm.model, f"{kind}_profile")(np.array([S]), y[:, None], sysm.par)
 
 
+def _legendre_min(sysm, t, sol, p):
+    """(min, where) over every free region of the Legendre determinant det d(tau_s, M_s)/d(lambda_s,
+    kappa_s), relative to its median magnitude there (scale-free; < 0: U is not convex in
+    (lambda_s, kappa_s) there, the free equations are singular where it crosses 0)."""
+    best, where = math.inf, math.nan
+    y = sol(t)
+    for k, reg in enumerate(sysm.regions):
+        if reg.kind != "free":
+            continue
+        S = sysm.S(k, t, p)
+        det = sysm.model.free_legendre(S, y[sysm.rows(k)], sysm.par)[0]
+        scale = float(np.median(np.abs(det)))
+        if not scale > 0:
+            continue
+        i = int(np.argmin(det))
+        if det[i] / scale < best:
+            best, where = float(det[i] / scale), float(S[i])
+    return (best, where) if math.isfinite(best) else (math.nan, math.nan)
+
+
+def _edge_model(sysm) -> str:
+    """"corner" if any contact edge is a Weierstrass-Erdmann corner, else the edges' model."""
+    models = {j.model for j in sysm.junctions if isinstance(j, Edge)}
+    return "corner" if "corner" in models else (models.pop() if len(models) == 1 else "")
+
+
+def _edge_jumps(sysm, ya, yb, p):
+    """Jumps (free minus contact side) of lambda_s and kappa_s at the outermost contact edge."""
+    edges = [j for j in sysm.junctions if isinstance(j, Edge)]
+    if not edges:
+        return 0.0, 0.0
+    j = edges[-1]
+    S = sysm.S_point(sysm.regions[min(j.kc, j.kf)].end, p)
+    yc = yb[sysm.rows(j.kc)] if j.kc < j.kf else ya[sysm.rows(j.kc)]
+    yf = ya[sysm.rows(j.kf)] if j.kc < j.kf else yb[sysm.rows(j.kf)]
+    on = _at(sysm, sysm.regions[j.kc].kind, S, yc)
+    return (float(yf[_LS] - on["lambda_s"][0]), float(yf[FREE_STATES.index("ks")] - on["kappa_s"][0]))
+
+
 def diagnose(sysm, bvp, tol, converged_note: str = "") -> Solution:
     """The Solution of a solve_bvp run of ``sysm`` (a ChainBVP) with the model's checks.
 
@@ -88,6 +127,8 @@ def diagnose(sysm, bvp, tol, converged_note: str = "") -> Solution:
     set_status(res, bvp, flags, converged_note)
     if not finite:
         res.update(energy=nan, pressure_min=nan, penetration=nan, force_defect=nan, edge_legendre=nan,
+                   legendre_min=nan, legendre_min_S=nan, edge_jump_ls=nan, edge_jump_ks=nan,
+                   contact_edge=_edge_model(sysm),
                    ring_force=nan, ring_force_inner=nan, cap_force=nan, edge_forces=[], valid=False, flags=flags)
         return _without_iterate_numbers(res)
 
@@ -120,6 +161,9 @@ def diagnose(sysm, bvp, tol, converged_note: str = "") -> Solution:
     t_leg = np.array([0.0, 0.5])
     leg = mod.free_legendre(sysm.S(last, t_leg, p), bvp.sol(t_leg)[sysm.rows(last)], par)[0]
     res.edge_legendre = float(leg[0] / leg[1]) if leg[1] != 0 else nan
+    res.legendre_min, res.legendre_min_S = _legendre_min(sysm, t, bvp.sol, p)
+    res.contact_edge = _edge_model(sysm)
+    res.edge_jump_ls, res.edge_jump_ks = _edge_jumps(sysm, ya, yb, p)
     res.energy = sysm.energy(bvp.sol, bvp.x, p)
 
     admissible, vflags = [], []
@@ -152,6 +196,10 @@ def diagnose(sysm, bvp, tol, converged_note: str = "") -> Solution:
     for (pt, _, _), N in zip(edges, normal):
         if N < -scale:
             vflags.append(f"negative ring force ({N:.3g}) at the contact edge {pt.name}")
+    if res.legendre_min < 0:
+        vflags.append(f"the energy is not convex in (lambda_s, kappa_s) in the free region (Legendre "
+                      f"determinant {res.legendre_min:.3g} of its median at S = {res.legendre_min_S:.4g}): "
+                      f"not an energy minimum")
     if res.penetration > 10 * tol:
         vflags.append(f"the free shell passes through the indenter (by {res.penetration:.3g})")
     for j in sysm.junctions:
@@ -175,7 +223,8 @@ def diagnose(sysm, bvp, tol, converged_note: str = "") -> Solution:
 #: prescribed one (its ``y``, ``x`` and ``p`` stay: the last iterate, for inspection).
 STATE_NUMBERS = ("delta", "force", "lambda0", "Sc", "S1", "S_end", "energy", "ring_force", "ring_force_inner",
                  "cap_force", "pressure_min", "penetration", "wall_gap", "force_defect", "edge_legendre",
-                 "curvature_excess", "tip_end_margin")
+                 "curvature_excess", "tip_end_margin", "legendre_min", "legendre_min_S", "edge_jump_ls",
+                 "edge_jump_ks")
 
 
 def _without_iterate_numbers(res):

@@ -2,8 +2,9 @@
 (atomic writes, a documented self-describing layout).  The continuation
 algorithm (``shellbvp.continuation``) fills a Curve; this module owns its shape.
 
-Layout (format ``shellbvp-curve``, version 2; version 1 lacked topology, S1 and
-ring_force_inner, which read as a single cap)::
+Layout (format ``shellbvp-curve``, version 3; version 1 lacked topology, S1 and
+ring_force_inner, which read as a single cap; version 2 lacked legendre_min,
+contact_edge and edge_jump_ls/ks, which read as NaN and "")::
 
     /                       attrs: format, format_version, package_version, created (UTC ISO)
     /curve                  NXdata group; attrs:
@@ -20,7 +21,8 @@ ring_force_inner, which read as a single cap)::
     /curve/force            (n,) signal: indenter force / (mu H R_L)
     /curve/<field>          (n,) each of POINT_FIELDS, plus
                             energy_residual (dE/ddelta - F) and flags (strings);
-                            topology (strings: shellbvp.chain.CONFIGURATION_NAMES)
+                            topology (strings: shellbvp.chain.CONFIGURATION_NAMES),
+                            contact_edge (strings: smooth, corner or paper)
     /curve/profiles/point_<i>   optional (profiles=True): S, region, r, z, ... at the
                             mesh nodes of point i (see Solution.profile)
 
@@ -48,17 +50,22 @@ __all__ = ["Curve", "POINT_FIELDS", "CAP_FIELD_DEFAULTS", "point_record", "energ
            "read_curve", "FORMAT", "FORMAT_VERSION"]
 
 FORMAT = "shellbvp-curve"
-FORMAT_VERSION = 2
+FORMAT_VERSION = 3
 
 #: Per-point fields of a curve (arrays of the Curve and datasets of its HDF5 file).
 POINT_FIELDS = (
     "delta", "force", "lambda0", "Sc", "status", "valid", "max_residual", "nodes", "niter",
     "force_error", "delta_error", "energy", "ring_force", "cap_force", "pressure_min",
     "penetration", "force_defect", "edge_legendre", "wall_time", "topology", "S1", "ring_force_inner",
+    "legendre_min", "contact_edge", "edge_jump_ls", "edge_jump_ks",
 )
 #: Fields a single-cap state does not carry, with their cap values (also what files of
 #: format version 1, which predate them, read as).
 CAP_FIELD_DEFAULTS = {"topology": "cap", "S1": 0.0, "ring_force_inner": 0.0}
+#: Fields that files of format version 2 predate, with what they read as (not computed then).
+V2_FIELD_DEFAULTS = {"legendre_min": float("nan"), "contact_edge": "", "edge_jump_ls": float("nan"),
+                     "edge_jump_ks": float("nan")}
+_MISSING_FIELD_DEFAULTS = {**CAP_FIELD_DEFAULTS, **V2_FIELD_DEFAULTS}
 
 
 @dataclass
@@ -143,7 +150,7 @@ def energy_residual(delta, energy, force):
 
 def point_record(sol) -> dict:
     """One point of a curve from a Solution: every POINT_FIELDS value (cap defaults where absent)."""
-    row = {k: sol.get(k, CAP_FIELD_DEFAULTS.get(k, np.nan)) for k in POINT_FIELDS}
+    row = {k: sol.get(k, _MISSING_FIELD_DEFAULTS.get(k, np.nan)) for k in POINT_FIELDS}
     if row["topology"] == "point":
         row["S1"] = 0.0
     row["valid"] = bool(sol.get("valid", False))
@@ -253,11 +260,12 @@ def write_curve(curve, path, *, profiles=False, overwrite=False, units=None):
 def _missing_field(name, n):
     """A field added after format version 1, as an older (single-cap) file reads it."""
 
-    return np.full(n, CAP_FIELD_DEFAULTS[name], dtype=object if name == "topology" else float)
+    value = _MISSING_FIELD_DEFAULTS[name]
+    return np.full(n, value, dtype=object if isinstance(value, str) else float)
 
 
 #: Fields stored as strings; every other point field is numeric.
-_STRING_FIELDS = ("topology", "flags")
+_STRING_FIELDS = ("topology", "flags", "contact_edge")
 #: Integer-valued fields (an empty curve stores them as float).
 _INTEGER_FIELDS = ("status", "nodes", "niter")
 
@@ -346,11 +354,15 @@ def _points(g):
     for k in POINT_FIELDS:
         if k in g:
             points[k] = _field(g, k, n)
-        elif k in CAP_FIELD_DEFAULTS:
+        elif k in _MISSING_FIELD_DEFAULTS:
             points[k] = _missing_field(k, n)
         else:
             raise ValueError(f"dataset {k} missing")
     points["topology"] = np.asarray(points["topology"], dtype=str)
+    points["contact_edge"] = np.asarray(points["contact_edge"], dtype=str)
+    unknown = sorted(set(points["contact_edge"]) - {"", "smooth", "corner", "paper"})
+    if unknown:
+        raise ValueError(f"contact_edge must be one of smooth, corner, paper; got {str(unknown[0])!r}")
     unknown = sorted(set(points["topology"]) - set(CONFIGURATION_NAMES))
     if unknown:
         raise ValueError(f"topology must be one of {CONFIGURATION_NAMES}; got {str(unknown[0])!r}")

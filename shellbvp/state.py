@@ -15,6 +15,7 @@ import time
 import numpy as np
 
 from .chain import ChainBVP, cap_chain
+from .corner import edge_model, is_corner, limit_estimate, near_limit
 from .diagnosis import diagnose
 from .pointload import SC_POINT, solve_point_load
 from .solution import (
@@ -27,7 +28,7 @@ from .solution import (
     thin_mesh,
 )
 
-__all__ = ["solve", "solve_from", "make_system", "warm_guess", "delta_bounds", "check_delta", "check_tol",
+__all__ = ["solve", "solve_from", "make_system", "system_like", "cross_convexity_limit", "warm_guess", "delta_bounds", "check_delta", "check_tol",
            "TOPOLOGIES"]
 
 log = logging.getLogger(__name__)
@@ -74,11 +75,60 @@ def _run_bvp(sysm, guess, tol, max_nodes, bc_tol):
                          tol=tol, bc_tol=bc_tol, max_nodes=max_nodes)
 
 
-def make_system(scene, control, value, eps):
-    """The single-cap system (``shellbvp.chain.cap_chain``) of a scene, control and value."""
-    sysm = ChainBVP(scene, cap_chain(eps, scene.shell_length, scene.contact), control, value)
+def make_system(scene, control, value, eps, edge=None):
+    """The single-cap system (``shellbvp.chain.cap_chain``) of a scene, control and value;
+    ``edge`` ("smooth", "corner", "paper") defaults to the scene's contact model."""
+    sysm = ChainBVP(scene, cap_chain(eps, scene.shell_length, edge or scene.contact), control, value)
     attach_tip_table(sysm)
     return sysm
+
+
+def system_like(prev, control, value, eps):
+    """The cap system of ``prev``'s scene with ``prev``'s contact edge (smooth or corner)."""
+    return make_system(prev.scene, control, value, eps, edge_model(prev))
+
+
+def cross_convexity_limit(prev, prev2, delta, *, eps, tol, max_nodes, bc_tol, exact=True):
+    """The corner cap at ``delta`` from the smooth cap ``prev`` near its convexity limit
+    (``shellbvp.corner``), or None.
+
+    Newton started at the limit itself meets a singular Jacobian (the corner's two edge
+    conditions are dependent at zero jump), so the first corner state is solved a little
+    past the limit estimated from ``prev2``, ``prev``.  If ``delta`` is nearer, that state is
+    continued back to it when ``exact`` (before the limit that gives the smooth root again,
+    which is the state there), else returned as it is (a continuation takes any depth).
+    """
+    d_star = limit_estimate(prev2, prev)
+    gap = (d_star - prev.delta) if d_star is not None and d_star > prev.delta else 0.005
+    # Newton's basin around the corner seen from a smooth state is narrow and uneven: try a
+    # ladder of depths past the limit, nearest first
+    # ladder of depths past the limit, nearest first, from prev and then from prev2 (a smooth
+    # state further from the limit is often the better start)
+    ladder = sorted({max(delta, prev.delta + k * gap, prev.delta + 0.005) for k in (3, 6, 12)}
+                    | {max(delta, prev.delta + 0.02), max(delta, prev.delta + 0.04)})
+    starts = [s for s in (prev, prev2) if s is not None and s.get("success") and edge_model(s) == "smooth"]
+    sol = None
+    for d_far, start in ((d, s) for s in starts for d in ladder):
+        sysm = make_system(prev.scene, "delta", d_far, eps, "corner")
+        sol = solve_from(sysm, warm_guess(sysm, start), tol=tol, max_nodes=max_nodes, bc_tol=bc_tol)
+        if is_corner(sol, tol):
+            break
+    else:
+        return None
+    if not exact or d_far == delta:
+        return sol
+    step = d_far - delta  # back to delta in steps that shrink where Newton fails
+    while sol.delta > delta:
+        d = max(delta, sol.delta - step)
+        sysm = make_system(prev.scene, "delta", d, eps, "corner")
+        nxt = solve_from(sysm, warm_guess(sysm, sol), tol=tol, max_nodes=max_nodes, bc_tol=bc_tol)
+        if nxt.success:
+            sol = nxt
+        else:
+            step /= 2
+            if step < 1e-4 * (1 + delta):
+                return None
+    return sol if sol.success and sol.get("legendre_min", -1.0) > 0 else None
 
 
 def solve_from(sysm, guess, *, tol=1e-6, max_nodes=10000, bc_tol=None):
@@ -228,14 +278,17 @@ def solve(scene, *, delta=None, lambda0=None, force=None, tol=1e-6, max_nodes=10
         guess = None  # a point-load state has no cap to start from: cold start (it finds the limit again)
 
     t0 = time.perf_counter()
-    sysm = make_system(scene, control, value, eps)
     kw = dict(tol=tol, max_nodes=max_nodes, bc_tol=bc_tol)
     if guess is not None:
+        sysm = system_like(guess, control, value, eps)
         res = solve_from(sysm, warm_guess(sysm, guess), **kw)
+        if not res.success and control == "delta" and near_limit(guess):
+            res = cross_convexity_limit(guess, None, value, eps=eps, **kw) or res
+        sysm = res.system if res.success else sysm
     elif control == "delta":
-        res = _cold_delta(sysm, value, **kw)
+        res = _cold_delta(make_system(scene, control, value, eps), value, **kw)
     else:
-        res = _cold_other(scene, sysm, control, value, eps, **kw)
+        res = _cold_other(scene, make_system(scene, control, value, eps), control, value, eps, **kw)
     if (topology == "auto" or topology in _WALL) and res.get("topology") == "cap":
         res = _onto_wall(res, topology, kw)
     if topology in ("auto", "line", "annulus") and scene.contact == "smooth" and res.get("topology") == "cap" \
@@ -338,20 +391,23 @@ def _continue_in_delta(scene, eps, target, starts=(0.1, 0.05), **kw):
         return None
     up = target > d
     frac = min(0.5, abs(target - d) / d) if up else 0.3
+    before = None
     while d != target:
         nd = min(target, d * (1 + frac)) if up else max(target, d * (1 - frac))
         if res.get("topology") == "point":
             nxt = solve_point_load(scene, nd, tol=kw["tol"], max_nodes=kw["max_nodes"], guess=res)
         else:
-            sysm = make_system(scene, "delta", nd, eps)
+            sysm = system_like(res, "delta", nd, eps)
             nxt = solve_from(sysm, warm_guess(sysm, res), **kw)
+            if up and not nxt.success and near_limit(res):
+                nxt = cross_convexity_limit(res, before, nd, eps=eps, **kw) or nxt
             if not up and scene.contact == "smooth" and (not nxt.success or nxt.Sc < SC_POINT) \
                     and res.Sc < 1e-8:
                 # the cap is leaving double precision: continue with its point-load limit
                 point = solve_point_load(scene, nd, tol=kw["tol"], max_nodes=kw["max_nodes"], guess=res)
                 nxt = point if point.success else nxt
         if nxt.success:
-            res, d = nxt, nd
+            before, res, d = res, nxt, nd
             frac = min(1.5 * frac, 0.5)
         else:
             frac /= 2
@@ -393,10 +449,14 @@ def _cold_other(scene, sysm, control, value, eps, **kw):
         if nd > _MARCH_DELTA_MAX:
             return _failure(5, f"{control} = {value:g} was not reached on the branch for delta up to "
                                f"{d:.3g} ({key} there: {cur[key]:.4g})")
-        dsys = make_system(scene, "delta", nd, eps)
         # a point-load state has no cap to warm-start from: a cold solve finds the cap or the limit again
-        nxt = _cold_delta(dsys, nd, **lk) if cur.get("topology") == "point" else solve_from(
-            dsys, warm_guess(dsys, cur), **lk)
+        if cur.get("topology") == "point":
+            nxt = _cold_delta(make_system(scene, "delta", nd, eps), nd, **lk)
+        else:
+            dsys = system_like(cur, "delta", nd, eps)
+            nxt = solve_from(dsys, warm_guess(dsys, cur), **lk)
+            if not nxt.success and near_limit(cur):
+                nxt = cross_convexity_limit(cur, prev, nd, eps=eps, **lk) or nxt
         if nxt.success:
             prev, cur, d = cur, nxt, nd
             step = min(1.5 * step, 0.05)
@@ -409,4 +469,5 @@ def _cold_other(scene, sysm, control, value, eps, **kw):
                 return _failure(5, f"continuation in delta towards {control} = {value:g} stalled at "
                                    f"delta = {d:.3g}")
     start = min((prev, cur), key=lambda s: abs(s[key] - value))
+    sysm = system_like(start, control, value, eps)
     return solve_from(sysm, warm_guess(sysm, start), **kw)

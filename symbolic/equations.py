@@ -342,11 +342,23 @@ class Derivation:
             J.let("res_phi", phiS_f - oc["phi"] / SC),
             J.let("res_z", z_f - (z_tip + oc["z"])),
         ]
+        # Weierstrass-Erdmann corner: lambda_s and kappa_s may jump.  Sliding the edge's material
+        # along the indenter (whose meridional curvature kappa_s^c turns phi with it) gives
+        # [tau_s] + kappa_s^c [M_s] = 0; moving the edge gives the Eshelby condition
+        # [lambda_s dU/dlambda_s - U] = 0 (R Psi continuous).  Both hold at continuity too:
+        # only a state with a jump is a corner (there the two rows are independent).
+        U_c = contact_out["U"].xreplace(cmap)
+        U_f = self.free_phys_out["U"].xreplace(fmap)
+        H_c = J.let("H_c", yc[1] * J.derivative(U_c, yc[1]) - U_c)
+        H_f = J.let("H_f", ls_f * J.derivative(U_f, ls_f) - U_f)
         res = {
             "smooth": common + [J.let("res_ls", ls_f - oc["lambda_s"]),
                                 J.let("res_ks", ks_f - oc["kappa_s"])],
             "paper": common + [J.let("res_Q", rQ_f - contact_out["rQ"].xreplace(cmap)),
                                J.let("res_tau", of["tau_s"] - oc["tau_s"])],
+            "corner": common + [J.let("res_slide", of["tau_s"] - oc["tau_s"]
+                                      + oc["kappa_s"] * (of["M_s"] - oc["M_s"])),
+                                J.let("res_H", H_f - H_c)],
         }
         force = J.let("res_F", of["axial_force_2pi"] - FORCE / (2 * sp.pi))
         return J, (SC, *yc, *yf), res, force
