@@ -20,14 +20,17 @@ import shellbvp as sb
 from shellbvp.fitting import example_data_path
 from shellbvp.plotting import plot_fit
 
-scene = sb.Scene.preset("fit")                      # gamma 2.5, rho 1/3, beta 0.01, Mooney-Rivlin 0.1
-d, F = sb.read_force_csv(example_data_path())       # SI: m and N (the header says mm and mN)
-res = sb.fit(scene, d, F, R_L=0.3e-3)               # about 3 s: one model curve
-print(f"mu*H = {res.mu_H:.4g} N/m, 95 % CI [{res.mu_H_ci95[0]:.4g}, {res.mu_H_ci95[1]:.4g}]")
-print(f"contact point {res.offset * 1e3:.4g} mm, rms residual {res.residual_rms * 1e3:.3g} mN")
+scene = sb.Scene.preset("fit")   # gamma 2.5, rho 1/3, beta 0.01, Mooney-Rivlin 0.1
+d, F = sb.read_force_csv(example_data_path())   # SI: m and N (the file: mm, mN)
+res = sb.fit(scene, d, F, R_L=0.3e-3)           # about 3 s: one model curve
+lo, hi = res.mu_H_ci95
+print(f"mu*H = {res.mu_H:.4g} N/m, 95 % CI [{lo:.4g}, {hi:.4g}]")
+print(f"contact point {res.offset * 1e3:.4g} mm, "
+      f"rms residual {res.residual_rms * 1e3:.3g} mN")
 
 fig, ax = plt.subplots(figsize=(6, 4.2))
 plot_fit(res, d, F, ax=ax)
-ax.set_title("synthetic Lepidium-like record (true mu*H = 52 N/m)", fontsize=9)
+ax.set_title("synthetic Lepidium-like record (true mu*H = 52 N/m)",
+             fontsize=9)
 fig.tight_layout()
 plt.show()

@@ -10,11 +10,11 @@ from pathlib import Path
 
 import matplotlib.pyplot as plt
 
-# benchmarks/ is not part of the installed package: find it from this file (docs/examples/).
+# benchmarks/ is not in the installed package: found from this file (docs/examples/)
 try:
     HERE = Path(__file__).resolve().parent
-except NameError:  # run by hand in an interactive session
-    HERE = Path.cwd()
+except NameError:  # pasted into an interactive session
+    HERE = Path.cwd() / "docs" / "examples"   # from the repository root
 sys.path.insert(0, str(HERE.parents[1] / "benchmarks"))
 
 import paper_figures  # noqa: E402
