@@ -45,7 +45,6 @@ extensions = [
 source_suffix = {".rst": "restructuredtext", ".md": "markdown"}
 exclude_patterns = ["_build", "auto_examples/*.ipynb", "auto_examples/*.py", "auto_examples/*.zip",
                     "auto_examples/*.md5", "auto_examples/*.codeobj.json"]
-templates_path = ["_templates"]
 html_static_path = []
 html_theme = "alabaster"
 html_theme_options = {"description": "Indentation of thin curved hyperelastic shells",
