@@ -77,7 +77,40 @@ def fit_figure(plt):
                  f"[{res.mu_H_ci95[0]:.3g}, {res.mu_H_ci95[1]:.3g}] N/m (true 52; {res.weights} weights)",
                  fontsize=8)
     fig.tight_layout()
-    fig.savefig(OUT / "fit.png", dpi=120)
+    return fig
+
+
+def make_figure(name, fam=None):
+    """The figure ``name`` (one of FIGURES) as a matplotlib Figure; also used by the docs' gallery."""
+    plt = require_matplotlib()
+    fam = families() if fam is None else fam
+    if name == "beta_xi":
+        fig, axes = plt.subplots(1, 2, figsize=(11, 4.2))
+        for ax, xi in zip(axes, (0, 1)):
+            family(ax, fam[f"beta_xi{xi}"], f"varying beta, xi = {xi}")
+    elif name == "rho":
+        fig, ax = plt.subplots(figsize=(6, 4.2))
+        family(ax, fam["rho"], "varying rho")
+    elif name == "gamma":
+        fig, ax = plt.subplots(figsize=(6, 4.2))
+        family(ax, fam["gamma"], "varying gamma")
+    elif name == "material":
+        fig, axes = plt.subplots(1, 2, figsize=(11, 4.2))
+        family(axes[0], fam["alpha"], "varying Mooney-Rivlin alpha")
+        family(axes[1], fam["gent"], "varying Gent Jm")
+    elif name == "profiles":
+        fig, axes = plt.subplots(1, 2, figsize=(11, 5))
+        plot_profiles(sb.Scene.preset("prolate2"), [0.1, 0.3, 0.5], ax=axes[0])
+        plot_profiles(sb.Scene.preset("dome"), [0.1, 0.3, 0.5], ax=axes[1])
+    elif name == "hemisphere_beta01":
+        fig, ax = plt.subplots(figsize=(6, 4.2))
+        family(ax, fam["hemisphere_beta01"], "shell on the hemisphere (paper: vs membrane)")
+    elif name == "fit":
+        return fit_figure(plt)
+    else:
+        raise ValueError(f"unknown figure {name!r}; choose from {FIGURES}")
+    fig.tight_layout()
+    return fig
 
 
 def main():
@@ -91,48 +124,9 @@ def main():
     OUT.mkdir(exist_ok=True)
     t0 = time.perf_counter()
     fam = families()
-
-    if "beta_xi" in only:
-        fig, axes = plt.subplots(1, 2, figsize=(11, 4.2))
-        for ax, xi in zip(axes, (0, 1)):
-            family(ax, fam[f"beta_xi{xi}"], f"varying beta, xi = {xi}")
-        fig.tight_layout()
-        fig.savefig(OUT / "beta_xi.png", dpi=120)
-
-    if "rho" in only:
-        fig, ax = plt.subplots(figsize=(6, 4.2))
-        family(ax, fam["rho"], "varying rho")
-        fig.tight_layout()
-        fig.savefig(OUT / "rho.png", dpi=120)
-
-    if "gamma" in only:
-        fig, ax = plt.subplots(figsize=(6, 4.2))
-        family(ax, fam["gamma"], "varying gamma")
-        fig.tight_layout()
-        fig.savefig(OUT / "gamma.png", dpi=120)
-
-    if "material" in only:
-        fig, axes = plt.subplots(1, 2, figsize=(11, 4.2))
-        family(axes[0], fam["alpha"], "varying Mooney-Rivlin alpha")
-        family(axes[1], fam["gent"], "varying Gent Jm")
-        fig.tight_layout()
-        fig.savefig(OUT / "material.png", dpi=120)
-
-    if "profiles" in only:
-        fig, axes = plt.subplots(1, 2, figsize=(11, 5))
-        plot_profiles(sb.Scene.preset("prolate2"), [0.1, 0.3, 0.5], ax=axes[0])
-        plot_profiles(sb.Scene.preset("dome"), [0.1, 0.3, 0.5], ax=axes[1])
-        fig.tight_layout()
-        fig.savefig(OUT / "profiles.png", dpi=120)
-
-    if "hemisphere_beta01" in only:
-        fig, ax = plt.subplots(figsize=(6, 4.2))
-        family(ax, fam["hemisphere_beta01"], "shell on the hemisphere (paper: vs membrane)")
-        fig.tight_layout()
-        fig.savefig(OUT / "hemisphere_beta01.png", dpi=120)
-
-    if "fit" in only:
-        fit_figure(plt)
+    for name in FIGURES:
+        if name in only:
+            make_figure(name, fam).savefig(OUT / f"{name}.png", dpi=120)
     plt.close("all")
     print(f"figures in {OUT} ({time.perf_counter() - t0:.0f} s)")
 

@@ -654,7 +654,7 @@ def markdown(data):
 
 
 def summary(data):
-    """The compact table for the README: every preset's natural-continuation curve against tol,
+    """The compact table for docs/benchmarking.md: every preset's natural-continuation curve against tol,
     the shooting peer at equal error, and the targets."""
     m = data["meta"]
     tols = sorted({r["tol"] for p in data["presets"].values() for r in p["natural"]}, reverse=True)

@@ -61,10 +61,12 @@ def curve(scene, delta_max: float = 0.5, *, deltas=None, force_max=None, lambda0
         Further stopping rules.  The curve also stops when the contact reaches
         the end of the tip (the indenter's cylinder).
     max_steps : int
+        Largest number of continuation steps.
     delta_start, delta_min : float, optional
         First point (default ``min(0.05, delta_max/4)``) and the end of the
         small-delta leg (default ``delta_max/100``).
-    tol, max_nodes : solve_bvp settings for every point.
+    tol, max_nodes : float, int
+        solve_bvp settings for every point (see :func:`solve`).
     ds_max : float, optional
         Largest arclength step in (delta, lambda0, F) (default ``delta_max/10``).
     estimate_error : bool
@@ -80,6 +82,20 @@ def curve(scene, delta_max: float = 0.5, *, deltas=None, force_max=None, lambda0
     Returns
     -------
     Curve
+        The points found, in the order computed; ``complete``, ``stop_reason``
+        say why the curve ended (it is returned, not raised, when the
+        continuation fails or is interrupted).
+
+    Examples
+    --------
+    >>> import shellbvp as sb
+    >>> c = sb.curve(sb.Scene.preset("base"), deltas=[0.1, 0.2], estimate_error=False)
+    >>> len(c), c.complete, c.stop_reason
+    (2, True, 'all requested deltas computed')
+    >>> print(", ".join(f"{f:.4f}" for f in c.force))
+    0.1505, 0.3639
+    >>> c.topology_summary()
+    'line x1, cap x1 (switch line -> cap at delta = 0.113089)'
     """
     _check_positive("delta_max", delta_max)
     check_tol(tol)

@@ -17,11 +17,18 @@ class Spheroid:
     """Built-in reference shell ``R = sin S``, ``Z = -gamma cos S``, ``L = pi/2``.
 
     gamma is a run-time parameter of the scene (``Scene.gamma``).
+
+    Examples
+    --------
+    >>> import shellbvp as sb
+    >>> sb.Scene(gamma=2.0, shell=sb.Spheroid()) == sb.Scene.preset("prolate2")
+    True
     """
 
     kind = "spheroid"
 
     def description(self):
+        """The structural choice, as files store it."""
         return {"kind": "spheroid"}
 
     def pole_curvature(self, values):
@@ -39,12 +46,22 @@ class Spheroid:
 
 
 class SphereTip:
-    """Built-in spherical tip ``A = sin omega``, ``B = 1 - cos omega`` (radius rho)."""
+    """Built-in spherical tip ``A = sin omega``, ``B = 1 - cos omega`` (radius rho).
+
+    It ends at omega = pi/2, where it joins the indenter's cylinder r = rho.
+
+    Examples
+    --------
+    >>> import shellbvp as sb
+    >>> sb.SphereTip().apex_curvature(), sb.SphereTip().omega_max
+    (1.0, 1.5707963267948966)
+    """
 
     kind = "sphere"
     omega_max = 1.5707963267948966  # pi/2: the sphere meets its cylinder
 
     def description(self):
+        """The structural choice, as files store it."""
         return {"kind": "sphere"}
 
     def apex_curvature(self):
@@ -64,8 +81,24 @@ class SphereTip:
 class UserShell:
     """Reference meridian ``R(S), Z(S)``, ``0 <= S <= L`` (formulas in S).
 
-    Rescaled so that ``R(L) = 1``, ``Z(L) = 0``.  Example:
-    ``UserShell("sin(S)", "-2*cos(S)", "pi/2")`` is the gamma = 2 spheroid.
+    Rescaled so that ``R(L) = 1``, ``Z(L) = 0``.  The formulas are parsed by a
+    whitelist (numbers, ``S``, ``pi``, arithmetic, elementary functions), never
+    evaluated as code.
+
+    Parameters
+    ----------
+    R, Z : str
+        The reference meridian, with ``R(0) = 0`` and ``Z'(0) = 0``.
+    L : str
+        The end of the meridian (the rim).
+
+    Examples
+    --------
+    >>> import shellbvp as sb
+    >>> shell = sb.UserShell("sin(S)", "-2*cos(S)", "pi/2")     # the gamma = 2 spheroid
+    >>> shell.pole_curvature({})
+    2.0
+    >>> scene = sb.Scene.preset("base", shell=shell)            # code is generated for it
     """
 
     kind = "user"
@@ -87,9 +120,11 @@ class UserShell:
         self._pole_kt = float(pole_kt)
 
     def description(self):
+        """The formulas as plain text (what files store)."""
         return dict(self._desc)
 
     def pole_curvature(self, values):
+        """kappa_theta^R at the pole (after rescaling)."""
         return self._pole_kt
 
     def __repr__(self):
@@ -103,7 +138,23 @@ class UserShell:
 
 
 class UserTip:
-    """Indenter tip ``r = rho A(omega)``, ``z = z_tip + rho B(omega)`` (formulas in omega)."""
+    """Indenter tip ``r = rho A(omega)``, ``z = z_tip + rho B(omega)`` (formulas in omega).
+
+    The tip ends where ``A'`` first vanishes (it joins the cylinder r = rho
+    there).  Formulas are parsed by a whitelist, never evaluated as code.
+
+    Parameters
+    ----------
+    A, B : str
+        With ``A(0) = B(0) = B'(0) = 0`` and a convex apex (``B''(0)/A'(0)^2 > 0``).
+
+    Examples
+    --------
+    >>> import shellbvp as sb
+    >>> tip = sb.UserTip("omega", "omega**2/2")                 # a paraboloid
+    >>> tip.apex_curvature()
+    1.0
+    """
 
     kind = "user"
 
@@ -131,9 +182,11 @@ class UserTip:
         self.omega_max = float(end) if end is not None else 2 * math.pi
 
     def description(self):
+        """The formulas as plain text (what files store)."""
         return dict(self._desc)
 
     def apex_curvature(self):
+        """B''(0)/A'(0)^2 in units of 1/rho."""
         return self._apex
 
     def __repr__(self):

@@ -92,6 +92,17 @@ class Curve:
         Solver and continuation settings.
     solutions : list of Solution
         In memory only (profiles); not stored unless ``to_hdf5(profiles=True)``.
+
+    Examples
+    --------
+    >>> import os, tempfile, shellbvp as sb
+    >>> c = sb.curve(sb.Scene.preset("base"), deltas=[0.1, 0.2], estimate_error=False)
+    >>> c.summary()
+    '2 points, delta 0.1..0.2, F 0.1505..0.3639, 2 valid; stopped: all requested deltas computed'
+    >>> path = os.path.join(tempfile.mkdtemp(), "base.h5")
+    >>> c.to_hdf5(path, units={"R_L": 0.3e-3, "mu_H": 52.0})    # SI columns too
+    >>> sb.read_curve(path).summary() == c.summary()
+    True
     """
 
     scene: object
@@ -115,6 +126,7 @@ class Curve:
 
     @property
     def energy_residual(self):
+        """``dE/ddelta - F`` at each point (see the class docstring)."""
         return energy_residual(self.points["delta"], self.points["energy"], self.points["force"])
 
     def to_hdf5(self, path, *, profiles: bool = False, overwrite: bool = False, units=None):
@@ -131,6 +143,7 @@ class Curve:
         return ", ".join(runs) + (f" (switch {where})" if where else "")
 
     def summary(self) -> str:
+        """One line: points, ranges of delta and F, valid points, why it stopped."""
         n = len(self)
         if n == 0:
             return f"0 points ({self.stop_reason})"
@@ -381,11 +394,34 @@ def _check_settings(settings):
 
 
 def read_curve(path):
-    """Read a curve written by :func:`write_curve`.
+    """Read a curve written by :func:`write_curve` (``Curve.to_hdf5``, ``shellbvp curve``).
 
-    Raises ``ValueError`` with a one-line reason for a missing, corrupt or
-    foreign file, naming the attribute or dataset that is missing or malformed
-    (every point field a 1-D array of one number, or string, per delta).
+    Parameters
+    ----------
+    path : str or Path
+        An HDF5 curve file (format ``shellbvp-curve``, versions 1 and 2), or a
+        ``.partial`` checkpoint of a running curve.
+
+    Returns
+    -------
+    Curve
+        With its scene rebuilt exactly (user formulas parsed, never evaluated).
+
+    Raises
+    ------
+    ValueError
+        With a one-line reason for a missing, corrupt or foreign file, naming
+        the attribute or dataset that is missing or malformed (every point
+        field a 1-D array of one number, or string, per delta).
+
+    Examples
+    --------
+    >>> import os, tempfile, shellbvp as sb
+    >>> path = os.path.join(tempfile.mkdtemp(), "base.h5")
+    >>> sb.curve(sb.Scene.preset("base"), deltas=[0.2], estimate_error=False).to_hdf5(path)
+    >>> c = sb.read_curve(path)
+    >>> c.scene == sb.Scene.preset("base"), round(float(c.force[0]), 4)
+    (True, 0.3639)
     """
     import h5py
 

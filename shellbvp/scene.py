@@ -52,6 +52,28 @@ class Scene:
         Contact-line conditions: variational (default) or the paper's eq. jumpeqns2.
     shell, tip : optional
         ``UserShell(R, Z, L)`` / ``UserTip(A, B)``; default spheroid and sphere.
+
+    Raises
+    ------
+    ValueError
+        Naming the parameter and its valid range.
+
+    See Also
+    --------
+    Scene.preset : the paper's scenes by name (:data:`PRESETS`).
+
+    Examples
+    --------
+    >>> import shellbvp as sb
+    >>> scene = sb.Scene(gamma=2.5, rho=1/3, beta=0.01, material=sb.MooneyRivlin(alpha=0.1))
+    >>> scene == sb.Scene.preset("fit")
+    True
+    >>> scene.replace(contact="paper").contact
+    'paper'
+    >>> sb.Scene(rho=0)
+    Traceback (most recent call last):
+    ...
+    ValueError: rho (indenter radius / rim radius) must be > 0; got 0
     """
 
     gamma: float = 1.0
@@ -98,7 +120,24 @@ class Scene:
     # -- presets -----------------------------------------------------------------
     @classmethod
     def preset(cls, name: str, **overrides) -> "Scene":
-        """A scene of the paper (SPEC section 6), with optional overrides."""
+        """A scene of the paper by name (:data:`PRESETS`), with optional overrides.
+
+        Parameters
+        ----------
+        name : str
+            ``base``, ``base-xi0``, ``prolate2``, ``fit``, ``flat``, ``gent1`` or ``dome``
+            (``shellbvp presets`` lists them).
+        **overrides
+            Any field of :class:`Scene`.
+
+        Examples
+        --------
+        >>> from shellbvp import Scene, Gent
+        >>> Scene.preset("dome").gamma
+        -1.0
+        >>> Scene.preset("base", material=Gent(Jm=97.2), contact="paper").material
+        Gent(Jm=97.2)
+        """
         if name not in PRESETS:
             raise ValueError(f"unknown preset {name!r}; choose one of {sorted(PRESETS)}")
         base = dict(PRESETS[name]["scene"])
@@ -106,6 +145,7 @@ class Scene:
         return cls(**base)
 
     def replace(self, **changes) -> "Scene":
+        """A copy with some fields changed (validated again)."""
         return replace(self, **changes)
 
     # -- serialisation -------------------------------------------------------------
@@ -172,6 +212,7 @@ class Scene:
                    contact=field(d, "contact", text, ""), shell=shell, tip=tip)
 
     def to_json(self) -> str:
+        """:meth:`to_dict` as a JSON string (sorted keys)."""
         import json
 
         return json.dumps(self.to_dict(), sort_keys=True)
@@ -210,6 +251,8 @@ class Scene:
         return float(self.shell.geometry.L)
 
 
+#: The paper's scenes by name: ``{name: {"doc": description, "scene": Scene fields}}``
+#: (``Scene.preset(name)``; ``shellbvp presets`` lists them).
 PRESETS = {
     "base": {"doc": "paper's base case: hemisphere, rho 0.2, beta 0.01, Mooney-Rivlin 0.1, xi 1",
              "scene": dict(gamma=1.0, rho=0.2, beta=0.01, material=MooneyRivlin(0.1), xi=1)},

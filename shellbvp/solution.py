@@ -16,6 +16,7 @@ __all__ = ["STATUS_MESSAGES", "Solution", "solve_bvp", "set_status", "thin_mesh"
            "penetration", "wall_gap", "attach_tip_table", "default_eps"]
 
 
+#: What each ``Solution.status`` means and what to try: ``{status: message}``.
 STATUS_MESSAGES = {
     0: "converged",
     1: "the maximum number of mesh nodes was exceeded: raise max_nodes or loosen tol, or start "
@@ -108,6 +109,12 @@ class Solution(dict):
     message : str
     delta, force, lambda0, Sc : float
         Pole displacement, indenter force F (> 0 pushing), pole stretch, contact circle.
+    topology : str
+        The contact configuration (``"cap"``, ``"point"``, ``"line"``, ``"annulus"``,
+        ``"cap+line(tip)"``, ``"cap+line(cylinder)"``, ``"cap+band(cylinder)"``,
+        ``"cap+cylinder"``; ``shellbvp.chain``).
+    S1 : float
+        Where the contact starts (0 when it reaches the pole; a lifted pole's first edge).
     x, y, p, sol, rms_residuals, niter
         solve_bvp's mesh on t in [0, 1], stacked states (8, m) (layout in
         ``shellbvp.chain``), unknown parameters, interpolant, residuals, iterations.
@@ -132,11 +139,22 @@ class Solution(dict):
     flags : list of str
         Why the state is not valid (empty when valid).
     force_defect : float
-        max |F(S) - F| over the free region (F is a first integral there).
+        ``max |F(S) - F|`` over the free region (F is a first integral there).
     force_error, delta_error : float
         Richardson error estimates (halved mesh; NaN if not estimated).
     wall_time : float
         Seconds.
+
+    Examples
+    --------
+    >>> import shellbvp as sb
+    >>> sol = sb.solve(sb.Scene.preset("base"), delta=0.2)
+    >>> sol.success, sol.status, sol.message, sol.topology
+    (True, 0, 'converged', 'cap')
+    >>> print(f"F = {sol.force:.4f}, lambda0 = {sol.lambda0:.4f}, valid: {sol.valid}")
+    F = 0.3639, lambda0 = 1.0010, valid: True
+    >>> sol.force_error < 1e-6                  # Richardson estimate
+    True
     """
 
     def __getattr__(self, name):
@@ -156,13 +174,29 @@ class Solution(dict):
     def profile(self, points_per_interval: int = 1):
         """Physical fields over S, pole to rim.
 
-        Returns a dict of 1-D arrays: ``S`` (increasing), ``region`` (0 on the indenter,
-        1 free; a lifted pole's free cap comes first), ``r``, ``z``,
-        ``phi``, ``lambda_s``, ``lambda_theta``, ``kappa_s``, ``kappa_theta``, ``T_s``,
-        ``T_theta``, ``M_s``, ``M_theta``, ``tau_s``, ``tau_theta``, ``Q``, ``P``,
-        ``axial_force`` (F(S), the axial force carried across the circle S), ``energy_density``.
-        For a point-load state (``topology == "point"``) there is no contact region.
-        ``points_per_interval > 1`` adds points between mesh nodes (from the interpolant).
+        Parameters
+        ----------
+        points_per_interval : int
+            ``> 1`` adds points between mesh nodes (from the interpolant).
+
+        Returns
+        -------
+        dict of ndarray
+            1-D arrays: ``S`` (increasing), ``region`` (0 on the indenter,
+            1 free; a lifted pole's free cap comes first), ``r``, ``z``,
+            ``phi``, ``lambda_s``, ``lambda_theta``, ``kappa_s``, ``kappa_theta``, ``T_s``,
+            ``T_theta``, ``M_s``, ``M_theta``, ``tau_s``, ``tau_theta``, ``Q``, ``P``,
+            ``axial_force`` (F(S), the axial force carried across the circle S), ``energy_density``.
+            For a point-load state (``topology == "point"``) there is no contact region.
+
+        Examples
+        --------
+        >>> import shellbvp as sb
+        >>> prof = sb.solve(sb.Scene.preset("base"), delta=0.2).profile()
+        >>> float(prof["S"][0]) < 1e-3 and abs(float(prof["S"][-1]) - 1.5708) < 1e-4
+        True
+        >>> bool(abs(prof["lambda_theta"][-1] - 1) < 1e-8)    # the rim is held: r(L) = R(L)
+        True
         """
         sysm = self["system"]
         t = self.x

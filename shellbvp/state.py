@@ -164,6 +164,24 @@ def delta_bounds(scene, tol: float) -> tuple[float, float]:
     exceed 2.5 even hanging straight down (``MEAN_STRETCH_LIMIT``).  The dome: 4.93
     (delta = 5 is refused at once), the base hemisphere: 2.93 (a wide indenter,
     rho = 0.6, pushes it to delta = 2.5 with every state valid), a flat plate: 2.5.
+
+    Parameters
+    ----------
+    scene : Scene
+    tol : float
+        The collocation tolerance the states will be solved with.
+
+    Returns
+    -------
+    (float, float)
+        The smallest and the largest pole displacement accepted.
+
+    Examples
+    --------
+    >>> import shellbvp as sb
+    >>> low, high = sb.delta_bounds(sb.Scene.preset("dome"), 1e-6)
+    >>> low, round(high, 2)
+    (1e-06, 4.93)
     """
     mod = scene.model()
     S = np.linspace(0.0, scene.shell_length, 4001)
@@ -198,9 +216,12 @@ def solve(scene, *, delta=None, lambda0=None, force=None, tol=1e-6, max_nodes=10
     Parameters
     ----------
     scene : Scene
+    delta, lambda0, force : float
+        The prescribed quantity (one of them); ``delta`` within :func:`delta_bounds`.
     tol : float
         solve_bvp's relative collocation tolerance (states are O(1)-scaled).
     max_nodes : int
+        Largest number of mesh nodes.
     guess : Solution, optional
         A neighbouring solution to start from (warm start on a thinned mesh).
     eps : float, optional
@@ -225,6 +246,26 @@ def solve(scene, *, delta=None, lambda0=None, force=None, tol=1e-6, max_nodes=10
     Returns
     -------
     Solution
+        Never raises for non-convergence: ``success``, ``status`` and ``message``
+        say what happened (:data:`STATUS_MESSAGES`); ``valid`` and ``flags`` whether
+        the contact pushes everywhere and the shell stays outside the indenter.
+
+    Raises
+    ------
+    ValueError
+        For arguments out of range (naming the argument and the range).
+
+    Examples
+    --------
+    >>> import shellbvp as sb
+    >>> scene = sb.Scene.preset("base")
+    >>> sol = sb.solve(scene, delta=0.2)
+    >>> print(f"{sol.force:.4f} {sol.topology} {sol.valid}")
+    0.3639 cap True
+    >>> sb.solve(scene, force=sol.force, guess=sol).delta    # force control
+    0.2...
+    >>> print(sb.solve(scene, delta=0.05).topology)          # the pole has lifted off
+    line
     """
     given = {k: v for k, v in (("delta", delta), ("lambda0", lambda0), ("force", force)) if v is not None}
     if len(given) != 1:

@@ -41,7 +41,38 @@ def plain_number(text: str, name: str = "value") -> float:
 
 
 def parse_quantity(text, kind: str = "length", default_unit: str | None = None) -> float:
-    """'0.3mm' -> 3e-4 (SI); a bare number takes ``default_unit`` (else SI)."""
+    """A length or force with its unit, in SI units.
+
+    Parameters
+    ----------
+    text : str or float
+        A number and a unit, e.g. ``"0.3mm"``, ``"0.3 mm"``, ``"15uN"``; a number
+        alone (str or float) is in ``default_unit``.
+    kind : {"length", "force"}
+        Which units are accepted (:data:`LENGTH_UNITS`, :data:`FORCE_UNITS`).
+    default_unit : str, optional
+        The unit of a bare number (default: SI, m or N).
+
+    Returns
+    -------
+    float
+        The value in metres or newtons.
+
+    Raises
+    ------
+    ValueError
+        For text that is not a number and a unit, or an unknown unit.
+
+    Examples
+    --------
+    >>> from shellbvp import parse_quantity
+    >>> parse_quantity("0.3mm")
+    0.0003
+    >>> round(parse_quantity("15 uN", kind="force"), 12)
+    1.5e-05
+    >>> parse_quantity(300, default_unit="um")
+    0.0003
+    """
     if isinstance(text, (int, float)):
         v = float(text)
         return v * (unit_factor(default_unit, kind) if default_unit else 1.0)
@@ -55,7 +86,29 @@ def parse_quantity(text, kind: str = "length", default_unit: str | None = None) 
 
 
 def beta_from_thickness(H: float, R_L: float) -> float:
-    """``beta = (H/R_L)^2/12`` (linear elasticity, incompressible)."""
+    """The bending stiffness of a shell of thickness H: ``beta = (H/R_L)^2/12``.
+
+    The paper's relation for an incompressible, linearly elastic sheet; a
+    starting value when the thickness is known.
+
+    Parameters
+    ----------
+    H : float
+        Shell thickness (any length unit).
+    R_L : float
+        Rim radius, in the same unit as H.
+
+    Returns
+    -------
+    float
+        beta, nondimensional.
+
+    Examples
+    --------
+    >>> from shellbvp import beta_from_thickness
+    >>> round(beta_from_thickness(H=50e-6, R_L=0.3e-3), 6)   # a 50 um endosperm, R_L = 0.3 mm
+    0.002315
+    """
     for name, v in (("H", H), ("R_L", R_L)):
         if not (math.isfinite(v) and v > 0):
             raise ValueError(f"{name} must be a finite length > 0; got {v!r}")
@@ -64,7 +117,28 @@ def beta_from_thickness(H: float, R_L: float) -> float:
 
 @dataclass(frozen=True)
 class Dimensions:
-    """Rim radius ``R_L`` (m) and ``mu_H`` (N/m) of an experiment."""
+    """Rim radius ``R_L`` (m) and ``mu_H`` (N/m) of an experiment: SI <-> nondimensional.
+
+    Lengths scale with ``R_L``, forces with ``mu_H * R_L``.
+
+    Parameters
+    ----------
+    R_L : float
+        Rim radius of the sample, m (> 0).
+    mu_H : float
+        Shear modulus times thickness, N/m (= um*MPa; > 0).
+
+    Examples
+    --------
+    >>> from shellbvp import Dimensions
+    >>> dims = Dimensions(R_L=0.3e-3, mu_H=52.0)
+    >>> round(float(dims.displacement(0.5)), 8)      # delta = 0.5 -> metres
+    0.00015
+    >>> round(float(dims.force(1.0)), 6)             # F = 1 -> newtons
+    0.0156
+    >>> round(float(dims.F(dims.force(0.7))), 12)
+    0.7
+    """
 
     R_L: float
     mu_H: float = 1.0

@@ -137,7 +137,7 @@ def test_energy_identity_through_the_switch_on_a_fine_grid():
     assert {"line", "cap"} <= set(c.topology)
     # At tol 1e-8 a window of width ~1e-3 at the switch has no valid state of the three
     # topologies (the cap pulls at its edge, the line bends through the tip by < 4e-4 in
-    # curvature): flagged, not hidden (README, known limits).
+    # curvature): flagged, not hidden (docs/limits.md).
     bad = ~c.valid
     assert np.all((c.delta[bad] > 0.111) & (c.delta[bad] < 0.1135)), c.delta[bad]
     assert all("no valid lift-off state found" in f for f, b in zip(c.flags, bad) if b)

@@ -343,7 +343,7 @@ def test_bad_scene_names_the_parameter(kwargs, match):
 def test_smooth_branch_end_is_detected_by_the_legendre_determinant(base):
     """On the base scene the determinant of the free region's (lambda_s', kappa_s') system at
     Sc+ falls to zero near delta = 0.6145: U loses convexity at the contact edge and the
-    smooth single-cap branch ends (README, known limits)."""
+    smooth single-cap branch ends (docs/limits.md)."""
     s = sb.solve(base, delta=0.3, estimate_error=False)
     assert s.edge_legendre > 0.3
     for d in (0.5, 0.58, 0.6, 0.61, 0.614):

@@ -1,0 +1,23 @@
+"""
+Varying the indenter radius rho
+===============================
+
+The base scene with rho = 0.1, 0.2, 1/3 and 0.5 (indenter radius / rim radius).
+"""
+
+import sys
+from pathlib import Path
+
+import matplotlib.pyplot as plt
+
+# benchmarks/ is not in the installed package: found from this file (docs/examples/)
+try:
+    HERE = Path(__file__).resolve().parent
+except NameError:  # pasted into an interactive session
+    HERE = Path.cwd() / "docs" / "examples"   # from the repository root
+sys.path.insert(0, str(HERE.parents[1] / "benchmarks"))
+
+import paper_figures  # noqa: E402
+
+fig = paper_figures.make_figure("rho")
+plt.show()
