@@ -340,7 +340,7 @@ def locate_corner_switch(smooth, corner, st, h=0.003):
     out of the smooth branch (a continuous switch); F and E extrapolated from each side give
     their jumps at the switch.
     """
-    kw = dict(tol=st["tol"], max_nodes=st["max_nodes"], bc_tol=st["bc_tol"])
+    kw = dict(tol=st["tol"], max_nodes=_step_nodes(smooth, st), bc_tol=st["bc_tol"])  # fail fast
     sysm = system_like(smooth, "delta", 0.98 * smooth.delta, st["eps"])
     d0 = limit_estimate(solve_from(sysm, warm_guess(sysm, smooth), **kw), smooth)
     d0 = d0 if d0 is not None and smooth.delta < d0 < corner.delta else 0.5 * (smooth.delta + corner.delta)

@@ -19,9 +19,12 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
+from scipy.optimize import fsolve
+
 from .chain import Edge
 
-__all__ = ["LEGENDRE_WATCH", "edge_model", "limit_estimate", "is_corner", "near_limit"]
+__all__ = ["LEGENDRE_WATCH", "edge_model", "limit_estimate", "is_corner", "near_limit", "other_edge_root"]
 
 #: Below this edge_legendre (relative to mid-region) a smooth cap is near its convexity
 #: limit: steps that fail, or that are predicted to pass the limit, try the corner.
@@ -61,3 +64,36 @@ def near_limit(sol) -> bool:
     """A smooth-edge cap state of the smooth model close to its convexity limit."""
     return bool(sol.get("topology") == "cap" and sol.scene.contact == "smooth" and edge_model(sol) == "smooth"
                 and sol.get("edge_legendre", math.inf) < LEGENDRE_WATCH)
+
+
+def other_edge_root(sol):
+    """The second root (jump of lambda_s, jump of kappa_s) of the corner conditions at the edge of
+    the smooth cap ``sol``, the free side's other state values held; None if not found.
+
+    At zero jump the two conditions are dependent (their Jacobian in the free side's
+    (lambda_s, kappa_s) has rank 1): the other root lies along its null vector, and near the
+    convexity limit it is close.  Before the limit it is the corner that is not convex; past it
+    the corner continues with the opposite sign (a transcritical crossing), so a jump of the
+    opposite sign, scaled with the distance to the limit, seeds the corner's Newton iteration.
+    """
+    sysm = sol.system
+    mod, par = sysm.model, sysm.par
+    yc, yf = sol.y[sysm.rows(0), -1], sol.y[sysm.rows(1), 0]
+    v0 = yf[2:4].copy()
+
+    def G(v):
+        y = yf.copy()
+        y[2:4] = v
+        return mod.junction_corner_res(sol.Sc, yc, y, sol.delta, 0.0, par)[3:5]
+
+    h = 1e-7 * (1 + np.abs(v0))
+    J = np.column_stack([(G(v0 + np.eye(2)[i] * h[i]) - G(v0 - np.eye(2)[i] * h[i])) / (2 * h[i]) for i in range(2)])
+    n = np.linalg.svd(J)[2][-1] * (1 + np.abs(v0))  # null direction, scaled to the variables
+    best = None
+    for t in (1e-3, -1e-3, 1e-2, -1e-2, 5e-2, -5e-2):
+        v, _, ier, _ = fsolve(G, v0 + t * n, full_output=True, xtol=1e-13)
+        jump = v - v0
+        if ier == 1 and np.max(np.abs(G(v))) < 1e-10 and abs(jump[0]) > 1e-7 * (1 + abs(v0[0])):
+            if best is None or np.linalg.norm(jump) < np.linalg.norm(best):
+                best = jump
+    return best

@@ -149,9 +149,12 @@ POINT_LIMIT_SC = 1e-8
 
 
 def lift_off_suspected(cap: Solution) -> bool:
-    """The cap state asks the indenter to pull: negative pressure or ring force."""
+    """The cap state asks the indenter to pull: negative pressure or normal ring force (at a
+    corner edge the axial ring force also carries the tangential force [tau_s] = -kappa [M_s],
+    so its sign is not the test)."""
+    normal = cap.get("edge_forces") or [cap.ring_force]
     return bool(cap.success and cap.get("topology") == "cap"
-                and (cap.pressure_min < 0 or cap.ring_force < 0))
+                and (cap.pressure_min < 0 or min(normal) < 0))
 
 
 def liftoff_state(cap: Solution, topology: str, *, tol=1e-6, max_nodes=10000, bc_tol=1e-10,

@@ -15,7 +15,7 @@ import time
 import numpy as np
 
 from .chain import ChainBVP, cap_chain
-from .corner import edge_model, is_corner, limit_estimate, near_limit
+from .corner import edge_model, is_corner, limit_estimate, near_limit, other_edge_root
 from .diagnosis import diagnose
 from .pointload import SC_POINT, solve_point_load
 from .solution import (
@@ -108,9 +108,14 @@ def cross_convexity_limit(prev, prev2, delta, *, eps, tol, max_nodes, bc_tol, ex
                     | {max(delta, prev.delta + 0.02), max(delta, prev.delta + 0.04)})
     starts = [s for s in (prev, prev2) if s is not None and s.get("success") and edge_model(s) == "smooth"]
     sol = None
-    for d_far, start in ((d, s) for s in starts for d in ladder):
+    for d_far, start, seeded in ((d, s, k) for s in starts for d in ladder for k in (True, False)):
         sysm = make_system(prev.scene, "delta", d_far, eps, "corner")
-        sol = solve_from(sysm, warm_guess(sysm, start), tol=tol, max_nodes=max_nodes, bc_tol=bc_tol)
+        guess = warm_guess(sysm, start)
+        if seeded:  # the jump expected at d_far put at the edge: Newton at zero jump is near-singular
+            guess = _seed_corner(sysm, guess, start, d_star, d_far)
+            if guess is None:
+                continue
+        sol = solve_from(sysm, guess, tol=tol, max_nodes=max_nodes, bc_tol=bc_tol)
         if is_corner(sol, tol):
             break
     else:
@@ -129,6 +134,21 @@ def cross_convexity_limit(prev, prev2, delta, *, eps, tol, max_nodes, bc_tol, ex
             if step < 1e-4 * (1 + delta):
                 return None
     return sol if sol.success and sol.get("legendre_min", -1.0) > 0 else None
+
+
+def _seed_corner(sysm, guess, start, d_star, d_far):
+    """``guess`` (from the smooth cap ``start``) with a jump at the edge's free side: the edge's
+    other root at ``start`` reflected through the limit ``d_star`` and scaled to ``d_far``."""
+    if d_star is None or not start.delta < d_star < d_far:
+        return None
+    jump = other_edge_root(start)
+    if jump is None or not jump[0] < 0:  # before the limit the other root stretches less
+        return None
+    x, y, p = guess
+    y = y.copy()
+    r = sysm.rows(1)
+    y[r.start + 2:r.start + 4, 0] -= jump * (d_far - d_star) / (d_star - start.delta)
+    return x, y, p
 
 
 def solve_from(sysm, guess, *, tol=1e-6, max_nodes=10000, bc_tol=None):
