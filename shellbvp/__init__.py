@@ -12,7 +12,7 @@ Quick use::
 from .continuation import curve
 from .geometry import SphereTip, Spheroid, UserShell, UserTip
 from .io import Curve, read_curve
-from .materials import Gent, MooneyRivlin, NeoHookean, StrainEnergy
+from .materials import BendingEnergy, Gent, MooneyRivlin, NeoHookean, RotationBending, StrainEnergy, TraceBending
 from .scene import PRESETS, Scene
 from .solution import STATUS_MESSAGES, Solution
 from .state import delta_bounds, solve
@@ -53,6 +53,9 @@ __all__ = [
     "NeoHookean",
     "Gent",
     "StrainEnergy",
+    "TraceBending",
+    "RotationBending",
+    "BendingEnergy",
     "Spheroid",
     "SphereTip",
     "UserShell",

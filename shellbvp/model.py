@@ -1,7 +1,7 @@
 """Generated code for a scene's structure: derive once, cache, load.
 
-The cache key is a SHA-256 of the structure description (material family or
-formula, xi, shell and tip shapes), the codegen version, a fingerprint of
+The cache key is a SHA-256 of the structure description (material and bending
+family or formula, xi, shell and tip shapes), the codegen version, a fingerprint of
 the ``symbolic/`` sources and the SymPy version.  Cached modules live in ``$SHELLBVP_CACHE_DIR``, else
 ``$XDG_CACHE_HOME/shellbvp``, else ``~/.cache/shellbvp``; they are written
 atomically (temporary file + rename) and checked on load (their ``KEY`` must
@@ -46,9 +46,10 @@ def cache_dir() -> Path:
     return base / "shellbvp"
 
 
-def structure_description(material, xi: int, shell, tip) -> dict:
+def structure_description(material, xi: int, shell, tip, bending=None) -> dict:
     """Everything the generated code depends on, as JSON-able data."""
     return {
+        "bending": bending.description() if bending is not None else {"family": "trace"},
         "codegen": CODEGEN_VERSION,
         "source": source_fingerprint(),
         "sympy": importlib.metadata.version("sympy"),

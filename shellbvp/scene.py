@@ -13,7 +13,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from .geometry import SphereTip, Spheroid, UserShell, UserTip
-from .materials import Gent, Material, MooneyRivlin
+from .materials import Bending, Gent, Material, MooneyRivlin, TraceBending
 from .model import load_module, structure_description
 
 __all__ = ["Scene", "PRESETS", "CONTACT_MODELS"]
@@ -52,6 +52,10 @@ class Scene:
         Contact-line conditions: variational (default) or the paper's eq. jumpeqns2.
     shell, tip : optional
         ``UserShell(R, Z, L)`` / ``UserTip(A, B)``; default spheroid and sphere.
+    bending : Bending, optional
+        The bending energy ``B`` in ``U = W + beta B``: ``TraceBending()`` (the paper's,
+        default), ``RotationBending()`` (convex in stretch and curvature) or
+        ``BendingEnergy(formula)``.
 
     Raises
     ------
@@ -84,6 +88,7 @@ class Scene:
     contact: str = "smooth"
     shell: object = field(default_factory=Spheroid)
     tip: object = field(default_factory=SphereTip)
+    bending: Bending = field(default_factory=TraceBending)
 
     def __post_init__(self):
         rho = _finite("rho", self.rho)
@@ -104,6 +109,9 @@ class Scene:
             raise ValueError(f"shell must be Spheroid() or UserShell(...); got {self.shell!r}")
         if not isinstance(self.tip, (SphereTip, UserTip)):
             raise ValueError(f"tip must be SphereTip() or UserTip(...); got {self.tip!r}")
+        if not isinstance(self.bending, Bending):
+            raise ValueError(f"bending must be TraceBending(), RotationBending() or BendingEnergy(...); "
+                             f"got {self.bending!r}")
         # First contact at the pole: kappa_theta^R(0) < B''(0)/(rho A'(0)^2).
         k_shell = self.shell.pole_curvature({"gamma": gamma})
         k_tip = self.tip.apex_curvature() / rho
@@ -156,6 +164,7 @@ class Scene:
             "contact": self.contact,
             "material": {**self.material.description(), **self.material.values()},
             "shell": self.shell.description(), "tip": self.tip.description(),
+            "bending": self.bending.description(),
         }
 
     @classmethod
@@ -168,7 +177,7 @@ class Scene:
         the field.
         """
         from .geometry import UserShell, UserTip
-        from .materials import NeoHookean, StrainEnergy
+        from .materials import BendingEnergy, NeoHookean, RotationBending, StrainEnergy
 
         def field(data, key, kind, where):
             if not isinstance(data, dict) or key not in data:
@@ -207,9 +216,19 @@ class Scene:
             tip = UserTip(*(field(tp, k, text, "tip.") for k in "AB"), legacy_srepr=True)
         else:
             raise ValueError(f"scene data: unknown tip kind {kind!r}")
+        bd = d.get("bending", {"family": "trace"})  # files from before the choice: the paper's
+        kind = field(bd, "family", text, "bending.")
+        if kind == "trace":
+            bend = TraceBending()
+        elif kind == "rotation":
+            bend = RotationBending()
+        elif kind == "user":
+            bend = BendingEnergy(field(bd, "B", text, "bending."))
+        else:
+            raise ValueError(f"scene data: unknown bending family {kind!r}")
         return cls(gamma=field(d, "gamma", number, ""), rho=field(d, "rho", number, ""),
                    beta=field(d, "beta", number, ""), material=material, xi=field(d, "xi", (int,), ""),
-                   contact=field(d, "contact", text, ""), shell=shell, tip=tip)
+                   contact=field(d, "contact", text, ""), shell=shell, tip=tip, bending=bend)
 
     def to_json(self) -> str:
         """:meth:`to_dict` as a JSON string (sorted keys)."""
@@ -220,7 +239,7 @@ class Scene:
     # -- generated code ------------------------------------------------------------
     def structure(self) -> dict:
         """The structural choices the generated code is specialised on."""
-        return structure_description(self.material, self.xi, self.shell, self.tip)
+        return structure_description(self.material, self.xi, self.shell, self.tip, self.bending)
 
     def model(self):
         """The generated module for this scene's structure (cached)."""

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import sympy as sp
 
-from . import codegen, geometry, materials
+from . import bending, codegen, geometry, materials
 from .equations import Structure, derive
 from .formula import parse_formula
 from .version import canonical_json
@@ -52,7 +52,10 @@ def structure_from_description(desc: dict) -> Structure:
         tip = geometry.sphere_tip()
     else:
         tip = geometry.user_tip(_expr(tp["A"], "A(omega)", geometry.OMEGA), _expr(tp["B"], "B(omega)", geometry.OMEGA))
-    return Structure(W=W, material_params=mpar, shell=shell, tip=tip, xi=int(desc["xi"]))
+    bend = desc.get("bending", {"family": "trace"})
+    B = None if bend["family"] == "trace" else bending.bending_energy(
+        bend["family"], _expr(bend["B"], "B", *bending.BENDING_SYMBOLS.values()) if bend["family"] == "user" else None)
+    return Structure(W=W, material_params=mpar, shell=shell, tip=tip, xi=int(desc["xi"]), B=B)
 
 
 def generate_source(desc: dict) -> str:

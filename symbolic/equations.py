@@ -2,9 +2,11 @@ r"""The shell's equations, derived from the energy, as straight-line programs.
 
 Everything follows from the kinematics and the energy density
 
-.. math:: U = W(\lambda_s, \lambda_\theta) + \frac{\beta}{2}(\operatorname{tr}\Delta)^2,
+.. math:: U = W(\lambda_s, \lambda_\theta) + \beta B, \quad
+          B = \tfrac12(\operatorname{tr}\Delta)^2,
           \quad \operatorname{tr}\Delta = \lambda_s^2\kappa_s + \lambda_\theta^2\kappa_\theta
-          - \kappa_s^R - \kappa_\theta^R ,
+          - \kappa_s^R - \kappa_\theta^R
+          \text{ (the paper's; other bending energies B: symbolic.bending)},
 
 with ``T_s = (1/lambda_theta) dW/dlambda_s``, ``T_theta = (1/lambda_s) dW/dlambda_theta``,
 ``M_alpha = h dU/dkappa_alpha`` (``h = 1/(lambda_s lambda_theta)``) and the generalised
@@ -25,7 +27,7 @@ Conditions (residuals; all O(1)-scaled):
 
 * pole (S = zeta, leading order of the odd series of omega): 2;
 * rim (S = L, simply supported): ``lt - 1``, ``tr Delta`` (``M_s = 0`` divided by
-  ``beta lambda_s/lambda_theta``), ``z``: 3;
+  ``beta lambda_s/lambda_theta``; for another bending energy ``dB/dkappa_s``), ``z``: 3;
 * contact line, smooth (variational) model: r, phi, z, lambda_s, kappa_s continuous
   (so M_s and tau_s are; Q may jump): 5;
 * contact line, paper model (eq. jumpeqns2): r, phi, z, Q and tau_s continuous
@@ -47,6 +49,7 @@ from dataclasses import dataclass
 
 import sympy as sp
 
+from . import bending
 from .dag import Program
 from .geometry import OMEGA, S, ShellGeometry, TipGeometry, cylinder_of
 from .materials import LS, LT
@@ -73,7 +76,8 @@ class Structure:
     """The structural choices a generated module is specialised on.
 
     ``W`` is the strain energy in ``materials.LS, LT`` and ``material_params``;
-    shell and tip are geometries; ``xi`` in {0, 1}.
+    shell and tip are geometries; ``xi`` in {0, 1}; ``B`` the bending energy per beta in
+    ``symbolic.bending``'s symbols (None: the paper's, ``trace_bending``).
     """
 
     W: sp.Expr
@@ -81,6 +85,7 @@ class Structure:
     shell: ShellGeometry
     tip: TipGeometry
     xi: int
+    B: sp.Expr | None = None
 
     @property
     def params(self) -> tuple:
@@ -138,26 +143,45 @@ class Derivation:
         return out
 
     def _constitutive(self, prog: Program, ls, lt, ks, kt, ksR, ktR, tag=""):
-        """T, M, tau and U from W and the bending energy; names get suffix ``tag``."""
+        """T, M, tau and U from W and the bending energy; names get suffix ``tag``.
+
+        ``m`` is what the rim's ``M_s = 0`` sets to zero: ``tr Delta`` for the paper's bending
+        energy (written through it, as the paper does), ``dB/dkappa_s`` for any other.
+        """
         st = self.structure
-        KS, KT = sp.symbols("kappa_s kappa_theta")
-        tr_delta = LS**2 * KS + LT**2 * KT - ksR - ktR
-        U = st.W + BETA / 2 * tr_delta**2
+        KS, KT = bending.KS, bending.KT
         h = 1 / (LS * LT)
         sub = {LS: ls, LT: lt, KS: ks, KT: kt}
-        m = prog.let(f"m{tag}", tr_delta.xreplace(sub))
-
-        def as_m(expr):  # write moments through the named bending strain m
-            return expr.xreplace(sub).subs(tr_delta.xreplace(sub), m)
-
         T_s = prog.let(f"T_s{tag}", (sp.diff(st.W, LS) / LT).xreplace(sub))
         T_t = prog.let(f"T_t{tag}", (sp.diff(st.W, LT) / LS).xreplace(sub))
-        M_s = prog.let(f"M_s{tag}", as_m(h * sp.diff(U, KS)))
-        M_t = prog.let(f"M_t{tag}", as_m(h * sp.diff(U, KT)))
-        tau_s = prog.let(f"tau_s{tag}", T_s + st.xi * M_s * ks)
-        tau_t = prog.let(f"tau_t{tag}", T_t + st.xi * M_t * kt)
         W = prog.let(f"W{tag}", st.W.xreplace(sub))
-        U_ = prog.let(f"U{tag}", W + BETA / 2 * m**2)
+        if st.B is None:  # the paper's (tr Delta)^2/2
+            tr_delta = LS**2 * KS + LT**2 * KT - ksR - ktR
+            U = st.W + BETA / 2 * tr_delta**2
+            m = prog.let(f"m{tag}", tr_delta.xreplace(sub))
+
+            def as_m(expr):  # write moments through the named bending strain m
+                return expr.xreplace(sub).subs(tr_delta.xreplace(sub), m)
+
+            M_s = prog.let(f"M_s{tag}", as_m(h * sp.diff(U, KS)))
+            M_t = prog.let(f"M_t{tag}", as_m(h * sp.diff(U, KT)))
+            U_ = prog.let(f"U{tag}", W + BETA / 2 * m**2)
+            tau_s = prog.let(f"tau_s{tag}", T_s + st.xi * M_s * ks)
+            tau_t = prog.let(f"tau_t{tag}", T_t + st.xi * M_t * kt)
+        else:
+            # The generalised tensions of the energy: r tau_s = R Psi dU/dpsi at fixed phi' (and
+            # the hoop one from dU/dr at fixed phi), i.e. tau_a = (dU/dlambda_a - dU/dkappa_a
+            # kappa_a/lambda_a)/lambda_b.  For the paper's B the bending part is M_a kappa_a (the
+            # branch above); for another it is not, and M kappa would break F = dE/ddelta.
+            B = st.B.xreplace({bending.KS0: ksR, bending.KT0: ktR})
+            m = prog.let(f"m{tag}", sp.diff(B, KS).xreplace(sub))
+            M_s = prog.let(f"M_s{tag}", (h * BETA).xreplace(sub) * m)
+            M_t = prog.let(f"M_t{tag}", (h * BETA * sp.diff(B, KT)).xreplace(sub))
+            U_ = prog.let(f"U{tag}", W + BETA * B.xreplace(sub))
+            bend_s = BETA * (sp.diff(B, LS) - sp.diff(B, KS) * KS / LS) / LT
+            bend_t = BETA * (sp.diff(B, LT) - sp.diff(B, KT) * KT / LT) / LS
+            tau_s = prog.let(f"tau_s{tag}", T_s + st.xi * bend_s.xreplace(sub))
+            tau_t = prog.let(f"tau_t{tag}", T_t + st.xi * bend_t.xreplace(sub))
         return dict(m=m, T_s=T_s, T_t=T_t, M_s=M_s, M_t=M_t, tau_s=tau_s, tau_t=tau_t, W=W, U=U_)
 
     def _tip_steps(self, prog: Program, omega, tip, tag=""):

@@ -41,6 +41,8 @@ SCENES = {
     "base-xi0": sb.Scene.preset("base-xi0"),
     "gent": sb.Scene.preset("gent1", material=sb.Gent(5.0)),  # Jm large enough for random stretches
     "neo-hookean": sb.Scene.preset("base", material=sb.NeoHookean()),
+    "rotation-bending": sb.Scene.preset("base", bending=sb.RotationBending()),
+    "rotation-bending-xi0": sb.Scene.preset("base-xi0", bending=sb.RotationBending()),
 }
 
 

@@ -1,0 +1,111 @@
+r"""Bending energies: the part of U = W + beta B that depends on curvature.
+
+``B(lambda_s, lambda_theta, kappa_s, kappa_theta; kappa_s0, kappa_theta0)`` per unit
+reference area and per unit beta (kappa_*0: the reference shell's curvatures).  The
+moments ``M = h dU/dkappa`` (h = 1/(lambda_s lambda_theta)) and every equation follow by
+differentiation (``symbolic.equations``).
+
+Built in:
+
+* ``trace`` (the paper's): ``B = (tr Delta)^2/2``,
+  ``tr Delta = lambda_s^2 kappa_s + lambda_theta^2 kappa_theta - kappa_s0 - kappa_theta0``.
+  In the kinematic variables of the free region, ``psi = lambda_s Psi`` and
+  ``phi' = kappa_s psi``, ``lambda_s^2 kappa_s = psi phi'/Psi^2`` is bilinear, so U is not
+  convex in (psi, phi') at large bending: the Legendre condition fails (issue 13).
+* ``rotation``: ``B = (lambda_s kappa_s + lambda_theta kappa_theta - kappa_s0 - kappa_theta0)^2/2``,
+  the square of the change of the rotation gradients, ``lambda_s kappa_s = phi'/Psi`` and
+  ``lambda_theta kappa_theta = sin(phi)/R`` per unit *reference* length: the bending strains of
+  the axisymmetric shell theories built on the rotation angle (Libai & Simmonds, *The Nonlinear
+  Theory of Elastic Shells*, 2nd ed. 1998, ch. 5; for a rod, Antman, *Nonlinear Problems of
+  Elasticity*, 2005, ch. 4: moment proportional to the change of phi').  Independent of psi, so
+  U is convex in (psi, phi') wherever W is convex in lambda_s: the Legendre condition never
+  fails through bending.  Same small-strain stiffness as ``trace`` (both give d^2B/dkappa_s^2 = 1
+  at the reference state).
+"""
+
+from __future__ import annotations
+
+import sympy as sp
+
+from .materials import FLOAT_ZERO, LS, LT
+
+__all__ = ["KS", "KT", "KS0", "KT0", "BENDING_SYMBOLS", "trace_bending", "rotation_bending", "bending_energy",
+           "check_bending", "legendre_determinant"]
+
+KS, KT = sp.symbols("kappa_s kappa_theta", real=True)
+KS0, KT0 = sp.symbols("kappa_s0 kappa_theta0", real=True)
+#: The names a user bending energy may use.
+BENDING_SYMBOLS = {"lambda_s": LS, "lambda_theta": LT, "kappa_s": KS, "kappa_theta": KT, "kappa_s0": KS0,
+                   "kappa_theta0": KT0}
+
+
+def trace_bending():
+    return (LS**2 * KS + LT**2 * KT - KS0 - KT0) ** 2 / 2
+
+
+def rotation_bending():
+    return (LS * KS + LT * KT - KS0 - KT0) ** 2 / 2
+
+
+def bending_energy(family: str, formula=None):
+    """B of a bending family ("trace", "rotation", or "user" with its parsed formula)."""
+    if family == "trace":
+        return trace_bending()
+    if family == "rotation":
+        return rotation_bending()
+    if family == "user":
+        return formula
+    raise ValueError(f"unknown bending family {family!r}")
+
+
+def _zero(e) -> bool:
+    e = sp.simplify(e)
+    if e == 0:
+        return True
+    if not e.has(sp.Float):
+        return False
+    for point in ((0.3, -0.2), (1.1, 0.7), (-2.0, 0.4)):
+        value = complex(e.subs({KS0: point[0], KT0: point[1]}).evalf(30))
+        if abs(value) > FLOAT_ZERO:
+            return False
+    return True
+
+
+def check_bending(B, name="B"):
+    """Validate a bending energy; return its bending stiffness d^2B/dkappa_s^2 at rest (1 for the built-ins).
+
+    ValueError unless ``B`` uses only the stretches, curvatures and reference curvatures, and
+    vanishes, is moment-free and has positive stiffness in the reference state
+    (lambda = 1, kappa = kappa_0) for any reference curvatures.
+    """
+    B = sp.sympify(B, strict=True)  # an expression already: text goes through formula.parse_formula
+    extra = B.free_symbols - set(BENDING_SYMBOLS.values())
+    if extra:
+        raise ValueError(f"{name} must be an expression in {', '.join(BENDING_SYMBOLS)}; it also contains "
+                         f"{sorted(map(str, extra))}")
+    if not B.has(KS):
+        raise ValueError(f"{name} must depend on kappa_s")
+    rest = {LS: 1, LT: 1, KS: KS0, KT: KT0}
+    if not _zero(B.subs(rest)):
+        raise ValueError(f"{name} must vanish in the reference state (lambda = 1, kappa = kappa_0); "
+                         f"it is {sp.simplify(B.subs(rest))}")
+    for k in (KS, KT):
+        if not _zero(sp.diff(B, k).subs(rest)):
+            raise ValueError(f"{name} must be moment-free in the reference state: d{name}/d{k} = "
+                             f"{sp.simplify(sp.diff(B, k).subs(rest))} there, expected 0")
+    stiffness = sp.simplify(sp.diff(B, KS, 2).subs(rest))
+    probe = stiffness.subs({KS0: 0.37, KT0: -0.21}) if stiffness.free_symbols else stiffness
+    if not (probe.is_number and float(probe) > 0):
+        raise ValueError(f"{name} must have a positive bending stiffness d2{name}/dkappa_s2 at rest; got {stiffness}")
+    return stiffness
+
+
+def legendre_determinant(W, B, beta=sp.Symbol("beta", positive=True)):
+    """det of the Hessian of U = W + beta B in the free region's velocities (psi, phi'), per Psi^4,
+    written in (lambda_s, lambda_theta, kappa_s, kappa_theta): > 0 where U is convex in them (the
+    Legendre condition; same sign as det d(tau_s, M_s)/d(lambda_s, kappa_s))."""
+    psi, dphi, Psi = sp.symbols("psi dphi Psi", positive=True)
+    U = (W + beta * B).xreplace({LS: psi / Psi, KS: dphi / psi})
+    H = sp.hessian(U, (psi, dphi))
+    det = (H[0, 0] * H[1, 1] - H[0, 1] ** 2) * Psi**4
+    return sp.simplify(det.xreplace({psi: LS * Psi, dphi: KS * LS * Psi}))
