@@ -263,18 +263,23 @@ def _cmd_fit(args):
     units = None
     if args.units:
         parts = [u.strip() for u in args.units.split(",")]
-        if len(parts) != 2:
-            raise ValueError(f"--units must be two units, displacement and force, e.g. mm,mN; got {args.units!r}")
+        if len(parts) not in (2, 3):
+            raise ValueError(f"--units must be two units, displacement and force (and a third for time), "
+                             f"e.g. mm,mN; got {args.units!r}")
         units = tuple(parts)
     columns = [c.strip() for c in args.columns.split(",")] if args.columns else None
-    if columns is not None and len(columns) != 2:
-        raise ValueError(f"--columns must name two columns (displacement, force); got {args.columns!r}")
+    if columns is not None and len(columns) not in (2, 3):
+        raise ValueError(f"--columns must name two columns (displacement, force) or three (and time); "
+                         f"got {args.columns!r}")
     if args.example == (args.data is not None):
         raise ValueError("give a CSV file or --example (one of them)")
     from .fitting import example_data_path
 
     data = example_data_path() if args.example else args.data
-    disp, force = sb.read_force_csv(data, columns=columns, units=units)
+    from .fitting import fit_record
+    from .instrument import read_instrument
+
+    record = read_instrument(data, columns=columns, units=units)
     bounds = {}
     for name, text in (("beta", args.beta_range), ("alpha", args.alpha_range)):
         if text is not None:
@@ -287,29 +292,15 @@ def _cmd_fit(args):
                 raise ValueError(f"--{name}-range must be two numbers LOW,HIGH; got {text!r}")
             if not (args.fit_beta if name == "beta" else args.fit_alpha):
                 raise ValueError(f"--{name}-range needs --fit-{name}")
-    res = sb.fit(scene, disp, force, R_L=R_L, fit_offset=not args.no_offset, fit_beta=args.fit_beta,
-                 fit_alpha=args.fit_alpha, weights=args.weights, tol=args.tol, **bounds)
+    res, used = fit_record(scene, record, R_L=R_L, segment=args.segment, baseline=args.baseline,
+                           fit_offset=not args.no_offset, fit_beta=args.fit_beta, fit_alpha=args.fit_alpha,
+                           weights=args.weights, tol=args.tol, **bounds)
     out = res.to_dict()
     out["exit_status"] = 0 if res.success else 1
     if args.json:
         print(json.dumps(out, allow_nan=False))
     else:
-        if not res.success:
-            print(f"fit failed (status {res.status}): {res.message}")
-        lo, hi = res.mu_H_ci95
-        print(f"mu*H   = {res.mu_H:.4g} N/m (um*MPa)   95% CI [{lo:.4g}, {hi:.4g}]")
-        if not args.no_offset:
-            o1, o2 = res.offset_ci95
-            print(f"offset = {res.offset * 1e3:.4g} mm   95% CI [{o1 * 1e3:.4g}, {o2 * 1e3:.4g}] mm")
-        for name in ("beta", "alpha"):
-            if name in res.fitted:
-                v, (c1, c2) = getattr(res, name), getattr(res, name + "_ci95")
-                print(f"{name:<6s} = {v:.4g}   95% CI [{c1:.4g}, {c2:.4g}] (profile likelihood; "
-                      f"{res.curves_computed} model curves)")
-        print(f"rms residual = {res.residual_rms * 1e3:.4g} mN over {res.n} points; R_L = {R_L * 1e3:.4g} mm; "
-              f"{res.weights} weights")
-        for text in res.warnings:
-            print(f"warning: {text}")
+        _print_fit(res, record, used, args)
     if args.output:
         if not res.success:
             print(f"shellbvp: not writing {args.output}: the fit failed its checks", file=sys.stderr)
@@ -319,6 +310,41 @@ def _cmd_fit(args):
             curve = dataclasses.replace(res.curve, settings={**res.curve.settings, "fit": record})
             curve.to_hdf5(args.output, overwrite=args.force, units={"R_L": R_L, "mu_H": res.mu_H})
     return 0 if res.success else 1
+
+
+def _print_fit(res, record, used, args):
+    """The fit in words, in the data's own units (and mu*H in N/m)."""
+    from .units import format_in
+
+    du, fu = record.units["displacement"], record.units["force"]
+    if not res.success:
+        print(f"fit failed (status {res.status}): {res.message}")
+    counts = ", ".join(f"{k} {v}" for k, v in record.counts().items())
+    print(f"data   = {record.path}: {len(record)} rows ({counts}); fitted the {args.segment} segment, "
+          f"{int(used.sum())} rows")
+    lo, hi = res.mu_H_ci95
+    print(f"mu*H   = {res.mu_H:.4g} N/m (um*MPa)   95% CI [{lo:.4g}, {hi:.4g}]")
+    show = (lambda v, unit, kind: format_in(v, unit, kind).split(" ")[0])
+    if "offset" in res.fitted:
+        o1, o2 = res.offset_ci95
+        print(f"offset = {format_in(res.offset, du, 'length')}   95% CI [{show(o1, du, 'length')}, "
+              f"{show(o2, du, 'length')}] {du} (the contact point)")
+    if res.baseline_model != "none":
+        b1, b2 = res.baseline_ci95
+        print(f"baseline = {format_in(res.baseline, fu, 'force')}   95% CI [{show(b1, fu, 'force')}, "
+              f"{show(b2, fu, 'force')}] {fu} ({res.baseline_model})")
+    if res.baseline_model == "linear":
+        s1, s2 = res.baseline_slope_ci95
+        print(f"baseline slope = {res.baseline_slope:.4g} N/m   95% CI [{s1:.4g}, {s2:.4g}]")
+    for name in ("beta", "alpha"):
+        if name in res.fitted:
+            v, (c1, c2) = getattr(res, name), getattr(res, name + "_ci95")
+            print(f"{name:<6s} = {v:.4g}   95% CI [{c1:.4g}, {c2:.4g}] (profile likelihood; "
+                  f"{res.curves_computed} model curves)")
+    print(f"rms residual = {format_in(res.residual_rms, fu, 'force')} over {res.n} points; R_L = "
+          f"{args.radius.strip()}; {res.weights} weights")
+    for text in res.warnings:
+        print(f"warning: {text}")
 
 
 def _cmd_plot(args):
@@ -428,6 +454,13 @@ def build_parser():
     f.add_argument("--radius", required=True, help="rim radius R_L of the sample, e.g. 0.3mm")
     f.add_argument("--columns", help="displacement,force columns by name or 0-based index (default 0,1)")
     f.add_argument("--units", help="units of the two columns, e.g. mm,mN (default: from the header)")
+    f.add_argument("--segment", choices=("loading", "retraction", "all"), default="loading",
+                   help="rows to fit: loading (default: the approach and the loading, up to the deepest point; "
+                        "segments by the direction of the displacement over time), retraction, or all "
+                        "(every row, whatever its direction)")
+    f.add_argument("--baseline", choices=("auto", "none", "constant", "linear"), default="auto",
+                   help="force baseline fitted with the contact point: auto (default: constant when the data "
+                        "have an approach before contact, else none), none, constant, linear")
     f.add_argument("--no-offset", action="store_true", dest="no_offset", help="do not fit the contact point")
     f.add_argument("--fit-beta", action="store_true", dest="fit_beta",
                    help="also fit beta (starting from the scene's; a few more model curves)")
