@@ -60,6 +60,21 @@ def _numbers(text, name):
     return [plain_number(v, name) for v in text.split(",")]
 
 
+def quantity(kind):
+    """argparse type: a quantity with its unit (``0.3mm``, ``52N/m``), > 0; a bare number is an
+    error that says which unit to add.  Every subcommand takes dimensional options this way."""
+    from .units import Quantity
+
+    def parse(text):
+        try:
+            return Quantity.parse(text, kind, "the value")  # argparse names the option
+        except ValueError as exc:
+            raise argparse.ArgumentTypeError(str(exc)) from None
+
+    parse.__name__ = f"{kind} with a unit"
+    return parse
+
+
 def _scene_options(p):
     g = p.add_argument_group("scene (overrides of the preset)")
     g.add_argument("--preset", default="base", help="built-in scene (see `shellbvp presets`; default base)")
@@ -151,9 +166,9 @@ def _cmd_curve(args):
     scene = _scene(args)
     units = None
     if (args.radius is None) != (args.mu_h is None):
-        raise ValueError("--radius and --muH go together (rim radius in m, mu*H in N/m)")
+        raise ValueError("--radius and --muH go together (rim radius, e.g. 0.3mm, and mu*H, e.g. 52N/m)")
     if args.radius is not None:
-        units = {"R_L": args.radius, "mu_H": args.mu_h}
+        units = {"R_L": args.radius.si, "mu_H": args.mu_h.si}
     deltas = None
     if args.points is not None:
         if not 2 <= args.points <= MAX_POINTS:
@@ -183,6 +198,14 @@ def _cmd_curve(args):
     write_curve(c, out, profiles=args.profiles, overwrite=True, units=units)
     partial.unlink(missing_ok=True)
     print(f"wrote {out}: {c.summary()} in {time.perf_counter() - t0:.1f} s")
+    if units is not None and len(c):
+        from .units import force_unit_of, format_in
+
+        fu = force_unit_of(args.mu_h.unit)
+        scale = args.radius.si * args.mu_h.si
+        print(f"  with R_L = {args.radius} and mu*H = {args.mu_h}: displacement up to "
+              f"{args.radius.show(args.radius.si * float(max(c.delta)))}, force "
+              f"{format_in(scale * float(min(c.force)), fu, 'force')} .. {format_in(scale * float(max(c.force)), fu, 'force')}")
     if len(c):
         print(f"  contact topologies along the curve: {c.topology_summary()}")
     if c.interrupted:
@@ -251,15 +274,12 @@ def _cmd_fit(args):
     import shellbvp as sb
 
     from .paths import check_output_path
-    from .units import parse_quantity
 
     if args.output is not None:
         check_output_path(args.output, overwrite=args.force)
 
     scene = _scene(args)
-    R_L = parse_quantity(args.radius, "length", default_unit="m")
-    if not (math.isfinite(R_L) and R_L > 0):
-        raise ValueError(f"--radius must be a finite length > 0 (e.g. 0.3mm); got {args.radius!r}")
+    R_L = args.radius.si
     units = None
     if args.units:
         parts = [u.strip() for u in args.units.split(",")]
@@ -342,7 +362,7 @@ def _print_fit(res, record, used, args):
             print(f"{name:<6s} = {v:.4g}   95% CI [{c1:.4g}, {c2:.4g}] (profile likelihood; "
                   f"{res.curves_computed} model curves)")
     print(f"rms residual = {format_in(res.residual_rms, fu, 'force')} over {res.n} points; R_L = "
-          f"{args.radius.strip()}; {res.weights} weights")
+          f"{args.radius}; {res.weights} weights")
     for text in res.warnings:
         print(f"warning: {text}")
 
@@ -421,8 +441,9 @@ def build_parser():
     c.add_argument("--lambda0-max", type=_number, dest="lambda0_max", help="stop at this pole stretch")
     c.add_argument("--max-steps", type=int, default=400, dest="max_steps")
     c.add_argument("--profiles", action="store_true", help="store each point's profiles")
-    c.add_argument("--radius", type=_number, help="rim radius R_L in m (with --muH: SI columns)")
-    c.add_argument("--muH", type=_number, dest="mu_h", help="mu*H in N/m")
+    c.add_argument("--radius", type=quantity("length"),
+                   help="rim radius R_L with its unit, e.g. 0.3mm (with --muH: SI columns in the file)")
+    c.add_argument("--muH", type=quantity("mu_H"), dest="mu_h", help="mu*H with its unit, e.g. 52N/m")
     c.add_argument("-o", "--output", help="output file (default <preset>.h5, or <preset>-2.h5, ... if that exists)")
     c.add_argument("--force", action="store_true", help="replace an existing output file")
     c.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
@@ -451,7 +472,8 @@ def build_parser():
     f.add_argument("--example", action="store_true",
                    help="use the synthetic Lepidium-like data shipped with shellbvp (README)")
     _scene_options(f)
-    f.add_argument("--radius", required=True, help="rim radius R_L of the sample, e.g. 0.3mm")
+    f.add_argument("--radius", required=True, type=quantity("length"),
+                   help="rim radius R_L of the sample with its unit, e.g. 0.3mm")
     f.add_argument("--columns", help="displacement,force columns by name or 0-based index (default 0,1)")
     f.add_argument("--units", help="units of the two columns, e.g. mm,mN (default: from the header)")
     f.add_argument("--segment", choices=("loading", "retraction", "all"), default="loading",

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 __all__ = ["Dimensions", "parse_quantity", "unit_factor", "unit_kind", "normalize_unit", "format_in",
            "beta_from_thickness", "plain_number", "PLAIN_NUMBER", "LENGTH_UNITS", "FORCE_UNITS", "TIME_UNITS",
-           "MU_H_UNITS", "UNIT_TABLES", "SI_UNITS", "split_quantity"]
+           "MU_H_UNITS", "UNIT_TABLES", "SI_UNITS", "split_quantity", "Quantity", "force_unit_of"]
 
 #: A number as a person or a CSV writes it: ASCII digits, optional sign, decimal point and
 #: exponent.  Python's float() also takes "5_0", "inf", "nan", "1e999" and non-ASCII digits.
@@ -137,6 +137,48 @@ def parse_quantity(text, kind: str = "length", default_unit: str | None = None, 
                              f"({kind} units: {', '.join(UNIT_TABLES[kind])})")
         unit = default_unit
     return value * (unit_factor(unit, kind) if unit else 1.0)
+
+
+@dataclass(frozen=True)
+class Quantity:
+    """A quantity as a person wrote it: ``value`` in ``unit``, and ``si`` in SI units.
+
+    Examples
+    --------
+    >>> q = Quantity.parse("0.3mm", "length")
+    >>> q.si, str(q)
+    (0.0003, '0.3 mm')
+    """
+
+    si: float
+    value: float
+    unit: str
+    kind: str
+
+    @classmethod
+    def parse(cls, text, kind: str = "length", name: str | None = None, positive: bool = True) -> "Quantity":
+        """Parse ``text`` with a unit required (a bare number is an error saying which unit to add).
+
+        ``positive``: also require a finite value > 0 (rim radius, mu*H).
+        """
+        value, unit = split_quantity(text, kind, name)
+        si = parse_quantity(text, kind, require_unit=True, name=name)
+        if positive and not si > 0:
+            raise ValueError(f"{name or 'the ' + kind} must be > 0; got {text!r}")
+        return cls(si=si, value=value, unit=unit, kind=kind)
+
+    def __str__(self):
+        return f"{self.value:g} {self.unit}"
+
+    def show(self, si_value: float, digits: int = 4) -> str:
+        """Another value of this kind (SI) in this quantity's unit."""
+        return format_in(si_value, self.unit, self.kind, digits)
+
+
+def force_unit_of(mu_H_unit: str) -> str:
+    """The force unit of a mu*H unit: ``'mN/mm'`` -> ``'mN'``; ``'N'`` when it has none."""
+    top = normalize_unit(mu_H_unit).split("/")[0]
+    return top if unit_kind(top) == "force" else "N"
 
 
 def beta_from_thickness(H: float, R_L: float) -> float:
