@@ -24,6 +24,7 @@ import math
 import os
 import sys
 import time
+from pathlib import Path
 
 __all__ = ["main"]
 
@@ -269,14 +270,12 @@ def _cmd_fit(args):
     """``shellbvp fit``: exit 0 (fit succeeded; warnings allowed), 1 (the fit ran but failed its
     checks) or 2 (bad input: a ValueError, one line on stderr).  With ``--json`` stdout holds
     exactly one JSON document in every case (errors: see :func:`main`)."""
-    import dataclasses
-
-    import shellbvp as sb
-
     from .paths import check_output_path
 
     if args.output is not None:
         check_output_path(args.output, overwrite=args.force)
+    if args.report is not None:
+        _check_report_path(args.report, overwrite=args.force)
 
     scene = _scene(args)
     R_L = args.radius.si
@@ -321,15 +320,39 @@ def _cmd_fit(args):
         print(json.dumps(out, allow_nan=False))
     else:
         _print_fit(res, record, used, args)
-    if args.output:
+    if args.output or args.report:
         if not res.success:
-            print(f"shellbvp: not writing {args.output}: the fit failed its checks", file=sys.stderr)
-        else:  # the file carries the fit's outcome (settings["fit"], read back by read_curve)
-            record = {k: out[k] for k in ("mu_H", "mu_H_ci95", "offset", "offset_ci95", "fitted", "weights",
-                                          "status", "message", "warnings", "warning_codes", "n", "R_L")}
-            curve = dataclasses.replace(res.curve, settings={**res.curve.settings, "fit": record})
-            curve.to_hdf5(args.output, overwrite=args.force, units={"R_L": R_L, "mu_H": res.mu_H})
+            print(f"shellbvp: not writing {args.output or args.report}: the fit failed its checks", file=sys.stderr)
+        else:
+            _save_fit(res, record, used, args.output, args.report, args.segment, args.force, args.json)
     return 0 if res.success else 1
+
+
+def _save_fit(res, record, used, output, report, segment, force, quiet_stdout=False):
+    """The fit's record (HDF5) and its one-page report (PNG/PDF), as asked (with --json the
+    'wrote' lines go to stderr: stdout holds the one JSON document)."""
+    import os
+    import tempfile
+
+    from .fitrecord import read_fit, write_fit
+
+    if output:
+        write_fit(output, res, record, used, segment=segment, overwrite=force)
+        print(f"wrote {output}", file=sys.stderr if quiet_stdout else sys.stdout)
+    if report:
+        from .plotting import fit_report
+
+        if output:
+            fit_report(read_fit(output), report)
+        else:  # the report alone: the record goes through a temporary file
+            fd, tmp = tempfile.mkstemp(suffix=".h5")
+            os.close(fd)
+            try:
+                write_fit(tmp, res, record, used, segment=segment, overwrite=True)
+                fit_report(read_fit(tmp), report)
+            finally:
+                os.unlink(tmp)
+        print(f"wrote {report}", file=sys.stderr if quiet_stdout else sys.stdout)
 
 
 def _print_fit(res, record, used, args):
@@ -367,11 +390,52 @@ def _print_fit(res, record, used, args):
         print(f"warning: {text}")
 
 
+def _check_report_path(path, overwrite):
+    from .paths import check_output_path
+
+    if not str(path).lower().endswith((".png", ".pdf")):
+        raise ValueError(f"--report must name a .png or .pdf file; got {path!r}")
+    return check_output_path(path, overwrite=overwrite)
+
+
+def _cmd_report(args):
+    """``shellbvp report FIT.h5 [-o FIT.pdf]``: the one-page summary of a fit file."""
+    from .fitrecord import read_fit
+    from .plotting import fit_report, require_matplotlib
+
+    out = args.output or str(Path(args.file).with_suffix(".pdf"))
+    _check_report_path(out, overwrite=True)  # a report is redrawn from its record: replaced
+    require_matplotlib()
+    fit_report(read_fit(args.file), out)
+    print(f"wrote {out}")
+    return 0
+
+
 def _cmd_plot(args):
     from .io import read_curve
     from .paths import check_output_path
     from .plotting import plot_curves, plot_profiles, require_matplotlib
 
+    from .fitrecord import is_fit_file, read_fit
+    from .plotting import plot_fit_record
+
+    fits = [f for f in args.files if is_fit_file(f)]
+    if fits:
+        if len(fits) != len(args.files):
+            raise ValueError("plot either curve files or fit files, not both in one call")
+        outdir = Path(args.output)
+        if len(fits) > 1 and not outdir.is_dir():
+            raise ValueError(f"several fit files: -o must be a directory for one figure each; got {args.output}")
+        plt = require_matplotlib()
+        for name in fits:
+            out = outdir / (Path(name).stem + ".png") if outdir.is_dir() else outdir
+            check_output_path(out, overwrite=True)
+            ax, _ = plot_fit_record(read_fit(name))
+            ax.figure.tight_layout()
+            ax.figure.savefig(out, dpi=args.dpi)
+            plt.close(ax.figure)
+            print(f"wrote {out}")
+        return 0
     check_output_path(args.output, overwrite=True)  # a figure is cheap to redraw: replaced
     plt = require_matplotlib()
     curves = [read_curve(f) for f in args.files]
@@ -393,7 +457,16 @@ def _cmd_plot(args):
 def _cmd_info(args):
     import numpy as np
 
+    from .fitrecord import is_fit_file, read_fit
     from .io import read_curve
+
+    if is_fit_file(args.file):
+        from .plotting import fit_summary_lines
+
+        print(f"file:      {args.file} (a fit)")
+        for line in fit_summary_lines(read_fit(args.file)):
+            print(f"  {line}")
+        return 0
 
     c = read_curve(args.file)
     s = c.scene
@@ -494,16 +567,24 @@ def build_parser():
                    help="noise model: uniform (same force noise everywhere), relative (noise proportional "
                         "to the force) or mixed (both, estimated; the default)")
     f.add_argument("--json", action="store_true")
-    f.add_argument("-o", "--output", help="write the fitted model curve (HDF5, with SI columns)")
+    f.add_argument("-o", "--output", help="write the fit as a record (HDF5/NeXus: data, model, parameters with "
+                   "intervals, weights, warnings, scene, source file and its SHA-256)")
+    f.add_argument("--report", help="write a one-page summary of the fit (.png or .pdf)")
     f.add_argument("--force", action="store_true", help="replace an existing output file")
     f.set_defaults(func=_cmd_fit)
     pl = sub.add_parser("plot", help="plot curves (and profiles) from HDF5 files (needs matplotlib)")
-    pl.add_argument("files", nargs="+", help="curve files written by `shellbvp curve`")
-    pl.add_argument("-o", "--output", default="curves.png", help="PNG or PDF (default curves.png)")
+    pl.add_argument("files", nargs="+", help="curve files (`shellbvp curve`) or fit files (`shellbvp fit -o`: data, "
+                    "model and residuals in SI units)")
+    pl.add_argument("-o", "--output", default="curves.png",
+                    help="PNG or PDF (default curves.png); for several fit files a directory (one figure each)")
     pl.add_argument("--profiles", help="also draw the deformed shell of the first file at these depths, e.g. 0.1,0.3")
     pl.add_argument("--dpi", type=int, default=150)
     pl.set_defaults(func=_cmd_plot)
-    i = sub.add_parser("info", help="describe a curve file")
+    rp = sub.add_parser("report", help="one-page summary (PDF or PNG) of a fit file written by `shellbvp fit -o`")
+    rp.add_argument("file", help="fit file (HDF5)")
+    rp.add_argument("-o", "--output", help="PDF or PNG (default: the fit file's name with .pdf)")
+    rp.set_defaults(func=_cmd_report)
+    i = sub.add_parser("info", help="describe a curve file or a fit file")
     i.add_argument("file")
     i.set_defaults(func=_cmd_info)
     r = sub.add_parser("presets", help="list the built-in scenes")

@@ -208,10 +208,12 @@ def test_cli_warnings_in_text_json_and_saved_file(good, tmp_path):
     r = run("fit", str(p), "--preset", "fit", "--radius", "0.3mm", "-o", str(tmp_path / "step.h5"))
     assert r.returncode == 0, r.stderr
     assert any(ln.startswith("warning: the residuals' signs") for ln in r.stdout.splitlines()), r.stdout
-    rec = sb.read_curve(tmp_path / "step.h5").settings["fit"]
-    assert rec["status"] == 0 and rec["warning_codes"] == ["residual_runs"] and "runs test" in rec["warnings"][0]
+    from shellbvp.fitrecord import read_fit
+
+    rec = read_fit(tmp_path / "step.h5")
+    assert rec.status == 0 and rec.warning_codes == ["residual_runs"] and "runs test" in rec.warnings[0]
     with h5py.File(tmp_path / "step.h5") as f:
-        assert f["curve"].attrs["mu_H_N_per_m"] == pytest.approx(rec["mu_H"])
+        assert f["fit/parameters/mu_H"][()] == pytest.approx(rec.parameters["mu_H"])
     r = run("fit", str(p), "--preset", "fit", "--radius", "0.3mm", "--json")
     out = json.loads(r.stdout)
     assert r.returncode == 0 and out["warning_codes"] == ["residual_runs"] and out["status"] == 0
