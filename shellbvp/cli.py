@@ -119,18 +119,20 @@ def _checkpoint_seconds():
     return value
 
 
-def _progress(enabled):
-    start = time.perf_counter()
+def _progress_bar(total, unit, args):
+    """A progress bar on stderr (tqdm; none when quiet, not a terminal, or tqdm absent)."""
+    from .progress import progress_bar, wanted
 
-    def show(curve, sol):
-        if not enabled:
-            return
-        n = len(curve)
-        sys.stderr.write(f"\r  {n:4d} points  delta = {sol.delta:8.5f}  F = {sol.force:10.5f}  "
-                         f"{time.perf_counter() - start:6.1f} s")
-        sys.stderr.flush()
+    return progress_bar(total, desc=args.command, unit=unit, enabled=wanted(getattr(args, "quiet", False)))
 
-    return show
+
+def _curve_bars(args, leave=True):
+    """``progress`` for :func:`shellbvp.fit`: one bar per model curve, over delta."""
+    from .progress import curve_progress, wanted
+
+    if not wanted(getattr(args, "quiet", False)):
+        return None
+    return lambda desc, delta_max: curve_progress(delta_max, desc, leave=leave)
 
 
 MAX_POINTS = 100_000  # --points: each is a solve (~0.05-0.5 s); more is a typo, not a curve
@@ -179,7 +181,9 @@ def _cmd_curve(args):
         deltas = [args.delta_max * (i + 1) / args.points for i in range(args.points)]
 
     every = _checkpoint_seconds()
-    show = _progress(sys.stderr.isatty() and not args.quiet)
+    from .progress import curve_progress, wanted
+
+    bar, show = curve_progress(args.delta_max, f"curve {args.preset}", enabled=wanted(args.quiet))
     last = [time.perf_counter()]
 
     def callback(curve, sol):
@@ -191,11 +195,12 @@ def _cmd_curve(args):
             last[0] = time.perf_counter()
 
     t0 = time.perf_counter()
-    c = sb.curve(scene, args.delta_max, deltas=deltas, force_max=args.force_max,
-                 lambda0_max=args.lambda0_max, max_steps=args.max_steps, tol=args.tol,
-                 max_nodes=args.max_nodes, callback=callback, topology=args.topology)
-    if sys.stderr.isatty() and not args.quiet:
-        sys.stderr.write("\n")
+    try:
+        c = sb.curve(scene, args.delta_max, deltas=deltas, force_max=args.force_max,
+                     lambda0_max=args.lambda0_max, max_steps=args.max_steps, tol=args.tol,
+                     max_nodes=args.max_nodes, callback=callback, topology=args.topology)
+    finally:
+        bar.close()
     write_curve(c, out, profiles=args.profiles, overwrite=True, units=units)
     partial.unlink(missing_ok=True)
     print(f"wrote {out}: {c.summary()} in {time.perf_counter() - t0:.1f} s")
@@ -266,19 +271,9 @@ def _cmd_solve(args):
     return 0 if sol.success else 1
 
 
-def _cmd_fit(args):
-    """``shellbvp fit``: exit 0 (fit succeeded; warnings allowed), 1 (the fit ran but failed its
-    checks) or 2 (bad input: a ValueError, one line on stderr).  With ``--json`` stdout holds
-    exactly one JSON document in every case (errors: see :func:`main`)."""
-    from .paths import check_output_path
-
-    if args.output is not None:
-        check_output_path(args.output, overwrite=args.force)
-    if args.report is not None:
-        _check_report_path(args.report, overwrite=args.force)
-
+def _fit_inputs(args):
+    """The scene, R_L and the reading and fitting options of ``fit``, checked before any work."""
     scene = _scene(args)
-    R_L = args.radius.si
     units = None
     if args.units:
         parts = [u.strip() for u in args.units.split(",")]
@@ -290,30 +285,46 @@ def _cmd_fit(args):
     if columns is not None and len(columns) not in (2, 3):
         raise ValueError(f"--columns must name two columns (displacement, force) or three (and time); "
                          f"got {args.columns!r}")
-    if args.example == (args.data is not None):
-        raise ValueError("give a CSV file or --example (one of them)")
-    from .fitting import example_data_path
-
-    data = example_data_path() if args.example else args.data
-    from .fitting import fit_record
-    from .instrument import read_instrument
-
-    record = read_instrument(data, columns=columns, units=units)
-    bounds = {}
+    options = {"fit_offset": not args.no_offset, "fit_beta": args.fit_beta, "fit_alpha": args.fit_alpha,
+               "weights": args.weights, "tol": args.tol}
     for name, text in (("beta", args.beta_range), ("alpha", args.alpha_range)):
         if text is not None:
             parts = text.split(",")
             try:
-                bounds[f"{name}_bounds"] = tuple(_numbers(text, f"--{name}-range"))
+                options[f"{name}_bounds"] = tuple(_numbers(text, f"--{name}-range"))
             except ValueError:
                 raise ValueError(f"--{name}-range must be two numbers LOW,HIGH; got {text!r}") from None
             if len(parts) != 2:
                 raise ValueError(f"--{name}-range must be two numbers LOW,HIGH; got {text!r}")
             if not (args.fit_beta if name == "beta" else args.fit_alpha):
                 raise ValueError(f"--{name}-range needs --fit-{name}")
-    res, used = fit_record(scene, record, R_L=R_L, segment=args.segment, baseline=args.baseline,
-                           fit_offset=not args.no_offset, fit_beta=args.fit_beta, fit_alpha=args.fit_alpha,
-                           weights=args.weights, tol=args.tol, **bounds)
+    return scene, args.radius.si, {"columns": columns, "units": units}, options
+
+
+def _cmd_fit(args):
+    """``shellbvp fit``: exit 0 (fit succeeded; warnings allowed), 1 (the fit ran but failed its
+    checks) or 2 (bad input: a ValueError, one line on stderr).  With ``--json`` stdout holds
+    exactly one JSON document in every case (errors: see :func:`main`).  Several files (or a
+    directory, a pattern, or ``--table``): a batch, see :func:`_fit_batch`."""
+    from .batch import expand_inputs
+    from .fitting import example_data_path, fit_record
+    from .instrument import read_instrument
+    from .paths import check_output_path
+
+    if args.example == bool(args.data):
+        raise ValueError("give data files (or a directory) or --example (one of them)")
+    inputs = [str(example_data_path())] if args.example else args.data
+    files = expand_inputs(inputs)
+    if len(files) > 1 or args.table or any(Path(x).is_dir() for x in inputs):
+        return _fit_batch(args, files)
+    if args.output is not None:
+        check_output_path(args.output, overwrite=args.force)
+    if args.report is not None:
+        _check_report_path(args.report, overwrite=args.force)
+    scene, R_L, reading, options = _fit_inputs(args)
+    options["progress"] = _curve_bars(args)
+    record = read_instrument(files[0], **reading)
+    res, used = fit_record(scene, record, R_L=R_L, segment=args.segment, baseline=args.baseline, **options)
     out = res.to_dict()
     out["exit_status"] = 0 if res.success else 1
     if args.json:
@@ -326,6 +337,80 @@ def _cmd_fit(args):
         else:
             _save_fit(res, record, used, args.output, args.report, args.segment, args.force, args.json)
     return 0 if res.success else 1
+
+
+def _output_dir(path, what, files, suffix, force):
+    """A directory for one output per file (created if its parent exists); names checked now."""
+    from .paths import check_output_path
+
+    d = Path(path)
+    if d.exists() and not d.is_dir():
+        raise ValueError(f"{what} {path}: with several files it must be a directory (one file each)")
+    if not d.exists():
+        if not d.parent.is_dir():
+            raise ValueError(f"{what} {path}: its parent directory does not exist")
+        d.mkdir()
+    stems = [Path(f).stem for f in files]
+    twice = sorted({s for s in stems if stems.count(s) > 1})
+    if twice:
+        raise ValueError(f"{what}: several input files are named {twice[0]!r} (their outputs would collide); "
+                         "fit them in separate calls")
+    for stem in stems:
+        check_output_path(d / f"{stem}{suffix}", overwrite=force)
+    return d
+
+
+def _fit_batch(args, files):
+    """``shellbvp fit A B ... [--table results.csv] [-o DIR] [--report DIR]``: every file with
+    the same scene and settings, one row each (status ok, failed or error), continuing past
+    a file that fails; exit 0 when every file was fitted, 1 otherwise."""
+    from .batch import fit_files, write_table
+    from .paths import check_output_path
+
+    if args.table is not None:
+        check_output_path(args.table, overwrite=args.force)
+    outdir = _output_dir(args.output, "-o", files, ".h5", args.force) if args.output else None
+    repdir = _output_dir(args.report, "--report", files, ".pdf", args.force) if args.report else None
+    scene, R_L, reading, options = _fit_inputs(args)
+    options["progress"] = _curve_bars(args, leave=False)
+    bar = _progress_bar(len(files), "file", args)
+
+    def step(row):
+        bar.update(1)
+        bar.set_postfix_str(f"{Path(row.file).name}: {row.status}")
+
+    try:
+        rows = fit_files(scene, files, R_L=R_L, segment=args.segment, baseline=args.baseline, on_file=step,
+                         **reading, **options)
+    finally:
+        bar.close()
+    for row in rows:
+        if row.status == "ok" and (outdir or repdir):
+            stem = Path(row.file).stem
+            _save_fit(row.result, row.record, row.used, outdir / f"{stem}.h5" if outdir else None,
+                      repdir / f"{stem}.pdf" if repdir else None, args.segment, args.force, True)
+    if args.table is not None:
+        write_table(args.table, rows, args.segment, overwrite=args.force)
+    ok = all(r.status == "ok" for r in rows)
+    if args.json:
+        docs = [{"file": r.file, "status": r.status, "message": r.message,
+                 **(r.result.to_dict() if r.result is not None else {})} for r in rows]
+        print(json.dumps(_strict_json({"files": docs, "success": ok, "exit_status": 0 if ok else 1}),
+                         allow_nan=False))
+    else:
+        width = max(len(r.file) for r in rows)
+        for r in rows:
+            if r.result is not None and r.status != "error":
+                lo, hi = r.result.mu_H_ci95
+                text = f"mu*H = {r.result.mu_H:.4g} N/m  95% CI [{lo:.4g}, {hi:.4g}]"
+                if r.result.warnings:
+                    text += f"  ({len(r.result.warnings)} warning{'s' * (len(r.result.warnings) > 1)})"
+            else:
+                text = r.message
+            print(f"{r.file:<{width}}  {r.status:<6s}  {text}")
+        n_ok = sum(r.status == "ok" for r in rows)
+        print(f"{n_ok} of {len(rows)} files fitted" + (f"; table: {args.table}" if args.table else ""))
+    return 0 if ok else 1
 
 
 def _save_fit(res, record, used, output, report, segment, force, quiet_stdout=False):
@@ -423,12 +508,15 @@ def _cmd_plot(args):
     if fits:
         if len(fits) != len(args.files):
             raise ValueError("plot either curve files or fit files, not both in one call")
-        outdir = Path(args.output)
-        if len(fits) > 1 and not outdir.is_dir():
-            raise ValueError(f"several fit files: -o must be a directory for one figure each; got {args.output}")
+        if args.output is None:  # each figure next to its fit file
+            outs = [Path(name).with_suffix(".png") for name in fits]
+        elif len(fits) > 1 or Path(args.output).is_dir():
+            outdir = _output_dir(args.output, "-o", fits, ".png", True)
+            outs = [outdir / (Path(name).stem + ".png") for name in fits]
+        else:
+            outs = [Path(args.output)]
         plt = require_matplotlib()
-        for name in fits:
-            out = outdir / (Path(name).stem + ".png") if outdir.is_dir() else outdir
+        for name, out in zip(fits, outs):
             check_output_path(out, overwrite=True)
             ax, _ = plot_fit_record(read_fit(name))
             ax.figure.tight_layout()
@@ -436,6 +524,7 @@ def _cmd_plot(args):
             plt.close(ax.figure)
             print(f"wrote {out}")
         return 0
+    args.output = "curves.png" if args.output is None else args.output
     check_output_path(args.output, overwrite=True)  # a figure is cheap to redraw: replaced
     plt = require_matplotlib()
     curves = [read_curve(f) for f in args.files]
@@ -519,7 +608,8 @@ def build_parser():
     c.add_argument("--muH", type=quantity("mu_H"), dest="mu_h", help="mu*H with its unit, e.g. 52N/m")
     c.add_argument("-o", "--output", help="output file (default <preset>.h5, or <preset>-2.h5, ... if that exists)")
     c.add_argument("--force", action="store_true", help="replace an existing output file")
-    c.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
+    c.add_argument("-q", "--quiet", action="store_true", help="no progress bar (there is none when stderr is not "
+                   "a terminal or tqdm is not installed: pip install 'shellbvp[progress]')")
     c.add_argument("--topology", choices=("auto", "cap"), default="auto",
                    help="auto (default): where the single contact cap would pull the shell, use the valid "
                         "lifted-off (line or annular) contact; cap: single cap only, flagged where invalid")
@@ -541,7 +631,10 @@ def build_parser():
                        "Exit status: 0 the fit succeeded (warnings, if any, printed as 'warning: ...'); "
                        "1 the fit ran but failed its checks (e.g. an interval not finite or wider than mu*H); "
                        "2 bad input (one-line message).")
-    f.add_argument("data", nargs="?", help="CSV file: displacement and force columns")
+    f.add_argument("data", nargs="*", help="instrument file(s) (CSV/TSV/text: displacement and force, optionally "
+                   "time); several files, a directory or a pattern fit each with the same settings (a batch)")
+    f.add_argument("--table", help="batch: write one row per file (CSV: file, status, mu*H and its interval, "
+                   "offset, baseline, residual, warnings, ...)")
     f.add_argument("--example", action="store_true",
                    help="use the synthetic Lepidium-like data shipped with shellbvp (README)")
     _scene_options(f)
@@ -568,15 +661,18 @@ def build_parser():
                         "to the force) or mixed (both, estimated; the default)")
     f.add_argument("--json", action="store_true")
     f.add_argument("-o", "--output", help="write the fit as a record (HDF5/NeXus: data, model, parameters with "
-                   "intervals, weights, warnings, scene, source file and its SHA-256)")
-    f.add_argument("--report", help="write a one-page summary of the fit (.png or .pdf)")
+                   "intervals, weights, warnings, scene, source file and its SHA-256); a batch: a directory "
+                   "(one <name>.h5 per file)")
+    f.add_argument("--report", help="write a one-page summary of the fit (.png or .pdf); a batch: a directory "
+                   "(one <name>.pdf per file)")
+    f.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
     f.add_argument("--force", action="store_true", help="replace an existing output file")
     f.set_defaults(func=_cmd_fit)
     pl = sub.add_parser("plot", help="plot curves (and profiles) from HDF5 files (needs matplotlib)")
     pl.add_argument("files", nargs="+", help="curve files (`shellbvp curve`) or fit files (`shellbvp fit -o`: data, "
                     "model and residuals in SI units)")
-    pl.add_argument("-o", "--output", default="curves.png",
-                    help="PNG or PDF (default curves.png); for several fit files a directory (one figure each)")
+    pl.add_argument("-o", "--output", help="PNG or PDF (default curves.png; for fit files <name>.png next to "
+                    "each); for several fit files a directory (one <name>.png each)")
     pl.add_argument("--profiles", help="also draw the deformed shell of the first file at these depths, e.g. 0.1,0.3")
     pl.add_argument("--dpi", type=int, default=150)
     pl.set_defaults(func=_cmd_plot)

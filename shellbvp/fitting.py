@@ -222,8 +222,9 @@ _CACHE: OrderedDict = OrderedDict()
 _CACHE_SIZE = 32
 
 
-def _model_curve(scene, deltas, tol, counter=None):
-    """The curve of ``scene`` at ``deltas`` (memoised per process: repeated fits reuse it)."""
+def _model_curve(scene, deltas, tol, counter=None, progress=None):
+    """The curve of ``scene`` at ``deltas`` (memoised per process: repeated fits reuse it);
+    ``progress(description, delta_max) -> (bar, callback)`` draws its progress."""
     from .continuation import curve
 
     try:
@@ -235,7 +236,12 @@ def _model_curve(scene, deltas, tol, counter=None):
         _CACHE.move_to_end(key)
         return _CACHE[key]
     _check_model_start(scene, float(deltas[0]), tol)
-    c = curve(scene, deltas=deltas, tol=tol, estimate_error=False)
+    bar, callback = progress("model curve", float(deltas[-1])) if progress is not None else (None, None)
+    try:
+        c = curve(scene, deltas=deltas, tol=tol, estimate_error=False, callback=callback)
+    finally:
+        if bar is not None:
+            bar.close()
     if counter is not None:
         counter[0] += 1
     c.solutions = []  # profiles are not needed here; keep the cache small
@@ -280,14 +286,15 @@ class _Shape:
     the nodes at each depth and a monotone cubic (PCHIP) in delta.
     """
 
-    def __init__(self, scene_at, grid, tol, need, counter):
+    def __init__(self, scene_at, grid, tol, need, counter, progress=None):
         self.scene_at, self.grid, self.tol, self.need, self.counter = scene_at, grid, tol, need, counter
+        self.progress = progress
         self.nodes = {}  # theta -> curve
         self._spline = None
 
     def add(self, theta):
         """Compute the node curve at theta; False if it does not reach the data."""
-        c = _model_curve(self.scene_at(theta), self.grid, self.tol, self.counter)
+        c = _model_curve(self.scene_at(theta), self.grid, self.tol, self.counter, self.progress)
         if len(c) < 3:
             raise ValueError(f"the model curve of this scene could not be computed to the data's depths "
                              f"({c.stop_reason})")
@@ -557,7 +564,7 @@ def _check_bounds(name, bounds, lo_ok, hi_ok, value):
 
 def fit(scene, displacement, force, *, R_L, fit_offset=True, fit_beta=False, fit_alpha=False,
         weights=None, floor=0.05, beta_bounds=BETA_BOUNDS, alpha_bounds=ALPHA_BOUNDS, delta_max=None,
-        tol=1e-6, loss="linear", baseline="none", contact_guess=None):
+        tol=1e-6, loss="linear", baseline="none", contact_guess=None, progress=None):
     """Least-squares fit of mu*H (the displacement origin, and beta or alpha) to measured data.
 
     Parameters
@@ -581,6 +588,9 @@ def fit(scene, displacement, force, *, R_L, fit_offset=True, fit_beta=False, fit
         A first guess of the contact point (m; e.g. :func:`shellbvp.instrument.estimate_contact`):
         the model curve is computed to 1.2 x the depth of the data beyond it.  Default 0
         (displacements measured from about the contact point).
+    progress : callable, optional
+        ``progress(description, delta_max) -> (bar, callback)`` for each model curve computed
+        (e.g. ``lambda d, m: shellbvp.progress.curve_progress(m, d)``); None: silent.
     fit_beta, fit_alpha : bool
         Also fit beta (within ``beta_bounds``) or the Mooney–Rivlin alpha
         (within ``alpha_bounds``, subset of [0, 1]); one of them at most.
@@ -681,14 +691,14 @@ def fit(scene, displacement, force, *, R_L, fit_offset=True, fit_beta=False, fit
         return res, rss, J, w
 
     if name is None:
-        shape = _Shape(lambda th: scene, grid, tol, depth, counter)
+        shape = _Shape(lambda th: scene, grid, tol, depth, counter, progress)
         shape.add(None)
         P, dP, top = shape.at(None)
         res, rss, J, w = irls(P, dP, top)
         theta_hat, theta_ci, interp_err, fit_scene, c = None, None, None, scene, shape.nodes[None]
         model_P = (P, top)
     else:
-        shape = _Shape(scene_at, grid, tol, depth, counter)
+        shape = _Shape(scene_at, grid, tol, depth, counter, progress)
         lim = [bounds[0], bounds[1]]  # shrinks where node curves do not reach the data
         if not shape.add(theta0):
             raise ValueError(f"the model curve at the scene's {name} ends before the deepest data point "

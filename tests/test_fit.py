@@ -120,7 +120,7 @@ def test_fit_shape_parameter_logic_on_closed_form_curves(monkeypatch, name, trut
     """Nodes, interpolation across them, profile interval: recovers the parameter of a known curve family."""
     calls = []
 
-    def fake(scene, deltas, tol, counter=None):
+    def fake(scene, deltas, tol, counter=None, progress=None):
         calls.append(scene)
         if counter is not None:
             counter[0] += 1

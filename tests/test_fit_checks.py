@@ -140,7 +140,7 @@ def test_data_deeper_than_the_model_reaches(good, monkeypatch):
         def __len__(self):
             return self.delta.size
 
-    monkeypatch.setattr(fitting, "_model_curve", lambda scene, deltas, tol, counter=None: Short(scene, deltas))
+    monkeypatch.setattr(fitting, "_model_curve", lambda scene, deltas, tol, counter=None, progress=None: Short(scene, deltas))
     scene, disp, F, force = good
     with pytest.raises(ValueError, match=r"data reach delta = 0\.48.* model curve ends at delta = 0\.18.*end of the tip"):
         sb.fit(scene, disp, force, R_L=R_L)
