@@ -254,6 +254,16 @@ def _cmd_solve(args):
             "delta_error", "nodes", "niter", "max_residual", "wall_time")
     out = {k: sol.get(k, 0.0 if k in ("S1", "ring_force_inner") else None) for k in keys}
     out = {k: (float(v) if isinstance(v, (np.floating,)) else v) for k, v in out.items()}
+    if (args.radius is None) != (args.mu_h is None):
+        raise ValueError("--radius and --muH go together (rim radius, e.g. 0.3mm, and mu*H, e.g. 52N/m)")
+    shown = {}
+    if args.radius is not None:  # the state in the units given: displacement R_L delta, force mu_H R_L F
+        from .units import force_unit_of, format_in
+
+        out["displacement_m"] = args.radius.si * sol.delta
+        out["force_N"] = args.mu_h.si * args.radius.si * sol.force
+        shown = {"displacement": args.radius.show(out["displacement_m"]),
+                 "force (SI)": format_in(out["force_N"], force_unit_of(args.mu_h.unit), "force")}
     if args.profiles and sol.success:
         out["profile"] = {k: np.asarray(v).tolist() for k, v in sol.profile().items()}
     if args.json:
@@ -261,6 +271,8 @@ def _cmd_solve(args):
     else:
         for k in keys:
             print(f"{k:>16s}: {out[k]}")
+        for k, v in shown.items():
+            print(f"{k:>16s}: {v}")
         if args.profiles and sol.success:
             prof = sol.profile()
             cols = ("S", "region", "r", "z", "lambda_s", "lambda_theta", "kappa_s", "kappa_theta",
@@ -620,6 +632,9 @@ def build_parser():
     g.add_argument("--delta", type=_number, help="pole displacement (default 0.2)")
     g.add_argument("--lambda0", type=_number, help="pole stretch")
     g.add_argument("--load", type=_number, help="indenter force F (force control)")
+    s.add_argument("--radius", type=quantity("length"), help="rim radius with its unit, e.g. 0.3mm (with --muH: "
+                   "the state also in these units)")
+    s.add_argument("--muH", type=quantity("mu_H"), dest="mu_h", help="mu*H with its unit, e.g. 52N/m")
     s.add_argument("--profiles", action="store_true", help="print the fields over S")
     s.add_argument("--json", action="store_true", help="print JSON")
     s.add_argument("--topology", choices=("auto", "cap", "line", "annulus"), default="auto",

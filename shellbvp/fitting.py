@@ -907,7 +907,8 @@ def fit_record(scene, record, *, R_L, segment="loading", baseline="auto", **opti
     -------
     result : FitResult
     used : ndarray of bool, shape (len(record),)
-        The rows fitted.
+        The rows fitted.  With ``segment="loading"`` the record's pushing rows are
+        relabelled at the fitted contact point (before it 'approach').
 
     Raises
     ------
@@ -929,7 +930,9 @@ def fit_record(scene, record, *, R_L, segment="loading", baseline="auto", **opti
     guess = estimate_contact(d, f)
     if baseline == "auto":
         baseline = "constant" if guess is not None else "none"
-    if guess is None and options.get("fit_offset", True):
+    if not options.get("fit_offset", True):
+        guess = 0.0  # the contact point is known: displacements are measured from it
+    elif guess is None:
         # no baseline to read: the record starts in contact.  Displacements measured from about
         # the contact (the old convention) keep 0; otherwise the first row is the best guess.
         lo = float(np.min(d))

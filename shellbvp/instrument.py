@@ -439,10 +439,12 @@ def segment(displacement, time=None) -> np.ndarray:
     row number: instruments sample at a fixed rate): moving in (rate above 10 % of the
     typical pushing rate), moving out (likewise), or still.  Runs shorter than half
     the window are noise and join their neighbour.  The main push is the pushing run
-    that gains the most depth: its rows are 'loading' (split into 'approach' and
-    'loading' at a contact point by :meth:`InstrumentRecord.relabel`); still rows right
-    after it 'hold'; the next run moving out 'retraction'; everything else 'other'
-    (pauses before the approach, later cycles).
+    that gains the most depth; with the runs pushing or still around it (a staircase of
+    steps and pauses, a pause before the approach) up to the runs moving out, it is the
+    'loading' (split into 'approach' and 'loading' at a contact point by
+    :meth:`InstrumentRecord.relabel`); still rows after its last push are the 'hold'; the
+    runs moving out after it (pauses between them included) up to the next push the
+    'retraction'; everything else 'other' (earlier and later cycles).
 
     Parameters
     ----------
@@ -501,13 +503,25 @@ def segment(displacement, time=None) -> np.ndarray:
             labels[runs[k][1]:runs[k][2]] = "retraction"
         return labels.astype(str)
     _, k = max(pushes)
-    labels[runs[k][1]:runs[k][2]] = "loading"
-    k += 1
-    if k < len(runs) and runs[k][0] == 0:
-        labels[runs[k][1]:runs[k][2]] = "hold"
-        k += 1
-    if k < len(runs) and runs[k][0] == -1:
-        labels[runs[k][1]:runs[k][2]] = "retraction"
+    # the loading: the main push with the pushes and pauses around it up to the runs moving out
+    # (a staircase of steps and holds is one loading); still rows after its last push: the hold
+    a, b = k, k
+    while a > 0 and runs[a - 1][0] != -1:
+        a -= 1
+    while b + 1 < len(runs) and runs[b + 1][0] != -1:
+        b += 1
+    last_push = max(j for j in range(a, b + 1) if runs[j][0] == 1)
+    labels[runs[a][1]:runs[last_push][2]] = "loading"
+    if last_push < b:
+        labels[runs[last_push + 1][1]:runs[b][2]] = "hold"
+    # the retraction: the runs moving out after it (with pauses between them), up to the next push
+    c = b + 1
+    if c < len(runs):
+        e = c
+        while e + 1 < len(runs) and runs[e + 1][0] != 1:
+            e += 1
+        last_pull = max(j for j in range(c, e + 1) if runs[j][0] == -1)
+        labels[runs[c][1]:runs[last_pull][2]] = "retraction"
     return labels.astype(str)
 
 

@@ -51,6 +51,11 @@ def test_solve_prints_state_and_json(tmp_path):
     out = json.loads(r.stdout)
     assert out["success"] and out["delta"] == 0.2
     assert out["force"] == pytest.approx(sb.solve(sb.Scene.preset("base"), delta=0.2).force, abs=1e-8)
+    r = run("solve", "--preset", "base", "--delta", "0.2", "--radius", "300um", "--muH", "52N/m", "--json")
+    si = json.loads(r.stdout)
+    assert si["displacement_m"] == pytest.approx(0.2 * 300e-6) and si["force_N"] == pytest.approx(52 * 3e-4 * si["force"])
+    r = run("solve", "--preset", "base", "--delta", "0.2", "--radius", "300um", "--muH", "52N/m")
+    assert "displacement: 60 um" in r.stdout and "force (SI): 0.005677 N" in r.stdout
     r = run("solve", "--load", str(out["force"]), "--profiles")
     assert r.returncode == 0 and "lambda_theta" in r.stdout and "0.2" in r.stdout
 

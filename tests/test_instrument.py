@@ -169,6 +169,13 @@ def test_segment_without_time_and_contact_estimate_edge_cases():
     lab = segment(d)
     assert lab[10] == "loading" and lab[55] == "hold" and lab[80] == "retraction" and lab[-1] == "other"
     assert set(segment(np.linspace(1, 0, 30))) == {"retraction"}  # a file sorted the other way: no loading
+    # a staircase (steps and holds) is one loading; two cycles: the deeper one is fitted
+    stairs = np.r_[np.repeat(np.linspace(0.1, 1, 10), 12), np.ones(12), np.linspace(1, 0, 40)]
+    lab = segment(stairs)
+    assert set(lab[:105]) == {"loading"} and lab[115] == "hold" and lab[125] == "hold" and lab[150] == "retraction"
+    two = np.r_[np.linspace(0, 0.5, 30), np.linspace(0.5, 0, 30), np.linspace(0, 1, 50), np.linspace(1, 0, 50)]
+    lab = segment(two)
+    assert lab[15] == "other" and lab[45] == "other" and lab[90] == "loading" and lab[150] == "retraction"
     x = np.linspace(0, 1, 50)
     assert estimate_contact(x, 0.1 + x) is None  # starts in contact: no baseline to read
     f = np.clip(x - 0.4, 0, None) ** 1.5 + 1e-4 * np.random.default_rng(0).standard_normal(50)
