@@ -4,8 +4,11 @@ The model force scales linearly in mu*H (``F_SI = mu_H R_L F(delta)``), so
 one model curve serves a fit of mu*H and the contact point: it is computed
 once on a grid of depths and interpolated (monotone cubic) in delta.  The
 unknowns are ``mu_H`` and, optionally, the origin offset ``d0`` of the
-displacement (real contact points are uncertain):
-``F_i = mu_H R_L F((d_i - d0)/R_L)`` for ``d_i > d0``, 0 before.
+displacement (real contact points are uncertain) and a force baseline (what the
+instrument reads before contact, as nanite fits it with the contact point):
+``F_i = mu_H R_L F((d_i - d0)/R_L) + b0 + b1 (d_i - d0)``, the first term 0 for
+``d_i <= d0`` (b0, b1 fitted or 0).  :func:`fit_record` fits a segment of an
+instrument record (:mod:`shellbvp.instrument`), the loading by default.
 
 beta (bending stiffness) and the Mooney–Rivlin alpha change the *shape* of
 the curve.  Fitting one of them uses a few model curves at trial values

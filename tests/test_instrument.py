@@ -83,9 +83,10 @@ def test_every_style_reads_to_the_same_si_record_and_segments(truth, tmp_path, s
     assert abs(rec.contact_estimate - D0) < 10e-6
 
 
-def test_fit_of_the_loading_recovers_mu_H_offset_and_baseline(truth, tmp_path):
+@pytest.mark.parametrize("style", ["tab", "two_rows", "nm_pN"])
+def test_fit_of_the_loading_recovers_mu_H_offset_and_baseline(truth, tmp_path, style):
     scene, t, d, f = truth
-    rec = read_instrument(write(tmp_path / "rec.txt", t, d, f, "tab"))
+    rec = read_instrument(write(tmp_path / "rec.txt", t, d, f, style))
     res, used = fit_record(scene, rec, R_L=R_L)
     assert res.success and res.baseline_model == "constant"
     assert res.mu_H_ci95[0] < MU_H < res.mu_H_ci95[1], (res.mu_H, res.mu_H_ci95)
