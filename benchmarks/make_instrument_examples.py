@@ -3,9 +3,9 @@
 Each record is what an indenter exports: tab-separated, ``#`` comment lines, columns
 ``Time (s)``, ``Displacement (um)``, ``Force (uN)``; an approach before contact at a force
 baseline of 80 uN, the loading, a short hold with creep and a retraction with hysteresis;
-2 % proportional noise.  The shell is the preset ``fit`` (gamma 2.5, rho 1/3, beta 0.01,
-Mooney-Rivlin 0.1) of rim radius 0.3 mm; mu*H is 35, 40 and 47 N/m, the contact points
-20, 30 and 25 um into the record.
+2 % proportional and 1 uN additive noise.  The shell is the preset ``fit`` (gamma 2.5,
+rho 1/3, beta 0.01, Mooney-Rivlin 0.1) of rim radius 0.3 mm; mu*H is 35, 40 and 47 N/m,
+the contact points 20, 30 and 25 um into the record.
 
     python benchmarks/make_instrument_examples.py DIR
     shellbvp fit DIR --preset fit --radius 0.3mm --table results.csv -o fits
@@ -39,7 +39,7 @@ def main():
         f = mu_H * R_L * shape(np.clip((d - d0) / R_L, 0, None))
         f[150:165] *= np.linspace(1, 0.97, 15)  # creep during the hold
         f[165:] *= 0.85 * np.linspace(0.97, 1, 150)  # hysteresis: the retraction carries less force
-        f = f * (1 + 0.02 * rng.standard_normal(d.size)) + BASELINE
+        f = f * (1 + 0.02 * rng.standard_normal(d.size)) + BASELINE + 1e-6 * rng.standard_normal(d.size)
         lines = [f"# synthetic indentation of {name}: preset fit, R_L = 0.3 mm, mu*H = {mu_H:g} N/m, "
                  f"contact at {d0 * 1e6:g} um, baseline {BASELINE * 1e6:g} uN",
                  "Time (s)\tDisplacement (um)\tForce (uN)"]

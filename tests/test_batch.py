@@ -43,7 +43,7 @@ def folder(tmp_path_factory):
         x = np.clip((d - d0) / R_L, 0, None)
         f = mu_H * R_L * shape(x)
         f[120:] *= 0.85  # hysteresis
-        f = f * (1 + 0.02 * rng.standard_normal(d.size)) + 80e-6
+        f = f * (1 + 0.02 * rng.standard_normal(d.size)) + 80e-6 + 1e-6 * rng.standard_normal(d.size)
         (data / f"{name}.tsv").write_text("Time (s)\tDisplacement (um)\tForce (uN)\n" + "\n".join(
             f"{0.1 * i:.1f}\t{a * 1e6:.5f}\t{b * 1e6:.5f}" for i, (a, b) in enumerate(zip(d, f))) + "\n")
     (data / "broken.csv").write_text("Time (s),Displacement (um),Force (uN)\n0,1,2\n0.1,x,3\n")
