@@ -460,7 +460,8 @@ def _print_fit(res, record, used, args):
     if not res.success:
         print(f"fit failed (status {res.status}): {res.message}")
     counts = ", ".join(f"{k} {v}" for k, v in record.counts().items())
-    print(f"data   = {record.path}: {len(record)} rows ({counts}); fitted the {args.segment} segment, "
+    name = Path(record.path).name if args.example else record.path
+    print(f"data   = {name}: {len(record)} rows ({counts}); fitted the {args.segment} segment, "
           f"{int(used.sum())} rows")
     lo, hi = res.mu_H_ci95
     print(f"mu*H   = {res.mu_H:.4g} N/m (um*MPa)   95% CI [{lo:.4g}, {hi:.4g}]")
