@@ -512,10 +512,10 @@ def _cmd_report(args):
 def _cmd_plot(args):
     from .io import read_curve
     from .paths import check_output_path
-    from .plotting import plot_curves, plot_profiles, require_matplotlib
+    from .plotting import plot_curves, plot_profiles, require_matplotlib, save_figure
 
     from .fitrecord import is_fit_file, read_fit
-    from .plotting import plot_fit_record
+    from .plotting import plot_fit_record, save_figure
 
     fits = [f for f in args.files if is_fit_file(f)]
     if fits:
@@ -533,8 +533,10 @@ def _cmd_plot(args):
             check_output_path(out, overwrite=True)
             ax, _ = plot_fit_record(read_fit(name))
             ax.figure.tight_layout()
-            ax.figure.savefig(out, dpi=args.dpi)
-            plt.close(ax.figure)
+            try:
+                save_figure(ax.figure, out, dpi=args.dpi)
+            finally:
+                plt.close(ax.figure)
             print(f"wrote {out}")
         return 0
     args.output = "curves.png" if args.output is None else args.output
@@ -551,7 +553,7 @@ def _cmd_plot(args):
                 raise ValueError(f"--profiles depths must be > 0; got {d}")
         plot_profiles(curves[0].scene, deltas, ax=axes[0, 1])
     fig.tight_layout()
-    fig.savefig(args.output, dpi=args.dpi)
+    save_figure(fig, args.output, dpi=args.dpi)
     print(f"wrote {args.output}")
     return 0
 

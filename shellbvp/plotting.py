@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 __all__ = ["plot_curves", "plot_profiles", "plot_fit", "plot_fit_record", "fit_report", "fit_summary_lines",
-           "require_matplotlib", "scene_label"]
+           "require_matplotlib", "scene_label", "save_figure"]
 
 
 def require_matplotlib():
@@ -111,6 +111,30 @@ def plot_fit(result, displacement, force, ax=None):
     return ax
 
 
+def save_figure(fig, path, dpi=150):
+    """Save ``fig`` atomically (a temporary file in the same directory, then renamed): a
+    reader never sees half a figure and an earlier one stays whole if drawing fails.
+    The format follows the name's suffix (png, pdf, svg, ...)."""
+    import os
+    import tempfile
+    from pathlib import Path
+
+    path = Path(path)
+    fmt = path.suffix.lstrip(".").lower() or "png"
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    os.close(fd)
+    try:
+        fig.savefig(tmp, dpi=dpi, format=fmt)
+        mask = os.umask(0)
+        os.umask(mask)
+        os.chmod(tmp, 0o666 & ~mask)
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+    return path
+
+
 def _si_axis(ax, which, unit):
     """SI units with engineering prefixes on an axis (``10 µm``, ``2 mN``)."""
     from matplotlib.ticker import EngFormatter
@@ -203,6 +227,8 @@ def fit_report(record, path):
     fig.suptitle("shellbvp fit report", fontsize=13, y=0.95)
     text = "\n".join(textwrap.fill(ln, 110, subsequent_indent="    ") for ln in fit_summary_lines(record))
     fig.text(0.06, 0.30, text, va="top", ha="left", family="monospace", fontsize=6.5)
-    fig.savefig(path, dpi=150)
-    plt.close(fig)
+    try:
+        save_figure(fig, path)
+    finally:
+        plt.close(fig)
     return path
