@@ -510,12 +510,10 @@ def _cmd_report(args):
 
 
 def _cmd_plot(args):
+    from .fitrecord import is_fit_file, read_fit
     from .io import read_curve
     from .paths import check_output_path
-    from .plotting import plot_curves, plot_profiles, require_matplotlib, save_figure
-
-    from .fitrecord import is_fit_file, read_fit
-    from .plotting import plot_fit_record, save_figure
+    from .plotting import plot_curves, plot_fit_record, plot_profiles, require_matplotlib, save_figure
 
     fits = [f for f in args.files if is_fit_file(f)]
     if fits:

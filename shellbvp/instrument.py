@@ -28,7 +28,6 @@ import hashlib
 import math
 import re
 from dataclasses import dataclass, field
-from pathlib import Path
 
 import numpy as np
 
