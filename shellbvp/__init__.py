@@ -19,7 +19,8 @@ from .state import delta_bounds, solve
 from .units import Dimensions, beta_from_thickness, parse_quantity
 from .version import __version__  # noqa: F401  (sb.__version__)
 
-_LAZY = {"fit": "fitting", "FitResult": "fitting", "read_force_csv": "fitting"}
+_LAZY = {"fit": "fitting", "FitResult": "fitting", "read_force_csv": "fitting", "fit_record": "fitting",
+         "read_instrument": "instrument", "fit_files": "batch", "read_fit": "fitrecord"}
 
 
 def __getattr__(name):
@@ -43,6 +44,10 @@ __all__ = [
     "fit",
     "FitResult",
     "read_force_csv",
+    "read_instrument",
+    "fit_record",
+    "fit_files",
+    "read_fit",
     "Dimensions",
     "beta_from_thickness",
     "parse_quantity",

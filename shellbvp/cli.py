@@ -24,6 +24,7 @@ import math
 import os
 import sys
 import time
+from pathlib import Path
 
 __all__ = ["main"]
 
@@ -58,6 +59,21 @@ def _numbers(text, name):
     from .units import plain_number
 
     return [plain_number(v, name) for v in text.split(",")]
+
+
+def quantity(kind):
+    """argparse type: a quantity with its unit (``0.3mm``, ``52N/m``), > 0; a bare number is an
+    error that says which unit to add.  Every subcommand takes dimensional options this way."""
+    from .units import Quantity
+
+    def parse(text):
+        try:
+            return Quantity.parse(text, kind, "the value")  # argparse names the option
+        except ValueError as exc:
+            raise argparse.ArgumentTypeError(str(exc)) from None
+
+    parse.__name__ = f"{kind} with a unit"
+    return parse
 
 
 def _scene_options(p):
@@ -103,18 +119,20 @@ def _checkpoint_seconds():
     return value
 
 
-def _progress(enabled):
-    start = time.perf_counter()
+def _progress_bar(total, unit, args):
+    """A progress bar on stderr (tqdm; none when quiet, not a terminal, or tqdm absent)."""
+    from .progress import progress_bar, wanted
 
-    def show(curve, sol):
-        if not enabled:
-            return
-        n = len(curve)
-        sys.stderr.write(f"\r  {n:4d} points  delta = {sol.delta:8.5f}  F = {sol.force:10.5f}  "
-                         f"{time.perf_counter() - start:6.1f} s")
-        sys.stderr.flush()
+    return progress_bar(total, desc=args.command, unit=unit, enabled=wanted(getattr(args, "quiet", False)))
 
-    return show
+
+def _curve_bars(args, leave=True):
+    """``progress`` for :func:`shellbvp.fit`: one bar per model curve, over delta."""
+    from .progress import curve_progress, wanted
+
+    if not wanted(getattr(args, "quiet", False)):
+        return None
+    return lambda desc, delta_max: curve_progress(delta_max, desc, leave=leave)
 
 
 MAX_POINTS = 100_000  # --points: each is a solve (~0.05-0.5 s); more is a typo, not a curve
@@ -151,9 +169,9 @@ def _cmd_curve(args):
     scene = _scene(args)
     units = None
     if (args.radius is None) != (args.mu_h is None):
-        raise ValueError("--radius and --muH go together (rim radius in m, mu*H in N/m)")
+        raise ValueError("--radius and --muH go together (rim radius, e.g. 0.3mm, and mu*H, e.g. 52N/m)")
     if args.radius is not None:
-        units = {"R_L": args.radius, "mu_H": args.mu_h}
+        units = {"R_L": args.radius.si, "mu_H": args.mu_h.si}
     deltas = None
     if args.points is not None:
         if not 2 <= args.points <= MAX_POINTS:
@@ -163,7 +181,9 @@ def _cmd_curve(args):
         deltas = [args.delta_max * (i + 1) / args.points for i in range(args.points)]
 
     every = _checkpoint_seconds()
-    show = _progress(sys.stderr.isatty() and not args.quiet)
+    from .progress import curve_progress, wanted
+
+    bar, show = curve_progress(args.delta_max, f"curve {args.preset}", enabled=wanted(args.quiet))
     last = [time.perf_counter()]
 
     def callback(curve, sol):
@@ -175,14 +195,23 @@ def _cmd_curve(args):
             last[0] = time.perf_counter()
 
     t0 = time.perf_counter()
-    c = sb.curve(scene, args.delta_max, deltas=deltas, force_max=args.force_max,
-                 lambda0_max=args.lambda0_max, max_steps=args.max_steps, tol=args.tol,
-                 max_nodes=args.max_nodes, callback=callback, topology=args.topology)
-    if sys.stderr.isatty() and not args.quiet:
-        sys.stderr.write("\n")
+    try:
+        c = sb.curve(scene, args.delta_max, deltas=deltas, force_max=args.force_max,
+                     lambda0_max=args.lambda0_max, max_steps=args.max_steps, tol=args.tol,
+                     max_nodes=args.max_nodes, callback=callback, topology=args.topology)
+    finally:
+        bar.close()
     write_curve(c, out, profiles=args.profiles, overwrite=True, units=units)
     partial.unlink(missing_ok=True)
     print(f"wrote {out}: {c.summary()} in {time.perf_counter() - t0:.1f} s")
+    if units is not None and len(c):
+        from .units import force_unit_of, format_in
+
+        fu = force_unit_of(args.mu_h.unit)
+        scale = args.radius.si * args.mu_h.si
+        print(f"  with R_L = {args.radius} and mu*H = {args.mu_h}: displacement up to "
+              f"{args.radius.show(args.radius.si * float(max(c.delta)))}, force "
+              f"{format_in(scale * float(min(c.force)), fu, 'force')} .. {format_in(scale * float(max(c.force)), fu, 'force')}")
     if len(c):
         print(f"  contact topologies along the curve: {c.topology_summary()}")
     if c.interrupted:
@@ -225,6 +254,16 @@ def _cmd_solve(args):
             "delta_error", "nodes", "niter", "max_residual", "wall_time")
     out = {k: sol.get(k, 0.0 if k in ("S1", "ring_force_inner") else None) for k in keys}
     out = {k: (float(v) if isinstance(v, (np.floating,)) else v) for k, v in out.items()}
+    if (args.radius is None) != (args.mu_h is None):
+        raise ValueError("--radius and --muH go together (rim radius, e.g. 0.3mm, and mu*H, e.g. 52N/m)")
+    shown = {}
+    if args.radius is not None:  # the state in the units given: displacement R_L delta, force mu_H R_L F
+        from .units import force_unit_of, format_in
+
+        out["displacement_m"] = args.radius.si * sol.delta
+        out["force_N"] = args.mu_h.si * args.radius.si * sol.force
+        shown = {"displacement": args.radius.show(out["displacement_m"]),
+                 "force (SI)": format_in(out["force_N"], force_unit_of(args.mu_h.unit), "force")}
     if args.profiles and sol.success:
         out["profile"] = {k: np.asarray(v).tolist() for k, v in sol.profile().items()}
     if args.json:
@@ -232,6 +271,8 @@ def _cmd_solve(args):
     else:
         for k in keys:
             print(f"{k:>16s}: {out[k]}")
+        for k, v in shown.items():
+            print(f"{k:>16s}: {v}")
         if args.profiles and sol.success:
             prof = sol.profile()
             cols = ("S", "region", "r", "z", "lambda_s", "lambda_theta", "kappa_s", "kappa_theta",
@@ -242,90 +283,261 @@ def _cmd_solve(args):
     return 0 if sol.success else 1
 
 
-def _cmd_fit(args):
-    """``shellbvp fit``: exit 0 (fit succeeded; warnings allowed), 1 (the fit ran but failed its
-    checks) or 2 (bad input: a ValueError, one line on stderr).  With ``--json`` stdout holds
-    exactly one JSON document in every case (errors: see :func:`main`)."""
-    import dataclasses
-
-    import shellbvp as sb
-
-    from .paths import check_output_path
-    from .units import parse_quantity
-
-    if args.output is not None:
-        check_output_path(args.output, overwrite=args.force)
-
+def _fit_inputs(args):
+    """The scene, R_L and the reading and fitting options of ``fit``, checked before any work."""
     scene = _scene(args)
-    R_L = parse_quantity(args.radius, "length", default_unit="m")
-    if not (math.isfinite(R_L) and R_L > 0):
-        raise ValueError(f"--radius must be a finite length > 0 (e.g. 0.3mm); got {args.radius!r}")
     units = None
     if args.units:
         parts = [u.strip() for u in args.units.split(",")]
-        if len(parts) != 2:
-            raise ValueError(f"--units must be two units, displacement and force, e.g. mm,mN; got {args.units!r}")
+        if len(parts) not in (2, 3):
+            raise ValueError(f"--units must be two units, displacement and force (and a third for time), "
+                             f"e.g. mm,mN; got {args.units!r}")
         units = tuple(parts)
     columns = [c.strip() for c in args.columns.split(",")] if args.columns else None
-    if columns is not None and len(columns) != 2:
-        raise ValueError(f"--columns must name two columns (displacement, force); got {args.columns!r}")
-    if args.example == (args.data is not None):
-        raise ValueError("give a CSV file or --example (one of them)")
-    from .fitting import example_data_path
-
-    data = example_data_path() if args.example else args.data
-    disp, force = sb.read_force_csv(data, columns=columns, units=units)
-    bounds = {}
+    if columns is not None and len(columns) not in (2, 3):
+        raise ValueError(f"--columns must name two columns (displacement, force) or three (and time); "
+                         f"got {args.columns!r}")
+    options = {"fit_offset": not args.no_offset, "fit_beta": args.fit_beta, "fit_alpha": args.fit_alpha,
+               "weights": args.weights, "tol": args.tol}
     for name, text in (("beta", args.beta_range), ("alpha", args.alpha_range)):
         if text is not None:
             parts = text.split(",")
             try:
-                bounds[f"{name}_bounds"] = tuple(_numbers(text, f"--{name}-range"))
+                options[f"{name}_bounds"] = tuple(_numbers(text, f"--{name}-range"))
             except ValueError:
                 raise ValueError(f"--{name}-range must be two numbers LOW,HIGH; got {text!r}") from None
             if len(parts) != 2:
                 raise ValueError(f"--{name}-range must be two numbers LOW,HIGH; got {text!r}")
             if not (args.fit_beta if name == "beta" else args.fit_alpha):
                 raise ValueError(f"--{name}-range needs --fit-{name}")
-    res = sb.fit(scene, disp, force, R_L=R_L, fit_offset=not args.no_offset, fit_beta=args.fit_beta,
-                 fit_alpha=args.fit_alpha, weights=args.weights, tol=args.tol, **bounds)
+    return scene, args.radius.si, {"columns": columns, "units": units}, options
+
+
+def _cmd_fit(args):
+    """``shellbvp fit``: exit 0 (fit succeeded; warnings allowed), 1 (the fit ran but failed its
+    checks) or 2 (bad input: a ValueError, one line on stderr).  With ``--json`` stdout holds
+    exactly one JSON document in every case (errors: see :func:`main`).  Several files (or a
+    directory, a pattern, or ``--table``): a batch, see :func:`_fit_batch`."""
+    from .batch import expand_inputs
+    from .fitting import example_data_path, fit_record
+    from .instrument import read_instrument
+    from .paths import check_output_path
+
+    if args.example == bool(args.data):
+        raise ValueError("give data files (or a directory) or --example (one of them)")
+    inputs = [str(example_data_path())] if args.example else args.data
+    files = expand_inputs(inputs)
+    if len(files) > 1 or args.table or any(Path(x).is_dir() for x in inputs):
+        return _fit_batch(args, files)
+    if args.output is not None:
+        check_output_path(args.output, overwrite=args.force)
+    if args.report is not None:
+        _check_report_path(args.report, overwrite=args.force)
+    scene, R_L, reading, options = _fit_inputs(args)
+    options["progress"] = _curve_bars(args)
+    record = read_instrument(files[0], **reading)
+    res, used = fit_record(scene, record, R_L=R_L, segment=args.segment, baseline=args.baseline, **options)
     out = res.to_dict()
     out["exit_status"] = 0 if res.success else 1
     if args.json:
         print(json.dumps(out, allow_nan=False))
     else:
+        _print_fit(res, record, used, args)
+    if args.output or args.report:
         if not res.success:
-            print(f"fit failed (status {res.status}): {res.message}")
-        lo, hi = res.mu_H_ci95
-        print(f"mu*H   = {res.mu_H:.4g} N/m (um*MPa)   95% CI [{lo:.4g}, {hi:.4g}]")
-        if not args.no_offset:
-            o1, o2 = res.offset_ci95
-            print(f"offset = {res.offset * 1e3:.4g} mm   95% CI [{o1 * 1e3:.4g}, {o2 * 1e3:.4g}] mm")
-        for name in ("beta", "alpha"):
-            if name in res.fitted:
-                v, (c1, c2) = getattr(res, name), getattr(res, name + "_ci95")
-                print(f"{name:<6s} = {v:.4g}   95% CI [{c1:.4g}, {c2:.4g}] (profile likelihood; "
-                      f"{res.curves_computed} model curves)")
-        print(f"rms residual = {res.residual_rms * 1e3:.4g} mN over {res.n} points; R_L = {R_L * 1e3:.4g} mm; "
-              f"{res.weights} weights")
-        for text in res.warnings:
-            print(f"warning: {text}")
-    if args.output:
-        if not res.success:
-            print(f"shellbvp: not writing {args.output}: the fit failed its checks", file=sys.stderr)
-        else:  # the file carries the fit's outcome (settings["fit"], read back by read_curve)
-            record = {k: out[k] for k in ("mu_H", "mu_H_ci95", "offset", "offset_ci95", "fitted", "weights",
-                                          "status", "message", "warnings", "warning_codes", "n", "R_L")}
-            curve = dataclasses.replace(res.curve, settings={**res.curve.settings, "fit": record})
-            curve.to_hdf5(args.output, overwrite=args.force, units={"R_L": R_L, "mu_H": res.mu_H})
+            print(f"shellbvp: not writing {args.output or args.report}: the fit failed its checks", file=sys.stderr)
+        else:
+            _save_fit(res, record, used, args.output, args.report, args.segment, args.force, args.json)
     return 0 if res.success else 1
 
 
+def _output_dir(path, what, files, suffix, force):
+    """A directory for one output per file (created if its parent exists); names checked now."""
+    from .paths import check_output_path
+
+    d = Path(path)
+    if d.exists() and not d.is_dir():
+        raise ValueError(f"{what} {path}: with several files it must be a directory (one file each)")
+    if not d.exists():
+        if not d.parent.is_dir():
+            raise ValueError(f"{what} {path}: its parent directory does not exist")
+        d.mkdir()
+    stems = [Path(f).stem for f in files]
+    twice = sorted({s for s in stems if stems.count(s) > 1})
+    if twice:
+        raise ValueError(f"{what}: several input files are named {twice[0]!r} (their outputs would collide); "
+                         "fit them in separate calls")
+    for stem in stems:
+        check_output_path(d / f"{stem}{suffix}", overwrite=force)
+    return d
+
+
+def _fit_batch(args, files):
+    """``shellbvp fit A B ... [--table results.csv] [-o DIR] [--report DIR]``: every file with
+    the same scene and settings, one row each (status ok, failed or error), continuing past
+    a file that fails; exit 0 when every file was fitted, 1 otherwise."""
+    from .batch import fit_files, write_table
+    from .paths import check_output_path
+
+    if args.table is not None:
+        check_output_path(args.table, overwrite=args.force)
+    outdir = _output_dir(args.output, "-o", files, ".h5", args.force) if args.output else None
+    repdir = _output_dir(args.report, "--report", files, ".pdf", args.force) if args.report else None
+    scene, R_L, reading, options = _fit_inputs(args)
+    options["progress"] = _curve_bars(args, leave=False)
+    bar = _progress_bar(len(files), "file", args)
+
+    def step(row):
+        bar.update(1)
+        bar.set_postfix_str(f"{Path(row.file).name}: {row.status}")
+
+    try:
+        rows = fit_files(scene, files, R_L=R_L, segment=args.segment, baseline=args.baseline, on_file=step,
+                         **reading, **options)
+    finally:
+        bar.close()
+    for row in rows:
+        if row.status == "ok" and (outdir or repdir):
+            stem = Path(row.file).stem
+            _save_fit(row.result, row.record, row.used, outdir / f"{stem}.h5" if outdir else None,
+                      repdir / f"{stem}.pdf" if repdir else None, args.segment, args.force, True)
+    if args.table is not None:
+        write_table(args.table, rows, args.segment, overwrite=args.force)
+    ok = all(r.status == "ok" for r in rows)
+    if args.json:
+        docs = [{"file": r.file, "status": r.status, "message": r.message,
+                 **(r.result.to_dict() if r.result is not None else {})} for r in rows]
+        print(json.dumps(_strict_json({"files": docs, "success": ok, "exit_status": 0 if ok else 1}),
+                         allow_nan=False))
+    else:
+        width = max(len(r.file) for r in rows)
+        for r in rows:
+            if r.result is not None and r.status != "error":
+                lo, hi = r.result.mu_H_ci95
+                text = f"mu*H = {r.result.mu_H:.4g} N/m  95% CI [{lo:.4g}, {hi:.4g}]"
+                if r.result.warnings:
+                    text += f"  ({len(r.result.warnings)} warning{'s' * (len(r.result.warnings) > 1)})"
+            else:
+                text = r.message
+            print(f"{r.file:<{width}}  {r.status:<6s}  {text}")
+        n_ok = sum(r.status == "ok" for r in rows)
+        print(f"{n_ok} of {len(rows)} files fitted" + (f"; table: {args.table}" if args.table else ""))
+    return 0 if ok else 1
+
+
+def _save_fit(res, record, used, output, report, segment, force, quiet_stdout=False):
+    """The fit's record (HDF5) and its one-page report (PNG/PDF), as asked (with --json the
+    'wrote' lines go to stderr: stdout holds the one JSON document)."""
+    import os
+    import tempfile
+
+    from .fitrecord import read_fit, write_fit
+
+    if output:
+        write_fit(output, res, record, used, segment=segment, overwrite=force)
+        print(f"wrote {output}", file=sys.stderr if quiet_stdout else sys.stdout)
+    if report:
+        from .plotting import fit_report
+
+        if output:
+            fit_report(read_fit(output), report)
+        else:  # the report alone: the record goes through a temporary file
+            fd, tmp = tempfile.mkstemp(suffix=".h5")
+            os.close(fd)
+            try:
+                write_fit(tmp, res, record, used, segment=segment, overwrite=True)
+                fit_report(read_fit(tmp), report)
+            finally:
+                os.unlink(tmp)
+        print(f"wrote {report}", file=sys.stderr if quiet_stdout else sys.stdout)
+
+
+def _print_fit(res, record, used, args):
+    """The fit in words, in the data's own units (and mu*H in N/m)."""
+    from .units import format_in
+
+    du, fu = record.units["displacement"], record.units["force"]
+    if not res.success:
+        print(f"fit failed (status {res.status}): {res.message}")
+    counts = ", ".join(f"{k} {v}" for k, v in record.counts().items())
+    name = Path(record.path).name if args.example else record.path
+    print(f"data   = {name}: {len(record)} rows ({counts}); fitted the {args.segment} segment, "
+          f"{int(used.sum())} rows")
+    lo, hi = res.mu_H_ci95
+    print(f"mu*H   = {res.mu_H:.4g} N/m (um*MPa)   95% CI [{lo:.4g}, {hi:.4g}]")
+    show = (lambda v, unit, kind: format_in(v, unit, kind).split(" ")[0])
+    if "offset" in res.fitted:
+        o1, o2 = res.offset_ci95
+        print(f"offset = {format_in(res.offset, du, 'length')}   95% CI [{show(o1, du, 'length')}, "
+              f"{show(o2, du, 'length')}] {du} (the contact point)")
+    if res.baseline_model != "none":
+        b1, b2 = res.baseline_ci95
+        print(f"baseline = {format_in(res.baseline, fu, 'force')}   95% CI [{show(b1, fu, 'force')}, "
+              f"{show(b2, fu, 'force')}] {fu} ({res.baseline_model})")
+    if res.baseline_model == "linear":
+        s1, s2 = res.baseline_slope_ci95
+        print(f"baseline slope = {res.baseline_slope:.4g} N/m   95% CI [{s1:.4g}, {s2:.4g}]")
+    for name in ("beta", "alpha"):
+        if name in res.fitted:
+            v, (c1, c2) = getattr(res, name), getattr(res, name + "_ci95")
+            print(f"{name:<6s} = {v:.4g}   95% CI [{c1:.4g}, {c2:.4g}] (profile likelihood; "
+                  f"{res.curves_computed} model curves)")
+    print(f"rms residual = {format_in(res.residual_rms, fu, 'force')} over {res.n} points; R_L = "
+          f"{args.radius}; {res.weights} weights")
+    for text in res.warnings:
+        print(f"warning: {text}")
+
+
+def _check_report_path(path, overwrite):
+    from .paths import check_output_path
+
+    if not str(path).lower().endswith((".png", ".pdf")):
+        raise ValueError(f"--report must name a .png or .pdf file; got {path!r}")
+    return check_output_path(path, overwrite=overwrite)
+
+
+def _cmd_report(args):
+    """``shellbvp report FIT.h5 [-o FIT.pdf]``: the one-page summary of a fit file."""
+    from .fitrecord import read_fit
+    from .plotting import fit_report, require_matplotlib
+
+    out = args.output or str(Path(args.file).with_suffix(".pdf"))
+    _check_report_path(out, overwrite=True)  # a report is redrawn from its record: replaced
+    require_matplotlib()
+    fit_report(read_fit(args.file), out)
+    print(f"wrote {out}")
+    return 0
+
+
 def _cmd_plot(args):
+    from .fitrecord import is_fit_file, read_fit
     from .io import read_curve
     from .paths import check_output_path
-    from .plotting import plot_curves, plot_profiles, require_matplotlib
+    from .plotting import plot_curves, plot_fit_record, plot_profiles, require_matplotlib, save_figure
 
+    fits = [f for f in args.files if is_fit_file(f)]
+    if fits:
+        if len(fits) != len(args.files):
+            raise ValueError("plot either curve files or fit files, not both in one call")
+        if args.output is None:  # each figure next to its fit file
+            outs = [Path(name).with_suffix(".png") for name in fits]
+        elif len(fits) > 1 or Path(args.output).is_dir():
+            outdir = _output_dir(args.output, "-o", fits, ".png", True)
+            outs = [outdir / (Path(name).stem + ".png") for name in fits]
+        else:
+            outs = [Path(args.output)]
+        plt = require_matplotlib()
+        for name, out in zip(fits, outs):
+            check_output_path(out, overwrite=True)
+            ax, _ = plot_fit_record(read_fit(name))
+            ax.figure.tight_layout()
+            try:
+                save_figure(ax.figure, out, dpi=args.dpi)
+            finally:
+                plt.close(ax.figure)
+            print(f"wrote {out}")
+        return 0
+    args.output = "curves.png" if args.output is None else args.output
     check_output_path(args.output, overwrite=True)  # a figure is cheap to redraw: replaced
     plt = require_matplotlib()
     curves = [read_curve(f) for f in args.files]
@@ -339,7 +551,7 @@ def _cmd_plot(args):
                 raise ValueError(f"--profiles depths must be > 0; got {d}")
         plot_profiles(curves[0].scene, deltas, ax=axes[0, 1])
     fig.tight_layout()
-    fig.savefig(args.output, dpi=args.dpi)
+    save_figure(fig, args.output, dpi=args.dpi)
     print(f"wrote {args.output}")
     return 0
 
@@ -347,7 +559,16 @@ def _cmd_plot(args):
 def _cmd_info(args):
     import numpy as np
 
+    from .fitrecord import is_fit_file, read_fit
     from .io import read_curve
+
+    if is_fit_file(args.file):
+        from .plotting import fit_summary_lines
+
+        print(f"file:      {args.file} (a fit)")
+        for line in fit_summary_lines(read_fit(args.file)):
+            print(f"  {line}")
+        return 0
 
     c = read_curve(args.file)
     s = c.scene
@@ -395,11 +616,13 @@ def build_parser():
     c.add_argument("--lambda0-max", type=_number, dest="lambda0_max", help="stop at this pole stretch")
     c.add_argument("--max-steps", type=int, default=400, dest="max_steps")
     c.add_argument("--profiles", action="store_true", help="store each point's profiles")
-    c.add_argument("--radius", type=_number, help="rim radius R_L in m (with --muH: SI columns)")
-    c.add_argument("--muH", type=_number, dest="mu_h", help="mu*H in N/m")
+    c.add_argument("--radius", type=quantity("length"),
+                   help="rim radius R_L with its unit, e.g. 0.3mm (with --muH: SI columns in the file)")
+    c.add_argument("--muH", type=quantity("mu_H"), dest="mu_h", help="mu*H with its unit, e.g. 52N/m")
     c.add_argument("-o", "--output", help="output file (default <preset>.h5, or <preset>-2.h5, ... if that exists)")
     c.add_argument("--force", action="store_true", help="replace an existing output file")
-    c.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
+    c.add_argument("-q", "--quiet", action="store_true", help="no progress bar (there is none when stderr is not "
+                   "a terminal or tqdm is not installed: pip install 'shellbvp[progress]')")
     c.add_argument("--topology", choices=("auto", "cap"), default="auto",
                    help="auto (default): where the single contact cap would pull the shell, use the valid "
                         "lifted-off (line or annular) contact; cap: single cap only, flagged where invalid")
@@ -410,6 +633,9 @@ def build_parser():
     g.add_argument("--delta", type=_number, help="pole displacement (default 0.2)")
     g.add_argument("--lambda0", type=_number, help="pole stretch")
     g.add_argument("--load", type=_number, help="indenter force F (force control)")
+    s.add_argument("--radius", type=quantity("length"), help="rim radius with its unit, e.g. 0.3mm (with --muH: "
+                   "the state also in these units)")
+    s.add_argument("--muH", type=quantity("mu_H"), dest="mu_h", help="mu*H with its unit, e.g. 52N/m")
     s.add_argument("--profiles", action="store_true", help="print the fields over S")
     s.add_argument("--json", action="store_true", help="print JSON")
     s.add_argument("--topology", choices=("auto", "cap", "line", "annulus"), default="auto",
@@ -421,13 +647,24 @@ def build_parser():
                        "Exit status: 0 the fit succeeded (warnings, if any, printed as 'warning: ...'); "
                        "1 the fit ran but failed its checks (e.g. an interval not finite or wider than mu*H); "
                        "2 bad input (one-line message).")
-    f.add_argument("data", nargs="?", help="CSV file: displacement and force columns")
+    f.add_argument("data", nargs="*", help="instrument file(s) (CSV/TSV/text: displacement and force, optionally "
+                   "time); several files, a directory or a pattern fit each with the same settings (a batch)")
+    f.add_argument("--table", help="batch: write one row per file (CSV: file, status, mu*H and its interval, "
+                   "offset, baseline, residual, warnings, ...)")
     f.add_argument("--example", action="store_true",
                    help="use the synthetic Lepidium-like data shipped with shellbvp (README)")
     _scene_options(f)
-    f.add_argument("--radius", required=True, help="rim radius R_L of the sample, e.g. 0.3mm")
+    f.add_argument("--radius", required=True, type=quantity("length"),
+                   help="rim radius R_L of the sample with its unit, e.g. 0.3mm")
     f.add_argument("--columns", help="displacement,force columns by name or 0-based index (default 0,1)")
     f.add_argument("--units", help="units of the two columns, e.g. mm,mN (default: from the header)")
+    f.add_argument("--segment", choices=("loading", "retraction", "all"), default="loading",
+                   help="rows to fit: loading (default: the approach and the loading, up to the deepest point; "
+                        "segments by the direction of the displacement over time), retraction, or all "
+                        "(every row, whatever its direction)")
+    f.add_argument("--baseline", choices=("auto", "none", "constant", "linear"), default="auto",
+                   help="force baseline fitted with the contact point: auto (default: constant when the data "
+                        "have an approach before contact, else none), none, constant, linear")
     f.add_argument("--no-offset", action="store_true", dest="no_offset", help="do not fit the contact point")
     f.add_argument("--fit-beta", action="store_true", dest="fit_beta",
                    help="also fit beta (starting from the scene's; a few more model curves)")
@@ -439,16 +676,27 @@ def build_parser():
                    help="noise model: uniform (same force noise everywhere), relative (noise proportional "
                         "to the force) or mixed (both, estimated; the default)")
     f.add_argument("--json", action="store_true")
-    f.add_argument("-o", "--output", help="write the fitted model curve (HDF5, with SI columns)")
+    f.add_argument("-o", "--output", help="write the fit as a record (HDF5/NeXus: data, model, parameters with "
+                   "intervals, weights, warnings, scene, source file and its SHA-256); a batch: a directory "
+                   "(one <name>.h5 per file)")
+    f.add_argument("--report", help="write a one-page summary of the fit (.png or .pdf); a batch: a directory "
+                   "(one <name>.pdf per file)")
+    f.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
     f.add_argument("--force", action="store_true", help="replace an existing output file")
     f.set_defaults(func=_cmd_fit)
     pl = sub.add_parser("plot", help="plot curves (and profiles) from HDF5 files (needs matplotlib)")
-    pl.add_argument("files", nargs="+", help="curve files written by `shellbvp curve`")
-    pl.add_argument("-o", "--output", default="curves.png", help="PNG or PDF (default curves.png)")
+    pl.add_argument("files", nargs="+", help="curve files (`shellbvp curve`) or fit files (`shellbvp fit -o`: data, "
+                    "model and residuals in SI units)")
+    pl.add_argument("-o", "--output", help="PNG or PDF (default curves.png; for fit files <name>.png next to "
+                    "each); for several fit files a directory (one <name>.png each)")
     pl.add_argument("--profiles", help="also draw the deformed shell of the first file at these depths, e.g. 0.1,0.3")
     pl.add_argument("--dpi", type=int, default=150)
     pl.set_defaults(func=_cmd_plot)
-    i = sub.add_parser("info", help="describe a curve file")
+    rp = sub.add_parser("report", help="one-page summary (PDF or PNG) of a fit file written by `shellbvp fit -o`")
+    rp.add_argument("file", help="fit file (HDF5)")
+    rp.add_argument("-o", "--output", help="PDF or PNG (default: the fit file's name with .pdf)")
+    rp.set_defaults(func=_cmd_report)
+    i = sub.add_parser("info", help="describe a curve file or a fit file")
     i.add_argument("file")
     i.set_defaults(func=_cmd_info)
     r = sub.add_parser("presets", help="list the built-in scenes")

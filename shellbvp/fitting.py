@@ -4,8 +4,11 @@ The model force scales linearly in mu*H (``F_SI = mu_H R_L F(delta)``), so
 one model curve serves a fit of mu*H and the contact point: it is computed
 once on a grid of depths and interpolated (monotone cubic) in delta.  The
 unknowns are ``mu_H`` and, optionally, the origin offset ``d0`` of the
-displacement (real contact points are uncertain):
-``F_i = mu_H R_L F((d_i - d0)/R_L)`` for ``d_i > d0``, 0 before.
+displacement (real contact points are uncertain) and a force baseline (what the
+instrument reads before contact, as nanite fits it with the contact point):
+``F_i = mu_H R_L F((d_i - d0)/R_L) + b0 + b1 (d_i - d0)``, the first term 0 for
+``d_i <= d0`` (b0, b1 fitted or 0).  :func:`fit_record` fits a segment of an
+instrument record (:mod:`shellbvp.instrument`), the loading by default.
 
 beta (bending stiffness) and the Mooney–Rivlin alpha change the *shape* of
 the curve.  Fitting one of them uses a few model curves at trial values
@@ -32,11 +35,8 @@ Student's t.  ``benchmarks/fit_coverage.py`` measures their coverage.
 
 from __future__ import annotations
 
-import codecs
-import csv
 import logging
 import math
-import re
 from collections import OrderedDict
 from dataclasses import dataclass, field
 
@@ -44,13 +44,17 @@ import numpy as np
 from scipy import optimize, stats
 from scipy.interpolate import CubicSpline, PchipInterpolator
 
-from .units import PLAIN_NUMBER, unit_factor
+from .instrument import read_force_csv
 
 log = logging.getLogger(__name__)
 
 __all__ = ["FitResult", "fit", "read_force_csv", "example_data_path", "WEIGHTS", "DEFAULT_WEIGHTS",
-           "FIT_STATUS", "FIT_WARNINGS", "PLAUSIBLE_MU_H", "runs_test"]
+           "FIT_STATUS", "FIT_WARNINGS", "PLAUSIBLE_MU_H", "runs_test", "BASELINES", "MODEL_PARAMETERS", "fit_record"]
 
+#: Force baselines of :func:`fit` (none; a constant b0; b0 + b1 (d - d0)).
+BASELINES = ("none", "constant", "linear")
+#: The parameters of the model at a fixed curve shape, in the order of the least squares.
+MODEL_PARAMETERS = ("mu_H", "offset", "baseline", "baseline_slope")
 #: Noise models of :func:`fit`.
 WEIGHTS = ("uniform", "relative", "mixed")
 #: The default noise model (chosen by the coverage measured in benchmarks/fit_coverage.py).
@@ -78,6 +82,7 @@ FIT_WARNINGS = {
     "implausible_mu_H": "mu*H is far outside the values of soft shells (PLAUSIBLE_MU_H): check the units",
     "search_range": "a shape parameter's interval or search reached the end of its range",
     "max_curves": "the number of model curves reached its limit",
+    "mixed_segments": "the fitted rows mix the loading and the retraction of an instrument record",
 }
 #: mu*H (N/m) of soft shells, from red-cell membranes (~1e-5) to thick rubber (~1e4); a fit
 #: outside this range gets a warning (a header in kN for data in mN gives 1e6 x the truth).
@@ -145,21 +150,15 @@ class FitResult:
         With beta or alpha fitted: ``max |F_interpolated - F_curve| / max |F|`` at
         the estimate before its own curve was added (None otherwise).
     R_L : float
-        Rim radius of the sample, m.
-
-    Examples
-    --------
-    >>> import shellbvp as sb
-    >>> from shellbvp.fitting import example_data_path
-    >>> d, F = sb.read_force_csv(example_data_path())
-    >>> res = sb.fit(sb.Scene.preset("fit"), d, F, R_L=0.3e-3)
-    >>> res.success, res.fitted, res.weights, res.n
-    (True, ('mu_H', 'offset'), 'mixed', 40)
-    >>> lo, hi = res.mu_H_ci95
-    >>> bool(lo < res.mu_H < hi), bool(lo < 52 < hi)       # the truth is 52 N/m
-    (True, True)
-    >>> print(f"{res.model_force(0.1e-3) * 1e3:.2f} mN at 0.1 mm")
-    14.03 mN at 0.1 mm
+    baseline_model : str
+        The force baseline fitted, one of :data:`BASELINES`.
+    baseline, baseline_ci95 : float, (float, float)
+        Force baseline b0 (N) at the contact point and its 95 % interval (0 when not fitted).
+    baseline_slope, baseline_slope_ci95 : float, (float, float)
+        Its slope b1 (N/m) with ``baseline="linear"`` (0 otherwise).
+    point_weights : ndarray
+        The noise model's weight (1/sigma, largest 1) of each data point as given (NaN
+        where a value was missing).
     """
 
     mu_H: float
@@ -184,6 +183,12 @@ class FitResult:
     interpolation_error: float = None
     warnings: list = field(default_factory=list)
     warning_codes: list = field(default_factory=list)
+    baseline_model: str = "none"
+    baseline: float = 0.0
+    baseline_ci95: tuple = (0.0, 0.0)
+    baseline_slope: float = 0.0
+    baseline_slope_ci95: tuple = (0.0, 0.0)
+    point_weights: object = field(repr=False, default=None)
 
     @property
     def success(self):
@@ -207,8 +212,12 @@ class FitResult:
                 "n": self.n, "success": self.success, "status": self.status, "message": self.message,
                 "warnings": list(self.warnings), "warning_codes": list(self.warning_codes), "R_L": self.R_L,
                 "curves_computed": self.curves_computed, "interpolation_error": num(self.interpolation_error),
+                "baseline_model": self.baseline_model, "baseline": num(self.baseline),
+                "baseline_ci95": ci(self.baseline_ci95), "baseline_slope": num(self.baseline_slope),
+                "baseline_slope_ci95": ci(self.baseline_slope_ci95),
                 "units": {"mu_H": "N/m (= um*MPa)", "offset": "m", "residual": "N (rms)",
-                          "residual_rms": "N", "R_L": "m", "beta": "1 (B/(mu R_L^2))", "alpha": "1"}}
+                          "residual_rms": "N", "R_L": "m", "beta": "1 (B/(mu R_L^2))", "alpha": "1",
+                          "baseline": "N", "baseline_slope": "N/m"}}
 
 
 # -- model curves ------------------------------------------------------------------------------
@@ -216,8 +225,9 @@ _CACHE: OrderedDict = OrderedDict()
 _CACHE_SIZE = 32
 
 
-def _model_curve(scene, deltas, tol, counter=None):
-    """The curve of ``scene`` at ``deltas`` (memoised per process: repeated fits reuse it)."""
+def _model_curve(scene, deltas, tol, counter=None, progress=None):
+    """The curve of ``scene`` at ``deltas`` (memoised per process: repeated fits reuse it);
+    ``progress(description, delta_max) -> (bar, callback)`` draws its progress."""
     from .continuation import curve
 
     try:
@@ -229,7 +239,12 @@ def _model_curve(scene, deltas, tol, counter=None):
         _CACHE.move_to_end(key)
         return _CACHE[key]
     _check_model_start(scene, float(deltas[0]), tol)
-    c = curve(scene, deltas=deltas, tol=tol, estimate_error=False)
+    bar, callback = progress("model curve", float(deltas[-1])) if progress is not None else (None, None)
+    try:
+        c = curve(scene, deltas=deltas, tol=tol, estimate_error=False, callback=callback)
+    finally:
+        if bar is not None:
+            bar.close()
     if counter is not None:
         counter[0] += 1
     c.solutions = []  # profiles are not needed here; keep the cache small
@@ -274,14 +289,15 @@ class _Shape:
     the nodes at each depth and a monotone cubic (PCHIP) in delta.
     """
 
-    def __init__(self, scene_at, grid, tol, need, counter):
+    def __init__(self, scene_at, grid, tol, need, counter, progress=None):
         self.scene_at, self.grid, self.tol, self.need, self.counter = scene_at, grid, tol, need, counter
+        self.progress = progress
         self.nodes = {}  # theta -> curve
         self._spline = None
 
     def add(self, theta):
         """Compute the node curve at theta; False if it does not reach the data."""
-        c = _model_curve(self.scene_at(theta), self.grid, self.tol, self.counter)
+        c = _model_curve(self.scene_at(theta), self.grid, self.tol, self.counter, self.progress)
         if len(c) < 3:
             raise ValueError(f"the model curve of this scene could not be computed to the data's depths "
                              f"({c.stop_reason})")
@@ -317,9 +333,20 @@ class _Shape:
 
 # -- least squares at a fixed shape ------------------------------------------------------------
 class _Model:
-    def __init__(self, d, f, R_L, fit_offset, loss):
-        self.d, self.f, self.R_L, self.fit_offset, self.loss = d, f, R_L, fit_offset, loss
+    """Weighted least squares at a fixed curve shape F(delta).
+
+    ``F_i = mu_H R_L F((d_i - d0)/R_L) + b0 + b1 (d_i - d0)``: the parameter vector is
+    always ``q = (mu_H, d0, b0, b1)`` (:data:`MODEL_PARAMETERS`); the ones not fitted stay
+    0.  The model is linear in mu_H, b0 and b1, so the start is a search over d0 with
+    those three solved exactly at every trial d0 (variable projection), then all free
+    parameters are refined together.
+    """
+
+    def __init__(self, d, f, R_L, fit_offset, baseline, loss):
+        self.d, self.f, self.R_L, self.loss = d, f, R_L, loss
+        self.free = np.array([True, bool(fit_offset), baseline != "none", baseline == "linear"])
         self.big = 1e3 * (np.max(np.abs(f)) + 1)
+        self.fscale = float(np.max(np.abs(f))) or 1.0
 
     @staticmethod
     def shape(P, top, x):  # nondimensional model force, 0 before contact, NaN beyond the curve
@@ -327,36 +354,87 @@ class _Model:
         out = np.where(x <= 0, 0.0, P(np.clip(x, 0, top)))
         return np.where(x > top, np.nan, out)
 
-    def force(self, P, top, disp, mu_H, d0):
-        return mu_H * self.R_L * self.shape(P, top, (disp - d0) / self.R_L)
+    def full(self, p):
+        """The free parameters ``p`` -> ``q = (mu_H, d0, b0, b1)``."""
+        q = np.zeros(4)
+        q[self.free] = p
+        return q
+
+    def baseline(self, disp, q):
+        """The force baseline b0 + b1 (d - d0), N."""
+        return q[2] + q[3] * (np.asarray(disp, float) - q[1])
+
+    def indentation(self, P, top, disp, q):
+        """The shell's force (model minus baseline), N."""
+        return q[0] * self.R_L * self.shape(P, top, (np.asarray(disp, float) - q[1]) / self.R_L)
+
+    def force(self, P, top, disp, q):
+        return self.indentation(P, top, disp, q) + self.baseline(disp, q)
+
+    def _columns(self, P, top, d0):
+        """Columns of the linear parameters (mu_H, b0, b1) at a fixed d0 (the free ones)."""
+        cols = [self.R_L * self.shape(P, top, (self.d - d0) / self.R_L), np.ones_like(self.d), self.d - d0]
+        return [c for c, free in zip(cols, self.free[[0, 2, 3]]) if free]
+
+    def start(self, P, top, w):
+        """Start values: the best d0 on a grid (mu_H, b0, b1 solved exactly at each)."""
+        d = self.d
+        if not self.free[1]:
+            trial = np.array([0.0])
+        else:
+            depth_ok = np.max(d) - top * self.R_L  # deeper data would be beyond the curve
+            k = int(np.sum(self.free))
+            lo, hi = max(depth_ok, np.min(d) - 0.5 * np.ptp(d)), np.sort(d)[-(k + 1)]
+            trial = np.linspace(lo, hi, 160) if hi > lo else np.array([lo])
+        best = (np.inf, None)
+        for d0 in trial:
+            cols = self._columns(P, top, d0)
+            A = w[:, None] * np.column_stack(cols)
+            if not np.all(np.isfinite(A)):
+                continue
+            coef, *_ = np.linalg.lstsq(A, w * self.f, rcond=None)
+            if not coef[0] > 0:
+                continue
+            r = A @ coef - w * self.f
+            rss = float(r @ r)
+            if rss < best[0]:
+                q = np.zeros(4)
+                q[[0, 2, 3]] = self._spread(coef)
+                q[1] = d0
+                best = (rss, q)
+        if best[1] is None:  # no trial gives a positive mu_H: start at d0 = 0 with a unit-scale mu_H
+            q = np.zeros(4)
+            q[0] = 1.0
+            return q[self.free]
+        return best[1][self.free]
+
+    def _spread(self, coef):
+        """(mu_H, b0, b1) from the coefficients of the free linear columns."""
+        out = np.zeros(3)
+        out[self.free[[0, 2, 3]]] = coef
+        return out
 
     def fit(self, P, dP, top, w, start=None):
-        """Weighted least squares of (mu_H, d0) at a fixed shape: (params, weighted RSS, weighted J)."""
-        d, f, R_L, fo = self.d, self.f, self.R_L, self.fit_offset
-
-        def unpack(p):
-            return (p[0], p[1]) if fo else (p[0], 0.0)
+        """Weighted least squares of the free parameters at a fixed shape: (result, weighted RSS,
+        weighted Jacobian); ``result.x`` holds the free parameters (see :meth:`full`)."""
+        d, f, R_L = self.d, self.f, self.R_L
 
         def residual(p):
-            r = self.force(P, top, d, *unpack(p)) - f
+            r = self.force(P, top, d, self.full(p)) - f
             return w * np.nan_to_num(r, nan=self.big)
 
         def jac(p):
-            mu_H, d0 = unpack(p)
+            mu_H, d0, _, b1 = self.full(p)
             x = (d - d0) / R_L
             ds = np.where((x > 0) & (x <= top), dP(np.clip(x, 0, top)), 0.0)
-            cols = [R_L * np.nan_to_num(self.shape(P, top, x))]
-            if fo:
-                cols.append(-mu_H * np.nan_to_num(ds))
-            return w[:, None] * np.stack(cols, axis=1)
+            cols = [R_L * np.nan_to_num(self.shape(P, top, x)), -mu_H * np.nan_to_num(ds) - b1,
+                    np.ones_like(d), d - d0]
+            return w[:, None] * np.stack([c for c, free in zip(cols, self.free) if free], axis=1)
 
-        if start is None:
-            s0 = w * np.nan_to_num(self.shape(P, top, d / R_L))
-            mu0 = float(np.dot(s0, w * f) / max(np.dot(s0, s0), 1e-300) / R_L)
-            start = [mu0 if mu0 > 0 else 1.0, 0.0] if fo else [mu0 if mu0 > 0 else 1.0]
-        start = list(start)
-        scale = [abs(start[0]) or 1.0, 0.01 * R_L] if fo else [abs(start[0]) or 1.0]
-        res = optimize.least_squares(residual, start, jac=jac, x_scale=scale, loss=self.loss, method="trf")
+        start = self.start(P, top, w) if start is None else np.asarray(start, float)
+        scale = np.array([abs(start[0]) or 1.0, 0.01 * R_L, 0.01 * self.fscale, 0.01 * self.fscale / R_L])
+        res = optimize.least_squares(residual, start, jac=jac, x_scale=scale[self.free], loss=self.loss,
+                                     method="trf")
         r = residual(res.x)
         return res, float(np.dot(r, r)), jac(res.x)
 
@@ -382,7 +460,7 @@ def _weights(kind, model_force, f, floor, w_prev):
     return 1.0 / np.sqrt(s2 / np.max(s2))
 
 
-def _check_data(d, f, k):
+def _check_data(d, f, k, origin=0.0):
     """Checks of the data before any model curve; returns the finite rows, or raises ValueError.
 
     ``k`` is the number of fitted parameters.  NaN rows are dropped (missing
@@ -405,8 +483,9 @@ def _check_data(d, f, k):
     if distinct < need:
         raise ValueError(f"displacement: need at least {need} distinct values to fit {k} parameters; got "
                          f"{distinct} (the data are {d.size} points at {distinct} depth(s))")
-    if np.max(d) <= 0:
-        raise ValueError("displacement must reach positive values (indentation into the shell)")
+    if np.max(d) <= origin:
+        raise ValueError("displacement must reach positive values (indentation into the shell)" if origin == 0 else
+                         f"displacement must reach beyond the contact point guess {origin:g} m")
     if np.ptp(f) == 0:
         raise ValueError(f"force is constant ({f[0]:g} N at every point): it must increase with the depth "
                          "of indentation")
@@ -488,7 +567,7 @@ def _check_bounds(name, bounds, lo_ok, hi_ok, value):
 
 def fit(scene, displacement, force, *, R_L, fit_offset=True, fit_beta=False, fit_alpha=False,
         weights=None, floor=0.05, beta_bounds=BETA_BOUNDS, alpha_bounds=ALPHA_BOUNDS, delta_max=None,
-        tol=1e-6, loss="linear"):
+        tol=1e-6, loss="linear", baseline="none", contact_guess=None, progress=None):
     """Least-squares fit of mu*H (the displacement origin, and beta or alpha) to measured data.
 
     Parameters
@@ -502,6 +581,19 @@ def fit(scene, displacement, force, *, R_L, fit_offset=True, fit_beta=False, fit
         Rim radius of the sample (m).
     fit_offset : bool
         Also fit the origin of the displacement (contact point).
+    baseline : {"none", "constant", "linear"}
+        Force baseline fitted with the contact point (as nanite does): ``"constant"`` adds
+        a force offset b0 (the force the instrument reads before contact), ``"linear"``
+        also a slope, ``b0 + b1 (d - d0)`` (a tilted baseline: drift or drag, continued
+        through contact).  It needs data before the contact point (the approach) to be
+        determined well.
+    contact_guess : float, optional
+        A first guess of the contact point (m; e.g. :func:`shellbvp.instrument.estimate_contact`):
+        the model curve is computed to 1.2 x the depth of the data beyond it.  Default 0
+        (displacements measured from about the contact point).
+    progress : callable, optional
+        ``progress(description, delta_max) -> (bar, callback)`` for each model curve computed
+        (e.g. ``lambda d, m: shellbvp.progress.curve_progress(m, d)``); None: silent.
     fit_beta, fit_alpha : bool
         Also fit beta (within ``beta_bounds``) or the Mooney–Rivlin alpha
         (within ``alpha_bounds``, subset of [0, 1]); one of them at most.
@@ -569,10 +661,16 @@ def fit(scene, displacement, force, *, R_L, fit_offset=True, fit_beta=False, fit
     if fit_beta and fit_alpha:
         raise ValueError("fit_beta and fit_alpha: fit one of beta, alpha at a time (each changes the curve's "
                          "shape only weakly; together with mu*H they are not identifiable from one curve)")
+    if baseline not in BASELINES:
+        raise ValueError(f"baseline must be one of {BASELINES}; got {baseline!r}")
+    origin = 0.0 if contact_guess is None else contact_guess
+    if not (isinstance(origin, (int, float)) and math.isfinite(origin)):
+        raise ValueError(f"contact_guess (m) must be a finite number; got {contact_guess!r}")
     d = np.asarray(displacement, float).ravel()
     f = np.asarray(force, float).ravel()
-    k = 1 + bool(fit_offset) + bool(fit_beta or fit_alpha)
-    d, f = _check_data(d, f, k)
+    keep = np.isfinite(d) & np.isfinite(f) if d.shape == f.shape else None
+    k = 1 + bool(fit_offset) + bool(fit_beta or fit_alpha) + (baseline != "none") + (baseline == "linear")
+    d, f = _check_data(d, f, k, float(origin))
     if not (isinstance(R_L, (int, float)) and math.isfinite(R_L) and R_L > 0):
         raise ValueError(f"R_L (rim radius, m) must be a finite number > 0; got {R_L!r}")
     if fit_beta:
@@ -590,12 +688,13 @@ def fit(scene, displacement, force, *, R_L, fit_offset=True, fit_beta=False, fit
         scene_at = (lambda th: scene.replace(material=MooneyRivlin(float(min(max(th, 0.0), 1.0)))))
     else:
         name = None
-    dm = 1.2 * np.max(d) / R_L if delta_max is None else float(delta_max)
+    depth = (np.max(d) - origin) / R_L  # the deepest datum's delta, if the contact is at the guess
+    dm = 1.2 * depth if delta_max is None else float(delta_max)
     if not (math.isfinite(dm) and dm > 0):
         raise ValueError(f"delta_max must be > 0; got {delta_max!r}")
     grid = dm * np.arange(1, N_DEPTHS + 1) / N_DEPTHS
     counter = [0]
-    mdl = _Model(d, f, R_L, fit_offset, loss)
+    mdl = _Model(d, f, R_L, fit_offset, baseline, loss)
     notes = []
 
     def irls(P, dP, top):
@@ -605,7 +704,8 @@ def fit(scene, displacement, force, *, R_L, fit_offset=True, fit_beta=False, fit
         for it in range(8):
             if weights == "uniform":
                 break
-            w_new = _weights(weights, mdl.force(P, top, d, *_unpack(res.x, fit_offset)), f, floor, w)
+            q = mdl.full(res.x)
+            w_new = _weights(weights, mdl.indentation(P, top, d, q), f - mdl.baseline(d, q), floor, w)
             change = np.max(np.abs(w_new / w - 1)) if it > 0 else np.inf
             w = w_new
             res, rss, J = mdl.fit(P, dP, top, w, start=res.x)
@@ -614,18 +714,18 @@ def fit(scene, displacement, force, *, R_L, fit_offset=True, fit_beta=False, fit
         return res, rss, J, w
 
     if name is None:
-        shape = _Shape(lambda th: scene, grid, tol, np.max(d) / R_L, counter)
+        shape = _Shape(lambda th: scene, grid, tol, depth, counter, progress)
         shape.add(None)
         P, dP, top = shape.at(None)
         res, rss, J, w = irls(P, dP, top)
         theta_hat, theta_ci, interp_err, fit_scene, c = None, None, None, scene, shape.nodes[None]
         model_P = (P, top)
     else:
-        shape = _Shape(scene_at, grid, tol, np.max(d) / R_L, counter)
+        shape = _Shape(scene_at, grid, tol, depth, counter, progress)
         lim = [bounds[0], bounds[1]]  # shrinks where node curves do not reach the data
         if not shape.add(theta0):
             raise ValueError(f"the model curve at the scene's {name} ends before the deepest data point "
-                             f"(delta = {np.max(d) / R_L:.4g}): fit shallower data, or check the units and R_L")
+                             f"(delta = {depth:.4g}): fit shallower data, or check the units and R_L")
 
         def extend(side):
             """Add the next node beyond the nodes on side -1 (low) or +1 (high); False at the limit."""
@@ -681,7 +781,8 @@ def fit(scene, displacement, force, *, R_L, fit_offset=True, fit_beta=False, fit
                 break
             rss, res = profile(theta_hat)
             P, dP, top = shape.at(theta_hat)
-            w_new = _weights(weights, mdl.force(P, top, d, *_unpack(res.x, fit_offset)), f, floor, w)
+            q = mdl.full(res.x)
+            w_new = _weights(weights, mdl.indentation(P, top, d, q), f - mdl.baseline(d, q), floor, w)
             change = np.max(np.abs(w_new / w - 1)) if it > 0 else np.inf
             w = w_new
             theta_hat = estimate()
@@ -740,32 +841,35 @@ def fit(scene, displacement, force, *, R_L, fit_offset=True, fit_beta=False, fit
         # (central; one-sided at the end of the nodes)
         h = 1e-4 * step
         ths = [min(max(t, shape.thetas[0]), shape.thetas[-1]) for t in (theta_hat - h, theta_hat + h)]
-        Fp = [mdl.force(*_drop(shape.at(t)), d, *_unpack(res.x, fit_offset)) for t in ths]
+        Fp = [mdl.force(*_drop(shape.at(t)), d, mdl.full(res.x)) for t in ths]
         col = w * np.nan_to_num((Fp[1] - Fp[0]) / (ths[1] - ths[0]))
         J = np.column_stack([J, col])
         near = min(shape.thetas, key=lambda t: abs(t - theta_hat))
         c = shape.nodes[near]
         fit_scene = shape.scene_at(near)
         model_P = (P, top)
-    # intervals of mu_H, d0 (Wald, t), from the weighted Jacobian
+    # intervals of the free parameters (Wald, t), from the weighted Jacobian
     n = d.size
     dof = max(n - k, 1)
     try:
         cov = np.linalg.inv(J.T @ J) * rss / dof
-        half = stats.t.ppf(0.975, dof) * np.sqrt(np.diag(cov))
+        half_free = stats.t.ppf(0.975, dof) * np.sqrt(np.diag(cov))
     except np.linalg.LinAlgError:
-        half = np.full(J.shape[1], np.nan)
-    mu_H = float(res.x[0])
-    d0 = float(res.x[1]) if fit_offset else 0.0
-    off_ci = (d0 - half[1], d0 + half[1]) if fit_offset else (0.0, 0.0)
-    off_ci = tuple(float(v) for v in off_ci)
+        half_free = np.full(J.shape[1], np.nan)
+    q = mdl.full(res.x)
+    half = np.zeros(4)
+    half[mdl.free] = half_free[:int(np.sum(mdl.free))]
+    ci = [(float(v - h), float(v + h)) for v, h in zip(q, half)]
+    mu_H, d0, b0, b1 = (float(v) for v in q)
+    off_ci = ci[1]
     P, top = model_P
 
-    def model(disp, mu_H, d0):
-        return mu_H * R_L * _Model.shape(P, top, (disp - d0) / R_L)
+    def model(disp, mu_H, d0, b0=b0, b1=b1):
+        disp = np.asarray(disp, float)
+        return mu_H * R_L * _Model.shape(P, top, (disp - d0) / R_L) + b0 + b1 * (disp - d0)
 
     resid = model(d, mu_H, d0) - f
-    fitted = ("mu_H",) + (("offset",) if fit_offset else ()) + ((name,) if name else ())
+    fitted = tuple(nm for nm, free in zip(MODEL_PARAMETERS, mdl.free) if free) + ((name,) if name else ())
     mat = fit_scene.material
     alpha = float(mat.alpha) if isinstance(mat, MooneyRivlin) else None
     beta = float(fit_scene.beta)
@@ -776,24 +880,24 @@ def fit(scene, displacement, force, *, R_L, fit_offset=True, fit_beta=False, fit
     elif name == "alpha":
         alpha = float(theta_hat)
         alpha_ci = tuple(float(v) for v in theta_ci)
-    mu_ci = (float(mu_H - half[0]), float(mu_H + half[0]))
-    status, checks = _check_result(bool(res.success), mu_H, mu_ci, off_ci if fit_offset else (0.0, 0.0),
-                                   bool(np.all(np.isfinite(resid))), d, resid)
+    mu_ci = ci[0]
+    status, checks = _check_result(bool(res.success), mu_H, mu_ci, off_ci, bool(np.all(np.isfinite(resid))), d,
+                                   resid)
     found = notes + checks
     for _, text in found:
         log.info("fit: warning: %s", text)
     message = f"{FIT_STATUS[status]} (least squares: {res.message})"
+    point_weights = np.full(keep.size, np.nan)
+    point_weights[keep] = w / np.max(w)
     return FitResult(mu_H=mu_H, mu_H_ci95=mu_ci, offset=d0,
                      offset_ci95=off_ci, residual_rms=float(np.sqrt(np.mean(np.nan_to_num(resid, nan=mdl.big) ** 2))),
                      n=n, status=status, message=message, R_L=float(R_L), curve=c, _model=model,
                      beta=beta, beta_ci95=beta_ci, alpha=alpha, alpha_ci95=alpha_ci, fitted=fitted,
                      weights=weights, scene=fit_scene, curves_computed=counter[0],
                      interpolation_error=interp_err, warnings=[t for _, t in found],
-                     warning_codes=[code for code, _ in found])
-
-
-def _unpack(p, fit_offset):
-    return (p[0], p[1]) if fit_offset else (p[0], 0.0)
+                     warning_codes=[code for code, _ in found], baseline_model=baseline, baseline=b0,
+                     baseline_ci95=ci[2], baseline_slope=b1, baseline_slope_ci95=ci[3],
+                     point_weights=point_weights)
 
 
 def _drop(pdt):
@@ -804,161 +908,66 @@ def _show(name, theta):
     return f"{math.exp(theta):.3g}" if name == "beta" else f"{theta:.3g}"
 
 
-_BOMS = ((codecs.BOM_UTF32_LE, "utf-32"), (codecs.BOM_UTF32_BE, "utf-32"), (codecs.BOM_UTF8, "utf-8-sig"),
-         (codecs.BOM_UTF16_LE, "utf-16"), (codecs.BOM_UTF16_BE, "utf-16"))
-
-
-def _decode(raw, path):
-    """Text of a CSV file: a BOM's encoding, else UTF-8, else UTF-16 (no BOM), else cp1252/Latin-1."""
-    for bom, enc in _BOMS:
-        if raw.startswith(bom):
-            try:
-                return raw.decode(enc)
-            except UnicodeDecodeError as exc:
-                raise ValueError(f"{path}: cannot decode as {enc} (its byte-order mark says so): {exc.reason} "
-                                 f"at byte {exc.start}") from None
-    tries = ["utf-8"]
-    if len(raw) >= 4 and raw.count(b"\x00") >= len(raw) // 4:  # ASCII text in UTF-16 without a BOM
-        tries += ["utf-16-le" if raw[1::2].count(0) > raw[0::2].count(0) else "utf-16-be"]
-    for enc in tries + ["cp1252", "latin-1"]:
-        try:
-            text = raw.decode(enc)
-        except UnicodeDecodeError:
-            continue
-        if not re.search(r"[\x00-\x08\x0b\x0c\x0e-\x1f\x7f]", text):  # control characters: not this encoding
-            return text
-    raise ValueError(f"{path}: not a text file in a known encoding (tried UTF-8, UTF-16, Windows-1252, Latin-1; "
-                     "it holds control characters): save it as CSV text, e.g. UTF-8")
-
-
-def _number(s, decimal_comma):
-    """float of a CSV cell: "" and "nan" are NaN; anything but a plain finite number is None."""
-    t = s.strip()
-    if decimal_comma:
-        t = t.replace(",", ".")
-    if not t or t.lower() == "nan":
-        return math.nan
-    if not PLAIN_NUMBER.fullmatch(t):
-        return None
-    v = float(t)
-    return v if math.isfinite(v) else None
-
-
-def read_force_csv(path, *, columns=None, units=None):
-    """Read displacement and force columns from an instrument's CSV file.
-
-    Accepts a header or none, comma, semicolon or tab delimiters, columns by
-    name or 0-based index (default: the first two), units in the header
-    (``"Displacement (mm)"``, ``"force [mN]"``, ``"µm"`` or ``"μm"``) or by
-    ``units=("mm", "mN")``, descending or repeated displacements and NaN/empty
-    rows (dropped), ``#`` comment lines.  Encodings: a byte-order mark's
-    (UTF-8, UTF-16, UTF-32), else UTF-8, UTF-16 or Windows-1252/Latin-1.
-    Numbers must be plain decimals (``1.5``, ``-2e-3``; with ``;`` delimiters
-    also ``1,5``); ``5_0``, ``inf`` or ``1e999`` are errors.
+def fit_record(scene, record, *, R_L, segment="loading", baseline="auto", **options):
+    """Fit one segment of an instrument record (:func:`shellbvp.instrument.read_instrument`).
 
     Parameters
     ----------
-    path : str or Path
-        The CSV file.
-    columns : (str or int, str or int), optional
-        Displacement and force columns, by header name or 0-based index.
-    units : (str, str), optional
-        Their units (e.g. ``("mm", "mN")``) when the header has none.
+    scene : Scene
+    record : InstrumentRecord
+    R_L : float
+        Rim radius (m).
+    segment : {"loading", "retraction", "all"}
+        Rows to fit (:meth:`InstrumentRecord.mask`): by default the pushing part, the
+        approach and the loading, never the retraction with it.
+    baseline : {"auto", "none", "constant", "linear"}
+        ``auto``: a constant baseline when the segment has an approach before contact
+        (:func:`shellbvp.instrument.estimate_contact` finds one), none otherwise.
+    **options
+        Passed to :func:`fit` (``fit_offset``, ``fit_beta``, ``weights``, ``tol``, ...).
 
     Returns
     -------
-    displacement, force : ndarray
-        In metres and newtons, sorted by displacement.
+    result : FitResult
+    used : ndarray of bool, shape (len(record),)
+        The rows fitted.  With ``segment="loading"`` the record's pushing rows are
+        relabelled at the fitted contact point (before it 'approach').
 
     Raises
     ------
     ValueError
-        Naming the line (counted in the file, comments included) of a
-        malformed row, or the column or unit that is missing.
-
-    Examples
-    --------
-    >>> import os, tempfile, shellbvp as sb
-    >>> path = os.path.join(tempfile.mkdtemp(), "run1.csv")
-    >>> with open(path, "w") as fh:
-    ...     _ = fh.write("# sample 1\\ntime (s),disp (um),force [uN]\\n0,20,150\\n1,10,40\\n2,30,300\\n")
-    >>> d, F = sb.read_force_csv(path, columns=("disp", "force"))
-    >>> [round(float(x), 9) for x in d], [round(float(x), 9) for x in F]
-    ([1e-05, 2e-05, 3e-05], [4e-05, 0.00015, 0.0003])
+        An unknown segment or baseline, a segment with fewer than 3 rows (the message
+        gives each segment's count), or what :func:`fit` refuses.
     """
-    try:
-        with open(path, "rb") as fh:
-            raw = fh.read()
-    except OSError as exc:
-        raise ValueError(f"{path}: cannot read ({exc.strerror})") from None
-    text = _decode(raw, path)
-    numbered = [(i, ln) for i, ln in enumerate(text.splitlines(), start=1)
-                if ln.strip() and not ln.lstrip().startswith("#")]
-    if not numbered:
-        raise ValueError(f"{path}: no data")
-    lines = [ln for _, ln in numbered]
-    try:
-        dialect = csv.Sniffer().sniff("\n".join(lines[:20]), delimiters=",;\t")
-        delim = dialect.delimiter
-    except csv.Error:
-        delim = "," if "," in lines[0] else (";" if ";" in lines[0] else "\t")
-    rows = [next(csv.reader([ln], delimiter=delim), []) for ln in lines]
-    line_no = [i for i, _ in numbered]
+    from .instrument import estimate_contact
 
-    def is_number(s):
-        return _number(s, delim == ";") is not None
-
-    header = None
-    if not all(is_number(c) for c in rows[0]):
-        header = [h.strip() for h in rows[0]]
-        rows, line_no = rows[1:], line_no[1:]
-    if columns is None:
-        cols = (0, 1)
-    else:
-        cols = []
-        for c in columns:
-            if isinstance(c, int) or (isinstance(c, str) and c.strip().isdigit()):
-                cols.append(int(c))
-            else:
-                if header is None:
-                    raise ValueError(f"{path}: column {c!r} given by name but the file has no header")
-                names = [h.split("(")[0].split("[")[0].strip().lower() for h in header]
-                key = str(c).strip().lower()
-                if key not in names:
-                    raise ValueError(f"{path}: no column named {c!r}; columns are {header}")
-                cols.append(names.index(key))
-        cols = tuple(cols)
-    unit_names = list(units) if units is not None else [None, None]
-    if units is None and header is not None:
-        for i, col in enumerate(cols):
-            if col < len(header):
-                m = re.search(r"[\(\[]\s*([^\)\]]+?)\s*[\)\]]", header[col])
-                if m:
-                    unit_names[i] = m.group(1).replace("\u03bc", "\u00b5")  # Greek mu -> micro sign
-    if unit_names[0] is None or unit_names[1] is None:
-        raise ValueError(f"{path}: units unknown; give them in the header, e.g. 'displacement (mm)', "
-                         "or with --units mm,mN")
-    fd, ff = unit_factor(unit_names[0], "length"), unit_factor(unit_names[1], "force")
-    disp, frc = [], []
-    for n, row in zip(line_no, rows):
-        if all(not c.strip() for c in row):
-            continue
-        try:
-            a, b = (row[c].strip() for c in cols)
-        except IndexError:
-            raise ValueError(f"{path}: line {n} has {len(row)} columns; need column {max(cols)}") from None
-        va, vb = _number(a, delim == ";"), _number(b, delim == ";")
-        if va is None or vb is None:
-            raise ValueError(f"{path}: line {n}: cannot read {a!r}, {b!r} as numbers (plain finite decimals "
-                             "such as 1.5 or -2e-3; empty or nan for a missing value)")
-        if math.isinf(va * fd) or math.isinf(vb * ff):
-            raise ValueError(f"{path}: line {n}: {a!r}, {b!r} overflow when converted to metres and newtons "
-                             f"({unit_names[0]}, {unit_names[1]})")
-        disp.append(va * fd)
-        frc.append(vb * ff)
-    d, f = np.array(disp), np.array(frc)
-    ok = np.isfinite(d) & np.isfinite(f)
-    if ok.sum() < 3:
-        raise ValueError(f"{path}: fewer than 3 rows with numbers")
-    order = np.argsort(d[ok], kind="stable")
-    return d[ok][order], f[ok][order]
+    if baseline not in ("auto",) + BASELINES:
+        raise ValueError(f"baseline must be one of {('auto',) + BASELINES}; got {baseline!r}")
+    used = record.mask(segment)
+    if used.sum() < 3:
+        raise ValueError(f"{record.path}: the {segment} segment has {int(used.sum())} rows; the record's segments "
+                         f"are {record.counts()} (by the direction of the displacement in file order"
+                         f"{' and time' if record.time is not None else ''}); choose another with --segment "
+                         f"(one of loading, retraction, all)")
+    d, f = record.displacement[used], record.force[used]
+    guess = estimate_contact(d, f)
+    if baseline == "auto":
+        baseline = "constant" if guess is not None else "none"
+    if not options.get("fit_offset", True):
+        guess = 0.0  # the contact point is known: displacements are measured from it
+    elif guess is None:
+        # no baseline to read: the record starts in contact.  Displacements measured from about
+        # the contact (the old convention) keep 0; otherwise the first row is the best guess.
+        lo = float(np.min(d))
+        guess = 0.0 if 0.0 <= lo and np.max(d) <= 3 * np.ptp(d) else lo
+    res = fit(scene, d, f, R_L=R_L, baseline=baseline, contact_guess=guess, **options)
+    counts = record.counts()
+    if segment == "all" and counts.get("retraction") and counts.get("loading"):
+        text = (f"the fitted rows mix the loading ({counts['loading']} rows) and the retraction "
+                f"({counts['retraction']} rows) of the record: with hysteresis the two branches differ and the "
+                f"fit of both is biased; fit one with --segment loading or retraction")
+        res.warnings.append(text)
+        res.warning_codes.append("mixed_segments")
+    if segment == "loading":
+        record.relabel(res.offset)
+    return res, used

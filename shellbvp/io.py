@@ -43,6 +43,7 @@ from pathlib import Path
 import numpy as np
 
 from .chain import CONFIGURATION_NAMES
+from .nexus import label_units
 from .paths import check_output_path
 from .version import __version__
 
@@ -264,6 +265,7 @@ def write_curve(curve, path, *, profiles=False, overwrite=False, units=None):
                     for k, v in sol.profile().items():
                         sg.create_dataset(k, data=v)
         os.chmod(tmp, 0o666 & ~_umask())  # mkstemp makes 0600; give the usual permissions
+        label_units(tmp)  # every dataset says its unit (nondimensional: "1")
         os.replace(tmp, path)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)

@@ -10,7 +10,8 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["plot_curves", "plot_profiles", "plot_fit", "require_matplotlib", "scene_label"]
+__all__ = ["plot_curves", "plot_profiles", "plot_fit", "plot_fit_record", "fit_report", "fit_summary_lines",
+           "require_matplotlib", "scene_label", "save_figure"]
 
 
 def require_matplotlib():
@@ -108,3 +109,126 @@ def plot_fit(result, displacement, force, ax=None):
     ax.set_ylabel("force (mN)")
     ax.legend(fontsize=8)
     return ax
+
+
+def save_figure(fig, path, dpi=150):
+    """Save ``fig`` atomically (a temporary file in the same directory, then renamed): a
+    reader never sees half a figure and an earlier one stays whole if drawing fails.
+    The format follows the name's suffix (png, pdf, svg, ...)."""
+    import os
+    import tempfile
+    from pathlib import Path
+
+    path = Path(path)
+    fmt = path.suffix.lstrip(".").lower() or "png"
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    os.close(fd)
+    try:
+        fig.savefig(tmp, dpi=dpi, format=fmt)
+        mask = os.umask(0)
+        os.umask(mask)
+        os.chmod(tmp, 0o666 & ~mask)
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+    return path
+
+
+def _si_axis(ax, which, unit):
+    """SI units with engineering prefixes on an axis (``10 µm``, ``2 mN``)."""
+    from matplotlib.ticker import EngFormatter
+
+    (ax.xaxis if which == "x" else ax.yaxis).set_major_formatter(EngFormatter(unit=unit))
+
+
+def plot_fit_record(record, axes=None):
+    """Data, model and residuals of a fit file (:func:`shellbvp.fitrecord.read_fit`), in SI units.
+
+    The rows fitted are drawn filled, the others (the retraction, a hold, ...) hollow and
+    grey; the model over the fitted depth range; below, the residuals (model - data) of
+    the rows fitted.  The legend gives mu*H and its 95 % interval.
+
+    Parameters
+    ----------
+    record : FitRecord
+    axes : (Axes, Axes), optional
+        The data and residual axes (default: a new figure with both).
+
+    Returns
+    -------
+    (Axes, Axes)
+    """
+    plt = require_matplotlib()
+    if axes is None:
+        fig, axes = plt.subplots(2, 1, figsize=(6.4, 6), sharex=True, gridspec_kw={"height_ratios": [3, 1]})
+    ax, axr = axes
+    data, p = record.data, record.parameters
+    used = data["used"]
+    d, f = data["displacement"], data["force"]
+    ax.plot(d[~used], f[~used], "o", mfc="none", mec="0.6", ms=3, label="not fitted")
+    ax.plot(d[used], f[used], "k.", ms=3, label=f"data ({record.settings['segment']}, {int(used.sum())} rows)")
+    lo, hi = record.intervals.get("mu_H", (np.nan, np.nan))
+    m = record.model
+    top = min(np.max(d[used]) if used.any() else np.max(d), np.max(m["displacement"]))
+    x = np.linspace(min(np.min(d[used]) if used.any() else np.min(d), p["offset"]), top, 400)
+    base = p["baseline"] + p["baseline_slope"] * (x - p["offset"])
+    yv = np.interp(x, m["displacement"], m["force"])
+    yv = np.where(x < p["offset"], base, yv)
+    ax.plot(x, yv, "-", color="C3",
+            label=f"model: mu*H = {p['mu_H']:.4g} N/m, 95% CI [{lo:.4g}, {hi:.4g}]")
+    if record.settings.get("baseline_model", "none") != "none":
+        ax.axvline(p["offset"], color="0.5", lw=0.6, ls=":", label="contact point")
+    _si_axis(ax, "y", "N")
+    ax.set_ylabel("force")
+    ax.set_title(f"{record.source['file_name'].split('/')[-1]}: {'fit' if record.success else 'FAILED fit'}",
+                 fontsize=9)
+    ax.legend(fontsize=7)
+    axr.axhline(0, color="0.6", lw=0.6)
+    axr.plot(d[used], data["residual"][used], "k.", ms=3)
+    _si_axis(axr, "y", "N")
+    _si_axis(axr, "x", "m")
+    axr.set_ylabel("model - data")
+    axr.set_xlabel("displacement")
+    return ax, axr
+
+
+def fit_summary_lines(record):
+    """The text of a fit report (one string per line)."""
+    p, iv = record.parameters, record.intervals
+    units = {"mu_H": "N/m", "offset": "m", "baseline": "N", "baseline_slope": "N/m", "beta": "", "alpha": ""}
+    lines = [f"source: {record.source['file_name']}", f"sha256: {record.source['sha256']}",
+             f"columns: {record.source['columns']}; units in the file: {record.source['units']}",
+             f"fit: {'succeeded' if record.success else 'FAILED'} (status {record.status}); "
+             f"{record.settings['segment']} segment, {int(p['n_points'])} rows; baseline {record.settings['baseline_model']}; "
+             f"{record.settings['weights']} weights"]
+    for name in record.fitted:
+        lo, hi = iv[name]
+        lines.append(f"{name} = {p[name]:.5g} {units.get(name, '')}   95% CI [{lo:.5g}, {hi:.5g}]")
+    lines.append(f"rms residual = {p['residual_rms']:.4g} N; R_L = {p['R_L']:.4g} m")
+    s = record.scene
+    lines.append(f"scene: {scene_label(s)}")
+    lines += [f"warning: {w}" for w in record.warnings] or ["warnings: none"]
+    lines.append(f"shellbvp {record.version}; {record.message}")
+    return lines
+
+
+def fit_report(record, path):
+    """A one-page summary of a fit (PNG or PDF by the name's suffix): the figure of
+    :func:`plot_fit_record` and the numbers, for a lab notebook."""
+    import textwrap
+
+    plt = require_matplotlib()
+    fig = plt.figure(figsize=(8.27, 11.69))  # A4 portrait
+    ax = fig.add_axes([0.12, 0.50, 0.8, 0.38])
+    axr = fig.add_axes([0.12, 0.36, 0.8, 0.12], sharex=ax)
+    plot_fit_record(record, (ax, axr))
+    plt.setp(ax.get_xticklabels(), visible=False)
+    fig.suptitle("shellbvp fit report", fontsize=13, y=0.95)
+    text = "\n".join(textwrap.fill(ln, 110, subsequent_indent="    ") for ln in fit_summary_lines(record))
+    fig.text(0.06, 0.30, text, va="top", ha="left", family="monospace", fontsize=6.5)
+    try:
+        save_figure(fig, path)
+    finally:
+        plt.close(fig)
+    return path

@@ -12,24 +12,65 @@ import math
 import re
 from dataclasses import dataclass
 
-__all__ = ["Dimensions", "parse_quantity", "unit_factor", "beta_from_thickness", "plain_number", "PLAIN_NUMBER",
-           "LENGTH_UNITS", "FORCE_UNITS"]
+__all__ = ["Dimensions", "parse_quantity", "unit_factor", "unit_kind", "normalize_unit", "format_in",
+           "beta_from_thickness", "plain_number", "PLAIN_NUMBER", "LENGTH_UNITS", "FORCE_UNITS", "TIME_UNITS",
+           "MU_H_UNITS", "UNIT_TABLES", "SI_UNITS", "split_quantity", "Quantity", "force_unit_of"]
 
 #: A number as a person or a CSV writes it: ASCII digits, optional sign, decimal point and
 #: exponent.  Python's float() also takes "5_0", "inf", "nan", "1e999" and non-ASCII digits.
 PLAIN_NUMBER = re.compile(r"[-+]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][-+]?[0-9]+)?")
 
-LENGTH_UNITS = {"m": 1.0, "mm": 1e-3, "um": 1e-6, "µm": 1e-6, "micron": 1e-6, "nm": 1e-9, "cm": 1e-2}
-FORCE_UNITS = {"N": 1.0, "mN": 1e-3, "uN": 1e-6, "µN": 1e-6, "nN": 1e-9, "kN": 1e3}
+#: SI factors of unit names (the micro sign: ``u``, U+00B5 or U+03BC; see :func:`normalize_unit`).
+LENGTH_UNITS = {"m": 1.0, "cm": 1e-2, "mm": 1e-3, "um": 1e-6, "µm": 1e-6, "micron": 1e-6, "nm": 1e-9}
+FORCE_UNITS = {"kN": 1e3, "N": 1.0, "mN": 1e-3, "uN": 1e-6, "µN": 1e-6, "nN": 1e-9, "pN": 1e-12}
+TIME_UNITS = {"h": 3600.0, "min": 60.0, "s": 1.0, "ms": 1e-3, "us": 1e-6, "µs": 1e-6}
+#: mu*H is a force per length: N/m (= um*MPa = mN/mm = uN/um).
+MU_H_UNITS = {"N/m": 1.0, "mN/m": 1e-3, "kN/m": 1e3, "mN/mm": 1.0, "uN/um": 1.0, "µN/µm": 1.0, "nN/nm": 1.0,
+              "um*MPa": 1.0, "µm*MPa": 1.0, "mm*kPa": 1.0, "kPa*mm": 1.0, "MPa*um": 1.0, "MPa*µm": 1.0}
+#: The unit table of each kind of quantity.
+UNIT_TABLES = {"length": LENGTH_UNITS, "force": FORCE_UNITS, "time": TIME_UNITS, "mu_H": MU_H_UNITS}
+#: The SI unit of each kind (what a bare number would have meant).
+SI_UNITS = {"length": "m", "force": "N", "time": "s", "mu_H": "N/m"}
+
+
+def normalize_unit(unit: str) -> str:
+    """A unit name as the tables spell it: micro as U+00B5, no brackets or spaces.
+
+    Instruments write micro as ``u``, the micro sign U+00B5 or the Greek mu U+03BC
+    (which NFKC-normalised text turns the micro sign into); all three are accepted.
+    """
+    u = str(unit).strip().strip("()[]{}").strip()
+    u = u.replace("\u03bc", "\u00b5").replace("·", "*").replace("⋅", "*").replace(" ", "")
+    return "micron" if u.lower() in ("micron", "microns", "micrometer", "micrometre") else u
+
+
+def unit_kind(unit: str):
+    """The kind ('length', 'force', 'time', 'mu_H') of a unit name, or None if it is none of them."""
+    u = normalize_unit(unit)
+    for kind, table in UNIT_TABLES.items():
+        if u in table:
+            return kind
+    return None
 
 
 def unit_factor(unit: str, kind: str) -> float:
-    """SI factor of a length ('length') or force ('force') unit name."""
-    table = LENGTH_UNITS if kind == "length" else FORCE_UNITS
-    u = unit.strip()
+    """SI factor of a unit name of one kind ('length', 'force', 'time' or 'mu_H').
+
+    Raises
+    ------
+    ValueError
+        The unit is not one of that kind (the message lists the valid ones).
+    """
+    table = UNIT_TABLES[kind]
+    u = normalize_unit(unit)
     if u not in table:
         raise ValueError(f"unknown {kind} unit {unit!r}; use one of {', '.join(table)}")
     return table[u]
+
+
+def format_in(value: float, unit: str, kind: str, digits: int = 4) -> str:
+    """``value`` (SI) written in ``unit``, e.g. ``format_in(1e-5, "um", "length") == "10 um"``."""
+    return f"{value / unit_factor(unit, kind):.{digits}g} {normalize_unit(unit)}"
 
 
 def plain_number(text: str, name: str = "value") -> float:
@@ -40,49 +81,104 @@ def plain_number(text: str, name: str = "value") -> float:
     return v
 
 
-def parse_quantity(text, kind: str = "length", default_unit: str | None = None) -> float:
-    """A length or force with its unit, in SI units.
+_EXAMPLE = {"length": "0.3mm", "force": "2mN", "time": "1.5s", "mu_H": "52N/m"}
+_SUGGEST = {"length": "mm", "force": "mN", "time": "s", "mu_H": "N/m"}
+
+
+def split_quantity(text, kind: str = "length", name: str | None = None):
+    """``'0.3mm'`` -> ``(0.3, 'mm')``; a bare number gives ``(value, '')``.
+
+    The number must be plain (see :data:`PLAIN_NUMBER`) and finite; the unit one of
+    ``UNIT_TABLES[kind]``.  ValueError naming ``name`` (or the kind) otherwise.
+    """
+    label = name or f"the {kind}"
+    m = re.fullmatch(r"\s*([-+]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][-+]?[0-9]+)?)\s*([A-Za-z\u00b5\u03bc]\S*)?\s*",
+                     str(text))
+    if not m or not math.isfinite(float(m.group(1))):
+        raise ValueError(f"cannot read {text!r} as {label}: a plain finite number and a unit, e.g. {_EXAMPLE[kind]}")
+    unit = m.group(2) or ""
+    if unit and unit_kind(unit) != kind:
+        raise ValueError(f"{label}: unknown {kind} unit {unit!r}; use one of {', '.join(UNIT_TABLES[kind])}")
+    return float(m.group(1)), normalize_unit(unit) if unit else ""
+
+
+def parse_quantity(text, kind: str = "length", default_unit: str | None = None, *, require_unit: bool = False,
+                   name: str | None = None) -> float:
+    """A quantity in SI units: ``'0.3mm'`` -> 3e-4, ``'52N/m'`` (kind ``'mu_H'``) -> 52.0.
 
     Parameters
     ----------
     text : str or float
-        A number and a unit, e.g. ``"0.3mm"``, ``"0.3 mm"``, ``"15uN"``; a number
-        alone (str or float) is in ``default_unit``.
-    kind : {"length", "force"}
-        Which units are accepted (:data:`LENGTH_UNITS`, :data:`FORCE_UNITS`).
+        A plain number with a unit (``0.3mm``, ``0.3 mm``, ``300µm``), or a bare number.
+    kind : {'length', 'force', 'time', 'mu_H'}
     default_unit : str, optional
-        The unit of a bare number (default: SI, m or N).
-
-    Returns
-    -------
-    float
-        The value in metres or newtons.
-
-    Raises
-    ------
-    ValueError
-        For text that is not a number and a unit, or an unknown unit.
+        Unit of a bare number (SI when not given).
+    require_unit : bool
+        A bare number is an error that says which unit to add (what the command line does:
+        ``--radius 0.3`` might mean m or mm).
+    name : str, optional
+        Name of the quantity in error messages (e.g. ``--radius``).
 
     Examples
     --------
-    >>> from shellbvp import parse_quantity
     >>> parse_quantity("0.3mm")
     0.0003
-    >>> round(parse_quantity("15 uN", kind="force"), 12)
-    1.5e-05
-    >>> parse_quantity(300, default_unit="um")
-    0.0003
+    >>> parse_quantity("52 N/m", "mu_H")
+    52.0
     """
-    if isinstance(text, (int, float)):
-        v = float(text)
-        return v * (unit_factor(default_unit, kind) if default_unit else 1.0)
-    m = re.fullmatch(r"\s*([-+]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][-+]?[0-9]+)?)\s*([A-Za-zµ]*)\s*", str(text))
-    if not m:
-        raise ValueError(f"cannot read {text!r} as a {kind} (e.g. 0.3mm)")
-    value, unit = float(m.group(1)), m.group(2)
-    if unit:
-        return value * unit_factor(unit, kind)
-    return value * (unit_factor(default_unit, kind) if default_unit else 1.0)
+    label = name or f"the {kind}"
+    if isinstance(text, (int, float)) and not isinstance(text, bool):
+        value, unit = float(text), ""
+    else:
+        value, unit = split_quantity(text, kind, name)
+    if not unit:
+        if require_unit:
+            raise ValueError(f"{label} needs a unit: write it as e.g. {value:g}{_SUGGEST[kind]} "
+                             f"({kind} units: {', '.join(UNIT_TABLES[kind])})")
+        unit = default_unit
+    return value * (unit_factor(unit, kind) if unit else 1.0)
+
+
+@dataclass(frozen=True)
+class Quantity:
+    """A quantity as a person wrote it: ``value`` in ``unit``, and ``si`` in SI units.
+
+    Examples
+    --------
+    >>> q = Quantity.parse("0.3mm", "length")
+    >>> q.si, str(q)
+    (0.0003, '0.3 mm')
+    """
+
+    si: float
+    value: float
+    unit: str
+    kind: str
+
+    @classmethod
+    def parse(cls, text, kind: str = "length", name: str | None = None, positive: bool = True) -> "Quantity":
+        """Parse ``text`` with a unit required (a bare number is an error saying which unit to add).
+
+        ``positive``: also require a finite value > 0 (rim radius, mu*H).
+        """
+        value, unit = split_quantity(text, kind, name)
+        si = parse_quantity(text, kind, require_unit=True, name=name)
+        if positive and not si > 0:
+            raise ValueError(f"{name or 'the ' + kind} must be > 0; got {text!r}")
+        return cls(si=si, value=value, unit=unit, kind=kind)
+
+    def __str__(self):
+        return f"{self.value:g} {self.unit}"
+
+    def show(self, si_value: float, digits: int = 4) -> str:
+        """Another value of this kind (SI) in this quantity's unit."""
+        return format_in(si_value, self.unit, self.kind, digits)
+
+
+def force_unit_of(mu_H_unit: str) -> str:
+    """The force unit of a mu*H unit: ``'mN/mm'`` -> ``'mN'``; ``'N'`` when it has none."""
+    top = normalize_unit(mu_H_unit).split("/")[0]
+    return top if unit_kind(top) == "force" else "N"
 
 
 def beta_from_thickness(H: float, R_L: float) -> float:

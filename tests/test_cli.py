@@ -36,8 +36,9 @@ def test_curve_without_arguments_writes_base_h5(tmp_path):
 
 def test_curve_with_options_and_points(tmp_path):
     r = run("curve", "--preset", "flat", "--beta", "0.02", "--contact", "paper", "--points", "4",
-            "--delta-max", "0.2", "--radius", "0.001", "--muH", "52", "-o", "f.h5", cwd=tmp_path)
+            "--delta-max", "0.2", "--radius", "1mm", "--muH", "52N/m", "-o", "f.h5", cwd=tmp_path)
     assert r.returncode == 0, r.stderr
+    assert "R_L = 1 mm and mu*H = 52 N/m: displacement up to 0.2 mm" in r.stdout, r.stdout
     with h5py.File(tmp_path / "f.h5") as f:
         g = f["curve"]
         assert g.attrs["scene_beta"] == 0.02 and g.attrs["scene_contact"] == "paper"
@@ -50,6 +51,11 @@ def test_solve_prints_state_and_json(tmp_path):
     out = json.loads(r.stdout)
     assert out["success"] and out["delta"] == 0.2
     assert out["force"] == pytest.approx(sb.solve(sb.Scene.preset("base"), delta=0.2).force, abs=1e-8)
+    r = run("solve", "--preset", "base", "--delta", "0.2", "--radius", "300um", "--muH", "52N/m", "--json")
+    si = json.loads(r.stdout)
+    assert si["displacement_m"] == pytest.approx(0.2 * 300e-6) and si["force_N"] == pytest.approx(52 * 3e-4 * si["force"])
+    r = run("solve", "--preset", "base", "--delta", "0.2", "--radius", "300um", "--muH", "52N/m")
+    assert "displacement: 60 um" in r.stdout and "force (SI): 0.005677 N" in r.stdout
     r = run("solve", "--load", str(out["force"]), "--profiles")
     assert r.returncode == 0 and "lambda_theta" in r.stdout and "0.2" in r.stdout
 
@@ -73,6 +79,13 @@ def test_presets_lists_all():
     (["info", "missing.h5"], ["missing.h5", "no such file"]),
     (["solve", "--delta", "-1"], ["delta", "> 0"]),
     (["curve", "--xi", "3"], ["xi"]),
+    # quantities carry their unit in every subcommand; a bare number says which unit to add
+    (["curve", "--radius", "0.3", "--muH", "52N/m", "-o", "x.h5"], ["--radius", "needs a unit", "0.3mm"]),
+    (["curve", "--radius", "0.3mm", "--muH", "52", "-o", "x.h5"], ["--muH", "needs a unit", "52N/m"]),
+    (["fit", "--example", "--radius", "0.3"], ["--radius", "needs a unit", "0.3mm"]),
+    (["fit", "--example", "--radius", "0.3 furlong"], ["--radius", "unknown length unit", "mm"]),
+    (["fit", "--example", "--radius", "0mm"], ["--radius", "> 0"]),
+    (["curve", "--radius", "0.3mm", "--muH", "52N", "-o", "x.h5"], ["--muH", "unknown mu_H unit", "N/m"]),
 ])
 def test_bad_input_exits_with_one_line_message(tmp_path, args, words):
     r = run(*args, cwd=tmp_path)

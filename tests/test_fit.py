@@ -120,7 +120,7 @@ def test_fit_shape_parameter_logic_on_closed_form_curves(monkeypatch, name, trut
     """Nodes, interpolation across them, profile interval: recovers the parameter of a known curve family."""
     calls = []
 
-    def fake(scene, deltas, tol, counter=None):
+    def fake(scene, deltas, tol, counter=None, progress=None):
         calls.append(scene)
         if counter is not None:
             counter[0] += 1
@@ -238,7 +238,10 @@ def test_fit_cli_with_csv(model, tmp_path):
     assert out["residual"] > 0 and out["offset"] > 0 and out["weights"] == "mixed"
     assert out["beta"] == 0.01 and out["beta_ci95"] is None and out["alpha"] == pytest.approx(0.1)
     assert out["fitted"] == ["mu_H", "offset"]
-    assert sb.read_curve(tmp_path / "fit.h5").scene == sb.Scene.preset("fit")
+    from shellbvp.fitrecord import read_fit
+
+    rec = read_fit(tmp_path / "fit.h5")
+    assert rec.scene == sb.Scene.preset("fit") and rec.parameters["mu_H"] == pytest.approx(out["mu_H"], rel=1e-12)
 
 
 def test_plots_headless_produce_png(model, tmp_path):

@@ -140,7 +140,7 @@ def test_data_deeper_than_the_model_reaches(good, monkeypatch):
         def __len__(self):
             return self.delta.size
 
-    monkeypatch.setattr(fitting, "_model_curve", lambda scene, deltas, tol, counter=None: Short(scene, deltas))
+    monkeypatch.setattr(fitting, "_model_curve", lambda scene, deltas, tol, counter=None, progress=None: Short(scene, deltas))
     scene, disp, F, force = good
     with pytest.raises(ValueError, match=r"data reach delta = 0\.48.* model curve ends at delta = 0\.18.*end of the tip"):
         sb.fit(scene, disp, force, R_L=R_L)
@@ -208,10 +208,12 @@ def test_cli_warnings_in_text_json_and_saved_file(good, tmp_path):
     r = run("fit", str(p), "--preset", "fit", "--radius", "0.3mm", "-o", str(tmp_path / "step.h5"))
     assert r.returncode == 0, r.stderr
     assert any(ln.startswith("warning: the residuals' signs") for ln in r.stdout.splitlines()), r.stdout
-    rec = sb.read_curve(tmp_path / "step.h5").settings["fit"]
-    assert rec["status"] == 0 and rec["warning_codes"] == ["residual_runs"] and "runs test" in rec["warnings"][0]
+    from shellbvp.fitrecord import read_fit
+
+    rec = read_fit(tmp_path / "step.h5")
+    assert rec.status == 0 and rec.warning_codes == ["residual_runs"] and "runs test" in rec.warnings[0]
     with h5py.File(tmp_path / "step.h5") as f:
-        assert f["curve"].attrs["mu_H_N_per_m"] == pytest.approx(rec["mu_H"])
+        assert f["fit/parameters/mu_H"][()] == pytest.approx(rec.parameters["mu_H"])
     r = run("fit", str(p), "--preset", "fit", "--radius", "0.3mm", "--json")
     out = json.loads(r.stdout)
     assert r.returncode == 0 and out["warning_codes"] == ["residual_runs"] and out["status"] == 0

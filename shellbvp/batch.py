@@ -1,0 +1,234 @@
+"""Fitting many instrument files with one scene and one set of settings.
+
+Experimenters measure dozens of seeds: :func:`fit_files` fits each file's segment with
+the same scene, radius and settings, continues past a file that cannot be read or
+fitted (its row says why), and reuses the model curve: every file whose depth is
+comparable shares one delta grid (1.2 x the deepest file's depth), so the curve is
+computed once (the fit's curve cache) instead of once per file.  :func:`write_table`
+writes one row per file (CSV, units in the header, written atomically).
+"""
+
+from __future__ import annotations
+
+import csv
+import glob
+import io
+import logging
+import math
+import os
+import tempfile
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+log = logging.getLogger(__name__)
+
+__all__ = ["BatchRow", "fit_files", "expand_inputs", "write_table", "TABLE_COLUMNS", "DATA_SUFFIXES"]
+
+#: File names a directory given as input contributes (instrument exports are text tables).
+DATA_SUFFIXES = (".csv", ".tsv", ".txt", ".dat")
+#: Columns of the results table, with their units.
+TABLE_COLUMNS = ("file", "status", "mu_H (N/m)", "mu_H 95% low (N/m)", "mu_H 95% high (N/m)", "offset (m)",
+                 "offset 95% low (m)", "offset 95% high (m)", "baseline (N)", "baseline 95% low (N)",
+                 "baseline 95% high (N)", "baseline slope (N/m)", "baseline model", "beta", "beta 95% low",
+                 "beta 95% high", "alpha", "alpha 95% low", "alpha 95% high", "residual rms (N)", "points",
+                 "segment", "warnings", "message", "sha256")
+
+
+@dataclass
+class BatchRow:
+    """The outcome for one file of a batch.
+
+    Attributes
+    ----------
+    file : str
+    status : str
+        ``"ok"`` (the fit succeeded; warnings allowed), ``"failed"`` (the fit ran but failed
+        its checks) or ``"error"`` (the file could not be read or fitted: ``message`` says why).
+    result : FitResult or None
+    record : InstrumentRecord or None
+    used : ndarray of bool or None
+        The rows fitted.
+    message : str
+    """
+
+    file: str
+    status: str
+    result: object = None
+    record: object = None
+    used: object = None
+    message: str = ""
+    extra: dict = field(default_factory=dict)
+
+    def table_row(self, segment: str) -> dict:
+        """This file's row of the results table (:data:`TABLE_COLUMNS`)."""
+        row = dict.fromkeys(TABLE_COLUMNS, "")
+        row.update({"file": self.file, "status": self.status, "segment": segment, "message": self.message})
+        if self.record is not None:
+            row["sha256"] = self.record.sha256
+        r = self.result
+        if r is None:
+            return row
+
+        def put(key, value, ci=None, unit=""):
+            suffix = f" ({unit})" if unit else ""
+            row[f"{key}{suffix}"] = _num(value)
+            if ci is not None:
+                row[f"{key} 95% low{suffix}"], row[f"{key} 95% high{suffix}"] = _num(ci[0]), _num(ci[1])
+
+        put("mu_H", r.mu_H, r.mu_H_ci95, "N/m")
+        if "offset" in r.fitted:
+            put("offset", r.offset, r.offset_ci95, "m")
+        if r.baseline_model != "none":
+            put("baseline", r.baseline, r.baseline_ci95, "N")
+        if r.baseline_model == "linear":
+            put("baseline slope", r.baseline_slope, None, "N/m")
+        for name in ("beta", "alpha"):
+            if name in r.fitted:
+                put(name, getattr(r, name), getattr(r, name + "_ci95"))
+        row["baseline model"] = r.baseline_model
+        row["residual rms (N)"] = _num(r.residual_rms)
+        row["points"] = str(r.n)
+        row["warnings"] = " | ".join(r.warnings)
+        return row
+
+
+def _num(v):
+    return "" if v is None or not math.isfinite(v) else f"{v:.8g}"
+
+
+def expand_inputs(inputs) -> list:
+    """File names from files, directories (their files ending in :data:`DATA_SUFFIXES`,
+    sorted) and glob patterns (for shells that do not expand them); order kept, no repeats.
+
+    Raises
+    ------
+    ValueError
+        An input that is no file, directory or matching pattern; a directory without data files.
+    """
+    out = []
+    for item in inputs:
+        p = Path(item)
+        if p.is_dir():
+            found = sorted(q for q in p.iterdir() if q.is_file() and q.suffix.lower() in DATA_SUFFIXES)
+            if not found:
+                raise ValueError(f"{item}: a directory without data files ({', '.join(DATA_SUFFIXES)})")
+            out += [str(q) for q in found]
+        elif p.exists():
+            out.append(str(p))
+        elif any(ch in str(item) for ch in "*?["):
+            found = sorted(glob.glob(str(item)))
+            if not found:
+                raise ValueError(f"{item}: no file matches this pattern")
+            out += found
+        else:
+            out.append(str(p))  # a missing file: its row will say so
+    seen, unique = set(), []
+    for name in out:
+        if name not in seen:
+            seen.add(name)
+            unique.append(name)
+    return unique
+
+
+def fit_files(scene, paths, *, R_L, segment="loading", baseline="auto", columns=None, units=None,
+              on_file=None, **options) -> list:
+    """Fit each file with the same scene and settings; one :class:`BatchRow` per file.
+
+    Parameters
+    ----------
+    scene : Scene
+    paths : sequence of str
+        Instrument files (:func:`expand_inputs` turns directories and patterns into these).
+    R_L : float
+        Rim radius (m), the same for every file.
+    segment, baseline : str
+        As :func:`shellbvp.fitting.fit_record`.
+    columns, units : sequence, optional
+        As :func:`shellbvp.instrument.read_instrument`.
+    on_file : callable, optional
+        Called as ``on_file(row)`` after each file (a progress bar over files).
+    **options
+        Passed to :func:`shellbvp.fitting.fit` (``fit_offset``, ``fit_beta``, ``weights``, ``tol``,
+        ``progress`` of the model curves...).
+
+    Returns
+    -------
+    list of BatchRow
+        In the order of ``paths``.  A file that cannot be read or fitted (a ``ValueError``)
+        gets status ``"error"`` with the message; the others are fitted regardless.
+    """
+    from .fitting import fit_record
+    from .instrument import estimate_contact, read_instrument
+
+    records, rows = {}, {}
+    for path in paths:  # read every file first: the common depth of the model curves
+        try:
+            records[path] = read_instrument(path, columns=columns, units=units)
+        except ValueError as exc:
+            rows[path] = BatchRow(file=path, status="error", message=" ".join(str(exc).split()))
+    depths = {}
+    for path, rec in records.items():
+        try:
+            m = rec.mask(segment)
+            d, f = rec.displacement[m], rec.force[m]
+            guess = estimate_contact(d, f)
+            depths[path] = (np.max(d) - (guess if guess is not None else min(0.0, np.min(d)))) / R_L
+        except ValueError:
+            pass
+    finite = [v for v in depths.values() if math.isfinite(v) and v > 0]
+    common = 1.2 * max(finite) if finite else None
+    out = []
+    for path in paths:
+        if path not in rows:
+            rec = records[path]
+            own = depths.get(path)
+            # files of comparable depth share one grid, hence one model curve (cached)
+            dm = common if (common is not None and own is not None and 1.2 * own >= 0.5 * common
+                            and "delta_max" not in options) else options.get("delta_max")
+            kwargs = {k: v for k, v in options.items() if k != "delta_max"}
+            try:
+                res, used = fit_record(scene, rec, R_L=R_L, segment=segment, baseline=baseline, delta_max=dm,
+                                       **kwargs)
+                rows[path] = BatchRow(file=path, status="ok" if res.success else "failed", result=res, record=rec,
+                                      used=used, message=res.message)
+            except ValueError as exc:
+                rows[path] = BatchRow(file=path, status="error", record=rec, message=" ".join(str(exc).split()))
+        log.info("batch: %s: %s", path, rows[path].status)
+        out.append(rows[path])
+        if on_file is not None:
+            on_file(rows[path])
+    return out
+
+
+def write_table(path, rows, segment="loading", *, overwrite=False):
+    """Write the results table (CSV, :data:`TABLE_COLUMNS`) atomically.
+
+    Raises
+    ------
+    FileExistsError
+        ``path`` exists and ``overwrite`` is False.
+    """
+    from .paths import check_output_path
+
+    path = Path(path)
+    if path.exists() and not overwrite:
+        raise FileExistsError(f"{path} exists; pass overwrite=True (CLI: --force) to replace it")
+    check_output_path(path, overwrite=True)
+    buf = io.StringIO()
+    w = csv.DictWriter(buf, fieldnames=TABLE_COLUMNS, lineterminator="\n")
+    w.writeheader()
+    for row in rows:
+        w.writerow(row.table_row(segment))
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8", newline="") as fh:
+            fh.write(buf.getvalue())
+        mask = os.umask(0)
+        os.umask(mask)
+        os.chmod(tmp, 0o666 & ~mask)
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise

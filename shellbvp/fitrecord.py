@@ -1,0 +1,290 @@
+"""A fit as a record: one NeXus HDF5 file with the data, the model and the result.
+
+Layout (format ``shellbvp-fit``, version 1; every dataset has a ``units`` attribute,
+SI units, ``"1"`` nondimensional, ``""`` text)::
+
+    /                          attrs: format, format_version, package_version, created,
+                                      NX_class = "NXroot", default = "fit"
+    /fit                       NXentry; attrs: default = "data", title, program_name, success,
+                                      status, message
+    /fit/data                  NXdata: signal = "force", axes = ["displacement"],
+                               auxiliary_signals = ["model_force"]: the data as read, every row
+                               in the file's (time) order
+      displacement, force      (n,) m, N
+      time                     (n,) s (when the file has a time column)
+      used                     (n,) 1: the rows fitted
+      segment                  (n,) approach / loading / hold / retraction / other
+      line                     (n,) the row's line in the source file
+      model_force, residual    (n,) N: the fitted model (baseline included) and model - data
+      weight                   (n,) 1: the noise model's 1/sigma (largest 1; NaN where not fitted)
+    /fit/model                 NXdata: signal = "force", axes = ["displacement"]: the model curve
+      displacement, force      (m,) m, N: offset + R_L delta, baseline + mu_H R_L F
+      delta, F                 (m,) 1: the nondimensional curve
+    /fit/parameters            NXparameters: mu_H (N/m), offset (m), baseline (N),
+                               baseline_slope (N/m), beta (1), alpha (1, NaN for other materials),
+                               R_L (m), residual_rms (N), n_points (1) -- scalars; and
+                               <name>_ci95 (2,) for each parameter fitted; attrs: fitted,
+                               baseline_model, weights, segment
+    /fit/warnings              (k,) the fit's warnings (text); attr codes
+    /fit/sample                NXsample; attrs: scene (JSON, rebuilds the Scene), scene_<key>
+    /fit/source                NXnote: file_name, sha256, columns (JSON), units (JSON) -- text
+
+Written atomically (temporary file + rename); an existing file is replaced only with
+``overwrite=True``.
+"""
+
+from __future__ import annotations
+
+import datetime as _dt
+import json
+import os
+import tempfile
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from .nexus import DIMENSIONLESS, number_dataset, string_dataset
+from .paths import check_output_path
+from .version import __version__
+
+__all__ = ["FitRecord", "write_fit", "read_fit", "is_fit_file", "FIT_FORMAT", "FIT_FORMAT_VERSION",
+           "PARAMETER_UNITS"]
+
+FIT_FORMAT = "shellbvp-fit"
+FIT_FORMAT_VERSION = 1
+#: Units of the scalar parameters in ``/fit/parameters``.
+PARAMETER_UNITS = {"mu_H": "N/m", "offset": "m", "baseline": "N", "baseline_slope": "N/m", "beta": DIMENSIONLESS,
+                   "alpha": DIMENSIONLESS, "R_L": "m", "residual_rms": "N", "n_points": DIMENSIONLESS}
+
+
+@dataclass
+class FitRecord:
+    """What a fit file holds (:func:`read_fit`), in SI units.
+
+    Attributes
+    ----------
+    data : dict of ndarray
+        ``displacement``, ``force``, ``time`` (or absent), ``used`` (bool), ``segment`` (str),
+        ``line``, ``model_force``, ``residual``, ``weight`` -- one entry per row of the source.
+    model : dict of ndarray
+        The model curve: ``displacement`` (m), ``force`` (N), ``delta``, ``F`` (nondimensional).
+    parameters : dict of float
+        ``mu_H``, ``offset``, ``baseline``, ``baseline_slope``, ``beta``, ``alpha``, ``R_L``,
+        ``residual_rms``, ``n_points``.
+    intervals : dict of (float, float)
+        The 95 % interval of each fitted parameter.
+    fitted : list of str
+    settings : dict
+        ``baseline_model``, ``weights``, ``segment``.
+    warnings : list of str
+    warning_codes : list of str
+    scene : Scene
+    source : dict
+        ``file_name``, ``sha256``, ``columns``, ``units`` (the units the file was in).
+    success : bool
+    status : int
+    message : str
+    version : str
+        Package version that wrote the file.
+    path : str
+    """
+
+    data: dict
+    model: dict
+    parameters: dict
+    intervals: dict
+    fitted: list
+    settings: dict
+    warnings: list
+    warning_codes: list
+    scene: object
+    source: dict
+    success: bool
+    status: int
+    message: str
+    version: str = ""
+    path: str = ""
+    extra: dict = field(default_factory=dict)
+
+
+def _umask():
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask
+
+
+def write_fit(path, result, record, used, *, segment="loading", overwrite=False):
+    """Write a fit and its data to ``path`` (HDF5, NeXus NXentry ``/fit``), atomically.
+
+    Parameters
+    ----------
+    path : str or Path
+    result : FitResult
+        The fit (:func:`shellbvp.fitting.fit_record`).
+    record : InstrumentRecord
+        The data as read (:func:`shellbvp.instrument.read_instrument`).
+    used : ndarray of bool, shape (len(record),)
+        The rows fitted.
+    segment : str
+        The segment fitted (recorded in the settings).
+    overwrite : bool
+        Replace an existing file (otherwise ``FileExistsError``).
+    """
+    import h5py
+
+    path = Path(path)
+    if path.exists() and not overwrite:
+        raise FileExistsError(f"{path} exists; pass overwrite=True (CLI: --force) to replace it")
+    check_output_path(path, overwrite=True)
+    d, f = record.displacement, record.force
+    model_force = result.model_force(d)
+    weight = np.full(d.size, np.nan)
+    if result.point_weights is not None and np.sum(used) == result.point_weights.size:
+        weight[used] = result.point_weights
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    os.close(fd)
+    try:
+        with h5py.File(tmp, "w") as h:
+            h.attrs.update({"format": FIT_FORMAT, "format_version": FIT_FORMAT_VERSION,
+                            "package_version": __version__, "NX_class": "NXroot", "default": "fit",
+                            "created": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds")})
+            e = h.create_group("fit")
+            e.attrs.update({"NX_class": "NXentry", "default": "data", "program_name": f"shellbvp {__version__}",
+                            "title": f"fit of mu*H to {Path(record.path).name}", "success": bool(result.success),
+                            "status": int(result.status), "message": result.message})
+            g = e.create_group("data")
+            g.attrs.update({"NX_class": "NXdata", "signal": "force",
+                            "axes": np.array(["displacement"], dtype=h5py.string_dtype()),
+                            "auxiliary_signals": np.array(["model_force"], dtype=h5py.string_dtype())})
+            number_dataset(g, "displacement", d, "m", "indenter displacement (as read)")
+            number_dataset(g, "force", f, "N", "force (as read)")
+            if record.time is not None:
+                number_dataset(g, "time", record.time, "s", "time")
+            number_dataset(g, "used", np.asarray(used, bool), DIMENSIONLESS, "row fitted")
+            string_dataset(g, "segment", [str(s) for s in record.segments], "segment of the record")
+            number_dataset(g, "line", np.asarray(record.line, int), DIMENSIONLESS, "line in the source file")
+            number_dataset(g, "model_force", model_force, "N", "fitted model force (baseline included)")
+            number_dataset(g, "residual", model_force - f, "N", "model - data")
+            number_dataset(g, "weight", weight, DIMENSIONLESS, "noise model weight 1/sigma (largest 1)")
+            m = e.create_group("model")
+            m.attrs.update({"NX_class": "NXdata", "signal": "force",
+                            "axes": np.array(["displacement"], dtype=h5py.string_dtype())})
+            c = result.curve
+            delta, F = np.r_[0.0, np.asarray(c.delta, float)], np.r_[0.0, np.asarray(c.force, float)]
+            x = result.offset + result.R_L * delta
+            number_dataset(m, "displacement", x, "m", "displacement: offset + R_L delta")
+            number_dataset(m, "force", result.model_force(x), "N", "model force: baseline + mu_H R_L F")
+            number_dataset(m, "delta", delta, DIMENSIONLESS, "pole displacement / R_L")
+            number_dataset(m, "F", F, DIMENSIONLESS, "force / (mu H R_L)")
+            p = e.create_group("parameters")
+            p.attrs.update({"NX_class": "NXparameters", "baseline_model": result.baseline_model,
+                            "weights": result.weights, "segment": segment,
+                            "fitted": np.array(list(result.fitted), dtype=h5py.string_dtype())})
+            values = {"mu_H": result.mu_H, "offset": result.offset, "baseline": result.baseline,
+                      "baseline_slope": result.baseline_slope, "beta": result.beta,
+                      "alpha": np.nan if result.alpha is None else result.alpha, "R_L": result.R_L,
+                      "residual_rms": result.residual_rms, "n_points": result.n}
+            for name, v in values.items():
+                number_dataset(p, name, float(v), PARAMETER_UNITS[name])
+            for name in result.fitted:
+                number_dataset(p, f"{name}_ci95", np.asarray(_interval(result, name), float), PARAMETER_UNITS[name],
+                               f"95 % interval of {name}")
+            w = string_dataset(e, "warnings", list(result.warnings), "warnings of the fit")
+            w.attrs["codes"] = np.array(list(result.warning_codes), dtype=h5py.string_dtype())
+            s = e.create_group("sample")
+            s.attrs["NX_class"] = "NXsample"
+            scene = result.scene.to_dict()
+            s.attrs["scene"] = json.dumps(scene, sort_keys=True)
+            for k, v in scene.items():
+                if not isinstance(v, dict):
+                    s.attrs[f"scene_{k}"] = v
+            src = e.create_group("source")
+            src.attrs["NX_class"] = "NXnote"
+            string_dataset(src, "file_name", str(record.path))
+            string_dataset(src, "sha256", record.sha256)
+            string_dataset(src, "columns", json.dumps({k: str(v) for k, v in record.columns.items()}))
+            string_dataset(src, "units", json.dumps(record.units, ensure_ascii=False))
+        os.chmod(tmp, 0o666 & ~_umask())
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
+def _interval(result, name):
+    return {"mu_H": result.mu_H_ci95, "offset": result.offset_ci95, "baseline": result.baseline_ci95,
+            "baseline_slope": result.baseline_slope_ci95, "beta": result.beta_ci95,
+            "alpha": result.alpha_ci95}[name]
+
+
+def is_fit_file(path) -> bool:
+    """True when ``path`` is an HDF5 file of format ``shellbvp-fit``."""
+    import h5py
+
+    try:
+        with h5py.File(path, "r") as h:
+            fmt = h.attrs.get("format")
+    except (OSError, ValueError):
+        return False
+    fmt = fmt.decode() if isinstance(fmt, bytes) else fmt
+    return fmt == FIT_FORMAT
+
+
+def _text(v):
+    return v.decode("utf-8", "replace") if isinstance(v, bytes) else str(v)
+
+
+def read_fit(path) -> FitRecord:
+    """Read a fit file written by :func:`write_fit`.
+
+    Raises
+    ------
+    ValueError
+        One line naming the file and what is missing or malformed.
+    """
+    import h5py
+
+    from .scene import Scene
+
+    path = Path(path)
+    if not path.is_file():
+        raise ValueError(f"{path}: no such file")
+    try:
+        h = h5py.File(path, "r")
+    except OSError as exc:
+        raise ValueError(f"{path}: not a readable HDF5 file ({' '.join(str(exc).split())})") from None
+    with h:
+        if _text(h.attrs.get("format", "")) != FIT_FORMAT or not isinstance(h.get("fit"), h5py.Group):
+            raise ValueError(f"{path}: not a shellbvp fit file (format attribute missing or different)")
+        try:
+            e = h["fit"]
+            data = {k: v[()] for k, v in e["data"].items()}
+            data["segment"] = np.array([_text(s) for s in data["segment"]])
+            data["used"] = np.asarray(data["used"], bool)
+            n = data["displacement"].shape[0]
+            for k, v in data.items():
+                if np.ndim(v) != 1 or len(v) != n:
+                    raise ValueError(f"data/{k} must be a 1-D array of {n} values")
+            model = {k: np.asarray(v[()], float) for k, v in e["model"].items()}
+            p = e["parameters"]
+            params = {k: float(p[k][()]) for k in PARAMETER_UNITS}
+            fitted = [_text(s) for s in p.attrs["fitted"]]
+            intervals = {k: tuple(float(x) for x in p[f"{k}_ci95"][()]) for k in fitted}
+            settings = {k: _text(p.attrs[k]) for k in ("baseline_model", "weights", "segment")}
+            warnings = [_text(s) for s in e["warnings"][()]]
+            codes = [_text(s) for s in e["warnings"].attrs.get("codes", [])]
+            scene = Scene.from_dict(json.loads(_text(e["sample"].attrs["scene"])))
+            src = e["source"]
+            source = {"file_name": _text(src["file_name"][()]), "sha256": _text(src["sha256"][()]),
+                      "columns": json.loads(_text(src["columns"][()])), "units": json.loads(_text(src["units"][()]))}
+            out = FitRecord(data=data, model=model, parameters=params, intervals=intervals, fitted=fitted,
+                            settings=settings, warnings=warnings, warning_codes=codes, scene=scene, source=source,
+                            success=bool(e.attrs["success"]), status=int(e.attrs["status"]),
+                            message=_text(e.attrs["message"]), version=_text(h.attrs.get("package_version", "")),
+                            path=str(path))
+        except ValueError as exc:
+            raise ValueError(f"{path}: {exc}") from None
+        except (KeyError, TypeError, OSError, json.JSONDecodeError) as exc:
+            raise ValueError(f"{path}: incomplete or corrupt fit file ({type(exc).__name__}: {exc})") from None
+    return out

@@ -1,0 +1,587 @@
+"""Instrument files: reading force–displacement exports and cutting them into segments.
+
+An indentation record, as instruments export it, is a table in time order:
+the indenter approaches the sample (force at its baseline), presses into it
+(loading), may hold its position, and retracts (the force follows a lower
+branch: hysteresis).  Fitting an elastic model to all of it at once -- rows
+sorted by displacement -- merges loading and retraction into one curve and
+biases mu*H with a confident but wrong interval.  So a record is segmented
+first and the fit uses the loading segment by default.
+
+* :func:`read_table` -- the text layer: encodings, ``#``/``%`` comment lines,
+  ``,`` ``;`` or tab delimiters, decimal commas, one or two header rows
+  (names, then units), plain numbers only.
+* :func:`read_instrument` -- an :class:`InstrumentRecord`: displacement and
+  force (and time) columns found by unit and name, converted to SI, in the
+  file's (time) order, with the segment of every row.
+* :func:`segment` -- approach / loading / hold / retraction / other, by the
+  direction of the displacement over time (or over rows).
+* :func:`estimate_contact` -- a first contact point from the baseline.
+* :func:`read_force_csv` -- the older two-column reader (rows sorted by displacement).
+"""
+
+from __future__ import annotations
+
+import codecs
+import csv
+import hashlib
+import math
+import re
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .units import PLAIN_NUMBER, normalize_unit, unit_factor, unit_kind
+
+__all__ = ["InstrumentRecord", "Table", "read_table", "read_instrument", "read_force_csv", "segment",
+           "estimate_contact", "SEGMENTS", "FIT_SEGMENTS", "sha256_of"]
+
+#: Labels of the rows of a record (:func:`segment`).
+SEGMENTS = ("approach", "loading", "hold", "retraction", "other")
+#: What ``fit`` may use: ``loading`` (the pushing part: the approach before contact and
+#: the loading after it, which together fix the baseline and the contact point),
+#: ``retraction`` (the unloading branch) or ``all`` (every row, in any order).
+FIT_SEGMENTS = ("loading", "retraction", "all")
+
+#: Column names that say what a column holds (lower case, units removed): names that say it
+#: plainly, then generic ones (a column of each tier wins over the next; two of one tier tie).
+_NAMES = {
+    "displacement": (("displacement", "indentation", "depth", "disp", "delta", "deformation"),
+                     ("position", "distance", "extension", "separation", "z", "height", "piezo", "d")),
+    "force": (("force", "load"), ("f",)),
+    "time": (("time",), ("t",)),
+}
+_KIND = {"displacement": "length", "force": "force", "time": "time"}
+
+_BOMS = ((codecs.BOM_UTF32_LE, "utf-32"), (codecs.BOM_UTF32_BE, "utf-32"), (codecs.BOM_UTF8, "utf-8-sig"),
+         (codecs.BOM_UTF16_LE, "utf-16"), (codecs.BOM_UTF16_BE, "utf-16"))
+
+
+def sha256_of(path) -> str:
+    """Hex SHA-256 of a file's bytes (a fit record names the data it was made from)."""
+    h = hashlib.sha256()
+    with open(path, "rb") as fh:
+        for block in iter(lambda: fh.read(1 << 20), b""):
+            h.update(block)
+    return h.hexdigest()
+
+
+def _decode(raw, path):
+    """Text of a file: a BOM's encoding, else UTF-8, else UTF-16 (no BOM), else cp1252/Latin-1."""
+    for bom, enc in _BOMS:
+        if raw.startswith(bom):
+            try:
+                return raw.decode(enc)
+            except UnicodeDecodeError as exc:
+                raise ValueError(f"{path}: cannot decode as {enc} (its byte-order mark says so): {exc.reason} "
+                                 f"at byte {exc.start}") from None
+    tries = ["utf-8"]
+    if len(raw) >= 4 and raw.count(b"\x00") >= len(raw) // 4:  # ASCII text in UTF-16 without a BOM
+        tries += ["utf-16-le" if raw[1::2].count(0) > raw[0::2].count(0) else "utf-16-be"]
+    for enc in tries + ["cp1252", "latin-1"]:
+        try:
+            text = raw.decode(enc)
+        except UnicodeDecodeError:
+            continue
+        if not re.search(r"[\x00-\x08\x0b\x0c\x0e-\x1f\x7f]", text):  # control characters: not this encoding
+            return text
+    raise ValueError(f"{path}: not a text file in a known encoding (tried UTF-8, UTF-16, Windows-1252, Latin-1; "
+                     "it holds control characters): save it as CSV text, e.g. UTF-8")
+
+
+def _number(s):
+    """float of a cell: "" and "nan" are NaN; a decimal comma (``1,5``) is read as ``1.5``;
+    anything but a plain finite number is None."""
+    t = s.strip()
+    if t.count(",") == 1 and "." not in t:  # a decimal comma (the delimiter is then not a comma)
+        t = t.replace(",", ".")
+    if not t or t.lower() == "nan":
+        return math.nan
+    if not PLAIN_NUMBER.fullmatch(t):
+        return None
+    v = float(t)
+    return v if math.isfinite(v) else None
+
+
+def _unit_of(name):
+    """The unit in a column name: ``'Force (uN)'``, ``'force [µN]'``, ``'Time / s'`` -> the unit or None."""
+    m = re.search(r"[\(\[]\s*([^\)\]]+?)\s*[\)\]]\s*$", name) or re.search(r"\s/\s*(\S+)\s*$", name)
+    return normalize_unit(m.group(1)) if m else None
+
+
+def _bare_name(name):
+    return re.sub(r"\s*([\(\[][^\)\]]*[\)\]]|/\s*\S+)\s*$", "", name).strip().lower()
+
+
+@dataclass
+class Table:
+    """The text of a delimited file, split (:func:`read_table`).
+
+    Attributes
+    ----------
+    header : list of str
+        Column names ('' where the file gives none; empty list without a header).
+    header_units : list of str or None
+        The units row (second header row) when the file has one.
+    rows : list of list of str
+        The data rows' cells.
+    line : list of int
+        Each data row's line number in the file (comment and blank lines counted).
+    delimiter : str
+    """
+
+    header: list
+    header_units: list
+    rows: list
+    line: list
+    delimiter: str
+
+
+def read_table(path) -> Table:
+    """Split a delimited text file into header rows and data rows.
+
+    ``#`` and ``%`` start comment lines; blank lines are skipped; the delimiter
+    (``,`` ``;`` or tab) is sniffed.  Leading rows that are not all numbers are
+    header rows: the last one before the data (or the last two, when the second
+    names units, e.g. ``um``, ``(µN)``, ``s``) -- earlier ones (an instrument's
+    preamble) are skipped.
+
+    Raises
+    ------
+    ValueError
+        The file cannot be read or decoded, or holds no data.
+    """
+    try:
+        with open(path, "rb") as fh:
+            raw = fh.read()
+    except OSError as exc:
+        raise ValueError(f"{path}: cannot read ({exc.strerror})") from None
+    text = _decode(raw, path)
+    numbered = [(i, ln) for i, ln in enumerate(text.splitlines(), start=1)
+                if ln.strip() and not ln.lstrip().startswith(("#", "%"))]
+    if not numbered:
+        raise ValueError(f"{path}: no data")
+    lines = [ln for _, ln in numbered]
+    try:
+        delim = csv.Sniffer().sniff("\n".join(lines[:20]), delimiters=",;\t").delimiter
+    except csv.Error:
+        delim = "\t" if "\t" in lines[-1] else (";" if ";" in lines[-1] else ",")
+    rows = [next(csv.reader([ln], delimiter=delim), []) for ln in lines]
+    line_no = [i for i, _ in numbered]
+    first = next((k for k, r in enumerate(rows) if r and all(_number(c) is not None for c in r)), len(rows))
+    if first == len(rows):
+        raise ValueError(f"{path}: fewer than 3 rows with numbers (no row is all numbers)")
+    heads = rows[:first]
+    header, header_units = [], None
+    if heads:
+        width = len(rows[first]) if first < len(rows) else len(heads[-1])
+        heads = [h for h in heads if len(h) == width] or heads[-1:]  # a preamble of other widths: skipped
+        if len(heads) >= 2 and all(not c.strip() or unit_kind(c) for c in heads[-1]) and \
+                any(c.strip() for c in heads[-1]):
+            header, header_units = [c.strip() for c in heads[-2]], [normalize_unit(c) for c in heads[-1]]
+        else:
+            header = [c.strip() for c in heads[-1]]
+    return Table(header=header, header_units=header_units, rows=rows[first:], line=line_no[first:], delimiter=delim)
+
+
+def _column_unit(table, i):
+    if table.header_units is not None and i < len(table.header_units) and table.header_units[i]:
+        return table.header_units[i]
+    return _unit_of(table.header[i]) if i < len(table.header) else None
+
+
+def _describe_header(table):
+    if not table.header:
+        return "the file has no header row"
+    cols = [h + (f" [{table.header_units[i]}]" if table.header_units and i < len(table.header_units)
+                 and table.header_units[i] else "") for i, h in enumerate(table.header)]
+    return "its columns are " + ", ".join(f"{i}: {c!r}" for i, c in enumerate(cols))
+
+
+def _find_column(table, role, path, taken):
+    """Index of the column holding ``role`` (displacement, force, time), by unit and name; None if absent."""
+    n = len(table.header)
+    kind = _KIND[role]
+    by_unit = [i for i in range(n) if i not in taken and unit_kind(_column_unit(table, i) or "") == kind]
+    tiers = _NAMES[role]
+
+    def rank(i):
+        """0: a plain name, 1: a generic one, 2: neither."""
+        bare = _bare_name(table.header[i])
+        words = re.split(r"[\s_\-./]+", bare)
+        for k, names in enumerate(tiers):
+            if any(w == bare or (len(w) > 1 and w in words) for w in names):
+                return k
+        return len(tiers)
+
+    pool = by_unit or [i for i in range(n) if i not in taken and rank(i) < len(tiers)]
+    if len(pool) <= 1:
+        return pool[0] if pool else None
+    ranked = sorted(pool, key=rank)
+    if rank(ranked[0]) < rank(ranked[1]):
+        return ranked[0]
+    raise ValueError(f"{path}: more than one column could be the {role} ({', '.join(repr(table.header[i]) for i in pool)}); "
+                     f"{_describe_header(table)}; choose with --columns DISPLACEMENT,FORCE")
+
+
+def _pick_columns(table, columns, path):
+    """(displacement, force, time or None) column indices."""
+    n = len(table.header)
+    if columns is not None:
+        cols = []
+        for c in columns:
+            if isinstance(c, int) or (isinstance(c, str) and c.strip().isdigit()):
+                cols.append(int(c))
+                continue
+            if not table.header:
+                raise ValueError(f"{path}: column {c!r} given by name but the file has no header")
+            key = str(c).strip().lower()
+            names = [_bare_name(h) for h in table.header]
+            full = [h.strip().lower() for h in table.header]
+            if key in full:
+                cols.append(full.index(key))
+            elif key in names:
+                cols.append(names.index(key))
+            else:
+                raise ValueError(f"{path}: no column named {c!r}; {_describe_header(table)}")
+        if len(cols) not in (2, 3):
+            raise ValueError(f"{path}: columns must be two (displacement, force) or three (and time); got {columns!r}")
+        return cols[0], cols[1], (cols[2] if len(cols) == 3 else None)
+    if n == 0:
+        return 0, 1, None  # no header: the first two columns
+    disp = _find_column(table, "displacement", path, set())
+    force = _find_column(table, "force", path, {disp} if disp is not None else set())
+    if (disp is None or force is None) and n == 2 and len(table.rows[0]) == 2:
+        return 0, 1, None  # two columns named neither way: displacement, then force
+    if disp is None or force is None:
+        missing = " and ".join(r for r, c in (("displacement", disp), ("force", force)) if c is None)
+        raise ValueError(f"{path}: cannot tell which column is the {missing} (by unit or name); "
+                         f"{_describe_header(table)}; choose with --columns DISPLACEMENT,FORCE "
+                         f"(names or 0-based indices) and give units with --units, e.g. um,uN")
+    time = _find_column(table, "time", path, {disp, force})
+    return disp, force, time
+
+
+@dataclass
+class InstrumentRecord:
+    """A force–displacement record as read from an instrument file (SI units, file order).
+
+    Attributes
+    ----------
+    path : str
+        The file read.
+    sha256 : str
+        SHA-256 of the file's bytes.
+    displacement : ndarray, shape (n,)
+        Indenter displacement in m (into the sample positive), one per data row kept.
+    force : ndarray, shape (n,)
+        Force in N.
+    time : ndarray, shape (n,) or None
+        Time in s when the file has a time column (rows are then in time order).
+    line : ndarray of int, shape (n,)
+        The line of the file each row comes from.
+    segments : ndarray of str, shape (n,)
+        Each row's segment, one of :data:`SEGMENTS` (:func:`segment`).
+    columns : dict
+        Header name (or index) of the ``displacement``, ``force`` and ``time`` columns used.
+    units : dict
+        The units the file's columns were in (``displacement``, ``force``, ``time``): results
+        are also printed in these.
+    header : list of str
+    contact_estimate : float or None
+        First estimate of the contact point (m) from the baseline (:func:`estimate_contact`),
+        None when the loading starts in contact.
+    """
+
+    path: str
+    sha256: str
+    displacement: np.ndarray
+    force: np.ndarray
+    time: object
+    line: np.ndarray
+    segments: np.ndarray
+    columns: dict
+    units: dict
+    header: list = field(default_factory=list)
+    contact_estimate: object = None
+
+    def __len__(self):
+        return self.displacement.size
+
+    def mask(self, which: str = "loading") -> np.ndarray:
+        """Rows used by a fit of segment ``which`` (one of :data:`FIT_SEGMENTS`).
+
+        ``loading`` is the approach and the loading (the pushing part up to the deepest
+        point), ``retraction`` the unloading branch, ``all`` every row.
+        """
+        if which not in FIT_SEGMENTS:
+            raise ValueError(f"segment must be one of {FIT_SEGMENTS}; got {which!r}")
+        if which == "all":
+            return np.ones(len(self), bool)
+        keep = ("approach", "loading") if which == "loading" else ("retraction",)
+        return np.isin(self.segments, keep)
+
+    def counts(self) -> dict:
+        """Number of rows in each segment (those with any)."""
+        return {s: int(np.sum(self.segments == s)) for s in SEGMENTS if np.any(self.segments == s)}
+
+    def relabel(self, contact):
+        """Split the pushing rows at the contact point ``contact`` (m): before it 'approach'."""
+        push = np.isin(self.segments, ("approach", "loading"))
+        self.segments = np.where(push, np.where(self.displacement < contact, "approach", "loading"), self.segments)
+
+
+def read_instrument(path, *, columns=None, units=None) -> InstrumentRecord:
+    """Read an instrument's force–displacement export and segment it.
+
+    Parameters
+    ----------
+    path : str or Path
+        Delimited text (see :func:`read_table`).
+    columns : sequence, optional
+        Displacement and force columns (and, third, time) by name or 0-based index.
+        Default: found by unit (a length, a force, a time) and name (``Displacement``,
+        ``Indentation``, ``Force``, ``Time``, ...).
+    units : sequence of str, optional
+        Units of the displacement and force (and time) columns, e.g. ``("um", "uN")``,
+        when the header gives none (micro as ``u``, µ or μ; ``pN`` .. ``kN``, ``nm`` .. ``m``).
+
+    Returns
+    -------
+    InstrumentRecord
+        In the file's order (sorted by time when there is a time column); rows with a
+        missing value dropped.
+
+    Raises
+    ------
+    ValueError
+        Naming the file and, for a bad row, its line; for columns that cannot be found,
+        the header and ``--columns``.
+    """
+    table = read_table(path)
+    dcol, fcol, tcol = _pick_columns(table, columns, path)
+    roles = [("displacement", dcol), ("force", fcol)] + ([("time", tcol)] if tcol is not None else [])
+    given = list(units) if units is not None else []
+    unit_names, factors = {}, {}
+    for k, (role, col) in enumerate(roles):
+        u = given[k] if k < len(given) and given[k] else (_column_unit(table, col) if table.header else None)
+        if u is None:
+            if role == "time":
+                u = "s"
+            else:
+                raise ValueError(f"{path}: units of the {role} column unknown; {_describe_header(table)}; give "
+                                 "them in the header, e.g. 'Displacement (um)', or with --units um,uN")
+        try:
+            factors[role] = unit_factor(u, _KIND[role])
+        except ValueError as exc:
+            raise ValueError(f"{path}: {role} column: {exc}") from None
+        unit_names[role] = normalize_unit(u)
+    values = {role: [] for role, _ in roles}
+    lines = []
+    for n, row in zip(table.line, table.rows):
+        if all(not c.strip() for c in row):
+            continue
+        try:
+            cells = [row[col].strip() for _, col in roles]
+        except IndexError:
+            raise ValueError(f"{path}: line {n} has {len(row)} columns; need column "
+                             f"{max(c for _, c in roles)}") from None
+        nums = [_number(c) for c in cells]
+        if any(v is None for v in nums):
+            raise ValueError(f"{path}: line {n}: cannot read {', '.join(repr(c) for c in cells)} as numbers (plain "
+                             "finite decimals such as 1.5, -2e-3 or 1,5; empty or nan for a missing value)")
+        si = [v * factors[role] for v, (role, _) in zip(nums, roles)]
+        if any(math.isinf(v) for v in si):
+            raise ValueError(f"{path}: line {n}: {', '.join(repr(c) for c in cells)} overflow when converted to "
+                             f"SI units ({', '.join(unit_names.values())})")
+        for v, (role, _) in zip(si, roles):
+            values[role].append(v)
+        lines.append(n)
+    arr = {role: np.array(v, float) for role, v in values.items()}
+    ok = np.all([np.isfinite(a) for a in arr.values()], axis=0) if lines else np.zeros(0, bool)
+    if ok.sum() < 3:
+        raise ValueError(f"{path}: fewer than 3 rows with numbers")
+    arr = {role: a[ok] for role, a in arr.items()}
+    line = np.array(lines)[ok]
+    t = arr.get("time")
+    if t is not None:
+        order = np.argsort(t, kind="stable")  # rows in time order: the segments follow time
+        arr = {role: a[order] for role, a in arr.items()}
+        line, t = line[order], arr["time"]
+    name = (lambda c: table.header[c] if c < len(table.header) and table.header[c] else c)
+    labels = segment(arr["displacement"], t)
+    rec = InstrumentRecord(path=str(path), sha256=sha256_of(path), displacement=arr["displacement"],
+                           force=arr["force"], time=t, line=line, segments=labels,
+                           columns={role: name(col) for role, col in roles}, units=unit_names,
+                           header=list(table.header))
+    push = rec.mask("loading")
+    if push.sum() >= 3:
+        rec.contact_estimate = estimate_contact(rec.displacement[push], rec.force[push])
+        if rec.contact_estimate is not None:
+            rec.relabel(rec.contact_estimate)
+    return rec
+
+
+def _runs(state):
+    """[(value, start, stop)] of the runs of equal values."""
+    edges = np.flatnonzero(np.diff(state)) + 1
+    starts = np.r_[0, edges]
+    stops = np.r_[edges, state.size]
+    return [(int(state[a]), int(a), int(b)) for a, b in zip(starts, stops)]
+
+
+def segment(displacement, time=None) -> np.ndarray:
+    """Label each row of a record: approach/loading (pushing), hold, retraction, other.
+
+    The direction of motion is the sign of the displacement's rate (a Savitzky–Golay
+    derivative over about 2 % of the rows, against time when given, else against the
+    row number: instruments sample at a fixed rate): moving in (rate above 10 % of the
+    typical pushing rate), moving out (likewise), or still.  Runs shorter than half
+    the window are noise and join their neighbour.  The main push is the pushing run
+    that gains the most depth; with the runs pushing or still around it (a staircase of
+    steps and pauses, a pause before the approach) up to the runs moving out, it is the
+    'loading' (split into 'approach' and 'loading' at a contact point by
+    :meth:`InstrumentRecord.relabel`); still rows after its last push are the 'hold'; the
+    runs moving out after it (pauses between them included) up to the next push the
+    'retraction'; everything else 'other' (earlier and later cycles).
+
+    Parameters
+    ----------
+    displacement : array_like, shape (n,)
+        In file (time) order.
+    time : array_like, shape (n,), optional
+        Increasing times of the rows.
+
+    Returns
+    -------
+    ndarray of str, shape (n,)
+
+    Examples
+    --------
+    >>> d = np.r_[np.linspace(0, 1, 20), np.ones(5), np.linspace(1, 0, 20)]
+    >>> labels = segment(d)
+    >>> [str(s) for s in labels[[0, 19, 22, 44]]]
+    ['loading', 'loading', 'hold', 'retraction']
+    """
+    d = np.asarray(displacement, float)
+    n = d.size
+    labels = np.full(n, "other", dtype=object)
+    if n < 3:
+        return labels.astype(str)
+    w = int(min(51, max(5, 2 * (n // 100) + 1)))
+    if n >= w + 2:
+        from scipy.signal import savgol_filter
+
+        rate = savgol_filter(d, w, 2, deriv=1)
+    else:
+        w = 3
+        rate = np.gradient(d)
+    if time is not None:
+        dt = np.gradient(np.asarray(time, float))
+        rate = np.where(dt > 0, rate / np.where(dt > 0, dt, 1.0), 0.0)
+    state = np.zeros(n, int)
+    for sign in (1, -1):
+        moving = sign * rate[sign * rate > 0]
+        if moving.size:
+            state[sign * rate > 0.1 * np.percentile(moving, 90)] = sign
+    short = max(2, w // 2)
+    for _ in range(n):  # merge runs shorter than `short` into the previous (or next) run
+        runs = _runs(state)
+        small = [k for k, (_, a, b) in enumerate(runs) if b - a < short]
+        if not small or len(runs) == 1:
+            break
+        k = small[0]
+        _, a, b = runs[k]
+        state[a:b] = runs[k - 1][0] if k > 0 else runs[k + 1][0]
+    runs = _runs(state)
+    pushes = [(d[b - 1] - d[a], k) for k, (s, a, b) in enumerate(runs) if s == 1]
+    if not pushes:
+        pulls = [(d[a] - d[b - 1], k) for k, (s, a, b) in enumerate(runs) if s == -1]
+        if pulls:
+            _, k = max(pulls)
+            labels[runs[k][1]:runs[k][2]] = "retraction"
+        return labels.astype(str)
+    _, k = max(pushes)
+    # the loading: the main push with the pushes and pauses around it up to the runs moving out
+    # (a staircase of steps and holds is one loading); still rows after its last push: the hold
+    a, b = k, k
+    while a > 0 and runs[a - 1][0] != -1:
+        a -= 1
+    while b + 1 < len(runs) and runs[b + 1][0] != -1:
+        b += 1
+    last_push = max(j for j in range(a, b + 1) if runs[j][0] == 1)
+    labels[runs[a][1]:runs[last_push][2]] = "loading"
+    if last_push < b:
+        labels[runs[last_push + 1][1]:runs[b][2]] = "hold"
+    # the retraction: the runs moving out after it (with pauses between them), up to the next push
+    c = b + 1
+    if c < len(runs):
+        e = c
+        while e + 1 < len(runs) and runs[e + 1][0] != 1:
+            e += 1
+        last_pull = max(j for j in range(c, e + 1) if runs[j][0] == -1)
+        labels[runs[c][1]:runs[last_pull][2]] = "retraction"
+    return labels.astype(str)
+
+
+def estimate_contact(displacement, force):
+    """First estimate of the contact point from the force's baseline (m), or None.
+
+    The first 10 % of the pushing rows (at least 5) are the baseline when the force
+    rises there by less than 5 % of its whole rise; the contact is then the last
+    row before the force leaves the baseline for good (its mean plus the larger of
+    5 standard deviations and 1 % of the rise; cf. nanite's "deviation from baseline").
+    None when the record starts in contact (no baseline to read).
+
+    Parameters
+    ----------
+    displacement, force : array_like, shape (n,)
+        The pushing rows, in time order.
+    """
+    d, f = np.asarray(displacement, float), np.asarray(force, float)
+    order = np.argsort(d, kind="stable")
+    d, f = d[order], f[order]
+    n = d.size
+    k = max(5, n // 10)
+    if n < 2 * k:
+        return None
+    rise = np.max(f) - np.median(f[:k])
+    if not rise > 0:
+        return None
+    base = f[:k]
+    slope = np.polyfit(d[:k], base, 1)[0]
+    if abs(slope) * np.ptp(d[:k]) > 0.05 * rise:
+        return None  # the force already rises: the record starts in contact
+    thr = np.mean(base) + max(5 * np.std(base), 0.01 * rise)
+    above = f > thr
+    stays = np.flatnonzero(~above)  # the last row still at the baseline
+    if stays.size == 0:
+        return None
+    last = stays[-1]
+    if last >= n - 1:
+        return None
+    return float(d[last])
+
+
+def read_force_csv(path, *, columns=None, units=None):
+    """Read displacement and force columns from a CSV file, sorted by displacement.
+
+    The reading of :func:`read_instrument` (header detection, units, comments,
+    decimal commas, encodings), without segments: every row with numbers, sorted by
+    displacement.  For instrument records with approach and retraction use
+    :func:`read_instrument` (``shellbvp fit`` does): sorting merges the branches.
+    Without a header the first two columns are read (``columns=[1, 0]`` swaps them).
+
+    Returns
+    -------
+    displacement_m, force_N : ndarray
+        Sorted by displacement.
+
+    Raises
+    ------
+    ValueError
+        Naming the line (counted in the file, comments included) of a malformed row.
+    """
+    rec = read_instrument(path, columns=columns, units=units)
+    order = np.argsort(rec.displacement, kind="stable")
+    return rec.displacement[order], rec.force[order]

@@ -1,0 +1,191 @@
+"""Instrument files (issue 15 item 1): reading exports as instruments write them, segmenting
+approach / loading / hold / retraction, and fitting the loading with a force baseline.
+
+The files are generated here from the model itself (preset fit, R_L = 0.3 mm, mu*H = 40 N/m)
+with an approach before contact, a hold with creep, a retraction with hysteresis, a baseline
+of 150 uN and 2 % noise: the truth is known.
+"""
+
+import json
+import os
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+from scipy.interpolate import PchipInterpolator
+
+import shellbvp as sb
+from shellbvp.fitting import fit_record
+from shellbvp.instrument import estimate_contact, read_instrument, read_table, segment
+
+R_L, MU_H, D0, BASE = 0.3e-3, 40.0, 25e-6, 150e-6
+N_PUSH, N_HOLD, N_RET = 160, 20, 160
+
+
+@pytest.fixture(scope="module")
+def truth():
+    """Time, displacement (m), force (N) of a record, and the rows of each segment."""
+    scene = sb.Scene.preset("fit")
+    c = sb.curve(scene, deltas=np.linspace(0.005, 0.45, 90), estimate_error=False)
+    shape = PchipInterpolator(np.r_[0, c.delta], np.r_[0, c.force])
+
+    def model(d):
+        x = (d - D0) / R_L
+        return np.where(x > 0, MU_H * R_L * shape(np.clip(x, 0, 0.45)), 0.0)
+
+    rng = np.random.default_rng(1)
+    top = D0 + 0.4 * R_L
+    d_push = np.linspace(-20e-6, top, N_PUSH)
+    d_ret = np.linspace(top, -20e-6, N_RET)
+    d = np.r_[d_push, np.full(N_HOLD, top), d_ret]
+    f = model(d)
+    f[N_PUSH:N_PUSH + N_HOLD] *= np.linspace(1, 0.97, N_HOLD)  # creep during the hold
+    f[N_PUSH + N_HOLD:] = 0.97 * model(d_ret + 8e-6) * (1 - 0.1 * np.linspace(0, 1, N_RET))  # hysteresis
+    f = f * (1 + 0.02 * rng.standard_normal(d.size)) + BASE + 0.5e-6 * rng.standard_normal(d.size)
+    t = 0.05 * np.arange(d.size)
+    return scene, t, d, f
+
+
+def write(path, t, d, f, style):
+    """The same record in the styles instruments write."""
+    if style == "tab":  # tab-separated, '#' comments, Greek mu (U+03BC), time first
+        lines = ["# exported by an indenter", "# sample: seed 1",
+                 "Time (s)\tDisplacement (um)\tForce (\u03bcN)"]
+        lines += [f"{a:.3f}\t{b * 1e6:.5f}\t{c * 1e6:.5f}" for a, b, c in zip(t, d, f)]
+    elif style == "two_rows":  # names, then units (micro sign U+00B5); ';' and decimal commas
+        lines = ["% instrument v2", "Force;Time;Indentation", "\u00b5N;s;\u00b5m"]
+        lines += [f"{c * 1e6:.5f};{a:.3f};{b * 1e6:.5f}".replace(".", ",") for a, b, c in zip(t, d, f)]
+    elif style == "nm_pN":  # nm and pN, comma-separated, time in ms
+        lines = ["time [ms],force [pN],displacement [nm]"]
+        lines += [f"{a * 1e3:.1f},{c * 1e12:.1f},{b * 1e9:.2f}" for a, b, c in zip(t, d, f)]
+    elif style == "shuffled":  # rows in any order: the time column restores it
+        lines = ["Time (s),Displacement (mm),Force (mN)"]
+        order = np.random.default_rng(0).permutation(t.size)
+        lines += [f"{t[i]:.3f},{d[i] * 1e3:.8f},{f[i] * 1e3:.8f}" for i in order]
+    path.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    return path
+
+
+@pytest.mark.parametrize("style", ["tab", "two_rows", "nm_pN", "shuffled"])
+def test_every_style_reads_to_the_same_si_record_and_segments(truth, tmp_path, style):
+    _, t, d, f = truth
+    rec = read_instrument(write(tmp_path / f"{style}.txt", t, d, f, style))
+    np.testing.assert_allclose(rec.displacement, d, atol=1e-11)
+    np.testing.assert_allclose(rec.force, f, rtol=1e-6, atol=1e-10)
+    np.testing.assert_allclose(rec.time, t, atol=1e-9)
+    assert set(rec.columns) == {"displacement", "force", "time"}
+    counts = rec.counts()
+    push = counts["approach"] + counts["loading"]
+    # the Savitzky-Golay window smears each corner by a few rows, no more
+    assert abs(push - N_PUSH) <= 5 and abs(counts["retraction"] - N_RET) <= 5 and counts["hold"] >= N_HOLD - 8
+    assert not np.any(rec.mask("loading")[N_PUSH + N_HOLD:])  # no retraction row among the loading
+    assert abs(rec.contact_estimate - D0) < 10e-6
+
+
+@pytest.mark.parametrize("style", ["tab", "two_rows", "nm_pN"])
+def test_fit_of_the_loading_recovers_mu_H_offset_and_baseline(truth, tmp_path, style):
+    scene, t, d, f = truth
+    rec = read_instrument(write(tmp_path / "rec.txt", t, d, f, style))
+    res, used = fit_record(scene, rec, R_L=R_L)
+    assert res.success and res.baseline_model == "constant"
+    assert res.mu_H_ci95[0] < MU_H < res.mu_H_ci95[1], (res.mu_H, res.mu_H_ci95)
+    assert abs(res.offset - D0) < 2e-6, res.offset
+    assert res.baseline_ci95[0] < BASE < res.baseline_ci95[1], (res.baseline, res.baseline_ci95)
+    assert res.fitted == ("mu_H", "offset", "baseline")
+    assert used.sum() == np.sum(np.isin(rec.segments, ("approach", "loading")))
+    assert not np.any(used & (rec.segments == "retraction"))
+    # after the fit the approach is what lies before the fitted contact point
+    assert np.all(rec.displacement[rec.segments == "approach"] < res.offset)
+
+
+def test_the_merged_segments_mistake_needs_asking_and_then_warns(truth, tmp_path):
+    """What the issue found: all rows sorted by displacement give a confident interval without the truth."""
+    scene, t, d, f = truth
+    rec = read_instrument(write(tmp_path / "rec.txt", t, d, f, "tab"))
+    merged, used = fit_record(scene, rec, R_L=R_L, segment="all")
+    assert used.all()
+    assert not merged.mu_H_ci95[0] < MU_H < merged.mu_H_ci95[1]  # the bias the default avoids
+    assert "mixed_segments" in merged.warning_codes
+    with pytest.raises(ValueError, match="segment must be one of"):
+        rec.mask("everything")
+
+
+def test_linear_baseline_recovers_its_slope(truth, tmp_path):
+    scene, t, d, f = truth
+    slope = 0.5  # N/m: 10 uN over the 20 um approach
+    tilted = f + slope * (d - D0)
+    rec = read_instrument(write(tmp_path / "tilt.txt", t, d, tilted, "tab"))
+    res, _ = fit_record(scene, rec, R_L=R_L, baseline="linear")
+    assert res.success and res.fitted == ("mu_H", "offset", "baseline", "baseline_slope")
+    assert res.baseline_slope_ci95[0] < slope < res.baseline_slope_ci95[1], (res.baseline_slope,
+                                                                               res.baseline_slope_ci95)
+    assert res.mu_H_ci95[0] < MU_H < res.mu_H_ci95[1] and abs(res.offset - D0) < 2e-6
+
+
+def test_cli_fits_the_loading_by_default_and_prints_the_data_units(truth, tmp_path):
+    _, t, d, f = truth
+    path = write(tmp_path / "rec.txt", t, d, f, "tab")
+    env = dict(os.environ)
+    r = subprocess.run([sys.executable, "-m", "shellbvp", "fit", str(path), "--preset", "fit", "--radius", "0.3mm"],
+                       capture_output=True, text=True, env=env, timeout=600)
+    assert r.returncode == 0, r.stderr
+    assert "fitted the loading segment" in r.stdout and "retraction 1" in r.stdout
+    offset_line = next(ln for ln in r.stdout.splitlines() if ln.startswith("offset"))
+    assert offset_line.split()[3] == "um" and abs(float(offset_line.split()[2]) - 25) < 2, offset_line
+    assert any(ln.startswith("baseline") and "\u00b5N" in ln for ln in r.stdout.splitlines()), r.stdout
+    r = subprocess.run([sys.executable, "-m", "shellbvp", "fit", str(path), "--preset", "fit", "--radius", "0.3mm",
+                        "--json"], capture_output=True, text=True, env=env, timeout=600)
+    out = json.loads(r.stdout)
+    assert out["mu_H_ci95"][0] < MU_H < out["mu_H_ci95"][1] and out["baseline_model"] == "constant"
+
+
+def test_columns_that_cannot_be_told_apart_list_the_header_and_suggest_columns(tmp_path):
+    p = tmp_path / "two_lengths.csv"
+    p.write_text("Time (s),Height (um),Z (um),Force (uN)\n" + "\n".join(f"{i},{i},{i},{i * i}" for i in range(10)))
+    with pytest.raises(ValueError, match=r"more than one column could be the displacement.*'Height \(um\)'.*--columns"):
+        read_instrument(p)
+    rec = read_instrument(p, columns=["Z", "Force"])
+    assert rec.columns == {"displacement": "Z (um)", "force": "Force (uN)"} and rec.time is None
+    q = tmp_path / "unnamed.csv"
+    q.write_text("a,b,c\n" + "\n".join(f"{i},{i},{i}" for i in range(10)))
+    with pytest.raises(ValueError, match=r"0: 'a', 1: 'b', 2: 'c'.*--columns"):
+        read_instrument(q)
+
+
+def test_read_table_header_rows_comments_and_decimal_commas(tmp_path):
+    p = tmp_path / "t.csv"
+    p.write_text("# comment\n% another\nInstrument XY;serial 5\nDepth;Load\n\u03bcm;mN\n1,5;2,25\n3;4\n")
+    tab = read_table(p)
+    assert tab.header == ["Depth", "Load"] and tab.header_units == ["\u00b5m", "mN"] and tab.line == [6, 7]
+    d = tmp_path / "d.csv"
+    d.write_text("Depth;Load\n\u03bcm;mN\n" + "\n".join(f"{i},5;{i * 2},25" for i in range(5)))
+    rec = read_instrument(d)
+    np.testing.assert_allclose(rec.displacement, (np.arange(5) + 0.5) * 1e-6)
+    np.testing.assert_allclose(rec.force, (np.arange(5) * 2 + 0.25) * 1e-3)
+
+
+def test_segment_without_time_and_contact_estimate_edge_cases():
+    d = np.r_[np.linspace(0, 1, 50), np.ones(10), np.linspace(1, 0.2, 40), np.linspace(0.2, 0.5, 20)]
+    lab = segment(d)
+    assert lab[10] == "loading" and lab[55] == "hold" and lab[80] == "retraction" and lab[-1] == "other"
+    assert set(segment(np.linspace(1, 0, 30))) == {"retraction"}  # a file sorted the other way: no loading
+    # a staircase (steps and holds) is one loading; two cycles: the deeper one is fitted
+    stairs = np.r_[np.repeat(np.linspace(0.1, 1, 10), 12), np.ones(12), np.linspace(1, 0, 40)]
+    lab = segment(stairs)
+    assert set(lab[:105]) == {"loading"} and lab[115] == "hold" and lab[125] == "hold" and lab[150] == "retraction"
+    two = np.r_[np.linspace(0, 0.5, 30), np.linspace(0.5, 0, 30), np.linspace(0, 1, 50), np.linspace(1, 0, 50)]
+    lab = segment(two)
+    assert lab[15] == "other" and lab[45] == "other" and lab[90] == "loading" and lab[150] == "retraction"
+    x = np.linspace(0, 1, 50)
+    assert estimate_contact(x, 0.1 + x) is None  # starts in contact: no baseline to read
+    f = np.clip(x - 0.4, 0, None) ** 1.5 + 1e-4 * np.random.default_rng(0).standard_normal(50)
+    assert abs(estimate_contact(x, f) - 0.4) < 0.1
+
+
+def test_no_loading_segment_is_a_clear_error(tmp_path):
+    p = tmp_path / "down.csv"
+    p.write_text("displacement (mm),force (mN)\n" + "\n".join(f"{1 - i / 20},{(1 - i / 20) ** 2}" for i in range(20)))
+    rec = read_instrument(p)
+    with pytest.raises(ValueError, match=r"loading segment has 0 rows.*retraction.*--segment"):
+        fit_record(sb.Scene.preset("fit"), rec, R_L=R_L)
