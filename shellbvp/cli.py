@@ -61,14 +61,25 @@ def _numbers(text, name):
     return [plain_number(v, name) for v in text.split(",")]
 
 
-def _scene_options(p):
+def _uncertain(text):
+    """argparse type: ``VALUE`` or ``VALUE+-U`` (plain numbers) -> (value, U or None)."""
+    from .uncertainty import parse_uncertain
+
+    try:
+        return parse_uncertain(text, "the value")
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+
+
+def _scene_options(p, uncertain=False):
     g = p.add_argument_group("scene (overrides of the preset)")
     g.add_argument("--preset", default="base", help="built-in scene (see `shellbvp presets`; default base)")
-    g.add_argument("--gamma", type=_number, help="spheroid aspect parameter (< 1/rho; >0 bowl, <0 dome)")
-    g.add_argument("--rho", type=_number, help="indenter radius / rim radius (> 0)")
-    g.add_argument("--beta", type=_number, help="bending stiffness B/(mu R_L^2) (> 0)")
+    kind, note = (_uncertain, "; VALUE+-U: with a standard uncertainty U") if uncertain else (_number, "")
+    g.add_argument("--gamma", type=kind, help=f"spheroid aspect parameter (< 1/rho; >0 bowl, <0 dome){note}")
+    g.add_argument("--rho", type=kind, help=f"indenter radius / rim radius (> 0){note}")
+    g.add_argument("--beta", type=kind, help=f"bending stiffness B/(mu R_L^2) (> 0){note}")
     m = g.add_mutually_exclusive_group()
-    m.add_argument("--alpha", type=_number, help="Mooney-Rivlin alpha in [0, 1]")
+    m.add_argument("--alpha", type=kind, help=f"Mooney-Rivlin alpha in [0, 1]{note}")
     m.add_argument("--gent-jm", type=_number, dest="gent_jm", help="Gent model with this Jm (> 0)")
     m.add_argument("--neo-hookean", action="store_true", help="neo-Hookean material")
     g.add_argument("--xi", type=int, choices=(0, 1), help="1: full generalised tensions; 0: first approximation")
@@ -257,6 +268,18 @@ def _cmd_fit(args):
     if args.output is not None:
         check_output_path(args.output, overwrite=args.force)
 
+    uncertainty = {}
+    for name in ("gamma", "rho", "beta", "alpha"):  # VALUE+-U: the value goes to the scene
+        given = getattr(args, name)
+        if given is not None:
+            setattr(args, name, given[0])
+            if given[1] is not None:
+                uncertainty[name] = given[1]
+    if (args.workers is not None or args.scheduler) and not uncertainty:
+        raise ValueError("--workers and --scheduler run the fits of an uncertain geometry: give a parameter "
+                         "as VALUE+-U (e.g. --rho 0.333+-0.02)")
+    if args.scheduler and args.workers is not None:
+        raise ValueError("--workers sets the local pool; with --scheduler the cluster has its own workers")
     scene = _scene(args)
     R_L = parse_quantity(args.radius, "length", default_unit="m")
     if not (math.isfinite(R_L) and R_L > 0):
@@ -288,17 +311,40 @@ def _cmd_fit(args):
                 raise ValueError(f"--{name}-range must be two numbers LOW,HIGH; got {text!r}")
             if not (args.fit_beta if name == "beta" else args.fit_alpha):
                 raise ValueError(f"--{name}-range needs --fit-{name}")
-    res = sb.fit(scene, disp, force, R_L=R_L, fit_offset=not args.no_offset, fit_beta=args.fit_beta,
-                 fit_alpha=args.fit_alpha, weights=args.weights, tol=args.tol, **bounds)
+    fit_kwargs = dict(fit_offset=not args.no_offset, fit_beta=args.fit_beta, fit_alpha=args.fit_alpha,
+                      weights=args.weights, tol=args.tol, **bounds)
+    geometry = None
+    if uncertainty:
+        from .sweep import dask_executor
+        from .uncertainty import fit_with_geometry
+
+        executor = dask_executor(args.scheduler) if args.scheduler else None
+        geometry = fit_with_geometry(scene, disp, force, R_L=R_L, uncertainty=uncertainty, executor=executor,
+                                     workers=args.workers, **fit_kwargs)
+        res = geometry.nominal
+    else:
+        res = sb.fit(scene, disp, force, R_L=R_L, **fit_kwargs)
     out = res.to_dict()
-    out["exit_status"] = 0 if res.success else 1
+    ok = res.success and (geometry is None or geometry.success)
+    if geometry is not None:
+        out["geometry"] = geometry.to_dict()
+        out["success"] = ok
+    out["exit_status"] = 0 if ok else 1
     if args.json:
-        print(json.dumps(out, allow_nan=False))
+        print(json.dumps(_strict_json(out), allow_nan=False))
     else:
         if not res.success:
             print(f"fit failed (status {res.status}): {res.message}")
+        elif geometry is not None and not geometry.success:
+            print(f"fit with the geometry's uncertainty failed: {geometry.message}")
         lo, hi = res.mu_H_ci95
-        print(f"mu*H   = {res.mu_H:.4g} N/m (um*MPa)   95% CI [{lo:.4g}, {hi:.4g}]")
+        print(f"mu*H   = {res.mu_H:.4g} N/m (um*MPa)   95% CI [{lo:.4g}, {hi:.4g}]"
+              + (" (the data's noise alone)" if geometry is not None else ""))
+        if geometry is not None:
+            g1, g2 = geometry.mu_H_ci95
+            print(f"         95% CI [{g1:.4g}, {g2:.4g}] with the geometry's uncertainty "
+                  f"(u = {geometry.u_geometry:.3g} N/m; {geometry.fits_computed} fits)")
+            print(geometry.table())
         if not args.no_offset:
             o1, o2 = res.offset_ci95
             print(f"offset = {res.offset * 1e3:.4g} mm   95% CI [{o1 * 1e3:.4g}, {o2 * 1e3:.4g}] mm")
@@ -312,11 +358,13 @@ def _cmd_fit(args):
         for text in res.warnings:
             print(f"warning: {text}")
     if args.output:
-        if not res.success:
+        if not ok:
             print(f"shellbvp: not writing {args.output}: the fit failed its checks", file=sys.stderr)
         else:  # the file carries the fit's outcome (settings["fit"], read back by read_curve)
             record = {k: out[k] for k in ("mu_H", "mu_H_ci95", "offset", "offset_ci95", "fitted", "weights",
                                           "status", "message", "warnings", "warning_codes", "n", "R_L")}
+            if geometry is not None:
+                record["geometry"] = out["geometry"]
             curve = dataclasses.replace(res.curve, settings={**res.curve.settings, "fit": record})
             curve.to_hdf5(args.output, overwrite=args.force, units={"R_L": R_L, "mu_H": res.mu_H})
     return 0 if res.success else 1
@@ -535,7 +583,10 @@ def build_parser():
     f.add_argument("data", nargs="?", help="CSV file: displacement and force columns")
     f.add_argument("--example", action="store_true",
                    help="use the synthetic Lepidium-like data shipped with shellbvp (README)")
-    _scene_options(f)
+    _scene_options(f, uncertain=True)
+    f.add_argument("--workers", type=int, help="with VALUE+-U parameters: local processes for their fits "
+                                               "(default: all cores)")
+    f.add_argument("--scheduler", help="with VALUE+-U parameters: run their fits on this Dask scheduler")
     f.add_argument("--radius", required=True, help="rim radius R_L of the sample, e.g. 0.3mm")
     f.add_argument("--columns", help="displacement,force columns by name or 0-based index (default 0,1)")
     f.add_argument("--units", help="units of the two columns, e.g. mm,mN (default: from the header)")

@@ -57,7 +57,7 @@ from .version import __version__
 log = logging.getLogger(__name__)
 
 __all__ = ["sweep", "read_sweep", "run_curve", "Sweep", "SWEEP_PARAMETERS", "STATUSES", "FORMAT",
-           "FORMAT_VERSION", "is_sweep_file", "dask_executor"]
+           "FORMAT_VERSION", "is_sweep_file", "dask_executor", "local_pool", "scene_at"]
 
 FORMAT = "shellbvp-sweep"
 FORMAT_VERSION = 1
@@ -450,7 +450,8 @@ def dask_executor(address: str):
     return client.get_executor()
 
 
-def _local_pool(workers):
+def local_pool(workers=None):
+    """A process pool of ``workers`` processes (default: all cores), started by spawn."""
     if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
         raise ValueError(f"workers must be an integer >= 1; got {workers!r}")
     # spawn, not fork: workers start clean whatever threads the parent runs (Dask, h5py)
@@ -588,7 +589,7 @@ def sweep(base_scene, grid, *, delta_max, executor=None, out=None, workers=None,
                     progress(rec, computed, len(todo))
         else:
             if executor is None:
-                executor = own = _local_pool(workers)
+                executor = own = local_pool(workers)
             futures = {executor.submit(run_curve, i, scenes[i], delta_max, settings): i for i in todo}
             pending = set(futures)
             try:

@@ -231,3 +231,79 @@ def test_cli_sweep_and_info(tmp_path, capsys):
     assert main(["sweep", "--beta", "0.01:0.02", "-o", str(tmp_path / "x.h5")]) == 2
     assert "LOW:HIGH:N" in capsys.readouterr().err
     assert main(["sweep", "--beta", "__import__('os')", "-o", str(tmp_path / "x.h5")]) == 2
+
+
+# -- the fit with an uncertain geometry ----------------------------------------------------------
+def test_geometry_uncertainty_widens_the_interval_to_the_truth():
+    """Data made with rho = 0.35 (mu*H = 52), fitted with the nominal rho = 1/3 +- 0.02: the fit's own
+    interval misses 52 (the geometry is off by 0.017), the interval with the geometry's uncertainty
+    is wider and contains it."""
+    from shellbvp.uncertainty import fit_with_geometry
+
+    R_L, MU_H, D0 = 0.3e-3, 52.0, 0.01e-3
+    c = sb.curve(sb.Scene.preset("fit", rho=0.35), deltas=np.linspace(0.02, 0.2, 10), estimate_error=False)
+    rng = np.random.default_rng(7)
+    disp, force = R_L * c.delta + D0, MU_H * R_L * c.force * (1 + 0.01 * rng.standard_normal(len(c)))
+    r = fit_with_geometry(sb.Scene.preset("fit"), disp, force, R_L=R_L, uncertainty={"rho": 0.02}, workers=1,
+                          tol=1e-4)
+    assert r.success, r.message
+    lo, hi = r.mu_H_ci95_fit
+    assert not lo < MU_H < hi  # the data's noise alone: a confident, wrong interval
+    assert r.mu_H_ci95[0] < MU_H < r.mu_H_ci95[1]
+    assert r.mu_H_ci95[1] - r.mu_H_ci95[0] > 3 * (hi - lo)
+    rho, noise = r.contributions
+    # a larger indenter spreads the load: the same force needs a softer shell
+    assert rho["sensitivity"] < 0 and rho["mu_H_plus"] < r.mu_H < rho["mu_H_minus"]
+    assert rho["share"] + noise["share"] == pytest.approx(1.0)
+    assert r.fits_computed == 3
+
+
+@pytest.mark.parametrize("text, value", [("2.5+-0.2", (2.5, 0.2)), ("2.5 ± 0.2", (2.5, 0.2)),
+                                         ("2.5+/-0.2", (2.5, 0.2)), ("0.01", (0.01, None))])
+def test_plus_minus_is_parsed_without_evaluation(text, value):
+    from shellbvp.uncertainty import parse_uncertain
+
+    assert parse_uncertain(text) == value
+
+
+@pytest.mark.parametrize("text", ["2.5+-", "2.5+-0", "2.5+--0.1", "2.5+-0.1+-0.1", "__import__('os')+-1",
+                                  "2.5+-1e999", "2.5+-nan", "0.2*2+-0.1"])
+def test_bad_plus_minus_is_refused(text):
+    from shellbvp.uncertainty import parse_uncertain
+
+    with pytest.raises(ValueError):
+        parse_uncertain(text, "--gamma")
+
+
+@pytest.mark.parametrize("uncertainty, kw, match", [
+    ({"mu": 0.1}, {}, "'mu' is not a scene parameter"),
+    ({"rho": 0.0}, {}, "uncertainty > 0"),
+    ({"gamma": 1.0}, {}, r"gamma = 2.5 \+ 1 is not valid"),
+    ({"beta": 0.005}, {"fit_beta": True}, "beta is fitted"),
+    ({}, {}, "non-empty mapping"),
+])
+def test_bad_uncertainties_are_refused_before_any_fit(uncertainty, kw, match):
+    from shellbvp.uncertainty import fit_with_geometry
+
+    d = np.linspace(1e-5, 1e-4, 10)
+    with pytest.raises(ValueError, match=match):
+        fit_with_geometry(sb.Scene.preset("fit"), d, d, R_L=0.3e-3, uncertainty=uncertainty, workers=1, **kw)
+
+
+@pytest.mark.parametrize("argv, match", [
+    (["--rho", "0.333+-0"], "must be > 0"),
+    (["--gamma", "2.5+-x"], "plain finite number"),
+    (["--beta", "0.01+-0.005", "--fit-beta"], "beta is fitted"),
+    (["--workers", "2"], "give a parameter as VALUE[+]-U"),
+])
+def test_fit_cli_uncertainty_errors(argv, match, capsys):
+    import re
+
+    from shellbvp.cli import main
+
+    try:
+        status = main(["fit", "--example", "--preset", "fit", "--radius", "0.3mm", *argv])
+    except SystemExit as exc:  # argparse's own exit for a value its type refused
+        status = exc.code
+    assert status == 2
+    assert re.search(match, capsys.readouterr().err)
