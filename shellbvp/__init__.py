@@ -7,6 +7,7 @@ Quick use::
     sol = sb.solve(scene, delta=0.2)           # one state
     c = sb.curve(scene, delta_max=0.5)         # force-displacement curve
     c.to_hdf5("base.h5")
+    grid = sb.sweep(scene, {"beta": [0.005, 0.01], "rho": [0.2, 0.25]}, delta_max=0.5, out="grid.h5")
 """
 
 from .continuation import curve
@@ -19,7 +20,9 @@ from .state import delta_bounds, solve
 from .units import Dimensions, beta_from_thickness, parse_quantity
 from .version import __version__  # noqa: F401  (sb.__version__)
 
-_LAZY = {"fit": "fitting", "FitResult": "fitting", "read_force_csv": "fitting"}
+_LAZY = {"fit": "fitting", "FitResult": "fitting", "read_force_csv": "fitting",
+         "sweep": "sweep", "read_sweep": "sweep", "Sweep": "sweep",
+         "fit_with_geometry": "uncertainty", "GeometryFit": "uncertainty"}
 
 
 def __getattr__(name):
@@ -43,6 +46,11 @@ __all__ = [
     "fit",
     "FitResult",
     "read_force_csv",
+    "sweep",
+    "read_sweep",
+    "Sweep",
+    "fit_with_geometry",
+    "GeometryFit",
     "Dimensions",
     "beta_from_thickness",
     "parse_quantity",

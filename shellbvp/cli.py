@@ -423,11 +423,6 @@ def _cmd_sweep(args):
         settings["deltas"] = [args.delta_max * (i + 1) / args.points for i in range(args.points)]
     if args.scheduler and args.workers is not None:
         raise ValueError("--workers sets the local pool; with --scheduler the cluster has its own workers")
-    if args.force and os.path.exists(args.output):
-        from .paths import check_output_path
-
-        check_output_path(args.output, overwrite=True)
-        os.unlink(args.output)  # started anew (the curves of the old file are not reused)
     executor = dask_executor(args.scheduler) if args.scheduler else None
 
     def progress(rec, done, total):
@@ -438,7 +433,7 @@ def _cmd_sweep(args):
 
     t0 = time.perf_counter()
     res = sweep(base, grid, delta_max=args.delta_max, executor=executor, out=args.output, workers=args.workers,
-                extend=args.extend, progress=progress, **settings)
+                extend=args.extend, restart=args.force, progress=progress, **settings)
     counts = ", ".join(f"{v} {k}" for k, v in res.counts().items())
     print(f"wrote {args.output}: {res.status.size} combinations ({counts}); {res.computed} curves computed "
           f"in {time.perf_counter() - t0:.1f} s" + (f"; {res.lost} lost (still pending)" if res.lost else ""))
@@ -633,7 +628,8 @@ def build_parser():
     w.add_argument("--scheduler", help="address of a running Dask scheduler, e.g. tcp://host:8786 (needs "
                                        "shellbvp[dask])")
     w.add_argument("--extend", action="store_true", help="add the new combinations of a changed grid to the file")
-    w.add_argument("--force", action="store_true", help="start the file anew (its curves are discarded)")
+    w.add_argument("--force", action="store_true", help="start the file anew (its curves are discarded once the "
+                                                         "new file is first written)")
     w.add_argument("-q", "--quiet", action="store_true", help="no line per finished curve")
     w.set_defaults(func=_cmd_sweep)
     pl = sub.add_parser("plot", help="plot curves (and profiles) from HDF5 files (needs matplotlib)")

@@ -274,8 +274,9 @@ def _umask():
     return mask
 
 
-def _rewrite(path: Path, edit) -> None:
-    """Apply ``edit(h5file)`` to a copy of ``path`` (or a new file) and rename it into place.
+def _rewrite(path: Path, edit, *, fresh: bool = False) -> None:
+    """Apply ``edit(h5file)`` to a copy of ``path`` (a new file if there is none or ``fresh``) and
+    rename it into place.
 
     The rename is the only moment the file changes: an interruption at any point before it
     (Ctrl-C, kill -9, a full disk) leaves the previous complete file, and at most a hidden
@@ -286,9 +287,10 @@ def _rewrite(path: Path, edit) -> None:
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
     os.close(fd)
     try:
-        if path.exists():
+        copy = path.exists() and not fresh
+        if copy:
             shutil.copyfile(path, tmp)
-        with h5py.File(tmp, "a" if path.exists() else "w") as f:
+        with h5py.File(tmp, "a" if copy else "w") as f:
             edit(f)
             f.attrs["updated"] = _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds")
         os.chmod(tmp, 0o666 & ~_umask())  # mkstemp makes 0600; give the usual permissions
@@ -461,7 +463,7 @@ def local_pool(workers=None):
 
 # -- the sweep -----------------------------------------------------------------------------------
 def sweep(base_scene, grid, *, delta_max, executor=None, out=None, workers=None, extend=False,
-          progress=None, **curve_settings) -> Sweep:
+          restart=False, progress=None, **curve_settings) -> Sweep:
     """One curve per combination of ``grid`` values, through an executor, into one file.
 
     Parameters
@@ -485,6 +487,9 @@ def sweep(base_scene, grid, *, delta_max, executor=None, out=None, workers=None,
         different grid is refused unless ``extend`` (new combinations are then added).
     workers : int, optional
     extend : bool
+    restart : bool
+        Start ``out`` anew, whatever it holds (the old file stays intact until the new one's
+        first write replaces it).
     progress : callable, optional
         ``progress(record, done, total)`` in this process after each curve (``record`` is
         what :func:`run_curve` returned).  Raising ``KeyboardInterrupt`` there stops the
@@ -503,6 +508,8 @@ def sweep(base_scene, grid, *, delta_max, executor=None, out=None, workers=None,
 
     grid = _check_grid(base_scene, grid)
     settings = _check_settings(curve_settings)
+    if executor is not None and workers is not None:
+        raise ValueError("workers sets the size of the default local pool; an executor given has its own workers")
     names = list(grid)
     delta_max = float(delta_max) if isinstance(delta_max, (int, float)) and not isinstance(delta_max, bool) \
         else delta_max
@@ -511,11 +518,9 @@ def sweep(base_scene, grid, *, delta_max, executor=None, out=None, workers=None,
     path = None
     found = None
     if out is not None:
-        path = Path(out)
-        if path.exists():
+        path = check_output_path(out, overwrite=True)  # a directory where a file can be written
+        if path.exists() and not restart:
             found = _reconcile(path, json.loads(json.dumps(meta)), extend)
-        else:
-            check_output_path(path, overwrite=False)
     if found is None:
         index = _new_index(names, _combinations(grid))
     else:
@@ -541,7 +546,7 @@ def sweep(base_scene, grid, *, delta_max, executor=None, out=None, workers=None,
             s.attrs["units"] = "nondimensional"
             _write_index(s, names, index)
 
-        _rewrite(path, write_meta)  # the file exists (all pending) before the first curve
+        _rewrite(path, write_meta, fresh=found is None)  # the file exists (all pending) before the first curve
 
     # derive each structure's code here, once, before any worker needs it (they load it from the cache)
     for desc in {json.dumps(s.structure(), sort_keys=True): s.structure() for s in scenes}.values():

@@ -179,6 +179,11 @@ def test_a_changed_sweep_is_refused_or_extended_when_asked(tmp_path):
     res = sweep(BASE, {"beta": [0.02, 0.01]}, delta_max=0.1, out=out, workers=1, extend=True, **kw)
     assert res.computed == 1 and list(res.values["beta"]) == [0.01, 0.02]
     assert read_sweep(out).counts() == {"complete": 2}
+    with pytest.raises(ValueError, match="beta .* must be > 0"):  # restart: refused before the old file goes
+        sweep(BASE, {"beta": [-0.01]}, delta_max=0.1, out=out, workers=1, restart=True, **kw)
+    assert read_sweep(out).counts() == {"complete": 2}
+    res = sweep(BASE, {"beta": [0.01]}, delta_max=0.1, out=out, workers=1, restart=True, deltas=[0.1], tol=1e-5)
+    assert res.computed == 1 and res.settings["tol"] == 1e-5 and res.counts() == {"complete": 1}
 
 
 @pytest.mark.parametrize("grid, kw, match", [
