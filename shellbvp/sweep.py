@@ -32,6 +32,7 @@ workers finish curves (see the README for the arithmetic).
 
 from __future__ import annotations
 
+import contextlib
 import datetime as _dt
 import inspect
 import itertools
@@ -461,6 +462,156 @@ def local_pool(workers=None):
                                mp_context=multiprocessing.get_context("spawn"))
 
 
+# -- the writer ----------------------------------------------------------------------------------
+class _Lock:
+    """An exclusive lock on ``<file>.lock`` for as long as a sweep writes ``<file>``.
+
+    Two sweeps writing one file would each replace the other's additions (every write is a
+    copy of the file as that process last saw it), so a second one is refused.  ``flock`` is
+    released by the kernel when the process ends, however it ends (a ``kill -9`` leaves no
+    stale lock).  Where ``fcntl`` does not exist (Windows) no lock is taken.
+    """
+
+    def __init__(self, path: Path):
+        self.path = path.with_name(path.name + ".lock")
+        self.fh = None
+
+    def __enter__(self):
+        try:
+            import fcntl
+        except ImportError:
+            return self
+        while True:
+            fh = open(self.path, "a+")  # held open for the sweep: the lock lives with it
+            try:
+                fcntl.flock(fh, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except BlockingIOError:
+                fh.close()
+                raise ValueError(f"{self.path.with_suffix('')} is being written by another sweep (lock "
+                                 f"{self.path}); wait for it to end, or choose another output file") from None
+            try:  # the file locked must still be the one at the path (another sweep may have removed it)
+                same = os.stat(self.path).st_ino == os.fstat(fh.fileno()).st_ino
+            except FileNotFoundError:
+                same = False
+            if same:
+                self.fh = fh
+                return self
+            fh.close()
+
+    def __exit__(self, *exc):
+        if self.fh is not None:
+            self.path.unlink(missing_ok=True)  # while still locked: a waiting sweep sees it gone and retries
+            self.fh.close()
+
+
+class _Writer:
+    """The sweep file as this process writes it: the index in memory, each write atomic (_rewrite)."""
+
+    def __init__(self, path: Path | None, names, index, meta):
+        self.path, self.names, self.index, self.meta = path, names, index, meta
+
+    def start(self, fresh: bool):
+        """Write the metadata and the index (every combination pending or as found)."""
+        if self.path is None:
+            return
+        for debris in self.path.parent.glob(f".{self.path.name}.*.tmp"):  # of a killed writer (we hold the lock)
+            debris.unlink(missing_ok=True)
+
+        def edit(f):
+            f.attrs["format"], f.attrs["format_version"] = FORMAT, FORMAT_VERSION
+            f.attrs["package_version"] = __version__
+            if "created" not in f.attrs:
+                f.attrs["created"] = _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds")
+            s = f.require_group("sweep")
+            s.require_group("curves")
+            for key in ("base_scene", "settings"):
+                s.attrs[key] = json.dumps(self.meta[key], sort_keys=True)
+            for key in ("parameters", "grid"):  # in grid order
+                s.attrs[key] = json.dumps(self.meta[key])
+            s.attrs["delta_max"] = self.meta["delta_max"]
+            s.attrs["units"] = "nondimensional"
+            _write_index(s, self.names, self.index)
+
+        _rewrite(self.path, edit, fresh=fresh)
+
+    def add(self, records, curves):
+        """Enter finished records in the index and write their curves (one atomic write)."""
+        for rec in records:
+            i = rec["index"]
+            for key in ("status", "message", "wall_time"):
+                self.index[key][i] = rec[key]
+            if i in curves:
+                self.index["stop_reason"][i] = rec["stop_reason"]
+                self.index["points"][i] = len(rec["points"]["delta"])
+                self.index["group"][i] = f"curves/curve_{i:06d}"
+        if self.path is None:
+            return
+
+        def edit(f):
+            s = f["sweep"]
+            for rec in records:
+                name = self.index["group"][rec["index"]]
+                if name:
+                    if name in s:  # a pending combination has no group; kept safe all the same
+                        del s[name]
+                    write_curve_group(s.create_group(name), curves[rec["index"]])
+                    _label_units(s[name])
+            _write_index(s, self.names, self.index)
+
+        _rewrite(self.path, edit)
+
+
+def _compute(todo, args_of, executor, on_records):
+    """Run :func:`run_curve` on ``args_of(i)`` for each i in ``todo``, through ``executor`` (None:
+    in this process), passing finished records on in batches (whatever finished meanwhile).
+
+    Returns (computed, lost): tasks the executor could not run (a worker died) are lost, logged
+    and left pending.  On an interruption, tasks not yet started are cancelled.
+    """
+    if executor is None:
+        for i in todo:
+            on_records([run_curve(*args_of(i))])
+        return len(todo), 0
+    computed = lost = 0
+    futures = {}
+    try:
+        futures = {executor.submit(run_curve, *args_of(i)): i for i in todo}
+        pending = set(futures)
+        while pending:
+            done, pending = wait(pending, return_when=FIRST_COMPLETED)
+            records = []
+            for fut in done:
+                try:
+                    records.append(fut.result())
+                except Exception as exc:  # the executor failed (a worker died): logged, stays pending
+                    lost += 1
+                    log.warning("curve %d was not computed (%s: %s); it stays pending", futures[fut],
+                                type(exc).__name__, exc)
+            computed += len(records)
+            if records:
+                on_records(records)
+    finally:
+        for fut in futures:  # after an interruption: what has not started never starts
+            fut.cancel()
+    return computed, lost
+
+
+def _plan(base_scene, grid, delta_max, settings, path, extend, restart):
+    """(meta, index, scenes) of a sweep, every input checked and an existing file reconciled."""
+    names = list(grid)
+    meta = {"base_scene": base_scene.to_dict(), "parameters": names, "grid": {n: list(v) for n, v in grid.items()},
+            "settings": settings, "delta_max": delta_max}
+    found = None
+    if path is not None and path.exists() and not restart:
+        found = _reconcile(path, json.loads(json.dumps(meta)), extend)
+    if found is None:
+        index = _new_index(names, _combinations(grid))
+    else:
+        meta["grid"], index = found
+    combos = list(zip(*(index[n] for n in names)))
+    return meta, index, _check_scenes(base_scene, names, combos, delta_max, settings), found is None
+
+
 # -- the sweep -----------------------------------------------------------------------------------
 def sweep(base_scene, grid, *, delta_max, executor=None, out=None, workers=None, extend=False,
           restart=False, progress=None, **curve_settings) -> Sweep:
@@ -510,120 +661,45 @@ def sweep(base_scene, grid, *, delta_max, executor=None, out=None, workers=None,
     settings = _check_settings(curve_settings)
     if executor is not None and workers is not None:
         raise ValueError("workers sets the size of the default local pool; an executor given has its own workers")
-    names = list(grid)
-    delta_max = float(delta_max) if isinstance(delta_max, (int, float)) and not isinstance(delta_max, bool) \
-        else delta_max
-    meta = {"base_scene": base_scene.to_dict(), "parameters": names, "grid": {n: list(v) for n, v in grid.items()},
-            "settings": settings, "delta_max": delta_max}
-    path = None
-    found = None
-    if out is not None:
-        path = check_output_path(out, overwrite=True)  # a directory where a file can be written
-        if path.exists() and not restart:
-            found = _reconcile(path, json.loads(json.dumps(meta)), extend)
-    if found is None:
-        index = _new_index(names, _combinations(grid))
-    else:
-        file_grid, index = found
-        grid = {n: tuple(v) for n, v in file_grid.items()}
-        meta["grid"] = file_grid
-    combos = list(zip(*(index[n] for n in names)))
-    scenes = _check_scenes(base_scene, names, combos, delta_max, settings)
-    todo = [i for i, st in enumerate(index["status"]) if st == "pending"]
+    if isinstance(delta_max, (int, float)) and not isinstance(delta_max, bool):
+        delta_max = float(delta_max)
+    path = None if out is None else check_output_path(out, overwrite=True)  # a directory we can write in
+    with _Lock(path) if path is not None else contextlib.nullcontext():
+        meta, index, scenes, fresh = _plan(base_scene, grid, delta_max, settings, path, extend, restart)
+        names = meta["parameters"]
+        writer = _Writer(path, names, index, meta)
+        writer.start(fresh)  # the file exists (every combination listed) before the first curve
+        # derive each structure's code here, once, before any worker needs it (they load it from the cache)
+        for desc in {json.dumps(sc.structure(), sort_keys=True): sc.structure() for sc in scenes}.values():
+            load_module(desc)
+        curves = {}
 
-    curves = {}
-    if path is not None:
-        def write_meta(f):
-            f.attrs["format"], f.attrs["format_version"] = FORMAT, FORMAT_VERSION
-            f.attrs["package_version"] = __version__
-            if "created" not in f.attrs:
-                f.attrs["created"] = _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds")
-            s = f.require_group("sweep")
-            s.require_group("curves")
-            for key in ("base_scene", "parameters", "grid", "settings"):
-                s.attrs[key] = json.dumps(meta[key], sort_keys=key != "parameters" and key != "grid")
-            s.attrs["delta_max"] = delta_max
-            s.attrs["units"] = "nondimensional"
-            _write_index(s, names, index)
-
-        _rewrite(path, write_meta, fresh=found is None)  # the file exists (all pending) before the first curve
-
-    # derive each structure's code here, once, before any worker needs it (they load it from the cache)
-    for desc in {json.dumps(s.structure(), sort_keys=True): s.structure() for s in scenes}.values():
-        load_module(desc)
-
-    def store(records):
-        for rec in records:
-            i = rec["index"]
-            index["status"][i] = rec["status"]
-            index["message"][i] = rec["message"]
-            index["wall_time"][i] = rec["wall_time"]
-            if rec["status"] != "error":
-                index["stop_reason"][i] = rec["stop_reason"]
-                index["points"][i] = len(rec["points"]["delta"])
-                index["group"][i] = f"curves/curve_{i:06d}"
-                curves[i] = _curve_of(rec, scenes[i])
-        if path is None:
-            return
-
-        def edit(f):
-            s = f["sweep"]
+        def on_records(records):
             for rec in records:
-                i = rec["index"]
-                if i in curves:
-                    name = index["group"][i]
-                    if name in s:  # (cannot happen for a pending combination; kept safe)
-                        del s[name]
-                    g = s.create_group(name)
-                    write_curve_group(g, curves[i])
-                    _label_units(g)
-            _write_index(s, names, index)
+                if rec["status"] != "error":
+                    curves[rec["index"]] = _curve_of(rec, scenes[rec["index"]])
+            writer.add(records, curves)
+            if progress is not None:
+                for rec in records:
+                    done[0] += 1
+                    progress(rec, done[0], len(todo))
 
-        _rewrite(path, edit)
-
-    computed = lost = 0
-    own = None
-    t0 = time.perf_counter()
-    try:
-        if executor is None and workers == 1 or not todo:
-            for i in todo:
-                rec = run_curve(i, scenes[i], delta_max, settings)
-                computed += 1
-                store([rec])
-                if progress is not None:
-                    progress(rec, computed, len(todo))
-        else:
-            if executor is None:
-                executor = own = local_pool(workers)
-            futures = {executor.submit(run_curve, i, scenes[i], delta_max, settings): i for i in todo}
-            pending = set(futures)
-            try:
-                while pending:
-                    done, pending = wait(pending, return_when=FIRST_COMPLETED)
-                    records = []
-                    for fut in done:
-                        try:
-                            records.append(fut.result())
-                        except Exception as exc:  # the executor failed (a worker died): stays pending
-                            lost += 1
-                            log.warning("curve %d was not computed (%s: %s); it stays pending", futures[fut],
-                                        type(exc).__name__, exc)
-                    computed += len(records)
-                    store(records)
-                    if progress is not None:
-                        for rec in records:
-                            progress(rec, computed, len(todo))
-            finally:
-                for fut in pending:  # on an interruption: what has not started never starts
-                    fut.cancel()
-    finally:
-        if own is not None:
-            own.shutdown(wait=True, cancel_futures=True)
+        todo = [i for i, st in enumerate(index["status"]) if st == "pending"]
+        done = [0]
+        t0 = time.perf_counter()
+        own = local_pool(workers) if executor is None and workers != 1 and todo else None
+        try:
+            computed, lost = _compute(todo, lambda i: (i, scenes[i], delta_max, settings), executor or own,
+                                      on_records)
+        finally:
+            if own is not None:
+                own.shutdown(wait=True, cancel_futures=True)
     log.info("sweep: %d curves computed in %.1f s (%d lost)", computed, time.perf_counter() - t0, lost)
     if path is not None:
         result = read_sweep(path)
-        result.computed, result.lost = computed, lost
-        return result
-    return Sweep(parameters=tuple(names), values={n: np.asarray(grid[n], float) for n in names},
-                 base_scene=base_scene, delta_max=delta_max, settings=settings,
-                 index={k: np.asarray(v) for k, v in index.items()}, curves=curves, computed=computed, lost=lost)
+    else:
+        result = Sweep(parameters=tuple(names), values={n: np.asarray(meta["grid"][n], float) for n in names},
+                       base_scene=base_scene, delta_max=delta_max, settings=settings,
+                       index={k: np.asarray(v) for k, v in index.items()}, curves=curves)
+    result.computed, result.lost = computed, lost
+    return result

@@ -312,3 +312,19 @@ def test_fit_cli_uncertainty_errors(argv, match, capsys):
         status = exc.code
     assert status == 2
     assert re.search(match, capsys.readouterr().err)
+
+
+def test_a_second_sweep_on_the_same_file_is_refused_while_one_runs(tmp_path):
+    fcntl = pytest.importorskip("fcntl")
+    from shellbvp.sweep import sweep
+
+    out = tmp_path / "g.h5"
+    with open(tmp_path / "g.h5.lock", "a+") as held:  # as a running sweep holds it
+        fcntl.flock(held, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        with pytest.raises(ValueError, match="being written by another sweep"):
+            sweep(BASE, {"beta": [0.01]}, delta_max=0.1, out=out, workers=1, deltas=[0.1])
+    assert not out.exists()
+    (tmp_path / ".g.h5.abc.tmp").write_text("debris of a killed writer")
+    res = sweep(BASE, {"beta": [0.01]}, delta_max=0.1, out=out, workers=1, deltas=[0.1], estimate_error=False)
+    assert res.computed == 1
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["g.h5"]  # no lock, no debris left
