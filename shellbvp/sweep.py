@@ -192,6 +192,8 @@ class Sweep:
         Combination number -> :class:`Curve` (finished curves only).
     computed : int
         Curves computed by the call that returned this (0 from :func:`read_sweep`).
+    lost : int
+        Curves the executor failed to run in that call (a worker died): still pending.
     delta : ndarray
         The common depths ``linspace(0, delta_max, 101)`` of :attr:`force`.
     force : ndarray, shape ``(len(values[p0]), len(values[p1]), ..., delta.size)``
@@ -200,6 +202,18 @@ class Sweep:
         combination has no curve.
     status, points, wall_time : ndarray, shape of the grid
         From the index ("" / -1 / NaN where the grid has no such combination).
+
+    Examples
+    --------
+    >>> import shellbvp as sb
+    >>> res = sb.sweep(sb.Scene.preset("base"), {"beta": [0.005, 0.01], "rho": [0.2, 0.25]}, delta_max=0.1,
+    ...                workers=1, deltas=[0.05, 0.1], estimate_error=False)
+    >>> res.parameters, res.shape, res.force.shape
+    (('beta', 'rho'), (2, 2), (2, 2, 101))
+    >>> res.counts(), res.finished
+    ({'complete': 4}, True)
+    >>> bool(res.force[1, 0, -1] > res.force[0, 0, -1])       # a stiffer shell pushes back harder
+    True
     """
 
     parameters: tuple
@@ -246,7 +260,7 @@ class Sweep:
         return self.status.shape
 
     def counts(self) -> dict:
-        """Number of combinations by status."""
+        """Number of combinations by status (only the statuses present)."""
         st = list(self.index["status"])
         return {s: st.count(s) for s in STATUSES if s in st}
 
@@ -383,7 +397,34 @@ def _read_attrs(path):
 def read_sweep(path) -> Sweep:
     """Read a sweep file written by :func:`sweep` (finished curves and the gridded arrays).
 
-    Raises ``ValueError`` with a one-line reason for a missing, foreign or malformed file.
+    Parameters
+    ----------
+    path : str or Path
+        A file of format ``shellbvp-sweep`` (complete or not: pending combinations are listed).
+
+    Returns
+    -------
+    Sweep
+        With ``computed = 0``.
+
+    Raises
+    ------
+    ValueError
+        A one-line reason for a missing, foreign or malformed file.
+
+    Examples
+    --------
+    >>> import shellbvp as sb
+    >>> _ = sb.sweep(sb.Scene.preset("base"), {"rho": [0.2, 0.25]}, delta_max=0.1, out="rho.h5", workers=1,
+    ...              deltas=[0.05, 0.1], estimate_error=False)
+    >>> grid = sb.read_sweep("rho.h5")
+    >>> grid.index["status"].tolist(), grid.computed
+    (['complete', 'complete'], 0)
+    >>> c = grid.curves[1]                                     # a Curve: rho = 0.25
+    >>> c.scene.rho, len(c)
+    (0.25, 2)
+    >>> bool(grid.force[1, -1] == c.force[-1])                 # F at delta_max, on the common grid
+    True
     """
     import h5py
 
@@ -653,6 +694,34 @@ def sweep(base_scene, grid, *, delta_max, executor=None, out=None, workers=None,
     Sweep
         ``computed``: the curves computed by this call; ``lost``: tasks that the executor
         failed to run (a worker died): they stay pending in the file, and a re-run computes them.
+
+    Raises
+    ------
+    ValueError
+        Before any curve: an unknown parameter or setting, a value that makes an invalid scene
+        or a depth outside its :func:`shellbvp.delta_bounds` (naming the grid point), a file
+        made with other settings or another grid (without ``extend``), a file another sweep
+        is writing.
+
+    Examples
+    --------
+    Two curves into a file (here in this process; by default on all cores), then the same
+    call again: nothing is left to compute.
+
+    >>> import shellbvp as sb
+    >>> base = sb.Scene.preset("base")
+    >>> kw = dict(delta_max=0.1, out="beta.h5", workers=1, deltas=[0.05, 0.1], estimate_error=False)
+    >>> res = sb.sweep(base, {"beta": [0.005, 0.01]}, **kw)
+    >>> res.computed, res.counts()
+    (2, {'complete': 2})
+    >>> sb.sweep(base, {"beta": [0.005, 0.01]}, **kw).computed
+    0
+    >>> sb.sweep(base, {"beta": [0.005, 0.01, 0.02]}, **kw)    # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    ValueError: beta.h5 holds another grid (beta: file [0.005, 0.01], asked [0.005, 0.01, 0.02]): pass extend=True ...
+    >>> sb.sweep(base, {"beta": [0.005, 0.01, 0.02]}, extend=True, **kw).computed
+    1
     """
     from .model import load_module
     from .paths import check_output_path
