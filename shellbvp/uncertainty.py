@@ -123,7 +123,7 @@ class GeometryFit:
     contributions : list of dict
         Per parameter: ``parameter``, ``value``, ``uncertainty``, ``mu_H_minus``, ``mu_H_plus``
         (fits at value -+ uncertainty), ``sensitivity`` (d mu_H / d parameter), ``u_mu_H``
-        (|sensitivity| x uncertainty), ``nonlinearity`` ((mu_H_plus + mu_H_minus)/2 - mu_H),
+        (``abs(sensitivity) * uncertainty``), ``nonlinearity`` ((mu_H_plus + mu_H_minus)/2 - mu_H),
         ``share`` (fraction of the interval's variance), and last the fit's own line
         (``parameter`` "noise (fit)").
     nominal : FitResult
