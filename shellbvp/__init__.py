@@ -7,6 +7,7 @@ Quick use::
     sol = sb.solve(scene, delta=0.2)           # one state
     c = sb.curve(scene, delta_max=0.5)         # force-displacement curve
     c.to_hdf5("base.h5")
+    grid = sb.sweep(scene, {"beta": [0.005, 0.01], "rho": [0.2, 0.25]}, delta_max=0.5, out="grid.h5")
 """
 
 from .continuation import curve
@@ -20,7 +21,9 @@ from .units import Dimensions, beta_from_thickness, parse_quantity
 from .version import __version__  # noqa: F401  (sb.__version__)
 
 _LAZY = {"fit": "fitting", "FitResult": "fitting", "read_force_csv": "fitting", "fit_record": "fitting",
-         "read_instrument": "instrument", "fit_files": "batch", "read_fit": "fitrecord"}
+         "read_instrument": "instrument", "fit_files": "batch", "read_fit": "fitrecord",
+         "sweep": "sweep", "read_sweep": "sweep", "Sweep": "sweep",
+         "fit_with_geometry": "uncertainty", "GeometryFit": "uncertainty"}
 
 
 def __getattr__(name):
@@ -48,6 +51,11 @@ __all__ = [
     "fit_record",
     "fit_files",
     "read_fit",
+    "sweep",
+    "read_sweep",
+    "Sweep",
+    "fit_with_geometry",
+    "GeometryFit",
     "Dimensions",
     "beta_from_thickness",
     "parse_quantity",

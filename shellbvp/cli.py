@@ -2,9 +2,10 @@
 
     shellbvp curve [--preset base] [scene options] [-o base.h5]   force-displacement curve -> HDF5
     shellbvp solve [scene options] --delta 0.2 [--profiles] [--json]   one state
+    shellbvp sweep --beta 0.005,0.01 --rho 0.15:0.3:4 -o grid.h5   one curve per combination -> one file
     shellbvp fit DATA.csv --radius 0.3mm [--units mm,mN] [--json]   mu*H from measured data
     shellbvp plot A.h5 [B.h5 ...] -o fig.png [--profiles 0.1,0.3]   figures (matplotlib)
-    shellbvp info FILE.h5                                            what a curve file holds
+    shellbvp info FILE.h5                                            what a curve or sweep file holds
     shellbvp presets                                                 the built-in scenes
 
 Invalid input exits with status 2 and a one-line message naming the parameter.
@@ -76,14 +77,25 @@ def quantity(kind):
     return parse
 
 
-def _scene_options(p):
+def _uncertain(text):
+    """argparse type: ``VALUE`` or ``VALUE+-U`` (plain numbers) -> (value, U or None)."""
+    from .uncertainty import parse_uncertain
+
+    try:
+        return parse_uncertain(text, "the value")
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+
+
+def _scene_options(p, uncertain=False):
     g = p.add_argument_group("scene (overrides of the preset)")
     g.add_argument("--preset", default="base", help="built-in scene (see `shellbvp presets`; default base)")
-    g.add_argument("--gamma", type=_number, help="spheroid aspect parameter (< 1/rho; >0 bowl, <0 dome)")
-    g.add_argument("--rho", type=_number, help="indenter radius / rim radius (> 0)")
-    g.add_argument("--beta", type=_number, help="bending stiffness B/(mu R_L^2) (> 0)")
+    kind, note = (_uncertain, "; VALUE+-U: with a standard uncertainty U") if uncertain else (_number, "")
+    g.add_argument("--gamma", type=kind, help=f"spheroid aspect parameter (< 1/rho; >0 bowl, <0 dome){note}")
+    g.add_argument("--rho", type=kind, help=f"indenter radius / rim radius (> 0){note}")
+    g.add_argument("--beta", type=kind, help=f"bending stiffness B/(mu R_L^2) (> 0){note}")
     m = g.add_mutually_exclusive_group()
-    m.add_argument("--alpha", type=_number, help="Mooney-Rivlin alpha in [0, 1]")
+    m.add_argument("--alpha", type=kind, help=f"Mooney-Rivlin alpha in [0, 1]{note}")
     m.add_argument("--gent-jm", type=_number, dest="gent_jm", help="Gent model with this Jm (> 0)")
     m.add_argument("--neo-hookean", action="store_true", help="neo-Hookean material")
     g.add_argument("--xi", type=int, choices=(0, 1), help="1: full generalised tensions; 0: first approximation")
@@ -283,6 +295,23 @@ def _cmd_solve(args):
     return 0 if sol.success else 1
 
 
+def _split_uncertain(args):
+    """``VALUE+-U`` options of ``fit``: the values go to the scene; returns {name: U}."""
+    uncertainty = {}
+    for name in ("gamma", "rho", "beta", "alpha"):
+        given = getattr(args, name)
+        if isinstance(given, tuple):
+            setattr(args, name, given[0])
+            if given[1] is not None:
+                uncertainty[name] = given[1]
+    if (args.workers is not None or args.scheduler) and not uncertainty:
+        raise ValueError("--workers and --scheduler run the fits of an uncertain geometry: give a parameter "
+                         "as VALUE+-U (e.g. --rho 0.333+-0.02)")
+    if args.scheduler and args.workers is not None:
+        raise ValueError("--workers sets the local pool; with --scheduler the cluster has its own workers")
+    return uncertainty
+
+
 def _fit_inputs(args):
     """The scene, R_L and the reading and fitting options of ``fit``, checked before any work."""
     scene = _scene(args)
@@ -327,7 +356,10 @@ def _cmd_fit(args):
         raise ValueError("give data files (or a directory) or --example (one of them)")
     inputs = [str(example_data_path())] if args.example else args.data
     files = expand_inputs(inputs)
+    uncertainty = _split_uncertain(args)
     if len(files) > 1 or args.table or any(Path(x).is_dir() for x in inputs):
+        if uncertainty:
+            raise ValueError("VALUE+-U (the geometry's uncertainty) is for one file at a time, not a batch")
         return _fit_batch(args, files)
     if args.output is not None:
         check_output_path(args.output, overwrite=args.force)
@@ -337,18 +369,40 @@ def _cmd_fit(args):
     options["progress"] = _curve_bars(args)
     record = read_instrument(files[0], **reading)
     res, used = fit_record(scene, record, R_L=R_L, segment=args.segment, baseline=args.baseline, **options)
+    geometry = None
+    if uncertainty and res.success:
+        from .sweep import dask_executor
+        from .uncertainty import fit_with_geometry
+
+        # the same rows, baseline model and contact point as the nominal fit, at each perturbed geometry
+        kw = {k: v for k, v in options.items() if k != "progress"}
+        executor = dask_executor(args.scheduler) if args.scheduler else None
+        geometry = fit_with_geometry(scene, record.displacement[used], record.force[used], R_L=R_L,
+                                     uncertainty=uncertainty, executor=executor, workers=args.workers,
+                                     baseline=res.baseline_model, contact_guess=res.offset, **kw)
     out = res.to_dict()
-    out["exit_status"] = 0 if res.success else 1
+    ok = res.success and (geometry is None or geometry.success)
+    if geometry is not None:
+        out["geometry"] = geometry.to_dict()
+        out["success"] = ok
+    out["exit_status"] = 0 if ok else 1
     if args.json:
-        print(json.dumps(out, allow_nan=False))
+        print(json.dumps(_strict_json(out), allow_nan=False))
     else:
         _print_fit(res, record, used, args)
+        if geometry is not None:
+            if not geometry.success:
+                print(f"fit with the geometry's uncertainty failed: {geometry.message}")
+            g1, g2 = geometry.mu_H_ci95
+            print(f"         95% CI [{g1:.4g}, {g2:.4g}] N/m with the geometry's uncertainty "
+                  f"(u = {geometry.u_geometry:.3g} N/m; {geometry.fits_computed} fits)")
+            print(geometry.table())
     if args.output or args.report:
         if not res.success:
             print(f"shellbvp: not writing {args.output or args.report}: the fit failed its checks", file=sys.stderr)
         else:
             _save_fit(res, record, used, args.output, args.report, args.segment, args.force, args.json)
-    return 0 if res.success else 1
+    return 0 if ok else 1
 
 
 def _output_dir(path, what, files, suffix, force):
@@ -556,11 +610,113 @@ def _cmd_plot(args):
     return 0
 
 
+MAX_SWEEP_VALUES = 10_000  # values of one swept parameter: more is a typo, not a grid
+
+
+def _sweep_values(text, name):
+    """Values of a swept parameter: ``a,b,c``, ``lo:hi:n`` (n equally spaced) or ``lo:hi:n:log``
+    (n spaced evenly in log), each number plain decimal text (nothing is evaluated)."""
+    import numpy as np
+
+    from .units import plain_number
+
+    parts = text.split(":")
+    if len(parts) == 1:
+        return [plain_number(v, name) for v in text.split(",")]
+    if len(parts) not in (3, 4) or (len(parts) == 4 and parts[3] != "log"):
+        raise ValueError(f"{name} must be a list a,b,c or a range LOW:HIGH:N[:log]; got {text!r}")
+    lo, hi = plain_number(parts[0], name), plain_number(parts[1], name)
+    if not parts[2].strip().isdigit() or not 1 <= int(parts[2]) <= MAX_SWEEP_VALUES:
+        raise ValueError(f"{name}: N of LOW:HIGH:N must be an integer in [1, {MAX_SWEEP_VALUES}]; got {parts[2]!r}")
+    n = int(parts[2])
+    if len(parts) == 4:
+        if not (lo > 0 and hi > 0):
+            raise ValueError(f"{name}: a log range needs LOW, HIGH > 0; got {text!r}")
+        return np.geomspace(lo, hi, n).tolist()
+    return np.linspace(lo, hi, n).tolist()
+
+
+def _cmd_sweep(args):
+    """``shellbvp sweep``: exit 0 every curve complete, 1 some stopped early, failed or were lost
+    (the index says which), 2 bad input, 130 interrupted (the file keeps the finished curves)."""
+    import shellbvp as sb
+
+    from .sweep import dask_executor, sweep
+
+    grid = {}
+    for name, text in (("beta", args.beta), ("rho", args.rho), ("gamma", args.gamma), ("alpha", args.alpha),
+                       ("Jm", args.gent_jm)):  # the grid's axes in this order (read_sweep's arrays)
+        if text is not None:
+            grid[name] = _sweep_values(text, f"--{'gent-jm' if name == 'Jm' else name}")
+    if not grid:
+        raise ValueError("give at least one of --gamma, --rho, --beta, --alpha, --gent-jm to sweep")
+    over = {k: getattr(args, k) for k in ("xi", "contact") if getattr(args, k) is not None}
+    if args.gent_jm is not None:
+        over["material"] = sb.Gent(grid["Jm"][0])
+    elif args.neo_hookean:
+        over["material"] = sb.NeoHookean()
+    base = sb.Scene.preset(args.preset, **over)
+    settings = {"tol": args.tol, "max_nodes": args.max_nodes, "max_steps": args.max_steps, "topology": args.topology}
+    if args.points is not None:
+        if not 2 <= args.points <= MAX_POINTS:
+            raise ValueError(f"--points must be in [2, {MAX_POINTS}]; got {args.points}")
+        settings["deltas"] = [args.delta_max * (i + 1) / args.points for i in range(args.points)]
+    if args.scheduler and args.workers is not None:
+        raise ValueError("--workers sets the local pool; with --scheduler the cluster has its own workers")
+    executor = dask_executor(args.scheduler) if args.scheduler else None
+
+    def progress(rec, done, total):
+        if not args.quiet:
+            what = rec["status"] + (f", {len(rec['points']['delta'])} points" if "points" in rec else "")
+            print(f"  [{done}/{total}] curve {rec['index']}: {what}, {rec['wall_time']:.1f} s"
+                  + (f" ({rec['message']})" if rec["message"] else ""), file=sys.stderr, flush=True)
+
+    t0 = time.perf_counter()
+    res = sweep(base, grid, delta_max=args.delta_max, executor=executor, out=args.output, workers=args.workers,
+                extend=args.extend, restart=args.force, progress=progress, **settings)
+    counts = ", ".join(f"{v} {k}" for k, v in res.counts().items())
+    print(f"wrote {args.output}: {res.status.size} combinations ({counts}); {res.computed} curves computed "
+          f"in {time.perf_counter() - t0:.1f} s" + (f"; {res.lost} lost (still pending)" if res.lost else ""))
+    return 0 if res.counts() == {"complete": res.status.size} else 1
+
+
+def _sweep_info(path):
+    import numpy as np
+
+    from .sweep import read_sweep
+
+    sw = read_sweep(path)
+    s = sw.base_scene
+    print(f"file:      {path} (shellbvp sweep)")
+    print(f"base:      gamma={s.gamma:g} rho={s.rho:g} beta={s.beta:g} xi={s.xi} contact={s.contact} "
+          f"material={s.material!r}")
+    for name in sw.parameters:
+        print(f"sweeps:    {name} = {', '.join(f'{v:g}' for v in sw.values[name])}")
+    print(f"settings:  delta_max={sw.delta_max:g} {json.dumps(sw.settings, sort_keys=True)}")
+    counts = ", ".join(f"{v} {k}" for k, v in sw.counts().items())
+    wall = np.asarray(sw.index["wall_time"], float)
+    done = np.isfinite(wall)
+    print(f"curves:    {len(sw.index['status'])} combinations: {counts}")
+    if np.any(done):
+        print(f"time:      {np.sum(wall[done]):.1f} s of curves in workers; slowest {np.max(wall[done]):.1f} s, "
+              f"median {np.median(wall[done]):.1f} s")
+    head = " ".join(f"{n:>10s}" for n in sw.parameters)
+    print(f"{head} {'status':>9s} {'points':>6s} {'delta_end':>9s} {'F_end':>10s} {'time(s)':>8s}  stop reason")
+    for i, st in enumerate(sw.index["status"]):
+        c = sw.curves.get(i)
+        end = (f"{c.delta[-1]:9.4g} {c.force[-1]:10.5g}" if c is not None and len(c) else f"{'':9s} {'':10s}")
+        why = sw.index["stop_reason"][i] or sw.index["message"][i]
+        print(" ".join(f"{sw.index[n][i]:10.5g}" for n in sw.parameters)
+              + f" {st:>9s} {int(sw.index['points'][i]):6d} {end} {float(sw.index['wall_time'][i]):8.2f}  {why}")
+    return 0
+
+
 def _cmd_info(args):
     import numpy as np
 
     from .fitrecord import is_fit_file, read_fit
     from .io import read_curve
+    from .sweep import is_sweep_file
 
     if is_fit_file(args.file):
         from .plotting import fit_summary_lines
@@ -569,7 +725,8 @@ def _cmd_info(args):
         for line in fit_summary_lines(read_fit(args.file)):
             print(f"  {line}")
         return 0
-
+    if os.path.isfile(args.file) and is_sweep_file(args.file):
+        return _sweep_info(args.file)
     c = read_curve(args.file)
     s = c.scene
     mat = s.material
@@ -653,7 +810,10 @@ def build_parser():
                    "offset, baseline, residual, warnings, ...)")
     f.add_argument("--example", action="store_true",
                    help="use the synthetic Lepidium-like data shipped with shellbvp (README)")
-    _scene_options(f)
+    _scene_options(f, uncertain=True)
+    f.add_argument("--workers", type=int, help="with VALUE+-U parameters: local processes for their fits "
+                                               "(default: all cores)")
+    f.add_argument("--scheduler", help="with VALUE+-U parameters: run their fits on this Dask scheduler")
     f.add_argument("--radius", required=True, type=quantity("length"),
                    help="rim radius R_L of the sample with its unit, e.g. 0.3mm")
     f.add_argument("--columns", help="displacement,force columns by name or 0-based index (default 0,1)")
@@ -684,6 +844,39 @@ def build_parser():
     f.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
     f.add_argument("--force", action="store_true", help="replace an existing output file")
     f.set_defaults(func=_cmd_fit)
+    w = sub.add_parser("sweep", help="one curve per combination of parameter values, into one resumable file",
+                       description="One force-displacement curve per combination of the swept values, computed "
+                       "in parallel (a local process pool, or a Dask cluster with --scheduler), into one HDF5 file "
+                       "that is written after every finished curve. Re-running the same command computes only "
+                       "the curves not yet in the file. Values: a,b,c or LOW:HIGH:N (N equally spaced) or "
+                       "LOW:HIGH:N:log. Exit status: 0 every curve complete; 1 some stopped early or failed "
+                       "(see `shellbvp info`); 2 bad input; 130 interrupted.")
+    g = w.add_argument_group("scene (the preset, with the swept parameters replaced)")
+    g.add_argument("--preset", default="base", help="built-in scene (see `shellbvp presets`; default base)")
+    for name, what in (("gamma", "spheroid aspect parameter"), ("rho", "indenter radius / rim radius"),
+                       ("beta", "bending stiffness B/(mu R_L^2)")):
+        g.add_argument(f"--{name}", help=f"{what}: values to sweep")
+    m = g.add_mutually_exclusive_group()
+    m.add_argument("--alpha", help="Mooney-Rivlin alpha: values to sweep")
+    m.add_argument("--gent-jm", dest="gent_jm", help="Gent material, Jm values to sweep")
+    m.add_argument("--neo-hookean", action="store_true", help="neo-Hookean material")
+    g.add_argument("--xi", type=int, choices=(0, 1))
+    g.add_argument("--contact", choices=("smooth", "paper"))
+    w.add_argument("--delta-max", type=_number, default=0.5, dest="delta_max", help="depth of every curve (default 0.5)")
+    w.add_argument("--points", type=int, help="N equally spaced depths up to delta-max (default: adaptive)")
+    w.add_argument("--tol", type=_number, default=1e-6, help="collocation tolerance (default 1e-6)")
+    w.add_argument("--max-nodes", type=int, default=10000, dest="max_nodes")
+    w.add_argument("--max-steps", type=int, default=400, dest="max_steps")
+    w.add_argument("--topology", choices=("auto", "cap"), default="auto")
+    w.add_argument("-o", "--output", required=True, help="the sweep file (HDF5); an existing one is resumed")
+    w.add_argument("--workers", type=int, help="local worker processes (default: all cores)")
+    w.add_argument("--scheduler", help="address of a running Dask scheduler, e.g. tcp://host:8786 (needs "
+                                       "shellbvp[dask])")
+    w.add_argument("--extend", action="store_true", help="add the new combinations of a changed grid to the file")
+    w.add_argument("--force", action="store_true", help="start the file anew (its curves are discarded once the "
+                                                         "new file is first written)")
+    w.add_argument("-q", "--quiet", action="store_true", help="no line per finished curve")
+    w.set_defaults(func=_cmd_sweep)
     pl = sub.add_parser("plot", help="plot curves (and profiles) from HDF5 files (needs matplotlib)")
     pl.add_argument("files", nargs="+", help="curve files (`shellbvp curve`) or fit files (`shellbvp fit -o`: data, "
                     "model and residuals in SI units)")

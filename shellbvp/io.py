@@ -48,7 +48,8 @@ from .paths import check_output_path
 from .version import __version__
 
 __all__ = ["Curve", "POINT_FIELDS", "CAP_FIELD_DEFAULTS", "point_record", "energy_residual", "write_curve",
-           "read_curve", "FORMAT", "FORMAT_VERSION"]
+           "read_curve", "write_curve_group", "read_curve_group", "FORMAT",
+           "FORMAT_VERSION"]
 
 FORMAT = "shellbvp-curve"
 FORMAT_VERSION = 3
@@ -190,6 +191,57 @@ def _umask():
     return mask
 
 
+def write_curve_group(g, curve, *, profiles=False, units=None):
+    """Fill the HDF5 group ``g`` with ``curve`` in the layout of the module docstring (the
+    ``/curve`` group of a curve file; sweep files hold one such group per curve)."""
+    import h5py
+
+    dims = _check_units(units)
+    g.attrs["NX_class"] = "NXdata"
+    g.attrs["signal"] = "force"
+    g.attrs["axes"] = np.array(["delta"], dtype=h5py.string_dtype())
+    scene = curve.scene.to_dict()
+    g.attrs["scene"] = json.dumps(scene, sort_keys=True)
+    for k, v in scene.items():
+        if isinstance(v, dict):
+            for kk, vv in v.items():
+                g.attrs[f"scene_{k}_{kk}"] = vv
+        else:
+            g.attrs[f"scene_{k}"] = v
+    g.attrs["settings"] = json.dumps(curve.settings, sort_keys=True, default=float)
+    g.attrs["stop_reason"] = curve.stop_reason
+    g.attrs["complete"] = bool(curve.complete)
+    g.attrs["interrupted"] = bool(curve.interrupted)
+    res = curve.energy_residual
+    g.attrs["energy_identity_max"] = float(np.nanmax(np.abs(res))) if np.any(np.isfinite(res)) else np.nan
+    for k, v in curve.points.items():
+        v = np.asarray(v)
+        if v.dtype.kind in "UO" or k in _STRING_FIELDS:  # strings (topology; also when empty)
+            g.create_dataset(k, data=np.array(v, dtype=object), dtype=h5py.string_dtype())
+        else:
+            g.create_dataset(k, data=v)
+    g.create_dataset("energy_residual", data=res)
+    g.create_dataset("flags", data=np.array(curve.flags, dtype=object), dtype=h5py.string_dtype())
+    g["delta"].attrs["long_name"] = "pole displacement delta / R_L"
+    g["force"].attrs["long_name"] = "indenter force F / (mu H R_L)"
+    if dims is None:
+        g.attrs["units"] = "nondimensional"
+    else:
+        R_L, mu_H = dims
+        g.attrs["units"] = "nondimensional; SI columns delta_m, force_N"
+        g.attrs["R_L_m"], g.attrs["mu_H_N_per_m"] = R_L, mu_H
+        g.create_dataset("delta_m", data=R_L * np.asarray(curve.points["delta"]))
+        g.create_dataset("force_N", data=mu_H * R_L * np.asarray(curve.points["force"]))
+    if profiles:
+        pg = g.create_group("profiles")
+        for i, sol in enumerate(curve.solutions):
+            if sol is None or not sol.get("success", False):
+                continue
+            sg = pg.create_group(f"point_{i:05d}")
+            for k, v in sol.profile().items():
+                sg.create_dataset(k, data=v)
+
+
 def write_curve(curve, path, *, profiles=False, overwrite=False, units=None):
     """Write ``curve`` to ``path`` atomically (temporary file + rename).
 
@@ -206,9 +258,8 @@ def write_curve(curve, path, *, profiles=False, overwrite=False, units=None):
     """
     import h5py
 
-
     path = Path(path)
-    dims = _check_units(units)
+    _check_units(units)  # bad units refused before any file is made
     if path.exists() and not overwrite:
         raise FileExistsError(f"{path} exists; pass overwrite=True (CLI: --force) to replace it")
     check_output_path(path, overwrite=True)
@@ -220,50 +271,7 @@ def write_curve(curve, path, *, profiles=False, overwrite=False, units=None):
             f.attrs["format_version"] = FORMAT_VERSION
             f.attrs["package_version"] = __version__
             f.attrs["created"] = _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds")
-            g = f.create_group("curve")
-            g.attrs["NX_class"] = "NXdata"
-            g.attrs["signal"] = "force"
-            g.attrs["axes"] = np.array(["delta"], dtype=h5py.string_dtype())
-            scene = curve.scene.to_dict()
-            g.attrs["scene"] = json.dumps(scene, sort_keys=True)
-            for k, v in scene.items():
-                if isinstance(v, dict):
-                    for kk, vv in v.items():
-                        g.attrs[f"scene_{k}_{kk}"] = vv
-                else:
-                    g.attrs[f"scene_{k}"] = v
-            g.attrs["settings"] = json.dumps(curve.settings, sort_keys=True, default=float)
-            g.attrs["stop_reason"] = curve.stop_reason
-            g.attrs["complete"] = bool(curve.complete)
-            g.attrs["interrupted"] = bool(curve.interrupted)
-            res = curve.energy_residual
-            g.attrs["energy_identity_max"] = float(np.nanmax(np.abs(res))) if np.any(np.isfinite(res)) else np.nan
-            for k, v in curve.points.items():
-                v = np.asarray(v)
-                if v.dtype.kind in "UO" or k in _STRING_FIELDS:  # strings (topology; also when empty)
-                    g.create_dataset(k, data=np.array(v, dtype=object), dtype=h5py.string_dtype())
-                else:
-                    g.create_dataset(k, data=v)
-            g.create_dataset("energy_residual", data=res)
-            g.create_dataset("flags", data=np.array(curve.flags, dtype=object), dtype=h5py.string_dtype())
-            g["delta"].attrs["long_name"] = "pole displacement delta / R_L"
-            g["force"].attrs["long_name"] = "indenter force F / (mu H R_L)"
-            if dims is None:
-                g.attrs["units"] = "nondimensional"
-            else:
-                R_L, mu_H = dims
-                g.attrs["units"] = "nondimensional; SI columns delta_m, force_N"
-                g.attrs["R_L_m"], g.attrs["mu_H_N_per_m"] = R_L, mu_H
-                g.create_dataset("delta_m", data=R_L * np.asarray(curve.points["delta"]))
-                g.create_dataset("force_N", data=mu_H * R_L * np.asarray(curve.points["force"]))
-            if profiles:
-                pg = g.create_group("profiles")
-                for i, sol in enumerate(curve.solutions):
-                    if sol is None or not sol.get("success", False):
-                        continue
-                    sg = pg.create_group(f"point_{i:05d}")
-                    for k, v in sol.profile().items():
-                        sg.create_dataset(k, data=v)
+            write_curve_group(f.create_group("curve"), curve, profiles=profiles, units=units)
         os.chmod(tmp, 0o666 & ~_umask())  # mkstemp makes 0600; give the usual permissions
         label_units(tmp)  # every dataset says its unit (nondimensional: "1")
         os.replace(tmp, path)
@@ -395,6 +403,27 @@ def _check_settings(settings):
             raise ValueError("settings.topology_switches must list {delta, from, to} objects")
 
 
+def read_curve_group(g, version: str = ""):
+    """The Curve held by the HDF5 group ``g`` (see :func:`write_curve_group`); ``ValueError``
+    naming the attribute or dataset that is missing or malformed."""
+    from .scene import Scene
+
+    scene_data = _json_attr(g, "scene")
+    try:
+        scene = Scene.from_dict(scene_data)
+    except ValueError as exc:  # Scene.from_dict names the field or formula
+        raise ValueError(f"attribute scene does not describe a scene: {exc}") from None
+    except (KeyError, TypeError, AttributeError) as exc:
+        raise ValueError(f"attribute scene does not describe a scene ({type(exc).__name__}: "
+                         f"{exc})") from None
+    settings = _json_attr(g, "settings")
+    _check_settings(settings)
+    points, flags = _points(g)
+    return Curve(scene=scene, points=points, flags=flags, stop_reason=_text_attr(g, "stop_reason"),
+                 complete=_bool_attr(g, "complete"), interrupted=_bool_attr(g, "interrupted"),
+                 settings=settings, version=version)
+
+
 def read_curve(path):
     """Read a curve written by :func:`write_curve` (``Curve.to_hdf5``, ``shellbvp curve``).
 
@@ -427,8 +456,6 @@ def read_curve(path):
     """
     import h5py
 
-    from .scene import Scene
-
     path = Path(path)
     if not path.exists():
         raise ValueError(f"{path}: no such file")
@@ -445,21 +472,7 @@ def read_curve(path):
             raise ValueError(f"{path}: not a shellbvp curve file (format attribute missing or different)")
         try:
             _format_version(f)
-            g = f["curve"]
-            scene_data = _json_attr(g, "scene")
-            try:
-                scene = Scene.from_dict(scene_data)
-            except ValueError as exc:  # Scene.from_dict names the field or formula
-                raise ValueError(f"attribute scene does not describe a scene: {exc}") from None
-            except (KeyError, TypeError, AttributeError) as exc:
-                raise ValueError(f"attribute scene does not describe a scene ({type(exc).__name__}: "
-                                 f"{exc})") from None
-            settings = _json_attr(g, "settings")
-            _check_settings(settings)
-            points, flags = _points(g)
-            curve = Curve(scene=scene, points=points, flags=flags, stop_reason=_text_attr(g, "stop_reason"),
-                          complete=_bool_attr(g, "complete"), interrupted=_bool_attr(g, "interrupted"),
-                          settings=settings, version=str(f.attrs.get("package_version", "")))
+            curve = read_curve_group(f["curve"], str(f.attrs.get("package_version", "")))
         except ValueError as exc:
             raise ValueError(f"{path}: {exc}") from None
         except (KeyError, TypeError, OSError) as exc:  # h5py's own errors on a damaged file
