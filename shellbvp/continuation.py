@@ -625,6 +625,7 @@ def _adaptive(scene, builder: _Builder, settings):
     ds = min(st["ds_max"], 2 * np.linalg.norm((_X(cur) - _X(prev)) / scale))
     ds_min = 1e-4  # in (delta, lambda0, F): below this the branch is taken to end here
     tangent = None
+    crossed_from = None  # the smooth cap from which the corner was last tried
     while True:
         if steps >= st["max_steps"]:
             raise _Stop(f"max_steps = {st['max_steps']} reached")
@@ -648,17 +649,25 @@ def _adaptive(scene, builder: _Builder, settings):
                 raise _Stop(f"no solution at delta_max = {st['delta_max']:g}: {sol.message}")
             continue
         sol = None
-        if near_limit(cur):  # past the convexity limit the smooth cap ends: the corner takes over
+        crossing = near_limit(cur) and crossed_from is not cur  # the corner is tried once from each state
+        if crossing:  # past the convexity limit the smooth cap ends: the corner takes over
             d_star = limit_estimate(prev, cur)
             if d_star is None or Xhat[0] > d_star:
                 sol = _cross(cur, prev, Xhat[0], st)
+                crossed_from = cur
         if sol is None:
             sysm = system_like(cur, "arclength", (Xhat, tangent, scale), st["eps"])
             a = ds / max(norm, 1e-300)
             guess = _secant(sysm, cur, prev, a)
             sol = solve_from(sysm, guess, tol=st["tol"], max_nodes=_step_nodes(cur, st), bc_tol=st["bc_tol"])
-            if not sol.success and near_limit(cur):
+            if not sol.success and crossing and crossed_from is not cur:
                 sol = _cross(cur, prev, Xhat[0], st) or sol
+                crossed_from = cur
+            if not sol.success and crossed_from is cur and cur.edge_legendre < LEGENDRE_WATCH / 5:
+                # at the limit, no smooth step and no corner: halving the step only stalls
+                raise _Stop(f"continuation failed near delta = {cur.delta:.6g}: the energy loses convexity at "
+                            f"the contact edge (Legendre determinant at Sc+ down to {cur.edge_legendre:.2g} of "
+                            f"its mid-region value) and no corner state was found past it ({sol.message})")
         steps += 1
         if sol.success and sol.delta > st["delta_max"]:  # overshot: land from the current point
             steps += 1

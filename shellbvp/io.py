@@ -141,7 +141,8 @@ class Curve:
 
         runs = [f"{k} x{len(list(g))}" for k, g in itertools.groupby(self.points["topology"])]
         switches = self.settings.get("topology_switches") or []
-        where = "; ".join(f"{s['from']} -> {s['to']} at delta = {s['delta']:.6g}" for s in switches)
+        where = "; ".join(f"{s['from']} -> {s['to']} at delta = {s['delta']:.6g}"
+                          + (f", {s['kind'].split(':')[0]}" if s.get("kind") else "") for s in switches)
         return ", ".join(runs) + (f" (switch {where})" if where else "")
 
     def summary(self) -> str:

@@ -136,3 +136,25 @@ def test_a_cold_solve_past_the_limit_finds_the_corner(base_curve):
     assert sol.success and sol.valid and sol.contact_edge == "corner"
     near = _corner_energy(0.8, min(base_curve.solutions, key=lambda s: abs(s.delta - 0.8)))
     assert sol.force == pytest.approx(near.force, rel=1e-5)
+
+
+def test_without_a_corner_the_curve_stops_at_the_limit_at_once(monkeypatch):
+    """If no corner state is found past the limit, the curve stops there with the reason after
+    one failed step, instead of halving its step many times (the old 40-50 s stall)."""
+    import shellbvp.continuation as cont
+
+    monkeypatch.setattr(cont, "cross_convexity_limit", lambda *a, **k: None)
+    failed = []
+    solve = cont.solve_from
+
+    def counted(*a, **k):
+        sol = solve(*a, **k)
+        if not sol.success:
+            failed.append(sol.delta)
+        return sol
+
+    monkeypatch.setattr(cont, "solve_from", counted)
+    c = sb.curve(BASE, delta_max=1.0, delta_start=0.55, estimate_error=False, topology="cap")
+    assert "no corner state was found" in c.stop_reason and not c.complete
+    assert 0.6 < c.points["delta"][-1] < 0.6146
+    assert len(failed) <= 4, failed
