@@ -23,7 +23,7 @@ from .version import __version__  # noqa: F401  (sb.__version__)
 _LAZY = {"fit": "fitting", "FitResult": "fitting", "read_force_csv": "fitting", "fit_record": "fitting",
          "read_instrument": "instrument", "fit_files": "batch", "read_fit": "fitrecord",
          "sweep": "sweep", "read_sweep": "sweep", "Sweep": "sweep",
-         "fit_with_geometry": "uncertainty", "GeometryFit": "uncertainty"}
+         "fit_with_geometry": "uncertainty", "GeometryFit": "uncertainty", "convexity_limits": "convexity"}
 
 
 def __getattr__(name):
@@ -69,6 +69,7 @@ __all__ = [
     "TraceBending",
     "RotationBending",
     "BendingEnergy",
+    "convexity_limits",
     "Spheroid",
     "SphereTip",
     "UserShell",

@@ -100,6 +100,12 @@ def _scene_options(p, uncertain=False):
     m.add_argument("--neo-hookean", action="store_true", help="neo-Hookean material")
     g.add_argument("--xi", type=int, choices=(0, 1), help="1: full generalised tensions; 0: first approximation")
     g.add_argument("--contact", choices=("smooth", "paper"), help="contact-line model (default smooth)")
+    b = g.add_mutually_exclusive_group()
+    b.add_argument("--bending", choices=("trace", "rotation"),
+                   help="bending energy B in U = W + beta B: trace (the paper's, default) or rotation (convex)")
+    b.add_argument("--bending-formula", dest="bending_formula",
+                   help="a user bending energy B per beta in lambda_s, lambda_theta, kappa_s, kappa_theta, "
+                        "kappa_s0, kappa_theta0 (the reference curvatures)")
     s = p.add_argument_group("solver")
     s.add_argument("--tol", type=_number, default=1e-6, help="collocation tolerance (default 1e-6)")
     s.add_argument("--max-nodes", type=int, default=10000, dest="max_nodes")
@@ -115,6 +121,10 @@ def _scene(args):
         over["material"] = sb.Gent(args.gent_jm)
     elif args.neo_hookean:
         over["material"] = sb.NeoHookean()
+    if getattr(args, "bending", None):
+        over["bending"] = sb.TraceBending() if args.bending == "trace" else sb.RotationBending()
+    elif getattr(args, "bending_formula", None):
+        over["bending"] = sb.BendingEnergy(args.bending_formula)
     return sb.Scene.preset(args.preset, **over)
 
 
@@ -711,6 +721,14 @@ def _sweep_info(path):
     return 0
 
 
+def _cmd_convexity(args):
+    """``shellbvp convexity``: where the scene's energy is convex in stretch and curvature."""
+    from .convexity import convexity_report
+
+    print(convexity_report(_scene(args)))
+    return 0
+
+
 def _cmd_info(args):
     import numpy as np
 
@@ -732,7 +750,7 @@ def _cmd_info(args):
     mat = s.material
     print(f"file:      {args.file} (shellbvp {c.version})")
     print(f"scene:     gamma={s.gamma:g} rho={s.rho:g} beta={s.beta:g} xi={s.xi} contact={s.contact} "
-          f"material={mat!r} shell={s.shell!r} tip={s.tip!r}")
+          f"material={mat!r} bending={s.bending!r} shell={s.shell!r} tip={s.tip!r}")
     print(f"curve:     {c.summary()}")
     print(f"complete:  {c.complete}  interrupted: {c.interrupted}")
     res = c.energy_residual
@@ -892,6 +910,10 @@ def build_parser():
     i = sub.add_parser("info", help="describe a curve file or a fit file")
     i.add_argument("file")
     i.set_defaults(func=_cmd_info)
+    cv = sub.add_parser("convexity", help="where the scene's energy is convex in stretch and curvature "
+                                          "(the Legendre condition; beyond it the contact edge becomes a corner)")
+    _scene_options(cv)
+    cv.set_defaults(func=_cmd_convexity)
     r = sub.add_parser("presets", help="list the built-in scenes")
     r.set_defaults(func=_cmd_presets)
     return p

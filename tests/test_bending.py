@@ -93,3 +93,18 @@ def test_rotation_bending_stays_convex_and_smooth_to_depth_one():
     P = c.points
     assert c.complete and np.all(P["valid"]) and np.all(P["legendre_min"] > 0.1)
     assert set(P["contact_edge"]) <= {"smooth", ""}  # no corner needed
+
+
+def test_cli_bending_choice_and_convexity_report(capsys):
+    from shellbvp.cli import main
+
+    assert main(["convexity", "--bending", "rotation"]) == 0
+    assert "convex throughout" in capsys.readouterr().out
+    assert main(["convexity"]) == 0
+    assert "not convex from kappa rho" in capsys.readouterr().out
+    assert main(["solve", "--preset", "base", "--delta", "0.3", "--bending", "rotation", "--json"]) == 0
+    import json
+
+    doc = json.loads(capsys.readouterr().out)
+    api = sb.solve(sb.Scene.preset("base", bending=sb.RotationBending()), delta=0.3, estimate_error=False)
+    assert doc["force"] == pytest.approx(api.force, rel=1e-8)
