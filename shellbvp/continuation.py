@@ -526,10 +526,12 @@ def _wall_leg(scene, builder, st, last_cap, key, *, reason, deltas=None):
     targets = list(deltas) if deltas is not None else None
     prev = builder.last_wall
     if prev is None:
-        prev = best_wall_state(last_cap, tried=tried, **kw)
+        prev, past_end = best_wall_state(last_cap, tried=tried, **kw), last_cap
+        if prev is None and last_cap.get("topology") == "cap":
+            prev, past_end = _wall_state_deeper(scene, last_cap, st, kw, tried)
         if prev is None:  # not a physical end: a configuration that is missing or not found
             raise _Stop(f"{reason}; no valid contact with the cylinder ({'; '.join(tried)})")
-        prev.cap_solution = last_cap  # the cap past the tip's end: where the switch is located from
+        prev.cap_solution = past_end  # the cap past the tip's end: where the switch is located from
         builder.last_wall = prev
         if targets is None:
             key += 1
@@ -567,6 +569,24 @@ def _cross(cur, prev, delta, st):
     if sol is not None:
         log.info("past the convexity limit near delta = %.6g: corner at the contact edge", cur.delta)
     return sol
+
+
+def _wall_state_deeper(scene, last_cap, st, kw, tried):
+    """(a wall state a little deeper than ``last_cap``, the cap there), or (None, last_cap).  Just past the tip's end the
+    contact's length on the cylinder is tiny and Newton from the cap lands on states whose
+    contact runs back onto the tip; a few hundredths deeper it has room (paper's model, beta
+    1e-3: from delta 0.94 where the end is reached at 0.915).  The switch itself is located
+    afterwards (``_locate_switches``)."""
+    for dd in (0.01, 0.02, 0.04, 0.08):
+        if last_cap.delta + dd > st["delta_max"]:
+            break
+        deeper = _solve_at_delta(scene, last_cap.delta + dd, last_cap, None, st)
+        if deeper.status not in (0, 4):  # converged, possibly past the tip's end
+            continue
+        wall = best_wall_state(deeper, tried=tried, **kw)
+        if wall is not None:
+            return wall, deeper
+    return None, last_cap
 
 
 def _land_on_delta_max(scene, cur, prev, builder, st, key):
