@@ -236,3 +236,14 @@ def test_fit_scene_with_thin_wall_to_the_geometric_limit():
     c = sb.curve(SCENE, delta_max=0.999 * hi, estimate_error=False)
     assert c.complete and np.all(c.valid), c.flags
     assert c.delta[-1] == pytest.approx(0.999 * hi)
+
+
+def test_paper_model_runs_onto_the_cylinder_when_the_first_wall_guess_has_no_room():
+    """beta = 1e-3, the paper's model: the cap reaches the tip's end near delta 0.915; from the
+    cap just past it cap+cylinder lands on a contact that runs back onto the tip, from a slightly
+    deeper cap it does not.  The curve goes on to delta = 1, every point valid."""
+    c = sb.curve(sb.Scene.preset("base", contact="paper", beta=1e-3), delta_max=1.0, estimate_error=False)
+    assert c.complete and c.delta[-1] == pytest.approx(1.0) and np.all(c.valid)
+    sw = [s for s in c.settings["topology_switches"] if s["to"] == "cap+cylinder"]
+    assert len(sw) == 1 and 0.905 < sw[0]["delta"] < 0.925
+    assert set(c.topology[c.delta > sw[0]["delta"] + 1e-6]) == {"cap+cylinder"}
