@@ -363,7 +363,7 @@ class ChainBVP:
     def S(self, k, t, p):
         """S on region ``k`` at ``t``."""
         a, b = self.ln_S(self.regions[k].start, p), self.ln_S(self.regions[k].end, p)
-        return np.exp(a + t * (b - a))
+        return np.exp(a * (1 - t) + b * t)  # exact at both ends: neighbouring regions meet, not cross
 
     def t_of(self, k, S, p):
         """The t at which region ``k`` reaches ``S`` (outside the region: outside [0, 1])."""
