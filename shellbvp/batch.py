@@ -158,6 +158,30 @@ def fit_files(scene, paths, *, R_L, segment="loading", baseline="auto", columns=
     list of BatchRow
         In the order of ``paths``.  A file that cannot be read or fitted (a ``ValueError``)
         gets status ``"error"`` with the message; the others are fitted regardless.
+
+    Examples
+    --------
+    Two seeds made from the shipped example (mu*H = 52 N/m; the second with 1.5 x the
+    force, 78 N/m) and a file that is not a record: one model curve serves both fits.
+
+    >>> import os, tempfile, shellbvp as sb
+    >>> from shellbvp.fitting import example_data_path
+    >>> folder = tempfile.mkdtemp()
+    >>> rows = open(example_data_path()).read().splitlines()[2:]      # after the comment and header
+    >>> for name, scale in (("seed_a.csv", 1.0), ("seed_b.csv", 1.5)):
+    ...     with open(os.path.join(folder, name), "w") as fh:
+    ...         _ = fh.write("displacement (mm),force (mN)\\n")
+    ...         _ = fh.writelines(f"{a},{scale * float(b):.6f}\\n" for a, b in (r.split(",") for r in rows))
+    >>> with open(os.path.join(folder, "notes.csv"), "w") as fh:
+    ...     _ = fh.write("seed,remark\\na,cracked\\n")
+    >>> paths = [os.path.join(folder, n) for n in ("seed_a.csv", "seed_b.csv", "notes.csv")]
+    >>> out = sb.fit_files(sb.Scene.preset("fit"), paths, R_L=0.3e-3)
+    >>> [(os.path.basename(r.file), r.status) for r in out]
+    [('seed_a.csv', 'ok'), ('seed_b.csv', 'ok'), ('notes.csv', 'error')]
+    >>> [round(r.result.mu_H) for r in out[:2]]
+    [52, 78]
+    >>> out[2].message
+    '...notes.csv: ...'
     """
     from .fitting import fit_record
     from .instrument import estimate_contact, read_instrument

@@ -236,12 +236,41 @@ def _text(v):
 
 
 def read_fit(path) -> FitRecord:
-    """Read a fit file written by :func:`write_fit`.
+    """Read a fit file written by :func:`write_fit` (``shellbvp fit -o FILE.h5``).
+
+    Parameters
+    ----------
+    path : str or Path
+        The fit file (HDF5, format ``shellbvp-fit``; the layout is in this module's docstring).
+
+    Returns
+    -------
+    FitRecord
+        The data, the model curve, the parameters and their intervals, the settings, the
+        scene and the source file's name, hash and units, in SI units.
 
     Raises
     ------
     ValueError
         One line naming the file and what is missing or malformed.
+
+    Examples
+    --------
+    >>> import os, tempfile, shellbvp as sb
+    >>> from shellbvp.fitting import example_data_path
+    >>> from shellbvp.fitrecord import write_fit
+    >>> rec = sb.read_instrument(example_data_path())
+    >>> res, used = sb.fit_record(sb.Scene.preset("fit"), rec, R_L=0.3e-3)
+    >>> path = os.path.join(tempfile.mkdtemp(), "fit.h5")
+    >>> write_fit(path, res, rec, used)
+    >>> fr = sb.read_fit(path)
+    >>> fr.success, fr.fitted, fr.settings["segment"], fr.source["units"]
+    (True, ['mu_H', 'offset'], 'loading', {'displacement': 'mm', 'force': 'mN'})
+    >>> lo, hi = fr.intervals["mu_H"]
+    >>> print(f"mu*H = {fr.parameters['mu_H']:.2f} N/m, 95% [{lo:.2f}, {hi:.2f}]")
+    mu*H = 51.91 N/m, 95% [51.53, 52.29]
+    >>> int(fr.data["used"].sum()), fr.data["model_force"].shape
+    (40, (40,))
     """
     import h5py
 

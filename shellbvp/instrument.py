@@ -357,6 +357,27 @@ def read_instrument(path, *, columns=None, units=None) -> InstrumentRecord:
     ValueError
         Naming the file and, for a bad row, its line; for columns that cannot be found,
         the header and ``--columns``.
+
+    Examples
+    --------
+    A record in um and uN with a time column: an approach at a 5 uN baseline, the
+    loading from contact at 20 um, and the retraction.
+
+    >>> import os, tempfile, shellbvp as sb
+    >>> disp = list(range(0, 44, 4)) + list(range(36, 16, -4))          # um: in, then out
+    >>> force = ([5 + 0.5 * max(d - 20, 0) ** 2 for d in disp[:11]]        # uN: loading,
+    ...          + [5 + 0.4 * max(d - 20, 0) ** 2 for d in disp[11:]])     # retraction below it
+    >>> path = os.path.join(tempfile.mkdtemp(), "seed.tsv")
+    >>> with open(path, "w") as fh:
+    ...     _ = fh.write("# exported by my indenter\\nTime (s)\\tDisplacement (um)\\tForce (uN)\\n")
+    ...     _ = fh.writelines(f"{0.5 * i}\\t{d}\\t{f:.1f}\\n" for i, (d, f) in enumerate(zip(disp, force)))
+    >>> rec = sb.read_instrument(path)
+    >>> len(rec), rec.units
+    (16, {'displacement': 'um', 'force': 'uN', 'time': 's'})
+    >>> rec.counts()
+    {'approach': 5, 'loading': 6, 'retraction': 5}
+    >>> print(f"contact near {rec.contact_estimate * 1e6:.0f} um; first rows {rec.displacement[:2]} m")
+    contact near 20 um; first rows [0.e+00 4.e-06] m
     """
     table = read_table(path)
     dcol, fcol, tcol = _pick_columns(table, columns, path)
@@ -572,6 +593,15 @@ def read_force_csv(path, *, columns=None, units=None):
     :func:`read_instrument` (``shellbvp fit`` does): sorting merges the branches.
     Without a header the first two columns are read (``columns=[1, 0]`` swaps them).
 
+    Parameters
+    ----------
+    path : str or Path
+        The file (see :func:`read_table`).
+    columns : (str or int, str or int), optional
+        Displacement and force columns, by header name or 0-based index.
+    units : (str, str), optional
+        Their units (e.g. ``("mm", "mN")``) when the header has none.
+
     Returns
     -------
     displacement_m, force_N : ndarray
@@ -581,6 +611,16 @@ def read_force_csv(path, *, columns=None, units=None):
     ------
     ValueError
         Naming the line (counted in the file, comments included) of a malformed row.
+
+    Examples
+    --------
+    >>> import os, tempfile, shellbvp as sb
+    >>> path = os.path.join(tempfile.mkdtemp(), "run1.csv")
+    >>> with open(path, "w") as fh:
+    ...     _ = fh.write("# sample 1\\ntime (s),disp (um),force [uN]\\n0,20,150\\n1,10,40\\n2,30,300\\n")
+    >>> d, F = sb.read_force_csv(path, columns=("disp", "force"))
+    >>> [round(float(x), 9) for x in d], [round(float(x), 9) for x in F]
+    ([1e-05, 2e-05, 3e-05], [4e-05, 0.00015, 0.0003])
     """
     rec = read_instrument(path, columns=columns, units=units)
     order = np.argsort(rec.displacement, kind="stable")

@@ -119,12 +119,32 @@ def parse_quantity(text, kind: str = "length", default_unit: str | None = None, 
     name : str, optional
         Name of the quantity in error messages (e.g. ``--radius``).
 
+    Returns
+    -------
+    float
+        The value in SI units: m, N, s or N/m.
+
+    Raises
+    ------
+    ValueError
+        For text that is not a plain finite number and a unit, a unit of another kind,
+        or (with ``require_unit``) a bare number; the message names the quantity.
+
     Examples
     --------
+    >>> from shellbvp import parse_quantity
     >>> parse_quantity("0.3mm")
+    0.0003
+    >>> round(parse_quantity("15 uN", kind="force"), 12)
+    1.5e-05
+    >>> parse_quantity(300, default_unit="um")
     0.0003
     >>> parse_quantity("52 N/m", "mu_H")
     52.0
+    >>> parse_quantity("0.3", require_unit=True, name="--radius")
+    Traceback (most recent call last):
+    ...
+    ValueError: --radius needs a unit: write it as e.g. 0.3mm (length units: m, cm, mm, um, µm, micron, nm)
     """
     label = name or f"the {kind}"
     if isinstance(text, (int, float)) and not isinstance(text, bool):
