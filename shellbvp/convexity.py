@@ -36,14 +36,29 @@ def convexity_limits(scene, stretches=(0.8, 1.0, 1.2, 1.5, 2.0), kappa_max=3.0, 
     kappa_theta = kappa, reference curvatures the shell's at the pole), the smallest kappa rho
     in [0, kappa_max] at which U stops being convex, per stretch (NaN: convex throughout).
 
-    A cap on a sphere of radius rho imposes kappa rho = 1 on the shell: a limit below 1 means the
-    smooth contact edge ends at some depth (where the stretch there reaches that value).
+    A cap on a sphere of radius rho imposes kappa rho = 1 on the shell: a limit at or below 1 means
+    the smooth contact edge ends at some depth (where the stretch there reaches that value).
+
+    Parameters
+    ----------
+    scene : Scene
+    stretches : sequence of float
+        The isotropic stretches lambda at which to look.
+    kappa_max : float
+        The largest kappa rho scanned.
+    n : int
+        Points of the scan in [0, kappa_max] (the limit is found to kappa_max/(n - 1)).
+
+    Returns
+    -------
+    dict
+        ``{lambda: kappa rho where convexity is lost, or NaN}``.
 
     Examples
     --------
     >>> import shellbvp as sb
-    >>> lim = sb.convexity_limits(sb.Scene.preset("base"), stretches=(1.2,))
-    >>> 0 < lim[1.2] < 1                 # the paper's bending energy: not convex at the tip's curvature
+    >>> lim = sb.convexity_limits(sb.Scene.preset("base"), stretches=(1.5,))
+    >>> 0 < lim[1.5] < 1                 # the paper's bending energy: not convex at the tip's curvature
     True
     >>> sb.convexity_limits(sb.Scene.preset("base", bending=sb.RotationBending()), stretches=(1.2,))
     {1.2: nan}
