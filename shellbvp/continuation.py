@@ -75,11 +75,11 @@ def curve(scene, delta_max: float = 0.5, *, deltas=None, force_max=None, lambda0
         mesh, about +50 % time) at every point.  ``"auto"``: Richardson at the first and
         last point, at every point whose contact configuration (topology,
         contact_edge) differs from a neighbour's, and at every
-        ``RICHARDSON_EVERY``-th point; in between, no solve: the Richardson
-        ``error / max_residual`` of the neighbouring Richardson points, interpolated,
-        times the point's own residual (within a factor 10 of the true error on the
-        work-precision scenes: ``benchmarks/results/error_estimates.md``).  The point
-        field ``error_method`` says which ("richardson" or "calibrated").
+        ``RICHARDSON_EVERY``-th point; in between, no solve: the larger Richardson
+        ``error / max_residual`` of the two neighbouring Richardson points times the
+        point's own residual (against tol-1e-10 references:
+        ``benchmarks/results/error_estimates.md``).  The point field ``error_method``
+        says which ("richardson" or "calibrated").
     callback : callable, optional
         ``callback(curve_so_far, solution)`` after each accepted point (progress,
         checkpoints).  It may raise ``KeyboardInterrupt`` to stop the curve.

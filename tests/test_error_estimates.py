@@ -72,9 +72,10 @@ def test_error_method_round_trips_and_older_files_read_empty(auto_curve, tmp_pat
     assert list(sb.read_curve(path).points["error_method"]) == ["", "", ""]
 
 
-def test_calibrated_error_interpolates_the_ratio_geometrically():
-    anchors = [(0.0, 1e-3), (2.0, 4e-3)]
-    assert calibrated_error(1e-6, 1.0, anchors) == pytest.approx(2e-9)  # sqrt(1e-3 * 4e-3) * 1e-6
-    assert calibrated_error(1e-6, 3.0, anchors) == pytest.approx(4e-9)  # beyond the last: nearest
+def test_calibrated_error_takes_the_larger_bracketing_ratio():
+    anchors = [(0.0, 1e-3), (2.0, 4e-3), (4.0, 1e-5)]
+    assert calibrated_error(1e-6, 1.0, anchors) == pytest.approx(4e-9)
+    assert calibrated_error(1e-6, 3.0, anchors) == pytest.approx(4e-9)  # the small (cancelled) one is not used
+    assert calibrated_error(1e-6, 5.0, anchors) == pytest.approx(1e-11)  # beyond the last: nearest
     assert calibrated_error(1e-6, 1.0, [(0.0, 0.0), (2.0, 0.0)]) == 0.0  # exact (prescribed) stays exact
     assert math.isnan(calibrated_error(1e-6, 1.0, []))
