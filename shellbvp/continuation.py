@@ -72,7 +72,7 @@ def curve(scene, delta_max: float = 0.5, *, deltas=None, force_max=None, lambda0
     estimate_error : {"auto", "full", False}
         Error estimates ``force_error``, ``delta_error`` at every point (``True`` means
         ``"auto"``).  ``"full"``: a Richardson estimate (one Newton solve on the halved
-        mesh, about +50 % time) at every point.  ``"auto"``: Richardson at the first and
+        mesh; +15-60 % CPU time on the work-precision scenes) at every point.  ``"auto"``: Richardson at the first and
         last point, at every point whose contact configuration (topology,
         contact_edge) differs from a neighbour's, and at every
         ``RICHARDSON_EVERY``-th point; in between, no solve: the larger Richardson
