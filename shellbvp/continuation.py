@@ -26,7 +26,7 @@ from .cylinder import best_wall_state, wall_contact_suspected, wall_state
 from .io import POINT_FIELDS, Curve, point_record
 from .liftoff import replace_invalid_cap
 from .pointload import SC_POINT, solve_point_load
-from .solution import Solution, default_eps, richardson_error, thin_mesh
+from .solution import Solution, calibrated_error, default_eps, richardson_error, thin_mesh
 from .corner import LEGENDRE_WATCH, edge_model, is_corner, limit_estimate, near_limit
 from .state import check_delta, check_tol, cross_convexity_limit, make_system, solve, solve_from, system_like, \
     warm_guess
@@ -46,7 +46,7 @@ def _X(sol):
 
 def curve(scene, delta_max: float = 0.5, *, deltas=None, force_max=None, lambda0_max=None,
           max_steps: int = 400, delta_start=None, delta_min=None, tol: float = 1e-6,
-          max_nodes: int = 10000, ds_max=None, estimate_error: bool = True, callback=None,
+          max_nodes: int = 10000, ds_max=None, estimate_error: bool | str = "auto", callback=None,
           topology: str = "auto"):
     """Force–displacement curve of a scene by continuation.
 
@@ -69,8 +69,17 @@ def curve(scene, delta_max: float = 0.5, *, deltas=None, force_max=None, lambda0
         solve_bvp settings for every point (see :func:`solve`).
     ds_max : float, optional
         Largest arclength step in (delta, lambda0, F) (default ``delta_max/10``).
-    estimate_error : bool
-        Richardson error estimate at every point (about +50 % time).
+    estimate_error : {"auto", "full", False}
+        Error estimates ``force_error``, ``delta_error`` at every point (``True`` means
+        ``"auto"``).  ``"full"``: a Richardson estimate (one Newton solve on the halved
+        mesh; +15-60 % CPU time on the work-precision scenes) at every point.  ``"auto"``: Richardson at the first and
+        last point, at every point whose contact configuration (topology,
+        contact_edge) differs from a neighbour's, and at every
+        ``RICHARDSON_EVERY``-th point; in between, no solve: the larger Richardson
+        ``error / max_residual`` of the two neighbouring Richardson points times the
+        point's own residual (against tol-1e-10 references:
+        ``benchmarks/results/error_estimates.md``).  The point field ``error_method``
+        says which ("richardson" or "calibrated").
     callback : callable, optional
         ``callback(curve_so_far, solution)`` after each accepted point (progress,
         checkpoints).  It may raise ``KeyboardInterrupt`` to stop the curve.
@@ -122,6 +131,7 @@ def curve(scene, delta_max: float = 0.5, *, deltas=None, force_max=None, lambda0
     _check_positive("ds_max", ds_max)
     if topology not in ("auto", "cap"):
         raise ValueError(f"topology must be 'auto' or 'cap' for a curve; got {topology!r}")
+    estimate_error = _error_mode(estimate_error)
 
     settings = dict(tol=tol, max_nodes=max_nodes, delta_max=delta_max, force_max=force_max,
                     lambda0_max=lambda0_max, max_steps=max_steps, delta_start=delta_start,
@@ -160,6 +170,26 @@ def _check_positive(name, v):
         raise ValueError(f"{name} must be a finite number > 0; got {v!r}")
 
 
+#: With ``estimate_error="auto"``, a Richardson estimate at least every this many points
+#: (measured: benchmarks/error_estimates.py).
+RICHARDSON_EVERY = 5
+
+
+def _error_mode(estimate_error):
+    """``estimate_error`` as "auto", "full" or False (bad values refused)."""
+    if estimate_error is True or (isinstance(estimate_error, str) and estimate_error == "auto"):
+        return "auto"
+    if estimate_error is False or estimate_error is None:
+        return False
+    if isinstance(estimate_error, str) and estimate_error == "full":
+        return "full"
+    raise ValueError(f'estimate_error must be "auto" (or True), "full" or False; got {estimate_error!r}')
+
+
+def _configuration(sol):
+    return sol.get("topology", "cap"), sol.get("contact_edge", "")
+
+
 class _Builder:
     """Collects accepted points (sorted into branch order at the end).
 
@@ -177,6 +207,8 @@ class _Builder:
         self.rows = []  # (order key, row, flags, solution)
         self.last_liftoff = None
         self.last_wall = None  # the last state with contact on the indenter's cylinder
+        self.since_richardson = None  # points added since the last Richardson estimate
+        self.last_configuration = None
 
     def _shown(self, sol: Solution) -> Solution:
         st = self.settings
@@ -202,16 +234,63 @@ class _Builder:
         """Accept a point; ``key`` orders points along the branch."""
         sol = self._shown(sol)
         if self.estimate_error and sol.success:
-            richardson_error(sol.system, sol, self.tol)
+            configuration = _configuration(sol)
+            if self.estimate_error == "full" or self.since_richardson is None \
+                    or self.since_richardson >= RICHARDSON_EVERY - 1 or configuration != self.last_configuration:
+                self._richardson(sol)
+                self.since_richardson = 0
+            else:
+                sol.error_method = "calibrated"  # values set by finish(), from the Richardson points
+                self.since_richardson += 1
+            self.last_configuration = configuration
         self.rows.append((key, point_record(sol), "; ".join(sol.get("flags", [])), sol))
         if self.callback is not None:
             self.callback(self.snapshot(), sol)
 
+    def _richardson(self, sol):
+        richardson_error(sol.system, sol, self.tol)
+        sol.error_method = "richardson"
+
+    def _estimate_calibrated(self, final):
+        """Fill the calibrated points' estimates (in branch order, per configuration run).
+
+        With ``final``, first add Richardson estimates where the branch order (known only
+        now: switches are located last) puts a calibrated point at an end of the curve or
+        next to another configuration.
+        """
+        rows = sorted((r for r in self.rows if r[3].get("error_method")), key=lambda r: r[0])
+        configurations = [_configuration(r[3]) for r in rows]
+        if final and not self.out.interrupted:
+            for i, (_, _, _, sol) in enumerate(rows):
+                at_edge = i in (0, len(rows) - 1) or configurations[i - 1] != configurations[i] \
+                    or configurations[i + 1] != configurations[i]
+                if sol.error_method == "calibrated" and at_edge:
+                    self._richardson(sol)
+        anchors = {}  # configuration -> [(key, force ratio, delta ratio)] of its Richardson points
+        for (key, _, _, sol), conf in zip(rows, configurations):
+            res = float(sol.max_residual)
+            errors = (sol.get("force_error", math.nan), sol.get("delta_error", math.nan))
+            ratios = (errors[0] / res, errors[1] / res) if res > 0 else (math.nan, math.nan)
+            if sol.error_method == "richardson" and all(map(math.isfinite, ratios)):
+                anchors.setdefault(conf, []).append((key,) + ratios)
+        everywhere = [a for run in anchors.values() for a in run]
+        for (key, _, _, sol), conf in zip(rows, configurations):
+            if sol.error_method == "calibrated":
+                near = anchors.get(conf) or everywhere  # another configuration only while incomplete
+                sol.force_error = calibrated_error(sol.max_residual, key, [(a[0], a[1]) for a in near])
+                sol.delta_error = calibrated_error(sol.max_residual, key, [(a[0], a[2]) for a in near])
+        for r in self.rows:
+            for k in ("force_error", "delta_error", "error_method"):
+                if k in r[3]:
+                    r[1][k] = r[3][k]
+
     def snapshot(self) -> Curve:
-        self.finish()
+        self.finish(final=False)
         return self.out
 
-    def finish(self):
+    def finish(self, final: bool = True):
+        if self.estimate_error == "auto":
+            self._estimate_calibrated(final)
         rows = sorted(self.rows, key=lambda r: r[0])
         pts = {k: np.array([r[1][k] for r in rows]) for k in POINT_FIELDS}
         pts["valid"] = pts["valid"].astype(bool)

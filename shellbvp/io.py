@@ -22,7 +22,9 @@ contact_edge and edge_jump_ls/ks, which read as NaN and "")::
     /curve/<field>          (n,) each of POINT_FIELDS, plus
                             energy_residual (dE/ddelta - F) and flags (strings);
                             topology (strings: shellbvp.chain.CONFIGURATION_NAMES),
-                            contact_edge (strings: smooth, corner or paper)
+                            contact_edge (strings: smooth, corner or paper);
+                            error_method (strings: how force_error/delta_error were
+                            made: richardson, calibrated, or empty: not estimated)
     /curve/profiles/point_<i>   optional (profiles=True): S, region, r, z, ... at the
                             mesh nodes of point i (see Solution.profile)
 
@@ -59,7 +61,7 @@ POINT_FIELDS = (
     "delta", "force", "lambda0", "Sc", "status", "valid", "max_residual", "nodes", "niter",
     "force_error", "delta_error", "energy", "ring_force", "cap_force", "pressure_min",
     "penetration", "force_defect", "edge_legendre", "wall_time", "topology", "S1", "ring_force_inner",
-    "legendre_min", "contact_edge", "edge_jump_ls", "edge_jump_ks",
+    "legendre_min", "contact_edge", "edge_jump_ls", "edge_jump_ks", "error_method",
 )
 #: Fields a single-cap state does not carry, with their cap values (also what files of
 #: format version 1, which predate them, read as).
@@ -67,7 +69,10 @@ CAP_FIELD_DEFAULTS = {"topology": "cap", "S1": 0.0, "ring_force_inner": 0.0}
 #: Fields that files of format version 2 predate, with what they read as (not computed then).
 V2_FIELD_DEFAULTS = {"legendre_min": float("nan"), "contact_edge": "", "edge_jump_ls": float("nan"),
                      "edge_jump_ks": float("nan")}
-_MISSING_FIELD_DEFAULTS = {**CAP_FIELD_DEFAULTS, **V2_FIELD_DEFAULTS}
+#: Fields added within format version 3 (additive: older readers ignore them), with what
+#: earlier files read as.  error_method: "richardson" | "calibrated" | "" (not estimated).
+V3_FIELD_DEFAULTS = {"error_method": ""}
+_MISSING_FIELD_DEFAULTS = {**CAP_FIELD_DEFAULTS, **V2_FIELD_DEFAULTS, **V3_FIELD_DEFAULTS}
 
 
 @dataclass
@@ -289,7 +294,7 @@ def _missing_field(name, n):
 
 
 #: Fields stored as strings; every other point field is numeric.
-_STRING_FIELDS = ("topology", "flags", "contact_edge")
+_STRING_FIELDS = ("topology", "flags", "contact_edge", "error_method")
 #: Integer-valued fields (an empty curve stores them as float).
 _INTEGER_FIELDS = ("status", "nodes", "niter")
 

@@ -294,6 +294,42 @@ def richardson_error(sysm, res, tol, bc_tol=1e-10):
 
 
 
+def calibrated_error(residual, key, anchors):
+    """An error estimate without a solve, calibrated against Richardson estimates.
+
+    solve_bvp refines every mesh to the same residual level, so along a branch of one
+    contact configuration the error of a collocation value per unit of the largest
+    residual keeps its size -- but it scatters from mesh to mesh, by 100x where the
+    signed contributions of the intervals happen to cancel.  So the ratio
+    ``error / max_residual`` is taken from the Richardson points ``anchors`` that
+    bracket ``key``, the larger of the two (a cancelled anchor must not make its
+    neighbours look exact; benchmarks/error_estimates.py compares the rules), or from
+    the nearest beyond the ends, and multiplied by this point's own ``residual``.
+
+    Parameters
+    ----------
+    residual : float
+        The point's largest relative collocation residual (``max_residual``).
+    key : float
+        The point's position along the branch.
+    anchors : sequence of (float, float)
+        ``(key, ratio)`` of Richardson points, ratio = error / max_residual (finite).
+
+    Returns
+    -------
+    float
+        NaN when there is no anchor.
+    """
+    if not anchors or not math.isfinite(residual):
+        return float("nan")
+    anchors = sorted(anchors)
+    below = [a for a in anchors if a[0] <= key]
+    above = [a for a in anchors if a[0] >= key]
+    if not below or not above:
+        return (above[0] if above else below[-1])[1] * residual
+    return max(below[-1][1], above[0][1]) * residual
+
+
 def default_eps(tol):
     # Pole start zeta = eps*Sc: the truncated series errs by O(eps^2) relative.
     return min(1e-3, 0.1 * math.sqrt(tol))

@@ -1,0 +1,81 @@
+"""Error estimates at a fraction of the cost (issue 14, item 3).
+
+The whole work-precision check (5 scenes, 40 depths, reference at tol 1e-10) is
+benchmarks/error_estimates.py; here one scene and three depths.
+"""
+
+import math
+
+import h5py
+import numpy as np
+import pytest
+
+import shellbvp as sb
+from shellbvp.solution import calibrated_error
+
+SCENE = sb.Scene.preset("base")
+DELTAS = [0.2, 0.25, 0.3]  # single-cap states: the middle one is calibrated (Richardson at both ends)
+
+
+@pytest.fixture(scope="module")
+def auto_curve():
+    return sb.curve(SCENE, deltas=DELTAS, estimate_error="auto")
+
+
+@pytest.fixture(scope="module")
+def full_curve():
+    return sb.curve(SCENE, deltas=DELTAS, estimate_error="full")
+
+
+def test_auto_estimates_are_within_a_factor_10_of_the_true_error(auto_curve):
+    c = auto_curve
+    assert list(c.points["error_method"]) == ["richardson", "calibrated", "richardson"]
+    for s in c.solutions:
+        ref = sb.solve(SCENE, delta=float(s.delta), tol=1e-10, guess=s, max_nodes=30000, estimate_error=False)
+        assert ref.success and ref.topology == s.topology
+        true = abs(s.force - ref.force)
+        ratio = s.force_error / true
+        assert 0.1 <= ratio <= 10, f"delta {s.delta}: estimate {s.force_error:.2e}, true {true:.2e} ({s.error_method})"
+    # delta is prescribed: nothing to estimate, and the estimate says so
+    assert np.all(c.delta_error == 0)
+
+
+def test_full_gives_richardson_at_every_point(auto_curve, full_curve):
+    assert list(full_curve.points["error_method"]) == ["richardson"] * 3
+    # the same states: Richardson points agree, the calibrated one is not a Richardson value
+    np.testing.assert_array_equal(full_curve.force, auto_curve.force)
+    np.testing.assert_array_equal(full_curve.force_error[[0, 2]], auto_curve.force_error[[0, 2]])
+    assert full_curve.force_error[1] != auto_curve.force_error[1]
+
+
+def test_true_means_auto_and_false_means_none():
+    c = sb.curve(SCENE, deltas=DELTAS[:2], estimate_error=False)
+    assert list(c.points["error_method"]) == ["", ""] and np.all(np.isnan(c.force_error))
+    c = sb.curve(SCENE, deltas=DELTAS[:2], estimate_error=True)
+    assert c.settings["estimate_error"] == "auto"
+    assert list(c.points["error_method"]) == ["richardson", "richardson"]  # first and last
+
+
+@pytest.mark.parametrize("bad", ["richardson", 1, 0.5, "Full"])
+def test_bad_estimate_error_is_refused(bad):
+    with pytest.raises(ValueError, match="estimate_error"):
+        sb.curve(SCENE, deltas=DELTAS, estimate_error=bad)
+
+
+def test_error_method_round_trips_and_older_files_read_empty(auto_curve, tmp_path):
+    path = tmp_path / "c.h5"
+    auto_curve.to_hdf5(path)
+    back = sb.read_curve(path)
+    assert list(back.points["error_method"]) == list(auto_curve.points["error_method"])
+    with h5py.File(path, "a") as f:  # a file written before the field existed
+        del f["curve/error_method"]
+    assert list(sb.read_curve(path).points["error_method"]) == ["", "", ""]
+
+
+def test_calibrated_error_takes_the_larger_bracketing_ratio():
+    anchors = [(0.0, 1e-3), (2.0, 4e-3), (4.0, 1e-5)]
+    assert calibrated_error(1e-6, 1.0, anchors) == pytest.approx(4e-9)
+    assert calibrated_error(1e-6, 3.0, anchors) == pytest.approx(4e-9)  # the small (cancelled) one is not used
+    assert calibrated_error(1e-6, 5.0, anchors) == pytest.approx(1e-11)  # beyond the last: nearest
+    assert calibrated_error(1e-6, 1.0, [(0.0, 0.0), (2.0, 0.0)]) == 0.0  # exact (prescribed) stays exact
+    assert math.isnan(calibrated_error(1e-6, 1.0, []))
