@@ -15,8 +15,6 @@ import glob
 import io
 import logging
 import math
-import os
-import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -234,7 +232,7 @@ def write_table(path, rows, segment="loading", *, overwrite=False):
     FileExistsError
         ``path`` exists and ``overwrite`` is False.
     """
-    from .paths import check_output_path
+    from .paths import atomic_file, check_output_path
 
     path = Path(path)
     if path.exists() and not overwrite:
@@ -245,14 +243,5 @@ def write_table(path, rows, segment="loading", *, overwrite=False):
     w.writeheader()
     for row in rows:
         w.writerow(row.table_row(segment))
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8", newline="") as fh:
-            fh.write(buf.getvalue())
-        mask = os.umask(0)
-        os.umask(mask)
-        os.chmod(tmp, 0o666 & ~mask)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
+    with atomic_file(path) as tmp:
+        tmp.write_text(buf.getvalue(), encoding="utf-8", newline="")

@@ -28,7 +28,7 @@ from .liftoff import replace_invalid_cap
 from .pointload import SC_POINT, solve_point_load
 from .solution import Solution, calibrated_error, default_eps, richardson_error, thin_mesh
 from .corner import LEGENDRE_WATCH, edge_model, is_corner, limit_estimate, near_limit
-from .state import check_delta, check_tol, cross_convexity_limit, make_system, solve, solve_from, system_like, \
+from .state import check_delta, check_tol, cross_convexity_limit, solve, solve_from, system_like, \
     warm_guess
 from .version import __version__ as VERSION
 

@@ -37,15 +37,13 @@ from __future__ import annotations
 
 import datetime as _dt
 import json
-import os
-import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
 from .nexus import DIMENSIONLESS, number_dataset, string_dataset
-from .paths import check_output_path
+from .paths import atomic_file, check_output_path
 from .version import __version__
 
 __all__ = ["FitRecord", "write_fit", "read_fit", "is_fit_file", "FIT_FORMAT", "FIT_FORMAT_VERSION",
@@ -108,12 +106,6 @@ class FitRecord:
     extra: dict = field(default_factory=dict)
 
 
-def _umask():
-    mask = os.umask(0)
-    os.umask(mask)
-    return mask
-
-
 def write_fit(path, result, record, used, *, segment="loading", overwrite=False):
     """Write a fit and its data to ``path`` (HDF5, NeXus NXentry ``/fit``), atomically.
 
@@ -142,9 +134,7 @@ def write_fit(path, result, record, used, *, segment="loading", overwrite=False)
     weight = np.full(d.size, np.nan)
     if result.point_weights is not None and np.sum(used) == result.point_weights.size:
         weight[used] = result.point_weights
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    os.close(fd)
-    try:
+    with atomic_file(path) as tmp:
         with h5py.File(tmp, "w") as h:
             h.attrs.update({"format": FIT_FORMAT, "format_version": FIT_FORMAT_VERSION,
                             "package_version": __version__, "NX_class": "NXroot", "default": "fit",
@@ -205,11 +195,6 @@ def write_fit(path, result, record, used, *, segment="loading", overwrite=False)
             string_dataset(src, "sha256", record.sha256)
             string_dataset(src, "columns", json.dumps({k: str(v) for k, v in record.columns.items()}))
             string_dataset(src, "units", json.dumps(record.units, ensure_ascii=False))
-        os.chmod(tmp, 0o666 & ~_umask())
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
 
 
 def _interval(result, name):

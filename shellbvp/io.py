@@ -37,8 +37,6 @@ from __future__ import annotations
 
 import datetime as _dt
 import json
-import os
-import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -46,7 +44,7 @@ import numpy as np
 
 from .chain import CONFIGURATION_NAMES
 from .nexus import label_units
-from .paths import check_output_path
+from .paths import atomic_file, check_output_path
 from .version import __version__
 
 __all__ = ["Curve", "POINT_FIELDS", "CAP_FIELD_DEFAULTS", "point_record", "energy_residual", "write_curve",
@@ -191,12 +189,6 @@ def _check_units(units):
     return R_L, mu_H
 
 
-def _umask():
-    mask = os.umask(0)
-    os.umask(mask)
-    return mask
-
-
 def write_curve_group(g, curve, *, profiles=False, units=None):
     """Fill the HDF5 group ``g`` with ``curve`` in the layout of the module docstring (the
     ``/curve`` group of a curve file; sweep files hold one such group per curve)."""
@@ -269,21 +261,14 @@ def write_curve(curve, path, *, profiles=False, overwrite=False, units=None):
     if path.exists() and not overwrite:
         raise FileExistsError(f"{path} exists; pass overwrite=True (CLI: --force) to replace it")
     check_output_path(path, overwrite=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    os.close(fd)
-    try:
+    with atomic_file(path) as tmp:
         with h5py.File(tmp, "w") as f:
             f.attrs["format"] = FORMAT
             f.attrs["format_version"] = FORMAT_VERSION
             f.attrs["package_version"] = __version__
             f.attrs["created"] = _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds")
             write_curve_group(f.create_group("curve"), curve, profiles=profiles, units=units)
-        os.chmod(tmp, 0o666 & ~_umask())  # mkstemp makes 0600; give the usual permissions
         label_units(tmp)  # every dataset says its unit (nondimensional: "1")
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
 
 
 def _missing_field(name, n):

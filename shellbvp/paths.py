@@ -1,12 +1,33 @@
-"""Output paths checked before any work is done (the CLI's ``-o`` of curve, fit and plot)."""
+"""Output paths checked before any work is done (the CLI's ``-o`` of curve, fit and plot), and
+files published atomically."""
 
 from __future__ import annotations
 
 import os
 import tempfile
+from contextlib import contextmanager
 from pathlib import Path
 
-__all__ = ["check_output_path", "partial_path"]
+__all__ = ["check_output_path", "partial_path", "atomic_file"]
+
+
+@contextmanager
+def atomic_file(path):
+    """A temporary file beside ``path`` (yielded as a Path) that is renamed onto ``path`` when the
+    block ends without error, with the usual permissions (mkstemp makes 0600), and removed on any
+    error: a reader never sees a half-written file and an earlier complete one stays until then."""
+    path = Path(path)
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    os.close(fd)
+    try:
+        yield Path(tmp)
+        mask = os.umask(0)
+        os.umask(mask)
+        os.chmod(tmp, 0o666 & ~mask)
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
 
 
 def partial_path(path) -> Path:

@@ -115,23 +115,14 @@ def save_figure(fig, path, dpi=150):
     """Save ``fig`` atomically (a temporary file in the same directory, then renamed): a
     reader never sees half a figure and an earlier one stays whole if drawing fails.
     The format follows the name's suffix (png, pdf, svg, ...)."""
-    import os
-    import tempfile
     from pathlib import Path
+
+    from .paths import atomic_file
 
     path = Path(path)
     fmt = path.suffix.lstrip(".").lower() or "png"
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    os.close(fd)
-    try:
+    with atomic_file(path) as tmp:
         fig.savefig(tmp, dpi=dpi, format=fmt)
-        mask = os.umask(0)
-        os.umask(mask)
-        os.chmod(tmp, 0o666 & ~mask)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
     return path
 
 

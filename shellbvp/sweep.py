@@ -42,7 +42,6 @@ import math
 import multiprocessing
 import os
 import shutil
-import tempfile
 import time
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from dataclasses import dataclass, field
@@ -53,6 +52,7 @@ import numpy as np
 from .continuation import curve
 from .io import Curve, read_curve_group, write_curve_group
 from .materials import Gent, MooneyRivlin
+from .paths import atomic_file
 from .version import __version__
 
 log = logging.getLogger(__name__)
@@ -283,12 +283,6 @@ def is_sweep_file(path) -> bool:
     return (fmt.decode() if isinstance(fmt, bytes) else fmt) == FORMAT
 
 
-def _umask():
-    mask = os.umask(0)
-    os.umask(mask)
-    return mask
-
-
 def _rewrite(path: Path, edit, *, fresh: bool = False) -> None:
     """Apply ``edit(h5file)`` to a copy of ``path`` (a new file if there is none or ``fresh``) and
     rename it into place.
@@ -299,20 +293,13 @@ def _rewrite(path: Path, edit, *, fresh: bool = False) -> None:
     """
     import h5py
 
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    os.close(fd)
-    try:
+    with atomic_file(path) as tmp:
         copy = path.exists() and not fresh
         if copy:
             shutil.copyfile(path, tmp)
         with h5py.File(tmp, "a" if copy else "w") as f:
             edit(f)
             f.attrs["updated"] = _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds")
-        os.chmod(tmp, 0o666 & ~_umask())  # mkstemp makes 0600; give the usual permissions
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
 
 
 def _label_units(g) -> None:
