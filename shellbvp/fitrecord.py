@@ -43,7 +43,7 @@ from pathlib import Path
 import numpy as np
 
 from .nexus import DIMENSIONLESS, number_dataset, string_dataset
-from .paths import atomic_file, check_output_path
+from .paths import atomic_file, check_output_path, open_hdf5
 from .version import __version__
 
 __all__ = ["FitRecord", "write_fit", "read_fit", "is_fit_file", "FIT_FORMAT", "FIT_FORMAT_VERSION",
@@ -257,20 +257,11 @@ def read_fit(path) -> FitRecord:
     >>> int(fr.data["used"].sum()), fr.data["model_force"].shape
     (40, (40,))
     """
-    import h5py
 
     from .scene import Scene
 
     path = Path(path)
-    if not path.is_file():
-        raise ValueError(f"{path}: no such file")
-    try:
-        h = h5py.File(path, "r")
-    except OSError as exc:
-        raise ValueError(f"{path}: not a readable HDF5 file ({' '.join(str(exc).split())})") from None
-    with h:
-        if _text(h.attrs.get("format", "")) != FIT_FORMAT or not isinstance(h.get("fit"), h5py.Group):
-            raise ValueError(f"{path}: not a shellbvp fit file (format attribute missing or different)")
+    with open_hdf5(path, fmt=FIT_FORMAT, group="fit", kind="fit") as h:
         try:
             e = h["fit"]
             data = {k: v[()] for k, v in e["data"].items()}

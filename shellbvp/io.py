@@ -44,7 +44,7 @@ import numpy as np
 
 from .chain import CONFIGURATION_NAMES
 from .nexus import label_units
-from .paths import atomic_file, check_output_path
+from .paths import atomic_file, check_output_path, open_hdf5
 from .version import __version__
 
 __all__ = ["Curve", "POINT_FIELDS", "CAP_FIELD_DEFAULTS", "point_record", "energy_residual", "write_curve",
@@ -445,22 +445,9 @@ def read_curve(path):
     >>> c.scene == sb.Scene.preset("base"), round(float(c.force[0]), 4)
     (True, 0.3639)
     """
-    import h5py
 
     path = Path(path)
-    if not path.exists():
-        raise ValueError(f"{path}: no such file")
-    if path.is_dir():
-        raise ValueError(f"{path}: is a directory, not a curve file")
-    try:
-        f = h5py.File(path, "r")
-    except OSError as exc:
-        raise ValueError(f"{path}: not a readable HDF5 file ({' '.join(str(exc).split())})") from None
-    with f:
-        fmt = f.attrs.get("format")
-        fmt = fmt.decode("utf-8", "replace") if isinstance(fmt, bytes) else fmt
-        if not isinstance(fmt, str) or fmt != FORMAT or not isinstance(f.get("curve"), h5py.Group):
-            raise ValueError(f"{path}: not a shellbvp curve file (format attribute missing or different)")
+    with open_hdf5(path, fmt=FORMAT, group="curve", kind="curve") as f:
         try:
             _format_version(f)
             curve = read_curve_group(f["curve"], str(f.attrs.get("package_version", "")))

@@ -8,7 +8,30 @@ import tempfile
 from contextlib import contextmanager
 from pathlib import Path
 
-__all__ = ["check_output_path", "partial_path", "atomic_file"]
+__all__ = ["check_output_path", "partial_path", "atomic_file", "open_hdf5"]
+
+
+def open_hdf5(path, *, fmt: str, group: str, kind: str):
+    """The HDF5 file at ``path`` opened for reading (use it in ``with``), once it is known to be a
+    shellbvp ``kind`` file: attribute ``format == fmt`` and a group ``group``.  ValueError with one
+    line naming the path otherwise (missing, a directory, not HDF5, another format)."""
+    import h5py
+
+    path = Path(path)
+    if not path.exists():
+        raise ValueError(f"{path}: no such file")
+    if path.is_dir():
+        raise ValueError(f"{path}: is a directory, not a {kind} file")
+    try:
+        f = h5py.File(path, "r")
+    except OSError as exc:
+        raise ValueError(f"{path}: not a readable HDF5 file ({' '.join(str(exc).split())})") from None
+    found = f.attrs.get("format")
+    found = found.decode("utf-8", "replace") if isinstance(found, bytes) else found
+    if not (isinstance(found, str) and found == fmt and isinstance(f.get(group), h5py.Group)):
+        f.close()
+        raise ValueError(f"{path}: not a shellbvp {kind} file (format attribute missing or different)")
+    return f
 
 
 @contextmanager

@@ -52,7 +52,7 @@ import numpy as np
 from .continuation import curve
 from .io import Curve, read_curve_group, write_curve_group
 from .materials import Gent, MooneyRivlin
-from .paths import atomic_file
+from .paths import atomic_file, open_hdf5
 from .version import __version__
 
 log = logging.getLogger(__name__)
@@ -336,17 +336,8 @@ def _new_index(names, combos) -> dict:
 
 def _read_attrs(path):
     """(meta, index) of a sweep file; ValueError with one line naming what is wrong."""
-    import h5py
 
-    try:
-        f = h5py.File(path, "r")
-    except OSError as exc:
-        raise ValueError(f"{path}: not a readable HDF5 file ({' '.join(str(exc).split())})") from None
-    with f:
-        fmt = f.attrs.get("format")
-        fmt = fmt.decode() if isinstance(fmt, bytes) else fmt
-        if fmt != FORMAT or not isinstance(f.get("sweep"), h5py.Group):
-            raise ValueError(f"{path}: not a shellbvp sweep file (format attribute missing or different)")
+    with open_hdf5(path, fmt=FORMAT, group="sweep", kind="sweep") as f:
         version = f.attrs.get("format_version")
         if version is None or int(version) != FORMAT_VERSION:
             raise ValueError(f"{path}: sweep format version {version!r} is not one this shellbvp reads "
