@@ -23,7 +23,8 @@ from .version import __version__  # noqa: F401  (sb.__version__)
 _LAZY = {"fit": "fitting", "FitResult": "fitting", "read_force_csv": "fitting", "fit_record": "fitting",
          "read_instrument": "instrument", "fit_files": "batch", "read_fit": "fitrecord",
          "sweep": "sweep", "read_sweep": "sweep", "Sweep": "sweep",
-         "fit_with_geometry": "uncertainty", "GeometryFit": "uncertainty", "convexity_limits": "convexity"}
+         "fit_with_geometry": "uncertainty", "GeometryFit": "uncertainty", "convexity_limits": "convexity",
+         "inflate": "inflation"}
 
 
 def __getattr__(name):
@@ -41,6 +42,7 @@ __all__ = [
     "Scene",
     "solve",
     "delta_bounds",
+    "inflate",
     "curve",
     "Curve",
     "read_curve",

@@ -277,14 +277,16 @@ class ChainBVP:
     value : float, or (Xhat, tangent, scale) for ``"arclength"``
     model : module, optional
         The scene's generated module (loaded if not given).
+    par : array, optional
+        Its run-time parameters (default ``scene.parameters(model)``).
     """
 
-    def __init__(self, scene, chain: Chain, control: str, value, model=None):
+    def __init__(self, scene, chain: Chain, control: str, value, model=None, par=None):
         if control not in CONTROLS:
             raise ValueError(f"control must be one of {CONTROLS}; got {control!r}")
         self.scene, self.chain, self.control = scene, chain, control
         self.model = mod = model if model is not None else scene.model()
-        self.par = scene.parameters(mod)
+        self.par = scene.parameters(mod) if par is None else np.asarray(par, float)
         self.regions = chain.regions
         self._bind()
         self.sizes = [SIZES[r.kind] for r in chain.regions]
@@ -616,9 +618,42 @@ class ChainBVP:
                 2 * np.pi * vals if key == "axial_force_2pi" else vals)
         return out
 
+    def _param(self, name) -> float:
+        """A run-time parameter by name; 0 for the pressure's in a structure without them."""
+        names = self.model.PARAMS
+        return float(self.par[names.index(name)]) if name in names else 0.0
+
+    @property
+    def pressure(self) -> float:
+        return self._param("pressure")
+
+    @property
+    def pole_height(self) -> float:
+        """Where the indenter finds the pole at delta = 0: ``Z(0) + pole_rise``."""
+        return float(self.model.reference_shell(0.0, self.par)["Z"]) + self._param("pole_rise")
+
     def energy(self, sol, x, p) -> float:
-        """``E = 2 pi Int U R Psi dS`` over every region (Gauss-Legendre on each mesh interval),
-        plus the leading term ``zeta U(zeta)/2`` of each pole disc ``[0, zeta]``."""
+        """``E = 2 pi Int U R Psi dS - p (V - V_ref)``: the elastic energy over every region
+        (Gauss-Legendre on each mesh interval, plus the leading term ``zeta U(zeta)/2`` of
+        each pole disc ``[0, zeta]``) and the pressure's potential (``shellbvp.inflation``)."""
+        elastic = self._elastic_energy(sol, x, p)
+        if not self.pressure:
+            return elastic
+        return elastic - self.pressure * (self.volume(sol, x, p) - self.scene.reference_volume())
+
+    def volume(self, sol, x, p) -> float:
+        """``V = Int dV/dS dS`` over every region (Gauss-Legendre on the mesh): the volume between
+        the shell and its rim's plane (``symbolic.equations.pressure_load``)."""
+        from .quadrature import gauss_points
+
+        t, w = gauss_points(x)
+        total = 0.0
+        for k, S, fields in self.region_profiles(t, sol(t), p):
+            reg = self.regions[k]
+            total += float(np.sum(w * fields["volume_density"] * S)) * (self.ln_S(reg.end, p) - self.ln_S(reg.start, p))
+        return total
+
+    def _elastic_energy(self, sol, x, p) -> float:
         from .quadrature import gauss_points
 
         t, w = gauss_points(x)

@@ -87,6 +87,18 @@ def _uncertain(text):
         raise argparse.ArgumentTypeError(str(exc)) from None
 
 
+def _pressure(text):
+    """argparse type: a plain number (``p R_L/(mu H)``) or a pressure with its unit (``0.2MPa``)."""
+    from .units import Quantity, plain_number, split_quantity
+
+    try:
+        if split_quantity(text, "pressure", "the value")[1]:
+            return Quantity.parse(text, "pressure", "the value", positive=False)
+        return plain_number(text, "the value")
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+
+
 def _scene_options(p, uncertain=False):
     g = p.add_argument_group("scene (overrides of the preset)")
     g.add_argument("--preset", default="base", help="built-in scene (see `shellbvp presets`; default base)")
@@ -99,6 +111,9 @@ def _scene_options(p, uncertain=False):
     m.add_argument("--gent-jm", type=_number, dest="gent_jm", help="Gent model with this Jm (> 0)")
     m.add_argument("--neo-hookean", action="store_true", help="neo-Hookean material")
     g.add_argument("--xi", type=int, choices=(0, 1), help="1: full generalised tensions; 0: first approximation")
+    g.add_argument("--pressure", type=_pressure,
+                   help="pressure below the shell (from the side away from the indenter; > 0 inflates a dome or "
+                        "cell): p R_L/(mu H), or with a unit (0.2MPa, 50kPa) together with --radius and --muH")
     g.add_argument("--contact", choices=("smooth", "paper"), help="contact-line model (default smooth)")
     b = g.add_mutually_exclusive_group()
     b.add_argument("--bending", choices=("trace", "rotation"),
@@ -125,7 +140,23 @@ def _scene(args):
         over["bending"] = sb.TraceBending() if args.bending == "trace" else sb.RotationBending()
     elif getattr(args, "bending_formula", None):
         over["bending"] = sb.BendingEnergy(args.bending_formula)
+    if getattr(args, "pressure", None) is not None:
+        over["pressure"] = _nondimensional_pressure(args)
     return sb.Scene.preset(args.preset, **over)
+
+
+def _nondimensional_pressure(args):
+    """``--pressure`` as ``p R_L/(mu H)``: a plain number as it is, a pressure with a unit through
+    ``--radius`` and ``--muH``."""
+    from .units import Dimensions, Quantity
+
+    if not isinstance(args.pressure, Quantity):
+        return args.pressure
+    radius, mu_h = getattr(args, "radius", None), getattr(args, "mu_h", None)
+    if radius is None or mu_h is None:
+        raise ValueError(f"--pressure {args.pressure} has a unit: it needs --radius and --muH (the nondimensional "
+                         f"pressure is p R_L/(mu H)); or give that number itself")
+    return Dimensions(R_L=radius.si, mu_H=mu_h.si).p(args.pressure.si)
 
 
 def _checkpoint_seconds():
@@ -771,8 +802,11 @@ def _cmd_presets(args):
 
     for name, p in PRESETS.items():
         sc = p["scene"]
-        print(f"{name:9s} gamma={sc['gamma']:<5g} rho={sc['rho']:<7.4g} beta={sc['beta']:<6g} "
-              f"xi={sc['xi']} material={sc['material']!r}  -- {p['doc']}")
+        shape = (f"shell=R,Z,L=({', '.join(sc['shell'])})" if isinstance(sc.get("shell"), tuple)
+                 else f"gamma={sc['gamma']:<5g}")
+        extra = f" pressure={sc['pressure']:g}" if sc.get("pressure") else ""
+        print(f"{name:9s} {shape} rho={sc['rho']:<7.4g} beta={sc['beta']:<6g} "
+              f"xi={sc['xi']} material={sc['material']!r}{extra}  -- {p['doc']}")
     return 0
 
 

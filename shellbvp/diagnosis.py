@@ -105,7 +105,7 @@ def diagnose(sysm, bvp, tol, converged_note: str = "") -> Solution:
         # where the contact starts from the pole's side: the pole itself, or a lifted pole's first edge
         S1=S_edges[0] if isinstance(first, FreePole) else 0.0,
         control=sysm.control, scene=sysm.scene, system=sysm,
-        z_tip=float(mod.reference_shell(0.0, par)["Z"]) - float(delta),
+        z_tip=sysm.pole_height - float(delta),
     )
     tip_end = next((j for j in sysm.junctions if isinstance(j, TipEnd)), None)
     if tip_end is not None:

@@ -46,9 +46,10 @@ def cache_dir() -> Path:
     return base / "shellbvp"
 
 
-def structure_description(material, xi: int, shell, tip, bending=None) -> dict:
-    """Everything the generated code depends on, as JSON-able data."""
-    return {
+def structure_description(material, xi: int, shell, tip, bending=None, pressurised=False) -> dict:
+    """Everything the generated code depends on, as JSON-able data (``pressurised``: the
+    pressure's terms and parameters are generated; descriptions without it are unchanged)."""
+    return {**({"pressurised": True} if pressurised else {}),
         "bending": bending.description() if bending is not None else {"family": "trace"},
         "codegen": CODEGEN_VERSION,
         "source": source_fingerprint(),

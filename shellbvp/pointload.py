@@ -13,6 +13,7 @@ import numpy as np
 
 from .chain import ChainBVP, point_chain
 from .diagnosis import diagnose
+from .inflation import start_shape
 from .solution import (
     attach_tip_table,
     solve_bvp,
@@ -43,10 +44,10 @@ def _point_guess(sysm, prev):
 def _crude_point_guess(sysm):
     x = np.linspace(0.0, 1.0, 61)
     S = sysm.S(0, x, None)
-    ref = sysm.model.reference_shell(S, sysm.par)
-    lam = 0.95
-    y = np.vstack([np.full(x.size, lam), ref["Phi"] / S, np.full(x.size, lam), ref["kappa_s"],
-                   np.zeros(x.size), ref["Z"] - sysm.value * (1 - (S - S[0]) / (S[-1] - S[0]))])
+    y = start_shape(sysm.scene, S)  # the reference shell, or the inflated one under pressure
+    y[[0, 2]] *= 0.95
+    y[4] = 0.0
+    y[5] -= sysm.value * (1 - (S - S[0]) / (S[-1] - S[0]))
     return x, y
 
 

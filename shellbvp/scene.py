@@ -7,6 +7,7 @@ elastic sheet of thickness ``eps = H/R_L``).
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass, field, replace
 
@@ -56,6 +57,12 @@ class Scene:
         The bending energy ``B`` in ``U = W + beta B``: ``TraceBending()`` (the paper's,
         default), ``RotationBending()`` (convex in stretch and curvature) or
         ``BendingEnergy(formula)``.
+    pressure : float
+        Pressure difference ``p R_L/(mu H)`` across the shell, from the side away from
+        the indenter (below it): > 0 inflates a dome or a cell indented from outside.
+        It acts on the deformed midsurface (a follower load); the curve starts from the
+        inflated shape (:func:`shellbvp.inflate`) and delta is measured from its pole.
+        Default 0.
 
     Raises
     ------
@@ -89,6 +96,7 @@ class Scene:
     shell: object = field(default_factory=Spheroid)
     tip: object = field(default_factory=SphereTip)
     bending: Bending = field(default_factory=TraceBending)
+    pressure: float = 0.0
 
     def __post_init__(self):
         rho = _finite("rho", self.rho)
@@ -124,6 +132,7 @@ class Scene:
         object.__setattr__(self, "gamma", gamma)
         object.__setattr__(self, "rho", rho)
         object.__setattr__(self, "beta", beta)
+        object.__setattr__(self, "pressure", _finite("pressure", self.pressure))
 
     # -- presets -----------------------------------------------------------------
     @classmethod
@@ -133,8 +142,8 @@ class Scene:
         Parameters
         ----------
         name : str
-            ``base``, ``base-xi0``, ``prolate2``, ``fit``, ``flat``, ``gent1`` or ``dome``
-            (``shellbvp presets`` lists them).
+            ``base``, ``base-xi0``, ``prolate2``, ``fit``, ``flat``, ``gent1``, ``dome``, and
+            the pressurised ``balloon`` and ``cell`` (``shellbvp presets`` lists them).
         **overrides
             Any field of :class:`Scene`.
 
@@ -149,6 +158,8 @@ class Scene:
         if name not in PRESETS:
             raise ValueError(f"unknown preset {name!r}; choose one of {sorted(PRESETS)}")
         base = dict(PRESETS[name]["scene"])
+        if isinstance(base.get("shell"), tuple):
+            base["shell"] = UserShell(*base["shell"])
         base.update(overrides)
         return cls(**base)
 
@@ -165,6 +176,7 @@ class Scene:
             "material": {**self.material.description(), **self.material.values()},
             "shell": self.shell.description(), "tip": self.tip.description(),
             "bending": self.bending.description(),
+            **({"pressure": self.pressure} if self.pressure else {}),  # files of unpressurised scenes as before
         }
 
     @classmethod
@@ -228,7 +240,8 @@ class Scene:
             raise ValueError(f"scene data: unknown bending family {kind!r}")
         return cls(gamma=field(d, "gamma", number, ""), rho=field(d, "rho", number, ""),
                    beta=field(d, "beta", number, ""), material=material, xi=field(d, "xi", (int,), ""),
-                   contact=field(d, "contact", text, ""), shell=shell, tip=tip, bending=bend)
+                   contact=field(d, "contact", text, ""), shell=shell, tip=tip, bending=bend,
+                   pressure=field(d, "pressure", number, "") if "pressure" in d else 0.0)
 
     def to_json(self) -> str:
         """:meth:`to_dict` as a JSON string (sorted keys)."""
@@ -239,7 +252,8 @@ class Scene:
     # -- generated code ------------------------------------------------------------
     def structure(self) -> dict:
         """The structural choices the generated code is specialised on."""
-        return structure_description(self.material, self.xi, self.shell, self.tip, self.bending)
+        return structure_description(self.material, self.xi, self.shell, self.tip, self.bending,
+                                     pressurised=self.pressure != 0)
 
     def model(self):
         """The generated module for this scene's structure (cached)."""
@@ -247,15 +261,31 @@ class Scene:
 
     def values(self) -> dict:
         """Continuous (run-time) parameters by name."""
-        v = {"beta": self.beta, "rho": self.rho, "gamma": self.gamma}
+        v = {"beta": self.beta, "rho": self.rho, "gamma": self.gamma, "pressure": self.pressure,
+             "pole_rise": 0.0}
         v.update(self.material.values())
         return v
 
-    def parameters(self, model=None) -> np.ndarray:
-        """Run-time parameter vector in the order of the generated functions."""
+    def parameters(self, model=None, *, pole_rise=None) -> np.ndarray:
+        """Run-time parameter vector in the order of the generated functions.
+
+        ``pole_rise`` (where the indenter finds the pole before indenting, above ``Z(0)``):
+        by default the inflated state's (:func:`shellbvp.inflate`, solved once per scene),
+        0 without pressure.
+        """
         model = model or self.model()
         v = self.values()
+        if pole_rise is None and self.pressure:
+            from .inflation import inflated_pole_rise
+
+            pole_rise = inflated_pole_rise(self)
+        v["pole_rise"] = float(pole_rise or 0.0)
         return np.array([v[name] for name in model.PARAMS], dtype=float)
+
+    def reference_volume(self) -> float:
+        """V of the undeformed shell, ``-pi Int R^2 Z' dS``: the volume between it and its rim's
+        plane (the origin of the pressure's potential ``-p (V - V_ref)``)."""
+        return _reference_volume(self)
 
     @property
     def tip_omega_max(self) -> float:
@@ -270,8 +300,20 @@ class Scene:
         return float(self.shell.geometry.L)
 
 
+@functools.lru_cache(maxsize=64)
+def _reference_volume(scene) -> float:
+    from scipy.integrate import quad
+
+    mod = scene.model()
+    par = scene.parameters(mod, pole_rise=0.0)
+    value, _ = quad(lambda S: float(mod.reference_shell(S, par)["volume_density"]), 0.0, scene.shell_length,
+                    epsabs=1e-13, epsrel=1e-12, limit=200)
+    return value
+
+
 #: The paper's scenes by name: ``{name: {"doc": description, "scene": Scene fields}}``
-#: (``Scene.preset(name)``; ``shellbvp presets`` lists them).
+#: (``Scene.preset(name)``; ``shellbvp presets`` lists them).  A user shell is written as its
+#: ``(R, Z, L)`` formulas, parsed when the preset is used (importing shellbvp needs no SymPy).
 PRESETS = {
     "base": {"doc": "paper's base case: hemisphere, rho 0.2, beta 0.01, Mooney-Rivlin 0.1, xi 1",
              "scene": dict(gamma=1.0, rho=0.2, beta=0.01, material=MooneyRivlin(0.1), xi=1)},
@@ -287,4 +329,13 @@ PRESETS = {
               "scene": dict(gamma=1.0, rho=0.2, beta=0.01, material=Gent(1.0), xi=1)},
     "dome": {"doc": "dome gamma = -1, indented from the convex side",
              "scene": dict(gamma=-1.0, rho=0.2, beta=0.01, material=MooneyRivlin(0.1), xi=1)},
+    "balloon": {"doc": "inflated membrane patch: a spherical cap of radius 2 clamped on its rim (half-angle 30 "
+                       "degrees), indented from outside, pressure 0.1 (tau = p R^2/(4 sqrt(3 beta)) = 5.8)",
+                "scene": dict(shell=("2*sin(S/2)", "2*cos(S/2)", "2*asin(1/2)"), rho=0.2, beta=1e-4,
+                              material=MooneyRivlin(0.1), xi=1, pressure=0.1)},
+    "cell": {"doc": "walled cell with turgor: a near-complete sphere held on a ring 144 degrees from the pole "
+                    "(sphere radius 1.70), colloidal probe rho 0.34, beta 3.9e-4, pressure 0.089 (yeast-like: "
+                    "radius 2.5 um, wall 0.1 um, mu H 3.3 N/m, turgor 0.2 MPa)",
+             "scene": dict(shell=("sin(S)", "cos(S)", "4*pi/5"), rho=0.34, beta=3.9e-4,
+                           material=MooneyRivlin(0.1), xi=1, pressure=0.089)},
 }

@@ -17,6 +17,7 @@ import numpy as np
 from .chain import ChainBVP, cap_chain
 from .corner import edge_model, is_corner, limit_estimate, near_limit, other_edge_root
 from .diagnosis import diagnose
+from .inflation import start_shape
 from .pointload import SC_POINT, solve_point_load
 from .solution import (
     STATUS_MESSAGES,
@@ -34,24 +35,26 @@ __all__ = ["solve", "solve_from", "make_system", "system_like", "cross_convexity
 log = logging.getLogger(__name__)
 
 def _undeformed_guess(sysm: ChainBVP, ln_Sc, lambda0, delta, n=41):
-    """Crude start: the reference shell moved down by delta, a small cap at stretch lambda0."""
-    mod, par, L = sysm.model, sysm.par, sysm.L
+    """Crude start: the shell before indentation (the reference shell, or the inflated one
+    under pressure) moved down by delta, a small cap at stretch lambda0 (times the pole's
+    stretch before indentation)."""
     t = np.linspace(0.0, 1.0, n)
+    Sf = sysm.S(1, t, sysm.pack(ln_Sc=ln_Sc, lambda0=lambda0, delta=delta))
+    start = start_shape(sysm.scene, Sf)
+    lambda0 = lambda0 * start[2, 0]
     p = sysm.pack(ln_Sc=ln_Sc, lambda0=lambda0, delta=delta)
-    Sf = sysm.S(1, t, p)
-    ref = mod.reference_shell(Sf, par)
-    chi0 = -mod.pole_res(0.0, 0.0, 1.0, par)[0]  # chi at the pole for lambda0 = 1
+    chi0 = -sysm.model.pole_res(0.0, 0.0, 1.0, sysm.par)[0]  # chi at the pole for lambda0 = 1
     Sc = np.exp(ln_Sc)
-    w = (Sf - Sc) / (L - Sc)
+    w = (Sf - Sc) / (sysm.L - Sc)
     y = np.vstack([
         np.full(n, lambda0 * chi0),
         np.full(n, lambda0),
-        lambda0 + (1.0 - lambda0) * w,
-        ref["Phi"] / Sf,
-        np.ones(n),
-        ref["kappa_s"],
-        np.zeros(n),
-        ref["Z"] - delta * (1.0 - w),
+        lambda0 + (start[0] - lambda0) * w,
+        start[1],
+        start[2],
+        start[3],
+        start[4],
+        start[5] - delta * (1.0 - w),
     ])
     return t, y, p
 

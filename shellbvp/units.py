@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 __all__ = ["Dimensions", "parse_quantity", "unit_factor", "unit_kind", "normalize_unit", "format_in",
            "beta_from_thickness", "plain_number", "PLAIN_NUMBER", "LENGTH_UNITS", "FORCE_UNITS", "TIME_UNITS",
-           "MU_H_UNITS", "UNIT_TABLES", "SI_UNITS", "split_quantity", "Quantity", "force_unit_of"]
+           "MU_H_UNITS", "PRESSURE_UNITS", "UNIT_TABLES", "SI_UNITS", "split_quantity", "Quantity", "force_unit_of"]
 
 #: A number as a person or a CSV writes it: ASCII digits, optional sign, decimal point and
 #: exponent.  Python's float() also takes "5_0", "inf", "nan", "1e999" and non-ASCII digits.
@@ -27,10 +27,13 @@ TIME_UNITS = {"h": 3600.0, "min": 60.0, "s": 1.0, "ms": 1e-3, "us": 1e-6, "µs":
 #: mu*H is a force per length: N/m (= um*MPa = mN/mm = uN/um).
 MU_H_UNITS = {"N/m": 1.0, "mN/m": 1e-3, "kN/m": 1e3, "mN/mm": 1.0, "uN/um": 1.0, "µN/µm": 1.0, "nN/nm": 1.0,
               "um*MPa": 1.0, "µm*MPa": 1.0, "mm*kPa": 1.0, "kPa*mm": 1.0, "MPa*um": 1.0, "MPa*µm": 1.0}
+#: Pressures (turgor, inflation): Pa and its multiples, bar.
+PRESSURE_UNITS = {"Pa": 1.0, "hPa": 1e2, "kPa": 1e3, "MPa": 1e6, "GPa": 1e9, "bar": 1e5, "mbar": 1e2}
 #: The unit table of each kind of quantity.
-UNIT_TABLES = {"length": LENGTH_UNITS, "force": FORCE_UNITS, "time": TIME_UNITS, "mu_H": MU_H_UNITS}
+UNIT_TABLES = {"length": LENGTH_UNITS, "force": FORCE_UNITS, "time": TIME_UNITS, "mu_H": MU_H_UNITS,
+               "pressure": PRESSURE_UNITS}
 #: The SI unit of each kind (what a bare number would have meant).
-SI_UNITS = {"length": "m", "force": "N", "time": "s", "mu_H": "N/m"}
+SI_UNITS = {"length": "m", "force": "N", "time": "s", "mu_H": "N/m", "pressure": "Pa"}
 
 
 def normalize_unit(unit: str) -> str:
@@ -81,8 +84,8 @@ def plain_number(text: str, name: str = "value") -> float:
     return v
 
 
-_EXAMPLE = {"length": "0.3mm", "force": "2mN", "time": "1.5s", "mu_H": "52N/m"}
-_SUGGEST = {"length": "mm", "force": "mN", "time": "s", "mu_H": "N/m"}
+_EXAMPLE = {"length": "0.3mm", "force": "2mN", "time": "1.5s", "mu_H": "52N/m", "pressure": "0.2MPa"}
+_SUGGEST = {"length": "mm", "force": "mN", "time": "s", "mu_H": "N/m", "pressure": "kPa"}
 
 
 def split_quantity(text, kind: str = "length", name: str | None = None):
@@ -110,7 +113,7 @@ def parse_quantity(text, kind: str = "length", default_unit: str | None = None, 
     ----------
     text : str or float
         A plain number with a unit (``0.3mm``, ``0.3 mm``, ``300µm``), or a bare number.
-    kind : {'length', 'force', 'time', 'mu_H'}
+    kind : {'length', 'force', 'time', 'mu_H', 'pressure'}
     default_unit : str, optional
         Unit of a bare number (SI when not given).
     require_unit : bool
@@ -122,7 +125,7 @@ def parse_quantity(text, kind: str = "length", default_unit: str | None = None, 
     Returns
     -------
     float
-        The value in SI units: m, N, s or N/m.
+        The value in SI units: m, N, s, N/m or Pa.
 
     Raises
     ------
@@ -254,6 +257,8 @@ class Dimensions:
     0.0156
     >>> round(float(dims.F(dims.force(0.7))), 12)
     0.7
+    >>> round(dims.p(2e5), 6)                        # a turgor of 0.2 MPa
+    1.153846
     """
 
     R_L: float
@@ -280,3 +285,11 @@ class Dimensions:
     def F(self, force):
         """Newtons -> nondimensional F."""
         return force / (self.mu_H * self.R_L)
+
+    def pressure(self, p):
+        """Nondimensional pressure ``p R_L/(mu H)`` -> pascals."""
+        return p * self.mu_H / self.R_L
+
+    def p(self, pascals):
+        """Pascals -> nondimensional pressure ``p R_L/(mu H)``."""
+        return pascals * self.R_L / self.mu_H

@@ -55,7 +55,8 @@ def structure_from_description(desc: dict) -> Structure:
     bend = desc.get("bending", {"family": "trace"})
     B = None if bend["family"] == "trace" else bending.bending_energy(
         bend["family"], _expr(bend["B"], "B", *bending.BENDING_SYMBOLS.values()) if bend["family"] == "user" else None)
-    return Structure(W=W, material_params=mpar, shell=shell, tip=tip, xi=int(desc["xi"]), B=B)
+    return Structure(W=W, material_params=mpar, shell=shell, tip=tip, xi=int(desc["xi"]), B=B,
+                     pressurised=bool(desc.get("pressurised", False)))
 
 
 def generate_source(desc: dict) -> str:

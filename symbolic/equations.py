@@ -11,7 +11,8 @@ Everything follows from the kinematics and the energy density
 with ``T_s = (1/lambda_theta) dW/dlambda_s``, ``T_theta = (1/lambda_s) dW/dlambda_theta``,
 ``M_alpha = h dU/dkappa_alpha`` (``h = 1/(lambda_s lambda_theta)``) and the generalised
 tensions ``tau_alpha = T_alpha + xi M_alpha kappa_alpha``; the equilibrium equations are
-the paper's (eq. equibshell), with ``P = 0`` off the indenter.
+the paper's (eq. equibshell), with ``P`` the load of a pressure ``p`` below the shell off
+the indenter (:func:`pressure_load`; 0 by default).
 
 State layout (one place; the solver and the tests import these tuples)
 ---------------------------------------------------------------------
@@ -67,6 +68,10 @@ CONTACT_STATES = ("chi", "ls")
 CONTACT_MODELS = ("smooth", "paper")
 
 BETA, RHO = sp.symbols("beta rho", positive=True)
+#: Pressure below the shell (the side away from the indenter; > 0 pushes the shell towards
+#: it: a dome or cell inflated from inside), ``p R_L/(mu H)``; and the pole's rise under it
+#: (the inflated pole is at ``Z(0) + pole_rise``; delta is measured from there).
+PRESSURE, POLE_RISE = sp.symbols("pressure pole_rise", real=True)
 SC = sp.Symbol("Sc", positive=True)
 LAMBDA0, DELTA, FORCE = sp.symbols("lambda0 delta F", real=True)
 
@@ -86,11 +91,54 @@ class Structure:
     tip: TipGeometry
     xi: int
     B: sp.Expr | None = None
+    pressurised: bool = False
 
     @property
     def params(self) -> tuple:
-        """Run-time parameters, in the order the generated functions take them."""
-        return (BETA, RHO) + tuple(self.shell.params) + tuple(self.material_params)
+        """Run-time parameters, in the order the generated functions take them (the pressure
+        and the inflated pole's rise only where there is a pressure)."""
+        extra = (PRESSURE, POLE_RISE) if self.pressurised else ()
+        return (BETA, RHO) + extra + tuple(self.shell.params) + tuple(self.material_params)
+
+    @property
+    def pressure(self):
+        """The pressure, or 0 in a structure without one (its terms are then not generated)."""
+        return PRESSURE if self.pressurised else sp.S.Zero
+
+    @property
+    def pole_rise(self):
+        return POLE_RISE if self.pressurised else sp.S.Zero
+
+
+def pressure_load():
+    r"""The follower load of the pressure, from the variation of its potential ``-p V``.
+
+    ``V = -pi Int r^2 z' dS`` is the volume between the shell and its rim's plane, signed
+    so that it grows as the shell moves towards the indenter's side (up).  The force per
+    reference length is ``-dPi/dx`` (Euler-Lagrange of ``Pi = -p V`` in r and z); its
+    component along the normal in which the contact pressure P counts positive,
+    ``(sin phi, -cos phi)``, per deformed area ``2 pi r psi``, is the load in the normal
+    balance's ``P``.  Returns ``(load, volume density)``: ``-p`` (a uniform pressure) and
+    ``-pi r^2 z'`` over the symbols ``r, phi, psi``.
+    """
+    r, z = sp.Function("r")(S), sp.Function("z")(S)
+    rr, phi, psi = sp.symbols("r phi psi")
+    v = -sp.pi * r**2 * sp.diff(z, S)
+    forces = [-eq.lhs for eq in sp.euler_equations(-PRESSURE * v, [r, z], S)]
+    on_shell = {sp.diff(r, S): psi * sp.cos(phi), sp.diff(z, S): psi * sp.sin(phi)}
+    fr, fz = (f.subs(on_shell).subs(r, rr) for f in forces)
+    load = sp.simplify((fr * sp.sin(phi) - fz * sp.cos(phi)) / (2 * sp.pi * rr * psi))
+    if load.free_symbols != {PRESSURE}:
+        raise AssertionError(f"pressure load is not uniform: {load}")
+    return load, v.subs(on_shell).subs(r, rr)
+
+
+PRESSURE_LOAD, _VOLUME_DENSITY = pressure_load()
+
+
+def volume_density(r, phi, psi):
+    """``dV/dS = -pi r^2 psi sin(phi)`` (see :func:`pressure_load`)."""
+    return _VOLUME_DENSITY.xreplace(dict(zip(sp.symbols("r phi psi"), (r, phi, psi))))
 
 
 class Derivation:
@@ -184,6 +232,16 @@ class Derivation:
             tau_t = prog.let(f"tau_t{tag}", T_t + st.xi * bend_t.xreplace(sub))
         return dict(m=m, T_s=T_s, T_t=T_t, M_s=M_s, M_t=M_t, tau_s=tau_s, tau_t=tau_t, W=W, U=U_)
 
+    @property
+    def _pressure_load(self):
+        return PRESSURE_LOAD.xreplace({PRESSURE: self.structure.pressure})
+
+    def _indenter_force(self, r, sin_phi, cos_phi, tau_s, Q):
+        """F(S)/(2 pi): the shell's axial force ``r sin(phi) tau_s - r cos(phi) Q`` plus the
+        pressure's axial force on the cap inside S, ``p r^2/2`` (the paper's F(S), eq. Flaw:
+        constant over a free region; the indenter's force at a contact edge)."""
+        return r * sin_phi * tau_s - r * cos_phi * Q + self.structure.pressure * r**2 / 2
+
     def _tip_steps(self, prog: Program, omega, tip, tag=""):
         d = tip.derived()
         sub = {OMEGA: omega}
@@ -193,9 +251,9 @@ class Derivation:
     def _build_free_physical(self):
         """Free region over the physical variables (S, r, phi, ls, ks, Q).
 
-        Equilibrium (paper eq. equibshell, P = 0):
+        Equilibrium (paper eq. equibshell, P the pressure's normal load, ``PRESSURE_LOAD``):
         (r tau_s)' - r' tau_theta + kappa_s r Q psi = 0,
-        kappa_s tau_s + kappa_theta tau_theta - (r Q)'/(r psi) = 0,
+        kappa_s tau_s + kappa_theta tau_theta - (r Q)'/(r psi) = P,
         (r M_s)' - r' M_theta - r Q psi = 0.
         The first and third are linear in (lambda_s', kappa_s'): a 2x2 system
         whose coefficients are partial derivatives of tau_s and M_s.
@@ -225,9 +283,9 @@ class Derivation:
         det = A.let("det", a11 * a22 - a12 * a21)
         dls = A.let("dls", (b1 * a22 - a12 * b2) / det)
         dks = A.let("dks", (a11 * b2 - a21 * b1) / det)
-        dQ = A.let("dQ", psi * (ks * c["tau_s"] + kt * c["tau_t"]) - dr * Q / r)
+        dQ = A.let("dQ", psi * (ks * c["tau_s"] + kt * c["tau_t"] - self._pressure_load) - dr * Q / r)
         dz = A.let("dz", psi * sp.sin(phi))
-        G = A.let("G", r * sp.sin(phi) * c["tau_s"] - r * sp.cos(phi) * Q)
+        G = A.let("G", self._indenter_force(r, sp.sin(phi), sp.cos(phi), c["tau_s"], Q))
         self.free_phys = A
         self.free_phys_vars = (r, phi, ls, ks, Q)
         self.free_phys_out = dict(c, lt=lt, kt=kt, psi=psi, dr=dr, dphi=dphi, dls=dls, dks=dks,
@@ -260,6 +318,7 @@ class Derivation:
             "M_s": o["M_s"], "M_theta": o["M_t"], "tau_s": o["tau_s"], "tau_theta": o["tau_t"],
             "Q": sp.Symbol("Q"), "P": sp.S.Zero, "axial_force_2pi": o["G"],
             "energy_density": o["U"] * o["R"] * o["Psi"],
+            "volume_density": volume_density(r, phi, o["psi"]),
         }
 
     # ------------------------------------------------------------------ contact region
@@ -293,10 +352,11 @@ class Derivation:
         dls = C.let("dls", num / (r * (ts_ls + ks * ms_ls)))
         rQ = C.let("rQ", (r * (ms_ls * dls + ms_rest) + dr * (c["M_s"] - c["M_t"])) / psi)
         Q = C.let("Q", rQ / r)
-        G = C.let("G", r * t["sin_phi"] * c["tau_s"] - r * t["cos_phi"] * Q)
-        # P from the normal balance; (rQ)' is a total derivative along the solution.
+        G = C.let("G", self._indenter_force(r, t["sin_phi"], t["cos_phi"], c["tau_s"], Q))
+        # The indenter's pressure from the normal balance, less the pressure's own load
+        # (the indenter carries it here); (rQ)' is a total derivative along the solution.
         drQ = C.derivative(rQ, S) + C.derivative(rQ, omega) * domega + C.derivative(rQ, ls) * dls
-        P = C.let("P", ks * c["tau_s"] + kt * c["tau_t"] - drQ / (r * psi))
+        P = C.let("P", ks * c["tau_s"] + kt * c["tau_t"] - drQ / (r * psi) - self._pressure_load)
         return C, dict(c, **g, tip=t, r=r, dr=dr, lt=lt, ks=ks, kt=kt, psi=psi,
                        domega=domega, dls=dls, rQ=rQ, Q=Q, G=G, P=P)
 
@@ -316,6 +376,7 @@ class Derivation:
             "M_s": o["M_s"], "M_theta": o["M_t"], "tau_s": o["tau_s"], "tau_theta": o["tau_t"],
             "Q": o["Q"], "P": o["P"], "axial_force_2pi": o["G"],
             "energy_density": o["U"] * o["R"] * o["Psi"], "omega": sp.Symbol("omega"),
+            "volume_density": -sp.pi * o["r"] ** 2 * o["psi"] * t["sin_phi"],
         }
         # note: profile z is relative to the tip apex; the solver adds z_tip.
         return P, ys, rhs, profile
@@ -359,7 +420,7 @@ class Derivation:
         J.extend(fprog)
         oc = {k: v.xreplace(cmap) for k, v in contact_profile.items()}
         of = {k: v.xreplace(fmap) for k, v in self.free_profile.items()}
-        z_tip = sh.Z.subs(S, 0) - DELTA
+        z_tip = sh.Z.subs(S, 0) + self.structure.pole_rise - DELTA
         lt_f, phiS_f, ls_f, ks_f, rQ_f, z_f = yf
         common = [
             J.let("res_r", lt_f - oc["lambda_theta"]),
@@ -438,7 +499,7 @@ class Derivation:
         self.point_load = P
         self.point_load_res = [
             P.let("res_iso", lt - ls),
-            P.let("res_zpole", z - (self.structure.shell.Z.subs(S, 0) - DELTA)),
+            P.let("res_zpole", z - (self.structure.shell.Z.subs(S, 0) + self.structure.pole_rise - DELTA)),
             P.let("res_rot", phiS - o["psi"] * (ks - g_ks)),
         ]
 
@@ -467,6 +528,7 @@ class Derivation:
         self.reference_shell = {
             "R": G.let("ref_R", sh.R), "Z": G.let("ref_Z", sh.Z), "Phi": G.let("ref_Phi", sp.atan2(dZ, dR)),
             "kappa_s": G.let("ref_ks", k_s), "kappa_theta": G.let("ref_kt", k_t),
+            "volume_density": G.let("ref_vol", -sp.pi * sh.R**2 * dZ),
         }
         self.tip_shape = {"A": G.let("tip_A", tip.A), "B": G.let("tip_B", tip.B),
                           "phi": G.let("tip_phi", tip.phi), "dA": G.let("tip_dA", sp.diff(tip.A, OMEGA))}

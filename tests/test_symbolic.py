@@ -267,6 +267,11 @@ def test_specialisation_leaves_out_unneeded_terms():
     text_nh = open(SCENES["neo-hookean"].model().__file__).read()
     assert "alpha" not in text_nh and "alpha" in text1
     assert SCENES["neo-hookean"].model().PARAMS == ("beta", "rho", "gamma")
+    # the pressure's terms only where there is a pressure
+    assert "pressure" not in text1 and "pole_rise" not in text1
+    inflated = SCENES["base"].replace(pressure=0.1).model()
+    assert inflated.PARAMS[:4] == ("beta", "rho", "pressure", "pole_rise")
+    assert re.search(r"^\s*dQ = .*pressure", open(inflated.__file__).read(), re.M)
 
 
 def test_regeneration_is_byte_identical():

@@ -1,0 +1,167 @@
+"""The shell under pressure before the indenter touches it: the start of a pressurised curve.
+
+A pressure ``p`` below the shell (``Scene.pressure``; > 0 pushes it towards the indenter)
+deforms it before any contact.  That state is itself a boundary-value problem, the
+chain ``inflated``: one free region from a regular pole (``FreePole``: isotropic
+stretch, ``phi/S = psi kappa_s``, and no axial force, ``F(S) = 0``) to the rim.
+
+What is held at the rim (the paper's remark on ``lambda_theta(L)``, its section on
+boundary conditions and its conclusion): the rim stays simply supported at its reference
+radius and height, ``lambda_theta(L) = 1``, ``z(L) = 0``, ``M_s(L) = 0``, as without
+pressure.  So the rim ring takes the pressure's reaction (a seed slotted in a hole, a
+patch of membrane clamped on a ring, a cell held by a pipette's rim); a pre-stretched
+rim, ``lambda_theta(L) = lambda_p > 1``, is not offered.  Consequently the inflated shape
+has a boundary layer at the rim where the hoop stretch returns to 1.
+
+The inflated pole rises by ``pole_rise`` above ``Z(0)``; delta is measured from there
+(the generated code's ``z_tip = Z(0) + pole_rise - delta``), so every curve starts at
+delta = 0 from the inflated shape, which is also what the crude guesses start from.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+
+import numpy as np
+
+from .chain import Chain, ChainBVP, FreePole, Point, Region, Rim
+from .diagnosis import diagnose
+from .solution import attach_tip_table, solve_bvp
+
+__all__ = ["inflate", "inflated_chain", "inflated_pole_rise", "start_shape"]
+
+#: Pole start of the inflated state, ``zeta = EPS * L`` (the free pole's truncation error
+#: is O(zeta^2): 1e-8 relative, below the inflation's tolerance).
+EPS = 1e-4
+#: Tolerance of the inflated state: it fixes the origin of delta for every point of a curve.
+TOL = 1e-8
+_MAX_NODES = 50000
+
+
+def inflated_chain(L: float) -> Chain:
+    """One free region on ``[EPS L, L]``: a regular free pole and the rim."""
+    ln_L = math.log(L)
+    return Chain("inflated", (Region("free", Point("zeta", None, ln_L + math.log(EPS)), Point("L", None, ln_L)),),
+                 (FreePole(0), Rim(0)), (), EPS)
+
+
+def _reference_states(sysm, S):
+    """The unstressed reference shell in the free region's states (lt, phiS, ls, ks, rQ, z)."""
+    ref = sysm.model.reference_shell(S, sysm.par)
+    one = np.ones_like(S)
+    return np.vstack([one, ref["Phi"] / S, one, ref["kappa_s"] * one, 0 * S, ref["Z"] * one])
+
+
+def _system(scene, pressure):
+    """The inflated chain of ``scene`` at ``pressure`` (a step of the continuation)."""
+    scene = scene.replace(pressure=pressure)
+    mod = scene.model()
+    sysm = ChainBVP(scene, inflated_chain(scene.shell_length), "delta", 0.0, model=mod,
+                    par=scene.parameters(mod, pole_rise=0.0))
+    attach_tip_table(sysm)
+    return sysm
+
+
+def _solve(sysm, x, y, tol, max_nodes):
+    with np.errstate(all="ignore"):
+        bvp = solve_bvp(sysm.fun, sysm.bc, x, y, None, fun_jac=sysm.fun_jac, bc_jac=sysm.bc_jac,
+                        tol=tol, bc_tol=1e-10, max_nodes=max_nodes)
+        return diagnose(sysm, bvp, tol)
+
+
+@functools.lru_cache(maxsize=64)
+def inflate(scene, tol: float = TOL, max_nodes: int = _MAX_NODES):
+    """The scene's shell under its pressure, held at the rim, before the indenter touches it.
+
+    Solved by continuation in the pressure from the unstressed shell (steps that halve
+    where Newton fails).  Cached per scene.
+
+    Parameters
+    ----------
+    scene : Scene
+        ``scene.pressure`` may be 0 (then the state is the reference shell).
+    tol, max_nodes : float, int
+        solve_bvp's settings.
+
+    Returns
+    -------
+    Solution
+        Topology ``"inflated"``; ``pole_rise`` (the pole's height above ``Z(0)``),
+        ``pole_stretch``, ``volume_change`` (``V - V_ref``, V the volume between the shell
+        and its rim's plane), ``rim_hoop_tension`` and the usual fields (``force`` is 0 to
+        tolerance: no indenter).  ``success`` False with a message if the continuation
+        stalled.
+
+    Examples
+    --------
+    >>> import shellbvp as sb
+    >>> state = sb.inflate(sb.Scene.preset("dome", pressure=0.05))
+    >>> state.success, round(state.pole_rise, 4)
+    (True, 0.0057)
+    """
+    target = float(scene.pressure)
+    sysm = _system(scene, 0.0)
+    x = np.linspace(0.0, 1.0, 81)
+    y = _reference_states(sysm, sysm.S(0, x, None))
+    if target == 0.0:
+        res = _solve(sysm, x, y, tol, max_nodes)
+        return _finish(res, sysm)
+    done, step, res = 0.0, target, None
+    while done != target:
+        p_next = target if abs(target - done) <= abs(step) else done + step
+        sysm = _system(scene, p_next)
+        nxt = _solve(sysm, x, y, tol, max_nodes)
+        if nxt.success:
+            res, done = nxt, p_next
+            x, y = nxt.x, nxt.y
+            step *= 1.5
+        else:
+            step /= 2
+            if abs(step) < 1e-6 * max(1.0, abs(target)):
+                out = nxt if res is None else res
+                out.success, out.status = False, 5
+                out.message = (f"the inflated state was not reached: continuation in the pressure stalled at "
+                               f"p = {done:.4g} of {target:.4g} ({nxt.message})")
+                return _finish(out, sysm, failed=True)
+    return _finish(res, sysm)
+
+
+def _finish(res, sysm, failed=False):
+    res.topology = "inflated"
+    nan = float("nan")
+    if failed or not res.success:
+        res.update(pole_rise=nan, pole_stretch=nan, volume_change=nan, rim_hoop_tension=nan)
+        return res
+    zeta = sysm.S_point(sysm.regions[0].start, None)
+    lt, phiS, ls, ks, rQ, z = res.y[:, 0]
+    Z0 = float(sysm.model.reference_shell(0.0, sysm.par)["Z"])
+    # z(zeta) - z(0) = Int_0^zeta psi sin(phi) dS ~ psi phiS zeta^2/2 (phi ~ phiS S near the pole)
+    res.pole_rise = float(z - ls * sysm.model.reference_shell(zeta, sysm.par)["R"] / zeta * phiS * zeta**2 / 2) - Z0
+    res.pole_stretch = float(ls)
+    res.volume_change = sysm.volume(res.sol, res.x, None) - sysm.scene.reference_volume()
+    rim = sysm.model.free_profile(np.array([sysm.L]), res.y[:, -1:], sysm.par)
+    res.rim_hoop_tension = float(rim["tau_theta"][0])
+    return res
+
+
+def inflated_pole_rise(scene) -> float:
+    """``inflate(scene).pole_rise``, or a ValueError if the inflated state was not found."""
+    state = inflate(scene)
+    if not state.success:
+        raise ValueError(f"pressure = {scene.pressure:g}: {state.message}")
+    return state.pole_rise
+
+
+def start_shape(scene, S):
+    """The shell before indentation at ``S`` as free-region states ``(lt, phiS, ls, ks, rQ, z)``:
+    the reference shell, or the inflated state under pressure (guesses start from it)."""
+    S = np.asarray(S, float)
+    if not scene.pressure:
+        return _reference_states(_system(scene, 0.0), S)
+    state = inflate(scene)
+    if not state.success:
+        raise ValueError(f"pressure = {scene.pressure:g}: {state.message}")
+    sysm = state.system
+    t = np.clip(sysm.t_of(0, np.maximum(S, sysm.S_point(sysm.regions[0].start, None)), None), 0.0, 1.0)
+    return state.sol(t)

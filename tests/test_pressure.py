@@ -1,0 +1,107 @@
+"""Pressurised shells (issue 17): the pressure's load and potential, the inflated state,
+the energy identity with the pressure's work, and p = 0 as before."""
+
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+import sympy as sp
+
+import shellbvp as sb
+from shellbvp.inflation import inflate, start_shape
+
+DATA = Path(__file__).parent / "data"
+
+
+def test_pressure_load_is_the_variation_of_the_volume():
+    """The derived normal load is a uniform -p along the contact pressure's normal, and the
+    volume density integrates to the volume under a spherical cap (V = pi h^2 (3a - h)/3)."""
+    from symbolic.equations import PRESSURE, PRESSURE_LOAD, volume_density
+
+    assert PRESSURE_LOAD == -PRESSURE
+    S = sp.Symbol("S")
+    a, L = sp.Rational(3, 2), sp.pi / 5  # a dome of radius a, r = a sin(S/a), z = a cos(S/a)
+    r, z = a * sp.sin(S / a), a * sp.cos(S / a)
+    psi = sp.sqrt(sp.diff(r, S) ** 2 + sp.diff(z, S) ** 2)
+    phi = sp.atan2(sp.diff(z, S), sp.diff(r, S))
+    V = sp.integrate(sp.simplify(volume_density(r, phi, psi)), (S, 0, L))
+    h = a - a * sp.cos(L / a)  # V: the spherical cap above the rim's plane
+    assert float(V) == pytest.approx(float(sp.pi * h**2 * (3 * a - h) / 3), rel=1e-12)
+
+
+def test_zero_pressure_reproduces_the_results_from_before_pressure():
+    """Values computed at commit 2043332, before the pressure existed: identical to 1e-12."""
+    ref = json.loads((DATA / "pressure_zero_reference.json").read_text())["states"]
+    scenes = {"base": sb.Scene.preset("base"), "dome": sb.Scene.preset("dome", pressure=0.0)}
+    for name, want in ref.items():
+        scene, delta = scenes[name.split()[0]], float(name.split()[-1])
+        s = sb.solve(scene, delta=delta, tol=1e-8, estimate_error=False)
+        assert s.topology == want["topology"]
+        for key in ("force", "energy", "lambda0", "Sc"):
+            if math.isnan(want[key]):
+                assert math.isnan(s[key])
+            else:
+                assert s[key] == pytest.approx(want[key], rel=1e-12, abs=1e-300), (name, key)
+
+
+def test_pressure_is_validated_and_kept_in_files():
+    with pytest.raises(ValueError, match="pressure must be finite"):
+        sb.Scene(pressure=float("inf"))
+    with pytest.raises(ValueError, match="pressure must be a real number"):
+        sb.Scene(pressure="1")
+    assert "pressure" not in sb.Scene().to_dict()  # files of unpressurised scenes as before
+    scene = sb.Scene.preset("dome", pressure=0.05)
+    assert sb.Scene.from_dict(json.loads(scene.to_json())) == scene
+
+
+def test_inflated_hemisphere_obeys_laplace_at_the_pole():
+    """Small pressure, thin shell: at the pole the membrane tension is p/(2 kappa) with the
+    deformed curvature (Laplace), and p R/2 (R = 1) to O(p); the stretch follows the
+    small-strain equibiaxial law tau = 6 (lambda - 1) (incompressible, mu = 1)."""
+    p = 1e-3
+    state = inflate(sb.Scene.preset("dome", beta=1e-5, pressure=p))
+    assert state.success, state.message
+    prof = state.profile()
+    i = 0  # the pole's end of the free region
+    tau, kappa = prof["tau_s"][i], -prof["kappa_s"][i]
+    assert prof["tau_theta"][i] == pytest.approx(tau, rel=1e-4)
+    assert tau == pytest.approx(p / (2 * kappa), rel=1e-8)  # measured 8e-12
+    assert tau == pytest.approx(p / 2, rel=1e-3)  # measured 8e-5 = O(p)
+    assert state.pole_stretch - 1 == pytest.approx(tau / 6, rel=2e-3)  # measured 3e-4
+    assert abs(state.force) < 1e-8 and state.force_defect < 1e-8
+    assert state.volume_change > 0 and state.pole_rise > 0
+
+
+def test_negative_pressure_deflates_and_zero_pressure_is_the_reference():
+    scene = sb.Scene.preset("dome")
+    flat = inflate(scene)
+    assert flat.success and abs(flat.pole_rise) < 1e-10 and abs(flat.volume_change) < 1e-8
+    down = inflate(scene.replace(pressure=-0.02))
+    assert down.success and down.pole_rise < 0 and down.volume_change < 0
+    S = np.linspace(0.01, scene.shell_length, 7)
+    np.testing.assert_allclose(start_shape(scene, S)[5], -scene.gamma * np.cos(S), atol=1e-12)
+    assert scene.reference_volume() == pytest.approx(2 * math.pi / 3, rel=1e-10)  # the hemisphere
+
+
+@pytest.mark.parametrize("delta", [0.1, 0.25])
+def test_energy_identity_with_the_pressure_work(delta):
+    """F = d(E_elastic - p V)/d delta, E from the profiles, F from the axial force (with p r^2/2)."""
+    scene = sb.Scene.preset("dome", pressure=0.1)
+    h = 1e-4
+    sols = [sb.solve(scene, delta=d, tol=1e-9, estimate_error=False) for d in (delta - h, delta, delta + h)]
+    assert all(s.success for s in sols)
+    dE = (sols[2].energy - sols[0].energy) / (2 * h)
+    assert sols[1].force == pytest.approx(dE, rel=2e-6)
+    # without the pressure's work the identity fails by p dV/d delta: the term is not negligible
+    assert sols[1].force_defect < 1e-7
+
+
+def test_pressure_stiffens_the_dome_and_the_curve_starts_at_the_inflated_pole():
+    plain = sb.solve(sb.Scene.preset("dome"), delta=0.1, estimate_error=False)
+    inflated = sb.solve(sb.Scene.preset("dome", pressure=0.1), delta=0.1, estimate_error=False)
+    assert plain.success and inflated.success and inflated.force > 1.03 * plain.force
+    rise = inflate(sb.Scene.preset("dome", pressure=0.1)).pole_rise
+    prof = inflated.profile()
+    assert prof["z"][0] == pytest.approx(1.0 + rise - 0.1, abs=1e-6)  # Z(0) = 1 for the dome
