@@ -152,6 +152,10 @@ def _nondimensional_pressure(args):
 
     if not isinstance(args.pressure, Quantity):
         return args.pressure
+    if args.command == "fit":
+        raise ValueError(f"fit: --pressure {args.pressure} has a unit, but the fit estimates mu*H, which makes it "
+                         f"nondimensional: give the start as p R_L/(mu H) (with --fit-pressure the fit reports "
+                         f"the pressure in Pa)")
     radius, mu_h = getattr(args, "radius", None), getattr(args, "mu_h", None)
     if radius is None or mu_h is None:
         raise ValueError(f"--pressure {args.pressure} has a unit: it needs --radius and --muH (the nondimensional "
@@ -368,8 +372,8 @@ def _fit_inputs(args):
         raise ValueError(f"--columns must name two columns (displacement, force) or three (and time); "
                          f"got {args.columns!r}")
     options = {"fit_offset": not args.no_offset, "fit_beta": args.fit_beta, "fit_alpha": args.fit_alpha,
-               "weights": args.weights, "tol": args.tol}
-    for name, text in (("beta", args.beta_range), ("alpha", args.alpha_range)):
+               "fit_pressure": args.fit_pressure, "weights": args.weights, "tol": args.tol}
+    for name, text in (("beta", args.beta_range), ("alpha", args.alpha_range), ("pressure", args.pressure_range)):
         if text is not None:
             parts = text.split(",")
             try:
@@ -378,7 +382,7 @@ def _fit_inputs(args):
                 raise ValueError(f"--{name}-range must be two numbers LOW,HIGH; got {text!r}") from None
             if len(parts) != 2:
                 raise ValueError(f"--{name}-range must be two numbers LOW,HIGH; got {text!r}")
-            if not (args.fit_beta if name == "beta" else args.fit_alpha):
+            if not getattr(args, f"fit_{name}"):
                 raise ValueError(f"--{name}-range needs --fit-{name}")
     return scene, args.radius.si, {"columns": columns, "units": units}, options
 
@@ -572,11 +576,16 @@ def _print_fit(res, record, used, args):
     if res.baseline_model == "linear":
         s1, s2 = res.baseline_slope_ci95
         print(f"baseline slope = {res.baseline_slope:.4g} N/m   95% CI [{s1:.4g}, {s2:.4g}]")
-    for name in ("beta", "alpha"):
+    for name in ("beta", "alpha", "pressure"):
         if name in res.fitted:
             v, (c1, c2) = getattr(res, name), getattr(res, name + "_ci95")
             print(f"{name:<6s} = {v:.4g}   95% CI [{c1:.4g}, {c2:.4g}] (profile likelihood; "
-                  f"{res.curves_computed} model curves)")
+                  f"{res.curves_computed} model curves)" + ("; nondimensional p R_L/(mu H)" if name == "pressure"
+                                                            else ""))
+    if "pressure" in res.fitted:
+        (c1, c2) = res.pressure_Pa_ci95
+        print(f"p      = {res.pressure_Pa / 1e3:.4g} kPa   95% CI [{c1 / 1e3:.4g}, {c2 / 1e3:.4g}] "
+              f"(p mu_H/R_L; linearised)")
     print(f"rms residual = {format_in(res.residual_rms, fu, 'force')} over {res.n} points; R_L = "
           f"{args.radius}; {res.weights} weights")
     for text in res.warnings:
@@ -884,6 +893,12 @@ def build_parser():
                    help="also fit the Mooney-Rivlin alpha (starting from the scene's)")
     f.add_argument("--beta-range", dest="beta_range", help="search range of --fit-beta, LOW,HIGH (default 1e-4,1)")
     f.add_argument("--alpha-range", dest="alpha_range", help="search range of --fit-alpha, LOW,HIGH (default 0,1)")
+    f.add_argument("--fit-pressure", action="store_true", dest="fit_pressure",
+                   help="also fit the pressure below the shell (turgor, inflation): mu*H and the pressure in Pa "
+                        "from one curve; --pressure (nondimensional p R_L/(mu H)) is the start")
+    f.add_argument("--pressure-range", dest="pressure_range",
+                   help="search range of --fit-pressure, nondimensional LOW,HIGH (default 0 to the larger of 4x "
+                        "the start and 40 sqrt(3 beta))")
     f.add_argument("--weights", choices=("uniform", "relative", "mixed"),
                    help="noise model: uniform (same force noise everywhere), relative (noise proportional "
                         "to the force) or mixed (both, estimated; the default)")

@@ -37,6 +37,7 @@ from __future__ import annotations
 
 import datetime as _dt
 import json
+import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -53,7 +54,10 @@ FIT_FORMAT = "shellbvp-fit"
 FIT_FORMAT_VERSION = 1
 #: Units of the scalar parameters in ``/fit/parameters``.
 PARAMETER_UNITS = {"mu_H": "N/m", "offset": "m", "baseline": "N", "baseline_slope": "N/m", "beta": DIMENSIONLESS,
-                   "alpha": DIMENSIONLESS, "R_L": "m", "residual_rms": "N", "n_points": DIMENSIONLESS}
+                   "alpha": DIMENSIONLESS, "R_L": "m", "residual_rms": "N", "n_points": DIMENSIONLESS,
+                   "pressure": DIMENSIONLESS, "pressure_Pa": "Pa"}
+#: Parameters that files written before they existed lack (read as NaN).
+_NEWER_PARAMETERS = ("pressure", "pressure_Pa")
 
 
 @dataclass
@@ -174,7 +178,9 @@ def write_fit(path, result, record, used, *, segment="loading", overwrite=False)
             values = {"mu_H": result.mu_H, "offset": result.offset, "baseline": result.baseline,
                       "baseline_slope": result.baseline_slope, "beta": result.beta,
                       "alpha": np.nan if result.alpha is None else result.alpha, "R_L": result.R_L,
-                      "residual_rms": result.residual_rms, "n_points": result.n}
+                      "residual_rms": result.residual_rms, "n_points": result.n,
+                      "pressure": result.pressure if result.pressure is not None else np.nan,
+                      "pressure_Pa": np.nan if result.pressure_Pa is None else result.pressure_Pa}
             for name, v in values.items():
                 number_dataset(p, name, float(v), PARAMETER_UNITS[name])
             for name in result.fitted:
@@ -200,7 +206,7 @@ def write_fit(path, result, record, used, *, segment="loading", overwrite=False)
 def _interval(result, name):
     return {"mu_H": result.mu_H_ci95, "offset": result.offset_ci95, "baseline": result.baseline_ci95,
             "baseline_slope": result.baseline_slope_ci95, "beta": result.beta_ci95,
-            "alpha": result.alpha_ci95}[name]
+            "alpha": result.alpha_ci95, "pressure": result.pressure_ci95}[name]
 
 
 def is_fit_file(path) -> bool:
@@ -273,7 +279,8 @@ def read_fit(path) -> FitRecord:
                     raise ValueError(f"data/{k} must be a 1-D array of {n} values")
             model = {k: np.asarray(v[()], float) for k, v in e["model"].items()}
             p = e["parameters"]
-            params = {k: float(p[k][()]) for k in PARAMETER_UNITS}
+            params = {k: float(p[k][()]) if k in p or k not in _NEWER_PARAMETERS else math.nan
+                      for k in PARAMETER_UNITS}
             fitted = [_text(s) for s in p.attrs["fitted"]]
             intervals = {k: tuple(float(x) for x in p[f"{k}_ci95"][()]) for k in fitted}
             settings = {k: _text(p.attrs[k]) for k in ("baseline_model", "weights", "segment")}

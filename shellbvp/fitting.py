@@ -119,8 +119,15 @@ class FitResult:
     beta_ci95, alpha_ci95 : (float, float) or None
         Profile-likelihood 95 % intervals (None when not fitted).  A side that
         reached the search bound is the bound (see ``message``).
+    pressure, pressure_ci95 : float, (float, float) or None
+        The pressure below the shell, nondimensional ``p R_L/(mu H)`` (the scene's unless
+        fitted) and, when fitted, its profile-likelihood 95 % interval.
+    pressure_Pa, pressure_Pa_ci95 : float, (float, float) or None
+        The same in pascals, ``p mu_H/R_L`` with the fitted mu*H, and its 95 % interval
+        (linearised: the covariance of mu*H and p, Student's t); None unless the pressure
+        was fitted.
     fitted : tuple of str
-        The fitted parameters ("mu_H", "offset", "beta" | "alpha").
+        The fitted parameters ("mu_H", "offset", "beta" | "alpha" | "pressure").
     weights : str
         The noise model, "uniform", "relative" or "mixed".
     residual_rms : float
@@ -192,6 +199,10 @@ class FitResult:
     beta_ci95: tuple = None
     alpha: float = None
     alpha_ci95: tuple = None
+    pressure: float = 0.0
+    pressure_ci95: tuple = None
+    pressure_Pa: float = None
+    pressure_Pa_ci95: tuple = None
     fitted: tuple = ("mu_H", "offset")
     weights: str = DEFAULT_WEIGHTS
     scene: object = field(repr=False, default=None)
@@ -223,7 +234,9 @@ class FitResult:
         ci = (lambda v: None if v is None else [num(x) for x in v])
         return {"mu_H": num(self.mu_H), "mu_H_ci95": ci(self.mu_H_ci95), "offset": num(self.offset),
                 "offset_ci95": ci(self.offset_ci95), "beta": num(self.beta), "beta_ci95": ci(self.beta_ci95),
-                "alpha": num(self.alpha), "alpha_ci95": ci(self.alpha_ci95), "fitted": list(self.fitted),
+                "alpha": num(self.alpha), "alpha_ci95": ci(self.alpha_ci95), "pressure": num(self.pressure),
+                "pressure_ci95": ci(self.pressure_ci95), "pressure_Pa": num(self.pressure_Pa),
+                "pressure_Pa_ci95": ci(self.pressure_Pa_ci95), "fitted": list(self.fitted),
                 "weights": self.weights, "residual": num(self.residual_rms), "residual_rms": num(self.residual_rms),
                 "n": self.n, "success": self.success, "status": self.status, "message": self.message,
                 "warnings": list(self.warnings), "warning_codes": list(self.warning_codes), "R_L": self.R_L,
@@ -233,6 +246,7 @@ class FitResult:
                 "baseline_slope_ci95": ci(self.baseline_slope_ci95),
                 "units": {"mu_H": "N/m (= um*MPa)", "offset": "m", "residual": "N (rms)",
                           "residual_rms": "N", "R_L": "m", "beta": "1 (B/(mu R_L^2))", "alpha": "1",
+                          "pressure": "1 (p R_L/(mu H))", "pressure_Pa": "Pa",
                           "baseline": "N", "baseline_slope": "N/m"}}
 
 
@@ -583,7 +597,8 @@ def _check_bounds(name, bounds, lo_ok, hi_ok, value):
 
 def fit(scene, displacement, force, *, R_L, fit_offset=True, fit_beta=False, fit_alpha=False,
         weights=None, floor=0.05, beta_bounds=BETA_BOUNDS, alpha_bounds=ALPHA_BOUNDS, delta_max=None,
-        tol=1e-6, loss="linear", baseline="none", contact_guess=None, progress=None):
+        tol=1e-6, loss="linear", baseline="none", contact_guess=None, progress=None, fit_pressure=False,
+        pressure_bounds=None):
     """Least-squares fit of mu*H (the displacement origin, and beta or alpha) to measured data.
 
     Parameters
@@ -610,9 +625,13 @@ def fit(scene, displacement, force, *, R_L, fit_offset=True, fit_beta=False, fit
     progress : callable, optional
         ``progress(description, delta_max) -> (bar, callback)`` for each model curve computed
         (e.g. ``lambda d, m: shellbvp.progress.curve_progress(m, d)``); None: silent.
-    fit_beta, fit_alpha : bool
-        Also fit beta (within ``beta_bounds``) or the Mooney–Rivlin alpha
-        (within ``alpha_bounds``, subset of [0, 1]); one of them at most.
+    fit_beta, fit_alpha, fit_pressure : bool
+        Also fit beta (within ``beta_bounds``), the Mooney–Rivlin alpha (within
+        ``alpha_bounds``, subset of [0, 1]) or the pressure below the shell (nondimensional
+        ``p R_L/(mu H)``, within ``pressure_bounds``, default from 0 to the larger of 4 times
+        the scene's and ``40 sqrt(3 beta)``, i.e. Vella's ``tau = p R^2/(4 sqrt(B Y))`` up to 10
+        for a pole of unit curvature); one of them at most.  With the pressure fitted, one
+        curve gives mu*H and the pressure in Pa (Vella et al. 2012's assay, with the full model).
     weights : {"uniform", "relative", "mixed"}, optional
         Noise model: the same force noise at every point, noise proportional
         to the force, or both (``sigma^2 = a^2 + b^2 F^2``, a and b estimated);
@@ -674,9 +693,9 @@ def fit(scene, displacement, force, *, R_L, fit_offset=True, fit_beta=False, fit
         raise ValueError(f"weights must be one of {WEIGHTS}; got {weights!r}")
     if not (isinstance(floor, (int, float)) and 0 < floor <= 1):
         raise ValueError(f"floor (of relative weights, fraction of max |force|) must be in (0, 1]; got {floor!r}")
-    if fit_beta and fit_alpha:
-        raise ValueError("fit_beta and fit_alpha: fit one of beta, alpha at a time (each changes the curve's "
-                         "shape only weakly; together with mu*H they are not identifiable from one curve)")
+    if int(bool(fit_beta)) + int(bool(fit_alpha)) + int(bool(fit_pressure)) > 1:
+        raise ValueError("fit_beta, fit_alpha and fit_pressure: fit one of beta, alpha, pressure at a time (each "
+                         "changes the curve's shape only weakly; two with mu*H are not identifiable from one curve)")
     if baseline not in BASELINES:
         raise ValueError(f"baseline must be one of {BASELINES}; got {baseline!r}")
     origin = 0.0 if contact_guess is None else contact_guess
@@ -685,7 +704,8 @@ def fit(scene, displacement, force, *, R_L, fit_offset=True, fit_beta=False, fit
     d = np.asarray(displacement, float).ravel()
     f = np.asarray(force, float).ravel()
     keep = np.isfinite(d) & np.isfinite(f) if d.shape == f.shape else None
-    k = 1 + bool(fit_offset) + bool(fit_beta or fit_alpha) + (baseline != "none") + (baseline == "linear")
+    k = 1 + bool(fit_offset) + bool(fit_beta or fit_alpha or fit_pressure) + (baseline != "none") \
+        + (baseline == "linear")
     d, f = _check_data(d, f, k, float(origin))
     if not (isinstance(R_L, (int, float)) and math.isfinite(R_L) and R_L > 0):
         raise ValueError(f"R_L (rim radius, m) must be a finite number > 0; got {R_L!r}")
@@ -702,6 +722,14 @@ def fit(scene, displacement, force, *, R_L, fit_offset=True, fit_beta=False, fit
                                               scene.material.alpha)
         step, theta0 = 0.2, float(scene.material.alpha)
         scene_at = (lambda th: scene.replace(material=MooneyRivlin(float(min(max(th, 0.0), 1.0)))))
+    elif fit_pressure:
+        scale = 4 * math.sqrt(3 * scene.beta)  # tau = 1 at a pole of unit curvature
+        p0 = float(scene.pressure)
+        default = (0.0, max(4 * abs(p0), 10 * scale))
+        name, bounds = "pressure", _check_bounds("pressure", default if pressure_bounds is None else pressure_bounds,
+                                                 lambda v: True, lambda v: True, p0)
+        step, theta0 = max(0.25 * abs(p0), 0.5 * scale), p0
+        scene_at = (lambda th: scene.replace(pressure=float(th)))
     else:
         name = None
     depth = (np.max(d) - origin) / R_L  # the deepest datum's delta, if the contact is at the guess
@@ -867,6 +895,7 @@ def fit(scene, displacement, force, *, R_L, fit_offset=True, fit_beta=False, fit
     # intervals of the free parameters (Wald, t), from the weighted Jacobian
     n = d.size
     dof = max(n - k, 1)
+    cov = None
     try:
         cov = np.linalg.inv(J.T @ J) * rss / dof
         half_free = stats.t.ppf(0.975, dof) * np.sqrt(np.diag(cov))
@@ -896,6 +925,11 @@ def fit(scene, displacement, force, *, R_L, fit_offset=True, fit_beta=False, fit
     elif name == "alpha":
         alpha = float(theta_hat)
         alpha_ci = tuple(float(v) for v in theta_ci)
+    pressure, pressure_ci, pressure_Pa, pressure_Pa_ci = float(fit_scene.pressure), None, None, None
+    if name == "pressure":
+        pressure, pressure_ci = float(theta_hat), tuple(float(v) for v in theta_ci)
+        pressure_Pa, pressure_Pa_ci = _pressure_in_pascals(pressure, q[0], R_L, cov,
+                                                           stats.t.ppf(0.975, dof))
     mu_ci = ci[0]
     status, checks = _check_result(bool(res.success), mu_H, mu_ci, off_ci, bool(np.all(np.isfinite(resid))), d,
                                    resid)
@@ -909,11 +943,24 @@ def fit(scene, displacement, force, *, R_L, fit_offset=True, fit_beta=False, fit
                      offset_ci95=off_ci, residual_rms=float(np.sqrt(np.mean(np.nan_to_num(resid, nan=mdl.big) ** 2))),
                      n=n, status=status, message=message, R_L=float(R_L), curve=c, _model=model,
                      beta=beta, beta_ci95=beta_ci, alpha=alpha, alpha_ci95=alpha_ci, fitted=fitted,
+                     pressure=pressure, pressure_ci95=pressure_ci, pressure_Pa=pressure_Pa,
+                     pressure_Pa_ci95=pressure_Pa_ci,
                      weights=weights, scene=fit_scene, curves_computed=counter[0],
                      interpolation_error=interp_err, warnings=[t for _, t in found],
                      warning_codes=[code for code, _ in found], baseline_model=baseline, baseline=b0,
                      baseline_ci95=ci[2], baseline_slope=b1, baseline_slope_ci95=ci[3],
                      point_weights=point_weights)
+
+
+def _pressure_in_pascals(p, mu_H, R_L, cov, t):
+    """``p mu_H/R_L`` (Pa) and its interval from the covariance of (mu_H, ..., p) (p last)."""
+    value = p * mu_H / R_L
+    if cov is None or not np.all(np.isfinite(cov)):
+        return float(value), (math.nan, math.nan)
+    g = np.zeros(cov.shape[0])
+    g[0], g[-1] = p / R_L, mu_H / R_L
+    half = t * math.sqrt(max(float(g @ cov @ g), 0.0))
+    return float(value), (float(value - half), float(value + half))
 
 
 def _drop(pdt):

@@ -85,8 +85,7 @@ def test_negative_pressure_deflates_and_zero_pressure_is_the_reference():
     assert scene.reference_volume() == pytest.approx(2 * math.pi / 3, rel=1e-10)  # the hemisphere
 
 
-@pytest.mark.parametrize("delta", [0.1, 0.25])
-def test_energy_identity_with_the_pressure_work(delta):
+def test_energy_identity_with_the_pressure_work(delta=0.25):
     """F = d(E_elastic - p V)/d delta, E from the profiles, F from the axial force (with p r^2/2)."""
     scene = sb.Scene.preset("dome", pressure=0.1)
     h = 1e-4
@@ -94,7 +93,10 @@ def test_energy_identity_with_the_pressure_work(delta):
     assert all(s.success for s in sols)
     dE = (sols[2].energy - sols[0].energy) / (2 * h)
     assert sols[1].force == pytest.approx(dE, rel=2e-6)
-    # without the pressure's work the identity fails by p dV/d delta: the term is not negligible
+    # without the pressure's work the identity would fail by p dV/d delta: the term is not negligible
+    dV = (sols[2].system.volume(sols[2].sol, sols[2].x, sols[2].p)
+          - sols[0].system.volume(sols[0].sol, sols[0].x, sols[0].p)) / (2 * h)
+    assert abs(scene.pressure * dV) > 1e-2 * sols[1].force
     assert sols[1].force_defect < 1e-7
 
 
@@ -105,3 +107,50 @@ def test_pressure_stiffens_the_dome_and_the_curve_starts_at_the_inflated_pole():
     rise = inflate(sb.Scene.preset("dome", pressure=0.1)).pole_rise
     prof = inflated.profile()
     assert prof["z"][0] == pytest.approx(1.0 + rise - 0.1, abs=1e-6)  # Z(0) = 1 for the dome
+
+
+def test_fit_pressure_refuses_bad_combinations_before_any_curve():
+    scene = sb.Scene.preset("dome", pressure=0.1)
+    d, F = np.linspace(1e-5, 1e-4, 10), np.linspace(1e-4, 1e-3, 10)
+    with pytest.raises(ValueError, match="one of beta, alpha, pressure"):
+        sb.fit(scene, d, F, R_L=1e-3, fit_pressure=True, fit_beta=True)
+    with pytest.raises(ValueError, match="pressure"):
+        sb.fit(scene, d, F, R_L=1e-3, fit_pressure=True, pressure_bounds=(1.0, 0.5))
+
+
+@pytest.mark.slow
+def test_fit_pressure_recovers_mu_h_and_the_pressure():
+    """Synthetic data of a pressurised dome (beta 1e-3, p R_L/(mu H) = 0.3, i.e. tau = 1.4;
+    mu H = 50 N/m, R_L = 1 mm, 1 % noise): one curve gives both, each inside its interval.
+    Measured: mu*H 50.26 [49.25, 51.27], p 0.297 [0.287, 0.308], 14.9 kPa [14.7, 15.2] (true 15)."""
+    truth = sb.Scene(gamma=-1.0, rho=0.2, beta=1e-3, pressure=0.3)
+    R_L, mu_H = 1e-3, 50.0
+    c = sb.curve(truth, deltas=np.linspace(0.005, 0.2, 40), estimate_error=False)
+    rng = np.random.default_rng(1)
+    d = R_L * np.asarray(c.delta)
+    F = mu_H * R_L * np.asarray(c.force) * (1 + 0.01 * rng.standard_normal(len(c.delta)))
+    res = sb.fit(truth.replace(pressure=0.15), d, F, R_L=R_L, fit_pressure=True, fit_offset=False)
+    assert res.success, res.message
+    assert res.fitted == ("mu_H", "pressure")
+    assert res.mu_H_ci95[0] < mu_H < res.mu_H_ci95[1]
+    assert res.pressure_ci95[0] < 0.3 < res.pressure_ci95[1]
+    assert res.pressure_Pa_ci95[0] < 0.3 * mu_H / R_L < res.pressure_Pa_ci95[1]
+    assert res.pressure_ci95[1] - res.pressure_ci95[0] < 0.1  # determined, not just bracketed
+    assert res.scene.pressure == pytest.approx(res.pressure, abs=0.02)
+
+
+def test_cli_pressure_with_a_unit_needs_the_scales(tmp_path, capsys):
+    from shellbvp.cli import main
+
+    out = tmp_path / "dome.h5"
+    assert main(["curve", "--preset", "dome", "--pressure", "5kPa", "--radius", "1mm", "--muH", "50N/m",
+                 "--delta-max", "0.05", "-o", str(out), "-q"]) == 0
+    c = sb.read_curve(out)
+    assert c.scene.pressure == pytest.approx(0.1)  # 5 kPa x 1 mm / (50 N/m)
+    assert main(["curve", "--preset", "dome", "--pressure", "5kPa", "-o", str(tmp_path / "x.h5")]) == 2
+    assert "needs --radius and --muH" in capsys.readouterr().err
+    with pytest.raises(SystemExit) as exc:  # argparse: usage error
+        main(["curve", "--preset", "dome", "--pressure", "5 psi", "-o", str(tmp_path / "x.h5")])
+    assert exc.value.code == 2 and "unknown pressure unit 'psi'" in capsys.readouterr().err
+    assert main(["fit", "--example", "--preset", "dome", "--radius", "1mm", "--pressure", "5kPa"]) == 2
+    assert "the fit estimates mu*H" in capsys.readouterr().err
