@@ -790,7 +790,8 @@ def _cmd_info(args):
     mat = s.material
     print(f"file:      {args.file} (shellbvp {c.version})")
     print(f"scene:     gamma={s.gamma:g} rho={s.rho:g} beta={s.beta:g} xi={s.xi} contact={s.contact} "
-          f"material={mat!r} bending={s.bending!r} shell={s.shell!r} tip={s.tip!r}")
+          f"material={mat!r} bending={s.bending!r} shell={s.shell!r} tip={s.tip!r}"
+          + (f" pressure={s.pressure:g} (delta from the inflated pole)" if s.pressure else ""))
     print(f"curve:     {c.summary()}")
     print(f"complete:  {c.complete}  interrupted: {c.interrupted}")
     res = c.energy_residual
