@@ -154,3 +154,33 @@ def test_cli_pressure_with_a_unit_needs_the_scales(tmp_path, capsys):
     assert exc.value.code == 2 and "unknown pressure unit 'psi'" in capsys.readouterr().err
     assert main(["fit", "--example", "--preset", "dome", "--radius", "1mm", "--pressure", "5kPa"]) == 2
     assert "the fit estimates mu*H" in capsys.readouterr().err
+
+
+def _vella():
+    import importlib.util
+
+    path = Path(__file__).resolve().parent.parent / "benchmarks" / "vella.py"
+    spec = importlib.util.spec_from_file_location("_bench_vella", path)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod
+
+
+def test_vella_formula_limits():
+    v = _vella().vella_factor
+    assert v(0.0) == 1.0 and v(1e-6) == pytest.approx(1.0, rel=1e-5)  # Reissner
+    assert v(1 - 1e-7) == pytest.approx(math.pi / 2, rel=1e-5) and v(1 + 1e-7) == pytest.approx(math.pi / 2, rel=1e-5)
+    tau = 1e6  # large tau: pi p R/ln(2 tau) = (8 sqrt(BY)/R) (pi/2) tau/ln(2 tau)
+    assert v(tau) == pytest.approx((math.pi / 2) * tau / math.log(2 * tau), rel=1e-5)
+
+
+def test_pressurised_dome_stiffness_follows_vella():
+    """Hemispherical dome, beta 1e-4 (bending length (beta/3)^(1/4) = 0.076 R), delta = 0.003 h:
+    F/delta against Vella et al. (2012).  Measured: 0.973 of the formula at tau = 0 (Reissner;
+    the finite bending length against R), 0.968 at tau = 3; the pressure's effect,
+    k(tau)/k(0), agrees with the formula's to 0.6 %.  (benchmarks/vella.py: the table.)"""
+    bench = _vella()
+    plain, pressed = bench.row(1e-4, 0.0, 0.003), bench.row(1e-4, 3.0, 0.003)
+    assert plain["success"] and pressed["success"]
+    assert 0.95 < plain["ratio"] < 1.0 and 0.95 < pressed["ratio"] < 1.0
+    assert pressed["k"] / plain["k"] == pytest.approx(bench.vella_factor(3.0), rel=0.01)
