@@ -13,14 +13,16 @@ stays the reference and the fallback: without numba nothing changes.
 The choice is the environment variable ``SHELLBVP_KERNELS``:
 
 ``auto`` (default)
-    numba's kernels when numba is installed, never waited for: the numpy
-    functions serve while the kernels are compiled in a background process
-    (once per structure, ~10 s on one core; it finishes even if this process
-    ends first, so the next run finds them) or loaded from the cache in a
-    background thread (~0.5 s), and the solver switches when they are ready.
-    A background *process*, not a thread: compiling is Python work that would
-    hold the interpreter lock and slow the solve it is meant to speed up
-    (benchmarks/results/kernels.md has the numbers).
+    numba's kernels when numba is installed, never waited for.  The numpy
+    functions serve, timed, until they have taken ``START_AFTER_S`` (0.5 s) in this
+    process, about what loading compiled kernels costs, so a single solve never pays
+    for them and a curve is repaid.  Then the kernels are loaded from the cache in a
+    background thread (~0.5 s) or, the first time for a structure, compiled in a
+    background process (once per structure, ~10 s on the other core; it finishes
+    even if this process ends first, so the next run finds them), and the solver
+    switches when they are ready.  A process, not a thread, compiles: compiling is
+    Python work that would hold the interpreter lock and slow the solve it is meant
+    to speed up (benchmarks/results/kernels.md has the numbers).
 ``numpy``
     never compile; the numpy functions only.
 ``numba``
@@ -61,6 +63,10 @@ CHOICES = ("auto", "numpy", "numba")
 #: What the compile log line announces (derivation if needed + numba compile; measured in
 #: benchmarks/results/kernels.md on the 2-core machine)
 COMPILE_ESTIMATE_S = 10
+#: auto starts the compiled kernels once the numpy ones have taken this long in this process:
+#: loading them costs about as much (numba's start-up and cache; benchmarks/results/kernels.md),
+#: so a single solve never pays it and a curve is repaid
+START_AFTER_S = 0.5
 _BUSY = 3  # exit status of the compile process when another process is compiling the same structure
 _LOCK_STALE_S = 1800.0  # a lock older than this is from a compile that died
 _WAIT_S = 1800.0  # how long a process waits for another one's compilation before giving up
@@ -230,8 +236,10 @@ class KernelSet:
     ``active`` has the numpy module's functions, and, once the compiled kernels are
     loaded, the compiled ones in place of those it has (same names, same values to
     rounding; they take 1-D ``S`` and 2-D ``y`` arrays of float64).  ``status`` says
-    which: ``numpy``, ``waiting`` (compiling or loading), ``numba``, or ``failed``
-    (numpy, with the reason logged).  ``settled`` is set once it is final.
+    which: ``numpy``; ``counting`` (auto: numpy, timing the hot calls until they have
+    taken ``START_AFTER_S``); ``waiting`` (compiling or loading in the background);
+    ``numba``; or ``failed`` (numpy, with the reason logged).  ``settled`` is set once
+    it is final.
     """
 
     def __init__(self, model, choice: str):
@@ -240,17 +248,23 @@ class KernelSet:
         self.choice = choice
         self.status = "numpy"
         self.reason = ""
+        self.numpy_seconds = 0.0  # time the hot numpy functions took while counting
         self.settled = threading.Event()
         self.pid = os.getpid()
+        self._structure = None
+        self._lock = threading.Lock()
 
     def __repr__(self):
         return f"KernelSet({self.numpy.KEY[:20]}, choice={self.choice!r}, status={self.status!r})"
 
-    def _use(self, mod):
+    def _namespace(self, replace: dict):
         names = {n: getattr(self.numpy, n) for n in dir(self.numpy) if not n.startswith("_")}
-        names.update({n: getattr(mod, n) for n in mod.KERNELS})
+        names.update(replace)
+        return types.SimpleNamespace(**names)  # assigned to ``active`` at once: a caller sees old or new
+
+    def _use(self, mod):
         self.compiled = mod
-        self.active = types.SimpleNamespace(**names)  # one assignment: the solver sees old or new
+        self.active = self._namespace({n: getattr(mod, n) for n in mod.KERNELS})
         self.status = "numba"
 
     def _fail(self, reason: str):
@@ -258,7 +272,7 @@ class KernelSet:
         log.warning("compiled kernels not used (%s); the numpy functions serve", reason)
 
     def start(self, structure):
-        """Settle the choice: at once (numpy, numba) or in the background (auto)."""
+        """Settle the choice: at once (numpy, numba) or after enough work, in the background (auto)."""
         if self.choice == "numpy":
             self.settled.set()
             return
@@ -272,8 +286,30 @@ class KernelSet:
             finally:
                 self.settled.set()
             return
-        self.status = "waiting"
-        threading.Thread(target=self._background, args=(structure,), daemon=True,
+        self._structure = structure
+        self.status = "counting"
+        self.active = self._namespace({n: self._timed(getattr(self.numpy, n)) for n in self.numpy.KERNELS})
+
+    def _timed(self, fn):
+        def timed(*args):
+            t0 = time.perf_counter()
+            try:
+                return fn(*args)
+            finally:
+                self._charge(time.perf_counter() - t0)
+        return timed
+
+    def _charge(self, seconds):
+        """Count time in the numpy kernels; past ``START_AFTER_S`` start the compiled ones."""
+        self.numpy_seconds += seconds
+        if self.numpy_seconds < START_AFTER_S or self.status != "counting":
+            return
+        with self._lock:
+            if self.status != "counting":
+                return
+            self.status = "waiting"
+            self.active = self.numpy  # stop counting
+        threading.Thread(target=self._background, daemon=True,
                          name=f"shellbvp-kernels-{self.numpy.KEY[:8]}").start()
 
     def _load(self, desc, foreground):
@@ -309,9 +345,9 @@ class KernelSet:
         log.info("compiled kernels %s loaded in %.2f s; the solver uses them from now on", src.name,
                  time.perf_counter() - t0)
 
-    def _background(self, structure):
+    def _background(self):
         try:
-            self._load(structure(), foreground=False)
+            self._load(self._structure(), foreground=False)
         except Exception as exc:  # numba missing, broken or incompatible; a failed compile
             self._fail(f"{type(exc).__name__}: {exc}")
         finally:

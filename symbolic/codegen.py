@@ -298,6 +298,7 @@ def module_source(d: Derivation, description: str, specs: list[FunctionSpec] | N
     shared with the compiled kernels' module).
     """
     key, comments = header("codegen.py", description)
+    specs = specs if specs is not None else function_specs(d)
     par = [p.name for p in d.params]
     head = [
         *comments,
@@ -309,7 +310,8 @@ def module_source(d: Derivation, description: str, specs: list[FunctionSpec] | N
         f"FREE_STATES = {FREE_STATES!r}",
         f"CONTACT_STATES = {CONTACT_STATES!r}",
         f"OMEGA_MAX = {float(d.structure.tip.omega_max)!r}" if d.has_cylinder else "OMEGA_MAX = None",
+        f"KERNELS = {tuple(s.name for s in specs if s.node_args)!r}  # also compiled: symbolic/codegen_numba.py",
         "",
     ]
-    body = [_function_source(s) for s in (specs if specs is not None else function_specs(d))]
+    body = [_function_source(s) for s in specs]
     return "\n".join(head) + "\n" + "\n\n".join(body)
