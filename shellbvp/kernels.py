@@ -95,7 +95,7 @@ def _marker(src: Path) -> Path:
 
 def _stamp(src: Path) -> dict:
     st = src.stat()
-    return {"numba": _numba_version(), "python": "%d.%d" % sys.version_info[:2],
+    return {"numba": _numba_version(), "python": "{}.{}".format(*sys.version_info[:2]),
             "source_mtime_ns": st.st_mtime_ns, "source_size": st.st_size}
 
 
