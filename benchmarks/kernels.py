@@ -256,7 +256,8 @@ def conditions_share(sb, np):
 # -- report ---------------------------------------------------------------------------------------------
 def markdown(data):
     m = data["meta"]
-    L = [f"Measured {m['date']} on {m['machine']} ({m['cpus']} cores, shared with other work), Python "
+    load = f", load average {m['load_average']:.1f} at the start" if m.get("load_average") is not None else ""
+    L = [f"Measured {m['date']} on {m['machine']} ({m['cpus']} cores, shared with other work{load}), Python "
          f"{m['python']}, NumPy {m['numpy']}, numba {m['numba']}; `python benchmarks/kernels.py"
          f"{' --quick' if m['quick'] else ''}`.  Absolute times on this machine are noisy; "
          "ratios come from runs interleaved in one process (medians).", ""]
@@ -328,7 +329,8 @@ def main(argv=None):
         print(f"warm-up (derive, compile) {time.perf_counter() - t0:.1f} s", flush=True)
         data = {"meta": dict(date=datetime.date.today().isoformat(), machine=platform.machine(), cpus=os.cpu_count(),
                              python=platform.python_version(), numpy=np.__version__, numba=numba.__version__,
-                             quick=args.quick, repeat=repeat)}
+                             quick=args.quick, repeat=repeat,
+                             load_average=os.getloadavg()[0] if hasattr(os, "getloadavg") else None)}
         data["per_call"] = per_call(sb, sk, np)
         print("per call done", flush=True)
         data["per_curve"] = per_curve(sb, sk, np, repeat, curves)
