@@ -38,7 +38,6 @@ __all__ = ["cache_dir", "structure_description", "description_key", "load_module
 
 log = logging.getLogger(__name__)
 _loaded: dict[str, object] = {}
-_dirs: dict[str, Path] = {}  # key -> the (trusted) directory its module was loaded from
 _private: Path | None = None  # this process's own cache when the shared one is not to be trusted
 
 
@@ -156,15 +155,13 @@ def load_module(desc: dict, *, regenerate: bool = False):
             write_atomic(kpath, kernel_src)
         mod = _import_file(path, key)
     _loaded[key] = mod
-    _dirs[key] = path.parent
     return mod
 
 
 def kernel_path(desc: dict) -> Path:
     """Where the kernels module of a structure lies (beside its numpy module; not generated here)."""
-    key = description_key(desc)
-    load_module(desc)  # chooses the trusted directory
-    return _kernel_path(_dirs[key], key)
+    mod = load_module(desc)  # its directory is the trusted one chosen for this structure
+    return _kernel_path(Path(mod.__file__).parent, mod.KEY)
 
 
 def _kernel_path(directory: Path, key: str) -> Path:
