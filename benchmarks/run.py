@@ -70,6 +70,9 @@ STEPS = (
          ["results/topologies-quick.json", "results/topologies-quick.md"]),
     Step("codegen_timing", "codegen_timing.py", ["--repeat", "3"], ["--quick"],
          ["results/codegen.json", "results/codegen.md"], ["results/codegen-quick.json", "results/codegen-quick.md"]),
+    # needs numba (pip install 'shellbvp[fast]'); without it the script says so and writes nothing
+    Step("kernels", "kernels.py", [], ["--quick"], ["results/kernels.json", "results/kernels.md"],
+         ["results/kernels-quick.json", "results/kernels-quick.md"]),
     Step("vella", "vella.py", [], ["--quick"], ["results/vella.json", "results/vella.md"],
          ["results/vella-quick.json", "results/vella-quick.md"]),
     Step("paper_figures", "paper_figures.py", [], None, ["figures/*.png"], out_flag=None, optional=True),

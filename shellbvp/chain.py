@@ -45,6 +45,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .kernels import kernel_set
+
 __all__ = ["Point", "Region", "ContactPole", "FreePole", "PointPole", "Edge", "TipEnd", "Line", "Rim", "Chain",
            "ChainBVP", "cap_chain", "point_chain", "annulus_chain", "line_chain", "cylinder_chain",
            "cap_line_cylinder_chain", "cap_band_cylinder_chain", "cap_line_tip_chain", "cap_band_tip_chain",
@@ -330,7 +332,7 @@ class ChainBVP:
     # pickling: the generated module is code, not data; it is loaded again (from the code
     # cache) by the scene on unpickling, so results can travel between processes
     def __getstate__(self):
-        return {k: v for k, v in self.__dict__.items() if k not in ("model", "_rhs_of", "_jac_of")}
+        return {k: v for k, v in self.__dict__.items() if k not in ("model", "kernels")}
 
     def __setstate__(self, state):
         self.__dict__.update(state)
@@ -385,15 +387,18 @@ class ChainBVP:
         return self.S_point(self.regions[-1].end, None)
 
     def _bind(self):
-        """The regions' generated right-hand sides and Jacobians, looked up once (hot path)."""
-        self._rhs_of = [getattr(self.model, f"{r.kind}_rhs") for r in self.regions]
-        self._jac_of = [getattr(self.model, f"{r.kind}_jac") for r in self.regions]
+        """The regions' right-hand sides and Jacobians (the hot path) come from the structure's
+        kernel set: the generated numpy functions, or the compiled ones once they are ready
+        (``shellbvp.kernels``; looked up on every call, so a curve switches as soon as they are)."""
+        self.kernels = kernel_set(self.model, self.scene.structure)
+        self._rhs_names = [f"{r.kind}_rhs" for r in self.regions]
+        self._jac_names = [f"{r.kind}_jac" for r in self.regions]
 
     def _rhs(self, k):
-        return self._rhs_of[k]
+        return getattr(self.kernels.active, self._rhs_names[k])
 
     def _jac(self, k):
-        return self._jac_of[k]
+        return getattr(self.kernels.active, self._jac_names[k])
 
     @staticmethod
     def _prefix(kind):

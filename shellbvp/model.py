@@ -8,6 +8,11 @@ atomically (temporary file + rename) and checked on load (their ``KEY`` must
 match), so a concurrent or interrupted writer never leaves a module that is
 used half-written.  A warm load imports neither SymPy nor the derivation.
 
+Beside each module ``model_<key>.py`` lies ``kernels_<key>.py``, the same structure's
+loop-over-nodes kernels for numba (``symbolic.codegen_numba``; imported only by
+``shellbvp.kernels``), written by the same derivation; numba keeps its compiled code in
+``__pycache__`` beside it.
+
 Cached modules are code that is imported, so a cache directory or file that
 another user owns or may write is never imported from: the module is
 regenerated, into a private temporary directory if the directory itself is
@@ -29,7 +34,7 @@ from pathlib import Path
 from symbolic.version import CODEGEN_VERSION, description_key, source_fingerprint
 
 __all__ = ["cache_dir", "structure_description", "description_key", "load_module", "module_path",
-           "untrusted_reason"]
+           "kernel_path", "kernel_source_path", "holds_key", "write_atomic", "untrusted_reason"]
 
 log = logging.getLogger(__name__)
 _loaded: dict[str, object] = {}
@@ -100,7 +105,7 @@ def _private_dir() -> Path:
     return _private
 
 
-def _write_atomic(path: Path, text: str) -> None:
+def write_atomic(path: Path, text: str) -> None:
     path.parent.mkdir(mode=0o700, parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=path.name + ".", suffix=".tmp")
     try:
@@ -135,17 +140,61 @@ def load_module(desc: dict, *, regenerate: bool = False):
         except Exception as exc:  # corrupt or foreign file: derive again
             log.warning("ignoring unusable cached module %s (%s); regenerating", path, exc)
     if mod is None:
-        from symbolic.build import generate_source
+        from symbolic.build import generate_sources
 
         t0 = time.perf_counter()
-        src = generate_source(desc)
+        src, kernel_src = generate_sources(desc)
         log.info("derived and generated %s in %.2f s", path.name, time.perf_counter() - t0)
         try:
-            _write_atomic(path, src)
+            write_atomic(path, src)
         except OSError as exc:  # read-only cache: keep the module in a private temp dir
             log.warning("cannot write the code cache %s (%s); using a temporary directory", path, exc)
             path = _private_dir() / path.name
-            _write_atomic(path, src)
+            write_atomic(path, src)
+        kpath = _kernel_path(path.parent, key)
+        if not holds_key(kpath, key):  # never rewritten when current: numba's cache stamps the file
+            write_atomic(kpath, kernel_src)
         mod = _import_file(path, key)
     _loaded[key] = mod
     return mod
+
+
+def kernel_path(desc: dict) -> Path:
+    """Where the kernels module of a structure lies (beside its numpy module; not generated here)."""
+    mod = load_module(desc)  # its directory is the trusted one chosen for this structure
+    return _kernel_path(Path(mod.__file__).parent, mod.KEY)
+
+
+def _kernel_path(directory: Path, key: str) -> Path:
+    return directory / f"kernels_{key[:20]}.py"
+
+
+def holds_key(path: Path, key: str) -> bool:
+    """``path`` is a generated kernel module of ``key`` (read as text: importing it compiles)."""
+    try:
+        with open(path, encoding="utf-8") as fh:
+            head = fh.read(4096)
+    except (OSError, UnicodeDecodeError):
+        return False
+    return f"\nKEY = {key!r}\n" in head
+
+
+def kernel_source_path(desc: dict) -> Path:
+    """The kernels module of a structure (``kernels_<key>.py`` beside its numpy module).
+
+    Generated (a derivation, a few seconds) if it is missing, belongs to another key, or is
+    not to be trusted; an existing current file is never rewritten, since numba's on-disk
+    cache of its compiled code is keyed by the file's time stamp.
+    """
+    key = description_key(desc)
+    path = kernel_path(desc)
+    untrusted = path.exists() and (why := untrusted_reason(path))
+    if untrusted:
+        log.warning("not importing the cached kernels %s: %s; regenerating them", path, why)
+    if untrusted or not holds_key(path, key):  # replaced by a rename: ours afterwards
+        from symbolic.build import generate_sources
+
+        t0 = time.perf_counter()
+        write_atomic(path, generate_sources(desc)[1])
+        log.info("derived and generated %s in %.2f s", path.name, time.perf_counter() - t0)
+    return path

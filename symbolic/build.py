@@ -12,12 +12,12 @@ from __future__ import annotations
 
 import sympy as sp
 
-from . import bending, codegen, geometry, materials
+from . import bending, codegen, codegen_numba, geometry, materials
 from .equations import Structure, derive
 from .formula import parse_formula
 from .version import canonical_json
 
-__all__ = ["structure_from_description", "generate_source"]
+__all__ = ["structure_from_description", "generate_source", "generate_sources"]
 
 ALPHA = sp.Symbol("alpha", positive=True)
 JM = sp.Symbol("Jm", positive=True)
@@ -62,3 +62,12 @@ def structure_from_description(desc: dict) -> Structure:
 def generate_source(desc: dict) -> str:
     """Derive and print the module of a description (deterministic)."""
     return codegen.module_source(derive(structure_from_description(desc)), canonical_json(desc))
+
+
+def generate_sources(desc: dict) -> tuple[str, str]:
+    """The numpy module and the compiled-kernel module of a description, from one derivation
+    (the kernels reuse the numpy module's lowering: printing both costs little more than one)."""
+    d = derive(structure_from_description(desc))
+    specs = codegen.function_specs(d)
+    text = canonical_json(desc)
+    return codegen.module_source(d, text, specs), codegen_numba.kernel_source(d, text, specs)

@@ -23,7 +23,8 @@ from .dag import Program
 from .equations import CONTACT_STATES, FREE_STATES, Derivation
 from .version import CODEGEN_VERSION
 
-__all__ = ["FunctionSpec", "module_source", "CODEGEN_VERSION"]
+__all__ = ["FunctionSpec", "module_source", "function_specs", "lower", "docstring", "header",
+           "CODEGEN_VERSION"]
 
 
 
@@ -35,6 +36,9 @@ class FunctionSpec:
     is passed as a single array/scalar, longer tuples are unpacked row-wise.
     ``outputs``: list of (name, sympy Matrix or list of expressions, or dict
     for a profile).  ``shape_of``: the argument whose shape the node axis takes.
+    ``node_args``: the arguments that vary over the nodes (the rest, e.g. ``par``,
+    are the same at every node); a function that has them is also printed as a
+    compiled loop-over-nodes kernel (``symbolic.codegen_numba``).
     """
 
     name: str
@@ -44,6 +48,8 @@ class FunctionSpec:
     doc: str
     shape_of: str | None = None
     extra_doc: list = field(default_factory=list)
+    node_args: tuple = ()
+    lowered: tuple | None = field(default=None, repr=False, compare=False)  # cache of lower()
 
 
 class _Printer(NumPyPrinter):
@@ -61,24 +67,19 @@ def _flatten(outputs):
     return [sp.sympify(e, strict=True) for e in flat]  # expressions, never text
 
 
-def _function_source(spec: FunctionSpec) -> str:
+def lower(spec: FunctionSpec):
+    """The straight-line code of one function, printed: ``(assignments, outputs)``.
+
+    ``assignments`` is a list of ``(name, text)`` in evaluation order (program steps and the
+    common subexpressions they need); ``outputs`` the printed text of every flattened output
+    entry (``_flatten`` order), ``None`` where the entry is identically zero.  Shared by the
+    vectorised printer below and the loop-over-nodes one (``symbolic.codegen_numba``), so that
+    both evaluate the same expressions in the same order.
+    """
+    if spec.lowered is not None:
+        return spec.lowered
     prog = spec.program
     printer = _Printer()
-    lines = [f"def {spec.name}({', '.join(a for a, _ in spec.args)}):"]
-    doc = [spec.doc.strip(), ""]
-    for a, syms in spec.args:
-        if len(syms) > 1:
-            doc.append(f"{a} : rows ({', '.join(s.name for s in syms)})")
-        else:
-            doc.append(f"{a} : {syms[0].name}")
-    doc += spec.extra_doc
-    lines.append(textwrap.indent('"""' + "\n".join(doc).rstrip() + '\n"""', "    "))
-    for a, syms in spec.args:
-        if len(syms) > 1:
-            lines.append(f"    {', '.join(s.name for s in syms)} = {a}")
-    shape = f"numpy.shape({spec.shape_of})" if spec.shape_of else "()"
-    lines.append(f"    _shape = {shape}")
-
     flat = _flatten(spec.outputs)
     steps = prog.dependencies(flat)
     exprs = [prog.expression(s) for s in steps] + flat
@@ -86,21 +87,48 @@ def _function_source(spec: FunctionSpec) -> str:
     rep_expr = dict(reps)
     rep_rank = {s: i for i, (s, _) in enumerate(reps)}
     emitted: set = set()
+    assignments = []
 
     def emit_reps(expr):
         for s in sorted(expr.free_symbols & rep_expr.keys(), key=rep_rank.__getitem__):
             if s in emitted:
                 continue
             emit_reps(rep_expr[s])
-            lines.append(f"    {s.name} = {printer.doprint(rep_expr[s])}")
+            assignments.append((s.name, printer.doprint(rep_expr[s])))
             emitted.add(s)
 
     for sym, e in zip(steps, reduced[: len(steps)]):
         emit_reps(e)
-        lines.append(f"    {sym.name} = {printer.doprint(e)}")
+        assignments.append((sym.name, printer.doprint(e)))
     outs = reduced[len(steps):]
     for e in outs:
         emit_reps(e)
+    spec.lowered = (assignments, [None if e == 0 else printer.doprint(e) for e in outs])
+    return spec.lowered
+
+
+def docstring(spec: FunctionSpec) -> list[str]:
+    """The generated docstring's lines (argument rows named)."""
+    doc = [spec.doc.strip(), ""]
+    for a, syms in spec.args:
+        if len(syms) > 1:
+            doc.append(f"{a} : rows ({', '.join(s.name for s in syms)})")
+        else:
+            doc.append(f"{a} : {syms[0].name}")
+    doc += spec.extra_doc
+    return doc
+
+
+def _function_source(spec: FunctionSpec) -> str:
+    lines = [f"def {spec.name}({', '.join(a for a, _ in spec.args)}):"]
+    lines.append(textwrap.indent('"""' + "\n".join(docstring(spec)).rstrip() + '\n"""', "    "))
+    for a, syms in spec.args:
+        if len(syms) > 1:
+            lines.append(f"    {', '.join(s.name for s in syms)} = {a}")
+    shape = f"numpy.shape({spec.shape_of})" if spec.shape_of else "()"
+    lines.append(f"    _shape = {shape}")
+    assignments, outs = lower(spec)
+    lines += [f"    {name} = {text}" for name, text in assignments]
 
     k = 0
     ret = []
@@ -108,7 +136,7 @@ def _function_source(spec: FunctionSpec) -> str:
         if isinstance(val, dict):
             lines.append(f"    {name} = {{}}")
             for key in val:
-                lines.append(f"    {name}[{key!r}] = numpy.zeros(_shape) + ({printer.doprint(outs[k])})")
+                lines.append(f"    {name}[{key!r}] = numpy.zeros(_shape) + ({outs[k] or 0})")
                 k += 1
         else:
             mat = sp.Matrix(val)
@@ -116,11 +144,11 @@ def _function_source(spec: FunctionSpec) -> str:
             lines.append(f"    {name} = numpy.zeros({dims!r} + _shape)")
             for i in range(mat.rows):
                 for j in range(mat.cols):
-                    e = outs[k]
+                    text = outs[k]
                     k += 1
-                    if e != 0:
+                    if text is not None:
                         idx = f"{i}" if mat.cols == 1 else f"{i}, {j}"
-                        lines.append(f"    {name}[{idx}] = {printer.doprint(e)}")
+                        lines.append(f"    {name}[{idx}] = {text}")
         ret.append(name)
     lines.append(f"    return {', '.join(ret)}")
     return "\n".join(lines) + "\n"
@@ -143,13 +171,15 @@ def function_specs(d: Derivation) -> list[FunctionSpec]:
         Ssym = prog.inputs[0]
         args[0] = ("S", (Ssym,))
         specs += [
+            # the hot path: also compiled as loops over the nodes (node_args)
             FunctionSpec(f"{region}_rhs", prog, args, [("g", rhs)],
-                         f"{region} region: g = S dy/dS, shape ({n}, m).", "S"),
+                         f"{region} region: g = S dy/dS, shape ({n}, m).", "S", node_args=("S", "y")),
             FunctionSpec(f"{region}_jac", prog, args,
                          [("dg_dy", prog.jacobian(rhs, states)), ("dg_dS", prog.jacobian(rhs, [Ssym]))],
-                         f"{region} region: dg/dy ({n}, {n}, m) and dg/dS ({n}, m).", "S"),
+                         f"{region} region: dg/dy ({n}, {n}, m) and dg/dS ({n}, m).", "S",
+                         node_args=("S", "y")),
             FunctionSpec(f"{region}_jac_par", prog, args, [("dg_dpar", prog.jacobian(rhs, par))],
-                         f"{region} region: dg/dpar ({n}, {len(par)}, m).", "S"),
+                         f"{region} region: dg/dpar ({n}, {len(par)}, m).", "S", node_args=("S", "y")),
             FunctionSpec(f"{region}_profile", prog, args, [("out", profile)],
                          f"{region} region: physical fields at the nodes (dict of arrays).", "S"),
         ]
@@ -246,21 +276,32 @@ def function_specs(d: Derivation) -> list[FunctionSpec]:
     return specs
 
 
-def module_source(d: Derivation, description: str) -> str:
-    """Full text of the generated module for derivation ``d``.
-
-    ``description`` is the structure's canonical description (it is hashed
-    into the cache key and written into the header).
-    """
+def header(generator: str, description: str) -> tuple[str, list[str]]:
+    """(key, comment lines) that open a generated module: who made it, from what, the key."""
     key = hashlib.sha256(description.encode()).hexdigest()  # == version.description_key
-    par = [p.name for p in d.params]
-    head = [
-        "# Generated by shellbvp's symbolic/codegen.py -- DO NOT EDIT BY HAND.",
+    return key, [
+        f"# Generated by shellbvp's symbolic/{generator} -- DO NOT EDIT BY HAND.",
         "# It is regenerated from the SymPy derivation in symbolic/ (see README, 'Generated code').",
         f"# sympy {sp.__version__}, codegen version {CODEGEN_VERSION}",
         f"# key {key}",
         "# structure:",
         *("#   " + line for line in description.splitlines()),
+    ]
+
+
+def module_source(d: Derivation, description: str, specs: list[FunctionSpec] | None = None) -> str:
+    """Full text of the generated module for derivation ``d``.
+
+    ``description`` is the structure's canonical description (it is hashed
+    into the cache key and written into the header).  ``specs``: the
+    derivation's :func:`function_specs`, if already made (their lowering is
+    shared with the compiled kernels' module).
+    """
+    key, comments = header("codegen.py", description)
+    specs = specs if specs is not None else function_specs(d)
+    par = [p.name for p in d.params]
+    head = [
+        *comments,
         '"""Generated equations of one shellbvp structure (see the header)."""',
         "import numpy",
         "",
@@ -269,7 +310,8 @@ def module_source(d: Derivation, description: str) -> str:
         f"FREE_STATES = {FREE_STATES!r}",
         f"CONTACT_STATES = {CONTACT_STATES!r}",
         f"OMEGA_MAX = {float(d.structure.tip.omega_max)!r}" if d.has_cylinder else "OMEGA_MAX = None",
+        f"KERNELS = {tuple(s.name for s in specs if s.node_args)!r}  # also compiled: symbolic/codegen_numba.py",
         "",
     ]
-    body = [_function_source(s) for s in function_specs(d)]
+    body = [_function_source(s) for s in specs]
     return "\n".join(head) + "\n" + "\n\n".join(body)

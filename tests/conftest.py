@@ -16,6 +16,12 @@ def pytest_collection_modifyitems(config, items):
             item.add_marker(skip)
 
 
+# The suite runs the numpy functions, the reference: with numba installed, "auto" would compile
+# every structure the suite meets in background processes.  tests/test_kernels.py compares the
+# compiled kernels with them; SHELLBVP_KERNELS=numba runs the whole suite on the compiled ones.
+os.environ.setdefault("SHELLBVP_KERNELS", "numpy")
+
+
 @pytest.fixture(scope="session", autouse=True)
 def _fresh_code_cache(tmp_path_factory):
     """Generate code into a private cache: the tests exercise the derivation."""

@@ -41,7 +41,7 @@ def wp():
 def test_full_plan_regenerates_everything(run):
     names = [s.name for s, _ in run.plan()]
     assert names == ["work_precision", "profile", "stability", "shooting", "states_table", "preset_curves",
-                     "topologies", "codegen_timing", "vella"]
+                     "topologies", "codegen_timing", "kernels", "vella"]
     for s, argv in run.plan():
         assert argv[0] == sys.executable and Path(argv[1]).exists()
         assert "--quick" not in argv
