@@ -695,11 +695,11 @@ def _cmd_sweep(args):
 
     grid = {}
     for name, text in (("beta", args.beta), ("rho", args.rho), ("gamma", args.gamma), ("alpha", args.alpha),
-                       ("Jm", args.gent_jm)):  # the grid's axes in this order (read_sweep's arrays)
+                       ("Jm", args.gent_jm), ("pressure", args.pressure)):  # the grid's axes in this order
         if text is not None:
             grid[name] = _sweep_values(text, f"--{'gent-jm' if name == 'Jm' else name}")
     if not grid:
-        raise ValueError("give at least one of --gamma, --rho, --beta, --alpha, --gent-jm to sweep")
+        raise ValueError("give at least one of --gamma, --rho, --beta, --alpha, --gent-jm, --pressure to sweep")
     over = {k: getattr(args, k) for k in ("xi", "contact") if getattr(args, k) is not None}
     if args.gent_jm is not None:
         over["material"] = sb.Gent(grid["Jm"][0])
@@ -928,6 +928,7 @@ def build_parser():
     m.add_argument("--alpha", help="Mooney-Rivlin alpha: values to sweep")
     m.add_argument("--gent-jm", dest="gent_jm", help="Gent material, Jm values to sweep")
     m.add_argument("--neo-hookean", action="store_true", help="neo-Hookean material")
+    g.add_argument("--pressure", help="pressure below the shell, nondimensional p R_L/(mu H): values to sweep")
     g.add_argument("--xi", type=int, choices=(0, 1))
     g.add_argument("--contact", choices=("smooth", "paper"))
     w.add_argument("--delta-max", type=_number, default=0.5, dest="delta_max", help="depth of every curve (default 0.5)")

@@ -63,7 +63,7 @@ __all__ = ["sweep", "read_sweep", "run_curve", "Sweep", "SWEEP_PARAMETERS", "STA
 FORMAT = "shellbvp-sweep"
 FORMAT_VERSION = 1
 #: Parameters a sweep may vary (run-time parameters of the generated code: no new derivation).
-SWEEP_PARAMETERS = ("beta", "rho", "gamma", "alpha", "Jm")
+SWEEP_PARAMETERS = ("beta", "rho", "gamma", "alpha", "Jm", "pressure")
 #: Status of a combination in the index.
 STATUSES = ("pending", "complete", "stopped", "error")
 #: Settings of :func:`shellbvp.curve` a sweep passes on (the rest are fixed by the sweep).
@@ -75,7 +75,7 @@ _INDEX_UNITS = {"status": "none", "stop_reason": "none", "message": "none", "gro
 # -- the grid ------------------------------------------------------------------------------------
 def scene_at(base_scene, values: dict):
     """``base_scene`` with the swept parameters set (``alpha``: Mooney-Rivlin, ``Jm``: Gent)."""
-    changes = {k: v for k, v in values.items() if k in ("beta", "rho", "gamma")}
+    changes = {k: v for k, v in values.items() if k in ("beta", "rho", "gamma", "pressure")}
     if "alpha" in values:
         changes["material"] = MooneyRivlin(values["alpha"])
     if "Jm" in values:

@@ -184,3 +184,23 @@ def test_pressurised_dome_stiffness_follows_vella():
     assert plain["success"] and pressed["success"]
     assert 0.95 < plain["ratio"] < 1.0 and 0.95 < pressed["ratio"] < 1.0
     assert pressed["k"] / plain["k"] == pytest.approx(bench.vella_factor(3.0), rel=0.01)
+
+
+def test_a_sweep_over_the_pressure(tmp_path):
+    """The pressure is a sweep axis (turgor series): each curve equals its own serial curve."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    from shellbvp.sweep import read_sweep, sweep
+
+    base = sb.Scene.preset("dome")
+    deltas = [0.02, 0.05]
+    with ThreadPoolExecutor(1) as pool:
+        res = sweep(base, {"pressure": [0.0, 0.1]}, delta_max=0.05, executor=pool, out=tmp_path / "p.h5",
+                    deltas=deltas, estimate_error=False)
+    back = read_sweep(tmp_path / "p.h5")
+    assert res.computed == 2 and back.parameters == ("pressure",)
+    for i, p in enumerate(back.index["pressure"]):
+        ref = sb.curve(base.replace(pressure=float(p)), deltas=deltas, estimate_error=False)
+        assert back.curves[i].scene.pressure == p
+        np.testing.assert_allclose(back.curves[i].force, ref.force, rtol=1e-12)
+    assert back.force[1, -1] > back.force[0, -1]  # the inflated dome is stiffer
