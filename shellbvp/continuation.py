@@ -533,8 +533,8 @@ def _step_from_point(scene, delta, prev, settings):
     """A step from a point-load state (no cap to warm-start from).  Deeper, the cap may
     come back within double precision: a cold solve finds the cap there, or the point-load
     limit again; shallower, the point-load limit from ``prev``."""
-    if delta > prev.delta:
-        return solve(scene, delta=delta, tol=settings["tol"], max_nodes=settings["max_nodes"],
+    if delta > prev.delta:  # (solve takes a point-load guess for its point-load limit only)
+        return solve(scene, delta=delta, guess=prev, tol=settings["tol"], max_nodes=settings["max_nodes"],
                      bc_tol=settings["bc_tol"], estimate_error=False, topology="cap")
     return solve_point_load(scene, delta, tol=settings["tol"], max_nodes=settings["max_nodes"], guess=prev)
 
@@ -716,6 +716,8 @@ def _adaptive(scene, builder: _Builder, settings):
         raise _Stop(f"delta_max = {st['delta_max']:g} reached")
     scale = np.array([1.0, 1.0, 1.0])
     cur = first
+    if below is not None and below.get("topology") != first.get("topology"):
+        below = None  # the small-delta leg went on in the point-load limit: no secant from a cap to it
     if below is None:  # need a second point for the tangent
         below = _solve_at_delta(scene, first.delta * 0.9, first, None, st)
         if not below.success:
