@@ -581,7 +581,7 @@ def _natural(scene, deltas, builder: _Builder, settings, first=None, key0=0):
             else:
                 step /= 2
                 if step < min(1e-6, 1e-3 * target):
-                    raise _Stop(f"no solution near delta = {nd:.6g}: {sol.message}")
+                    raise _Stop(f"no solution near delta = {nd:.6g}: {sol.message}{_fold_note(prev, prev2)}")
         rule = _stop_rule(prev, settings)
         if rule:
             raise _Stop(rule)
@@ -590,6 +590,19 @@ def _natural(scene, deltas, builder: _Builder, settings, first=None, key0=0):
                       reason="the contact reached the end of the tip (the indenter's cylinder)")
     builder.out.complete = True
     builder.out.stop_reason = "all requested deltas computed"
+
+
+def _fold_note(prev, prev2):
+    """What the last two states say where natural continuation in delta stalls: a force
+    falling with delta announces a turning point in delta (a fold; under displacement
+    control the shell snaps there), which no delta-controlled step passes."""
+    if prev2 is None or not prev.delta > prev2.delta:
+        return ""
+    slope = (prev.force - prev2.force) / (prev.delta - prev2.delta)
+    if not slope < 0:
+        return ""
+    return (f" (the force falls with delta before it, dF/ddelta = {slope:.3g} between delta = {prev2.delta:.6g} "
+            f"and {prev.delta:.6g}: likely a turning point in delta, a fold past which the shell snaps)")
 
 
 def _wall_leg(scene, builder, st, last_cap, key, *, reason, deltas=None):

@@ -42,7 +42,14 @@ def _point_guess(sysm, prev):
 
 
 def _crude_point_guess(sysm):
-    x = np.linspace(0.0, 1.0, 61)
+    """The undeformed shell (stretches 1: a 5 % compression overflowed Newton at beta 1e-5),
+    the pole moved down by delta and linearly back to the rim, on a mesh geometric in S
+    towards the pole and uniform in S over the rest: the rim's boundary layer (width ~
+    sqrt(beta)) starts resolved (a spheroidal dome, gamma -0.2 at beta 1e-5, converged
+    from the geometric mesh alone only below delta ~ 1e-5)."""
+    t_outer = sysm.t_of(0, sysm.L * np.linspace(0.05, 1.0, 100), None)
+    x = np.union1d(np.linspace(0.0, 1.0, 61), t_outer[(t_outer > 0) & (t_outer < 1 - 1e-9)])
+    x = x[np.r_[True, np.diff(x) > 1e-9]]  # no near-duplicate nodes; 0 and 1 stay
     S = sysm.S(0, x, None)
     ref = sysm.model.reference_shell(S, sysm.par)
     lam = 1.0
@@ -66,9 +73,9 @@ def solve_point_load(scene, delta, *, tol=1e-6, max_nodes=10000, guess=None, bc_
     """
     t0 = time.perf_counter()
     kw = dict(tol=tol, max_nodes=max_nodes, bc_tol=bc_tol)
-    res = _point_run(scene, delta, guess, **kw)
+    res = _point_run(scene, delta, guess, **(kw if guess is not None else _crude(kw)))
     if guess is not None and not res.success:  # e.g. a cap of 1e-30 whose free region is no start
-        res = _point_run(scene, delta, None, **kw)
+        res = _point_run(scene, delta, None, **_crude(kw))
     if not res.success:
         res = _from_smaller_depth(scene, delta, **kw) or res
     res.wall_time = time.perf_counter() - t0
@@ -86,6 +93,15 @@ def _point_run(scene, delta, guess, *, tol, max_nodes, bc_tol):
         return diagnose(sysm, bvp, tol, " (point-load limit: the contact cap is exponentially small)")
 
 
+#: Node budget of a run from the crude guess: one that needs more is far from the state
+#: (seconds each at 8000 nodes); the march from a smaller depth then takes over.
+_CRUDE_MAX_NODES = 3000
+
+
+def _crude(kw):
+    return dict(kw, max_nodes=min(kw["max_nodes"], _CRUDE_MAX_NODES))
+
+
 #: Depths (fractions of the asked one) from which the crude guess is tried when it fails at
 #: the asked depth, and the largest and smallest ratios of a step up from there.
 _START_FRACTIONS = (0.1, 0.01, 0.001)
@@ -96,16 +112,19 @@ def _from_smaller_depth(scene, delta, **kw):
     """The point-load state at ``delta`` by natural continuation from a smaller depth, or None.
 
     The crude guess (the undeformed shell, the pole moved down linearly to the rim) is
-    near the state only while the depth is small against the bending length: a
-    spheroidal dome gamma -0.2 at beta 1e-5 converges from it at delta 3e-5 but not
-    at 1e-3 or 0.05.  Steps grow by 1.5 after a success and shrink to their square root
-    after a failure; a fold on the way ends the march (None).
+    near the state only while the depth is small against the bending length (the
+    shallow dome of radius 5 at beta 1e-5 converges from it at delta 0.01, not at
+    0.05).  Steps grow by 1.5 after a success and shrink to the square root of the
+    ratio tried after a failure, with a node budget of a few times the last state's
+    so that a step towards a singular state fails fast; a fold on the way ends the
+    march (None), and so does a state that passes through the tip (the contact is then
+    resolved and no longer a point: ``shellbvp.state`` grows a cap from such a state).
     """
     start = None
     for fraction in _START_FRACTIONS:
         if delta * fraction < 10 * kw["tol"]:  # below, delta is in the solver's noise
             break
-        start = _point_run(scene, delta * fraction, None, **kw)
+        start = _point_run(scene, delta * fraction, None, **_crude(kw))
         if start.success:
             break
     if start is None or not start.success:
@@ -113,11 +132,14 @@ def _from_smaller_depth(scene, delta, **kw):
     prev, ratio = start, _STEP_MAX / 2
     while prev.delta < delta:
         d = min(delta, prev.delta * ratio)
-        nxt = _point_run(scene, d, prev, **kw)
+        step_kw = dict(kw, max_nodes=int(min(kw["max_nodes"], max(2000, 4 * prev.nodes))))
+        nxt = _point_run(scene, d, prev, **step_kw)
+        if nxt.success and d < delta and not nxt.valid:
+            return None
         if nxt.success:
             prev, ratio = nxt, min(_STEP_MAX, 1.5 * ratio)
         else:
-            ratio = math.sqrt(ratio)
+            ratio = math.sqrt(d / prev.delta)
             if ratio < _STEP_MIN:
                 return None
     return prev

@@ -426,8 +426,7 @@ def _cold_delta(sysm, delta, near_point=None, **kw):
         if res.success:
             return _tighten(sysm, res, **kw)
         best = best or res
-    point_route = sysm.scene.contact == "smooth"
-    if point_route and near_point is not None:
+    if sysm.scene.contact == "smooth":
         res = _point_route(sysm, delta, near_point, **kw)
         if res is not None:
             return res
@@ -436,10 +435,6 @@ def _cold_delta(sysm, delta, near_point=None, **kw):
         if res.get("topology") == "point":
             return solve_point_load(sysm.scene, delta, tol=kw["tol"], max_nodes=kw["max_nodes"], guess=res)
         return _tighten(res.system, res, **kw)
-    if point_route and near_point is None:
-        res = _point_route(sysm, delta, None, **kw)
-        if res is not None:
-            return res
     return as_failure(best, 5, STATUS_MESSAGES[5] + f" (first attempt: {best.message})")
 
 
