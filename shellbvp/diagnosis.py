@@ -234,6 +234,8 @@ def _without_iterate_numbers(res):
     for key in STATE_NUMBERS:
         if key in res and key != prescribed:
             res[key] = float("nan")
+    if prescribed in STATE_NUMBERS and res.get("system") is not None:
+        res[prescribed] = float(res.system.value)  # as given (the iterate's force is not it)
     for key in ("edge_forces", "edge_S"):  # per-edge lists: as many NaN as edges
         if key in res:
             res[key] = [float("nan")] * len(res[key])

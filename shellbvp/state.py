@@ -417,17 +417,22 @@ def _tighten(sysm, res, **kw):
 
 
 def _cold_delta(sysm, delta, near_point=None, **kw):
-    """Crude guesses at a few cap sizes; then continuation in delta from a moderate depth;
-    then (smooth model) the point-load limit, cold or from ``near_point`` (a point-load
-    state at another depth: then it is tried before the continuation)."""
+    """Crude guesses at a few cap sizes; then (smooth model) the point-load limit, or a cap
+    grown from it; then continuation in delta from a moderate depth.  From ``near_point``
+    (a point-load state at another depth) the point-load limit is tried first."""
+    point_route = sysm.scene.contact == "smooth"
+    if point_route and near_point is not None:
+        res = _point_route(sysm, delta, near_point, **kw)
+        if res is not None:
+            return res
     best = None
     for Sc0 in _SC_GUESSES:
         res = solve_from(sysm, _undeformed_guess(sysm, math.log(Sc0), 1.0, delta), **_loose(kw))
         if res.success:
             return _tighten(sysm, res, **kw)
         best = best or res
-    if sysm.scene.contact == "smooth":
-        res = _point_route(sysm, delta, near_point, **kw)
+    if point_route and near_point is None:
+        res = _point_route(sysm, delta, None, **kw)
         if res is not None:
             return res
     res = _continue_in_delta(sysm.scene, sysm.eps, delta, **_loose(kw))
@@ -548,11 +553,14 @@ def _continue_in_delta(scene, eps, target, starts=(0.1, 0.05), **kw):
     return res
 
 
-def _failure(status, message):
+def _failure(status, message, control, value):
+    """A result without any state: NaN but the prescribed ``control`` = ``value``."""
     nan = float("nan")
-    return Solution(status=status, message=message, success=False, valid=False, flags=[],
-                    delta=nan, force=nan, lambda0=nan, Sc=nan, nodes=0, niter=0, wall_time=nan,
-                    x=np.empty(0), y=np.empty((8, 0)), p=np.full(2, nan), topology="cap")
+    res = Solution(status=status, message=message, success=False, valid=False, flags=[],
+                   delta=nan, force=nan, lambda0=nan, Sc=nan, nodes=0, niter=0, wall_time=nan,
+                   x=np.empty(0), y=np.empty((8, 0)), p=np.full(2, nan), topology="cap", control=control)
+    res[control] = float(value)
+    return res
 
 
 _MARCH_DELTA_MAX = 1.0  # pole displacement of a rim radius: beyond any indentation test
@@ -562,11 +570,15 @@ _MARCH_MAX_SOLVES = 60
 def _cold_other(scene, sysm, control, value, eps, **kw):
     """lambda0 or force prescribed: march in delta until the target is bracketed, then switch."""
     key = "lambda0" if control == "lambda0" else "force"
+
+    def fail(message):
+        return _failure(5, message, control, value)
+
     d, step = 0.02, 0.02
     lk = _loose(kw)
     cur = _cold_delta(make_system(scene, "delta", d, eps), d, **lk)
     if not cur.success:
-        return _failure(5, STATUS_MESSAGES[5])
+        return fail(STATUS_MESSAGES[5])
     prev = None
     attempts = 0
     def bracketed():  # a point-load state's lambda0 is NaN: it brackets nothing
@@ -575,15 +587,15 @@ def _cold_other(scene, sysm, control, value, eps, **kw):
     while not bracketed():
         attempts += 1
         if attempts > _MARCH_MAX_SOLVES:
-            return _failure(5, f"{control} = {value:g} was not bracketed within {_MARCH_MAX_SOLVES} "
-                               f"continuation steps (delta reached {d:.3g}, {key} there {cur[key]:.4g})")
+            return fail(f"{control} = {value:g} was not bracketed within {_MARCH_MAX_SOLVES} "
+                        f"continuation steps (delta reached {d:.3g}, {key} there {cur[key]:.4g})")
         nd = d + step
         if nd > _MARCH_DELTA_MAX:
-            return _failure(5, f"{control} = {value:g} was not reached on the branch for delta up to "
-                               f"{d:.3g} ({key} there: {cur[key]:.4g})")
+            return fail(f"{control} = {value:g} was not reached on the branch for delta up to "
+                        f"{d:.3g} ({key} there: {cur[key]:.4g})")
         # a point-load state has no cap to warm-start from: a cold solve finds the cap or the limit again
         if cur.get("topology") == "point":
-            nxt = _cold_delta(make_system(scene, "delta", nd, eps), nd, **lk)
+            nxt = _cold_delta(make_system(scene, "delta", nd, eps), nd, near_point=cur, **lk)
         else:
             dsys = system_like(cur, "delta", nd, eps)
             nxt = solve_from(dsys, warm_guess(dsys, cur), **lk)
@@ -593,13 +605,13 @@ def _cold_other(scene, sysm, control, value, eps, **kw):
             prev, cur, d = cur, nxt, nd
             step = min(1.5 * step, 0.05)
         elif nxt.status == 4 and "end of the tip" in nxt.message:
-            return _failure(5, f"{control} = {value:g} not reached before the contact reaches the end "
-                               f"of the tip (the indenter's cylinder) near delta = {nd:.3g}")
+            return fail(f"{control} = {value:g} not reached before the contact reaches the end "
+                        f"of the tip (the indenter's cylinder) near delta = {nd:.3g}")
         else:
             step /= 2
             if step < 1e-3:
-                return _failure(5, f"continuation in delta towards {control} = {value:g} stalled at "
-                                   f"delta = {d:.3g}")
+                return fail(f"continuation in delta towards {control} = {value:g} stalled at "
+                            f"delta = {d:.3g}")
     start = min((prev, cur), key=lambda s: abs(s[key] - value))
     sysm = system_like(start, control, value, eps)
     return solve_from(sysm, warm_guess(sysm, start), **kw)
