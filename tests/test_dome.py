@@ -116,7 +116,7 @@ def test_spheroidal_dome_pairs_with_its_bowl():
 @pytest.mark.slow
 def test_dome_snaps_at_a_fold_in_delta():
     """Past its force maximum (F 3.28e-4 near delta 0.169) the dome's branch turns back in
-    delta at 0.18289 (F 1.41e-4): under displacement control it snaps there.  Natural
+    delta at 0.18289 (F about 1.4e-4): under displacement control it snaps there.  Natural
     continuation stops at the fold and says so; arclength continuation (the cap branch, its
     caps of 1e-12 .. 1e-5 flagged as pulling) goes round it."""
     scene = _cap("")
