@@ -533,8 +533,8 @@ def _step_from_point(scene, delta, prev, settings):
     """A step from a point-load state (no cap to warm-start from).  Deeper, the cap may
     come back within double precision: a cold solve finds the cap there, or the point-load
     limit again; shallower, the point-load limit from ``prev``."""
-    if delta > prev.delta:
-        return solve(scene, delta=delta, tol=settings["tol"], max_nodes=settings["max_nodes"],
+    if delta > prev.delta:  # (solve takes a point-load guess for its point-load limit only)
+        return solve(scene, delta=delta, guess=prev, tol=settings["tol"], max_nodes=settings["max_nodes"],
                      bc_tol=settings["bc_tol"], estimate_error=False, topology="cap")
     return solve_point_load(scene, delta, tol=settings["tol"], max_nodes=settings["max_nodes"], guess=prev)
 
@@ -581,7 +581,7 @@ def _natural(scene, deltas, builder: _Builder, settings, first=None, key0=0):
             else:
                 step /= 2
                 if step < min(1e-6, 1e-3 * target):
-                    raise _Stop(f"no solution near delta = {nd:.6g}: {sol.message}")
+                    raise _Stop(f"no solution near delta = {nd:.6g}: {sol.message}{_fold_note(prev, prev2)}")
         rule = _stop_rule(prev, settings)
         if rule:
             raise _Stop(rule)
@@ -590,6 +590,19 @@ def _natural(scene, deltas, builder: _Builder, settings, first=None, key0=0):
                       reason="the contact reached the end of the tip (the indenter's cylinder)")
     builder.out.complete = True
     builder.out.stop_reason = "all requested deltas computed"
+
+
+def _fold_note(prev, prev2):
+    """What the last two states say where natural continuation in delta stalls: a force
+    falling with delta announces a turning point in delta (a fold; under displacement
+    control the shell snaps there), which no delta-controlled step passes."""
+    if prev2 is None or not prev.delta > prev2.delta:
+        return ""
+    slope = (prev.force - prev2.force) / (prev.delta - prev2.delta)
+    if not slope < 0:
+        return ""
+    return (f" (the force falls with delta before it, dF/ddelta = {slope:.3g} between delta = {prev2.delta:.6g} "
+            f"and {prev.delta:.6g}: likely a turning point in delta, a fold past which the shell snaps)")
 
 
 def _wall_leg(scene, builder, st, last_cap, key, *, reason, deltas=None):
@@ -716,6 +729,8 @@ def _adaptive(scene, builder: _Builder, settings):
         raise _Stop(f"delta_max = {st['delta_max']:g} reached")
     scale = np.array([1.0, 1.0, 1.0])
     cur = first
+    if below is not None and below.get("topology") != first.get("topology"):
+        below = None  # the small-delta leg went on in the point-load limit: no secant from a cap to it
     if below is None:  # need a second point for the tangent
         below = _solve_at_delta(scene, first.delta * 0.9, first, None, st)
         if not below.success:

@@ -17,7 +17,7 @@ import numpy as np
 from .chain import FREE_STATES, ContactPole, Edge, FreePole, Line, PointPole, TipEnd
 from .solution import Solution, penetration, set_status, wall_gap
 
-__all__ = ["diagnose", "STATE_NUMBERS"]
+__all__ = ["diagnose", "STATE_NUMBERS", "as_failure"]
 
 _LS, _LT = FREE_STATES.index("ls"), FREE_STATES.index("lt")
 
@@ -234,6 +234,24 @@ def _without_iterate_numbers(res):
     for key in STATE_NUMBERS:
         if key in res and key != prescribed:
             res[key] = float("nan")
-    res.edge_forces = [float("nan")] * len(res.get("edge_forces", []))
+    if prescribed in STATE_NUMBERS and res.get("system") is not None:
+        res[prescribed] = float(res.system.value)  # as given (the iterate's force is not it)
+    for key in ("edge_forces", "edge_S"):  # per-edge lists: as many NaN as edges
+        if key in res:
+            res[key] = [float("nan")] * len(res[key])
+    if "z_tip" in res:  # the tip's height follows from delta: known only where delta is prescribed
+        res.z_tip = res.z_tip if prescribed == "delta" else float("nan")
     res.valid = False
     return res
+
+
+def as_failure(res, status, message):
+    """``res`` (a diagnosed Solution) turned into a failure with ``status`` (1, 2, 3 or 5) and
+    ``message``: the state's numbers NaN as for any run that did not converge (a converged
+    but inadmissible state that stands for a failed search must not keep its numbers)."""
+    if status in (0, 4):
+        raise ValueError(f"status must be that of a failure (1, 2, 3 or 5); got {status}")
+    res.status, res.message, res.success = status, message, False
+    for key in ("force_error", "delta_error"):
+        res[key] = float("nan")
+    return _without_iterate_numbers(res)

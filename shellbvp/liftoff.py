@@ -227,7 +227,8 @@ def valid_liftoff_state(cap: Solution, *, tol=1e-6, max_nodes=10000, bc_tol=1e-1
     (exponentially close; a line that small strains double precision in its inner cap).
     """
     tried = []
-    if cap.Sc < POINT_LIMIT_SC and cap.control == "delta":
+    # (a cap on an arclength step has its delta too: the curve's caps are such)
+    if cap.Sc < POINT_LIMIT_SC and cap.control in ("delta", "arclength"):
         res = solve_point_load(cap.scene, cap.delta, tol=tol, max_nodes=max_nodes, guess=cap, bc_tol=bc_tol)
         if res.success and res.valid:
             return res, tried

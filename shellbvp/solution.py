@@ -145,6 +145,14 @@ class Solution(dict):
     wall_time : float
         Seconds.
 
+    Notes
+    -----
+    A run that did not converge (status 1, 2, 3 or 5) carries NaN for every number of a
+    state (force, delta, lambda0, Sc, energy, ring and edge forces, pressures, errors, ...)
+    but the prescribed delta, force or lambda0, as given; ``x``, ``y``, ``p`` are its last
+    iterate, for inspection, and ``niter``, ``nodes``, ``max_residual``,
+    ``rms_residuals``, ``wall_time`` describe the run.
+
     Examples
     --------
     >>> import shellbvp as sb

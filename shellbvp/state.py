@@ -14,9 +14,9 @@ import time
 
 import numpy as np
 
-from .chain import ChainBVP, cap_chain
+from .chain import FREE_STATES, ChainBVP, cap_chain
 from .corner import edge_model, is_corner, limit_estimate, near_limit, other_edge_root
-from .diagnosis import diagnose
+from .diagnosis import as_failure, diagnose
 from .inflation import start_shape
 from .pointload import SC_POINT, solve_point_load
 from .solution import (
@@ -338,8 +338,11 @@ def solve(scene, *, delta=None, lambda0=None, force=None, tol=1e-6, max_nodes=10
             return res
         guess = None  # back to the cap
 
+    near_point = None
     if guess is not None and guess.get("topology") == "point":
-        guess = None  # a point-load state has no cap to start from: cold start (it finds the limit again)
+        # a point-load state has no cap to start from: cold start, with the point-load limit
+        # (tried where the crude caps fail) warm-started from it
+        near_point, guess = guess, None
 
     t0 = time.perf_counter()
     kw = dict(tol=tol, max_nodes=max_nodes, bc_tol=bc_tol)
@@ -350,7 +353,7 @@ def solve(scene, *, delta=None, lambda0=None, force=None, tol=1e-6, max_nodes=10
             res = cross_convexity_limit(guess, None, value, eps=eps, **kw) or res
         sysm = res.system if res.success else sysm
     elif control == "delta":
-        res = _cold_delta(make_system(scene, control, value, eps), value, **kw)
+        res = _cold_delta(make_system(scene, control, value, eps), value, near_point=near_point, **kw)
     else:
         res = _cold_other(scene, make_system(scene, control, value, eps), control, value, eps, **kw)
     if (topology == "auto" or topology in _WALL) and res.get("topology") == "cap":
@@ -416,23 +419,96 @@ def _tighten(sysm, res, **kw):
     return solve_from(sysm, warm_guess(sysm, res), **kw)
 
 
-def _cold_delta(sysm, delta, **kw):
-    """Crude guesses at a few cap sizes; then continuation in delta from a moderate depth."""
+def _cold_delta(sysm, delta, near_point=None, **kw):
+    """Crude guesses at a few cap sizes; then (smooth model) the point-load limit, or a cap
+    grown from it; then continuation in delta from a moderate depth.  From ``near_point``
+    (a point-load state at another depth) the point-load limit is tried first."""
+    point_route = sysm.scene.contact == "smooth"
+    if point_route and near_point is not None:
+        res = _point_route(sysm, delta, near_point, **kw)
+        if res is not None:
+            return res
     best = None
     for Sc0 in _SC_GUESSES:
         res = solve_from(sysm, _undeformed_guess(sysm, math.log(Sc0), 1.0, delta), **_loose(kw))
         if res.success:
             return _tighten(sysm, res, **kw)
         best = best or res
+    if point_route and near_point is None:
+        res = _point_route(sysm, delta, None, **kw)
+        if res is not None:
+            return res
     res = _continue_in_delta(sysm.scene, sysm.eps, delta, **_loose(kw))
     if res is not None and res.success:
         if res.get("topology") == "point":
             return solve_point_load(sysm.scene, delta, tol=kw["tol"], max_nodes=kw["max_nodes"], guess=res)
         return _tighten(res.system, res, **kw)
-    best.status = 5
-    best.message = STATUS_MESSAGES[5] + f" (first attempt: {best.message})"
-    best.success = False
-    return best
+    return as_failure(best, 5, STATUS_MESSAGES[5] + f" (first attempt: {best.message})")
+
+
+#: Contact radii tried for a cap grown from a point-load state (:func:`_point_route`).
+_SC_FROM_POINT = (1e-6, 1e-3)
+#: How far a point-load state's free shell may reach above the tip's surface at a mesh node
+#: and still be taken as touching it at the pole only: rounding of z = O(1) (measured
+#: -2e-15 at the pole node of such states; a contact the mesh resolves shows as > 1e-8).
+_POINT_CLEARANCE = 1e-12
+
+
+def _point_route(sysm, delta, near_point=None, **kw):
+    """The point-load limit at ``delta`` where the crude caps fail, or a cap grown from it;
+    None if it does not converge or the free shell passes through the tip.
+
+    The crude caps start at Sc = 0.002 .. 0.2; where the contact is exponentially small
+    Newton runs ln Sc towards -200 and the iterate leaves double precision.  A shallow dome
+    indented from its convex side is such a case throughout its early, softening range:
+    sphere of radius 5, rho 0.05, beta 1e-5 (tests/test_solve.py), the cap that exists has
+    Sc ~ 4e-28 at delta 0.01 and 2e-13 at 0.05 (the point force, softened, makes the
+    shell's log-curvature reach the tip's only there), and it pulls: its lift-off state is
+    the point-load limit (``shellbvp.liftoff.POINT_LIMIT_SC``).  The point-load problem
+    has no Sc to lose, so it converges from the undeformed shell.
+
+    Where a contact of ``POINT_LIMIT_SC`` or more exists after all, a cap started from the
+    point state at ``_SC_FROM_POINT`` finds it, and it is returned instead (the caller
+    replaces an invalid cap by its lift-off state as for any cap).
+    """
+    from .liftoff import POINT_LIMIT_SC
+
+    scene = sysm.scene
+    pkw = dict(tol=kw["tol"], max_nodes=kw["max_nodes"], bc_tol=kw["bc_tol"])
+    point = solve_point_load(scene, delta, guess=near_point, **pkw)
+    if not point.success:
+        return None
+    touching = point.valid and point.penetration <= _POINT_CLEARANCE
+    # a point state through the tip: the contact is about as large as where it is deepest
+    sizes = _SC_FROM_POINT if touching else (_deepest_S(point), *_SC_FROM_POINT)
+    for Sc in sizes:
+        cap = solve_from(sysm, _cap_guess_from_point(sysm, point, Sc), **_loose(kw))
+        if cap.success and cap.Sc >= POINT_LIMIT_SC:
+            cap = _tighten(sysm, cap, **kw)
+            if cap.success:
+                return cap
+    return point if touching else None
+
+
+def _deepest_S(point):
+    """S of the point-load state's mesh node that is deepest inside the tip."""
+    prof = point.profile()
+    A, B = point.system.tip_A, point.system.tip_B
+    rho = point.scene.rho
+    r = np.minimum(prof["r"], rho * A[-1])
+    height = prof["z"] - (point.z_tip + rho * np.interp(r / rho, A, B))
+    return float(prof["S"][int(np.argmax(np.where(prof["r"] < rho * A[-1], height, -np.inf)))])
+
+
+def _cap_guess_from_point(sysm, point, Sc, n=81):
+    """A cap of size ``Sc`` on the tip at the pole stretch of the point-load state ``point``
+    (leading order of the pole series: chi = lambda0 chi(1)), its free region beyond."""
+    t = np.linspace(0.0, 1.0, n)
+    lambda0 = float(point.y[FREE_STATES.index("ls"), 0])
+    p = sysm.pack(ln_Sc=math.log(Sc), lambda0=lambda0, delta=point.delta)
+    chi0 = -sysm.model.pole_res(0.0, 0.0, 1.0, sysm.par)[0]  # chi at the pole for lambda0 = 1
+    free = point.sol(np.clip(point.system.t_of(0, sysm.S(1, t, p), None), 0.0, 1.0))
+    return t, np.vstack([np.full(n, lambda0 * chi0), np.full(n, lambda0), free]), p
 
 
 def _continue_in_delta(scene, eps, target, starts=(0.1, 0.05), **kw):
@@ -480,11 +556,14 @@ def _continue_in_delta(scene, eps, target, starts=(0.1, 0.05), **kw):
     return res
 
 
-def _failure(status, message):
+def _failure(status, message, control, value):
+    """A result without any state: NaN but the prescribed ``control`` = ``value``."""
     nan = float("nan")
-    return Solution(status=status, message=message, success=False, valid=False, flags=[],
-                    delta=nan, force=nan, lambda0=nan, Sc=nan, nodes=0, niter=0, wall_time=nan,
-                    x=np.empty(0), y=np.empty((8, 0)), p=np.full(2, nan), topology="cap")
+    res = Solution(status=status, message=message, success=False, valid=False, flags=[],
+                   delta=nan, force=nan, lambda0=nan, Sc=nan, nodes=0, niter=0, wall_time=nan,
+                   x=np.empty(0), y=np.empty((8, 0)), p=np.full(2, nan), topology="cap", control=control)
+    res[control] = float(value)
+    return res
 
 
 _MARCH_DELTA_MAX = 1.0  # pole displacement of a rim radius: beyond any indentation test
@@ -494,11 +573,15 @@ _MARCH_MAX_SOLVES = 60
 def _cold_other(scene, sysm, control, value, eps, **kw):
     """lambda0 or force prescribed: march in delta until the target is bracketed, then switch."""
     key = "lambda0" if control == "lambda0" else "force"
+
+    def fail(message):
+        return _failure(5, message, control, value)
+
     d, step = 0.02, 0.02
     lk = _loose(kw)
     cur = _cold_delta(make_system(scene, "delta", d, eps), d, **lk)
     if not cur.success:
-        return _failure(5, STATUS_MESSAGES[5])
+        return fail(STATUS_MESSAGES[5])
     prev = None
     attempts = 0
     def bracketed():  # a point-load state's lambda0 is NaN: it brackets nothing
@@ -507,15 +590,15 @@ def _cold_other(scene, sysm, control, value, eps, **kw):
     while not bracketed():
         attempts += 1
         if attempts > _MARCH_MAX_SOLVES:
-            return _failure(5, f"{control} = {value:g} was not bracketed within {_MARCH_MAX_SOLVES} "
-                               f"continuation steps (delta reached {d:.3g}, {key} there {cur[key]:.4g})")
+            return fail(f"{control} = {value:g} was not bracketed within {_MARCH_MAX_SOLVES} "
+                        f"continuation steps (delta reached {d:.3g}, {key} there {cur[key]:.4g})")
         nd = d + step
         if nd > _MARCH_DELTA_MAX:
-            return _failure(5, f"{control} = {value:g} was not reached on the branch for delta up to "
-                               f"{d:.3g} ({key} there: {cur[key]:.4g})")
+            return fail(f"{control} = {value:g} was not reached on the branch for delta up to "
+                        f"{d:.3g} ({key} there: {cur[key]:.4g})")
         # a point-load state has no cap to warm-start from: a cold solve finds the cap or the limit again
         if cur.get("topology") == "point":
-            nxt = _cold_delta(make_system(scene, "delta", nd, eps), nd, **lk)
+            nxt = _cold_delta(make_system(scene, "delta", nd, eps), nd, near_point=cur, **lk)
         else:
             dsys = system_like(cur, "delta", nd, eps)
             nxt = solve_from(dsys, warm_guess(dsys, cur), **lk)
@@ -525,13 +608,13 @@ def _cold_other(scene, sysm, control, value, eps, **kw):
             prev, cur, d = cur, nxt, nd
             step = min(1.5 * step, 0.05)
         elif nxt.status == 4 and "end of the tip" in nxt.message:
-            return _failure(5, f"{control} = {value:g} not reached before the contact reaches the end "
-                               f"of the tip (the indenter's cylinder) near delta = {nd:.3g}")
+            return fail(f"{control} = {value:g} not reached before the contact reaches the end "
+                        f"of the tip (the indenter's cylinder) near delta = {nd:.3g}")
         else:
             step /= 2
             if step < 1e-3:
-                return _failure(5, f"continuation in delta towards {control} = {value:g} stalled at "
-                                   f"delta = {d:.3g}")
+                return fail(f"continuation in delta towards {control} = {value:g} stalled at "
+                            f"delta = {d:.3g}")
     start = min((prev, cur), key=lambda s: abs(s[key] - value))
     sysm = system_like(start, control, value, eps)
     return solve_from(sysm, warm_guess(sysm, start), **kw)
