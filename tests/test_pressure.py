@@ -175,15 +175,23 @@ def test_vella_formula_limits():
 
 
 def test_pressurised_dome_stiffness_follows_vella():
-    """Hemispherical dome, beta 1e-4 (bending length (beta/3)^(1/4) = 0.076 R), delta = 0.003 h:
-    F/delta against Vella et al. (2012).  Measured: 0.973 of the formula at tau = 0 (Reissner;
-    the finite bending length against R), 0.968 at tau = 3; the pressure's effect,
-    k(tau)/k(0), agrees with the formula's to 0.6 %.  (benchmarks/vella.py: the table.)"""
+    """Hemispherical dome, beta 1e-5 (bending length (beta/3)^(1/4) = 0.043 R, pre-strain
+    p R/(2 Y) <= 3.7 %), delta = 0.003 h: F/delta within 3 % of Vella et al. (2012) at a small
+    and a large tau, and the large-tau trend k(10)/k(0.3) to 1 %.  Measured: 0.9867 and
+    0.9845 (benchmarks/results/vella.md: 0.983-0.988 for tau 0 to 10)."""
     bench = _vella()
-    plain, pressed = bench.row(1e-4, 0.0, 0.003), bench.row(1e-4, 3.0, 0.003)
-    assert plain["success"] and pressed["success"]
-    assert 0.95 < plain["ratio"] < 1.0 and 0.95 < pressed["ratio"] < 1.0
-    assert pressed["k"] / plain["k"] == pytest.approx(bench.vella_factor(3.0), rel=0.01)
+    small, large = bench.row(1e-5, 0.3, 0.003), bench.row(1e-5, 10.0, 0.003)
+    assert small["success"] and large["success"]
+    assert 0.97 < small["ratio"] < 1.0 and 0.97 < large["ratio"] < 1.0
+    assert large["k"] / small["k"] == pytest.approx(bench.vella_factor(10.0) / bench.vella_factor(0.3), rel=0.01)
+
+
+@pytest.mark.slow
+def test_pressurised_dome_stiffness_follows_vella_over_tau():
+    bench = _vella()
+    for tau in bench.TAUS:
+        r = bench.row(1e-5, tau, 0.003)
+        assert r["success"] and 0.97 < r["ratio"] < 1.0, r
 
 
 def test_a_sweep_over_the_pressure(tmp_path):
