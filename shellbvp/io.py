@@ -230,6 +230,8 @@ def write_curve_group(g, curve, *, profiles=False, units=None):
         g.attrs["R_L_m"], g.attrs["mu_H_N_per_m"] = R_L, mu_H
         g.create_dataset("delta_m", data=R_L * np.asarray(curve.points["delta"]))
         g.create_dataset("force_N", data=mu_H * R_L * np.asarray(curve.points["force"]))
+    if curve.scene.pressure:
+        _write_inflated(g.create_group("inflated"), curve.scene)
     if profiles:
         pg = g.create_group("profiles")
         for i, sol in enumerate(curve.solutions):
@@ -238,6 +240,21 @@ def write_curve_group(g, curve, *, profiles=False, units=None):
             sg = pg.create_group(f"point_{i:05d}")
             for k, v in sol.profile().items():
                 sg.create_dataset(k, data=v)
+
+
+def _write_inflated(ig, scene):
+    """The inflated state of a pressurised scene, where its curve starts (``sb.inflate``)."""
+    from .inflation import inflate
+
+    state = inflate(scene)
+    ig.attrs["NX_class"] = "NXnote"
+    ig.attrs["long_name"] = "the shell under its pressure before indentation: delta is measured from its pole"
+    for name, units, what in (("pole_rise", "1 (R_L)", "height of the inflated pole above the reference pole"),
+                              ("pole_stretch", "1", "stretch at the inflated pole"),
+                              ("volume_change", "1 (R_L^3)", "V - V_ref, V between the shell and its rim's plane"),
+                              ("rim_hoop_tension", "1 (mu H)", "tau_theta at the rim")):
+        d = ig.create_dataset(name, data=float(state[name]))
+        d.attrs["units"], d.attrs["long_name"] = units, what
 
 
 def write_curve(curve, path, *, profiles=False, overwrite=False, units=None):
