@@ -153,6 +153,8 @@ def curve(scene, delta_max: float = 0.5, *, deltas=None, force_max=None, lambda0
         out.stop_reason = "interrupted"
     except _Stop as stop:
         out.stop_reason = str(stop)
+    # what the stop cost: failed attempts after the last accepted point (issue 14: <= 2 s)
+    settings["after_last_point_s"] = time.perf_counter() - (builder.last_accepted or t0)
     if topology == "auto" and not out.interrupted:
         try:
             _locate_switches(builder, settings)
@@ -209,6 +211,7 @@ class _Builder:
         self.last_wall = None  # the last state with contact on the indenter's cylinder
         self.since_richardson = None  # points added since the last Richardson estimate
         self.last_configuration = None
+        self.last_accepted = None  # perf_counter() when the last point was accepted
 
     def _shown(self, sol: Solution) -> Solution:
         st = self.settings
@@ -244,6 +247,7 @@ class _Builder:
                 self.since_richardson += 1
             self.last_configuration = configuration
         self.rows.append((key, point_record(sol), "; ".join(sol.get("flags", [])), sol))
+        self.last_accepted = time.perf_counter()
         if self.callback is not None:
             self.callback(self.snapshot(), sol)
 

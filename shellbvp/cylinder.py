@@ -49,6 +49,8 @@ WALL_TOPOLOGIES = {"cap+line(cylinder)": cap_line_cylinder_chain, "cap+band(cyli
 #: A cap whose contact edge has reached this fraction of the tip's end, and whose free shell
 #: passes through the indenter, is tried against the wall configurations.
 NEAR_TIP_END = 0.7
+#: The smallest node budget of a wall state's solve (see :func:`wall_state`).
+WALL_MIN_NODES = 2000
 _BAND_HALF_WIDTH = 0.02  # relative half width of a band grown from a line
 _CAP_SPLITS = ((0.97, 1.15), (0.9, 1.3), (0.99, 1.05))  # (S*/Sc, Sc'/Sc) of cap+cylinder guesses from a cap
 
@@ -229,7 +231,10 @@ def wall_state(start: Solution, topology: str, *, control=None, value=None, tol=
     control, value = _control_of(start, control, value)
     t0 = time.perf_counter()
     sysm = make_wall_system(start.scene, topology, control, value, start.system.eps)
-    kw = dict(tol=tol, max_nodes=max_nodes, bc_tol=bc_tol)
+    # a node budget of a few times the start's mesh, as for every guessed configuration: valid
+    # wall states need about their cap's mesh (stability grid: <= 650 nodes), and a guess whose
+    # mesh runs away (a boundary layer: no such state) fails fast instead of at max_nodes
+    kw = dict(tol=tol, max_nodes=int(min(max_nodes, max(WALL_MIN_NODES, 4 * start.nodes))), bc_tol=bc_tol)
     res = None
     for guess in _guesses(sysm, start):
         res = solve_chain_from(sysm, guess, **kw)
