@@ -128,12 +128,12 @@ def worker(spec):
             setattr(m, name, value)
     kw = dict(_curve_kwargs(spec["kind"]), **spec["curve_kw"])
     scipy.integrate.solve_bvp = counted
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     c = sb.curve(scene, **kw)
-    wall = time.perf_counter() - t0
+    wall, cpu = time.perf_counter() - t0, time.process_time() - c0
     scipy.integrate.solve_bvp = orig
     sols = getattr(c, "solutions", None) or []
-    out = dict(wall=wall, points=len(c), stop=c.stop_reason, complete=bool(c.complete),
+    out = dict(wall=wall, cpu=cpu, points=len(c), stop=c.stop_reason, complete=bool(c.complete),
                delta=[float(v) for v in c.delta], force=[float(v) for v in c.force],
                topology=[str(s.get("topology", "cap")) for s in sols] or ["cap"] * len(c),
                valid=[bool(v) for v in c.valid], nodes=[int(v) for v in c.points["nodes"]],
@@ -277,14 +277,14 @@ def shooting(preset, ref, log):
     start = ref["start"][idx[0]]
     rows = []
     for rtol in SHOOT_RTOLS:
-        t0 = time.perf_counter()
+        t0, c0 = time.perf_counter(), time.process_time()
         sc = shoot_curve(sb.Scene.preset(preset), lam, rtol=rtol, guess=(start["Sc"], start["u"]))
-        wall = time.perf_counter() - t0
+        wall, cpu = time.perf_counter() - t0, time.process_time() - c0
         ok = np.asarray(sc.success, bool)
         F = np.asarray(sc.F, float)
         err = np.abs(F[ok] - Fref[ok]) / np.abs(Fref[ok])
-        rows.append(dict(rtol=rtol, points=int(lam.size), converged=int(ok.sum()), wall=wall,
-                         per_point_ms=1e3 * wall / lam.size, max_rel=float(err.max()) if err.size else math.nan))
+        rows.append(dict(rtol=rtol, points=int(lam.size), converged=int(ok.sum()), wall=wall, cpu=cpu,
+                         per_point_ms=1e3 * cpu / lam.size, max_rel=float(err.max()) if err.size else math.nan))
         log(f"  shooting {preset} rtol {rtol:g}: {rows[-1]['converged']}/{lam.size} converged, "
             f"max F error {rows[-1]['max_rel']:.1e}, {rows[-1]['per_point_ms']:.0f} ms/point")
     return rows
@@ -304,12 +304,14 @@ def summarize(data):
             first = rs[0]
             case.setdefault("rows", {})[variant] = dict(
                 wall_median=statistics.median(r["wall"] for r in rs), wall_min=min(r["wall"] for r in rs),
+                cpu_median=statistics.median(r["cpu"] for r in rs),
+                cpu_vs_this=_median_ratio([r["cpu"] for r in rs], [r["cpu"] for r in new]),
                 repeats=len(rs), points=first["points"], calls=first["calls"], niter=first["niter"],
                 failed=first["failed"], richardson=first["richardson"], max_nodes=first["max_nodes"],
                 stop=first["stop"],
                 f_error=first.get("f_error"), compared=first.get("compared"), left_out=first.get("left_out"),
                 calls_per_point=first["calls"] / max(first["points"], 1),
-                ms_per_point=1e3 * statistics.median(r["wall"] for r in rs) / max(first["points"], 1),
+                ms_per_point=1e3 * statistics.median(r["cpu"] for r in rs) / max(first["points"], 1),
                 time_vs_this=_median_ratio([r["wall"] for r in rs], [r["wall"] for r in new]),
                 deterministic_counts=len({(r["calls"], r["niter"]) for r in rs}) == 1)
     return data
@@ -336,23 +338,27 @@ def markdown(data):
     lines = [f"Measured {m['date']} on {m['machine']} ({m['cpus']} cores, shared), Python {m['python']}, "
              f"NumPy {m['numpy']}, SciPy {m['scipy']}: this commit ({m['this_commit']}) against the baseline "
              f"{m['baseline'][:7]}, each curve a fresh process with a warm code cache (its own per side), "
-             f"{m['repeat']} repeats alternating the variants; time: median wall time of the curve; ratio: median "
-             f"over repeats of (variant time / this commit's time in the same repeat); counts (solve_bvp runs, "
+             f"{m['repeat']} repeats alternating the variants; time: median over repeats of the curve's CPU time "
+             f"(the process's, the measure least disturbed by other users of a shared machine) and wall time; "
+             f"ratio: median over repeats of (variant time / this commit's time in the same repeat); speed-ups "
+             f"and per-point times use CPU time; counts (solve_bvp runs, "
              f"of them Richardson estimates, failed runs other than those (a Richardson estimate is one Newton "
              f"iteration on the halved mesh, 'too many nodes' by design), Newton iterations, largest mesh) "
              f"{same}; F error: max relative error "
              f"against states solved at tol {REF_TOL:g} at the same depths (points of another topology than the "
              f"reference's left out; {_check_text(data)}). Total {m['total_s']:.0f} s.", ""]
     variants = list(VARIANTS)
-    lines += ["| curve | variant | time (s) | x this commit | points | solve_bvp runs (Richardson) | failed | "
-              "Newton its | max nodes | ms/point | max F error (compared/left out) |",
-              "|---|---|---|---|---|---|---|---|---|---|---|"]
+    lines += ["| curve | variant | CPU time (s) | x this commit | wall time (s) | x this commit | points | "
+              "solve_bvp runs (Richardson) | failed | Newton its | max nodes | CPU ms/point | "
+              "max F error (compared/left out) |",
+              "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for case in data["cases"]:
         for v in variants:
             r = case["rows"].get(v)
             if r is None:
                 continue
-            lines.append(f"| {case['id']} | {v} | {_fmt(r['wall_median'])} | {_fmt(r['time_vs_this'])} | "
+            lines.append(f"| {case['id']} | {v} | {_fmt(r['cpu_median'])} | {_fmt(r['cpu_vs_this'])} | "
+                         f"{_fmt(r['wall_median'])} | {_fmt(r['time_vs_this'])} | "
                          f"{r['points']} | {r['calls']} ({r['richardson']}) | {r['failed']} | {r['niter']} | "
                          f"{r['max_nodes']} | "
                          f"{_fmt(r['ms_per_point'], '.0f')} | {_fmt(r['f_error'], '.1e')} "
@@ -364,7 +370,7 @@ def markdown(data):
                   f"with delta >= {SHOOT_FROM}, each from its neighbour (tangent predictor; no cold start "
                   "counted), against this commit's default curve per point. 'equal error': the loosest "
                   "shooting rtol whose max F error is at most the collocation curve's.", "",
-                  "| preset | collocation ms/point (max F error) | shooting rtol: ms/point (max F error, converged) "
+                  "| preset | collocation CPU ms/point (max F error) | shooting rtol: CPU ms/point (max F error, converged) "
                   "| shooting / collocation per point at equal or better error |", "|---|---|---|---|"]
         for case in sh:
             r = case["rows"]["this commit"]
@@ -388,10 +394,11 @@ def targets(data):
         if case not in rows:
             return
         r = rows[case]
-        speed = r["baseline"]["time_vs_this"]  # baseline time / this commit's, median over repeats
+        speed = r["baseline"]["cpu_vs_this"]  # baseline CPU time / this commit's, median over repeats
         err = r["this commit"]["f_error"]
-        out.append(dict(target=text, measured=f"{speed:.2f}x ({r['baseline']['wall_median']:.2f} s -> "
-                                                f"{r['this commit']['wall_median']:.2f} s), max F error {_fmt(err, '.1e')}",
+        out.append(dict(target=text, measured=f"{speed:.2f}x CPU time ({r['baseline']['cpu_median']:.2f} s -> "
+                                                f"{r['this commit']['cpu_median']:.2f} s; wall time "
+                                                f"{r['baseline']['time_vs_this']:.2f}x), max F error {_fmt(err, '.1e')}",
                         met="yes" if speed >= want and (err is None or err <= 1e-6) else "no"))
 
     ratio_target("base default", 5, "default base curve to delta 0.5, F error <= 1e-6: >= 5x faster than the baseline")
@@ -480,7 +487,7 @@ def main(argv=None):
                     continue  # what each change bought: measured on the base curves
                 out = sides.run(v, case)
                 entry["runs"][v].append(out)
-                log(f"repeat {rep + 1}: {case[0]:>26} | {v:>16}: {out['wall']:6.2f} s, {out['points']} points, "
+                log(f"repeat {rep + 1}: {case[0]:>26} | {v:>16}: {out['cpu']:6.2f} s CPU, {out['wall']:6.2f} s, {out['points']} points, "
                     f"{out['calls']} solve_bvp, {out['niter']} Newton its")
     for case, entry in zip(cases, data["cases"]):
         entry["runs"] = {v: rs for v, rs in entry["runs"].items() if rs}
