@@ -617,8 +617,9 @@ def _wall_leg(scene, builder, st, last_cap, key, *, reason, deltas=None):
     targets = list(deltas) if deltas is not None else None
     prev = builder.last_wall
     if prev is None:
-        prev, past_end = best_wall_state(last_cap, tried=tried, **kw), last_cap
-        if prev is None and last_cap.get("topology") == "cap":
+        outcomes = []
+        prev, past_end = best_wall_state(last_cap, tried=tried, outcomes=outcomes, **kw), last_cap
+        if prev is None and last_cap.get("topology") == "cap" and _room_may_help(outcomes):
             prev, past_end = _wall_state_deeper(scene, last_cap, st, kw, tried)
         if prev is None:  # not a physical end: a configuration that is missing or not found
             raise _Stop(f"{reason}; no valid contact with the cylinder ({'; '.join(tried)})")
@@ -662,21 +663,36 @@ def _cross(cur, prev, delta, st):
     return sol
 
 
+def _room_may_help(outcomes):
+    """Whether a deeper start may find the wall state that these attempts did not: only if one
+    of them converged (to a state that is inadmissible, status 4, or not valid, status 0) --
+    the contact running back onto the tip, which room on the cylinder cures.  Attempts that
+    all end with a mesh running away (1), a singular Jacobian (2) or unmet conditions (3)
+    found no state at all; going deeper then only repeats them (xi 0 with the paper's
+    contact: 30 s of such attempts after the curve's last point)."""
+    return any(s in (0, 4) for s in outcomes)
+
+
 def _wall_state_deeper(scene, last_cap, st, kw, tried):
     """(a wall state a little deeper than ``last_cap``, the cap there), or (None, last_cap).  Just past the tip's end the
     contact's length on the cylinder is tiny and Newton from the cap lands on states whose
     contact runs back onto the tip; a few hundredths deeper it has room (paper's model, beta
-    1e-3: from delta 0.94 where the end is reached at 0.915).  The switch itself is located
-    afterwards (``_locate_switches``)."""
+    1e-3: from delta 0.94 where the end is reached at 0.915).  Deeper starts are tried while
+    they may help (:func:`_room_may_help`).  The switch itself is located afterwards
+    (``_locate_switches``)."""
     for dd in (0.01, 0.02, 0.04, 0.08):
         if last_cap.delta + dd > st["delta_max"]:
             break
         deeper = _solve_at_delta(scene, last_cap.delta + dd, last_cap, None, st)
         if deeper.status not in (0, 4):  # converged, possibly past the tip's end
             continue
-        wall = best_wall_state(deeper, tried=tried, **kw)
+        outcomes = []
+        wall = best_wall_state(deeper, tried=tried, outcomes=outcomes, **kw)
         if wall is not None:
             return wall, deeper
+        if not _room_may_help(outcomes):
+            tried.append(f"no deeper start tried past delta = {deeper.delta:.6g}: no state found there")
+            break
     return None, last_cap
 
 

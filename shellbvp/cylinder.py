@@ -260,14 +260,15 @@ def _neighbours(topology):
 
 
 def best_wall_state(start: Solution, *, control=None, value=None, tol=1e-6, max_nodes=10000, bc_tol=1e-10,
-                    tried=None):
+                    tried=None, outcomes=None):
     """The valid wall configuration of lowest energy at ``start``'s depth, or None.
 
     From a cap every configuration is tried; from a wall state its own configuration, the
     next deeper one and the one before.  ``tried`` (a list) collects what was tried and why
-    it was not taken.
+    it was not taken, ``outcomes`` (a list) the status of each attempt.
     """
     tried = [] if tried is None else tried
+    outcomes = [] if outcomes is None else outcomes
     order = list(WALL_TOPOLOGIES) if start.get("topology") == "cap" else _neighbours(start.topology)
     if start.scene.contact == "paper":
         order = [t for t in order if t == "cap+cylinder"]
@@ -275,6 +276,7 @@ def best_wall_state(start: Solution, *, control=None, value=None, tol=1e-6, max_
     for topology in order:
         res = wall_state(start, topology, control=control, value=value, tol=tol, max_nodes=max_nodes,
                          bc_tol=bc_tol)
+        outcomes.append(int(res.status))
         if res.success and res.valid:
             valid.append(res)
         else:

@@ -332,11 +332,25 @@ def second_zone_state(cap: Solution, *, tol=1e-6, max_nodes=10000, bc_tol=1e-10,
         guesses.append(transfer_guess(sysm, cap, ln_Sc=math.log(a * S_p), ln_S1=math.log(S1), chi1=rho * w_edge / cap.Sc))
     res = None
     for guess in guesses:
-        res = solve_chain_from(sysm, guess, **kw)
+        res = _probe_then_solve(sysm, guess, solve_chain_from, **kw)
         if res.success and res.valid:
             break
     res.wall_time = time.perf_counter() - t0
     return res
+
+
+def _probe_then_solve(sysm, guess, solve_from, *, tol, max_nodes, bc_tol):
+    """``solve_from`` at tol, after a probe at a loose tolerance on a small mesh when tol is
+    tighter: a guess from which Newton finds no state fails in the probe (a fraction of a
+    second) instead of refining towards the node budget (base, delta 0.1125, where no second
+    zone exists: 3 s); one that converges is tightened from the probe."""
+    if tol >= _PROBE_TOL:
+        return solve_from(sysm, guess, tol=tol, max_nodes=max_nodes, bc_tol=bc_tol)
+    probe = solve_from(sysm, guess, tol=_PROBE_TOL, max_nodes=min(max_nodes, _PROBE_NODES), bc_tol=bc_tol)
+    if not probe.success:
+        return probe
+    x = thin_mesh(probe.x)
+    return solve_from(sysm, (x, probe.sol(x), probe.p), tol=tol, max_nodes=max_nodes, bc_tol=bc_tol)
 
 
 def replace_invalid_cap(cap: Solution, *, tol=1e-6, max_nodes=10000, bc_tol=1e-10, previous=None, before=None):

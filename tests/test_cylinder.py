@@ -274,3 +274,27 @@ def test_a_wall_guess_whose_mesh_runs_away_fails_at_the_node_budget(monkeypatch)
     assert not (res.success and res.valid)
     budget = max(shellbvp.cylinder.WALL_MIN_NODES, 4 * cap.nodes)
     assert meshes and all(limit == budget and n <= budget for n, limit in meshes), (meshes, budget)
+
+
+@pytest.mark.slow  # ~25 s with the code generation of the xi = 0 structure
+def test_no_deeper_wall_starts_where_no_guess_finds_a_state(monkeypatch):
+    """Going deeper past the tip's end gives the contact room on the cylinder: it cures wall
+    states that converge with their contact back on the tip, not guesses that find no state
+    at all (xi 0, paper's contact: every guess's mesh runs away).  The curve stops after the
+    one set of wall attempts from the cap past the end, and says why."""
+    import shellbvp.cylinder
+
+    statuses = []
+    orig = shellbvp.cylinder.solve_bvp
+
+    def counted(*args, **kw):
+        r = orig(*args, **kw)
+        statuses.append(int(r.status))
+        return r
+
+    monkeypatch.setattr(shellbvp.cylinder, "solve_bvp", counted)
+    c = sb.curve(sb.Scene.preset("base", xi=0, contact="paper"), deltas=np.linspace(0.85, 1.0, 7),
+                 estimate_error=False)
+    assert not c.complete and "no valid contact with the cylinder" in c.stop_reason
+    assert c.delta.max() < 0.93
+    assert 1 <= len(statuses) <= len(shellbvp.cylinder._CAP_SPLITS) and 0 not in statuses, statuses
