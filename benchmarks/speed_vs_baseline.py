@@ -421,11 +421,14 @@ def shooting_ratio(case):
     return best["per_point_ms"] / r["ms_per_point"]
 
 
-def meta(args, baseline, total):
+def this_commit():
+    return subprocess.run(["git", "describe", "--always", "--dirty"], cwd=REPO, capture_output=True,
+                          text=True).stdout.strip()
+
+
+def meta(args, baseline, total, head):
     import scipy
 
-    head = subprocess.run(["git", "describe", "--always", "--dirty"], cwd=REPO, capture_output=True,
-                          text=True).stdout.strip()
     return dict(date=datetime.date.today().isoformat(), machine=f"{platform.machine()} {platform.system()}",
                 cpus=os.cpu_count(), python=platform.python_version(), numpy=np.__version__,
                 scipy=scipy.__version__, baseline=baseline, this_commit=head, repeat=args.repeat,
@@ -460,6 +463,7 @@ def main(argv=None):
         worker(json.loads(args.worker))
         return 0
     t_all = time.perf_counter()
+    head = this_commit()  # read now: the workers import this tree as it is now
     if args.quick:
         args.repeat = 1
     cases = CASES[:1] if args.quick else CASES
@@ -513,7 +517,7 @@ def main(argv=None):
                 for k in ("delta", "force", "topology", "valid", "nodes"):
                     r.pop(k, None)
     data["targets"] = targets(data)
-    data["meta"] = meta(args, baseline, time.perf_counter() - t_all)
+    data["meta"] = meta(args, baseline, time.perf_counter() - t_all, head)
     res = (Path(args.out_dir) if args.out_dir else HERE) / "results"
     res.mkdir(parents=True, exist_ok=True)
     name = "speed_vs_baseline-quick" if args.quick else "speed_vs_baseline"
