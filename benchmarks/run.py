@@ -1,6 +1,6 @@
 """Regenerate every benchmark result (issue 5): one command.
 
-    python benchmarks/run.py                 # everything (about 1.5-2 h on 2 shared cores)
+    python benchmarks/run.py                 # everything (about 2-2.5 h on 2 shared cores)
     python benchmarks/run.py --quick         # a small subset, < 2 min: a smoke test (writes *-quick files)
     python benchmarks/run.py --figures       # ... and the paper's figures (benchmarks/paper_figures.py)
     python benchmarks/run.py --only work_precision,profile
@@ -75,6 +75,9 @@ STEPS = (
          ["results/kernels-quick.json", "results/kernels-quick.md"]),
     Step("vella", "vella.py", [], ["--quick"], ["results/vella.json", "results/vella.md"],
          ["results/vella-quick.json", "results/vella-quick.md"]),
+    Step("speed_vs_baseline", "speed_vs_baseline.py", [], ["--quick"],
+         ["results/speed_vs_baseline.json", "results/speed_vs_baseline.md"],
+         ["results/speed_vs_baseline-quick.json", "results/speed_vs_baseline-quick.md"]),
     Step("paper_figures", "paper_figures.py", [], None, ["figures/*.png"], out_flag=None, optional=True),
 )
 

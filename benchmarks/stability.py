@@ -157,6 +157,9 @@ def worker(spec_path, out_path):
     wall = time.perf_counter() - t0
     # seconds spent after the last accepted point (failed attempts before the stop)
     row["stall_s"] = wall - (accepted[-1] - t0) if accepted else wall
+    # ... of which the continuation's own search for a next point (the rest: switches located,
+    # error estimates finished); issue 14: at most 2 s
+    row["after_last_point_s"] = c.settings.get("after_last_point_s")
 
     n = len(c)
     p = c.points
@@ -226,8 +229,8 @@ def diagnose(r):
         out.append(f"Gent limit: max (I1-3)/Jm = {r['gent_ratio_last']:.4f} (F -> infinity)")
     if r["omega_c_last_frac"] > 0.95:
         out.append(f"contact at omega_c = {r['omega_c_last_frac']:.4f} x the tip's end (cylinder)")
-    if r.get("stall_s", 0) > 20:
-        out.append(f"{r['stall_s']:.0f} s spent after the last accepted point")
+    if (r.get("after_last_point_s") or 0) > 2:
+        out.append(f"{r['after_last_point_s']:.1f} s spent after the last accepted point before the stop")
     return "; ".join(out)
 
 
@@ -309,16 +312,16 @@ def markdown(rows, meta):
         f"time limit {meta['time_limit']:.0f} s per curve; total {meta['total_s']:.0f} s.",
         "",
         "| scene | contact | delta reached | max F | stopped | complete | points | max nodes | time (s) "
-        "| max F error | min P | invalid | F < 0 at delta | max \\|dE/dδ − F\\| | contact topologies | at the last point |",
-        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|",
+        "| after the last point (s) | max F error | min P | invalid | F < 0 at delta | max \\|dE/dδ − F\\| | contact topologies | at the last point |",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     for r in rows:
         if r.get("skipped"):
-            lines.append(f"| {r['id']} | {r['contact']} | skipped: {r['skipped'][:50]} |" + " |" * 13)
+            lines.append(f"| {r['id']} | {r['contact']} | skipped: {r['skipped'][:50]} |" + " |" * 14)
             continue
         if not r.get("points"):
             lines.append(f"| {r['id']} | {r['contact']} | — | | {short_reason(r)} | no | 0 | | "
-                         f"{r['wall_time']:.1f} | | | | | | | |")
+                         f"{r['wall_time']:.1f} | | | | | | | | |")
             continue
         neg = ("" if not r["F_negative"] else
                f"{r['F_negative_delta'][0]:.3g}–{r['F_negative_delta'][1]:.3g}")
@@ -328,7 +331,7 @@ def markdown(rows, meta):
         lines.append(
             f"| {r['id']} | {r['contact']} | {r['delta_min']:.3g}–{r['delta_max']:.4g} | {r['force_max']:.4g} "
             f"| {short_reason(r)} | {'yes' if r['complete'] else 'no'} | {r['points']} | {r['nodes_max']} "
-            f"| {r['wall_time']:.1f} | {fe} | {g(r['pressure_min'])} | {r['invalid']} | {neg or 'no'} "
+            f"| {r['wall_time']:.1f} | {g(r.get('after_last_point_s'), '.2f')} | {fe} | {g(r['pressure_min'])} | {r['invalid']} | {neg or 'no'} "
             f"| {g(r['energy_residual_max'], '.1e')} | {r.get('topologies', '')} | {r.get('diagnosis', '')} |")
     lines += [
         "",
@@ -341,8 +344,10 @@ def markdown(rows, meta):
         "~1e-3 for the smooth model is the differencing error at this point spacing, O(0.1-1) for the "
         "paper model and for xi = 0 is real). at the last point: automatic diagnosis of the last point "
         "(det of d(tau_s, M_s)/d(lambda_s, kappa_s) at the contact line, the 2x2 system the free-region "
-        "ODE inverts; Gent's (I1-3)/Jm; contact angle against the tip's end; time spent after the last "
-        "accepted point).",
+        "ODE inverts; Gent's (I1-3)/Jm; contact angle against the tip's end; more than 2 s spent after "
+        "the last accepted point). after the last point: seconds the continuation spent after its last "
+        "accepted point before it stopped (failed attempts; locating switches and finishing the error "
+        "estimates come after and are not counted; issue 14's target: at most 2 s).",
     ]
     return "\n".join(lines) + "\n"
 

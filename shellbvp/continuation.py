@@ -153,6 +153,8 @@ def curve(scene, delta_max: float = 0.5, *, deltas=None, force_max=None, lambda0
         out.stop_reason = "interrupted"
     except _Stop as stop:
         out.stop_reason = str(stop)
+    # what the stop cost: failed attempts after the last accepted point (issue 14: <= 2 s)
+    settings["after_last_point_s"] = time.perf_counter() - (builder.last_accepted or t0)
     if topology == "auto" and not out.interrupted:
         try:
             _locate_switches(builder, settings)
@@ -205,10 +207,11 @@ class _Builder:
         self.settings = settings
         self.tol = settings["tol"]
         self.rows = []  # (order key, row, flags, solution)
-        self.last_liftoff = None
+        self.last_liftoff = self.liftoff_before = None  # the last two lift-off states (warm starts)
         self.last_wall = None  # the last state with contact on the indenter's cylinder
         self.since_richardson = None  # points added since the last Richardson estimate
         self.last_configuration = None
+        self.last_accepted = None  # perf_counter() when the last point was accepted
 
     def _shown(self, sol: Solution) -> Solution:
         st = self.settings
@@ -217,9 +220,9 @@ class _Builder:
         kw = dict(tol=st["tol"], max_nodes=st["max_nodes"], bc_tol=st["bc_tol"])
         shown = sol
         if sol.scene.contact == "smooth":
-            shown = replace_invalid_cap(sol, previous=self.last_liftoff, **kw)
+            shown = replace_invalid_cap(sol, previous=self.last_liftoff, before=self.liftoff_before, **kw)
             if shown is not sol:
-                self.last_liftoff = shown
+                self.liftoff_before, self.last_liftoff = self.last_liftoff, shown
         if shown.get("topology") == "cap" and wall_contact_suspected(shown):
             wall = None
             if self.last_wall is not None:
@@ -244,6 +247,7 @@ class _Builder:
                 self.since_richardson += 1
             self.last_configuration = configuration
         self.rows.append((key, point_record(sol), "; ".join(sol.get("flags", [])), sol))
+        self.last_accepted = time.perf_counter()
         if self.callback is not None:
             self.callback(self.snapshot(), sol)
 
@@ -512,6 +516,13 @@ def _stop_rule(sol, settings):
     return None
 
 
+#: The secant predictor of a delta step is linear in ln Sc; it is used only while it moves
+#: ln Sc by at most this much.  Near the point-load limit the cap grows exponentially (base:
+#: Sc = 9e-12, 2e-6, 1e-4 at delta = 0.0125, 0.025, 0.0375), the secant overshoots by orders
+#: of magnitude and the step fails at the node budget; the plain warm start converges.
+SECANT_MAX_LN_SC = 1.0
+
+
 def _solve_at_delta(scene, delta, prev, prev2, settings):
     """Delta-controlled solve warm-started from prev with a secant predictor from prev2."""
     if prev.get("topology") == "point":
@@ -521,7 +532,8 @@ def _solve_at_delta(scene, delta, prev, prev2, settings):
     if prev2 is not None and prev2.delta != prev.delta and prev2.get("topology") != "point" \
             and edge_model(prev2) == edge_model(prev):
         a = (delta - prev.delta) / (prev.delta - prev2.delta)
-        guess = _secant(sysm, prev, prev2, a)
+        if abs(a * (prev.p[0] - prev2.p[0])) <= SECANT_MAX_LN_SC:
+            guess = _secant(sysm, prev, prev2, a)
     kw = dict(tol=settings["tol"], max_nodes=_step_nodes(prev, settings), bc_tol=settings["bc_tol"])
     sol = solve_from(sysm, guess, **kw)
     if not sol.success and delta > prev.delta and near_limit(prev):
@@ -618,8 +630,9 @@ def _wall_leg(scene, builder, st, last_cap, key, *, reason, deltas=None):
     targets = list(deltas) if deltas is not None else None
     prev = builder.last_wall
     if prev is None:
-        prev, past_end = best_wall_state(last_cap, tried=tried, **kw), last_cap
-        if prev is None and last_cap.get("topology") == "cap":
+        outcomes = []
+        prev, past_end = best_wall_state(last_cap, tried=tried, outcomes=outcomes, **kw), last_cap
+        if prev is None and last_cap.get("topology") == "cap" and _room_may_help(outcomes):
             prev, past_end = _wall_state_deeper(scene, last_cap, st, kw, tried)
         if prev is None:  # not a physical end: a configuration that is missing or not found
             raise _Stop(f"{reason}; no valid contact with the cylinder ({'; '.join(tried)})")
@@ -663,21 +676,36 @@ def _cross(cur, prev, delta, st):
     return sol
 
 
+def _room_may_help(outcomes):
+    """Whether a deeper start may find the wall state that these attempts did not: only if one
+    of them converged (to a state that is inadmissible, status 4, or not valid, status 0) --
+    the contact running back onto the tip, which room on the cylinder cures.  Attempts that
+    all end with a mesh running away (1), a singular Jacobian (2) or unmet conditions (3)
+    found no state at all; going deeper then only repeats them (xi 0 with the paper's
+    contact: 30 s of such attempts after the curve's last point)."""
+    return any(s in (0, 4) for s in outcomes)
+
+
 def _wall_state_deeper(scene, last_cap, st, kw, tried):
     """(a wall state a little deeper than ``last_cap``, the cap there), or (None, last_cap).  Just past the tip's end the
     contact's length on the cylinder is tiny and Newton from the cap lands on states whose
     contact runs back onto the tip; a few hundredths deeper it has room (paper's model, beta
-    1e-3: from delta 0.94 where the end is reached at 0.915).  The switch itself is located
-    afterwards (``_locate_switches``)."""
+    1e-3: from delta 0.94 where the end is reached at 0.915).  Deeper starts are tried while
+    they may help (:func:`_room_may_help`).  The switch itself is located afterwards
+    (``_locate_switches``)."""
     for dd in (0.01, 0.02, 0.04, 0.08):
         if last_cap.delta + dd > st["delta_max"]:
             break
         deeper = _solve_at_delta(scene, last_cap.delta + dd, last_cap, None, st)
         if deeper.status not in (0, 4):  # converged, possibly past the tip's end
             continue
-        wall = best_wall_state(deeper, tried=tried, **kw)
+        outcomes = []
+        wall = best_wall_state(deeper, tried=tried, outcomes=outcomes, **kw)
         if wall is not None:
             return wall, deeper
+        if not _room_may_help(outcomes):
+            tried.append(f"no deeper start tried past delta = {deeper.delta:.6g}: no state found there")
+            break
     return None, last_cap
 
 

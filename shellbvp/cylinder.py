@@ -49,6 +49,8 @@ WALL_TOPOLOGIES = {"cap+line(cylinder)": cap_line_cylinder_chain, "cap+band(cyli
 #: A cap whose contact edge has reached this fraction of the tip's end, and whose free shell
 #: passes through the indenter, is tried against the wall configurations.
 NEAR_TIP_END = 0.7
+#: The smallest node budget of a wall state's solve (see :func:`wall_state`).
+WALL_MIN_NODES = 2000
 _BAND_HALF_WIDTH = 0.02  # relative half width of a band grown from a line
 _CAP_SPLITS = ((0.97, 1.15), (0.9, 1.3), (0.99, 1.05))  # (S*/Sc, Sc'/Sc) of cap+cylinder guesses from a cap
 
@@ -229,7 +231,10 @@ def wall_state(start: Solution, topology: str, *, control=None, value=None, tol=
     control, value = _control_of(start, control, value)
     t0 = time.perf_counter()
     sysm = make_wall_system(start.scene, topology, control, value, start.system.eps)
-    kw = dict(tol=tol, max_nodes=max_nodes, bc_tol=bc_tol)
+    # a node budget of a few times the start's mesh, as for every guessed configuration: valid
+    # wall states need about their cap's mesh (stability grid: <= 650 nodes), and a guess whose
+    # mesh runs away (a boundary layer: no such state) fails fast instead of at max_nodes
+    kw = dict(tol=tol, max_nodes=int(min(max_nodes, max(WALL_MIN_NODES, 4 * start.nodes))), bc_tol=bc_tol)
     res = None
     for guess in _guesses(sysm, start):
         res = solve_chain_from(sysm, guess, **kw)
@@ -255,14 +260,15 @@ def _neighbours(topology):
 
 
 def best_wall_state(start: Solution, *, control=None, value=None, tol=1e-6, max_nodes=10000, bc_tol=1e-10,
-                    tried=None):
+                    tried=None, outcomes=None):
     """The valid wall configuration of lowest energy at ``start``'s depth, or None.
 
     From a cap every configuration is tried; from a wall state its own configuration, the
     next deeper one and the one before.  ``tried`` (a list) collects what was tried and why
-    it was not taken.
+    it was not taken, ``outcomes`` (a list) the status of each attempt.
     """
     tried = [] if tried is None else tried
+    outcomes = [] if outcomes is None else outcomes
     order = list(WALL_TOPOLOGIES) if start.get("topology") == "cap" else _neighbours(start.topology)
     if start.scene.contact == "paper":
         order = [t for t in order if t == "cap+cylinder"]
@@ -270,6 +276,7 @@ def best_wall_state(start: Solution, *, control=None, value=None, tol=1e-6, max_
     for topology in order:
         res = wall_state(start, topology, control=control, value=value, tol=tol, max_nodes=max_nodes,
                          bc_tol=bc_tol)
+        outcomes.append(int(res.status))
         if res.success and res.valid:
             valid.append(res)
         else:

@@ -95,11 +95,19 @@ def liftoff_guess_from_cap(sysm: ChainBVP, cap: Solution, S1_fraction: float, n:
     return t, y, p
 
 
-def liftoff_warm_guess(sysm: ChainBVP, prev: Solution):
-    """A neighbouring lift-off state of the same topology on its thinned mesh."""
+def liftoff_warm_guess(sysm: ChainBVP, prev: Solution, before: Solution | None = None, delta=None):
+    """A neighbouring lift-off state of the same topology on its thinned mesh; with ``before``
+    (the state before ``prev`` on the curve, same topology) and the target ``delta``, moved
+    along their secant to that depth (states, unknowns and delta)."""
     x = thin_mesh(prev.x)
     q = dict(zip(prev.system.unknowns, prev.p), delta=prev.delta)
-    return x, prev.sol(x), sysm.pack(**q)
+    y = prev.sol(x)
+    if before is not None and delta is not None and before.delta != prev.delta:
+        a = (delta - prev.delta) / (prev.delta - before.delta)
+        qb = dict(zip(before.system.unknowns, before.p), delta=before.delta)
+        q = {k: v + a * (v - qb[k]) for k, v in q.items()}
+        y = y + a * (y - before.sol(x))
+    return x, y, sysm.pack(**q)
 
 
 # -- solving --------------------------------------------------------------------------------
@@ -157,9 +165,30 @@ def lift_off_suspected(cap: Solution) -> bool:
                 and (cap.pressure_min < 0 or min(normal) < 0))
 
 
+#: A lift-off state is continued from the previous one of its topology (``previous``) first
+#: when their depths differ by at most this fraction of the larger; farther, the cap is the
+#: better guess.
+WARM_REACH = 0.5
+#: Node budget of that warm start, in multiples of the previous state's mesh: a neighbour
+#: needs about its own mesh, and a start that does not converge must fail fast.
+WARM_NODES = 3
+_WARM_FIRST = True  # False: the cap's guesses first, as before issue 14 (benchmarks measure the gain)
+
+
+def _near(state, cap, topology):
+    return (state is not None and state.get("topology") == topology and state.get("success")
+            and abs(state.delta - cap.delta) <= WARM_REACH * max(state.delta, cap.delta))
+
+
 def liftoff_state(cap: Solution, topology: str, *, tol=1e-6, max_nodes=10000, bc_tol=1e-10,
-                  previous: Solution | None = None):
+                  previous: Solution | None = None, before: Solution | None = None):
     """The ``topology`` state at the cap's delta (or force), from ``previous`` or from the cap.
+
+    ``previous`` (and ``before`` it) are the last lift-off states of a curve: when
+    ``previous`` has this topology and a nearby depth (``WARM_REACH``), the state is
+    continued from it first (along the secant through ``before`` when that is near too),
+    with a node budget of ``WARM_NODES`` times its mesh; else, or if that fails, from
+    guesses made from the cap, then from ``previous`` as it is.
 
     Returns a Solution (check ``success`` and ``valid``).  An annulus whose inner edge
     runs to the pole is the cap itself: it is returned as a failure saying so.
@@ -167,20 +196,28 @@ def liftoff_state(cap: Solution, topology: str, *, tol=1e-6, max_nodes=10000, bc
     control = cap.control if cap.control in ("force", "lambda0") else "delta"
     value = {"force": cap.force, "lambda0": cap.lambda0, "delta": cap.delta}[control]
     sysm = make_liftoff_system(cap.scene, topology, control, value, cap.system.eps)
-    # The cap is the better guess (the lift-off state is close to it near the switch and
-    # its contact edge is where the cap's is); a neighbour of the same topology is the
-    # fallback.  A node budget of a few times the cap's makes hopeless starts fail fast.
+    # Far from a neighbour the cap is the better guess (the lift-off state is close to it
+    # near the switch and its contact edge is where the cap's is).  A node budget of a few
+    # times the cap's makes hopeless starts fail fast.
     kw = dict(tol=tol, max_nodes=int(min(max_nodes, max(2000, 4 * cap.nodes))), bc_tol=bc_tol)
     attempt = _solve_annulus if topology == "annulus" else solve_liftoff_from
+    tries = []
+    warm = _WARM_FIRST and _near(previous, cap, topology)
+    if warm:
+        secant = before if control == "delta" and _near(before, cap, topology) else None
+        guess = liftoff_warm_guess(sysm, previous, secant, cap.delta if secant is not None else None)
+        budget = int(min(kw["max_nodes"], WARM_NODES * previous.nodes))
+        tries.append(attempt(sysm, guess, **dict(kw, max_nodes=budget)))
+        if tries[-1].success and not _closed_at_pole(tries[-1]):
+            return tries[-1]
     # The annulus equations also hold, degenerately, for the cap (S1 -> 0): Newton may run
     # there from one guess and find a true annulus from another, so every guess is tried.
-    tries = []
     for frac in ((0.9, 0.5) if topology == "line" else (0.5, 0.9)):
         tries.append(attempt(sysm, liftoff_guess_from_cap(sysm, cap, frac), **kw))
         if tries[-1].success and not _closed_at_pole(tries[-1]):
             break
     else:
-        if previous is not None and previous.get("topology") == topology:
+        if previous is not None and previous.get("topology") == topology and not warm:
             tries.append(attempt(sysm, liftoff_warm_guess(sysm, previous), **kw))
     good = [r for r in tries if r.success and not _closed_at_pole(r)]
     closed = [r for r in tries if _closed_at_pole(r)]
@@ -220,7 +257,7 @@ def _solve_annulus(sysm, guess, *, tol, max_nodes, bc_tol):
     return solve_liftoff_from(sysm, guess, tol=tol, max_nodes=max_nodes, bc_tol=bc_tol)
 
 
-def valid_liftoff_state(cap: Solution, *, tol=1e-6, max_nodes=10000, bc_tol=1e-10, previous=None):
+def valid_liftoff_state(cap: Solution, *, tol=1e-6, max_nodes=10000, bc_tol=1e-10, previous=None, before=None):
     """A valid line or annular state where the cap is invalid; (state or None, what was tried).
 
     A contact radius below ``POINT_LIMIT_SC`` is taken as its point-load limit
@@ -243,7 +280,8 @@ def valid_liftoff_state(cap: Solution, *, tol=1e-6, max_nodes=10000, bc_tol=1e-1
             # bent through the tip, Newton only walks its inner edge to the pole (seconds)
             tried.append("annulus: not tried (the cap pulls everywhere)")
             continue
-        res = liftoff_state(cap, topology, tol=tol, max_nodes=max_nodes, bc_tol=bc_tol, previous=previous)
+        res = liftoff_state(cap, topology, tol=tol, max_nodes=max_nodes, bc_tol=bc_tol, previous=previous,
+                            before=before)
         if res.success and res.valid:
             return res, tried
         line_too_curved |= topology == "line" and res.get("curvature_excess", -1.0) > 0
@@ -295,20 +333,36 @@ def second_zone_state(cap: Solution, *, tol=1e-6, max_nodes=10000, bc_tol=1e-10,
         guesses.append(transfer_guess(sysm, cap, ln_Sc=math.log(a * S_p), ln_S1=math.log(S1), chi1=rho * w_edge / cap.Sc))
     res = None
     for guess in guesses:
-        res = solve_chain_from(sysm, guess, **kw)
+        res = _probe_then_solve(sysm, guess, solve_chain_from, **kw)
         if res.success and res.valid:
             break
     res.wall_time = time.perf_counter() - t0
     return res
 
 
-def replace_invalid_cap(cap: Solution, *, tol=1e-6, max_nodes=10000, bc_tol=1e-10, previous=None):
+def _probe_then_solve(sysm, guess, solve_from, *, tol, max_nodes, bc_tol):
+    """``solve_from`` at tol, after a probe at a loose tolerance on a small mesh when tol is
+    tighter: a guess from which Newton finds no state fails in the probe (a fraction of a
+    second) instead of refining towards the node budget (base, delta 0.1125, where no second
+    zone exists: 3 s); one that converges is tightened from the probe."""
+    if tol >= _PROBE_TOL:
+        return solve_from(sysm, guess, tol=tol, max_nodes=max_nodes, bc_tol=bc_tol)
+    probe = solve_from(sysm, guess, tol=_PROBE_TOL, max_nodes=min(max_nodes, _PROBE_NODES), bc_tol=bc_tol)
+    if not probe.success:
+        return probe
+    x = thin_mesh(probe.x)
+    return solve_from(sysm, (x, probe.sol(x), probe.p), tol=tol, max_nodes=max_nodes, bc_tol=bc_tol)
+
+
+def replace_invalid_cap(cap: Solution, *, tol=1e-6, max_nodes=10000, bc_tol=1e-10, previous=None, before=None):
     """The state to report for a cap state: itself if it does not pull, else the valid
     lift-off state (with ``cap_state``/``cap_solution`` kept), else the cap flagged with
-    what was tried."""
+    what was tried.  ``previous``, ``before``: the last two lift-off states of a curve
+    (warm starts, :func:`liftoff_state`)."""
     if not lift_off_suspected(cap):
         return cap
-    alt, tried = valid_liftoff_state(cap, tol=tol, max_nodes=max_nodes, bc_tol=bc_tol, previous=previous)
+    alt, tried = valid_liftoff_state(cap, tol=tol, max_nodes=max_nodes, bc_tol=bc_tol, previous=previous,
+                                     before=before)
     if alt is None:
         cap.flags = list(cap.flags) + ["no valid lift-off state found (" + "; ".join(tried) + ")"]
         return cap

@@ -41,7 +41,7 @@ def wp():
 def test_full_plan_regenerates_everything(run):
     names = [s.name for s, _ in run.plan()]
     assert names == ["work_precision", "profile", "stability", "shooting", "states_table", "preset_curves",
-                     "topologies", "codegen_timing", "kernels", "vella"]
+                     "topologies", "codegen_timing", "kernels", "vella", "speed_vs_baseline"]
     for s, argv in run.plan():
         assert argv[0] == sys.executable and Path(argv[1]).exists()
         assert "--quick" not in argv
@@ -127,3 +127,15 @@ def test_quick_run_smoke(tmp_path):
     assert max(r["max_rel"] for r in base["natural"]) < 1e-3
     # nothing written into the committed results
     assert not [p.name for p in (BENCH / "results").iterdir() if p.stat().st_mtime >= start]
+
+
+def test_speed_vs_baseline_compares_points_of_the_same_depth_and_topology():
+    sv = _load("speed_vs_baseline")
+    ref = dict(delta=[0.1, 0.2, 0.3], force=[1.0, 2.0, 3.0], topology=["line", "cap", "cap"])
+    run = dict(delta=[0.1, 0.2, 0.3], force=[1.5, 2.0 + 2e-7, 3.0 - 3e-6], topology=["cap", "cap", "cap"])
+    worst, compared, left = sv.f_error(run, ref)
+    assert compared == 2 and left == 1  # the depth where the reference is a line: left out
+    assert worst == pytest.approx(1e-6)
+    assert list(sv._distinct([0.3, 0.1, 0.1 * (1 + 1e-14), 0.2])) == [0.1, 0.2, 0.3]
+    with pytest.raises(SystemExit):
+        sv.parse_args(["--repeat", "0"])

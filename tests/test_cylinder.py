@@ -247,3 +247,54 @@ def test_paper_model_runs_onto_the_cylinder_when_the_first_wall_guess_has_no_roo
     sw = [s for s in c.settings["topology_switches"] if s["to"] == "cap+cylinder"]
     assert len(sw) == 1 and 0.905 < sw[0]["delta"] < 0.925
     assert set(c.topology[c.delta > sw[0]["delta"] + 1e-6]) == {"cap+cylinder"}
+
+
+@pytest.mark.slow  # ~25 s, most of it generating the code of the xi = 0 structure
+def test_a_wall_guess_whose_mesh_runs_away_fails_at_the_node_budget(monkeypatch):
+    """xi = 0 with the paper's contact has no valid state on the cylinder past the tip's end
+    (benchmarks/results/stability.md); a guess there refined its mesh to max_nodes (8101
+    nodes, ~10 s a try, 34 s after the curve's last point).  The budget is a few times the
+    cap's mesh, as for every guessed configuration."""
+    import shellbvp.cylinder
+
+    meshes = []
+    orig = shellbvp.cylinder.solve_bvp
+
+    def counted(*args, **kw):
+        r = orig(*args, **kw)
+        meshes.append((int(r.x.size), kw["max_nodes"]))
+        return r
+
+    scene = sb.Scene.preset("base", xi=0, contact="paper")
+    near = sb.curve(scene, deltas=np.linspace(0.2, 0.9, 8), estimate_error=False, topology="cap").solutions[-1]
+    cap = sb.solve(scene, delta=0.97, guess=near, topology="cap", estimate_error=False)
+    assert cap.status in (0, 4) and wall_contact_suspected(cap)
+    monkeypatch.setattr(shellbvp.cylinder, "solve_bvp", counted)
+    res = wall_state(cap, "cap+cylinder")
+    assert not (res.success and res.valid)
+    budget = max(shellbvp.cylinder.WALL_MIN_NODES, 4 * cap.nodes)
+    assert meshes and all(limit == budget and n <= budget for n, limit in meshes), (meshes, budget)
+
+
+@pytest.mark.slow  # ~25 s with the code generation of the xi = 0 structure
+def test_no_deeper_wall_starts_where_no_guess_finds_a_state(monkeypatch):
+    """Going deeper past the tip's end gives the contact room on the cylinder: it cures wall
+    states that converge with their contact back on the tip, not guesses that find no state
+    at all (xi 0, paper's contact: every guess's mesh runs away).  The curve stops after the
+    one set of wall attempts from the cap past the end, and says why."""
+    import shellbvp.cylinder
+
+    statuses = []
+    orig = shellbvp.cylinder.solve_bvp
+
+    def counted(*args, **kw):
+        r = orig(*args, **kw)
+        statuses.append(int(r.status))
+        return r
+
+    monkeypatch.setattr(shellbvp.cylinder, "solve_bvp", counted)
+    c = sb.curve(sb.Scene.preset("base", xi=0, contact="paper"), deltas=np.linspace(0.85, 1.0, 7),
+                 estimate_error=False)
+    assert not c.complete and "no valid contact with the cylinder" in c.stop_reason
+    assert c.delta.max() < 0.93
+    assert 1 <= len(statuses) <= len(shellbvp.cylinder._CAP_SPLITS) and 0 not in statuses, statuses

@@ -257,3 +257,66 @@ def test_a_cap_pressed_at_the_pole_and_pulling_further_out_splits_into_a_cap_and
     slope, kinds = _energy_slope(scene, delta)
     assert kinds == {"cap+line(tip)"}
     assert abs(slope - s.force) < 1e-8 + 10 * s.force_error
+
+
+# -- warm starts of lift-off states (issue 14 item 1) -------------------------------------------------
+class _Count:
+    """solve_bvp runs and Newton iterations of the lift-off solves (counts are deterministic)."""
+
+    def __init__(self, monkeypatch):
+        import shellbvp.liftoff
+
+        self.calls = self.niter = 0
+        orig = shellbvp.liftoff.solve_bvp
+
+        def counted(*args, **kw):
+            r = orig(*args, **kw)
+            self.calls += 1
+            self.niter += int(r.niter)
+            return r
+
+        monkeypatch.setattr(shellbvp.liftoff, "solve_bvp", counted)
+
+
+@pytest.mark.parametrize("scene_kw, deltas", [({}, np.linspace(0.04, 0.1, 5)),
+                                              (ANNULAR, np.linspace(0.095, 0.105, 4))])
+def test_warm_lift_off_gives_the_same_curve_with_fewer_newton_iterations(monkeypatch, scene_kw, deltas):
+    import shellbvp.liftoff
+
+    scene = sb.Scene.preset("base", **scene_kw)
+    curves, counts = {}, {}
+    for warm in (False, True):
+        with monkeypatch.context() as m:
+            m.setattr(shellbvp.liftoff, "_WARM_FIRST", warm)
+            counts[warm] = _Count(m)
+            curves[warm] = sb.curve(scene, deltas=deltas, estimate_error="full")
+    cold, warm = curves[False], curves[True]
+    assert cold.complete and warm.complete
+    assert list(warm.topology) == list(cold.topology) and set(warm.topology) <= {"line", "annulus"}
+    assert np.all(warm.valid)
+    # the same states, to the solver's accuracy (their Richardson estimates)
+    bound = 10 * np.maximum(warm.points["force_error"], cold.points["force_error"]) + 1e-12
+    assert np.all(np.abs(warm.force - cold.force) <= bound), (warm.force - cold.force, bound)
+    # continued from the neighbour: no more solves, fewer Newton iterations
+    assert counts[True].calls <= counts[False].calls
+    assert counts[True].niter < counts[False].niter, (counts[True].niter, counts[False].niter)
+
+
+def test_no_failed_step_where_the_cap_grows_exponentially(monkeypatch):
+    """Near the point-load limit Sc grows by orders of magnitude per step (base: 9e-12, 2e-6,
+    1e-4 at delta 0.0125, 0.025, 0.0375): a secant linear in ln Sc overshoots and the step
+    failed at the node budget; the plain warm start converges at once."""
+    import shellbvp.state
+
+    failed = []
+    orig = shellbvp.state.solve_bvp
+
+    def counted(*args, **kw):
+        r = orig(*args, **kw)
+        failed.append(not r.success)
+        return r
+
+    monkeypatch.setattr(shellbvp.state, "solve_bvp", counted)
+    c = sb.curve(sb.Scene.preset("base"), deltas=[0.0125, 0.025, 0.0375], estimate_error=False, topology="cap")
+    assert c.complete and len(failed) >= 3
+    assert not any(failed), failed

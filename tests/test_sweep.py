@@ -122,6 +122,7 @@ def _contents(path):
         if isinstance(v, str) and v.startswith("{"):
             v = json.loads(v)
             v.pop("wall_time", None)  # a curve's settings record its time
+            v.pop("after_last_point_s", None)  # ... and what its stop cost
         return np.asarray(v).tolist() if not isinstance(v, dict) else v
 
     out = {}

@@ -1,0 +1,532 @@
+"""The package at this commit against the package at a baseline commit, and against shooting (issue 14).
+
+One run measures, side by side on the same machine, the curves of the base scene (the default
+adaptive curve; 40 depths ``linspace(0.0125, 0.5, 40)`` with lift-off; the same cap-only) and
+the default curve of every other preset: wall time, solve_bvp runs, Newton iterations, nodes,
+and the largest relative F error of each curve against a reference (every depth at tol 1e-9,
+every 12th also at 1e-10 to show the reference's own error).
+
+* The baseline (default 1109cdf) is extracted with ``git archive`` into a work directory and
+  imported from there (``PYTHONPATH``); this commit is the checkout this script lives in.
+  Each side has its own code cache (``XDG_CACHE_HOME`` and ``SHELLBVP_CACHE_DIR``), warmed
+  before timing, so the generated modules of the two never collide.
+* Every curve is a fresh process (``--worker``) that loads the cached model, then times the
+  curve alone; solve_bvp runs and Newton iterations are counted by wrapping
+  ``scipy.integrate.solve_bvp`` in that process (both sides import it on first use).
+* Runs alternate: each repeat runs every case on every variant, the variants' order rotating,
+  so that a noisy shared machine weighs on both sides alike; a ratio is the median of the
+  per-repeat ratios.
+* Variants of this commit with one change switched off by a private flag measure what each
+  change bought: ``cold lift-off`` (lift-off states from the cap's guesses first, as before),
+  ``no secant guard`` (the secant predictor in ln Sc unguarded), ``full Richardson``
+  (``estimate_error="full"``: a Richardson solve at every point, as at the baseline); these
+  on the three base curves only.
+* Shooting (``benchmarks/shooting.py``, the paper's method) re-solves the reference's cap
+  states (delta >= 0.15) at its rtol 1e-8 and 1e-9, each from its neighbour with the
+  tangent predictor (the first from the reference's own unknowns: no cold start is counted);
+  its time per point at equal or better F error than the collocation curve is compared with
+  the collocation curve's time per point.
+
+Writes benchmarks/results/speed_vs_baseline.json and .md (``--quick``: base default curve, one
+repeat, no shooting, ``speed_vs_baseline-quick.*``).
+
+    python benchmarks/speed_vs_baseline.py [--baseline 1109cdf] [--repeat 3] [--quick] [--out-dir DIR]
+"""
+
+from __future__ import annotations
+
+import argparse
+import datetime
+import io
+import json
+import math
+import os
+import platform
+import statistics
+import subprocess
+import sys
+import tarfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+HERE = Path(__file__).resolve().parent
+REPO = HERE.parent
+#: The reference: every depth at tol 1e-9 (at 1e-10 a state costs ~10x: 3-10 s and 5000-7000 nodes
+#: on the base curve, 30 s and a failure at 30000 nodes at delta 0.49); every CHECK_EVERY-th
+#: depth also at 1e-10 (base: the two agree to ~1e-12 relative)
+REF_TOL, CHECK_TOL, CHECK_EVERY, REF_MAX_NODES = 1e-9, 1e-10, 12, 30000
+DELTAS40 = np.linspace(0.0125, 0.5, 40)
+SHOOT_RTOLS = (1e-8, 1e-9)  # F errors ~2e-7 and ~1e-8 on base (work_precision.md)
+SHOOT_FROM = 0.15  # shooting solves single caps: from where every preset's curve is a cap
+
+#: (id, preset, kind): the curves compared
+CASES = [("base default", "base", "default"), ("base 40 depths", "base", "deltas40"),
+         ("base 40 depths, cap only", "base", "deltas40-cap")] + [
+    (f"{p} default", p, "default") for p in ("base-xi0", "prolate2", "fit", "flat", "gent1", "dome")]
+
+#: variant -> (side, patches {module: {attribute: value}}, curve keyword arguments)
+VARIANTS = {
+    "baseline": ("old", {}, {}),
+    "this commit": ("new", {}, {}),
+    "cold lift-off": ("new", {"shellbvp.liftoff": {"_WARM_FIRST": False}}, {}),
+    "no secant guard": ("new", {"shellbvp.continuation": {"SECANT_MAX_LN_SC": math.inf}}, {}),
+    "full Richardson": ("new", {}, {"estimate_error": "full"}),
+}
+
+ABLATIONS = ("cold lift-off", "no secant guard", "full Richardson")  # run on the base curves only
+
+
+# ---------------------------------------------------------------------------------------------
+# the worker: one curve in a fresh process
+# ---------------------------------------------------------------------------------------------
+def _curve_kwargs(kind):
+    if kind == "default":
+        return {}
+    if kind == "deltas40":
+        return {"deltas": DELTAS40}
+    if kind == "deltas40-cap":
+        return {"deltas": DELTAS40, "topology": "cap"}
+    raise ValueError(f"unknown curve kind {kind!r}")
+
+
+def worker(spec):
+    """Run one curve as ``spec`` says; print one JSON line of measurements."""
+    import importlib
+
+    import scipy.integrate
+
+    import shellbvp as sb
+
+    import sys as _sys
+
+    counts = dict(calls=0, niter=0, richardson=0, failed=0, max_nodes=0)
+    orig = scipy.integrate.solve_bvp
+
+    def counted(*args, **kw):
+        r = orig(*args, **kw)
+        counts["calls"] += 1
+        counts["niter"] += int(r.niter)
+        # a Richardson estimate is one Newton iteration on the halved mesh, whose status is
+        # "too many nodes" by design: counted apart, not as a failure
+        f, richardson = _sys._getframe(1), False
+        while f is not None and not richardson:
+            richardson, f = f.f_code.co_name == "richardson_error", f.f_back
+        counts["richardson"] += int(richardson)
+        counts["failed"] += int(not r.success and not richardson)
+        counts["max_nodes"] = max(counts["max_nodes"], int(r.x.size))
+        return r
+
+    scene = sb.Scene.preset(spec["preset"])
+    scene.model()  # the cached generated code: loaded, not timed
+    for module, attrs in spec["patches"].items():
+        m = importlib.import_module(module)
+        for name, value in attrs.items():
+            if not hasattr(m, name):
+                raise SystemExit(f"{module} has no {name}: this variant does not apply to this tree")
+            setattr(m, name, value)
+    kw = dict(_curve_kwargs(spec["kind"]), **spec["curve_kw"])
+    scipy.integrate.solve_bvp = counted
+    t0, c0 = time.perf_counter(), time.process_time()
+    c = sb.curve(scene, **kw)
+    wall, cpu = time.perf_counter() - t0, time.process_time() - c0
+    scipy.integrate.solve_bvp = orig
+    sols = getattr(c, "solutions", None) or []
+    out = dict(wall=wall, cpu=cpu, points=len(c), stop=c.stop_reason, complete=bool(c.complete),
+               delta=[float(v) for v in c.delta], force=[float(v) for v in c.force],
+               topology=[str(s.get("topology", "cap")) for s in sols] or ["cap"] * len(c),
+               valid=[bool(v) for v in c.valid], nodes=[int(v) for v in c.points["nodes"]],
+               shellbvp=str(Path(sb.__file__).parent), **counts)
+    print(json.dumps(out))
+
+
+# ---------------------------------------------------------------------------------------------
+# the driver
+# ---------------------------------------------------------------------------------------------
+def extract(commit, dest: Path) -> str:
+    """``git archive`` of ``commit`` into ``dest`` (once); returns the full hash."""
+    full = subprocess.run(["git", "rev-parse", commit], cwd=REPO, capture_output=True, text=True,
+                          check=True).stdout.strip()
+    stamp = dest / ".commit"
+    if not (stamp.exists() and stamp.read_text() == full):
+        dest.mkdir(parents=True, exist_ok=True)
+        tar = subprocess.run(["git", "archive", "--format=tar", full], cwd=REPO, capture_output=True,
+                             check=True).stdout
+        with tarfile.open(fileobj=io.BytesIO(tar)) as t:
+            t.extractall(dest, filter="data")
+        stamp.write_text(full)
+    return full
+
+
+class Sides:
+    def __init__(self, work: Path, old_tree: Path):
+        self.trees = {"old": old_tree, "new": REPO}
+        self.caches = {side: work / f"cache-{side}" for side in self.trees}
+
+    def env(self, side):
+        env = dict(os.environ, PYTHONPATH=str(self.trees[side]), XDG_CACHE_HOME=str(self.caches[side]),
+                   SHELLBVP_CACHE_DIR=str(self.caches[side] / "shellbvp"), PYTHONHASHSEED="0")
+        env.pop("PYTHONSTARTUP", None)
+        return env
+
+    def run(self, variant, case):
+        side, patches, curve_kw = VARIANTS[variant]
+        _, preset, kind = case
+        spec = dict(preset=preset, kind=kind, patches=patches, curve_kw=curve_kw)
+        r = subprocess.run([sys.executable, str(Path(__file__).resolve()), "--worker", json.dumps(spec)],
+                           env=self.env(side), capture_output=True, text=True, cwd=str(self.trees[side]))
+        if r.returncode != 0:
+            raise RuntimeError(f"{variant} / {case[0]} failed:\n{r.stderr[-3000:]}")
+        out = json.loads(r.stdout.strip().splitlines()[-1])
+        if Path(out["shellbvp"]).resolve().parent != self.trees[side].resolve():
+            raise RuntimeError(f"{variant} imported {out['shellbvp']}, not the {side} tree")
+        return out
+
+    def warm(self, presets, log):
+        """Generate every structure's code into each side's cache (not timed)."""
+        code = "import sys, shellbvp as sb\nfor p in sys.argv[1:]: sb.Scene.preset(p).model()"
+        for side in self.trees:
+            t0 = time.perf_counter()
+            subprocess.run([sys.executable, "-c", code, *presets], env=self.env(side), check=True,
+                           cwd=str(self.trees[side]))
+            log(f"code cache of the {side} side ready in {time.perf_counter() - t0:.0f} s")
+
+
+def _tight(scene, state, tol):
+    """``state`` solved again at ``tol``, same depth and topology, warm from it."""
+    import shellbvp as sb
+    from shellbvp.pointload import solve_point_load
+    from shellbvp.state import TOPOLOGIES
+
+    top = state.get("topology", "cap")
+    if top == "point":
+        return solve_point_load(scene, float(state.delta), tol=tol, max_nodes=REF_MAX_NODES, guess=state)
+    return sb.solve(scene, delta=float(state.delta), tol=tol, guess=state, max_nodes=REF_MAX_NODES,
+                    estimate_error=False, topology=top if top in TOPOLOGIES else "auto")
+
+
+def reference(preset, deltas, topology, log, quick=False):
+    """F at each depth solved at tol REF_TOL, each state warm from the state of the same
+    topology at that depth on a tol-1e-6 curve through the same depths (as work_precision.py
+    does); every CHECK_EVERY-th depth also at CHECK_TOL, to show the reference's own error.
+    With each state's topology, lambda0 and, for caps, shooting's unknowns (Sc, u = rQ(Sc+))."""
+    import shellbvp as sb
+
+    t0 = time.perf_counter()
+    scene = sb.Scene.preset(preset)
+    c = sb.curve(scene, deltas=deltas, estimate_error=False, topology=topology)
+    ref = dict(delta=[], force=[], lambda0=[], topology=[], start=[], nodes=[], check=[])
+    for i, s in enumerate(c.solutions):
+        r = _tight(scene, s, REF_TOL)
+        ok = bool(r.success)
+        ref["delta"].append(float(s.delta))
+        ref["force"].append(float(r.force) if ok else math.nan)
+        ref["lambda0"].append(float(r.lambda0) if ok else math.nan)
+        ref["topology"].append(str(r.get("topology", "cap")) if ok else "failed")
+        ref["nodes"].append(int(r.nodes))
+        is_cap = ok and r.get("topology", "cap") == "cap" and r.y.shape[0] == 8
+        ref["start"].append(dict(Sc=float(r.Sc), u=float(r.y[6, 0])) if is_cap else None)
+        if ok and not quick and i % CHECK_EVERY == 0:
+            t = _tight(scene, r, CHECK_TOL)
+            ref["check"].append(dict(delta=float(s.delta), topology=ref["topology"][-1], converged=bool(t.success),
+                                     rel=abs(t.force - r.force) / abs(r.force) if t.success else math.nan))
+    ref.update(complete=bool(c.complete), stop=c.stop_reason, seconds=time.perf_counter() - t0)
+    rels = [ch["rel"] for ch in ref["check"] if ch["converged"]]
+    log(f"  reference {preset} ({topology}) at tol {REF_TOL:g}: {len(ref['delta'])} depths, "
+        f"{sum(t != 'failed' for t in ref['topology'])} converged, max nodes {max(ref['nodes'], default=0)}; "
+        f"tol {CHECK_TOL:g} at {len(rels)}/{len(ref['check'])} of them: max |dF|/F {max(rels, default=math.nan):.1e}; "
+        f"{ref['seconds']:.0f} s")
+    return ref
+
+
+def _distinct(depths):
+    """The depths sorted, without repeats closer than 1e-12 relative."""
+    d = np.sort(np.asarray(depths, float))
+    return d[np.r_[True, np.diff(d) > 1e-12 * (1 + d[1:])]]
+
+
+def f_error(run, ref):
+    """Largest relative F error of a curve against the reference, over the points where the
+    reference has a state of the same topology at the same depth (compared, left out)."""
+    rd = np.asarray(ref["delta"])
+    worst, compared, left = 0.0, 0, 0
+    for d, F, top in zip(run["delta"], run["force"], run["topology"]):
+        i = int(np.argmin(np.abs(rd - d))) if rd.size else -1
+        if i < 0 or abs(rd[i] - d) > 1e-12 * (1 + d) or ref["topology"][i] != top or not math.isfinite(ref["force"][i]):
+            left += 1
+            continue
+        worst = max(worst, abs(F - ref["force"][i]) / abs(ref["force"][i]))
+        compared += 1
+    return (worst if compared else math.nan), compared, left
+
+
+def shooting(preset, ref, log):
+    """Shooting at the reference's cap states with delta >= SHOOT_FROM: per rtol, its time
+    per point and max relative F error (at equal lambda0)."""
+    sys.path.insert(0, str(HERE))
+    from shooting import shoot_curve
+
+    import shellbvp as sb
+
+    idx = [i for i, (d, s) in enumerate(zip(ref["delta"], ref["start"])) if s is not None and d >= SHOOT_FROM]
+    if not idx:
+        return []
+    lam = np.array([ref["lambda0"][i] for i in idx])
+    Fref = np.array([ref["force"][i] for i in idx])
+    start = ref["start"][idx[0]]
+    rows = []
+    for rtol in SHOOT_RTOLS:
+        t0, c0 = time.perf_counter(), time.process_time()
+        sc = shoot_curve(sb.Scene.preset(preset), lam, rtol=rtol, guess=(start["Sc"], start["u"]))
+        wall, cpu = time.perf_counter() - t0, time.process_time() - c0
+        ok = np.asarray(sc.success, bool)
+        F = np.asarray(sc.F, float)
+        err = np.abs(F[ok] - Fref[ok]) / np.abs(Fref[ok])
+        rows.append(dict(rtol=rtol, points=int(lam.size), converged=int(ok.sum()), wall=wall, cpu=cpu,
+                         per_point_ms=1e3 * cpu / lam.size, max_rel=float(err.max()) if err.size else math.nan))
+        log(f"  shooting {preset} rtol {rtol:g}: {rows[-1]['converged']}/{lam.size} converged, "
+            f"max F error {rows[-1]['max_rel']:.1e}, {rows[-1]['per_point_ms']:.0f} ms/point")
+    return rows
+
+
+def _median_ratio(num, den):
+    r = [a / b for a, b in zip(num, den) if b > 0]
+    return statistics.median(r) if r else math.nan
+
+
+def summarize(data):
+    """Per case and variant: medians, counts, errors, ratios to this commit (in place)."""
+    for case in data["cases"]:
+        runs = case["runs"]
+        new = runs["this commit"]
+        for variant, rs in runs.items():
+            first = rs[0]
+            case.setdefault("rows", {})[variant] = dict(
+                wall_median=statistics.median(r["wall"] for r in rs), wall_min=min(r["wall"] for r in rs),
+                cpu_median=statistics.median(r["cpu"] for r in rs),
+                cpu_vs_this=_median_ratio([r["cpu"] for r in rs], [r["cpu"] for r in new]),
+                repeats=len(rs), points=first["points"], calls=first["calls"], niter=first["niter"],
+                failed=first["failed"], richardson=first["richardson"], max_nodes=first["max_nodes"],
+                stop=first["stop"],
+                f_error=first.get("f_error"), compared=first.get("compared"), left_out=first.get("left_out"),
+                calls_per_point=first["calls"] / max(first["points"], 1),
+                ms_per_point=1e3 * statistics.median(r["cpu"] for r in rs) / max(first["points"], 1),
+                time_vs_this=_median_ratio([r["wall"] for r in rs], [r["wall"] for r in new]),
+                deterministic_counts=len({(r["calls"], r["niter"]) for r in rs}) == 1)
+    return data
+
+
+def _fmt(v, f=".2f"):
+    return "–" if v is None or (isinstance(v, float) and not math.isfinite(v)) else format(v, f)
+
+
+def _check_text(data):
+    checks = [ch for c in data["cases"] for ch in c.get("reference", {}).get("check", [])]
+    ok = [ch["rel"] for ch in checks if ch["converged"]]
+    if not checks:
+        return f"not checked at tol {CHECK_TOL:g}"
+    return (f"every {CHECK_EVERY}th reference depth also at tol {CHECK_TOL:g}: {len(ok)} of {len(checks)} "
+            f"converged, F differs by at most {max(ok, default=math.nan):.1e} relative")
+
+
+def markdown(data):
+    m = data["meta"]
+    same = ("are the same in every repeat" if all(r["deterministic_counts"] for c in data["cases"]
+                                                for r in c["rows"].values()) else
+            "differ between repeats in some rows (deterministic_counts in the JSON)")
+    lines = [f"Measured {m['date']} on {m['machine']} ({m['cpus']} cores, shared), Python {m['python']}, "
+             f"NumPy {m['numpy']}, SciPy {m['scipy']}: this commit ({m['this_commit']}) against the baseline "
+             f"{m['baseline'][:7]}, each curve a fresh process with a warm code cache (its own per side), "
+             f"{m['repeat']} repeats alternating the variants; time: median over repeats of the curve's CPU time "
+             f"(the process's, the measure least disturbed by other users of a shared machine) and wall time; "
+             f"ratio: median over repeats of (variant time / this commit's time in the same repeat); speed-ups "
+             f"and per-point times use CPU time; counts (solve_bvp runs, "
+             f"of them Richardson estimates, failed runs other than those (a Richardson estimate is one Newton "
+             f"iteration on the halved mesh, 'too many nodes' by design), Newton iterations, largest mesh) "
+             f"{same}; F error: max relative error "
+             f"against states solved at tol {REF_TOL:g} at the same depths (points of another topology than the "
+             f"reference's left out; {_check_text(data)}). Total {m['total_s']:.0f} s.", ""]
+    variants = list(VARIANTS)
+    lines += ["| curve | variant | CPU time (s) | x this commit | wall time (s) | x this commit | points | "
+              "solve_bvp runs (Richardson) | failed | Newton its | max nodes | CPU ms/point | "
+              "max F error (compared/left out) |",
+              "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    for case in data["cases"]:
+        for v in variants:
+            r = case["rows"].get(v)
+            if r is None:
+                continue
+            lines.append(f"| {case['id']} | {v} | {_fmt(r['cpu_median'])} | {_fmt(r['cpu_vs_this'])} | "
+                         f"{_fmt(r['wall_median'])} | {_fmt(r['time_vs_this'])} | "
+                         f"{r['points']} | {r['calls']} ({r['richardson']}) | {r['failed']} | {r['niter']} | "
+                         f"{r['max_nodes']} | "
+                         f"{_fmt(r['ms_per_point'], '.0f')} | {_fmt(r['f_error'], '.1e')} "
+                         f"({r['compared']}/{r['left_out']}) |")
+    lines.append("")
+    sh = [c for c in data["cases"] if c.get("shooting")]
+    if sh:
+        lines += ["Shooting (the paper's method, `benchmarks/shooting.py`) on the reference's cap states "
+                  f"with delta >= {SHOOT_FROM}, each from its neighbour (tangent predictor; no cold start "
+                  "counted), against this commit's default curve per point. 'equal error': the loosest "
+                  "shooting rtol whose max F error is at most the collocation curve's.", "",
+                  "| preset | collocation CPU ms/point (max F error) | shooting rtol: CPU ms/point (max F error, converged) "
+                  "| shooting / collocation per point at equal or better error |", "|---|---|---|---|"]
+        for case in sh:
+            r = case["rows"]["this commit"]
+            cells = "; ".join(f"{s['rtol']:g}: {s['per_point_ms']:.0f} ({_fmt(s['max_rel'], '.0e')}, "
+                              f"{s['converged']}/{s['points']})" for s in case["shooting"])
+            eq = case.get("shooting_ratio")
+            lines.append(f"| {case['preset']} | {r['ms_per_point']:.0f} ({_fmt(r['f_error'], '.0e')}) | {cells} | "
+                         f"{_fmt(eq, '.1f') + 'x' if eq is not None else 'no shooting rtol reached that error'} |")
+        lines.append("")
+    lines += ["| target (issue 14) | measured | met |", "|---|---|---|"]
+    for t in data["targets"]:
+        lines.append(f"| {t['target']} | {t['measured']} | {t['met']} |")
+    return "\n".join(lines) + "\n"
+
+
+def targets(data):
+    rows = {c["id"]: c["rows"] for c in data["cases"]}
+    out = []
+
+    def ratio_target(case, want, text):
+        if case not in rows:
+            return
+        r = rows[case]
+        speed = r["baseline"]["cpu_vs_this"]  # baseline CPU time / this commit's, median over repeats
+        err = r["this commit"]["f_error"]
+        out.append(dict(target=text, measured=f"{speed:.2f}x CPU time ({r['baseline']['cpu_median']:.2f} s -> "
+                                                f"{r['this commit']['cpu_median']:.2f} s; wall time "
+                                                f"{r['baseline']['time_vs_this']:.2f}x), max F error {_fmt(err, '.1e')}",
+                        met="yes" if speed >= want and (err is None or err <= 1e-6) else "no"))
+
+    ratio_target("base default", 5, "default base curve to delta 0.5, F error <= 1e-6: >= 5x faster than the baseline")
+    ratio_target("base 40 depths", 8, "40-depth curve with lift-off: >= 8x")
+    ratio_target("base 40 depths, cap only", 2.5, "cap-only 40-depth curve: >= 2.5x")
+    eqs = [c["shooting_ratio"] for c in data["cases"] if c.get("shooting_ratio") is not None]
+    if eqs:
+        out.append(dict(target=">= 40x faster than shooting per point at equal or better F error",
+                        measured=f"median {statistics.median(eqs):.1f}x ({min(eqs):.1f}x–{max(eqs):.1f}x over "
+                                 f"{len(eqs)} presets)", met="yes" if min(eqs) >= 40 else "no"))
+    return out
+
+
+def shooting_ratio(case):
+    r = case["rows"]["this commit"]
+    good = [s for s in case["shooting"] if s["converged"] == s["points"] and s["max_rel"] <= r["f_error"]]
+    if not good:
+        return None
+    best = min(good, key=lambda s: s["per_point_ms"])
+    return best["per_point_ms"] / r["ms_per_point"]
+
+
+def this_commit():
+    return subprocess.run(["git", "describe", "--always", "--dirty"], cwd=REPO, capture_output=True,
+                          text=True).stdout.strip()
+
+
+def meta(args, baseline, total, head):
+    import scipy
+
+    return dict(date=datetime.date.today().isoformat(), machine=f"{platform.machine()} {platform.system()}",
+                cpus=os.cpu_count(), python=platform.python_version(), numpy=np.__version__,
+                scipy=scipy.__version__, baseline=baseline, this_commit=head, repeat=args.repeat,
+                quick=args.quick, total_s=total)
+
+
+def write_atomic(path: Path, text: str):
+    tmp = path.with_name(path.name + ".tmp")
+    tmp.write_text(text)
+    os.replace(tmp, path)
+
+
+def parse_args(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--baseline", default="1109cdf", help="the commit compared with (default 1109cdf)")
+    ap.add_argument("--repeat", type=int, default=3, help="timed runs per curve and variant (default 3)")
+    ap.add_argument("--quick", action="store_true", help="base default curve, 1 repeat, no shooting (*-quick files)")
+    ap.add_argument("--no-shooting", action="store_true", help="leave out the shooting peer")
+    ap.add_argument("--work-dir", default=None,
+                    help="the baseline's tree and both code caches (default: a folder in ~/.cache)")
+    ap.add_argument("--out-dir", default=None, help="write results/ under this directory (default benchmarks/)")
+    ap.add_argument("--worker", default=None, help=argparse.SUPPRESS)
+    args = ap.parse_args(argv)
+    if args.repeat < 1:
+        ap.error(f"--repeat must be >= 1; got {args.repeat}")
+    return args
+
+
+def main(argv=None):
+    args = parse_args(argv)
+    if args.worker:
+        worker(json.loads(args.worker))
+        return 0
+    t_all = time.perf_counter()
+    head = this_commit()  # read now: the workers import this tree as it is now
+    if args.quick:
+        args.repeat = 1
+    cases = CASES[:1] if args.quick else CASES
+    variants = ["baseline", "this commit"] if args.quick else list(VARIANTS)
+    work = Path(args.work_dir) if args.work_dir else \
+        Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "shellbvp-speed-vs-baseline"
+
+    def log(msg):
+        print(msg, flush=True)
+
+    baseline = extract(args.baseline, work / f"tree-{args.baseline}")
+    sides = Sides(work, work / f"tree-{args.baseline}")
+    # this process (references, shooting) is this commit, with this side's code cache
+    sys.path.insert(0, str(REPO))
+    os.environ.update({k: sides.env("new")[k] for k in ("XDG_CACHE_HOME", "SHELLBVP_CACHE_DIR")})
+    sides.warm(sorted({c[1] for c in cases}), log)
+    data = dict(cases=[dict(id=c[0], preset=c[1], kind=c[2], runs={v: [] for v in variants}) for c in cases])
+    for rep in range(args.repeat):
+        for k, (case, entry) in enumerate(zip(cases, data["cases"])):
+            shift = (rep + k) % len(variants)
+            for v in variants[shift:] + variants[:shift]:
+                if case[2] == "deltas40-cap" and v == "cold lift-off":
+                    continue  # no lift-off on a cap-only curve
+                if v in ABLATIONS and case[1] != "base":
+                    continue  # what each change bought: measured on the base curves
+                out = sides.run(v, case)
+                entry["runs"][v].append(out)
+                log(f"repeat {rep + 1}: {case[0]:>26} | {v:>16}: {out['cpu']:6.2f} s CPU, {out['wall']:6.2f} s, {out['points']} points, "
+                    f"{out['calls']} solve_bvp, {out['niter']} Newton its")
+    for case, entry in zip(cases, data["cases"]):
+        entry["runs"] = {v: rs for v, rs in entry["runs"].items() if rs}
+        depths = np.concatenate([np.asarray(rs[0]["delta"]) for rs in entry["runs"].values()])
+        topology = "cap" if case[2] == "deltas40-cap" else "auto"
+        ref = reference(case[1], _distinct(depths), topology, log, quick=args.quick)
+        entry["reference"] = {k: ref[k] for k in ("complete", "stop", "seconds", "check")}
+        entry["reference"].update(depths=len(ref["delta"]), converged=sum(t != "failed" for t in ref["topology"]),
+                                  max_nodes=max(ref["nodes"], default=0))
+        for rs in entry["runs"].values():
+            rs[0]["f_error"], rs[0]["compared"], rs[0]["left_out"] = f_error(rs[0], ref)
+        entry["_ref"] = ref
+    summarize(data)
+    if not (args.quick or args.no_shooting):
+        for entry in data["cases"]:
+            if entry["kind"] == "default":
+                entry["shooting"] = shooting(entry["preset"], entry["_ref"], log)
+                entry["shooting_ratio"] = shooting_ratio(entry) if entry["shooting"] else None
+    for entry in data["cases"]:
+        entry.pop("_ref")
+        for rs in entry["runs"].values():  # keep the measurements, not every point
+            for r in rs[1:]:
+                for k in ("delta", "force", "topology", "valid", "nodes"):
+                    r.pop(k, None)
+    data["targets"] = targets(data)
+    data["meta"] = meta(args, baseline, time.perf_counter() - t_all, head)
+    res = (Path(args.out_dir) if args.out_dir else HERE) / "results"
+    res.mkdir(parents=True, exist_ok=True)
+    name = "speed_vs_baseline-quick" if args.quick else "speed_vs_baseline"
+    write_atomic(res / f"{name}.json", json.dumps(data, indent=1, default=float))
+    md = markdown(data)
+    write_atomic(res / f"{name}.md", md)
+    print(md)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
