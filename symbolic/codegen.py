@@ -119,6 +119,20 @@ def docstring(spec: FunctionSpec) -> list[str]:
     return doc
 
 
+def matrix_entries(val, outs, k):
+    """``(dims, [(index, text)], next k)`` of a matrix output whose entries' texts start at
+    ``outs[k]`` (zero entries, None, are left out: the array starts at zeros)."""
+    mat = sp.Matrix(val)
+    dims = (mat.rows,) if mat.cols == 1 else (mat.rows, mat.cols)
+    entries = []
+    for i in range(mat.rows):
+        for j in range(mat.cols):
+            if outs[k] is not None:
+                entries.append((f"{i}" if mat.cols == 1 else f"{i}, {j}", outs[k]))
+            k += 1
+    return dims, entries, k
+
+
 def _function_source(spec: FunctionSpec) -> str:
     lines = [f"def {spec.name}({', '.join(a for a, _ in spec.args)}):"]
     lines.append(textwrap.indent('"""' + "\n".join(docstring(spec)).rstrip() + '\n"""', "    "))
@@ -139,16 +153,9 @@ def _function_source(spec: FunctionSpec) -> str:
                 lines.append(f"    {name}[{key!r}] = numpy.zeros(_shape) + ({outs[k] or 0})")
                 k += 1
         else:
-            mat = sp.Matrix(val)
-            dims = (mat.rows,) if mat.cols == 1 else (mat.rows, mat.cols)
+            dims, entries, k = matrix_entries(val, outs, k)
             lines.append(f"    {name} = numpy.zeros({dims!r} + _shape)")
-            for i in range(mat.rows):
-                for j in range(mat.cols):
-                    text = outs[k]
-                    k += 1
-                    if text is not None:
-                        idx = f"{i}" if mat.cols == 1 else f"{i}, {j}"
-                        lines.append(f"    {name}[{idx}] = {text}")
+            lines += [f"    {name}[{idx}] = {text}" for idx, text in entries]
         ret.append(name)
     lines.append(f"    return {', '.join(ret)}")
     return "\n".join(lines) + "\n"

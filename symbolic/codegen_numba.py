@@ -26,9 +26,14 @@ from __future__ import annotations
 
 import textwrap
 
-import sympy as sp
-
-from .codegen import FunctionSpec, docstring, function_specs, header, lower
+from .codegen import (
+    FunctionSpec,
+    docstring,
+    function_specs,
+    header,
+    lower,
+    matrix_entries,
+)
 from .equations import Derivation
 
 __all__ = ["kernel_source", "KERNEL_OPTIONS"]
@@ -77,17 +82,10 @@ def _kernel_source(spec: FunctionSpec) -> str:
     lines.append(f"    _m = {_arg_name(spec.shape_of)}.shape[0]")
     stores, k, ret = [], 0, []
     for name, val in spec.outputs:
-        mat = sp.Matrix(val)
         out = f"_out_{name}"
-        dims = (mat.rows,) if mat.cols == 1 else (mat.rows, mat.cols)
+        dims, entries, k = matrix_entries(val, outs, k)
         lines.append(f"    {out} = numpy.zeros(({', '.join(map(str, dims))}, _m))")
-        for i in range(mat.rows):
-            for j in range(mat.cols):
-                text = outs[k]
-                k += 1
-                if text is not None:
-                    idx = f"{i}" if mat.cols == 1 else f"{i}, {j}"
-                    stores.append(f"        {out}[{idx}, {_NODE}] = {text}")
+        stores += [f"        {out}[{idx}, {_NODE}] = {text}" for idx, text in entries]
         ret.append(out)
     lines.append(f"    for {_NODE} in range(_m):")
     for a, syms in spec.args:  # this node's values
