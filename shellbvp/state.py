@@ -599,6 +599,10 @@ def _cold_other(scene, sysm, control, value, eps, **kw):
         # a point-load state has no cap to warm-start from: a cold solve finds the cap or the limit again
         if cur.get("topology") == "point":
             nxt = _cold_delta(make_system(scene, "delta", nd, eps), nd, near_point=cur, **lk)
+            if not nxt.success:  # a cold solve does not start from cur: smaller steps do not help it
+                return fail(f"{control} = {value:g} not reached: the states up to delta = {d:.3g} are point-load "
+                            f"limits ({key} there: {cur[key]:.4g}) and no state was found at delta = {nd:.3g} "
+                            f"({nxt.message})")
         else:
             dsys = system_like(cur, "delta", nd, eps)
             nxt = solve_from(dsys, warm_guess(dsys, cur), **lk)
