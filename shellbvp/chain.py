@@ -32,6 +32,12 @@ pole), or the pseudo-arclength condition (``arclength``,
 ``sum_i t_i (X_i - Xhat_i)/s_i = 0`` over ``X = (delta, lambda0, F)``; its
 value is the tuple ``(Xhat, t, s)``).
 
+Volume control (a sealed shell, ``Scene.sealed``): the pressure is an unknown too
+(the last), each region ``k`` gains a state ``v_k`` (rows after all regions' states,
+``v_k' = (b_k - a_k) S dV/dS``) with ``v_k(0) = 0``, and ``sum_k v_k(1) = V0`` closes
+the system (rows after the control's).  Guesses need only the regions' states and
+the unknowns before the pressure: :meth:`ChainBVP.solve` completes them.
+
 :func:`cap_chain`, :func:`point_chain`, :func:`annulus_chain` and
 :func:`line_chain` declare today's configurations; :class:`ChainBVP`
 assembles any chain into ``fun``, ``fun_jac``, ``bc``, ``bc_jac`` (analytic,
@@ -281,9 +287,12 @@ class ChainBVP:
         The scene's generated module (loaded if not given).
     par : array, optional
         Its run-time parameters (default ``scene.parameters(model)``).
+    volume_control : bool, optional
+        The pressure as an unknown with the enclosed volume held at ``scene.enclosed_volume()``
+        (default: ``scene.sealed``).
     """
 
-    def __init__(self, scene, chain: Chain, control: str, value, model=None, par=None):
+    def __init__(self, scene, chain: Chain, control: str, value, model=None, par=None, volume_control=None):
         if control not in CONTROLS:
             raise ValueError(f"control must be one of {CONTROLS}; got {control!r}")
         self.scene, self.chain, self.control = scene, chain, control
@@ -293,7 +302,9 @@ class ChainBVP:
         self._bind()
         self.sizes = [SIZES[r.kind] for r in chain.regions]
         self.offsets = np.cumsum([0, *self.sizes])[:-1].tolist()
-        self.n = int(sum(self.sizes))
+        self.n_shell = int(sum(self.sizes))  # the regions' states; then one volume state per region
+        self.volume_control = bool(scene.sealed if volume_control is None else volume_control)
+        self.n = self.n_shell + (len(self.regions) if self.volume_control else 0)
         kinds = {type(j) for j in chain.junctions}
         self.has_contact_pole = ContactPole in kinds
         if control == "arclength" and not self.has_contact_pole:
@@ -307,6 +318,11 @@ class ChainBVP:
             names.append("lambda0")
         if control != "delta":
             names.append("delta")
+        if self.volume_control:
+            if "pressure" not in mod.PARAMS:
+                raise ValueError("volume control needs a pressurised structure (Scene.sealed)")
+            names.append("pressure")
+            self.enclosed_volume = scene.enclosed_volume()
         self.unknowns = tuple(names)
         self.k = len(names)
         self.col = {name: i for i, name in enumerate(names)}
@@ -324,7 +340,8 @@ class ChainBVP:
         elif control == "arclength":
             self.extra = "arclength"
         self.force_at = next((j for j in reversed(self.junctions) if isinstance(j, (Edge, Line))), None)
-        self.n_conditions = sum(j.rows for j in self.junctions) + (self.extra is not None)
+        self.n_conditions = (sum(j.rows for j in self.junctions) + (self.extra is not None)
+                             + (len(self.regions) + 1 if self.volume_control else 0))
 
     def __repr__(self):
         return f"ChainBVP({self.control}={self.value:g})\n{self.chain.layout()}"
@@ -350,8 +367,62 @@ class ChainBVP:
         return q
 
     def pack(self, **values) -> np.ndarray:
-        """``p`` from named values (extra names, e.g. a prescribed delta, are ignored)."""
+        """``p`` from named values (extra names, e.g. a prescribed delta, are ignored; a missing
+        pressure under volume control is the scene's)."""
+        if self.volume_control:
+            values.setdefault("pressure", self.scene.pressure)
         return np.array([values[name] for name in self.unknowns], float)
+
+    # -- volume control ------------------------------------------------------------------------------
+    def par_at(self, p) -> np.ndarray:
+        """The run-time parameters at unknowns ``p``: the pressure is one of them under volume control."""
+        if not self.volume_control or p is None:
+            return self.par
+        par = self.par.copy()
+        par[self._i_pressure] = p[self.col["pressure"]]
+        return par
+
+    @property
+    def _i_pressure(self) -> int:
+        return self.model.PARAMS.index("pressure")
+
+    def at(self, p) -> "ChainBVP":
+        """This system with its parameters at the solution ``p`` (the pressure under volume
+        control; ``self`` otherwise): what profiles and checks of that solution evaluate."""
+        if not self.volume_control or p is None:
+            return self
+        other = object.__new__(type(self))
+        other.__dict__.update(self.__dict__)
+        other.par = self.par_at(p)
+        return other
+
+    def _volume_rates(self, t, y, p, k):
+        a, b = self.ln_S(self.regions[k].start, p), self.ln_S(self.regions[k].end, p)
+        S = np.exp(a + t * (b - a))
+        return (b - a) * getattr(self.model, f"{self.regions[k].kind}_vol")(S, y[self.rows(k)], self.par)[0]
+
+    def complete(self, x, y, p):
+        """``(y, p)`` for a solve from a guess of the regions' states and the unknowns before
+        the pressure: under volume control the volume states (integrated from ``y`` by the
+        trapezoidal rule) and the pressure (the scene's, if ``p`` has none) are added."""
+        y = np.asarray(y, float)
+        if not self.volume_control:
+            return y, p
+        p = np.empty(0) if p is None else np.asarray(p, float)
+        if p.size == self.k - 1:
+            p = np.append(p, self.scene.pressure)
+        from scipy.integrate import cumulative_trapezoid
+
+        acc = [cumulative_trapezoid(self._volume_rates(x, y, p, k), x, initial=0.0) for k in range(len(self.regions))]
+        return np.vstack([y[:self.n_shell], *acc]), p
+
+    def solve(self, x, y, p=None, **kwargs):
+        """``shellbvp.solution.solve_bvp`` of this system from a guess (completed, see
+        :meth:`complete`); keyword arguments go to solve_bvp."""
+        from .solution import solve_bvp
+
+        y, p = self.complete(x, y, p)
+        return solve_bvp(self.fun, self.bc, x, y, p, fun_jac=self.fun_jac, bc_jac=self.bc_jac, **kwargs)
 
     def ln_S(self, point: Point, p) -> float:
         return point.ln_offset + (p[self.col[point.unknown]] if point.unknown else 0.0)
@@ -412,32 +483,47 @@ class ChainBVP:
     # -- ODE ------------------------------------------------------------------------------------
     def fun(self, t, y, p=None):
         f = np.empty_like(y)
+        par = self.par_at(p)
         for k, reg in enumerate(self.regions):
             a, b = self.ln_S(reg.start, p), self.ln_S(reg.end, p)
             rows = self.rows(k)
-            f[rows] = (b - a) * self._rhs(k)(np.exp(a + t * (b - a)), y[rows], self.par)
+            S = np.exp(a + t * (b - a))
+            f[rows] = (b - a) * self._rhs(k)(S, y[rows], par)
+            if self.volume_control:
+                f[self.n_shell + k] = (b - a) * getattr(self.model, f"{reg.kind}_vol")(S, y[rows], par)[0]
         return f
 
     def fun_jac(self, t, y, p=None):
         n, m = self.n, t.size
         dfdy = np.zeros((n, n, m))
         dfdp = np.zeros((n, self.k, m)) if self.k else None
+        par = self.par_at(p)
         for k, reg in enumerate(self.regions):
             a, b = self.ln_S(reg.start, p), self.ln_S(reg.end, p)
             rows = self.rows(k)
             S = np.exp(a + t * (b - a))
-            gy, gS = self._jac(k)(S, y[rows], self.par)
+            gy, gS = self._jac(k)(S, y[rows], par)
             dfdy[rows, rows] = (b - a) * gy
+            if self.volume_control:
+                v = self.n_shell + k
+                vy, vS = getattr(self.model, f"{reg.kind}_vol_jac")(S, y[rows], par)
+                dfdy[v, rows] = (b - a) * vy[0]
+                dfdp[rows, self.col["pressure"]] = (b - a) * getattr(
+                    self.kernels.active, f"{reg.kind}_jac_par")(S, y[rows], par)[:, self._i_pressure]
             if dfdp is None:
                 continue
-            # d/da and d/db of (b - a) g(exp(a + t (b - a)), y)
+            # d/da and d/db of (b - a) g(exp(a + t (b - a)), y), and of the volume rate
             g = None
             for point, dS_dln, sign in ((reg.start, 1.0 - t, -1.0), (reg.end, t, 1.0)):
                 if point.unknown is None:
                     continue
                 if g is None:
-                    g = self._rhs(k)(S, y[rows], self.par)
+                    g = self._rhs(k)(S, y[rows], par)
+                    if self.volume_control:
+                        rate = getattr(self.model, f"{reg.kind}_vol")(S, y[rows], par)[0]
                 dfdp[rows, self.col[point.unknown]] += sign * g + (b - a) * gS * S * dS_dln
+                if self.volume_control:
+                    dfdp[v, self.col[point.unknown]] += sign * rate + (b - a) * vS[0] * S * dS_dln
         return (dfdy, dfdp) if dfdp is not None else dfdy
 
     # -- conditions -------------------------------------------------------------------------------
@@ -453,7 +539,7 @@ class ChainBVP:
         return self.regions[j.k].end, np.array([q["chi1"], yin[_LS]]), yin, ya[self.rows(j.k + 1)]
 
     def bc(self, ya, yb, p=None):
-        mod, par = self.model, self.par
+        mod, par = self.model, self.par_at(p)
         q = self.quantities(p)
         parts = []
         for j in self.junctions:
@@ -487,6 +573,9 @@ class ChainBVP:
             force = 2 * np.pi * self._force_function("res")(S, yc, yf, q["delta"], 0.0, par)[0]
             X = np.array([q["delta"], q["lambda0"], force])
             parts.append([np.sum(self.arc_tangent * (X - self.arc_point) / self.arc_scale)])
+        if self.volume_control:
+            acc = slice(self.n_shell, self.n)
+            parts += [ya[acc], [np.sum(yb[acc]) - self.enclosed_volume]]
         return np.concatenate(parts)
 
     def _line_function(self, j, what):
@@ -513,12 +602,18 @@ class ChainBVP:
         if name is not None and name in self.col:
             P[rows, self.col[name]] += values
 
+    def _pressure_column(self, P, rows, dres_dpar):
+        """Under volume control, a condition's derivative in the pressure (an unknown)."""
+        if self.volume_control:
+            P[rows, self.col["pressure"]] += dres_dpar[..., self._i_pressure]
+
     def bc_jac(self, ya, yb, p=None):
-        mod, par = self.model, self.par
+        mod, par = self.model, self.par_at(p)
         q = self.quantities(p)
         m, n = self.n_conditions, self.n
         A, B = np.zeros((m, n)), np.zeros((m, n))
         P = np.zeros((m, self.k)) if self.k else None
+        vc = self.volume_control
         r = 0
         for j in self.junctions:
             rows = slice(r, r + j.rows)
@@ -528,15 +623,21 @@ class ChainBVP:
                 pj = mod.pole_jac(y0[0], y0[1], q["lambda0"], par)  # d/d(chi, ls, lambda0)
                 A[rows, o:o + 2] = pj[:, :2]
                 self._add_p(P, rows, "lambda0", pj[:, 2])
+                if vc:
+                    self._pressure_column(P, rows, mod.pole_jac_par(y0[0], y0[1], q["lambda0"], par))
             elif isinstance(j, (FreePole, PointPole)):
                 point = self.regions[j.k].start
                 S = self.S_point(point, p)
                 if isinstance(j, FreePole):
                     pj = mod.free_pole_jac(S, ya[self.rows(j.k)], par)  # d/d(y, S)
                     self._add_p(P, rows, point.unknown, pj[:, 6] * S)
+                    if vc:
+                        self._pressure_column(P, rows, mod.free_pole_jac_par(S, ya[self.rows(j.k)], par))
                 else:
                     pj = mod.point_load_jac(S, ya[self.rows(j.k)], q["delta"], par)  # d/d(y, delta)
                     self._add_p(P, rows, "delta", pj[:, 6])
+                    if vc:
+                        self._pressure_column(P, rows, mod.point_load_jac_par(S, ya[self.rows(j.k)], q["delta"], par))
                 A[rows, self.rows(j.k)] = pj[:, :6]
             elif isinstance(j, Edge):
                 point, yc, yf, c_at_a, f_at_a = self._edge_states(j, ya, yb)
@@ -546,6 +647,8 @@ class ChainBVP:
                 (A if f_at_a else B)[rows, self.rows(j.kf)] = jj[:, 3:9]
                 self._add_p(P, rows, point.unknown, jj[:, 0] * S)
                 self._add_p(P, rows, "delta", jj[:, 9])
+                if vc:
+                    self._pressure_column(P, rows, self._edge_function(j, "jac_par")(S, yc, yf, q["delta"], q["F"], par))
             elif isinstance(j, Line):
                 point, yc, yin, yout = self._line_states(j, ya, yb, q)
                 S = self.S_point(point, p)
@@ -554,6 +657,9 @@ class ChainBVP:
                 self._add_p(P, on, point.unknown, jj[:, 0] * S)
                 self._add_p(P, on, "chi1", jj[:, 1])
                 self._add_p(P, on, "delta", jj[:, 9])
+                if vc:
+                    self._pressure_column(P, on, self._line_function(j, "jac_par")(S, yc, yin, q["delta"], q["F"],
+                                                                                 par)[:3])
                 i0, o0 = self.offsets[j.k], self.offsets[j.k + 1]
                 B[on, i0:i0 + 6] = jj[:, 3:9]
                 B[on, i0 + _LS] += jj[:, 2]  # ls of the contact state is the inner region's
@@ -567,9 +673,14 @@ class ChainBVP:
                 B[rows, self.rows(j.k)] = ej[:, 1:3]
                 A[rows, self.rows(j.k + 1)] = ej[:, 3:5]
                 self._add_p(P, rows, point.unknown, ej[:, 0] * S)
+                if vc:
+                    self._pressure_column(P, rows, mod.tip_end_jac_par(S, yb[self.rows(j.k)], ya[self.rows(j.k + 1)],
+                                                                       par))
             elif isinstance(j, Rim):
-                B[rows, self.rows(j.k)] = mod.rim_jac(self.S_point(self.regions[j.k].end, p),
-                                                      yb[self.rows(j.k)], par)
+                S = self.S_point(self.regions[j.k].end, p)
+                B[rows, self.rows(j.k)] = mod.rim_jac(S, yb[self.rows(j.k)], par)
+                if vc:
+                    self._pressure_column(P, rows, mod.rim_jac_par(S, yb[self.rows(j.k)], par))
             r += j.rows
         if self.extra in ("force", "arclength"):
             w = 1.0 if self.extra == "force" else 2 * np.pi * self.arc_tangent[2] / self.arc_scale[2]
@@ -578,12 +689,19 @@ class ChainBVP:
             fj = w * self._force_function("jac")(S, yc, yf, q["delta"], F, par)  # d/d(Sc, yf, F)
             (A if f_at_a else B)[r, self.rows(kf)] = fj[0, 1:7]
             self._add_p(P, r, point.unknown, fj[0, 0] * S)
+            if vc:
+                self._pressure_column(P, r, w * self._force_function("jac_par")(S, yc, yf, q["delta"], F, par)[0])
             if self.extra == "arclength":
                 w3 = self.arc_tangent / self.arc_scale  # weights of (delta, lambda0, F)
                 self._add_p(P, r, "lambda0", w3[1])
                 self._add_p(P, r, "delta", w3[0])
         elif self.extra == "pole_stretch":
             A[r, self.offsets[0] + _LS] = 1.0
+        if vc:
+            r += self.extra is not None
+            for k in range(len(self.regions)):
+                A[r + k, self.n_shell + k] = 1.0
+                B[-1, self.n_shell + k] = 1.0
         return (A, B, P) if P is not None else (A, B)
 
     # -- values of a solution -----------------------------------------------------------------------
@@ -592,7 +710,7 @@ class ChainBVP:
         (a first integral of a free region, so the indenter's force)."""
         k = len(self.regions) - 1
         S = self.S_point(self.regions[k].start, p)
-        G = self.model.free_profile(np.array([S]), ya[self.rows(k), None], self.par)["axial_force_2pi"][0]
+        G = self.model.free_profile(np.array([S]), ya[self.rows(k), None], self.par_at(p))["axial_force_2pi"][0]
         return 2 * np.pi * float(G), float(self.quantities(p)["delta"])
 
     def region_profiles(self, t, y, p):
@@ -600,7 +718,7 @@ class ChainBVP:
         out = []
         for k, reg in enumerate(self.regions):
             S = self.S(k, t, p)
-            out.append((k, S, getattr(self.model, f"{reg.kind}_profile")(S, y[self.rows(k)], self.par)))
+            out.append((k, S, getattr(self.model, f"{reg.kind}_profile")(S, y[self.rows(k)], self.par_at(p))))
         return out
 
     def profile(self, t, y, p, z_tip: float) -> dict:
@@ -630,6 +748,7 @@ class ChainBVP:
 
     @property
     def pressure(self) -> float:
+        """The pressure of the parameters (under volume control: of the solution, see :meth:`at`)."""
         return self._param("pressure")
 
     @property
@@ -640,9 +759,10 @@ class ChainBVP:
     def energy(self, sol, x, p) -> float:
         """``E = 2 pi Int U R Psi dS - p (V - V_ref)``: the elastic energy over every region
         (Gauss-Legendre on each mesh interval, plus the leading term ``zeta U(zeta)/2`` of
-        each pole disc ``[0, zeta]``) and the pressure's potential (``shellbvp.inflation``)."""
+        each pole disc ``[0, zeta]``) and the pressure's potential (``shellbvp.inflation``).
+        Under volume control the pressure does no work (V is held): E is the elastic energy."""
         elastic = self._elastic_energy(sol, x, p)
-        if not self.pressure:
+        if self.volume_control or not self.pressure:
             return elastic
         return elastic - self.pressure * (self.volume(sol, x, p) - self.scene.reference_volume())
 
@@ -672,6 +792,6 @@ class ChainBVP:
             if isinstance(j, (ContactPole, FreePole)):
                 zeta = self.S_point(self.regions[j.k].start, p)
                 prof = getattr(self.model, f"{self.regions[j.k].kind}_profile")
-                density = prof(np.array([zeta]), sol(np.array([0.0]))[self.rows(j.k)], self.par)["energy_density"]
+                density = prof(np.array([zeta]), sol(np.array([0.0]))[self.rows(j.k)], self.par_at(p))["energy_density"]
                 total += 0.5 * float(density[0]) * zeta
         return 2 * np.pi * total

@@ -37,7 +37,7 @@ from .chain import (
     cylinder_chain,
 )
 from .diagnosis import diagnose
-from .solution import Solution, attach_tip_table, richardson_error, solve_bvp, thin_mesh
+from .solution import Solution, attach_tip_table, richardson_error, thin_mesh
 
 __all__ = ["WALL_TOPOLOGIES", "make_wall_system", "wall_contact_suspected", "solve_chain_from", "wall_state",
            "best_wall_state", "transfer_guess"]
@@ -209,8 +209,7 @@ def solve_chain_from(sysm, guess, *, tol=1e-6, max_nodes=10000, bc_tol=1e-10):
     x, y, p = guess
     t0 = time.perf_counter()
     with np.errstate(all="ignore"):
-        bvp = solve_bvp(sysm.fun, sysm.bc, x, y, p, fun_jac=sysm.fun_jac, bc_jac=sysm.bc_jac, tol=tol,
-                        bc_tol=bc_tol, max_nodes=max_nodes)
+        bvp = sysm.solve(x, y, p, tol=tol, bc_tol=bc_tol, max_nodes=max_nodes)
         res = diagnose(sysm, bvp, tol)
     res.wall_time = time.perf_counter() - t0
     return res

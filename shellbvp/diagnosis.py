@@ -87,6 +87,7 @@ def diagnose(sysm, bvp, tol, converged_note: str = "") -> Solution:
     """
     nan = float("nan")
     p = bvp.p
+    sysm = sysm.at(p)  # under volume control, the parameters at the solution's pressure
     q = sysm.quantities(p) if sysm.k else sysm.quantities(None)
     ya, yb = bvp.y[:, 0], bvp.y[:, -1]
     force, delta = sysm.end_values(ya, yb, p)
@@ -105,7 +106,7 @@ def diagnose(sysm, bvp, tol, converged_note: str = "") -> Solution:
         # where the contact starts from the pole's side: the pole itself, or a lifted pole's first edge
         S1=S_edges[0] if isinstance(first, FreePole) else 0.0,
         control=sysm.control, scene=sysm.scene, system=sysm,
-        z_tip=sysm.pole_height - float(delta),
+        z_tip=sysm.pole_height - float(delta), pressure=sysm.pressure,
     )
     tip_end = next((j for j in sysm.junctions if isinstance(j, TipEnd)), None)
     if tip_end is not None:
@@ -239,6 +240,8 @@ def _without_iterate_numbers(res):
     for key in ("edge_forces", "edge_S"):  # per-edge lists: as many NaN as edges
         if key in res:
             res[key] = [float("nan")] * len(res[key])
+    if res.get("system") is not None and res.system.volume_control:  # the pressure was an unknown
+        res.pressure = float("nan")
     if "z_tip" in res:  # the tip's height follows from delta: known only where delta is prescribed
         res.z_tip = res.z_tip if prescribed == "delta" else float("nan")
     res.valid = False

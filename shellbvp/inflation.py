@@ -27,7 +27,7 @@ import numpy as np
 
 from .chain import Chain, ChainBVP, FreePole, Point, Region, Rim
 from .diagnosis import diagnose
-from .solution import attach_tip_table, solve_bvp
+from .solution import attach_tip_table
 
 __all__ = ["inflate", "inflated_chain", "inflated_pole_rise", "start_shape"]
 
@@ -58,15 +58,14 @@ def _system(scene, pressure):
     scene = scene.replace(pressure=pressure)
     mod = scene.model()
     sysm = ChainBVP(scene, inflated_chain(scene.shell_length), "delta", 0.0, model=mod,
-                    par=scene.parameters(mod, pole_rise=0.0))
+                    par=scene.parameters(mod, pole_rise=0.0), volume_control=False)
     attach_tip_table(sysm)
     return sysm
 
 
 def _solve(sysm, x, y, tol, max_nodes):
     with np.errstate(all="ignore"):
-        bvp = solve_bvp(sysm.fun, sysm.bc, x, y, None, fun_jac=sysm.fun_jac, bc_jac=sysm.bc_jac,
-                        tol=tol, bc_tol=1e-10, max_nodes=max_nodes)
+        bvp = sysm.solve(x, y, None, tol=tol, bc_tol=1e-10, max_nodes=max_nodes)
         return diagnose(sysm, bvp, tol)
 
 

@@ -24,7 +24,9 @@ contact_edge and edge_jump_ls/ks, which read as NaN and "")::
                             topology (strings: shellbvp.chain.CONFIGURATION_NAMES),
                             contact_edge (strings: smooth, corner or paper);
                             error_method (strings: how force_error/delta_error were
-                            made: richardson, calibrated, or empty: not estimated)
+                            made: richardson, calibrated, or empty: not estimated);
+                            pressure (the pressure below the shell: the scene's, or
+                            under volume control the one that holds the volume)
     /curve/profiles/point_<i>   optional (profiles=True): S, region, r, z, ... at the
                             mesh nodes of point i (see Solution.profile)
 
@@ -59,7 +61,7 @@ POINT_FIELDS = (
     "delta", "force", "lambda0", "Sc", "status", "valid", "max_residual", "nodes", "niter",
     "force_error", "delta_error", "energy", "ring_force", "cap_force", "pressure_min",
     "penetration", "force_defect", "edge_legendre", "wall_time", "topology", "S1", "ring_force_inner",
-    "legendre_min", "contact_edge", "edge_jump_ls", "edge_jump_ks", "error_method",
+    "legendre_min", "contact_edge", "edge_jump_ls", "edge_jump_ks", "error_method", "pressure",
 )
 #: Fields a single-cap state does not carry, with their cap values (also what files of
 #: format version 1, which predate them, read as).
@@ -69,7 +71,7 @@ V2_FIELD_DEFAULTS = {"legendre_min": float("nan"), "contact_edge": "", "edge_jum
                      "edge_jump_ks": float("nan")}
 #: Fields added within format version 3 (additive: older readers ignore them), with what
 #: earlier files read as.  error_method: "richardson" | "calibrated" | "" (not estimated).
-V3_FIELD_DEFAULTS = {"error_method": ""}
+V3_FIELD_DEFAULTS = {"error_method": "", "pressure": float("nan")}  # pressure: the scene's, filled in on reading
 _MISSING_FIELD_DEFAULTS = {**CAP_FIELD_DEFAULTS, **V2_FIELD_DEFAULTS, **V3_FIELD_DEFAULTS}
 
 
@@ -427,6 +429,8 @@ def read_curve_group(g, version: str = ""):
     settings = _json_attr(g, "settings")
     _check_settings(settings)
     points, flags = _points(g)
+    if "pressure" not in g:  # before volume control, every point had the scene's pressure
+        points["pressure"] = np.full(points["delta"].shape, float(scene.pressure))
     return Curve(scene=scene, points=points, flags=flags, stop_reason=_text_attr(g, "stop_reason"),
                  complete=_bool_attr(g, "complete"), interrupted=_bool_attr(g, "interrupted"),
                  settings=settings, version=version)

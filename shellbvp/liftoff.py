@@ -33,7 +33,6 @@ from .solution import (
     attach_tip_table,
     default_eps,
     richardson_error,
-    solve_bvp,
     thin_mesh,
 )
 
@@ -140,8 +139,7 @@ def solve_liftoff_from(sysm, guess, *, tol=1e-6, max_nodes=10000, bc_tol=1e-10):
     x, y, p = guess
     t0 = time.perf_counter()
     with np.errstate(all="ignore"):
-        bvp = solve_bvp(sysm.fun, sysm.bc, x, y, p, fun_jac=sysm.fun_jac, bc_jac=sysm.bc_jac,
-                        tol=tol, bc_tol=bc_tol, max_nodes=max_nodes)
+        bvp = sysm.solve(x, y, p, tol=tol, bc_tol=bc_tol, max_nodes=max_nodes)
         res = diagnose(sysm, bvp, tol)
     res.wall_time = time.perf_counter() - t0
     return res

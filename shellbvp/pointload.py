@@ -17,7 +17,6 @@ from .diagnosis import diagnose
 from .inflation import start_shape
 from .solution import (
     attach_tip_table,
-    solve_bvp,
     thin_mesh,
 )
 
@@ -88,8 +87,7 @@ def _point_run(scene, delta, guess, *, tol, max_nodes, bc_tol):
     attach_tip_table(sysm)
     x, y = _point_guess(sysm, guess) if guess is not None else _crude_point_guess(sysm)
     with np.errstate(all="ignore"):
-        bvp = solve_bvp(sysm.fun, sysm.bc, x, y, fun_jac=sysm.fun_jac, bc_jac=sysm.bc_jac, tol=tol,
-                        bc_tol=bc_tol, max_nodes=max_nodes)
+        bvp = sysm.solve(x, y, None, tol=tol, bc_tol=bc_tol, max_nodes=max_nodes)
         return diagnose(sysm, bvp, tol, " (point-load limit: the contact cap is exponentially small)")
 
 

@@ -63,6 +63,12 @@ class Scene:
         It acts on the deformed midsurface (a follower load); the curve starts from the
         inflated shape (:func:`shellbvp.inflate`) and delta is measured from its pole.
         Default 0.
+    sealed : bool
+        Volume control: the shell encloses a fixed volume of incompressible fluid (a
+        sealed capsule), the volume between it and its rim's plane in the inflated
+        state at ``pressure`` (then the pressure before indenting).  While indenting,
+        the pressure is an unknown of every solve (``Solution.pressure``) with the
+        constraint ``V = V0``.  Default False (pressure control).
 
     Raises
     ------
@@ -97,6 +103,7 @@ class Scene:
     tip: object = field(default_factory=SphereTip)
     bending: Bending = field(default_factory=TraceBending)
     pressure: float = 0.0
+    sealed: bool = False
 
     def __post_init__(self):
         rho = _finite("rho", self.rho)
@@ -133,6 +140,10 @@ class Scene:
         object.__setattr__(self, "rho", rho)
         object.__setattr__(self, "beta", beta)
         object.__setattr__(self, "pressure", _finite("pressure", self.pressure))
+        if not isinstance(self.sealed, (bool, np.bool_)):
+            raise ValueError(f"sealed must be True (volume control) or False (pressure control); "
+                             f"got {self.sealed!r}")
+        object.__setattr__(self, "sealed", bool(self.sealed))
 
     # -- presets -----------------------------------------------------------------
     @classmethod
@@ -177,6 +188,7 @@ class Scene:
             "shell": self.shell.description(), "tip": self.tip.description(),
             "bending": self.bending.description(),
             **({"pressure": self.pressure} if self.pressure else {}),  # files of unpressurised scenes as before
+            **({"sealed": True} if self.sealed else {}),
         }
 
     @classmethod
@@ -200,7 +212,7 @@ class Scene:
             return value
 
         number, text = (int, float), (str,)
-        what = {number: "a number", text: "text", (dict,): "a mapping", (int,): "an integer"}
+        what = {number: "a number", text: "text", (dict,): "a mapping", (int,): "an integer", (bool,): "true or false"}
         m = field(d, "material", (dict,), "")
         family = field(m, "family", text, "material.")
         if family == "mooney-rivlin":
@@ -241,7 +253,8 @@ class Scene:
         return cls(gamma=field(d, "gamma", number, ""), rho=field(d, "rho", number, ""),
                    beta=field(d, "beta", number, ""), material=material, xi=field(d, "xi", (int,), ""),
                    contact=field(d, "contact", text, ""), shell=shell, tip=tip, bending=bend,
-                   pressure=field(d, "pressure", number, "") if "pressure" in d else 0.0)
+                   pressure=field(d, "pressure", number, "") if "pressure" in d else 0.0,
+                   sealed=field(d, "sealed", (bool,), "") if "sealed" in d else False)
 
     def to_json(self) -> str:
         """:meth:`to_dict` as a JSON string (sorted keys)."""
@@ -253,7 +266,12 @@ class Scene:
     def structure(self) -> dict:
         """The structural choices the generated code is specialised on."""
         return structure_description(self.material, self.xi, self.shell, self.tip, self.bending,
-                                     pressurised=self.pressure != 0)
+                                     pressurised=self.pressurised)
+
+    @property
+    def pressurised(self) -> bool:
+        """Whether the generated code carries the pressure (a pressure, or volume control)."""
+        return self.pressure != 0 or self.sealed
 
     def model(self):
         """The generated module for this scene's structure (cached)."""
@@ -281,6 +299,19 @@ class Scene:
             pole_rise = inflated_pole_rise(self)
         v["pole_rise"] = float(pole_rise or 0.0)
         return np.array([v[name] for name in model.PARAMS], dtype=float)
+
+    def enclosed_volume(self) -> float:
+        """V0 of a sealed scene: the volume between the shell and its rim's plane in the
+        inflated state at ``pressure`` (the reference volume at pressure 0)."""
+        if not self.pressure:
+            return self.reference_volume()
+        from .inflation import inflate
+
+        state = inflate(self.replace(sealed=False))
+        if not state.success:
+            raise ValueError(f"the inflated state at pressure {self.pressure:g} was not found "
+                             f"({state.message}): no enclosed volume for the sealed shell")
+        return self.reference_volume() + state.volume_change
 
     def reference_volume(self) -> float:
         """V of the undeformed shell, ``-pi Int R^2 Z' dS``: the volume between it and its rim's

@@ -126,6 +126,9 @@ class Solution(dict):
     ring_force, cap_force : float
         Axial force of the ring at Sc (jump of Q) and of the pressure on the cap;
         ``force = ring_force + cap_force``.  For ``contact="paper"`` the ring force is ~0.
+    pressure : float
+        The pressure below the shell (``p R_L/(mu H)``): the scene's, or under volume control
+        (``Scene.sealed``) the one that holds the enclosed volume.
     pressure_min : float
         Minimum contact pressure over the cap (< 0: the shell would pull the indenter).
     edge_legendre : float
@@ -289,8 +292,8 @@ def richardson_error(sysm, res, tol, bc_tol=1e-10):
     x2 = np.sort(np.r_[x, 0.5 * (x[1:] + x[:-1])])
     p = np.asarray(res.p, float)
     with np.errstate(all="ignore"):
-        fine = solve_bvp(sysm.fun, sysm.bc, x2, res.sol(x2), p if p.size else None, fun_jac=sysm.fun_jac,
-                         bc_jac=sysm.bc_jac, tol=tol / 100, bc_tol=bc_tol / 100, max_nodes=x2.size)
+        fine = sysm.solve(x2, res.sol(x2), p if p.size else None, tol=tol / 100, bc_tol=bc_tol / 100,
+                          max_nodes=x2.size)
         if fine.status == 2 or not np.all(np.isfinite(fine.y)) \
                 or (fine.p is not None and not np.all(np.isfinite(fine.p))):
             res.force_error = res.delta_error = float("nan")

@@ -25,7 +25,6 @@ from .solution import (
     attach_tip_table,
     default_eps,
     richardson_error,
-    solve_bvp,
     thin_mesh,
 )
 
@@ -74,8 +73,7 @@ def warm_guess(sysm: ChainBVP, prev: "Solution", predictor=None):
 def _run_bvp(sysm, guess, tol, max_nodes, bc_tol):
     x, y, p = guess
     with np.errstate(all="ignore"):
-        return solve_bvp(sysm.fun, sysm.bc, x, y, p, fun_jac=sysm.fun_jac, bc_jac=sysm.bc_jac,
-                         tol=tol, bc_tol=bc_tol, max_nodes=max_nodes)
+        return sysm.solve(x, y, p, tol=tol, bc_tol=bc_tol, max_nodes=max_nodes)
 
 
 def make_system(scene, control, value, eps, edge=None):

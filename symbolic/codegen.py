@@ -190,6 +190,17 @@ def function_specs(d: Derivation) -> list[FunctionSpec]:
             FunctionSpec(f"{region}_profile", prog, args, [("out", profile)],
                          f"{region} region: physical fields at the nodes (dict of arrays).", "S"),
         ]
+        if d.structure.pressurised:  # volume control (a sealed shell): V = Int dV/dS dS
+            vol = [Ssym * profile["volume_density"]]
+            if any(s.name == "pressure" for s in prog.expand(vol[0]).free_symbols):
+                raise AssertionError(f"the {region} region's volume density depends on the pressure")
+            specs += [
+                FunctionSpec(f"{region}_vol", prog, args, [("v", vol)],
+                             f"{region} region: S dV/dS, (1, m).", "S"),
+                FunctionSpec(f"{region}_vol_jac", prog, args,
+                             [("dv_dy", prog.jacobian(vol, states)), ("dv_dS", prog.jacobian(vol, [Ssym]))],
+                             f"{region} region: d(S dV/dS)/dy (1, {n}, m) and d/dS (1, m).", "S"),
+            ]
     # Legendre condition of the free region: det of the (lambda_s', kappa_s') system
     r_ = sp.Symbol("r")
     legendre = [d.free.let("legendre", sp.Symbol("det") / r_**2)]
@@ -206,6 +217,11 @@ def function_specs(d: Derivation) -> list[FunctionSpec]:
                      [("dres", d.pole.jacobian(d.pole_res, [chi, ls, LAMBDA0]))],
                      "Pole conditions: d/d(chi, ls, lambda0), (2, 3)."),
     ]
+    pressurised = d.structure.pressurised  # d/dpar of every condition: the pressure is an unknown under
+    # volume control (the other junctions' *_jac_par exist for every structure)
+    if pressurised:
+        specs.append(FunctionSpec("pole_jac_par", d.pole, pargs, [("dres", d.pole.jacobian(d.pole_res, par))],
+                                  f"Pole conditions: d/dpar (2, {len(par)})."))
     # rim (S = L)
     Ssym = d.free.inputs[0]
     rargs = [("S", (Ssym,)), ("y", d.free_states), ("par", par)]
@@ -242,6 +258,9 @@ def function_specs(d: Derivation) -> list[FunctionSpec]:
             FunctionSpec(f"force_{prefix}jac", J, jargs, [("dres", J.jacobian([force_res], [Sc, *yf, FORCE]))],
                          f"Force control at a {where} edge: d/d(Sc, yf, F), (1, 8)."),
         ]
+        if pressurised:
+            specs.append(FunctionSpec(f"force_{prefix}jac_par", J, jargs, [("dres", J.jacobian([force_res], par))],
+                                      f"Force control at a {where} edge: d/dpar (1, {len(par)})."))
     if d.has_cylinder:
         E, (SS, *ye) = d.tip_end, d.tip_end_inputs
         eargs = [("S_end", (SS,)), ("yt", tuple(ye[:2])), ("yw", tuple(ye[2:])), ("par", par)]
@@ -252,6 +271,9 @@ def function_specs(d: Derivation) -> list[FunctionSpec]:
             FunctionSpec("tip_end_jac", E, eargs, [("dres", E.jacobian(d.tip_end_res, [SS, *ye]))],
                          "Tip | cylinder junction: d/d(S, yt, yw), (3, 5)."),
         ]
+        if pressurised:
+            specs.append(FunctionSpec("tip_end_jac_par", E, eargs, [("dres", E.jacobian(d.tip_end_res, par))],
+                                      f"Tip | cylinder junction: d/dpar (3, {len(par)})."))
     # point-load limit: pole conditions of the free region alone
     PL = d.point_load
     plargs = [("S", (PL.inputs[0],)), ("y", d.free_states), ("delta", (DELTA,)), ("par", par)]
@@ -262,6 +284,9 @@ def function_specs(d: Derivation) -> list[FunctionSpec]:
                      [("dres", PL.jacobian(d.point_load_res, [*d.free_states, DELTA]))],
                      "Point-load pole conditions: d/d(y, delta), (3, 7)."),
     ]
+    if pressurised:
+        specs.append(FunctionSpec("point_load_jac_par", PL, plargs, [("dres", PL.jacobian(d.point_load_res, par))],
+                                  f"Point-load pole conditions: d/dpar (3, {len(par)})."))
     # regular pole of a free cap (annular and line contact)
     fargs = [("S", (d.free.inputs[0],)), ("y", d.free_states), ("par", par)]
     specs += [
@@ -271,6 +296,10 @@ def function_specs(d: Derivation) -> list[FunctionSpec]:
                      [("dres", d.free.jacobian(d.free_pole_res, [*d.free_states, d.free.inputs[0]]))],
                      "Regular pole of a free cap: d/d(y, S), (3, 7)."),
     ]
+    if pressurised:
+        specs.append(FunctionSpec("free_pole_jac_par", d.free, fargs,
+                                  [("dres", d.free.jacobian(d.free_pole_res, par))],
+                                  f"Regular pole of a free cap: d/dpar (3, {len(par)})."))
     # geometry of the scene (guesses, plots, penetration checks)
     specs += [
         FunctionSpec("reference_shell", d.geometry_prog, [("S", (d.geometry_S,)), ("par", par)],

@@ -118,8 +118,11 @@ def pressure_load():
     reference length is ``-dPi/dx`` (Euler-Lagrange of ``Pi = -p V`` in r and z); its
     component along the normal in which the contact pressure P counts positive,
     ``(sin phi, -cos phi)``, per deformed area ``2 pi r psi``, is the load in the normal
-    balance's ``P``.  Returns ``(load, volume density)``: ``-p`` (a uniform pressure) and
-    ``-pi r^2 z'`` over the symbols ``r, phi, psi``.
+    balance's ``P``.  The potential does not depend on z itself, so axial translation
+    leaves it invariant and it adds ``dPi/dz' / (2 pi)`` to the axial first integral
+    F(S)/(2 pi) (Noether; the paper's F(S), eq. Flaw, with the pressure on the cap
+    inside S).  Returns ``(load, volume density, axial force / (2 pi))``: ``-p`` (a uniform
+    pressure), ``-pi r^2 z'`` and ``p r^2/2``, over the symbols ``r, phi, psi``.
     """
     r, z = sp.Function("r")(S), sp.Function("z")(S)
     rr, phi, psi = sp.symbols("r phi psi")
@@ -130,15 +133,23 @@ def pressure_load():
     load = sp.simplify((fr * sp.sin(phi) - fz * sp.cos(phi)) / (2 * sp.pi * rr * psi))
     if load.free_symbols != {PRESSURE}:
         raise AssertionError(f"pressure load is not uniform: {load}")
-    return load, v.subs(on_shell).subs(r, rr)
+    if sp.diff(v, z) != 0:
+        raise AssertionError("the pressure's potential depends on z: no axial first integral")
+    axial = sp.diff(-PRESSURE * v, sp.diff(z, S)).subs(r, rr) / (2 * sp.pi)
+    return load, v.subs(on_shell).subs(r, rr), sp.simplify(axial)
 
 
-PRESSURE_LOAD, _VOLUME_DENSITY = pressure_load()
+PRESSURE_LOAD, _VOLUME_DENSITY, _PRESSURE_AXIAL_FORCE = pressure_load()
 
 
 def volume_density(r, phi, psi):
     """``dV/dS = -pi r^2 psi sin(phi)`` (see :func:`pressure_load`)."""
     return _VOLUME_DENSITY.xreplace(dict(zip(sp.symbols("r phi psi"), (r, phi, psi))))
+
+
+def pressure_axial_force(r, pressure):
+    """The pressure's part of F(S)/(2 pi), ``p r^2/2`` (see :func:`pressure_load`)."""
+    return _PRESSURE_AXIAL_FORCE.xreplace({sp.Symbol("r"): r, PRESSURE: pressure})
 
 
 class Derivation:
@@ -238,9 +249,10 @@ class Derivation:
 
     def _indenter_force(self, r, sin_phi, cos_phi, tau_s, Q):
         """F(S)/(2 pi): the shell's axial force ``r sin(phi) tau_s - r cos(phi) Q`` plus the
-        pressure's axial force on the cap inside S, ``p r^2/2`` (the paper's F(S), eq. Flaw:
-        constant over a free region; the indenter's force at a contact edge)."""
-        return r * sin_phi * tau_s - r * cos_phi * Q + self.structure.pressure * r**2 / 2
+        pressure's axial force on the cap inside S, ``p r^2/2`` (derived: :func:`pressure_load`;
+        the paper's F(S), eq. Flaw: constant over a free region; the indenter's force at a
+        contact edge)."""
+        return r * sin_phi * tau_s - r * cos_phi * Q + pressure_axial_force(r, self.structure.pressure)
 
     def _tip_steps(self, prog: Program, omega, tip, tag=""):
         d = tip.derived()

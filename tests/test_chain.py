@@ -41,9 +41,18 @@ def central_difference(f, x, h=1e-7):
     return np.stack(cols, axis=-1)
 
 
-def system(kind, contact, control):
+#: Volume control (a sealed shell: the pressure an unknown, one volume state per region)
+SEALED_CASES = [(k, "smooth", "delta") for k in CHAINS] + \
+               [("cap", "smooth", m) for m in ("lambda0", "force", "arclength")] + \
+               [("cap", "paper", "force"), ("cap", "corner", "delta"), ("line", "smooth", "lambda0"),
+                ("cylinder", "paper", "force"), ("wall_line", "smooth", "arclength"), ("tip_band", "smooth", "force")]
+
+
+def system(kind, contact, control, sealed=False):
     # "corner": the smooth model's cap with a Weierstrass-Erdmann corner at its edge
-    scene = sb.Scene.preset("base", contact="smooth" if contact == "corner" else contact)
+    contact_model = "smooth" if contact == "corner" else contact
+    scene = (sb.Scene.preset("balloon", sealed=True, contact=contact_model) if sealed
+             else sb.Scene.preset("base", contact=contact_model))
     value = ARC if control == "arclength" else 0.3
     return ch.ChainBVP(scene, CHAINS[kind](scene.shell_length, contact), control, value)
 
@@ -52,13 +61,15 @@ def state(sysm, rng):
     t = np.linspace(0.0, 1.0, 4)
     y = 0.5 + 0.3 * rng.random((sysm.n, t.size))
     values = dict(ln_Sc=np.log(0.1), ln_S1=np.log(0.05), ln_S2=np.log(0.15), ln_Send=np.log(0.07), chi1=0.9,
-                  lambda0=1.02, delta=0.3)
+                  lambda0=1.02, delta=0.3, pressure=0.13)
     return t, y, sysm.pack(**values)
 
 
-@pytest.mark.parametrize("kind, contact, control", CASES)
-def test_analytic_jacobians_equal_central_differences(kind, contact, control):
-    sysm = system(kind, contact, control)
+@pytest.mark.parametrize("kind, contact, control, sealed",
+                         [(*c, False) for c in CASES] + [(*c, True) for c in SEALED_CASES])
+def test_analytic_jacobians_equal_central_differences(kind, contact, control, sealed):
+    sysm = system(kind, contact, control, sealed)
+    assert sysm.volume_control == sealed and ("pressure" in sysm.unknowns) == sealed
     t, y, p = state(sysm, np.random.default_rng(2))
     rel = lambda a, b: np.max(np.abs(a - b)) / (1 + np.max(np.abs(b)))  # noqa: E731
     jac = sysm.fun_jac(t, y, p)

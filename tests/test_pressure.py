@@ -217,3 +217,52 @@ def test_a_sweep_over_the_pressure(tmp_path):
         assert back.curves[i].scene.pressure == p
         np.testing.assert_allclose(back.curves[i].force, ref.force, rtol=1e-12)
     assert back.force[1, -1] > back.force[0, -1]  # the inflated dome is stiffer
+
+
+# -- volume control: a sealed capsule ------------------------------------------------------------------
+def test_sealed_capsule_holds_its_volume_and_obeys_the_energy_identity(delta=0.1):
+    """Under volume control the pressure is an unknown: V (by quadrature of the profile, not the
+    solver's volume states) stays at V0, the pressure rises, the same state solves under pressure
+    control at that pressure, and F = dE_elastic/d delta (the pressure does no work)."""
+    scene = sb.Scene.preset("balloon", sealed=True)
+    V0 = scene.enclosed_volume()
+    assert V0 - scene.reference_volume() == pytest.approx(inflate(scene.replace(sealed=False)).volume_change)
+    h = 1e-4
+    sols = [sb.solve(scene, delta=d, tol=1e-9, estimate_error=False) for d in (delta - h, delta, delta + h)]
+    assert all(s.success for s in sols), [s.message for s in sols]
+    mid = sols[1]
+    assert mid.system.volume(mid.sol, mid.x, mid.p) == pytest.approx(V0, rel=1e-10)  # measured 1e-13
+    assert mid.pressure > 1.2 * scene.pressure  # squeezing a sealed capsule raises its pressure
+    dE = (sols[2].energy - sols[0].energy) / (2 * h)
+    assert mid.force == pytest.approx(dE, rel=2e-6)
+    # (its delta is measured from the pole inflated at the new pressure: shift by the rises' difference)
+    shift = inflate(scene.replace(sealed=False, pressure=mid.pressure)).pole_rise - inflate(
+        scene.replace(sealed=False)).pole_rise
+    again = sb.solve(scene.replace(sealed=False, pressure=mid.pressure), delta=delta + shift, tol=1e-9,
+                     estimate_error=False)
+    assert again.success
+    assert again.force == pytest.approx(mid.force, rel=1e-9)  # measured 3e-14
+    # the sealed capsule is stiffer than the same shell at its initial pressure
+    open_ = sb.solve(scene.replace(sealed=False), delta=delta, estimate_error=False)
+    assert mid.force > 1.1 * open_.force
+
+
+def test_sealed_curve_records_the_pressure_and_files_keep_it(tmp_path):
+    scene = sb.Scene.preset("balloon", sealed=True, pressure=0.0)  # filled at zero pressure
+    c = sb.curve(scene, deltas=[0.02, 0.05, 0.08])
+    assert c.complete and np.all(c.points["valid"])
+    p = c.points["pressure"]
+    assert p[0] > 0 and np.all(np.diff(p) > 0)
+    path = tmp_path / "sealed.h5"
+    c.to_hdf5(path)
+    back = sb.read_curve(path)
+    assert back.scene.sealed and back.scene == scene
+    np.testing.assert_array_equal(back.points["pressure"], p)
+    # a failed state has no pressure: it was an unknown
+    bad = sb.solve(scene, delta=0.05, max_nodes=12, estimate_error=False)
+    assert not bad.success and math.isnan(bad.pressure)
+
+
+def test_sealed_needs_a_boolean():
+    with pytest.raises(ValueError, match="sealed must be True"):
+        sb.Scene(sealed="yes")
