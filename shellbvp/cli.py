@@ -114,6 +114,9 @@ def _scene_options(p, uncertain=False):
     g.add_argument("--pressure", type=_pressure,
                    help="pressure below the shell (from the side away from the indenter; > 0 inflates a dome or "
                         "cell): p R_L/(mu H), or with a unit (0.2MPa, 50kPa) together with --radius and --muH")
+    g.add_argument("--sealed", action="store_true", default=None,
+                   help="volume control: the shell encloses the volume it has when inflated at --pressure (a "
+                        "sealed capsule); the pressure becomes an unknown of every state")
     g.add_argument("--contact", choices=("smooth", "paper"), help="contact-line model (default smooth)")
     b = g.add_mutually_exclusive_group()
     b.add_argument("--bending", choices=("trace", "rotation"),
@@ -129,7 +132,8 @@ def _scene_options(p, uncertain=False):
 def _scene(args):
     import shellbvp as sb
 
-    over = {k: getattr(args, k) for k in ("gamma", "rho", "beta", "xi", "contact") if getattr(args, k) is not None}
+    over = {k: getattr(args, k) for k in ("gamma", "rho", "beta", "xi", "contact", "sealed")
+            if getattr(args, k, None) is not None}
     if args.alpha is not None:
         over["material"] = sb.MooneyRivlin(args.alpha)
     elif args.gent_jm is not None:
@@ -305,7 +309,7 @@ def _cmd_solve(args):
     if not given:
         given = {"delta": 0.2}
     sol = sb.solve(scene, tol=args.tol, max_nodes=args.max_nodes, topology=args.topology, **given)
-    keys = ("success", "status", "message", "topology", "delta", "force", "lambda0", "S1", "Sc",
+    keys = ("success", "status", "message", "topology", "delta", "force", "lambda0", "S1", "Sc", "pressure",
             "ring_force", "ring_force_inner", "cap_force",
             "pressure_min", "penetration", "valid", "flags", "energy", "force_defect", "force_error",
             "delta_error", "nodes", "niter", "max_residual", "wall_time")
@@ -791,7 +795,8 @@ def _cmd_info(args):
     print(f"file:      {args.file} (shellbvp {c.version})")
     print(f"scene:     gamma={s.gamma:g} rho={s.rho:g} beta={s.beta:g} xi={s.xi} contact={s.contact} "
           f"material={mat!r} bending={s.bending!r} shell={s.shell!r} tip={s.tip!r}"
-          + (f" pressure={s.pressure:g} (delta from the inflated pole)" if s.pressure else ""))
+          + (f" pressure={s.pressure:g} (delta from the inflated pole)" if s.pressure else "")
+          + (" sealed (volume control: the pressure is per point)" if s.sealed else ""))
     print(f"curve:     {c.summary()}")
     print(f"complete:  {c.complete}  interrupted: {c.interrupted}")
     res = c.energy_residual
@@ -800,10 +805,11 @@ def _cmd_info(args):
     if len(c):
         print(f"topology:  {c.topology_summary()}")
         print(f"{'delta':>10s} {'force':>12s} {'lambda0':>9s} {'S1':>10s} {'Sc':>10s} {'topology':>8s} "
-              f"{'status':>6s} {'valid':>5s}")
+              f"{'status':>6s} {'valid':>5s}" + (f" {'pressure':>10s}" if s.sealed else ""))
         for i in range(len(c)):
             print(f"{c.delta[i]:10.5f} {c.force[i]:12.6g} {c.lambda0[i]:9.5f} {c.S1[i]:10.4g} {c.Sc[i]:10.4g} "
-                  f"{c.topology[i]:>8s} {int(c.status[i]):6d} {str(bool(c.valid[i])):>5s}")
+                  f"{c.topology[i]:>8s} {int(c.status[i]):6d} {str(bool(c.valid[i])):>5s}"
+                  + (f" {c.points['pressure'][i]:10.5g}" if s.sealed else ""))
     return 0
 
 
@@ -814,7 +820,7 @@ def _cmd_presets(args):
         sc = p["scene"]
         shape = (f"shell=R,Z,L=({', '.join(sc['shell'])})" if isinstance(sc.get("shell"), tuple)
                  else f"gamma={sc['gamma']:<5g}")
-        extra = f" pressure={sc['pressure']:g}" if sc.get("pressure") else ""
+        extra = (f" pressure={sc['pressure']:g}" if sc.get("pressure") else "") + (" sealed" if sc.get("sealed") else "")
         print(f"{name:9s} {shape} rho={sc['rho']:<7.4g} beta={sc['beta']:<6g} "
               f"xi={sc['xi']} material={sc['material']!r}{extra}  -- {p['doc']}")
     return 0

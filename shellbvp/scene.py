@@ -369,4 +369,8 @@ PRESETS = {
                     "radius 2.5 um, wall 0.1 um, mu H 3.3 N/m, turgor 0.2 MPa)",
              "scene": dict(shell=("sin(S)", "cos(S)", "4*pi/5"), rho=0.34, beta=3.9e-4,
                            material=MooneyRivlin(0.1), xi=1, pressure=0.089)},
+    "capsule": {"doc": "sealed liquid-filled capsule: the cell's near-complete sphere with no pressure before "
+                       "indenting, under volume control (the pressure rises as it is indented)",
+                "scene": dict(shell=("sin(S)", "cos(S)", "4*pi/5"), rho=0.34, beta=3.9e-4,
+                              material=MooneyRivlin(0.1), xi=1, sealed=True)},
 }

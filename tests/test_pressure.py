@@ -266,3 +266,30 @@ def test_sealed_curve_records_the_pressure_and_files_keep_it(tmp_path):
 def test_sealed_needs_a_boolean():
     with pytest.raises(ValueError, match="sealed must be True"):
         sb.Scene(sealed="yes")
+
+
+def test_axial_first_integral_includes_the_derived_pressure_term():
+    """F(S) (the axial first integral, with the pressure's p r^2/2 from Noether's theorem in
+    symbolic.equations.pressure_load) is constant over the free region and equals the indenter's
+    force; the elastic part alone is not (it varies by more than the force itself)."""
+    from symbolic.equations import PRESSURE, pressure_load
+
+    assert sp.simplify(pressure_load()[2] - PRESSURE * sp.Symbol("r") ** 2 / 2) == 0
+    scene = sb.Scene.preset("balloon")
+    s = sb.solve(scene, delta=0.1, tol=1e-9, estimate_error=False)
+    prof = s.profile()
+    free = prof["region"] == 1
+    F_S = prof["axial_force"][free]
+    assert np.max(np.abs(F_S - s.force)) < 1e-7 * s.force
+    elastic = F_S - 2 * np.pi * scene.pressure * prof["r"][free] ** 2 / 2
+    assert np.ptp(elastic) > s.force
+
+
+def test_cli_sealed_solves_for_the_pressure(capsys):
+    from shellbvp.cli import main
+
+    assert main(["solve", "--preset", "base", "--sealed", "--delta", "0.2"]) == 0
+    out = {k.strip(): v for k, v in (line.split(":", 1) for line in capsys.readouterr().out.splitlines() if ":" in line)}
+    assert out["topology"].strip() == "cap" and float(out["pressure"]) > 0.01
+    assert main(["presets"]) == 0
+    assert any(line.startswith("capsule") and "sealed" in line for line in capsys.readouterr().out.splitlines())
