@@ -242,7 +242,9 @@ def wall_state(start: Solution, topology: str, *, control=None, value=None, tol=
     if res is None:
         nan = float("nan")
         res = Solution(status=5, success=False, valid=False, flags=[], topology=topology, delta=nan, force=nan,
-                       lambda0=nan, Sc=nan, energy=nan, message=f"no guess for {topology} from a "
+                       lambda0=nan, Sc=nan, energy=nan, scene=sysm.scene,
+                       pressure=nan if sysm.scene.sealed else sysm.scene.pressure,
+                       message=f"no guess for {topology} from a "
                        f"{start.get('topology')} state")
     elif res.success and estimate_error:
         richardson_error(sysm, res, tol, bc_tol)

@@ -554,11 +554,13 @@ def _continue_in_delta(scene, eps, target, starts=(0.1, 0.05), **kw):
     return res
 
 
-def _failure(status, message, control, value):
-    """A result without any state: NaN but the prescribed ``control`` = ``value``."""
+def _failure(status, message, control, value, scene):
+    """A result without any state: NaN but the prescribed ``control`` = ``value`` (and the
+    scene's pressure, unless it is an unknown: volume control)."""
     nan = float("nan")
     res = Solution(status=status, message=message, success=False, valid=False, flags=[],
                    delta=nan, force=nan, lambda0=nan, Sc=nan, nodes=0, niter=0, wall_time=nan,
+                   pressure=nan if scene.sealed else scene.pressure, scene=scene,
                    x=np.empty(0), y=np.empty((8, 0)), p=np.full(2, nan), topology="cap", control=control)
     res[control] = float(value)
     return res
@@ -573,7 +575,7 @@ def _cold_other(scene, sysm, control, value, eps, **kw):
     key = "lambda0" if control == "lambda0" else "force"
 
     def fail(message):
-        return _failure(5, message, control, value)
+        return _failure(5, message, control, value, scene)
 
     d, step = 0.02, 0.02
     lk = _loose(kw)

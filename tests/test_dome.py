@@ -171,6 +171,7 @@ def test_failed_results_carry_nan_not_the_last_iterate():
         assert not sol.success and sol.status in (1, 2, 3, 5) and not sol.valid, name
         nums = _numbers(sol)
         assert nums.pop(control) == [value], name
+        assert nums.pop("pressure") == [sol.scene.pressure], name  # given, not an unknown (no volume control)
         if control == "delta" and "z_tip" in nums:  # the tip's height follows from delta
             assert nums.pop("z_tip") == [pytest.approx(float(sol.scene.model().reference_shell(
                 0.0, sol.scene.parameters(sol.scene.model()))["Z"]) - value)], name
@@ -186,7 +187,7 @@ def test_as_failure_drops_a_converged_states_numbers():
     fail = as_failure(sol, 5, "no guess converged")
     assert (fail.status, fail.success, fail.valid, fail.delta) == (5, False, False, 0.2)
     nums = _numbers(fail)
-    nums.pop("delta"), nums.pop("z_tip")
+    nums.pop("delta"), nums.pop("z_tip"), nums.pop("pressure")  # delta and the pressure given; z_tip from delta
     assert nums and all(math.isnan(x) for v in nums.values() for x in v), nums
     with pytest.raises(ValueError, match="status"):
         as_failure(sb.solve(base, delta=0.2, estimate_error=False), 4, "inadmissible")
