@@ -648,7 +648,8 @@ class ChainBVP:
                 self._add_p(P, rows, point.unknown, jj[:, 0] * S)
                 self._add_p(P, rows, "delta", jj[:, 9])
                 if vc:
-                    self._pressure_column(P, rows, self._edge_function(j, "jac_par")(S, yc, yf, q["delta"], q["F"], par))
+                    dpar = self._edge_function(j, "jac_par")(S, yc, yf, q["delta"], q["F"], par)
+                    self._pressure_column(P, rows, dpar)
             elif isinstance(j, Line):
                 point, yc, yin, yout = self._line_states(j, ya, yb, q)
                 S = self.S_point(point, p)

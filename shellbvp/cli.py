@@ -820,7 +820,8 @@ def _cmd_presets(args):
         sc = p["scene"]
         shape = (f"shell=R,Z,L=({', '.join(sc['shell'])})" if isinstance(sc.get("shell"), tuple)
                  else f"gamma={sc['gamma']:<5g}")
-        extra = (f" pressure={sc['pressure']:g}" if sc.get("pressure") else "") + (" sealed" if sc.get("sealed") else "")
+        extra = f" pressure={sc['pressure']:g}" if sc.get("pressure") else ""
+        extra += " sealed" if sc.get("sealed") else ""
         print(f"{name:9s} {shape} rho={sc['rho']:<7.4g} beta={sc['beta']:<6g} "
               f"xi={sc['xi']} material={sc['material']!r}{extra}  -- {p['doc']}")
     return 0

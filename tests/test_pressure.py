@@ -289,7 +289,8 @@ def test_cli_sealed_solves_for_the_pressure(capsys):
     from shellbvp.cli import main
 
     assert main(["solve", "--preset", "base", "--sealed", "--delta", "0.2"]) == 0
-    out = {k.strip(): v for k, v in (line.split(":", 1) for line in capsys.readouterr().out.splitlines() if ":" in line)}
+    lines = [line.split(":", 1) for line in capsys.readouterr().out.splitlines() if ":" in line]
+    out = {k.strip(): v for k, v in lines}
     assert out["topology"].strip() == "cap" and float(out["pressure"]) > 0.01
     assert main(["presets"]) == 0
     assert any(line.startswith("capsule") and "sealed" in line for line in capsys.readouterr().out.splitlines())
