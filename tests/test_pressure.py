@@ -294,3 +294,17 @@ def test_cli_sealed_solves_for_the_pressure(capsys):
     assert out["topology"].strip() == "cap" and float(out["pressure"]) > 0.01
     assert main(["presets"]) == 0
     assert any(line.startswith("capsule") and "sealed" in line for line in capsys.readouterr().out.splitlines())
+
+
+@pytest.mark.slow
+def test_corner_edge_with_pressure_keeps_the_energy_identity(delta=0.7):
+    """Past the convexity limit (base: 0.614) the contact edge is a Weierstrass-Erdmann corner.
+    Its conditions (sliding and Eshelby) are those without pressure: the pressure's potential
+    has no Hamiltonian part and its boundary term is continuous.  If that were wrong, F =
+    d(E_el - p V)/d delta would fail at a corner state; measured 1.9e-9."""
+    scene = sb.Scene.preset("base", pressure=0.05)
+    h = 1e-4
+    sols = [sb.solve(scene, delta=d, tol=1e-9, estimate_error=False) for d in (delta - h, delta, delta + h)]
+    assert all(s.success and s.contact_edge == "corner" and s.edge_jump_ls > 0.1 for s in sols)
+    dE = (sols[2].energy - sols[0].energy) / (2 * h)
+    assert sols[1].force == pytest.approx(dE, rel=1e-7)
