@@ -220,7 +220,9 @@ class _Builder:
         kw = dict(tol=st["tol"], max_nodes=st["max_nodes"], bc_tol=st["bc_tol"])
         shown = sol
         if sol.scene.contact == "smooth":
-            shown = replace_invalid_cap(sol, previous=self.last_liftoff, before=self.liftoff_before, **kw)
+            last = self.rows[-1][3] if self.rows else None  # the point computed before this one
+            shown = replace_invalid_cap(sol, previous=self.last_liftoff, before=self.liftoff_before, last=last,
+                                        **kw)
             if shown is not sol:
                 self.liftoff_before, self.last_liftoff = self.last_liftoff, shown
         if shown.get("topology") == "cap" and wall_contact_suspected(shown):

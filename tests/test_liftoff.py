@@ -259,6 +259,28 @@ def test_a_cap_pressed_at_the_pole_and_pulling_further_out_splits_into_a_cap_and
     assert abs(slope - s.force) < 1e-8 + 10 * s.force_error
 
 
+def test_no_split_probe_where_the_previous_point_lifted_its_pole(monkeypatch):
+    """base at delta 0.1125 after the line at 0.1: the line is too curved, the annulus closes
+    onto the pole, the cap still pulls at its edge and presses at the pole.  The split
+    cap+line(tip) grows from a cap or from a line whose pole comes down; here the line's pole
+    stays above the tip, so it is not probed (it used to cost 1.7 s and find nothing); the
+    recorded point is the same flagged cap as before."""
+    import shellbvp.liftoff
+
+    calls = []
+    orig = shellbvp.liftoff.second_zone_state
+    monkeypatch.setattr(shellbvp.liftoff, "second_zone_state", lambda *a, **k: calls.append(1) or orig(*a, **k))
+    scene = sb.Scene.preset("base")
+    c = sb.curve(scene, deltas=[0.1, 0.1125], estimate_error=False)
+    assert list(c.topology) == ["line", "cap"] and list(c.valid) == [True, False]
+    assert calls == []
+    assert any("cap+line(tip): not tried" in f for f in c.flags[1:])
+    cap = sb.solve(scene, delta=0.1125, topology="cap", estimate_error=False)
+    assert c.force[1] == pytest.approx(cap.force, rel=1e-7)
+    # (a single solve has no previous point: it still probes the split, as
+    # test_a_cap_pressed_at_the_pole_and_pulling_further_out_splits_into_a_cap_and_a_line needs)
+
+
 # -- warm starts of lift-off states (issue 14 item 1) -------------------------------------------------
 class _Count:
     """solve_bvp runs and Newton iterations of the lift-off solves (counts are deterministic)."""
