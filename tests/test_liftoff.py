@@ -7,6 +7,8 @@ satisfy the energy identity F = dE/ddelta, and that curves switch topology
 without a jump in F(delta).
 """
 
+import math
+
 import numpy as np
 import pytest
 from scipy.integrate import trapezoid
@@ -342,3 +344,25 @@ def test_no_failed_step_where_the_cap_grows_exponentially(monkeypatch):
     c = sb.curve(sb.Scene.preset("base"), deltas=[0.0125, 0.025, 0.0375], estimate_error=False, topology="cap")
     assert c.complete and len(failed) >= 3
     assert not any(failed), failed
+
+
+def test_no_warm_start_from_a_line_whose_contact_circle_is_far_off(monkeypatch):
+    """gent1's small-delta leg: the line at delta 0.03 (Sc 1.3e-5) is a poor guess for the line
+    at 0.018 (Sc 1.4e-8): Newton stalls from it (10 iterations) before the cap's guess
+    converges.  Past WARM_MAX_LN_SC in ln Sc the cap's guess is used at once: the same curve,
+    one lift-off solve and some 10 Newton iterations fewer."""
+    import shellbvp.liftoff as lo
+
+    scene = sb.Scene.preset("gent1")
+    curves, counts = {}, {}
+    for limit in (lo.WARM_MAX_LN_SC, math.inf):
+        with monkeypatch.context() as m:
+            m.setattr(lo, "WARM_MAX_LN_SC", limit)
+            counts[limit] = _Count(m)
+            curves[limit] = sb.curve(scene, delta_max=0.2, estimate_error=False)
+    guarded, unguarded = curves[lo.WARM_MAX_LN_SC], curves[math.inf]
+    assert guarded.complete and list(guarded.topology) == list(unguarded.topology)
+    np.testing.assert_allclose(guarded.delta, unguarded.delta, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(guarded.force, unguarded.force, rtol=1e-7)
+    c, u = counts[lo.WARM_MAX_LN_SC], counts[math.inf]
+    assert u.calls - c.calls == 1 and u.niter - c.niter >= 8, ((c.calls, c.niter), (u.calls, u.niter))
