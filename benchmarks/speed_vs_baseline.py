@@ -66,16 +66,32 @@ CASES = [("base default", "base", "default"), ("base 40 depths", "base", "deltas
          ("base 40 depths, cap only", "base", "deltas40-cap")] + [
     (f"{p} default", p, "default") for p in ("base-xi0", "prolate2", "fit", "flat", "gent1", "dome")]
 
-#: variant -> (side, patches {module: {attribute: value}}, curve keyword arguments)
+#: variant -> (side, patches {module: {attribute: value}}, curve keyword arguments, environment).
+#: This commit runs with the numpy functions (SHELLBVP_KERNELS=numpy: the reference, and what
+#: the ablations switch changes off from) and with numba's compiled kernels (compiled while
+#: warming, not timed); the baseline has no compiled kernels.
+NUMPY, NUMBA = {"SHELLBVP_KERNELS": "numpy"}, {"SHELLBVP_KERNELS": "numba"}
 VARIANTS = {
-    "baseline": ("old", {}, {}),
-    "this commit": ("new", {}, {}),
-    "cold lift-off": ("new", {"shellbvp.liftoff": {"_WARM_FIRST": False}}, {}),
-    "no secant guard": ("new", {"shellbvp.continuation": {"SECANT_MAX_LN_SC": math.inf}}, {}),
-    "full Richardson": ("new", {}, {"estimate_error": "full"}),
+    "baseline": ("old", {}, {}, {}),
+    "this commit": ("new", {}, {}, NUMPY),
+    "this commit, numba": ("new", {}, {}, NUMBA),
+    "cold lift-off": ("new", {"shellbvp.liftoff": {"_WARM_FIRST": False}}, {}, NUMPY),
+    "no secant guard": ("new", {"shellbvp.continuation": {"SECANT_MAX_LN_SC": math.inf}}, {}, NUMPY),
+    "full Richardson": ("new", {}, {"estimate_error": "full"}, NUMPY),
+    "no split rule": ("new", {"shellbvp.liftoff": {"_SPLIT_RULE": False}}, {}, NUMPY),
+    "no ln Sc guard": ("new", {"shellbvp.liftoff": {"WARM_MAX_LN_SC": math.inf}}, {}, NUMPY),
+    "no tightening": ("new", {"shellbvp.continuation": {"_TIGHTEN": False}}, {}, NUMPY),
 }
 
-ABLATIONS = ("cold lift-off", "no secant guard", "full Richardson")  # run on the base curves only
+#: variant -> the curves it runs on (each change switched off where it acts; the others run everywhere)
+ABLATIONS = {
+    "cold lift-off": ("base default", "base 40 depths"),
+    "no secant guard": ("base default", "base 40 depths", "base 40 depths, cap only"),
+    "full Richardson": ("base default", "base 40 depths", "base 40 depths, cap only"),
+    "no split rule": ("base default", "base 40 depths"),
+    "no ln Sc guard": ("base default", "gent1 default", "dome default"),
+    "no tightening": ("base default", "fit default", "flat default"),
+}
 
 
 # ---------------------------------------------------------------------------------------------
@@ -120,6 +136,13 @@ def worker(spec):
 
     scene = sb.Scene.preset(spec["preset"])
     scene.model()  # the cached generated code: loaded, not timed
+    kernel_load = 0.0
+    if os.environ.get("SHELLBVP_KERNELS") == "numba":  # numba's compiled kernels: loaded from its cache,
+        from shellbvp.kernels import kernel_set          # timed apart (once per process and structure)
+
+        t0 = time.perf_counter()
+        kernel_set(scene.model(), scene.structure)
+        kernel_load = time.perf_counter() - t0
     for module, attrs in spec["patches"].items():
         m = importlib.import_module(module)
         for name, value in attrs.items():
@@ -137,7 +160,7 @@ def worker(spec):
                delta=[float(v) for v in c.delta], force=[float(v) for v in c.force],
                topology=[str(s.get("topology", "cap")) for s in sols] or ["cap"] * len(c),
                valid=[bool(v) for v in c.valid], nodes=[int(v) for v in c.points["nodes"]],
-               shellbvp=str(Path(sb.__file__).parent), **counts)
+               shellbvp=str(Path(sb.__file__).parent), kernel_load_s=kernel_load, **counts)
     print(json.dumps(out))
 
 
@@ -164,18 +187,18 @@ class Sides:
         self.trees = {"old": old_tree, "new": REPO}
         self.caches = {side: work / f"cache-{side}" for side in self.trees}
 
-    def env(self, side):
+    def env(self, side, extra=None):
         env = dict(os.environ, PYTHONPATH=str(self.trees[side]), XDG_CACHE_HOME=str(self.caches[side]),
-                   SHELLBVP_CACHE_DIR=str(self.caches[side] / "shellbvp"), PYTHONHASHSEED="0")
+                   SHELLBVP_CACHE_DIR=str(self.caches[side] / "shellbvp"), PYTHONHASHSEED="0", **(extra or {}))
         env.pop("PYTHONSTARTUP", None)
         return env
 
     def run(self, variant, case):
-        side, patches, curve_kw = VARIANTS[variant]
+        side, patches, curve_kw, extra = VARIANTS[variant]
         _, preset, kind = case
         spec = dict(preset=preset, kind=kind, patches=patches, curve_kw=curve_kw)
         r = subprocess.run([sys.executable, str(Path(__file__).resolve()), "--worker", json.dumps(spec)],
-                           env=self.env(side), capture_output=True, text=True, cwd=str(self.trees[side]))
+                           env=self.env(side, extra), capture_output=True, text=True, cwd=str(self.trees[side]))
         if r.returncode != 0:
             raise RuntimeError(f"{variant} / {case[0]} failed:\n{r.stderr[-3000:]}")
         out = json.loads(r.stdout.strip().splitlines()[-1])
@@ -183,13 +206,19 @@ class Sides:
             raise RuntimeError(f"{variant} imported {out['shellbvp']}, not the {side} tree")
         return out
 
-    def warm(self, presets, log):
-        """Generate every structure's code into each side's cache (not timed)."""
+    def warm(self, presets, log, numba=False):
+        """Generate every structure's code into each side's cache, and on this commit's side
+        compile numba's kernels (a solve with SHELLBVP_KERNELS=numba compiles them first); not timed."""
         code = "import sys, shellbvp as sb\nfor p in sys.argv[1:]: sb.Scene.preset(p).model()"
+        kernels = ("import sys, shellbvp as sb\nfor p in sys.argv[1:]: "
+                   "sb.solve(sb.Scene.preset(p), delta=0.1, estimate_error=False)")
         for side in self.trees:
             t0 = time.perf_counter()
             subprocess.run([sys.executable, "-c", code, *presets], env=self.env(side), check=True,
                            cwd=str(self.trees[side]))
+            if side == "new" and numba:
+                subprocess.run([sys.executable, "-c", kernels, *presets], env=self.env(side, NUMBA), check=True,
+                               cwd=str(self.trees[side]))
             log(f"code cache of the {side} side ready in {time.perf_counter() - t0:.0f} s")
 
 
@@ -321,6 +350,11 @@ def _fmt(v, f=".2f"):
     return "–" if v is None or (isinstance(v, float) and not math.isfinite(v)) else format(v, f)
 
 
+def _kernel_load(data):
+    loads = [r.get("kernel_load_s", 0.0) for c in data["cases"] for r in c["runs"].get("this commit, numba", [])]
+    return f"median {statistics.median(loads):.2f} s, at most {max(loads):.2f} s" if loads else "not run"
+
+
 def _check_text(data):
     checks = [ch for c in data["cases"] for ch in c.get("reference", {}).get("check", [])]
     ok = [ch["rel"] for ch in checks if ch["converged"]]
@@ -338,7 +372,10 @@ def markdown(data):
     lines = [f"Measured {m['date']} on {m['machine']} ({m['cpus']} cores, shared), Python {m['python']}, "
              f"NumPy {m['numpy']}, SciPy {m['scipy']}: this commit ({m['this_commit']}) against the baseline "
              f"{m['baseline'][:7]}, each curve a fresh process with a warm code cache (its own per side), "
-             f"{m['repeat']} repeats alternating the variants; time: median over repeats of the curve's CPU time "
+             f"{m['repeat']} repeats alternating the variants; this commit with the numpy functions "
+             f"(SHELLBVP_KERNELS=numpy; every ablation too) and with numba's compiled kernels (compiled "
+             f"beforehand; loaded from numba's cache before the curve is timed, once per process and "
+             f"structure: {_kernel_load(data)}); time: median over repeats of the curve's CPU time "
              f"(the process's, the measure least disturbed by other users of a shared machine) and wall time; "
              f"ratio: median over repeats of (variant time / this commit's time in the same repeat); speed-ups "
              f"and per-point times use CPU time; counts (solve_bvp runs, "
@@ -371,14 +408,24 @@ def markdown(data):
                   "counted), against this commit's default curve per point. 'equal error': the loosest "
                   "shooting rtol whose max F error is at most the collocation curve's.", "",
                   "| preset | collocation CPU ms/point (max F error) | shooting rtol: CPU ms/point (max F error, converged) "
-                  "| shooting / collocation per point at equal or better error |", "|---|---|---|---|"]
+                  "| shooting / collocation per point at equal or better error | the same, numba kernels |",
+                  "|---|---|---|---|---|"]
+        if data.get("shooting_from"):
+            sf = data["shooting_from"]
+            lines[-2:-2] = [f"Shooting's rows are from the run of {sf['date']} (at {sf['commit']}; "
+                            f"`benchmarks/shooting.py` unchanged since), not measured again in this run; the "
+                            f"collocation side is this run's.", ""]
         for case in sh:
             r = case["rows"]["this commit"]
             cells = "; ".join(f"{s['rtol']:g}: {s['per_point_ms']:.0f} ({_fmt(s['max_rel'], '.0e')}, "
                               f"{s['converged']}/{s['points']})" for s in case["shooting"])
-            eq = case.get("shooting_ratio")
+            eq, eqn = case.get("shooting_ratio"), case.get("shooting_ratio_numba")
+            rn = case["rows"].get("this commit, numba")
+            numba_cell = "–" if rn is None else (f"{rn['ms_per_point']:.0f} ms/point ({_fmt(rn['f_error'], '.0e')}): " +
+                                                  (f"{eqn:.1f}x" if eqn is not None else "no shooting rtol reached that error"))
             lines.append(f"| {case['preset']} | {r['ms_per_point']:.0f} ({_fmt(r['f_error'], '.0e')}) | {cells} | "
-                         f"{_fmt(eq, '.1f') + 'x' if eq is not None else 'no shooting rtol reached that error'} |")
+                         f"{_fmt(eq, '.1f') + 'x' if eq is not None else 'no shooting rtol reached that error'} | "
+                         f"{numba_cell} |")
         lines.append("")
     lines += ["| target (issue 14) | measured | met |", "|---|---|---|"]
     for t in data["targets"]:
@@ -387,33 +434,46 @@ def markdown(data):
 
 
 def targets(data):
-    rows = {c["id"]: c["rows"] for c in data["cases"]}
+    cases = {c["id"]: c for c in data["cases"]}
     out = []
 
-    def ratio_target(case, want, text):
-        if case not in rows:
+    def speedup(case, variant):
+        """Median over repeats of baseline CPU time / ``variant``'s in the same repeat."""
+        runs = case["runs"]
+        if variant not in runs:
+            return math.nan
+        return _median_ratio([r["cpu"] for r in runs["baseline"]], [r["cpu"] for r in runs[variant]])
+
+    def ratio_target(case_id, want, text):
+        if case_id not in cases:
             return
-        r = rows[case]
-        speed = r["baseline"]["cpu_vs_this"]  # baseline CPU time / this commit's, median over repeats
-        err = r["this commit"]["f_error"]
-        out.append(dict(target=text, measured=f"{speed:.2f}x CPU time ({r['baseline']['cpu_median']:.2f} s -> "
-                                                f"{r['this commit']['cpu_median']:.2f} s; wall time "
-                                                f"{r['baseline']['time_vs_this']:.2f}x), max F error {_fmt(err, '.1e')}",
-                        met="yes" if speed >= want and (err is None or err <= 1e-6) else "no"))
+        case, parts, met = cases[case_id], [], False
+        for variant, label in (("this commit", "numpy"), ("this commit, numba", "numba kernels")):
+            r = case["rows"].get(variant)
+            if r is None:
+                continue
+            speed, err = speedup(case, variant), r["f_error"]
+            parts.append(f"{label}: {speed:.2f}x CPU time ({case['rows']['baseline']['cpu_median']:.2f} s -> "
+                         f"{r['cpu_median']:.2f} s), max F error {_fmt(err, '.1e')}")
+            met |= speed >= want and (err is None or err <= 1e-6)
+        out.append(dict(target=text, measured="; ".join(parts), met="yes" if met else "no"))
 
     ratio_target("base default", 5, "default base curve to delta 0.5, F error <= 1e-6: >= 5x faster than the baseline")
     ratio_target("base 40 depths", 8, "40-depth curve with lift-off: >= 8x")
     ratio_target("base 40 depths, cap only", 2.5, "cap-only 40-depth curve: >= 2.5x")
-    eqs = [c["shooting_ratio"] for c in data["cases"] if c.get("shooting_ratio") is not None]
-    if eqs:
-        out.append(dict(target=">= 40x faster than shooting per point at equal or better F error",
-                        measured=f"median {statistics.median(eqs):.1f}x ({min(eqs):.1f}x–{max(eqs):.1f}x over "
-                                 f"{len(eqs)} presets)", met="yes" if min(eqs) >= 40 else "no"))
+    for key, label in (("shooting_ratio", "numpy"), ("shooting_ratio_numba", "numba kernels")):
+        eqs = [c[key] for c in data["cases"] if c.get(key) is not None]
+        if eqs:
+            out.append(dict(target=f">= 40x faster than shooting per point at equal or better F error ({label})",
+                            measured=f"median {statistics.median(eqs):.1f}x ({min(eqs):.1f}x–{max(eqs):.1f}x over "
+                                     f"{len(eqs)} presets)", met="yes" if min(eqs) >= 40 else "no"))
     return out
 
 
-def shooting_ratio(case):
-    r = case["rows"]["this commit"]
+def shooting_ratio(case, variant="this commit"):
+    r = case["rows"].get(variant)
+    if r is None:
+        return None
     good = [s for s in case["shooting"] if s["converged"] == s["points"] and s["max_rel"] <= r["f_error"]]
     if not good:
         return None
@@ -447,6 +507,9 @@ def parse_args(argv=None):
     ap.add_argument("--repeat", type=int, default=3, help="timed runs per curve and variant (default 3)")
     ap.add_argument("--quick", action="store_true", help="base default curve, 1 repeat, no shooting (*-quick files)")
     ap.add_argument("--no-shooting", action="store_true", help="leave out the shooting peer")
+    ap.add_argument("--reuse-shooting", default=None, metavar="JSON",
+                    help="take shooting's rows from an earlier results file instead of running it again "
+                         "(prolate2 and fit: ~30 min); the tables say so")
     ap.add_argument("--work-dir", default=None,
                     help="the baseline's tree and both code caches (default: a folder in ~/.cache)")
     ap.add_argument("--out-dir", default=None, help="write results/ under this directory (default benchmarks/)")
@@ -467,7 +530,7 @@ def main(argv=None):
     if args.quick:
         args.repeat = 1
     cases = CASES[:1] if args.quick else CASES
-    variants = ["baseline", "this commit"] if args.quick else list(VARIANTS)
+    variants = ["baseline", "this commit", "this commit, numba"] if args.quick else list(VARIANTS)
     work = Path(args.work_dir) if args.work_dir else \
         Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "shellbvp-speed-vs-baseline"
 
@@ -479,16 +542,14 @@ def main(argv=None):
     # this process (references, shooting) is this commit, with this side's code cache
     sys.path.insert(0, str(REPO))
     os.environ.update({k: sides.env("new")[k] for k in ("XDG_CACHE_HOME", "SHELLBVP_CACHE_DIR")})
-    sides.warm(sorted({c[1] for c in cases}), log)
+    sides.warm(sorted({c[1] for c in cases}), log, numba="this commit, numba" in variants)
     data = dict(cases=[dict(id=c[0], preset=c[1], kind=c[2], runs={v: [] for v in variants}) for c in cases])
     for rep in range(args.repeat):
         for k, (case, entry) in enumerate(zip(cases, data["cases"])):
             shift = (rep + k) % len(variants)
             for v in variants[shift:] + variants[:shift]:
-                if case[2] == "deltas40-cap" and v == "cold lift-off":
-                    continue  # no lift-off on a cap-only curve
-                if v in ABLATIONS and case[1] != "base":
-                    continue  # what each change bought: measured on the base curves
+                if v in ABLATIONS and case[0] not in ABLATIONS[v]:
+                    continue  # what each change bought: measured on the curves where it acts
                 out = sides.run(v, case)
                 entry["runs"][v].append(out)
                 log(f"repeat {rep + 1}: {case[0]:>26} | {v:>16}: {out['cpu']:6.2f} s CPU, {out['wall']:6.2f} s, {out['points']} points, "
@@ -505,11 +566,22 @@ def main(argv=None):
             rs[0]["f_error"], rs[0]["compared"], rs[0]["left_out"] = f_error(rs[0], ref)
         entry["_ref"] = ref
     summarize(data)
-    if not (args.quick or args.no_shooting):
+    if args.reuse_shooting:  # shooting's rows measured in an earlier run (its code unchanged since)
+        earlier = json.loads(Path(args.reuse_shooting).read_text())
+        rows = {c["preset"]: c.get("shooting") for c in earlier["cases"] if c.get("kind") == "default"}
+        data["shooting_from"] = dict(file=str(args.reuse_shooting), date=earlier["meta"]["date"],
+                                     commit=earlier["meta"]["this_commit"])
+        for entry in data["cases"]:
+            if entry["kind"] == "default" and rows.get(entry["preset"]):
+                entry["shooting"] = rows[entry["preset"]]
+                entry["shooting_ratio"] = shooting_ratio(entry)
+                entry["shooting_ratio_numba"] = shooting_ratio(entry, "this commit, numba")
+    elif not (args.quick or args.no_shooting):
         for entry in data["cases"]:
             if entry["kind"] == "default":
                 entry["shooting"] = shooting(entry["preset"], entry["_ref"], log)
                 entry["shooting_ratio"] = shooting_ratio(entry) if entry["shooting"] else None
+                entry["shooting_ratio_numba"] = shooting_ratio(entry, "this commit, numba") if entry["shooting"] else None
     for entry in data["cases"]:
         entry.pop("_ref")
         for rs in entry["runs"].values():  # keep the measurements, not every point

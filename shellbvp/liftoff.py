@@ -171,11 +171,18 @@ WARM_REACH = 0.5
 #: needs about its own mesh, and a start that does not converge must fail fast.
 WARM_NODES = 3
 _WARM_FIRST = True  # False: the cap's guesses first, as before issue 14 (benchmarks measure the gain)
+#: ... and when their contact radii differ by at most this much in ln Sc.  Near the point-load
+#: limit the contact circle shrinks exponentially (gent1: Sc 1.3e-5 at delta 0.03, 1.4e-8 at
+#: 0.018 on the small-delta leg); a neighbour that far off is a guess from which Newton stalls
+#: (10 iterations, 0.6 s) before the cap's guess converges in 5.  Steps that converged warm
+#: moved ln Sc by up to 2.
+WARM_MAX_LN_SC = 3.0
 
 
 def _near(state, cap, topology):
     return (state is not None and state.get("topology") == topology and state.get("success")
-            and abs(state.delta - cap.delta) <= WARM_REACH * max(state.delta, cap.delta))
+            and abs(state.delta - cap.delta) <= WARM_REACH * max(state.delta, cap.delta)
+            and state.Sc > 0 and cap.Sc > 0 and abs(math.log(state.Sc / cap.Sc)) <= WARM_MAX_LN_SC)
 
 
 def liftoff_state(cap: Solution, topology: str, *, tol=1e-6, max_nodes=10000, bc_tol=1e-10,
@@ -255,11 +262,15 @@ def _solve_annulus(sysm, guess, *, tol, max_nodes, bc_tol):
     return solve_liftoff_from(sysm, guess, tol=tol, max_nodes=max_nodes, bc_tol=bc_tol)
 
 
-def valid_liftoff_state(cap: Solution, *, tol=1e-6, max_nodes=10000, bc_tol=1e-10, previous=None, before=None):
+def valid_liftoff_state(cap: Solution, *, tol=1e-6, max_nodes=10000, bc_tol=1e-10, previous=None, before=None,
+                        last=None):
     """A valid line or annular state where the cap is invalid; (state or None, what was tried).
 
     A contact radius below ``POINT_LIMIT_SC`` is taken as its point-load limit
     (exponentially close; a line that small strains double precision in its inner cap).
+    ``last``: the curve's previous point, if any; where it had its pole lifted and the line
+    here still holds its pole above the tip, the split cap+line(tip) is not probed
+    (:func:`_split_possible`).
     """
     tried = []
     # (a cap on an arclength step has its delta too: the curve's caps are such)
@@ -272,6 +283,7 @@ def valid_liftoff_state(cap: Solution, *, tol=1e-6, max_nodes=10000, bc_tol=1e-1
     if previous is not None and previous.get("topology") in order:
         order = (previous.topology,) + tuple(t for t in order if t != previous.topology)
     line_too_curved = False
+    line = None
     for topology in order:
         if topology == "annulus" and not (line_too_curved or _pressed_somewhere(cap)):
             # an annulus needs a pressed band: where the whole cap pulls and the line is not
@@ -283,14 +295,38 @@ def valid_liftoff_state(cap: Solution, *, tol=1e-6, max_nodes=10000, bc_tol=1e-1
         if res.success and res.valid:
             return res, tried
         line_too_curved |= topology == "line" and res.get("curvature_excess", -1.0) > 0
+        line = res if topology == "line" else line
         why = res.message if not res.success else "; ".join(res.flags)
         tried.append(f"{topology}: {why}")
-    if _pressed_at_the_pole(cap):
+    if _pressed_at_the_pole(cap) and _SPLIT_RULE and not _split_possible(last, line, tol):
+        tried.append("cap+line(tip): not tried (the pole was lifted at the previous point and the line here "
+                     "keeps it above the tip)")
+    elif _pressed_at_the_pole(cap):
         res = second_zone_state(cap, tol=tol, max_nodes=max_nodes, bc_tol=bc_tol, previous=previous)
         if res.success and res.valid:
             return res, tried
         tried.append(f"{res.topology}: {res.message if not res.success else '; '.join(res.flags)}")
     return None, tried
+
+
+_SPLIT_RULE = True  # False: the split probed wherever the cap is pressed at the pole (benchmarks measure the gain)
+
+
+def _split_possible(last, line, tol):
+    """Whether a cap+line(tip) state may be what follows the curve's previous point ``last``.
+
+    The split (a cap at the pole, a lifted gap, a line further out) grows either from a cap
+    whose edge starts to pull, or from a line whose lifted pole comes down onto the tip.  So
+    after a point with the pole lifted (a valid line or annulus) it is probed only when the
+    line at this depth touches the tip inside its contact circle (``penetration``), or did
+    not converge.  Without this, base at delta 0.1125 (after the line at 0.1; the line too
+    curved here, the cap still pulling at its edge) spent 1.7 s of a 4.7 s curve on split
+    guesses that find no state.  Without ``last`` (a single solve) it is always probed."""
+    if last is None or not (last.get("valid") and last.get("topology") in ("line", "annulus")):
+        return True
+    if line is None or not line.get("success"):
+        return True
+    return bool(not line.get("penetration", math.inf) <= 10 * tol)
 
 
 #: (Sc'/S_p, S1/Sc) of second-zone guesses from a cap pressed at the pole and pulling further out
@@ -352,15 +388,17 @@ def _probe_then_solve(sysm, guess, solve_from, *, tol, max_nodes, bc_tol):
     return solve_from(sysm, (x, probe.sol(x), probe.p), tol=tol, max_nodes=max_nodes, bc_tol=bc_tol)
 
 
-def replace_invalid_cap(cap: Solution, *, tol=1e-6, max_nodes=10000, bc_tol=1e-10, previous=None, before=None):
+def replace_invalid_cap(cap: Solution, *, tol=1e-6, max_nodes=10000, bc_tol=1e-10, previous=None, before=None,
+                        last=None):
     """The state to report for a cap state: itself if it does not pull, else the valid
     lift-off state (with ``cap_state``/``cap_solution`` kept), else the cap flagged with
     what was tried.  ``previous``, ``before``: the last two lift-off states of a curve
-    (warm starts, :func:`liftoff_state`)."""
+    (warm starts, :func:`liftoff_state`); ``last``: the curve's previous point
+    (:func:`valid_liftoff_state`)."""
     if not lift_off_suspected(cap):
         return cap
     alt, tried = valid_liftoff_state(cap, tol=tol, max_nodes=max_nodes, bc_tol=bc_tol, previous=previous,
-                                     before=before)
+                                     before=before, last=last)
     if alt is None:
         cap.flags = list(cap.flags) + ["no valid lift-off state found (" + "; ".join(tried) + ")"]
         return cap

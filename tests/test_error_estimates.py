@@ -79,3 +79,28 @@ def test_calibrated_error_takes_the_larger_bracketing_ratio():
     assert calibrated_error(1e-6, 5.0, anchors) == pytest.approx(1e-11)  # beyond the last: nearest
     assert calibrated_error(1e-6, 1.0, [(0.0, 0.0), (2.0, 0.0)]) == 0.0  # exact (prescribed) stays exact
     assert math.isnan(calibrated_error(1e-6, 1.0, []))
+
+
+def test_a_point_whose_estimate_exceeds_tol_is_solved_again_tighter(monkeypatch):
+    """solve_bvp bounds residuals, not F's error: where F is small it can exceed tol
+    (flat preset, point-load limit at delta 0.005: 2e-6 relative at tol 1e-6, the Richardson
+    estimate saying so).  Such points are solved again at tol/10 from themselves."""
+    from shellbvp.continuation import _Builder
+    from shellbvp.pointload import solve_point_load
+
+    scene = sb.Scene.preset("flat")
+    kw = dict(delta_max=0.1, delta_start=0.05, delta_min=0.005, tol=1e-6)  # the default curve's small-delta leg
+    c = sb.curve(scene, **kw)
+    with monkeypatch.context() as m:
+        m.setattr(_Builder, "_above_tol", lambda self, sol: False)
+        loose = sb.curve(scene, **kw)
+    np.testing.assert_array_equal(c.delta, loose.delta)
+    i = int(np.argmin(c.delta))
+    assert c.topology[i] == "point" and c.points["error_method"][i] == "richardson"
+    ref = solve_point_load(scene, float(c.delta[i]), tol=1e-9, max_nodes=30000, guess=c.solutions[i])
+    assert ref.success
+    before, after = (abs(x.force[i] - ref.force) / ref.force for x in (loose, c))
+    assert before > 1e-6 > after, (before, after)
+    assert loose.points["force_error"][i] > 1e-6 * loose.force[i]  # the estimate saw it
+    # every estimate now at or below tol (the tightened points' own Richardson estimates)
+    assert np.all(c.points["force_error"] <= 1e-6 * np.abs(c.force))

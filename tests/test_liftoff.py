@@ -7,6 +7,8 @@ satisfy the energy identity F = dE/ddelta, and that curves switch topology
 without a jump in F(delta).
 """
 
+import math
+
 import numpy as np
 import pytest
 from scipy.integrate import trapezoid
@@ -259,6 +261,28 @@ def test_a_cap_pressed_at_the_pole_and_pulling_further_out_splits_into_a_cap_and
     assert abs(slope - s.force) < 1e-8 + 10 * s.force_error
 
 
+def test_no_split_probe_where_the_previous_point_lifted_its_pole(monkeypatch):
+    """base at delta 0.1125 after the line at 0.1: the line is too curved, the annulus closes
+    onto the pole, the cap still pulls at its edge and presses at the pole.  The split
+    cap+line(tip) grows from a cap or from a line whose pole comes down; here the line's pole
+    stays above the tip, so it is not probed (it used to cost 1.7 s and find nothing); the
+    recorded point is the same flagged cap as before."""
+    import shellbvp.liftoff
+
+    calls = []
+    orig = shellbvp.liftoff.second_zone_state
+    monkeypatch.setattr(shellbvp.liftoff, "second_zone_state", lambda *a, **k: calls.append(1) or orig(*a, **k))
+    scene = sb.Scene.preset("base")
+    c = sb.curve(scene, deltas=[0.1, 0.1125], estimate_error=False)
+    assert list(c.topology) == ["line", "cap"] and list(c.valid) == [True, False]
+    assert calls == []
+    assert any("cap+line(tip): not tried" in f for f in c.flags[1:])
+    cap = sb.solve(scene, delta=0.1125, topology="cap", estimate_error=False)
+    assert c.force[1] == pytest.approx(cap.force, rel=1e-7)
+    # (a single solve has no previous point: it still probes the split, as
+    # test_a_cap_pressed_at_the_pole_and_pulling_further_out_splits_into_a_cap_and_a_line needs)
+
+
 # -- warm starts of lift-off states (issue 14 item 1) -------------------------------------------------
 class _Count:
     """solve_bvp runs and Newton iterations of the lift-off solves (counts are deterministic)."""
@@ -320,3 +344,25 @@ def test_no_failed_step_where_the_cap_grows_exponentially(monkeypatch):
     c = sb.curve(sb.Scene.preset("base"), deltas=[0.0125, 0.025, 0.0375], estimate_error=False, topology="cap")
     assert c.complete and len(failed) >= 3
     assert not any(failed), failed
+
+
+def test_no_warm_start_from_a_line_whose_contact_circle_is_far_off(monkeypatch):
+    """gent1's small-delta leg: the line at delta 0.03 (Sc 1.3e-5) is a poor guess for the line
+    at 0.018 (Sc 1.4e-8): Newton stalls from it (10 iterations) before the cap's guess
+    converges.  Past WARM_MAX_LN_SC in ln Sc the cap's guess is used at once: the same curve,
+    one lift-off solve and some 10 Newton iterations fewer."""
+    import shellbvp.liftoff as lo
+
+    scene = sb.Scene.preset("gent1")
+    curves, counts = {}, {}
+    for limit in (lo.WARM_MAX_LN_SC, math.inf):
+        with monkeypatch.context() as m:
+            m.setattr(lo, "WARM_MAX_LN_SC", limit)
+            counts[limit] = _Count(m)
+            curves[limit] = sb.curve(scene, delta_max=0.2, estimate_error=False)
+    guarded, unguarded = curves[lo.WARM_MAX_LN_SC], curves[math.inf]
+    assert guarded.complete and list(guarded.topology) == list(unguarded.topology)
+    np.testing.assert_allclose(guarded.delta, unguarded.delta, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(guarded.force, unguarded.force, rtol=1e-7)
+    c, u = counts[lo.WARM_MAX_LN_SC], counts[math.inf]
+    assert u.calls - c.calls == 1 and u.niter - c.niter >= 8, ((c.calls, c.niter), (u.calls, u.niter))
