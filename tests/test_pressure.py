@@ -119,11 +119,13 @@ def test_fit_pressure_refuses_bad_combinations_before_any_curve():
 
 
 @pytest.mark.slow
-def test_fit_pressure_recovers_mu_h_and_the_pressure():
+@pytest.mark.parametrize("sealed", [False, True])
+def test_fit_pressure_recovers_mu_h_and_the_pressure(sealed):
     """Synthetic data of a pressurised dome (beta 1e-3, p R_L/(mu H) = 0.3, i.e. tau = 1.4;
     mu H = 50 N/m, R_L = 1 mm, 1 % noise): one curve gives both, each inside its interval.
-    Measured: mu*H 50.26 [49.25, 51.27], p 0.297 [0.287, 0.308], 14.9 kPa [14.7, 15.2] (true 15)."""
-    truth = sb.Scene(gamma=-1.0, rho=0.2, beta=1e-3, pressure=0.3)
+    Measured: mu*H 50.26 [49.25, 51.27], p 0.297 [0.287, 0.308], 14.9 kPa [14.7, 15.2] (true 15);
+    sealed (the pressure before indenting): mu*H 50.47 [49.14, 51.79], p 0.295 [0.282, 0.309]."""
+    truth = sb.Scene(gamma=-1.0, rho=0.2, beta=1e-3, pressure=0.3, sealed=sealed)
     R_L, mu_H = 1e-3, 50.0
     c = sb.curve(truth, deltas=np.linspace(0.005, 0.2, 40), estimate_error=False)
     rng = np.random.default_rng(1)
