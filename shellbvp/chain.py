@@ -33,9 +33,10 @@ pole), or the pseudo-arclength condition (``arclength``,
 value is the tuple ``(Xhat, t, s)``).
 
 Volume control (a sealed shell, ``Scene.sealed``): the pressure is an unknown too
-(the last), each region ``k`` gains a state ``v_k`` (rows after all regions' states,
-``v_k' = (b_k - a_k) S dV/dS``) with ``v_k(0) = 0``, and ``sum_k v_k(1) = V0`` closes
-the system (rows after the control's).  Guesses need only the regions' states and
+(the last), and one state ``v`` (the last row) sums the regions' volumes, which all
+run on the same t: ``v' = sum_k (b_k - a_k) S dV/dS``, ``v(0) = 0``, ``v(1) = V0``
+(rows after the control's).  One state, not one per region: solve_bvp's LU costs
+about the cube of the states per node.  Guesses need only the regions' states and
 the unknowns before the pressure: :meth:`ChainBVP.solve` completes them.
 
 :func:`cap_chain`, :func:`point_chain`, :func:`annulus_chain` and
@@ -302,9 +303,9 @@ class ChainBVP:
         self._bind()
         self.sizes = [SIZES[r.kind] for r in chain.regions]
         self.offsets = np.cumsum([0, *self.sizes])[:-1].tolist()
-        self.n_shell = int(sum(self.sizes))  # the regions' states; then one volume state per region
+        self.n_shell = int(sum(self.sizes))  # the regions' states; then the volume state
         self.volume_control = bool(scene.sealed if volume_control is None else volume_control)
-        self.n = self.n_shell + (len(self.regions) if self.volume_control else 0)
+        self.n = self.n_shell + self.volume_control
         kinds = {type(j) for j in chain.junctions}
         self.has_contact_pole = ContactPole in kinds
         if control == "arclength" and not self.has_contact_pole:
@@ -341,7 +342,7 @@ class ChainBVP:
             self.extra = "arclength"
         self.force_at = next((j for j in reversed(self.junctions) if isinstance(j, (Edge, Line))), None)
         self.n_conditions = (sum(j.rows for j in self.junctions) + (self.extra is not None)
-                             + (len(self.regions) + 1 if self.volume_control else 0))
+                             + (2 if self.volume_control else 0))
 
     def __repr__(self):
         return f"ChainBVP({self.control}={self.value:g})\n{self.chain.layout()}"
@@ -403,7 +404,7 @@ class ChainBVP:
 
     def complete(self, x, y, p):
         """``(y, p)`` for a solve from a guess of the regions' states and the unknowns before
-        the pressure: under volume control the volume states (integrated from ``y`` by the
+        the pressure: under volume control the volume state (integrated from ``y`` by the
         trapezoidal rule) and the pressure (the scene's, if ``p`` has none) are added."""
         y = np.asarray(y, float)
         if not self.volume_control:
@@ -413,8 +414,8 @@ class ChainBVP:
             p = np.append(p, self.scene.pressure)
         from scipy.integrate import cumulative_trapezoid
 
-        acc = [cumulative_trapezoid(self._volume_rates(x, y, p, k), x, initial=0.0) for k in range(len(self.regions))]
-        return np.vstack([y[:self.n_shell], *acc]), p
+        rate = sum(self._volume_rates(x, y, p, k) for k in range(len(self.regions)))
+        return np.vstack([y[:self.n_shell], cumulative_trapezoid(rate, x, initial=0.0)]), p
 
     def solve(self, x, y, p=None, **kwargs):
         """``shellbvp.solution.solve_bvp`` of this system from a guess (completed, see
@@ -484,13 +485,15 @@ class ChainBVP:
     def fun(self, t, y, p=None):
         f = np.empty_like(y)
         par = self.par_at(p)
+        if self.volume_control:
+            f[self.n_shell] = 0.0
         for k, reg in enumerate(self.regions):
             a, b = self.ln_S(reg.start, p), self.ln_S(reg.end, p)
             rows = self.rows(k)
             S = np.exp(a + t * (b - a))
             f[rows] = (b - a) * self._rhs(k)(S, y[rows], par)
             if self.volume_control:
-                f[self.n_shell + k] = (b - a) * getattr(self.model, f"{reg.kind}_vol")(S, y[rows], par)[0]
+                f[self.n_shell] += (b - a) * getattr(self.model, f"{reg.kind}_vol")(S, y[rows], par)[0]
         return f
 
     def fun_jac(self, t, y, p=None):
@@ -505,7 +508,7 @@ class ChainBVP:
             gy, gS = self._jac(k)(S, y[rows], par)
             dfdy[rows, rows] = (b - a) * gy
             if self.volume_control:
-                v = self.n_shell + k
+                v = self.n_shell
                 vy, vS = getattr(self.model, f"{reg.kind}_vol_jac")(S, y[rows], par)
                 dfdy[v, rows] = (b - a) * vy[0]
                 dfdp[rows, self.col["pressure"]] = (b - a) * getattr(
@@ -574,8 +577,7 @@ class ChainBVP:
             X = np.array([q["delta"], q["lambda0"], force])
             parts.append([np.sum(self.arc_tangent * (X - self.arc_point) / self.arc_scale)])
         if self.volume_control:
-            acc = slice(self.n_shell, self.n)
-            parts += [ya[acc], [np.sum(yb[acc]) - self.enclosed_volume]]
+            parts += [[ya[self.n_shell]], [yb[self.n_shell] - self.enclosed_volume]]
         return np.concatenate(parts)
 
     def _line_function(self, j, what):
@@ -700,9 +702,8 @@ class ChainBVP:
             A[r, self.offsets[0] + _LS] = 1.0
         if vc:
             r += self.extra is not None
-            for k in range(len(self.regions)):
-                A[r + k, self.n_shell + k] = 1.0
-                B[-1, self.n_shell + k] = 1.0
+            A[r, self.n_shell] = 1.0
+            B[r + 1, self.n_shell] = 1.0
         return (A, B, P) if P is not None else (A, B)
 
     # -- values of a solution -----------------------------------------------------------------------
