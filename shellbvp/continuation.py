@@ -563,11 +563,39 @@ def _first_point(scene, delta, settings):
     return sol
 
 
+#: A Gent material's strain energy ``-Jm/2 ln(1 - (I1 - 3)/Jm)`` diverges as ``(I1 - 3)/Jm``
+#: reaches 1 (the chains' limiting extensibility): F grows without bound before some
+#: depth, and arclength steps go into F.  Past this ratio (its stiffness in I1 is 50x the
+#: small-strain one) the curve stops with that physical reason instead of running into max_steps.
+GENT_LOCK = 0.98
+
+
+def gent_lock_ratio(sol) -> float:
+    """max (I1 - 3)/Jm over a state of a Gent scene (NaN for other materials)."""
+    from .materials import Gent
+
+    material = sol.scene.material
+    if not isinstance(material, Gent):
+        return float("nan")
+    prof = sol.profile()
+    ls, lt = prof["lambda_s"], prof["lambda_theta"]
+    return float(np.max(ls**2 + lt**2 + 1 / (ls * lt) ** 2 - 3) / material.Jm)
+
+
 def _stop_rule(sol, settings):
     if settings["force_max"] is not None and sol.force >= settings["force_max"]:
         return f"force_max = {settings['force_max']:g} reached"
     if settings["lambda0_max"] is not None and sol.lambda0 >= settings["lambda0_max"]:
         return f"lambda0_max = {settings['lambda0_max']:g} reached"
+    return None
+
+
+def _physical_end(sol):
+    """Why no state beyond ``sol`` can be reached on the way to delta_max, or None."""
+    ratio = gent_lock_ratio(sol)
+    if ratio >= GENT_LOCK:
+        return (f"the Gent material locks: max (I1 - 3)/Jm = {ratio:.4f} >= {GENT_LOCK} at delta = "
+                f"{sol.delta:.6g}, where F = {sol.force:.4g} grows without bound before delta_max")
     return None
 
 
@@ -830,6 +858,9 @@ def _adaptive(scene, builder: _Builder, settings):
         if rule:
             builder.out.complete = True
             raise _Stop(rule)
+        end = _physical_end(cur)
+        if end:
+            raise _Stop(end)
         chord = (_X(cur) - _X(prev)) / scale
         norm = np.linalg.norm(chord)
         new_tangent = chord / norm

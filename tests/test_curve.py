@@ -66,6 +66,19 @@ def test_stopping_rules():
     assert not c.complete and "max_steps" in c.stop_reason and len(c) >= 1
 
 
+def test_a_gent_curve_stops_where_the_material_locks():
+    """Gent's energy diverges as (I1 - 3)/Jm -> 1: the curve stops with that reason once the
+    ratio passes continuation.GENT_LOCK (Jm 0.4 ran 400 steps into max_steps at delta 0.85)."""
+    from shellbvp.continuation import GENT_LOCK, gent_lock_ratio
+
+    c = sb.curve(sb.Scene.preset("base", material=sb.Gent(0.03)), delta_max=1.0, estimate_error=False)
+    assert not c.complete and c.stop_reason.startswith("the Gent material locks")
+    ratios = [gent_lock_ratio(s) for s in c.solutions[-2:]]
+    assert ratios[0] < GENT_LOCK <= ratios[1] < 1
+    assert c.delta[-1] < 0.4 and c.force[-1] > 4 * np.interp(c.delta[-1] / 2, c.delta, c.force)
+    assert np.all(c.valid) and np.all(np.diff(c.force) > 0)
+
+
 def test_hdf5_round_trip(base_curve, tmp_path):
     path = tmp_path / "c.h5"
     base_curve.to_hdf5(path)
