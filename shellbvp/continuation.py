@@ -24,7 +24,7 @@ import numpy as np
 
 from .cylinder import best_wall_state, wall_contact_suspected, wall_state
 from .io import POINT_FIELDS, Curve, point_record
-from .liftoff import replace_invalid_cap
+from .liftoff import lift_off_suspected, lifted_pole_branch_end, lifted_pole_end_reason, replace_invalid_cap
 from .pointload import SC_POINT, solve_point_load
 from .solution import Solution, calibrated_error, default_eps, richardson_error, thin_mesh
 from .corner import LEGENDRE_WATCH, edge_model, is_corner, limit_estimate, near_limit
@@ -212,6 +212,7 @@ class _Builder:
         self.since_richardson = None  # points added since the last Richardson estimate
         self.last_configuration = None
         self.last_accepted = None  # perf_counter() when the last point was accepted
+        self.branch_end = None  # the stop reason where the followed branch ends physically
 
     def _shown(self, sol: Solution) -> Solution:
         st = self.settings
@@ -223,6 +224,12 @@ class _Builder:
             shown = replace_invalid_cap(sol, previous=self.last_liftoff, before=self.liftoff_before, **kw)
             if shown is not sol:
                 self.liftoff_before, self.last_liftoff = self.last_liftoff, shown
+            elif lift_off_suspected(sol) and self.last_liftoff is not None and sol.delta > self.last_liftoff.delta:
+                # no lifted state here: has the lifted-pole branch ended before this depth?
+                end = lifted_pole_branch_end(self.last_liftoff, self.liftoff_before, **kw)
+                if end is not None and end.delta < sol.delta:
+                    self.branch_end = lifted_pole_end_reason(end)
+                    return end
         if shown.get("topology") == "cap" and wall_contact_suspected(shown):
             wall = None
             if self.last_wall is not None:
@@ -246,10 +253,16 @@ class _Builder:
                 sol.error_method = "calibrated"  # values set by finish(), from the Richardson points
                 self.since_richardson += 1
             self.last_configuration = configuration
+        if self.branch_end and self.settings["mode"] != "adaptive":  # requested depths only
+            self.out.complete = True
+            raise _Stop(self.branch_end)
         self.rows.append((key, point_record(sol), "; ".join(sol.get("flags", [])), sol))
         self.last_accepted = time.perf_counter()
         if self.callback is not None:
             self.callback(self.snapshot(), sol)
+        if self.branch_end:  # a physical end of the curve, recorded as its last point
+            self.out.complete = True
+            raise _Stop(self.branch_end)
 
     def _richardson(self, sol):
         richardson_error(sol.system, sol, self.tol)
@@ -339,8 +352,10 @@ def _regula_falsi(a, fa, sa, b, fb, sb, solve_at):
 def _locate_switches(builder: _Builder, st):
     """Add the point where the recorded topology switches between neighbouring points.
 
-    cap <-> line or annulus: where the cap's minimum contact pressure crosses zero
-    (the cap state there, pressure >= 0 side).  line <-> annulus: where the line's
+    cap <-> line, annulus or cap+line(tip): where the cap's minimum contact pressure crosses
+    zero (the cap state there, pressure >= 0 side; for cap+line(tip) that is where its gap
+    closes).  line <-> cap+line(tip): where the line's lifted cap comes down onto the tip
+    (its penetration crosses zero).  line <-> annulus: where the line's
     curvature excess over the indenter crosses zero (the line state there).  Both by
     regula falsi (Illinois); the point is added to an adaptive curve, and every switch
     is listed in ``settings["topology_switches"]``.
@@ -359,6 +374,11 @@ def _locate_switches(builder: _Builder, st):
         sol = solve_liftoff(scene, "line", delta=d, guess=near, tol=st["tol"], max_nodes=st["max_nodes"],
                             bc_tol=st["bc_tol"])
         return (sol, -sol.curvature_excess) if sol.success else (None, None)
+
+    def line_touch_at(d, near):  # the line whose lifted cap comes down onto the tip
+        sol = solve_liftoff(scene, "line", delta=d, guess=near, tol=st["tol"], max_nodes=st["max_nodes"],
+                            bc_tol=st["bc_tol"])
+        return (sol, -sol.penetration) if sol.success else (None, None)
 
     def cap_touch_at(d, near):  # the cap whose free shell just touches the cylinder
         sol = _solve_at_delta(scene, d, near, None, st)
@@ -385,6 +405,9 @@ def _locate_switches(builder: _Builder, st):
             continue
         if "cap" in pair and pair & {"line", "annulus", "cap+line(tip)"}:
             ends, criterion, sign, solve_at = [_cap_of(s1), _cap_of(s2)], "pressure_min", 1.0, cap_at
+        elif pair == {"line", "cap+line(tip)"}:  # the lifted cap touches down: a cap grows at the pole
+            ends = [s if s.get("topology") == "line" else _line_state_at(s, st) for s in (s1, s2)]
+            criterion, sign, solve_at = "penetration", -1.0, line_touch_at
         elif pair == {"line", "annulus"}:
             ends = [s if s.get("topology") == "line" else _line_state_at(s, st) for s in (s1, s2)]
             criterion, sign, solve_at = "curvature_excess", -1.0, line_at
