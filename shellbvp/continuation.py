@@ -28,7 +28,7 @@ from .liftoff import lift_off_suspected, lifted_pole_branch_end, lifted_pole_end
 from .pointload import SC_POINT, solve_point_load
 from .solution import Solution, calibrated_error, default_eps, richardson_error, thin_mesh
 from .corner import LEGENDRE_WATCH, edge_model, is_corner, limit_estimate, near_limit
-from .state import check_delta, check_tol, cross_convexity_limit, solve, solve_from, system_like, \
+from .state import check_delta, check_tol, cross_convexity_limit, make_system, solve, solve_from, system_like, \
     warm_guess
 from .version import __version__ as VERSION
 
@@ -230,7 +230,7 @@ class _Builder:
                 if end is not None and end.delta < sol.delta:
                     self.branch_end = lifted_pole_end_reason(end)
                     return end
-        if shown.get("topology") == "cap" and wall_contact_suspected(shown):
+        if shown.get("topology") == "cap" and edge_model(shown) != "pinned" and wall_contact_suspected(shown):
             wall = None
             if self.last_wall is not None:
                 wall = best_wall_state(self.last_wall, control="delta", value=shown.delta, **kw)
@@ -398,6 +398,15 @@ def _locate_switches(builder: _Builder, st):
         if c1 is not None and c2 is not None and c1.success and c2.success \
                 and (edge_model(c1), edge_model(c2)) == ("smooth", "corner"):
             switches.append(locate_corner_switch(c1, c2, st))
+            continue
+        if s1.get("valid") and s2.get("valid") and (edge_model(s1), edge_model(s2)) == ("paper", "pinned"):
+            # the free cap's edge reaches the tip's end: from the caps either side of it
+            ends = [s1, s2.get("cap_solution")]
+            if ends[1] is not None and ends[1].status in (0, 4) and ends[0].tip_end_margin > 0 > ends[1].tip_end_margin:
+                best = _regula_falsi(ends[0].delta, ends[0].tip_end_margin, ends[0], ends[1].delta,
+                                     ends[1].tip_end_margin, ends[1], cap_end_at)
+                _add_switch(builder, st, switches, best, "cap", "cap (pinned at the tip's end)", k1, k2,
+                            "tip_end_margin")
             continue
         frm, to = s1.get("topology"), s2.get("topology")
         pair = {frm, to}
@@ -657,11 +666,13 @@ def _wall_leg(scene, builder, st, last_cap, key, *, reason, deltas=None):
         prev, past_end = best_wall_state(last_cap, tried=tried, outcomes=outcomes, **kw), last_cap
         if prev is None and last_cap.get("topology") == "cap" and _room_may_help(outcomes):
             prev, past_end = _wall_state_deeper(scene, last_cap, st, kw, tried)
+        if prev is None and scene.contact == "paper" and last_cap.get("topology") == "cap":
+            prev = _pinned_state(scene, last_cap, last_cap.delta, st, tried)
         if prev is None:  # not a physical end: a configuration that is missing or not found
             raise _Stop(f"{reason}; no valid contact with the cylinder ({'; '.join(tried)})")
         prev.cap_solution = past_end  # the cap past the tip's end: where the switch is located from
         builder.last_wall = prev
-        if targets is None:
+        if targets is None or any(abs(prev.delta - t) < 1e-12 for t in targets):  # (a requested depth)
             key += 1
             builder.add(prev, key)
     d_end = st["delta_max"] if targets is None else (targets[-1] if targets else prev.delta)
@@ -674,7 +685,11 @@ def _wall_leg(scene, builder, st, last_cap, key, *, reason, deltas=None):
         nxt_target = min(d_end, prev.delta + step) if targets is None else min(
             min(t for t in targets if t > prev.delta), prev.delta + step)
         tried = []
-        sol = best_wall_state(prev, control="delta", value=nxt_target, tried=tried, **kw)
+        sol = None
+        if edge_model(prev) == "pinned":  # held at the tip's end while its ring force pushes
+            sol = _pinned_state(scene, prev, nxt_target, st, tried)
+        if sol is None:
+            sol = best_wall_state(prev, control="delta", value=nxt_target, tried=tried, **kw)
         if sol is None:
             step /= 2
             if step < 1e-5 * (1 + prev.delta):
@@ -688,6 +703,24 @@ def _wall_leg(scene, builder, st, last_cap, key, *, reason, deltas=None):
         step *= 1.5
     builder.out.complete = True
     raise _Stop(f"delta_max = {st['delta_max']:g} reached" if targets is None else "all requested deltas computed")
+
+
+def _pinned_state(scene, start, delta, st, tried):
+    """The paper's cap held at the tip's end (``contact_edge = "pinned"``) at ``delta``, warm
+    from ``start`` (a cap near or past the tip's end, or a pinned cap); None unless valid.
+
+    Where the indenter's meridional curvature jumps (the tip meets the cylinder) the paper's
+    edge can stay while the indenter pushes the edge's circle (a ring force normal to the
+    shell: at a hemispherical tip's end it is radial and carries no axial force); xi = 0: from
+    delta 0.9295, where the free cap's edge reaches the end, to delta 1, where no cap+cylinder
+    state exists (its band on the cylinder would have a negative length)."""
+    sysm = make_system(scene, "delta", delta, st["eps"], edge="pinned")
+    sol = solve_from(sysm, warm_guess(sysm, start), tol=st["tol"], max_nodes=_step_nodes(start, st),
+                     bc_tol=st["bc_tol"])
+    if sol.success and sol.valid:
+        return sol
+    tried.append(f"cap held at the tip's end: {sol.message if not sol.success else '; '.join(sol.flags)}")
+    return None
 
 
 def _cross(cur, prev, delta, st):

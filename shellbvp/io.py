@@ -391,9 +391,9 @@ def _points(g):
             raise ValueError(f"dataset {k} missing")
     points["topology"] = np.asarray(points["topology"], dtype=str)
     points["contact_edge"] = np.asarray(points["contact_edge"], dtype=str)
-    unknown = sorted(set(points["contact_edge"]) - {"", "smooth", "corner", "paper"})
+    unknown = sorted(set(points["contact_edge"]) - {"", "smooth", "corner", "paper", "pinned"})
     if unknown:
-        raise ValueError(f"contact_edge must be one of smooth, corner, paper; got {str(unknown[0])!r}")
+        raise ValueError(f"contact_edge must be one of smooth, corner, paper, pinned; got {str(unknown[0])!r}")
     unknown = sorted(set(points["topology"]) - set(CONFIGURATION_NAMES))
     if unknown:
         raise ValueError(f"topology must be one of {CONFIGURATION_NAMES}; got {str(unknown[0])!r}")
