@@ -493,9 +493,9 @@ def lifted_pole_branch_end(previous: Solution, before: Solution, *, tol=1e-6, ma
 def lifted_pole_end_reason(end: Solution) -> str:
     """The stop reason of a curve at the end of its lifted-pole branch."""
     prof = end.profile()
-    return (f"the lifted-pole {end.topology} branch ends at delta = {end.delta:.6g} (F = {end.force:.6g}): the "
-            f"energy loses convexity at the lifted cap's free pole (Legendre determinant there "
-            f"{pole_legendre(end):.2g} of the outer free region's; lambda0 = {end.lambda0:.5g}, kappa_s = "
+    return (f"the energy loses convexity at the lifted cap's free pole: the lifted-pole {end.topology} branch "
+            f"ends at delta = {end.delta:.6g} (F = {end.force:.6g}; Legendre determinant at the pole "
+            f"{pole_legendre(end):.2g} of the outer free region's, lambda0 = {end.lambda0:.5g}, kappa_s = "
             f"{float(prof['kappa_s'][0]):.4g} against the tip's {1 / end.scene.rho:.4g}); delta is largest there "
             f"along the branch, and deeper the single cap pulls at the pole: the state beyond needs an interior "
             f"Weierstrass-Erdmann corner in the free region, which is not built")
