@@ -213,6 +213,7 @@ class _Builder:
         self.last_configuration = None
         self.last_accepted = None  # perf_counter() when the last point was accepted
         self.branch_end = None  # the stop reason where the followed branch ends physically
+        self.end_searched_from = None  # the lifted state from which that end was last searched
 
     def _shown(self, sol: Solution) -> Solution:
         st = self.settings
@@ -224,8 +225,11 @@ class _Builder:
             shown = replace_invalid_cap(sol, previous=self.last_liftoff, before=self.liftoff_before, **kw)
             if shown is not sol:
                 self.liftoff_before, self.last_liftoff = self.last_liftoff, shown
-            elif lift_off_suspected(sol) and self.last_liftoff is not None and sol.delta > self.last_liftoff.delta:
+            elif lift_off_suspected(sol) and self.last_liftoff is not None and sol.delta > self.last_liftoff.delta \
+                    and self.end_searched_from is not self.last_liftoff:
                 # no lifted state here: has the lifted-pole branch ended before this depth?
+                # (searched once from each last lifted state)
+                self.end_searched_from = self.last_liftoff
                 end = lifted_pole_branch_end(self.last_liftoff, self.liftoff_before, **kw)
                 if end is not None and end.delta < sol.delta:
                     self.branch_end = lifted_pole_end_reason(end)

@@ -446,8 +446,12 @@ def pole_legendre(state) -> float:
     return float(pole / mid) if mid != 0 else math.nan
 
 
-#: Solves of :func:`lifted_pole_branch_end` at most
-_END_STEPS = 12
+#: Solves of :func:`lifted_pole_branch_end` at most; a step in lambda0 that lowers pole_legendre
+#: by less than this factor ends the search (rho 0.05: each step lowers it 3-10x)
+_END_STEPS = 24
+_END_MIN_GAIN = 0.8
+#: The smallest delta step of its natural continuation towards the end
+_END_DELTA_STEP = 2e-3
 
 
 def lifted_pole_branch_end(previous: Solution, before: Solution, *, tol=1e-6, max_nodes=10000, bc_tol=1e-10):
@@ -456,12 +460,18 @@ def lifted_pole_branch_end(previous: Solution, before: Solution, *, tol=1e-6, ma
     the branch through ``before`` and ``previous`` (two of its states, ``previous`` the deeper)
     is not heading there.
 
-    The branch is followed in the pole's stretch lambda0 (secant steps of 90 % towards the
-    zero of pole_legendre, which is nearly linear in lambda0 there): delta grows along it to a
-    maximum where the determinant vanishes (rho 0.05: delta* = 0.1754322, lambda0 = 0.68291,
-    kappa_s = 29.47 at the pole against the tip's 20), so natural continuation in delta stalls
-    short of it and no lifted state of this kind exists deeper.  Past it the pole's state is
-    not convex: an interior Weierstrass-Erdmann corner would be needed (not built).
+    First natural continuation in delta from ``previous`` (steps halved when one fails, down
+    to ``_END_DELTA_STEP``) brings the search close to the end, where delta stops growing;
+    then the branch is followed in the pole's stretch lambda0 (secant steps of 80 % towards
+    the zero of pole_legendre, nearly linear in lambda0 close to it; 40 % or 15 % where a step
+    fails).  Along lambda0, delta grows to a maximum where the determinant vanishes (rho 0.05:
+    delta* = 0.1754322, lambda0 = 0.68291, kappa_s = 29.47 at the pole against the tip's 20),
+    so natural continuation in delta stalls short of it and no lifted state of this kind
+    exists deeper.  Past it the pole's state is not convex: an interior Weierstrass-Erdmann
+    corner would be needed (not built).  A state of the continuation in delta that is not
+    valid or whose pole determinant does not fall, or a step in lambda0 that does not lower
+    it by ``_END_MIN_GAIN``, ends the search (beta 0.2: it levels off near 0.01 and rises
+    again while the lifted cap comes down onto the tip).
     """
     if previous is None or before is None or previous.get("topology") != before.get("topology") \
             or previous.get("topology") not in ("line", "annulus") or not previous.delta > before.delta:
@@ -469,24 +479,42 @@ def lifted_pole_branch_end(previous: Solution, before: Solution, *, tol=1e-6, ma
     g_prev, g = pole_legendre(before), pole_legendre(previous)
     if not (math.isfinite(g_prev) and math.isfinite(g) and 0 < g < g_prev):
         return None
+    scene, topology = previous.scene, previous.topology
+
+    def budget(state):  # past the end the mesh runs away: fail fast
+        return int(min(max_nodes, max(2000, WARM_NODES * state.nodes)))
+
     a, b = before, previous
-    for _ in range(_END_STEPS):
+    step, solves = b.delta - a.delta, 0
+    while step >= _END_DELTA_STEP and solves < _END_STEPS:
+        res = solve_liftoff(scene, topology, delta=b.delta + step, guess=b, tol=tol, max_nodes=budget(b),
+                            bc_tol=bc_tol)
+        solves += 1
+        if not res.success:
+            step /= 2
+        elif res.valid and 0 < pole_legendre(res) < pole_legendre(b):
+            a, b = b, res
+        else:  # the branch goes on, invalid or with the pole's determinant not falling: no such end
+            return None
+    g_prev, g = pole_legendre(a), pole_legendre(b)
+    while solves < _END_STEPS:
         if g < POLE_LEGENDRE_END:
             return b if b.valid and b.delta >= previous.delta else None
         slope = (g - g_prev) / (b.lambda0 - a.lambda0)
         if not slope != 0:
             return None
         res = None
-        for fraction in (0.9, 0.5):
-            res = solve_liftoff(b.scene, b.topology, lambda0=b.lambda0 - fraction * g / slope, guess=b, tol=tol,
-                                max_nodes=max_nodes, bc_tol=bc_tol)
+        for fraction in (0.8, 0.4, 0.15):
+            res = solve_liftoff(scene, topology, lambda0=b.lambda0 - fraction * g / slope, guess=b, tol=tol,
+                                max_nodes=budget(b), bc_tol=bc_tol)
+            solves += 1
             if res.success:
                 break
         if not res.success:
             return None
         a, b, g_prev, g = b, res, g, pole_legendre(res)
-        if not math.isfinite(g) or g < 0:
-            return None
+        if not math.isfinite(g) or g < 0 or g > _END_MIN_GAIN * g_prev:
+            return None  # not falling to zero
     return None
 
 
