@@ -22,7 +22,7 @@ contact_edge and edge_jump_ls/ks, which read as NaN and "")::
     /curve/<field>          (n,) each of POINT_FIELDS, plus
                             energy_residual (dE/ddelta - F) and flags (strings);
                             topology (strings: shellbvp.chain.CONFIGURATION_NAMES),
-                            contact_edge (strings: smooth, corner or paper);
+                            contact_edge (strings: smooth, corner, paper or pinned);
                             error_method (strings: how force_error/delta_error were
                             made: richardson, calibrated, or empty: not estimated)
     /curve/profiles/point_<i>   optional (profiles=True): S, region, r, z, ... at the
