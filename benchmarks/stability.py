@@ -278,6 +278,9 @@ def short_reason(r):
         return "contact reached the cylinder"
     if s.startswith("no valid contact configuration beyond"):
         return s[:60]
+    m = re.search(r"loses convexity at the lifted cap's free pole: .* ends at delta = ([-\d.e+]+)", s)
+    if m:
+        return f"lifted pole loses convexity: branch ends at delta {float(m.group(1)):.6g}"
     if s.startswith("delta_max"):
         return "delta_max reached"
     m = re.match(r"continuation failed near delta = ([-\d.e+]+): (.*)", s)

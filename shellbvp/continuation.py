@@ -24,11 +24,11 @@ import numpy as np
 
 from .cylinder import best_wall_state, wall_contact_suspected, wall_state
 from .io import POINT_FIELDS, Curve, point_record
-from .liftoff import replace_invalid_cap
+from .liftoff import lift_off_suspected, lifted_pole_branch_end, lifted_pole_end_reason, replace_invalid_cap
 from .pointload import SC_POINT, solve_point_load
 from .solution import Solution, calibrated_error, default_eps, richardson_error, thin_mesh
 from .corner import LEGENDRE_WATCH, edge_model, is_corner, limit_estimate, near_limit
-from .state import check_delta, check_tol, cross_convexity_limit, solve, solve_from, system_like, \
+from .state import check_delta, check_tol, cross_convexity_limit, make_system, solve, solve_from, system_like, \
     warm_guess
 from .version import __version__ as VERSION
 
@@ -217,6 +217,8 @@ class _Builder:
         self.since_richardson = None  # points added since the last Richardson estimate
         self.last_configuration = None
         self.last_accepted = None  # perf_counter() when the last point was accepted
+        self.branch_end = None  # the stop reason where the followed branch ends physically
+        self.end_searched_from = None  # the lifted state from which that end was last searched
 
     def _shown(self, sol: Solution) -> Solution:
         st = self.settings
@@ -230,7 +232,16 @@ class _Builder:
                                         **kw)
             if shown is not sol:
                 self.liftoff_before, self.last_liftoff = self.last_liftoff, shown
-        if shown.get("topology") == "cap" and wall_contact_suspected(shown):
+            elif lift_off_suspected(sol) and self.last_liftoff is not None and sol.delta > self.last_liftoff.delta \
+                    and self.end_searched_from is not self.last_liftoff:
+                # no lifted state here: has the lifted-pole branch ended before this depth?
+                # (searched once from each last lifted state)
+                self.end_searched_from = self.last_liftoff
+                end = lifted_pole_branch_end(self.last_liftoff, self.liftoff_before, **kw)
+                if end is not None and end.delta < sol.delta:
+                    self.branch_end = lifted_pole_end_reason(end)
+                    return end
+        if shown.get("topology") == "cap" and edge_model(shown) != "pinned" and wall_contact_suspected(shown):
             wall = None
             if self.last_wall is not None:
                 wall = best_wall_state(self.last_wall, control="delta", value=shown.delta, **kw)
@@ -253,10 +264,16 @@ class _Builder:
                 sol.error_method = "calibrated"  # values set by finish(), from the Richardson points
                 self.since_richardson += 1
             self.last_configuration = configuration
+        if self.branch_end and self.settings["mode"] != "adaptive":  # requested depths only
+            self.out.complete = True
+            raise _Stop(self.branch_end)
         self.rows.append((key, point_record(sol), "; ".join(sol.get("flags", [])), sol))
         self.last_accepted = time.perf_counter()
         if self.callback is not None:
             self.callback(self.snapshot(), sol)
+        if self.branch_end:  # a physical end of the curve, recorded as its last point
+            self.out.complete = True
+            raise _Stop(self.branch_end)
 
     def _richardson(self, sol):
         """Richardson estimate of ``sol``; returns the point to record: ``sol``, or, where the
@@ -394,8 +411,10 @@ def _regula_falsi(a, fa, sa, b, fb, sb, solve_at):
 def _locate_switches(builder: _Builder, st):
     """Add the point where the recorded topology switches between neighbouring points.
 
-    cap <-> line or annulus: where the cap's minimum contact pressure crosses zero
-    (the cap state there, pressure >= 0 side).  line <-> annulus: where the line's
+    cap <-> line, annulus or cap+line(tip): where the cap's minimum contact pressure crosses
+    zero (the cap state there, pressure >= 0 side; for cap+line(tip) that is where its gap
+    closes).  line <-> cap+line(tip): where the line's lifted cap comes down onto the tip
+    (its penetration crosses zero).  line <-> annulus: where the line's
     curvature excess over the indenter crosses zero (the line state there).  Both by
     regula falsi (Illinois); the point is added to an adaptive curve, and every switch
     is listed in ``settings["topology_switches"]``.
@@ -414,6 +433,11 @@ def _locate_switches(builder: _Builder, st):
         sol = solve_liftoff(scene, "line", delta=d, guess=near, tol=st["tol"], max_nodes=st["max_nodes"],
                             bc_tol=st["bc_tol"])
         return (sol, -sol.curvature_excess) if sol.success else (None, None)
+
+    def line_touch_at(d, near):  # the line whose lifted cap comes down onto the tip
+        sol = solve_liftoff(scene, "line", delta=d, guess=near, tol=st["tol"], max_nodes=st["max_nodes"],
+                            bc_tol=st["bc_tol"])
+        return (sol, -sol.penetration) if sol.success else (None, None)
 
     def cap_touch_at(d, near):  # the cap whose free shell just touches the cylinder
         sol = _solve_at_delta(scene, d, near, None, st)
@@ -434,12 +458,24 @@ def _locate_switches(builder: _Builder, st):
                 and (edge_model(c1), edge_model(c2)) == ("smooth", "corner"):
             switches.append(locate_corner_switch(c1, c2, st))
             continue
+        if s1.get("valid") and s2.get("valid") and (edge_model(s1), edge_model(s2)) == ("paper", "pinned"):
+            # the free cap's edge reaches the tip's end: from the caps either side of it
+            ends = [s1, s2.get("cap_solution")]
+            if ends[1] is not None and ends[1].status in (0, 4) and ends[0].tip_end_margin > 0 > ends[1].tip_end_margin:
+                best = _regula_falsi(ends[0].delta, ends[0].tip_end_margin, ends[0], ends[1].delta,
+                                     ends[1].tip_end_margin, ends[1], cap_end_at)
+                _add_switch(builder, st, switches, best, "cap", "cap (pinned at the tip's end)", k1, k2,
+                            "tip_end_margin")
+            continue
         frm, to = s1.get("topology"), s2.get("topology")
         pair = {frm, to}
         if not (s1.get("valid") and s2.get("valid")) or frm == to:
             continue
         if "cap" in pair and pair & {"line", "annulus", "cap+line(tip)"}:
             ends, criterion, sign, solve_at = [_cap_of(s1), _cap_of(s2)], "pressure_min", 1.0, cap_at
+        elif pair == {"line", "cap+line(tip)"}:  # the lifted cap touches down: a cap grows at the pole
+            ends = [s if s.get("topology") == "line" else _line_state_at(s, st) for s in (s1, s2)]
+            criterion, sign, solve_at = "penetration", -1.0, line_touch_at
         elif pair == {"line", "annulus"}:
             ends = [s if s.get("topology") == "line" else _line_state_at(s, st) for s in (s1, s2)]
             criterion, sign, solve_at = "curvature_excess", -1.0, line_at
@@ -717,11 +753,13 @@ def _wall_leg(scene, builder, st, last_cap, key, *, reason, deltas=None):
         prev, past_end = best_wall_state(last_cap, tried=tried, outcomes=outcomes, **kw), last_cap
         if prev is None and last_cap.get("topology") == "cap" and _room_may_help(outcomes):
             prev, past_end = _wall_state_deeper(scene, last_cap, st, kw, tried)
+        if prev is None and scene.contact == "paper" and last_cap.get("topology") == "cap":
+            prev = _pinned_state(scene, last_cap, last_cap.delta, st, tried)
         if prev is None:  # not a physical end: a configuration that is missing or not found
             raise _Stop(f"{reason}; no valid contact with the cylinder ({'; '.join(tried)})")
         prev.cap_solution = past_end  # the cap past the tip's end: where the switch is located from
         builder.last_wall = prev
-        if targets is None:
+        if targets is None or any(abs(prev.delta - t) < 1e-12 for t in targets):  # (a requested depth)
             key += 1
             builder.add(prev, key)
     d_end = st["delta_max"] if targets is None else (targets[-1] if targets else prev.delta)
@@ -734,7 +772,11 @@ def _wall_leg(scene, builder, st, last_cap, key, *, reason, deltas=None):
         nxt_target = min(d_end, prev.delta + step) if targets is None else min(
             min(t for t in targets if t > prev.delta), prev.delta + step)
         tried = []
-        sol = best_wall_state(prev, control="delta", value=nxt_target, tried=tried, **kw)
+        sol = None
+        if edge_model(prev) == "pinned":  # held at the tip's end while its ring force pushes
+            sol = _pinned_state(scene, prev, nxt_target, st, tried)
+        if sol is None:
+            sol = best_wall_state(prev, control="delta", value=nxt_target, tried=tried, **kw)
         if sol is None:
             step /= 2
             if step < 1e-5 * (1 + prev.delta):
@@ -748,6 +790,24 @@ def _wall_leg(scene, builder, st, last_cap, key, *, reason, deltas=None):
         step *= 1.5
     builder.out.complete = True
     raise _Stop(f"delta_max = {st['delta_max']:g} reached" if targets is None else "all requested deltas computed")
+
+
+def _pinned_state(scene, start, delta, st, tried):
+    """The paper's cap held at the tip's end (``contact_edge = "pinned"``) at ``delta``, warm
+    from ``start`` (a cap near or past the tip's end, or a pinned cap); None unless valid.
+
+    Where the indenter's meridional curvature jumps (the tip meets the cylinder) the paper's
+    edge can stay while the indenter pushes the edge's circle (a ring force normal to the
+    shell: at a hemispherical tip's end it is radial and carries no axial force); xi = 0: from
+    delta 0.9295, where the free cap's edge reaches the end, to delta 1, where no cap+cylinder
+    state exists (its band on the cylinder would have a negative length)."""
+    sysm = make_system(scene, "delta", delta, st["eps"], edge="pinned")
+    sol = solve_from(sysm, warm_guess(sysm, start), tol=st["tol"], max_nodes=_step_nodes(start, st),
+                     bc_tol=st["bc_tol"])
+    if sol.success and sol.valid:
+        return sol
+    tried.append(f"cap held at the tip's end: {sol.message if not sol.success else '; '.join(sol.flags)}")
+    return None
 
 
 def _cross(cur, prev, delta, st):

@@ -32,12 +32,13 @@ LEGENDRE_WATCH = 0.1
 
 
 def edge_model(sol) -> str:
-    """The contact-edge model of a cap state's system ("smooth", "corner" or "paper")."""
+    """The contact-edge model of a cap state's system ("smooth", "corner", "paper", or "pinned":
+    the paper's edge held at the tip's end)."""
     sysm = sol.get("system")
     if sysm is None:
         return sol.scene.contact
     models = {j.model for j in sysm.junctions if isinstance(j, Edge)}
-    return "corner" if "corner" in models else sol.scene.contact
+    return next((m for m in ("corner", "pinned") if m in models), sol.scene.contact)
 
 
 def limit_estimate(a, b):

@@ -22,7 +22,7 @@ contact_edge and edge_jump_ls/ks, which read as NaN and "")::
     /curve/<field>          (n,) each of POINT_FIELDS, plus
                             energy_residual (dE/ddelta - F) and flags (strings);
                             topology (strings: shellbvp.chain.CONFIGURATION_NAMES),
-                            contact_edge (strings: smooth, corner or paper);
+                            contact_edge (strings: smooth, corner, paper or pinned);
                             error_method (strings: how force_error/delta_error were
                             made: richardson, calibrated, or empty: not estimated);
                             pressure (the pressure below the shell: the scene's, or
@@ -393,9 +393,9 @@ def _points(g):
             raise ValueError(f"dataset {k} missing")
     points["topology"] = np.asarray(points["topology"], dtype=str)
     points["contact_edge"] = np.asarray(points["contact_edge"], dtype=str)
-    unknown = sorted(set(points["contact_edge"]) - {"", "smooth", "corner", "paper"})
+    unknown = sorted(set(points["contact_edge"]) - {"", "smooth", "corner", "paper", "pinned"})
     if unknown:
-        raise ValueError(f"contact_edge must be one of smooth, corner, paper; got {str(unknown[0])!r}")
+        raise ValueError(f"contact_edge must be one of smooth, corner, paper, pinned; got {str(unknown[0])!r}")
     unknown = sorted(set(points["topology"]) - set(CONFIGURATION_NAMES))
     if unknown:
         raise ValueError(f"topology must be one of {CONFIGURATION_NAMES}; got {str(unknown[0])!r}")

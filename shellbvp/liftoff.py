@@ -24,7 +24,7 @@ import time
 
 import numpy as np
 
-from .chain import ChainBVP, annulus_chain, cap_line_tip_chain, line_chain
+from .chain import ChainBVP, FreePole, annulus_chain, cap_line_tip_chain, line_chain
 from .diagnosis import diagnose
 from .pointload import solve_point_load
 from .solution import (
@@ -38,7 +38,8 @@ from .solution import (
 
 __all__ = ["solve_liftoff", "solve_liftoff_from", "make_liftoff_system", "liftoff_guess_from_cap",
            "liftoff_warm_guess", "liftoff_state", "valid_liftoff_state", "lift_off_suspected",
-           "replace_invalid_cap"]
+           "replace_invalid_cap", "pole_legendre", "lifted_pole_branch_end", "lifted_pole_end_reason",
+           "POLE_LEGENDRE_END"]
 
 
 def make_liftoff_system(scene, topology, control, value, eps):
@@ -302,7 +303,8 @@ def valid_liftoff_state(cap: Solution, *, tol=1e-6, max_nodes=10000, bc_tol=1e-1
         tried.append("cap+line(tip): not tried (the pole was lifted at the previous point and the line here "
                      "keeps it above the tip)")
     elif _pressed_at_the_pole(cap):
-        res = second_zone_state(cap, tol=tol, max_nodes=max_nodes, bc_tol=bc_tol, previous=previous)
+        res = second_zone_state(cap, tol=tol, max_nodes=max_nodes, bc_tol=bc_tol, previous=previous,
+                                 before=before)
         if res.success and res.valid:
             return res, tried
         tried.append(f"{res.topology}: {res.message if not res.success else '; '.join(res.flags)}")
@@ -340,11 +342,12 @@ def _pressed_at_the_pole(cap):
     return bool(P.size and P[0] > 0 and np.min(P) < 0)
 
 
-def second_zone_state(cap: Solution, *, tol=1e-6, max_nodes=10000, bc_tol=1e-10, previous=None):
+def second_zone_state(cap: Solution, *, tol=1e-6, max_nodes=10000, bc_tol=1e-10, previous=None, before=None):
     """Where the cap is pressed at the pole but would pull further out: the contact splits into
     a smaller cap and, beyond a lifted gap, a line on the tip (``cap+line(tip)``) where the cap's
-    edge was; from ``previous`` (the same configuration) when given, else a few guesses from the
-    cap.  Returns a Solution (check ``success`` and ``valid``)."""
+    edge was; from ``previous`` (the same configuration; along the secant through ``before``
+    when that is one too) when given, else a few guesses from the cap.  Returns a Solution
+    (check ``success`` and ``valid``)."""
     from .cylinder import solve_chain_from, transfer_guess
 
     t0 = time.perf_counter()
@@ -354,6 +357,15 @@ def second_zone_state(cap: Solution, *, tol=1e-6, max_nodes=10000, bc_tol=1e-10,
     sysm = ChainBVP(scene, cap_line_tip_chain(cap.system.eps, scene.shell_length), control, value)
     attach_tip_table(sysm)
     kw = dict(tol=tol, max_nodes=int(min(max_nodes, max(2000, 4 * cap.nodes))), bc_tol=bc_tol)
+    if _near(previous, cap, sysm.topology) and control == "delta":
+        # near the closing of the gap (beta 0.1: S_c/S1 -> 1 at delta 0.394) the unknowns move
+        # fast and a guess re-sampled from another state fails; the state itself on its mesh,
+        # moved along the secant, and shorter steps towards the depth when that fails, do not
+        res = _continue_in_delta(sysm, previous, before if _near(before, cap, sysm.topology) else None,
+                                 cap.delta, **kw)
+        if res is not None:
+            res.wall_time = time.perf_counter() - t0
+            return res
     guesses = []
     if previous is not None and previous.get("topology") == sysm.topology:
         q = dict(zip(previous.system.unknowns, previous.p))
@@ -372,6 +384,42 @@ def second_zone_state(cap: Solution, *, tol=1e-6, max_nodes=10000, bc_tol=1e-10,
             break
     res.wall_time = time.perf_counter() - t0
     return res
+
+
+#: Solves of :func:`_continue_in_delta` at most (each a warm start of a few hundred to a few
+#: thousand nodes), and its node budget: near the closing of a gap the mesh needs a few
+#: thousand nodes for a while (beta 0.1: 2188 at delta 0.386)
+_CONTINUATION_STEPS = 16
+_CONTINUATION_NODES = 5000
+
+
+def _continue_in_delta(sysm, previous, before, delta, *, tol, max_nodes, bc_tol):
+    """The valid state of ``sysm``'s configuration at ``delta`` by natural continuation from
+    ``previous`` (same configuration; secant through ``before`` if given, over at most its own
+    length): the whole step first, halved while a step fails or lands on an invalid state (a
+    narrow basin: beta 0.1 near the gap's closing, where Newton from a good guess finds another
+    root with the gap nearly shut), at most ``_CONTINUATION_STEPS`` solves.  Returns the valid
+    state at ``delta``, or None."""
+    from .cylinder import solve_chain_from
+
+    budget = int(min(max_nodes, max(_CONTINUATION_NODES, WARM_NODES * previous.nodes)))
+    step = delta - previous.delta
+    for _ in range(_CONTINUATION_STEPS):
+        last = abs(delta - previous.delta) <= abs(step)
+        target = delta if last else previous.delta + step
+        stepper = ChainBVP(sysm.scene, sysm.chain, "delta", target, model=sysm.model, par=sysm.par)
+        stepper.tip_A, stepper.tip_B = sysm.tip_A, sysm.tip_B
+        secant = before if before is not None and abs(target - previous.delta) <= abs(previous.delta - before.delta) \
+            else None
+        res = solve_chain_from(stepper, liftoff_warm_guess(stepper, previous, secant, target), tol=tol,
+                               max_nodes=budget, bc_tol=bc_tol)
+        if not (res.success and res.valid):
+            step /= 2
+            continue
+        if last:
+            return res
+        before, previous = previous, res  # the step is kept: a longer one fails there
+    return None
 
 
 def _probe_then_solve(sysm, guess, solve_from, *, tol, max_nodes, bc_tol):
@@ -410,3 +458,109 @@ def replace_invalid_cap(cap: Solution, *, tol=1e-6, max_nodes=10000, bc_tol=1e-1
 def _pressed_somewhere(cap):
     prof = cap.profile()
     return bool(np.max(prof["P"][prof["region"] == 0]) > 0)
+
+
+# -- the end of a lifted-pole branch: loss of convexity at the free pole -----------------------------
+#: A lifted pole whose Legendre determinant (:func:`pole_legendre`) is below this is at the end
+#: of its branch (rho 0.05: 0.2 at delta 0.16, 2e-3 at 0.17543, 0 at 0.1754322).
+POLE_LEGENDRE_END = 1e-3
+
+
+def pole_legendre(state) -> float:
+    """det d(tau_s, M_s)/d(lambda_s, kappa_s) at a lifted pole relative to its value in the middle
+    of the free region that ends at the rim (as ``edge_legendre``); NaN without a free pole.
+
+    The lifted cap is nearly uniform, so its own median falls with it: the outer region is
+    the scale that stays (rho 0.05: about 0.04 there while the pole's falls to 0)."""
+    sysm = state.get("system")
+    if sysm is None or not state.get("success") or not isinstance(sysm.junctions[0], FreePole):
+        return math.nan
+    last = len(sysm.regions) - 1
+    pole = sysm.model.free_legendre(sysm.S(0, np.array([0.0]), state.p), state.sol(np.array([0.0]))[sysm.rows(0)],
+                                    sysm.par)[0][0]
+    mid = sysm.model.free_legendre(sysm.S(last, np.array([0.5]), state.p),
+                                   state.sol(np.array([0.5]))[sysm.rows(last)], sysm.par)[0][0]
+    return float(pole / mid) if mid != 0 else math.nan
+
+
+#: Solves of :func:`lifted_pole_branch_end` at most; a step in lambda0 that lowers pole_legendre
+#: by less than this factor ends the search (rho 0.05: each step lowers it 3-10x)
+_END_STEPS = 24
+_END_MIN_GAIN = 0.8
+#: The smallest delta step of its natural continuation towards the end
+_END_DELTA_STEP = 2e-3
+
+
+def lifted_pole_branch_end(previous: Solution, before: Solution, *, tol=1e-6, max_nodes=10000, bc_tol=1e-10):
+    """Where a lifted-pole branch (line or annulus) ends: the state at which the energy loses
+    convexity at the free pole (:func:`pole_legendre` below ``POLE_LEGENDRE_END``), or None if
+    the branch through ``before`` and ``previous`` (two of its states, ``previous`` the deeper)
+    is not heading there.
+
+    First natural continuation in delta from ``previous`` (steps halved when one fails, down
+    to ``_END_DELTA_STEP``) brings the search close to the end, where delta stops growing;
+    then the branch is followed in the pole's stretch lambda0 (secant steps of 80 % towards
+    the zero of pole_legendre, nearly linear in lambda0 close to it; 40 % or 15 % where a step
+    fails).  Along lambda0, delta grows to a maximum where the determinant vanishes (rho 0.05:
+    delta* = 0.1754322, lambda0 = 0.68291, kappa_s = 29.47 at the pole against the tip's 20),
+    so natural continuation in delta stalls short of it and no lifted state of this kind
+    exists deeper.  Past it the pole's state is not convex: an interior Weierstrass-Erdmann
+    corner would be needed (not built).  A state of the continuation in delta that is not
+    valid or whose pole determinant does not fall, or a step in lambda0 that does not lower
+    it by ``_END_MIN_GAIN``, ends the search (beta 0.2: it levels off near 0.01 and rises
+    again while the lifted cap comes down onto the tip).
+    """
+    if previous is None or before is None or previous.get("topology") != before.get("topology") \
+            or previous.get("topology") not in ("line", "annulus") or not previous.delta > before.delta:
+        return None
+    g_prev, g = pole_legendre(before), pole_legendre(previous)
+    if not (math.isfinite(g_prev) and math.isfinite(g) and 0 < g < g_prev):
+        return None
+    scene, topology = previous.scene, previous.topology
+
+    def budget(state):  # past the end the mesh runs away: fail fast
+        return int(min(max_nodes, max(2000, WARM_NODES * state.nodes)))
+
+    a, b = before, previous
+    step, solves = b.delta - a.delta, 0
+    while step >= _END_DELTA_STEP and solves < _END_STEPS:
+        res = solve_liftoff(scene, topology, delta=b.delta + step, guess=b, tol=tol, max_nodes=budget(b),
+                            bc_tol=bc_tol)
+        solves += 1
+        if not res.success:
+            step /= 2
+        elif res.valid and 0 < pole_legendre(res) < pole_legendre(b):
+            a, b = b, res
+        else:  # the branch goes on, invalid or with the pole's determinant not falling: no such end
+            return None
+    g_prev, g = pole_legendre(a), pole_legendre(b)
+    while solves < _END_STEPS:
+        if g < POLE_LEGENDRE_END:
+            return b if b.valid and b.delta >= previous.delta else None
+        slope = (g - g_prev) / (b.lambda0 - a.lambda0)
+        if not slope != 0:
+            return None
+        res = None
+        for fraction in (0.8, 0.4, 0.15):
+            res = solve_liftoff(scene, topology, lambda0=b.lambda0 - fraction * g / slope, guess=b, tol=tol,
+                                max_nodes=budget(b), bc_tol=bc_tol)
+            solves += 1
+            if res.success:
+                break
+        if not res.success:
+            return None
+        a, b, g_prev, g = b, res, g, pole_legendre(res)
+        if not math.isfinite(g) or g < 0 or g > _END_MIN_GAIN * g_prev:
+            return None  # not falling to zero
+    return None
+
+
+def lifted_pole_end_reason(end: Solution) -> str:
+    """The stop reason of a curve at the end of its lifted-pole branch."""
+    prof = end.profile()
+    return (f"the energy loses convexity at the lifted cap's free pole: the lifted-pole {end.topology} branch "
+            f"ends at delta = {end.delta:.6g} (F = {end.force:.6g}; Legendre determinant at the pole "
+            f"{pole_legendre(end):.2g} of the outer free region's, lambda0 = {end.lambda0:.5g}, kappa_s = "
+            f"{float(prof['kappa_s'][0]):.4g} against the tip's {1 / end.scene.rho:.4g}); delta is largest there "
+            f"along the branch, and deeper the single cap pulls at the pole: the state beyond needs an interior "
+            f"Weierstrass-Erdmann corner in the free region, which is not built")

@@ -171,7 +171,8 @@ class Derivation:
             self.contact_phys, self.contact_phys_out)
         self._build_boundaries()
         (self.junction, self.junction_inputs, self.junction_res,
-         self.force_res) = self._edge(self.contact, self.contact_profile, self.contact_phys_out)
+         self.force_res) = self._edge(self.contact, self.contact_profile, self.contact_phys_out,
+                                      pin_at=st.tip.omega_max)
         # The indenter's cylinder r = rho A(omega_max): the same contact equations on the
         # continuation of the tip past its end (kappa_s = 0), its edge to a free region, and
         # the junction where the shell passes from the tip onto it.
@@ -414,13 +415,14 @@ class Derivation:
                         F.let("res_z", z)]
 
 
-    def _edge(self, contact: Program, contact_profile: dict, contact_out: dict):
+    def _edge(self, contact: Program, contact_profile: dict, contact_out: dict, pin_at=None):
         """Contact-line programs between a contact region (tip or cylinder) and a free one.
 
         Returns ``(program, inputs (Sc, yc, yf), {model: residuals}, force residual)``:
         contact end (chi_c, ls_c) and free start (suffix _f) at S = Sc.  (Ring forces are
         the jumps of the axial force across an edge, from the regions' profiles:
-        ``shellbvp.diagnosis``.)
+        ``shellbvp.diagnosis``.)  With ``pin_at`` (the tip's end omega_max) also the paper's
+        edge held there ("pinned").
         """
         sh = self.structure.shell
         yc = sp.symbols("chi_c ls_c")
@@ -457,6 +459,14 @@ class Derivation:
                                       + oc["kappa_s"] * (of["M_s"] - oc["M_s"])),
                                 J.let("res_H", H_f - H_c)],
         }
+        if pin_at is not None:
+            # The paper's edge held at the tip's end, where the indenter's meridional curvature
+            # jumps from the tip's to the cylinder's 0: there the indenter can push on the edge's
+            # circle (Q jumps: a ring force, normal to the shell, which must push), so the
+            # paper's no-ring-force condition gives way to omega = omega_max; tau_s stays
+            # continuous (frictionless).
+            res["pinned"] = common + [J.let("res_pin", yc[0] - RHO * pin_at / SC),
+                                      J.let("res_tau_pin", of["tau_s"] - oc["tau_s"])]
         force = J.let("res_F", of["axial_force_2pi"] - FORCE / (2 * sp.pi))
         return J, (SC, *yc, *yf), res, force
 

@@ -23,7 +23,8 @@ CHAINS = {"cap": lambda L, contact: ch.cap_chain(EPS, L, contact),
           "wall_band": lambda L, contact: ch.cap_band_cylinder_chain(EPS, L, contact),
           "tip_line": lambda L, contact: ch.cap_line_tip_chain(EPS, L),
           "tip_band": lambda L, contact: ch.cap_band_tip_chain(EPS, L)}
-CASES = [("cap", c, m) for c in ("smooth", "paper", "corner") for m in ("delta", "lambda0", "force", "arclength")] + \
+CASES = [("cap", c, m) for c in ("smooth", "paper", "corner", "pinned")
+         for m in ("delta", "lambda0", "force", "arclength")] + \
         [(k, "smooth", m) for k in ("annulus", "line") for m in ("delta", "lambda0", "force")] + \
         [("point", "smooth", "delta")] + \
         [(k, c, m) for k in ("cylinder", "wall_line", "wall_band") for c in ("smooth", "paper")
@@ -50,7 +51,8 @@ SEALED_CASES = [(k, "smooth", "delta") for k in CHAINS] + \
 
 def system(kind, contact, control, sealed=False):
     # "corner": the smooth model's cap with a Weierstrass-Erdmann corner at its edge
-    contact_model = "smooth" if contact == "corner" else contact
+    # "pinned": the paper's cap with its edge held at the tip's end
+    contact_model = {"corner": "smooth", "pinned": "paper"}.get(contact, contact)
     scene = (sb.Scene.preset("balloon", sealed=True, contact=contact_model) if sealed
              else sb.Scene.preset("base", contact=contact_model))
     value = ARC if control == "arclength" else 0.3

@@ -280,8 +280,8 @@ def test_a_wall_guess_whose_mesh_runs_away_fails_at_the_node_budget(monkeypatch)
 def test_no_deeper_wall_starts_where_no_guess_finds_a_state(monkeypatch):
     """Going deeper past the tip's end gives the contact room on the cylinder: it cures wall
     states that converge with their contact back on the tip, not guesses that find no state
-    at all (xi 0, paper's contact: every guess's mesh runs away).  The curve stops after the
-    one set of wall attempts from the cap past the end, and says why."""
+    at all (xi 0, paper's contact: every guess's mesh runs away).  After the one set of wall
+    attempts from the cap past the end the curve goes on with the cap held at the tip's end."""
     import shellbvp.cylinder
 
     statuses = []
@@ -295,6 +295,69 @@ def test_no_deeper_wall_starts_where_no_guess_finds_a_state(monkeypatch):
     monkeypatch.setattr(shellbvp.cylinder, "solve_bvp", counted)
     c = sb.curve(sb.Scene.preset("base", xi=0, contact="paper"), deltas=np.linspace(0.85, 1.0, 7),
                  estimate_error=False)
-    assert not c.complete and "no valid contact with the cylinder" in c.stop_reason
-    assert c.delta.max() < 0.93
+    assert c.complete and c.delta.max() == pytest.approx(1.0) and np.all(c.valid)
+    assert c.points["contact_edge"][-1] == "pinned"
     assert 1 <= len(statuses) <= len(shellbvp.cylinder._CAP_SPLITS) and 0 not in statuses, statuses
+
+
+def test_the_paper_cap_held_at_the_tip_end_takes_over_where_the_free_edge_reaches_it():
+    """The paper's cap with its edge held at the tip's end (contact_edge "pinned"): shallower than
+    where the free cap's edge reaches the end its ring force would pull, deeper it pushes; it
+    vanishes where the free cap's edge is at the end, and there the two caps agree in F."""
+    from shellbvp.state import make_system, solve_from, warm_guess
+
+    scene = sb.Scene.preset("base", contact="paper", beta=1e-3)
+    free = {0.91: sb.solve(scene, delta=0.91, topology="cap", estimate_error=False)}
+    sysm = make_system(scene, "delta", 0.92, free[0.91].system.eps)
+    free[0.92] = solve_from(sysm, warm_guess(sysm, free[0.91]))  # past the end: inadmissible, status 4
+    assert free[0.91].success and free[0.92].status == 4
+    assert free[0.91].tip_end_margin > 0 > free[0.92].tip_end_margin
+    held = {}
+    for d in (0.91, 0.92):
+        sysm = make_system(scene, "delta", d, free[0.91].system.eps, edge="pinned")
+        held[d] = solve_from(sysm, warm_guess(sysm, free[0.91]))
+        assert held[d].success and held[d].contact_edge == "pinned"
+        assert abs(held[d].tip_end_margin) < 1e-12  # the edge is at the tip's end
+    n1, n2 = held[0.91].edge_forces[0], held[0.92].edge_forces[0]
+    assert n1 < 0 < n2 and held[0.92].valid and not held[0.91].valid
+    m1, m2 = free[0.91].tip_end_margin, free[0.92].tip_end_margin
+    d_held = 0.91 + 0.01 * n1 / (n1 - n2)
+    d_free = 0.91 + 0.01 * m1 / (m1 - m2)
+    assert d_held == pytest.approx(d_free, abs=2e-4)  # linear interpolation over 0.01
+    f_held = held[0.91].force + (held[0.92].force - held[0.91].force) * (d_held - 0.91) / 0.01
+    f_free = free[0.91].force + (free[0.92].force - free[0.91].force) * (d_free - 0.91) / 0.01
+    assert f_held == pytest.approx(f_free, rel=1e-4)
+
+
+@pytest.mark.slow  # ~25 s with the code generation of the xi = 0 structure
+def test_the_paper_cap_is_held_at_the_tip_end_where_no_cylinder_state_exists():
+    """xi = 0, the paper's contact: past delta 0.934 no cap+cylinder state exists (followed in beta
+    from 1e-4, where it does, its band on the cylinder shrinks to nothing near beta 2e-3 at
+    delta 1), and the free cap's edge would pass the tip's end.  The edge stays at the tip's end,
+    where the indenter's curvature jumps and can push on the edge's circle: the curve reaches
+    delta 1, every point valid.  At the located switch the held cap is the free cap: computed
+    as the held cap whose ring force vanishes and as the free cap whose edge reaches the end,
+    the two agree in delta and F."""
+    from shellbvp.state import make_system, solve_from, warm_guess
+
+    scene = sb.Scene.preset("base", xi=0, contact="paper")
+    c = sb.curve(scene, delta_max=1.0, delta_start=0.85, delta_min=0.84, estimate_error=False)
+    assert c.complete and c.delta[-1] == pytest.approx(1.0) and np.all(c.valid), c.stop_reason
+    sw, = [s for s in c.settings["topology_switches"] if s["to"] == "cap (pinned at the tip's end)"]
+    assert 0.93 < sw["delta"] < 0.94
+    held = [s for s in c.solutions if s.contact_edge == "pinned"]
+    assert held and all(s.delta > sw["delta"] and s.edge_forces[0] > 0 for s in held)
+    assert np.all(np.diff([s.edge_forces[0] for s in held]) > 0)  # pushed harder as it goes deeper
+    # the held cap's ring force vanishes at the switch: from held caps either side of it
+    near = held[0]
+    ring = {}
+    for d in (sw["delta"] - 2e-3, sw["delta"] + 2e-3):
+        sysm = make_system(scene, "delta", d, near.system.eps, edge="pinned")
+        s = solve_from(sysm, warm_guess(sysm, near))
+        assert s.success
+        ring[d] = (s.edge_forces[0], s.force)
+    (d1, (n1, f1)), (d2, (n2, f2)) = sorted(ring.items())
+    assert n1 < 0 < n2  # before the switch the held cap would pull the edge
+    d0 = d1 - n1 * (d2 - d1) / (n2 - n1)
+    assert d0 == pytest.approx(sw["delta"], abs=2e-4)
+    assert f1 + (f2 - f1) * (d0 - d1) / (d2 - d1) == pytest.approx(sw["force"], rel=1e-4)

@@ -366,3 +366,73 @@ def test_no_warm_start_from_a_line_whose_contact_circle_is_far_off(monkeypatch):
     np.testing.assert_allclose(guarded.force, unguarded.force, rtol=1e-7)
     c, u = counts[lo.WARM_MAX_LN_SC], counts[math.inf]
     assert u.calls - c.calls == 1 and u.niter - c.niter >= 8, ((c.calls, c.niter), (u.calls, u.niter))
+
+
+# -- the ends of the lifted and split branches on the stability grid (issues 12, 13) ---------------------
+@pytest.mark.slow  # 10-20 s: eleven line states, five at tol 1e-8
+def test_the_lifted_pole_branch_ends_where_the_pole_loses_convexity():
+    """rho = 0.05: the lifted-pole line branch ends at delta* = 0.17543 because the energy stops
+    being convex in (lambda_s, kappa_s) at the lifted cap's free pole, not at a regular fold:
+    followed in the pole's stretch, delta grows to a maximum exactly where the pole's Legendre
+    determinant reaches zero, with F(delta) smooth up to it (dE/ddelta = F there)."""
+    from shellbvp.liftoff import lifted_pole_branch_end, pole_legendre, replace_invalid_cap, solve_liftoff
+
+    scene = sb.Scene.preset("base", rho=0.05)
+    a, b = (replace_invalid_cap(sb.solve(scene, delta=d, topology="cap", estimate_error=False))
+            for d in (0.11768, 0.14826))
+    assert a.topology == b.topology == "line" and a.valid and b.valid
+    assert 0 < pole_legendre(b) < pole_legendre(a)  # falling towards zero as delta grows
+    end = lifted_pole_branch_end(b, a)
+    assert end is not None and end.valid and end.topology == "line"
+    assert 0 < pole_legendre(end) < 1e-3
+    assert 0.1754 < end.delta < 0.17544  # delta* = 0.1754322 (followed to det 1e-6 at tol 1e-7)
+    # delta is largest at the end along the branch: slope d delta/d lambda0 falls towards 0
+    near, mid, far = (solve_liftoff(scene, "line", lambda0=end.lambda0 + dl, guess=end) for dl in (0.001, 0.02, 0.03))
+    assert near.success and mid.success and far.success and far.delta < mid.delta < near.delta < end.delta
+    slope_near = (end.delta - near.delta) / 0.001
+    slope_far = (mid.delta - far.delta) / 0.01
+    assert 0 < slope_near < 0.6 * slope_far
+    # the energy identity on the line branch just before its end (Richardson differences)
+    h, d0 = 1e-3, 0.172
+    E = {}
+    for k in (-2, -1, 0, 1, 2):
+        s = solve_liftoff(scene, "line", delta=d0 + k * h, guess=end, tol=1e-8, estimate_error=k == 0)
+        assert s.success and s.valid, s.flags
+        E[k] = s
+    slope = (4 * (E[1].energy - E[-1].energy) / (2 * h) - (E[2].energy - E[-2].energy) / (4 * h)) / 3
+    assert abs(slope - E[0].force) < 1e-8 + 10 * E[0].force_error
+
+
+def test_a_curve_stops_at_once_where_the_lifted_pole_branch_ends():
+    """rho = 0.05: the curve ends at the lifted-pole line branch's end (recorded, valid) with the
+    physical reason, instead of ten invalid caps that pull at the pole (delta 0.18-0.37)."""
+    c = sb.curve(sb.Scene.preset("base", rho=0.05), delta_max=0.3, delta_min=0.045, estimate_error=False)
+    assert c.complete and "loses convexity at the lifted cap's free pole" in c.stop_reason
+    assert "interior Weierstrass-Erdmann corner" in c.stop_reason
+    assert np.all(c.valid) and c.topology[-1] == "line"
+    assert 0.1754 < c.delta[-1] < 0.17544
+
+
+@pytest.mark.slow  # 6-10 s
+def test_the_cap_and_line_on_the_tip_are_followed_until_the_gap_closes():
+    """beta = 0.1: between the cap and the line on the tip the lifted gap closes near delta
+    0.3941; at 0.39198 (the stability grid's one invalid point) the cap+line(tip) state is found
+    by continuation in delta from the two before it, valid, with the gap nearly shut: its F and
+    E are the (pulling) cap's to 1e-5 and 1e-7."""
+    from shellbvp.liftoff import replace_invalid_cap, second_zone_state
+
+    scene = sb.Scene.preset("base", beta=0.1)
+    before = second_zone_state(sb.solve(scene, delta=0.34862, topology="cap", estimate_error=False))
+    previous = second_zone_state(sb.solve(scene, delta=0.37039, topology="cap", estimate_error=False),
+                                 previous=before)
+    assert before.valid and previous.valid
+    cap = sb.solve(scene, delta=0.39198, topology="cap", estimate_error=False)
+    assert cap.success and not cap.valid and cap.pressure_min < 0
+    s = replace_invalid_cap(cap, previous=previous, before=before)
+    assert s.topology == "cap+line(tip)" and s.valid, s.flags
+    assert s.delta == cap.delta
+    q = dict(zip(s.system.unknowns, s.p))
+    assert 0.98 < np.exp(q["ln_Sc"] - q["ln_S1"]) < 1  # the gap is nearly shut
+    assert s.edge_forces[0] < 1e-4 < s.edge_forces[1]  # the inner edge's ring force vanishes with it
+    assert s.force == pytest.approx(cap.force, rel=1e-5)
+    assert s.energy == pytest.approx(cap.energy, rel=1e-7) and s.energy <= cap.energy + 1e-9

@@ -226,7 +226,7 @@ def test_generated_jacobians_equal_finite_differences(name):
     yc = np.array([1.02, 1.05])
     yf = _random_free(rng, 1)[1][:, 0]
     xj = np.r_[0.15, yc, yf, 0.3]
-    for model in ("smooth", "paper", "corner"):
+    for model in ("smooth", "paper", "corner", "pinned"):  # pinned: the paper's edge held at the tip's end
         res = getattr(mod, f"junction_{model}_res")
         jac = getattr(mod, f"junction_{model}_jac")
         check(jac(0.15, yc, yf, 0.3, 0.0, par),
@@ -247,7 +247,7 @@ def test_condition_counts_close_each_control_mode():
     yf = np.array([1.0, 1.0, 1.0, 1.0, 0.0, -0.5])
     pole = mod.pole_res(1.0, 1.0, 1.0, par).size
     rim = mod.rim_res(np.pi / 2, yf, par).size
-    for model in ("smooth", "paper", "corner"):
+    for model in ("smooth", "paper", "corner", "pinned"):
         jun = getattr(mod, f"junction_{model}_res")(0.1, np.ones(2), yf, 0.1, 0.0, par).size
         force = mod.force_res(0.1, np.ones(2), yf, 0.1, 0.5, par).size
         assert pole + rim + jun == n + 2          # unknowns: ln Sc and lambda0 (or delta)
