@@ -139,7 +139,7 @@ def report(out):
                  f"[{m['coverage_ci95'][0]:.3f}, {m['coverage_ci95'][1]:.3f}] | {m['median_width']:.3g} | "
                  f"{m['rms_error']:.3g} | {m['bias']:+.2g} | {o['covered']}/{o['n']} = {o['coverage']:.3f} | "
                  f"{o['median_width'] * 1e6:.3g} |")
-    L += ["", f"## beta fitted (data at beta = 0.02, proportional noise; the fit starts at 0.01)", "",
+    L += ["", "## beta fitted (data at beta = 0.02, proportional noise; the fit starts at 0.01)", "",
           "| weights | beta coverage | median beta | median beta CI width | RMS error of beta | CI open at a bound "
           "| mu*H coverage | median mu*H CI width (N/m) | new model curves per fit (memoised across seeds) "
           "| max interpolation error |",
