@@ -38,7 +38,7 @@ from .solution import (
 
 __all__ = ["solve_liftoff", "solve_liftoff_from", "make_liftoff_system", "liftoff_guess_from_cap",
            "liftoff_warm_guess", "liftoff_state", "valid_liftoff_state", "lift_off_suspected",
-           "replace_invalid_cap", "pole_legendre", "lifted_pole_branch_end", "lifted_pole_end_reason",
+           "replace_invalid_cap", "pole_legendre", "pole_clearance", "lifted_pole_branch_end", "lifted_pole_end_reason",
            "POLE_LEGENDRE_END"]
 
 
@@ -304,7 +304,7 @@ def valid_liftoff_state(cap: Solution, *, tol=1e-6, max_nodes=10000, bc_tol=1e-1
                      "keeps it above the tip)")
     elif _pressed_at_the_pole(cap):
         res = second_zone_state(cap, tol=tol, max_nodes=max_nodes, bc_tol=bc_tol, previous=previous,
-                                 before=before)
+                                 before=before, line=line)
         if res.success and res.valid:
             return res, tried
         tried.append(f"{res.topology}: {res.message if not res.success else '; '.join(res.flags)}")
@@ -328,7 +328,16 @@ def _split_possible(last, line, tol):
         return True
     if line is None or not line.get("success"):
         return True
-    return bool(not line.get("penetration", math.inf) <= 10 * tol)
+    return bool(not line.get("penetration", math.inf) <= 10 * tol or pole_clearance(line) <= 10 * tol)
+
+
+def pole_clearance(state) -> float:
+    """Height of the tip's apex above a lifted pole (the gap there; <= 0 where the pole is down
+    on the tip to the solver's accuracy): where the lifted pole of a line comes down, the
+    contact splits into a cap and the line (base at delta 0.1125: -1e-8; Gent 0.03 at 0.119:
+    -3e-8)."""
+    prof = state.profile()
+    return float(state["z_tip"] - prof["z"][0])
 
 
 #: (Sc'/S_p, S1/Sc) of second-zone guesses from a cap pressed at the pole and pulling further out
@@ -342,12 +351,18 @@ def _pressed_at_the_pole(cap):
     return bool(P.size and P[0] > 0 and np.min(P) < 0)
 
 
-def second_zone_state(cap: Solution, *, tol=1e-6, max_nodes=10000, bc_tol=1e-10, previous=None, before=None):
+#: S_c/S1 of second-zone guesses from a line state whose lifted pole has come down
+_SECOND_ZONE_FROM_LINE = (0.7, 0.5)
+
+
+def second_zone_state(cap: Solution, *, tol=1e-6, max_nodes=10000, bc_tol=1e-10, previous=None, before=None,
+                      line=None):
     """Where the cap is pressed at the pole but would pull further out: the contact splits into
     a smaller cap and, beyond a lifted gap, a line on the tip (``cap+line(tip)``) where the cap's
     edge was; from ``previous`` (the same configuration; along the secant through ``before``
-    when that is one too) when given, else a few guesses from the cap.  Returns a Solution
-    (check ``success`` and ``valid``)."""
+    when that is one too) when given, else a few guesses from ``line`` (the line state at this
+    depth, if one converged) and from the cap.  Returns a Solution (check ``success`` and
+    ``valid``)."""
     from .cylinder import solve_chain_from, transfer_guess
 
     t0 = time.perf_counter()
@@ -370,6 +385,12 @@ def second_zone_state(cap: Solution, *, tol=1e-6, max_nodes=10000, bc_tol=1e-10,
     if previous is not None and previous.get("topology") == sysm.topology:
         q = dict(zip(previous.system.unknowns, previous.p))
         guesses.append(transfer_guess(sysm, previous, ln_Sc=q["ln_Sc"], ln_S1=q["ln_S1"], chi1=q["chi1"]))
+    if line is not None and line.get("success") and line.get("topology") == "line":
+        # a lifted pole coming down inside the line (base at delta 0.1125: the guesses from
+        # the cap below leave the model's domain; from the line, 0.7 S1, it converges at once)
+        q = dict(zip(line.system.unknowns, line.p))
+        guesses += [transfer_guess(sysm, line, ln_Sc=q["ln_S1"] + math.log(a), ln_S1=q["ln_S1"], chi1=q["chi1"])
+                    for a in _SECOND_ZONE_FROM_LINE]
     prof = cap.profile()
     on = prof["region"] == 0
     S_p = float(prof["S"][on][np.nonzero(prof["P"][on] < 0)[0][0]])
