@@ -312,7 +312,8 @@ def markdown(rows, meta):
         f"Measured {meta['date']} on {meta['machine']} ({meta['cpus']} cores, shared), "
         f"shellbvp {meta['shellbvp']} ({meta['git']}), SciPy {meta['scipy']}; `sb.curve(scene, delta_max={meta['delta_max']:g}, "
         f"delta_min={meta['delta_min']:g}, estimate_error=True)`, tol 1e-6, max_nodes 10000, "
-        f"time limit {meta['time_limit']:.0f} s per curve; total {meta['total_s']:.0f} s.",
+        f"time limit {meta['time_limit']:.0f} s per curve; kernels {meta.get('kernels', 'auto')}; "
+        f"total {meta['total_s']:.0f} s.",
         "",
         "| scene | contact | delta reached | max F | stopped | complete | points | max nodes | time (s) "
         "| after the last point (s) | max F error | min P | invalid | F < 0 at delta | max \\|dE/dδ − F\\| | contact topologies | at the last point |",
@@ -364,12 +365,17 @@ def main():
     ap.add_argument("--delta-min", type=float, default=1e-4, help="end of the small-delta leg")
     ap.add_argument("--time-limit", type=float, default=None, help="seconds per curve (default 300; quick 60)")
     ap.add_argument("--grace", type=float, default=120.0, help="extra seconds before a worker is killed")
+    ap.add_argument("--kernels", choices=("numpy", "numba", "auto"), default="numpy",
+                    help="SHELLBVP_KERNELS of the workers (default numpy, the reference: with auto a curve "
+                         "may switch to the compiled kernels part way, and rounding then decides a few "
+                         "fragile steps, so the table would depend on the code cache's state)")
     ap.add_argument("--out", default=None, help="basename in benchmarks/results (default stability[-quick])")
     ap.add_argument("--out-dir", default=None, help="write results/ under this directory (default benchmarks/)")
     ap.add_argument("--rebuild", action="store_true",
                     help="only rewrite the Markdown (and diagnoses) from the existing JSON")
     ap.add_argument("--worker", nargs=2, help=argparse.SUPPRESS)
     args = ap.parse_args()
+    os.environ["SHELLBVP_KERNELS"] = args.kernels  # inherited by the workers
     global RESULTS
     if args.out_dir:
         RESULTS = Path(args.out_dir) / "results"
@@ -430,7 +436,7 @@ def main():
                 cpus=os.cpu_count(), python=platform.python_version(), numpy=numpy.__version__,
                 scipy=scipy.__version__, shellbvp=sb.__version__, delta_max=delta_max,
                 delta_min=args.delta_min, time_limit=time_limit, total_s=total,
-                quick=args.quick, base=dict(BASE, material=list(BASE["material"])))
+                quick=args.quick, base=dict(BASE, material=list(BASE["material"])), kernels=args.kernels)
     RESULTS.mkdir(parents=True, exist_ok=True)
     name = args.out or ("stability-quick" if args.quick else "stability")
     (RESULTS / f"{name}.json").write_text(json.dumps({"meta": meta, "scenes": rows}, indent=1, default=float))

@@ -24,7 +24,7 @@ from scipy.optimize import fsolve
 
 from .chain import Edge
 
-__all__ = ["LEGENDRE_WATCH", "edge_model", "limit_estimate", "is_corner", "near_limit", "other_edge_root"]
+__all__ = ["LEGENDRE_WATCH", "edge_model", "edge_null_jump", "limit_estimate", "is_corner", "near_limit", "other_edge_root"]
 
 #: Below this edge_legendre (relative to mid-region) a smooth cap is near its convexity
 #: limit: steps that fail, or that are predicted to pass the limit, try the corner.
@@ -67,16 +67,10 @@ def near_limit(sol) -> bool:
                 and sol.get("edge_legendre", math.inf) < LEGENDRE_WATCH)
 
 
-def other_edge_root(sol):
-    """The second root (jump of lambda_s, jump of kappa_s) of the corner conditions at the edge of
-    the smooth cap ``sol``, the free side's other state values held; None if not found.
-
-    At zero jump the two conditions are dependent (their Jacobian in the free side's
-    (lambda_s, kappa_s) has rank 1): the other root lies along its null vector, and near the
-    convexity limit it is close.  Before the limit it is the corner that is not convex; past it
-    the corner continues with the opposite sign (a transcritical crossing), so a jump of the
-    opposite sign, scaled with the distance to the limit, seeds the corner's Newton iteration.
-    """
+def _edge_conditions(sol):
+    """(G, v0, null): the corner's two natural conditions G(lambda_s+, kappa_s+) at the edge of
+    the smooth cap ``sol`` (the other values held), the smooth root v0, and the null direction
+    of their Jacobian there (rank 1 at zero jump)."""
     sysm = sol.system
     mod, par = sysm.model, sysm.par
     yc, yf = sol.y[sysm.rows(0), -1], sol.y[sysm.rows(1), 0]
@@ -89,7 +83,29 @@ def other_edge_root(sol):
 
     h = 1e-7 * (1 + np.abs(v0))
     J = np.column_stack([(G(v0 + np.eye(2)[i] * h[i]) - G(v0 - np.eye(2)[i] * h[i])) / (2 * h[i]) for i in range(2)])
-    n = np.linalg.svd(J)[2][-1] * (1 + np.abs(v0))  # null direction, scaled to the variables
+    return G, v0, np.linalg.svd(J)[2][-1]
+
+
+def edge_null_jump(sol):
+    """A jump (of lambda_s, of kappa_s) along the null direction of the corner conditions at the
+    edge of the smooth cap ``sol``, per unit jump of lambda_s: the direction in which the
+    corner leaves the smooth state (first order), whatever its size."""
+    _, _, null = _edge_conditions(sol)
+    return null / null[0] if abs(null[0]) > 1e-12 * np.linalg.norm(null) else None
+
+
+def other_edge_root(sol):
+    """The second root (jump of lambda_s, jump of kappa_s) of the corner conditions at the edge of
+    the smooth cap ``sol``, the free side's other state values held; None if not found.
+
+    At zero jump the two conditions are dependent (their Jacobian in the free side's
+    (lambda_s, kappa_s) has rank 1): the other root lies along its null vector, and near the
+    convexity limit it is close.  Before the limit it is the corner that is not convex; past it
+    the corner continues with the opposite sign (a transcritical crossing), so a jump of the
+    opposite sign, scaled with the distance to the limit, seeds the corner's Newton iteration.
+    """
+    G, v0, null = _edge_conditions(sol)
+    n = null * (1 + np.abs(v0))  # null direction, scaled to the variables
     best = None
     for t in (1e-3, -1e-3, 1e-2, -1e-2, 5e-2, -5e-2):
         v, _, ier, _ = fsolve(G, v0 + t * n, full_output=True, xtol=1e-13)

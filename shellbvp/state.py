@@ -15,7 +15,7 @@ import time
 import numpy as np
 
 from .chain import FREE_STATES, ChainBVP, cap_chain
-from .corner import edge_model, is_corner, limit_estimate, near_limit, other_edge_root
+from .corner import edge_model, edge_null_jump, is_corner, limit_estimate, near_limit, other_edge_root
 from .diagnosis import as_failure, diagnose
 from .inflation import start_shape
 from .pointload import SC_POINT, solve_point_load
@@ -109,13 +109,19 @@ def cross_convexity_limit(prev, prev2, delta, *, eps, tol, max_nodes, bc_tol, ex
                     | {max(delta, prev.delta + 0.02), max(delta, prev.delta + 0.04)})
     starts = [s for s in (prev, prev2) if s is not None and s.get("success") and edge_model(s) == "smooth"]
     sol = None
-    for d_far, start, seeded in ((d, s, k) for s in starts for d in ladder for k in (True, False)):
+    # seeds: the edge's other root scaled to d_far; else a jump of CORNER_SEED_JUMP in lambda_s
+    # (either sign) along the null direction of the edge conditions (gamma = 0 with the numpy
+    # functions: the other root is not found, the conditions are flat to 1e-15 near v0); none
+    seeds = ("root", CORNER_SEED_JUMP, -CORNER_SEED_JUMP, None)
+    for d_far, start, seeded in ((d, s, k) for s in starts for d in ladder for k in seeds):
         sysm = make_system(prev.scene, "delta", d_far, eps, "corner")
         guess = warm_guess(sysm, start)
-        if seeded:  # the jump expected at d_far put at the edge: Newton at zero jump is near-singular
+        if seeded == "root":  # the jump expected at d_far put at the edge: Newton at zero jump is near-singular
             guess = _seed_corner(sysm, guess, start, d_star, d_far)
-            if guess is None:
-                continue
+        elif seeded is not None:
+            guess = _seed_along_null(sysm, guess, start, seeded)
+        if guess is None:
+            continue
         sol = solve_from(sysm, guess, tol=tol, max_nodes=max_nodes, bc_tol=bc_tol)
         if is_corner(sol, tol):
             break
@@ -135,6 +141,25 @@ def cross_convexity_limit(prev, prev2, delta, *, eps, tol, max_nodes, bc_tol, ex
             if step < 1e-4 * (1 + delta):
                 return None
     return sol if sol.success and sol.get("legendre_min", -1.0) > 0 else None
+
+
+#: Size of the jump of lambda_s put at the edge of a corner guess along the null direction of
+#: the edge conditions (the corner jumps grow from 0 at the limit: base 0.17 at 0.086 past it;
+#: gamma 0: 0.017 at 0.009 past it, found from +-0.02 and +-0.05 alike)
+CORNER_SEED_JUMP = 0.02
+
+
+def _seed_along_null(sysm, guess, start, size):
+    """``guess`` with a jump of ``size`` in lambda_s (and kappa_s along the null direction of the
+    edge conditions of the smooth cap ``start``) at the edge's free side; None if degenerate."""
+    direction = edge_null_jump(start)
+    if direction is None:
+        return None
+    x, y, p = guess
+    y = y.copy()
+    r = sysm.rows(1)
+    y[r.start + 2:r.start + 4, 0] += size * direction
+    return x, y, p
 
 
 def _seed_corner(sysm, guess, start, d_star, d_far):

@@ -158,3 +158,22 @@ def test_without_a_corner_the_curve_stops_at_the_limit_at_once(monkeypatch):
     assert "no corner state was found" in c.stop_reason and not c.complete
     assert 0.6 < c.points["delta"][-1] < 0.6146
     assert len(failed) <= 4, failed
+
+
+def test_the_corner_is_seeded_along_the_null_direction_where_no_other_root_is_found():
+    """gamma = 0 (numpy functions): at the last smooth caps before the limit (0.7113) the edge
+    conditions are flat to 1e-15 along their null direction near the smooth root, the other root
+    is not found, and the corner was not reached (the grid's curve stopped at 0.7008).  A jump of
+    CORNER_SEED_JUMP along the null direction reaches it."""
+    from shellbvp.corner import edge_null_jump, is_corner
+    from shellbvp.state import cross_convexity_limit
+
+    scene = sb.Scene.preset("base", gamma=0.0)
+    prev2 = sb.solve(scene, delta=0.675, estimate_error=False)
+    prev = sb.solve(scene, delta=0.7008, guess=prev2, estimate_error=False)
+    assert prev2.success and prev.success and prev.contact_edge == "smooth"
+    direction = edge_null_jump(prev)
+    assert direction[0] == 1 and direction[1] < 0
+    sol = cross_convexity_limit(prev, prev2, 0.72, eps=prev.system.eps, tol=1e-6, max_nodes=10000, bc_tol=1e-10)
+    assert sol is not None and is_corner(sol, 1e-6) and sol.valid
+    assert sol.delta == 0.72 and 0.01 < sol.edge_jump_ls < 0.03  # 0.0168
