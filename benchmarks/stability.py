@@ -375,7 +375,8 @@ def main():
                     help="only rewrite the Markdown (and diagnoses) from the existing JSON")
     ap.add_argument("--worker", nargs=2, help=argparse.SUPPRESS)
     args = ap.parse_args()
-    os.environ["SHELLBVP_KERNELS"] = args.kernels  # inherited by the workers
+    if not args.worker:
+        os.environ["SHELLBVP_KERNELS"] = args.kernels  # inherited by the workers
     global RESULTS
     if args.out_dir:
         RESULTS = Path(args.out_dir) / "results"
