@@ -249,6 +249,30 @@ def test_paper_model_runs_onto_the_cylinder_when_the_first_wall_guess_has_no_roo
     assert set(c.topology[c.delta > sw[0]["delta"] + 1e-6]) == {"cap+cylinder"}
 
 
+def _wall_solves(record):
+    """shellbvp.cylinder.solve_chain_from (the solve of every wall state) with each solve_bvp run
+    of its system passed to ``record(run, kwargs)`` (the raw run: status 0 = converged)."""
+    import shellbvp.cylinder
+
+    orig = shellbvp.cylinder.solve_chain_from
+
+    def counted(sysm, guess, **kw):
+        raw = sysm.solve
+
+        def solve(*a, **k):
+            r = raw(*a, **k)
+            record(r, k)
+            return r
+
+        sysm.solve = solve  # this system only
+        try:
+            return orig(sysm, guess, **kw)
+        finally:
+            del sysm.solve
+
+    return counted
+
+
 @pytest.mark.slow  # ~25 s, most of it generating the code of the xi = 0 structure
 def test_a_wall_guess_whose_mesh_runs_away_fails_at_the_node_budget(monkeypatch):
     """xi = 0 with the paper's contact has no valid state on the cylinder past the tip's end
@@ -258,18 +282,13 @@ def test_a_wall_guess_whose_mesh_runs_away_fails_at_the_node_budget(monkeypatch)
     import shellbvp.cylinder
 
     meshes = []
-    orig = shellbvp.cylinder.solve_bvp
-
-    def counted(*args, **kw):
-        r = orig(*args, **kw)
-        meshes.append((int(r.x.size), kw["max_nodes"]))
-        return r
+    counted = _wall_solves(lambda r, kw: meshes.append((int(r.x.size), kw["max_nodes"])))
 
     scene = sb.Scene.preset("base", xi=0, contact="paper")
     near = sb.curve(scene, deltas=np.linspace(0.2, 0.9, 8), estimate_error=False, topology="cap").solutions[-1]
     cap = sb.solve(scene, delta=0.97, guess=near, topology="cap", estimate_error=False)
     assert cap.status in (0, 4) and wall_contact_suspected(cap)
-    monkeypatch.setattr(shellbvp.cylinder, "solve_bvp", counted)
+    monkeypatch.setattr(shellbvp.cylinder, "solve_chain_from", counted)
     res = wall_state(cap, "cap+cylinder")
     assert not (res.success and res.valid)
     budget = max(shellbvp.cylinder.WALL_MIN_NODES, 4 * cap.nodes)
@@ -285,14 +304,8 @@ def test_no_deeper_wall_starts_where_no_guess_finds_a_state(monkeypatch):
     import shellbvp.cylinder
 
     statuses = []
-    orig = shellbvp.cylinder.solve_bvp
-
-    def counted(*args, **kw):
-        r = orig(*args, **kw)
-        statuses.append(int(r.status))
-        return r
-
-    monkeypatch.setattr(shellbvp.cylinder, "solve_bvp", counted)
+    record = _wall_solves(lambda r, kw: statuses.append(int(r.status)))
+    monkeypatch.setattr(shellbvp.cylinder, "solve_chain_from", record)
     c = sb.curve(sb.Scene.preset("base", xi=0, contact="paper"), deltas=np.linspace(0.85, 1.0, 7),
                  estimate_error=False)
     assert c.complete and c.delta.max() == pytest.approx(1.0) and np.all(c.valid)
