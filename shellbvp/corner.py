@@ -24,7 +24,8 @@ from scipy.optimize import fsolve
 
 from .chain import Edge
 
-__all__ = ["LEGENDRE_WATCH", "edge_model", "edge_null_jump", "limit_estimate", "is_corner", "near_limit", "other_edge_root"]
+__all__ = ["LEGENDRE_WATCH", "edge_model", "edge_null_jump", "limit_estimate", "is_corner", "near_limit",
+           "other_edge_root"]
 
 #: Below this edge_legendre (relative to mid-region) a smooth cap is near its convexity
 #: limit: steps that fail, or that are predicted to pass the limit, try the corner.
