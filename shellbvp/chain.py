@@ -350,7 +350,7 @@ class ChainBVP:
     # pickling: the generated module is code, not data; it is loaded again (from the code
     # cache) by the scene on unpickling, so results can travel between processes
     def __getstate__(self):
-        return {k: v for k, v in self.__dict__.items() if k not in ("model", "kernels")}
+        return {k: v for k, v in self.__dict__.items() if k not in ("model", "kernels", "_vol", "_vol_jac")}
 
     def __setstate__(self, state):
         self.__dict__.update(state)
@@ -383,9 +383,6 @@ class ChainBVP:
         par[self._i_pressure] = p[self.col["pressure"]]
         return par
 
-    @property
-    def _i_pressure(self) -> int:
-        return self.model.PARAMS.index("pressure")
 
     def at(self, p) -> "ChainBVP":
         """This system with its parameters at the solution ``p`` (the pressure under volume
@@ -400,7 +397,7 @@ class ChainBVP:
     def _volume_rates(self, t, y, p, k):
         a, b = self.ln_S(self.regions[k].start, p), self.ln_S(self.regions[k].end, p)
         S = np.exp(a + t * (b - a))
-        return (b - a) * getattr(self.model, f"{self.regions[k].kind}_vol")(S, y[self.rows(k)], self.par)[0]
+        return (b - a) * self._vol[k](S, y[self.rows(k)], self.par)[0]
 
     def complete(self, x, y, p):
         """``(y, p)`` for a solve from a guess of the regions' states and the unknowns before
@@ -465,6 +462,10 @@ class ChainBVP:
         self.kernels = kernel_set(self.model, self.scene.structure)
         self._rhs_names = [f"{r.kind}_rhs" for r in self.regions]
         self._jac_names = [f"{r.kind}_jac" for r in self.regions]
+        if "pressure" in self.model.PARAMS:  # volume control's functions (pressurised structures)
+            self._i_pressure = self.model.PARAMS.index("pressure")
+            self._vol = [getattr(self.model, f"{r.kind}_vol") for r in self.regions]
+            self._vol_jac = [getattr(self.model, f"{r.kind}_vol_jac") for r in self.regions]
 
     def _rhs(self, k):
         return getattr(self.kernels.active, self._rhs_names[k])
@@ -493,7 +494,7 @@ class ChainBVP:
             S = np.exp(a + t * (b - a))
             f[rows] = (b - a) * self._rhs(k)(S, y[rows], par)
             if self.volume_control:
-                f[self.n_shell] += (b - a) * getattr(self.model, f"{reg.kind}_vol")(S, y[rows], par)[0]
+                f[self.n_shell] += (b - a) * self._vol[k](S, y[rows], par)[0]
         return f
 
     def fun_jac(self, t, y, p=None):
@@ -509,7 +510,7 @@ class ChainBVP:
             dfdy[rows, rows] = (b - a) * gy
             if self.volume_control:
                 v = self.n_shell
-                vy, vS = getattr(self.model, f"{reg.kind}_vol_jac")(S, y[rows], par)
+                vy, vS = self._vol_jac[k](S, y[rows], par)
                 dfdy[v, rows] = (b - a) * vy[0]
                 dfdp[rows, self.col["pressure"]] = (b - a) * getattr(
                     self.kernels.active, f"{reg.kind}_jac_par")(S, y[rows], par)[:, self._i_pressure]
@@ -523,7 +524,7 @@ class ChainBVP:
                 if g is None:
                     g = self._rhs(k)(S, y[rows], par)
                     if self.volume_control:
-                        rate = getattr(self.model, f"{reg.kind}_vol")(S, y[rows], par)[0]
+                        rate = self._vol[k](S, y[rows], par)[0]
                 dfdp[rows, self.col[point.unknown]] += sign * g + (b - a) * gS * S * dS_dln
                 if self.volume_control:
                     dfdp[v, self.col[point.unknown]] += sign * rate + (b - a) * vS[0] * S * dS_dln

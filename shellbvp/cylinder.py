@@ -141,10 +141,10 @@ def transfer_guess(sysm: ChainBVP, source: Solution, n: int = 101, **unknowns):
                              _wall_omega(sysm, f["z"], source["z_tip"]))
             omega = np.maximum.accumulate(omega)
         elif not np.all(np.isfinite(omega)):
-            # where the source is free (a lifted pole coming down): the tip's point at its radius
-            grid = np.linspace(0.0, sysm.scene.tip_omega_max, 401)
-            omega = np.where(np.isfinite(omega), omega,
-                             np.interp(f["r"] / rho, sysm.model.tip_shape(grid, sysm.par)["A"], grid))
+            # where the source is free (a lifted pole coming down): the tip's point at its radius,
+            # from the system's tip table (attach_tip_table)
+            grid = np.linspace(0.0, sysm.scene.tip_omega_max, sysm.tip_A.size)
+            omega = np.where(np.isfinite(omega), omega, np.interp(f["r"] / rho, sysm.tip_A, grid))
         if any(isinstance(j, TipEnd) and j.k == k for j in sysm.junctions):  # reach omega_max at S*
             w_end = omega[-1]
             omega = omega * (sysm.model.OMEGA_MAX / w_end) ** ((S / S[-1]) ** 2)

@@ -153,12 +153,16 @@ def _seed_along_null(sysm, guess, start, size):
     """``guess`` with a jump of ``size`` in lambda_s (and kappa_s along the null direction of the
     edge conditions of the smooth cap ``start``) at the edge's free side; None if degenerate."""
     direction = edge_null_jump(start)
-    if direction is None:
-        return None
+    return None if direction is None else _with_edge_jump(sysm, guess, size * direction)
+
+
+def _with_edge_jump(sysm, guess, jump):
+    """``guess`` with ``jump`` added to (lambda_s, kappa_s) at the start of the free region (the
+    edge's free side)."""
     x, y, p = guess
     y = y.copy()
     r = sysm.rows(1)
-    y[r.start + 2:r.start + 4, 0] += size * direction
+    y[r.start + 2:r.start + 4, 0] += jump
     return x, y, p
 
 
@@ -170,11 +174,7 @@ def _seed_corner(sysm, guess, start, d_star, d_far):
     jump = other_edge_root(start)
     if jump is None or not jump[0] < 0:  # before the limit the other root stretches less
         return None
-    x, y, p = guess
-    y = y.copy()
-    r = sysm.rows(1)
-    y[r.start + 2:r.start + 4, 0] -= jump * (d_far - d_star) / (d_star - start.delta)
-    return x, y, p
+    return _with_edge_jump(sysm, guess, -jump * (d_far - d_star) / (d_star - start.delta))
 
 
 def solve_from(sysm, guess, *, tol=1e-6, max_nodes=10000, bc_tol=None):
