@@ -343,6 +343,7 @@ def test_no_failed_step_where_the_cap_grows_exponentially(monkeypatch):
     assert not any(failed), failed
 
 
+@pytest.mark.slow  # two gent1 curves, 5-10 s
 def test_no_warm_start_from_a_line_whose_contact_circle_is_far_off(monkeypatch):
     """gent1's small-delta leg: the line at delta 0.03 (Sc 1.3e-5) is a poor guess for the line
     at 0.018 (Sc 1.4e-8): Newton stalls from it (10 iterations) before the cap's guess
