@@ -54,9 +54,11 @@ import numpy as np
 
 from .kernels import kernel_set
 
-__all__ = ["Point", "Region", "ContactPole", "FreePole", "PointPole", "Edge", "TipEnd", "Line", "Rim", "Chain",
+__all__ = ["Point", "Region", "ContactPole", "FreePole", "PointPole", "Edge", "TipEnd", "Line", "Kink", "Rim",
+           "Chain",
            "ChainBVP", "cap_chain", "point_chain", "annulus_chain", "line_chain", "cylinder_chain",
            "cap_line_cylinder_chain", "cap_band_cylinder_chain", "cap_line_tip_chain", "cap_band_tip_chain",
+           "line_kink_chain",
            "CONTROLS",
            "SIZES", "FREE_STATES", "CONTACT_STATES", "CONTACT_KINDS", "REGION_CODES", "CONFIGURATION_NAMES"]
 
@@ -70,6 +72,8 @@ REGION_CODES = {"contact": 0, "free": 1, "cylinder": 2}
 _LS = FREE_STATES.index("ls")
 # states continuous across a line contact (rQ jumps: the ring force)
 _LINE_CONTINUOUS = [FREE_STATES.index(s) for s in ("lt", "phiS", "ls", "ks", "z")]
+# states continuous across an interior corner (ls, ks jump)
+_KINK_CONTINUOUS = [FREE_STATES.index(s) for s in ("lt", "phiS", "rQ", "z")]
 
 
 # -- declarations ---------------------------------------------------------------------------------
@@ -153,6 +157,19 @@ class Line:
 
 
 @dataclass(frozen=True)
+class Kink:
+    """Interior Weierstrass-Erdmann corner between free regions ``k`` and ``k + 1``: 7 rows.
+
+    lt, phiS, rQ, z continuous (4); lambda_s and kappa_s jump with [tau_s] = [M_s] = 0 and the
+    Eshelby condition [lambda_s dU/dlambda_s - U] = 0 (3, ``kink_res``).  Where U is convex
+    the jump is 0 (the rows then hold for any S_k): only a state with a jump is a corner.
+    """
+
+    k: int
+    rows = 7
+
+
+@dataclass(frozen=True)
 class Rim:
     """Simply supported rim at the end of region ``k``: 3 rows."""
 
@@ -193,7 +210,7 @@ def _fields(j):
 
 #: Every configuration's name (``Solution.topology``, a curve's per-point ``topology``).
 CONFIGURATION_NAMES = ("cap", "point", "line", "annulus", "cap+line(tip)", "cap+band(tip)", "cap+line(cylinder)",
-                       "cap+band(cylinder)", "cap+cylinder")
+                       "cap+band(cylinder)", "cap+cylinder", "line+corner")
 
 
 def cap_chain(eps: float, L: float, model: str = "smooth") -> Chain:
@@ -272,6 +289,15 @@ def line_chain(eps: float, L: float) -> Chain:
     return Chain("line", (Region("free", Point("zeta", "ln_S1", math.log(eps)), S1),
                           Region("free", S1, Point("L", None, math.log(L)))),
                  (FreePole(0), Line(0), Rim(1)), ("ln_S1", "chi1"), eps)
+
+
+def line_kink_chain(eps: float, L: float) -> Chain:
+    """Lifted pole, an interior corner at S_k, contact on one circle S1: free [zeta, S_k],
+    free [S_k, S1], free [S1, L]; unknowns ln S_k, ln S1, chi1."""
+    Sk, S1 = Point("Sk", "ln_Sk"), Point("S1", "ln_S1")
+    return Chain("line+corner", (Region("free", Point("zeta", "ln_Sk", math.log(eps)), Sk), Region("free", Sk, S1),
+                                 Region("free", S1, Point("L", None, math.log(L)))),
+                 (FreePole(0), Kink(0), Line(1), Rim(2)), ("ln_Sk", "ln_S1", "chi1"), eps)
 
 
 # -- the assembler -------------------------------------------------------------------------------
@@ -565,6 +591,10 @@ class ChainBVP:
                 point, yc, yin, yout = self._line_states(j, ya, yb, q)
                 on_tip = self._line_function(j, "res")(self.S_point(point, p), yc, yin, q["delta"], q["F"], par)[:3]
                 parts += [on_tip, (yout - yin)[_LINE_CONTINUOUS]]
+            elif isinstance(j, Kink):
+                yl, yr = yb[self.rows(j.k)], ya[self.rows(j.k + 1)]
+                parts += [mod.kink_res(self.S_point(self.regions[j.k].end, p), yl, yr, par),
+                          (yr - yl)[_KINK_CONTINUOUS]]
             elif isinstance(j, Rim):
                 parts.append(mod.rim_res(self.S_point(self.regions[j.k].end, p), yb[self.rows(j.k)], par))
         if self.extra == "force":
@@ -680,6 +710,21 @@ class ChainBVP:
                 if vc:
                     self._pressure_column(P, rows, mod.tip_end_jac_par(S, yb[self.rows(j.k)], ya[self.rows(j.k + 1)],
                                                                        par))
+            elif isinstance(j, Kink):
+                point = self.regions[j.k].end
+                S = self.S_point(point, p)
+                yl, yr = yb[self.rows(j.k)], ya[self.rows(j.k + 1)]
+                kj = mod.kink_jac(S, yl, yr, par)  # d/d(S, yl, yr)
+                jump = slice(r, r + 3)
+                B[jump, self.rows(j.k)] = kj[:, 1:7]
+                A[jump, self.rows(j.k + 1)] = kj[:, 7:13]
+                self._add_p(P, jump, point.unknown, kj[:, 0] * S)
+                if vc:
+                    self._pressure_column(P, jump, mod.kink_jac_par(S, yl, yr, par))
+                l0, r0 = self.offsets[j.k], self.offsets[j.k + 1]
+                for row, c in enumerate(_KINK_CONTINUOUS, start=r + 3):
+                    A[row, r0 + c] = 1.0
+                    B[row, l0 + c] = -1.0
             elif isinstance(j, Rim):
                 S = self.S_point(self.regions[j.k].end, p)
                 B[rows, self.rows(j.k)] = mod.rim_jac(S, yb[self.rows(j.k)], par)

@@ -12,7 +12,7 @@ import math
 
 import numpy as np
 
-__all__ = ["convexity_limits", "convexity_report"]
+__all__ = ["convexity_limits", "convexity_report", "envelope_partner"]
 
 
 def _determinant(scene):
@@ -78,6 +78,70 @@ def convexity_limits(scene, stretches=(0.8, 1.0, 1.2, 1.5, 2.0), kappa_max=3.0, 
                 break
         out[ls] = limit
     return out
+
+
+def _stretched(a, b, n, fine=0.002):
+    """n points on [a, b] (a < 0 < b) spaced ~``fine`` near 0 and growing geometrically outwards."""
+    u = np.linspace(-1.0, 1.0, n)
+    c = np.arcsinh(max(-a, b) / fine) / 1.0
+    x = fine * np.sinh(c * u)
+    return np.clip(x, a, b)
+
+
+def envelope_partner(sysm, S, y, *, lambda_min=0.1, kappa_rho_max=100.0, n=(161, 201)) -> dict:
+    """Is a free-region state on the convex envelope of U in (lambda_s, lambda_s kappa_s), and where
+    is the other phase of an interior Weierstrass-Erdmann corner from it?
+
+    An interior corner (``chain.Kink``) joins two states of equal (lambda_theta, kappa_theta),
+    equal gradient of U in the derivative variables (lambda_s, k = lambda_s kappa_s, i.e. equal
+    tau_s and M_s) and equal Legendre transform (Eshelby): the ends of a segment of U's convex
+    envelope at those (lambda_theta, kappa_theta).  The envelope is taken of U sampled on the box
+    ``lambda_s in [lambda_min, 3]``, ``|kappa_s rho| <= kappa_rho_max`` (the state itself a sample);
+    the rest of the state (S, lt, phiS, rQ, z) is held.
+
+    Parameters
+    ----------
+    sysm : ChainBVP
+        The state's system (its generated module and parameters).
+    S, y : float, array (6,)
+        A point of a free region and its state.
+
+    Returns
+    -------
+    dict
+        ``gap``: (U - envelope)/U at the state (0 on the envelope: the Weierstrass condition holds
+        in the box); ``partner``: (lambda_s, kappa_s) of the envelope's facet vertex farthest from
+        the state (the other phase, where ``gap > 0``; compare two boxes: a partner that moves out
+        with the box is no state of the shell, see ``liftoff.pole_corner_partner``).
+    """
+    from scipy.spatial import ConvexHull
+
+    mod, par, rho = sysm.model, sysm.par, sysm.scene.rho
+    y = np.asarray(y, float)
+    l0, k0 = float(y[2]), float(y[2] * y[3])
+    k_max = kappa_rho_max / rho  # |kappa_s| <= k_max: the box in k = lambda_s kappa_s is k_max lambda_s wide
+    # fine near the state (an envelope's segment may start a few per cent away), coarse far out
+    ls = np.unique(np.append(l0 * np.exp(_stretched(math.log(lambda_min / l0), math.log(3.0 / l0), n[0])), l0))
+    reach = 3.0 * k_max + abs(k0)
+    kk = np.unique(np.append(k0 + _stretched(-reach, reach, n[1], fine=0.02 / rho), k0))
+    L, K = np.meshgrid(ls, kk, indexing="ij")
+    inside = np.abs(K) <= k_max * L
+    L, K = L[inside], K[inside]
+    states = np.repeat(y[:, None], L.size, axis=1)
+    states[2], states[3] = L, K / L
+    U = mod.free_profile(np.full(L.size, float(S)), states, par)["energy_density"]  # U R Psi: R Psi > 0 fixed
+    pts = np.column_stack([(L - l0) / (3.0 - lambda_min), (K - k0) / k_max, U])
+    hull = ConvexHull(pts)
+    lower = hull.equations[:, 2] < 0
+    eq, simplices = hull.equations[lower], hull.simplices[lower]
+    here = int(np.flatnonzero((L == l0) & (K == k0))[0])
+    below = -eq[:, 3] / eq[:, 2]  # each lower facet's plane at the state (its shifted origin)
+    f = int(np.argmax(below))
+    u0 = float(U[here])
+    gap = max(0.0, (u0 - float(below[f])) / abs(u0)) if here not in set(np.unique(simplices)) else 0.0
+    vertices = simplices[f]
+    far = int(vertices[np.argmax(np.hypot(pts[vertices, 0], pts[vertices, 1]))])
+    return {"gap": gap, "partner": (float(L[far]), float(K[far] / L[far]))}
 
 
 def convexity_report(scene) -> str:

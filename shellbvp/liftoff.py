@@ -39,6 +39,7 @@ from .solution import (
 __all__ = ["solve_liftoff", "solve_liftoff_from", "make_liftoff_system", "liftoff_guess_from_cap",
            "liftoff_warm_guess", "liftoff_state", "valid_liftoff_state", "lift_off_suspected",
            "replace_invalid_cap", "pole_legendre", "pole_clearance", "lifted_pole_branch_end", "lifted_pole_end_reason",
+           "pole_corner_partner",
            "POLE_LEGENDRE_END"]
 
 
@@ -525,8 +526,9 @@ def lifted_pole_branch_end(previous: Solution, before: Solution, *, tol=1e-6, ma
     fails).  Along lambda0, delta grows to a maximum where the determinant vanishes (rho 0.05:
     delta* = 0.1754322, lambda0 = 0.68291, kappa_s = 29.47 at the pole against the tip's 20),
     so natural continuation in delta stalls short of it and no lifted state of this kind
-    exists deeper.  Past it the pole's state is not convex: an interior Weierstrass-Erdmann
-    corner would be needed (not built).  A state of the continuation in delta that is not
+    exists deeper.  Past it the pole's state is not convex, and no interior Weierstrass-Erdmann
+    corner continues it where the corner's other phase is a crease (:func:`pole_corner_partner`).
+    A state of the continuation in delta that is not
     valid or whose pole determinant does not fall, or a step in lambda0 that does not lower
     it by ``_END_MIN_GAIN``, ends the search (beta 0.2: it levels off near 0.01 and rises
     again while the lifted cap comes down onto the tip).
@@ -576,12 +578,51 @@ def lifted_pole_branch_end(previous: Solution, before: Solution, *, tol=1e-6, ma
     return None
 
 
+#: The two boxes of (lambda_s >= lambda_min, |kappa_s rho| <= kappa_rho_max) in which the lifted
+#: pole's interior-corner partner is sought (``convexity.envelope_partner``): a partner that
+#: moves out with the box is not a state of the shell (rho 0.05: lambda_s 0.21 -> 0.10)
+_CORNER_BOXES = ((0.1, 100.0), (0.05, 1000.0))
+
+
+def pole_corner_partner(end: Solution) -> dict:
+    """Is there an interior Weierstrass-Erdmann corner from the lifted pole of ``end``?
+
+    The corner's other phase is the far end of U's convex-envelope segment from the pole's
+    state (:func:`shellbvp.convexity.envelope_partner`), sought in the two boxes
+    ``_CORNER_BOXES``.  Returns ``gap`` (U above its envelope, relative, in the larger box),
+    ``partners`` ((lambda_s, kappa_s) per box) and ``finite``: a partner that stays put when the
+    box grows (False where the envelope's segment runs out with the box, towards lambda_s -> 0
+    and kappa_s -> infinity: a crease, not a corner of the shell)."""
+    from .convexity import envelope_partner
+
+    sysm = end.system
+    t = np.array([0.0])
+    S, y = float(sysm.S(0, t, end.p)[0]), end.sol(t)[sysm.rows(0), 0]
+    found = [envelope_partner(sysm, S, y, lambda_min=lm, kappa_rho_max=km) for lm, km in _CORNER_BOXES]
+    partners = [f["partner"] for f in found]
+    (l1, k1), (l2, k2) = partners
+    finite = bool(found[-1]["gap"] > 0 and abs(l2 - l1) < 0.05 * l1 and abs(k2 - k1) < 0.05 * abs(k1))
+    return {"gap": found[-1]["gap"], "partners": partners, "finite": finite}
+
+
 def lifted_pole_end_reason(end: Solution) -> str:
     """The stop reason of a curve at the end of its lifted-pole branch."""
     prof = end.profile()
+    rho = end.scene.rho
+    corner = pole_corner_partner(end)
+    (l1, k1), (l2, k2) = corner["partners"]
+    if corner["finite"]:
+        beyond = (f"an interior Weierstrass-Erdmann corner to lambda_s = {l2:.3g}, kappa_s rho = {k2 * rho:.3g} "
+                  f"may continue it; it is not searched")
+    else:
+        beyond = (f"no interior Weierstrass-Erdmann corner with a shell state on its other side continues it: the "
+                  f"pole's state lies "
+                  f"{100 * corner['gap']:.2g} % above the convex envelope of U in (lambda_s, lambda_s kappa_s), "
+                  f"and the envelope's other phase runs out with the box sampled (lambda_s {l1:.2g} -> {l2:.2g}, "
+                  f"kappa_s rho {k1 * rho:.3g} -> {k2 * rho:.3g}): a crease, not a state of the shell; a convex "
+                  f"bending energy (bending='rotation') continues")
     return (f"the energy loses convexity at the lifted cap's free pole: the lifted-pole {end.topology} branch "
             f"ends at delta = {end.delta:.6g} (F = {end.force:.6g}; Legendre determinant at the pole "
             f"{pole_legendre(end):.2g} of the outer free region's, lambda0 = {end.lambda0:.5g}, kappa_s = "
-            f"{float(prof['kappa_s'][0]):.4g} against the tip's {1 / end.scene.rho:.4g}); delta is largest there "
-            f"along the branch, and deeper the single cap pulls at the pole: the state beyond needs an interior "
-            f"Weierstrass-Erdmann corner in the free region, which is not built")
+            f"{float(prof['kappa_s'][0]):.4g} against the tip's {1 / rho:.4g}); delta is largest there "
+            f"along the branch, and deeper the single cap pulls at the pole; {beyond}")

@@ -300,6 +300,19 @@ def function_specs(d: Derivation) -> list[FunctionSpec]:
         specs.append(FunctionSpec("free_pole_jac_par", d.free, fargs,
                                   [("dres", d.free.jacobian(d.free_pole_res, par))],
                                   f"Regular pole of a free cap: d/dpar (3, {len(par)})."))
+    # interior corner of the free region (left state yl, right state yr at S = S_k)
+    K, (SK, *yk) = d.kink, d.kink_inputs
+    kargs = [("S_k", (SK,)), ("yl", tuple(yk[:6])), ("yr", tuple(yk[6:])), ("par", par)]
+    specs += [
+        FunctionSpec("kink_res", K, kargs, [("res", d.kink_res)],
+                     "Interior corner of the free region at S = S_k: [tau_s], [M_s] and "
+                     "[lambda_s U_ls - U], (3,)."),
+        FunctionSpec("kink_jac", K, kargs, [("dres", K.jacobian(d.kink_res, [SK, *yk]))],
+                     "Interior corner: d/d(S_k, yl, yr), (3, 13)."),
+    ]
+    if pressurised:
+        specs.append(FunctionSpec("kink_jac_par", K, kargs, [("dres", K.jacobian(d.kink_res, par))],
+                                  f"Interior corner: d/dpar (3, {len(par)})."))
     # geometry of the scene (guesses, plots, penetration checks)
     specs += [
         FunctionSpec("reference_shell", d.geometry_prog, [("S", (d.geometry_S,)), ("par", par)],

@@ -187,6 +187,7 @@ class Derivation:
         self._build_geometry()
         self._build_point_load()
         self._build_free_pole()
+        self._build_kink()
 
     # ------------------------------------------------------------------ shared pieces
     def _shell_steps(self, prog: Program, Svar, tag=""):
@@ -540,6 +541,38 @@ class Derivation:
             F.let("res_pole_rot", phiS - o["psi"] * ks),
             F.let("res_pole_G", o["G"] / S**2),
         ]
+
+    def _build_kink(self):
+        """An interior Weierstrass-Erdmann corner of the free region, at an unknown S = S_k.
+
+        Where U is not convex in (lambda_s, kappa_s) the minimiser may jump between two states
+        of equal (lambda_theta, kappa_theta) inside the free region.  r, phi, z and Q stay
+        continuous (``shellbvp.chain.Kink`` equates the states lt, phiS, rQ, z); the momenta of
+        E = 2 pi Int U R Psi dS conjugate to r, z and phi, i.e. the force resultants tau_s, Q and
+        the moment M_s, are continuous; and so is the Hamiltonian R Psi (lambda_s dU/dlambda_s
+        - U) (the Eshelby condition; R Psi continuous).  The three rows below hold at
+        continuity too: only a state with a jump is a corner.  (The contact edge's corner is
+        the same construction with the indenter on one side: ``_edge``.)
+        """
+        SK = sp.Symbol("S_k", positive=True)
+        yl = sp.symbols(" ".join(n + "_l" for n in FREE_STATES))
+        yr = sp.symbols(" ".join(n + "_r" for n in FREE_STATES))
+        K = Program([SK, *yl, *yr, *self.params])
+        sides = []
+        for tag, ys in (("_l", yl), ("_r", yr)):
+            prog, mapping = self.free.renamed(tag, {S: SK, **dict(zip(self.free_states, ys))}, keep=self.params)
+            K.extend(prog)
+            U = self.free_phys_out["U"].xreplace(mapping)
+            ls = ys[FREE_STATES.index("ls")]
+            sides.append(dict(tau_s=self.free_phys_out["tau_s"].xreplace(mapping),
+                              M_s=self.free_phys_out["M_s"].xreplace(mapping),
+                              H=K.let(f"H{tag}", ls * K.derivative(U, ls) - U)))
+        left, right = sides
+        self.kink = K
+        self.kink_inputs = (SK, *yl, *yr)
+        self.kink_res = [K.let("res_kink_tau", right["tau_s"] - left["tau_s"]),
+                         K.let("res_kink_M", right["M_s"] - left["M_s"]),
+                         K.let("res_kink_H", right["H"] - left["H"])]
 
     def _build_geometry(self):
         """Reference shell and tip shape as plain functions (no states)."""

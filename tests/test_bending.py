@@ -79,6 +79,24 @@ def _energy_identity_error(scene, delta, h=0.01):
     return abs((4 * D[1] - D[0]) / 3 - mid.force), abs(D[1] - D[0])
 
 
+def test_the_weierstrass_condition_against_the_convex_envelope():
+    """``envelope_partner``: a base state lies on U's convex envelope in (lambda_s, lambda_s kappa_s);
+    the same point stretched to lambda_s 1.2 with kappa_s rho 3 lies far above it with the paper's
+    energy (a Weierstrass-Erdmann corner would lower it) and on it with the convex rotation energy."""
+    from shellbvp.convexity import envelope_partner
+
+    gaps = {}
+    for bending in (sb.TraceBending(), sb.RotationBending()):
+        sol = sb.solve(sb.Scene.preset("base", bending=bending), delta=0.3, estimate_error=False)
+        sysm, t = sol.system, np.array([0.5])
+        S, y = sysm.S(1, t, sol.p)[0], sol.sol(t)[sysm.rows(1)][:, 0]
+        assert envelope_partner(sysm, S, y)["gap"] == 0.0
+        y[2], y[3] = 1.2, 3.0 / sysm.scene.rho
+        gaps[type(bending).__name__] = envelope_partner(sysm, S, y)
+    assert gaps["TraceBending"]["gap"] > 0.1 and gaps["TraceBending"]["partner"][0] < 0.5
+    assert gaps["RotationBending"]["gap"] == 0.0
+
+
 def test_energy_identity_holds_for_the_rotation_bending_energy():
     """With any B the generalised tensions come from the energy, so F = dE/ddelta still holds
     (with the paper's tau = T + M kappa it would fail by ~0.2 at delta = 1)."""

@@ -22,10 +22,11 @@ CHAINS = {"cap": lambda L, contact: ch.cap_chain(EPS, L, contact),
           "wall_line": lambda L, contact: ch.cap_line_cylinder_chain(EPS, L, contact),
           "wall_band": lambda L, contact: ch.cap_band_cylinder_chain(EPS, L, contact),
           "tip_line": lambda L, contact: ch.cap_line_tip_chain(EPS, L),
-          "tip_band": lambda L, contact: ch.cap_band_tip_chain(EPS, L)}
+          "tip_band": lambda L, contact: ch.cap_band_tip_chain(EPS, L),
+          "line_corner": lambda L, contact: ch.line_kink_chain(EPS, L)}
 CASES = [("cap", c, m) for c in ("smooth", "paper", "corner", "pinned")
          for m in ("delta", "lambda0", "force", "arclength")] + \
-        [(k, "smooth", m) for k in ("annulus", "line") for m in ("delta", "lambda0", "force")] + \
+        [(k, "smooth", m) for k in ("annulus", "line", "line_corner") for m in ("delta", "lambda0", "force")] + \
         [("point", "smooth", "delta")] + \
         [(k, c, m) for k in ("cylinder", "wall_line", "wall_band") for c in ("smooth", "paper")
          for m in ("delta", "lambda0", "force", "arclength")] + \
@@ -62,7 +63,7 @@ def system(kind, contact, control, sealed=False):
 def state(sysm, rng):
     t = np.linspace(0.0, 1.0, 4)
     y = 0.5 + 0.3 * rng.random((sysm.n, t.size))
-    values = dict(ln_Sc=np.log(0.1), ln_S1=np.log(0.05), ln_S2=np.log(0.15), ln_Send=np.log(0.07), chi1=0.9,
+    values = dict(ln_Sc=np.log(0.1), ln_S1=np.log(0.05), ln_Sk=np.log(0.02), ln_S2=np.log(0.15), ln_Send=np.log(0.07), chi1=0.9,
                   lambda0=1.02, delta=0.3, pressure=0.13)
     return t, y, sysm.pack(**values)
 

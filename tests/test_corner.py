@@ -58,6 +58,39 @@ def test_corner_conditions_are_sliding_and_eshelby_from_the_profiles():
     assert np.max(np.abs(mod.junction_corner_res(Sc, yc, yf, sol.delta, 0.0, par))) < 1e-8
 
 
+def test_interior_corner_conditions_are_the_momenta_and_eshelby_from_the_profiles():
+    """The generated interior-corner rows (``kink_res``) against the free region's own profile:
+    [tau_s] = [M_s] = 0 and [lambda_s dU/dlambda_s - U] = 0, U_lambda by central differences of
+    the energy density at fixed kappa_s; a continuous state satisfies them at any S."""
+    sol = sb.solve(BASE, delta=0.4, estimate_error=False, topology="cap")
+    sysm = sol.system
+    mod, par = sysm.model, sysm.par
+    t = np.array([0.4])
+    S = float(sysm.S(1, t, sol.p)[0])
+    yl = sol.sol(t)[sysm.rows(1), 0]
+    yr = yl.copy()
+    yr[2] *= 0.93  # a jump in lambda_s
+    yr[3] += 0.6   # and in kappa_s
+    prof = lambda y: mod.free_profile(np.array([S]), y[:, None], par)  # noqa: E731
+
+    def H(y):  # R Psi (lambda_s dU/dlambda_s - U) from the energy density U R Psi
+        h = 1e-6
+        up, dn = y.copy(), y.copy()
+        up[2] += h
+        dn[2] -= h
+        dU = (prof(up)["energy_density"][0] - prof(dn)["energy_density"][0]) / (2 * h)
+        return y[2] * dU - prof(y)["energy_density"][0]
+
+    pl, pr = prof(yl), prof(yr)
+    res = mod.kink_res(S, yl, yr, par)
+    R_Psi = float(mod.reference_shell(np.array([S]), par)["R"][0]) * np.hypot(np.cos(S), BASE.gamma * np.sin(S))
+    assert min(abs(res)) > 1e-4  # not a corner: every row nonzero
+    assert res[0] == pytest.approx(pr["tau_s"][0] - pl["tau_s"][0], rel=1e-10)
+    assert res[1] == pytest.approx(pr["M_s"][0] - pl["M_s"][0], rel=1e-10)
+    assert res[2] * R_Psi == pytest.approx(H(yr) - H(yl), rel=1e-6)
+    assert np.max(np.abs(mod.kink_res(S, yl, yl, par))) < 1e-13
+
+
 def test_before_the_limit_the_edges_other_root_is_not_convex():
     """Before the convexity limit the corner conditions at the edge of the smooth state have a
     second root (lambda_s smaller, kappa_s larger on the free side), but there the free side's

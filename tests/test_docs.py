@@ -94,6 +94,7 @@ def test_docs_page_examples_run(page, tmp_path, monkeypatch):
 DOCS_EXTRA = ("sphinx", "numpydoc", "sphinxarg", "myst_parser", "sphinx_gallery")
 
 
+@pytest.mark.slow  # 14 s; the docstring examples run by default (test_public_docstring_examples_run)
 def test_docs_build_without_warnings(tmp_path):
     missing = [m for m in DOCS_EXTRA if importlib.util.find_spec(m) is None]
     if missing:
