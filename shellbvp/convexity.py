@@ -140,7 +140,7 @@ def envelope_partner(sysm, S, y, *, lambda_min=0.1, kappa_rho_max=100.0, n=(161,
     u0 = float(U[here])
     gap = max(0.0, (u0 - float(below[f])) / abs(u0)) if here not in set(np.unique(simplices)) else 0.0
     vertices = simplices[f]
-    far = int(vertices[np.argmax(np.hypot(pts[vertices, 0], pts[vertices, 1]))])
+    far = int(vertices[np.argmax(np.hypot(np.log(L[vertices] / l0), (K[vertices] / L[vertices] - y[3]) * rho))])
     return {"gap": gap, "partner": (float(L[far]), float(K[far] / L[far]))}
 
 

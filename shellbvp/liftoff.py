@@ -578,31 +578,32 @@ def lifted_pole_branch_end(previous: Solution, before: Solution, *, tol=1e-6, ma
     return None
 
 
-#: The two boxes of (lambda_s >= lambda_min, |kappa_s rho| <= kappa_rho_max) in which the lifted
-#: pole's interior-corner partner is sought (``convexity.envelope_partner``): a partner that
-#: moves out with the box is not a state of the shell (rho 0.05: lambda_s 0.21 -> 0.10)
-_CORNER_BOXES = ((0.1, 100.0), (0.05, 1000.0))
+#: The boxes of (lambda_s >= lambda_min, |kappa_s rho| <= kappa_rho_max), growing, in which the
+#: lifted pole's interior-corner partner is sought (``convexity.envelope_partner``): where the
+#: gap above the envelope keeps growing with the box, the partner is no state of the shell
+#: (rho 0.05: 0.56 %, 1.2 %, 1.6 %; its partner lambda_s 0.21 -> 0.10)
+_CORNER_BOXES = ((0.1, 100.0), (0.05, 1000.0), (0.02, 10000.0))
 
 
 def pole_corner_partner(end: Solution) -> dict:
     """Is there an interior Weierstrass-Erdmann corner from the lifted pole of ``end``?
 
     The corner's other phase is the far end of U's convex-envelope segment from the pole's
-    state (:func:`shellbvp.convexity.envelope_partner`), sought in the two boxes
-    ``_CORNER_BOXES``.  Returns ``gap`` (U above its envelope, relative, in the larger box),
-    ``partners`` ((lambda_s, kappa_s) per box) and ``finite``: a partner that stays put when the
-    box grows (False where the envelope's segment runs out with the box, towards lambda_s -> 0
-    and kappa_s -> infinity: a crease, not a corner of the shell)."""
+    state (:func:`shellbvp.convexity.envelope_partner`), sought in the growing boxes
+    ``_CORNER_BOXES``.  Returns ``gaps`` (U above its envelope, relative, per box),
+    ``partners`` ((lambda_s, kappa_s) per box) and ``finite``: the gap settles (the last two
+    boxes agree to 5 %), so the partner lies inside them.  Where the gap keeps growing the
+    envelope's segment runs out with the box, towards lambda_s -> 0 and kappa_s -> infinity: a
+    crease, not a corner between two states of the shell."""
     from .convexity import envelope_partner
 
     sysm = end.system
     t = np.array([0.0])
     S, y = float(sysm.S(0, t, end.p)[0]), end.sol(t)[sysm.rows(0), 0]
     found = [envelope_partner(sysm, S, y, lambda_min=lm, kappa_rho_max=km) for lm, km in _CORNER_BOXES]
-    partners = [f["partner"] for f in found]
-    (l1, k1), (l2, k2) = partners
-    finite = bool(found[-1]["gap"] > 0 and abs(l2 - l1) < 0.05 * l1 and abs(k2 - k1) < 0.05 * abs(k1))
-    return {"gap": found[-1]["gap"], "partners": partners, "finite": finite}
+    gaps = [f["gap"] for f in found]
+    finite = bool(gaps[-1] > 0 and gaps[-1] < 1.05 * gaps[-2])
+    return {"gaps": gaps, "partners": [f["partner"] for f in found], "finite": finite}
 
 
 def lifted_pole_end_reason(end: Solution) -> str:
@@ -610,17 +611,17 @@ def lifted_pole_end_reason(end: Solution) -> str:
     prof = end.profile()
     rho = end.scene.rho
     corner = pole_corner_partner(end)
-    (l1, k1), (l2, k2) = corner["partners"]
+    (l1, k1), (l2, k2), _ = corner["partners"]
+    gaps = ", ".join(f"{100 * g:.2g}" for g in corner["gaps"])
     if corner["finite"]:
         beyond = (f"an interior Weierstrass-Erdmann corner to lambda_s = {l2:.3g}, kappa_s rho = {k2 * rho:.3g} "
                   f"may continue it; it is not searched")
     else:
         beyond = (f"no interior Weierstrass-Erdmann corner with a shell state on its other side continues it: the "
-                  f"pole's state lies "
-                  f"{100 * corner['gap']:.2g} % above the convex envelope of U in (lambda_s, lambda_s kappa_s), "
-                  f"and the envelope's other phase runs out with the box sampled (lambda_s {l1:.2g} -> {l2:.2g}, "
-                  f"kappa_s rho {k1 * rho:.3g} -> {k2 * rho:.3g}): a crease, not a state of the shell; a convex "
-                  f"bending energy (bending='rotation') continues")
+                  f"pole's state lies above the convex envelope of U in (lambda_s, lambda_s kappa_s) by a gap that "
+                  f"grows with the box sampled ({gaps} %), whose other phase runs out with the box (lambda_s "
+                  f"{l1:.2g} -> {l2:.2g}, kappa_s rho {k1 * rho:.3g} -> {k2 * rho:.3g}): a crease, not a state of "
+                  f"the shell; a convex bending energy (bending='rotation') continues")
     return (f"the energy loses convexity at the lifted cap's free pole: the lifted-pole {end.topology} branch "
             f"ends at delta = {end.delta:.6g} (F = {end.force:.6g}; Legendre determinant at the pole "
             f"{pole_legendre(end):.2g} of the outer free region's, lambda0 = {end.lambda0:.5g}, kappa_s = "
