@@ -12,7 +12,7 @@ import math
 
 import numpy as np
 
-__all__ = ["convexity_limits", "convexity_report", "envelope_partner"]
+__all__ = ["convexity_limits", "convexity_report", "envelope_partner", "weierstrass_gap"]
 
 
 def _determinant(scene):
@@ -142,6 +142,36 @@ def envelope_partner(sysm, S, y, *, lambda_min=0.1, kappa_rho_max=100.0, n=(161,
     vertices = simplices[f]
     far = int(vertices[np.argmax(np.hypot(np.log(L[vertices] / l0), (K[vertices] / L[vertices] - y[3]) * rho))])
     return {"gap": gap, "partner": (float(L[far]), float(K[far] / L[far]))}
+
+
+def weierstrass_gap(sol, points: int = 9, *, lambda_min=0.05, kappa_rho_max=1000.0) -> dict:
+    """The Weierstrass condition over a state's free regions: the largest relative height of U
+    above its convex envelope (:func:`envelope_partner`) at ``points`` equally spaced t of each
+    free region.
+
+    0 means every point sampled lies on the envelope in the box (a strong local minimum there,
+    as far as the box reaches); a positive gap means a short segment in the envelope's other
+    phase (a crease where the partner is extreme) would lower the energy: the state is then a
+    weak local minimum only (the Legendre condition, ``legendre_min``, is what the solver
+    needs).  About 0.1 s per point: a diagnosis, not part of every solve.
+
+    Returns
+    -------
+    dict
+        ``gap``, and where it is largest: ``region``, ``S`` and the ``partner`` (lambda_s, kappa_s).
+    """
+    sysm = sol.system
+    worst = {"gap": 0.0, "region": None, "S": math.nan, "partner": (math.nan, math.nan)}
+    for k, reg in enumerate(sysm.regions):
+        if reg.kind != "free":
+            continue
+        for t in np.linspace(0.0, 1.0, points):
+            S = float(sysm.S(k, np.array([t]), sol.p)[0])
+            found = envelope_partner(sysm.at(sol.p), S, sol.sol(np.array([t]))[sysm.rows(k), 0],
+                                     lambda_min=lambda_min, kappa_rho_max=kappa_rho_max)
+            if found["gap"] > worst["gap"]:
+                worst = {"gap": found["gap"], "region": k, "S": S, "partner": found["partner"]}
+    return worst
 
 
 def convexity_report(scene) -> str:

@@ -97,6 +97,19 @@ def test_the_weierstrass_condition_against_the_convex_envelope():
     assert gaps["RotationBending"]["gap"] == 0.0
 
 
+def test_weierstrass_gap_of_states_with_each_bending_energy():
+    """Base at delta 0.6 (a smooth edge, just before the corner): with the paper's energy the free
+    side of the edge lies well above U's convex envelope (a crease phase would lower it: a weak
+    minimum only); with the rotation energy every sampled point lies on it."""
+    from shellbvp.convexity import weierstrass_gap
+
+    paper = weierstrass_gap(sb.solve(sb.Scene.preset("base"), delta=0.6, estimate_error=False, topology="cap"),
+                            points=3)
+    assert paper["gap"] > 0.01 and paper["region"] == 1 and paper["partner"][0] < 0.5
+    rotation = sb.solve(sb.Scene.preset("base", bending=sb.RotationBending()), delta=0.6, estimate_error=False)
+    assert weierstrass_gap(rotation, points=3)["gap"] == 0.0
+
+
 def test_energy_identity_holds_for_the_rotation_bending_energy():
     """With any B the generalised tensions come from the energy, so F = dE/ddelta still holds
     (with the paper's tau = T + M kappa it would fail by ~0.2 at delta = 1)."""
