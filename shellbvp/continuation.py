@@ -24,7 +24,15 @@ import numpy as np
 
 from .cylinder import best_wall_state, wall_contact_suspected, wall_state
 from .io import POINT_FIELDS, Curve, point_record
-from .liftoff import lift_off_suspected, lifted_pole_branch_end, lifted_pole_end_reason, replace_invalid_cap
+from .liftoff import (
+    lift_off_suspected,
+    lifted_pole_branch_end,
+    lifted_pole_end_reason,
+    lifted_pole_fold,
+    lifted_pole_fold_reason,
+    lifted_state_at,
+    replace_invalid_cap,
+)
 from .pointload import SC_POINT, solve_point_load
 from .solution import Solution, calibrated_error, default_eps, richardson_error, thin_mesh
 from .corner import LEGENDRE_WATCH, edge_model, is_corner, limit_estimate, near_limit
@@ -241,6 +249,8 @@ class _Builder:
                 if end is not None and end.delta < sol.delta:
                     self.branch_end = lifted_pole_end_reason(end)
                     return end
+                if end is None:
+                    shown = self._before_fold(sol, kw)
         if shown.get("topology") == "cap" and edge_model(shown) != "pinned" and wall_contact_suspected(shown):
             wall = None
             if self.last_wall is not None:
@@ -250,6 +260,26 @@ class _Builder:
                 wall.cap_solution = shown
                 self.last_wall = shown = wall
         return shown
+
+    def _before_fold(self, cap, kw):
+        """Where no lifted state was found at the invalid ``cap``'s depth: has the lifted-pole
+        branch turned back in delta (a fold) before it?  Then the fold, recorded as the curve's
+        physical end (the shell snaps there); if the branch reaches this depth (near a fold the
+        warm starts of :func:`replace_invalid_cap` miss it), its state here, replacing the cap;
+        else the cap."""
+        last, before = self.last_liftoff, self.liftoff_before
+        # followed one curve step past this depth at most
+        fold, on_way = lifted_pole_fold(last, before, delta_limit=2 * cap.delta - last.delta, **kw)
+        if fold is not None and fold.delta < cap.delta:
+            self.branch_end = lifted_pole_fold_reason(fold)
+            return fold
+        lifted = lifted_state_at(cap.delta, on_way, fold, **kw)
+        if lifted is None:
+            return cap
+        lifted.cap_state = {k: cap[k] for k in ("delta", "force", "energy", "pressure_min", "Sc")}
+        lifted.cap_solution = cap
+        self.liftoff_before, self.last_liftoff = last, lifted
+        return lifted
 
     def add(self, sol: Solution, key: float):
         """Accept a point; ``key`` orders points along the branch."""
