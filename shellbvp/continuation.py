@@ -527,6 +527,11 @@ def _locate_switches(builder: _Builder, st):
             continue
         e1, e2 = sorted(ends, key=lambda e: e.delta)
         f1, f2 = (sign * (min(e[criterion], 1.0) if criterion == "wall_gap" else e[criterion]) for e in (e1, e2))
+        if not f1 * f2 < 0 and criterion == "penetration":
+            # a line recorded as valid may touch the tip already (penetration up to 10 tol): the
+            # touch-down lies between two of the line points before it
+            e1, e2 = _touchdown_bracket([r[3] for r in rows], min(s1.delta, s2.delta)) or (e1, e2)
+            f1, f2 = -e1.penetration, -e2.penetration
         if not f1 * f2 < 0:
             continue
         best = _regula_falsi(e1.delta, f1, e1, e2.delta, f2, e2, solve_at)
@@ -599,6 +604,17 @@ def _wall_line_at(sol, st):
     """The cap+line(cylinder) state at a band point's delta (from the band), or None."""
     line = wall_state(sol, "cap+line(cylinder)", tol=st["tol"], max_nodes=st["max_nodes"], bc_tol=st["bc_tol"])
     return line if line.success and "curvature_excess" in line else None
+
+
+def _touchdown_bracket(states, delta):
+    """The two line states, not deeper than ``delta``, between which a line's lifted pole comes
+    down onto the tip (its penetration crosses zero), or None."""
+    lines = sorted((s for s in states if s.get("topology") == "line" and s.get("success") and s.delta <= delta),
+                   key=lambda s: s.delta)
+    for a, b in reversed(list(zip(lines[:-1], lines[1:]))):
+        if a.penetration < 0 < b.penetration:
+            return a, b
+    return None
 
 
 def _line_state_at(sol, st):
