@@ -24,7 +24,15 @@ import numpy as np
 
 from .cylinder import best_wall_state, wall_contact_suspected, wall_state
 from .io import POINT_FIELDS, Curve, point_record
-from .liftoff import lift_off_suspected, lifted_pole_branch_end, lifted_pole_end_reason, replace_invalid_cap
+from .liftoff import (
+    lift_off_suspected,
+    lifted_pole_branch_end,
+    lifted_pole_end_reason,
+    lifted_pole_fold,
+    lifted_pole_fold_reason,
+    lifted_state_at,
+    replace_invalid_cap,
+)
 from .pointload import SC_POINT, solve_point_load
 from .solution import Solution, calibrated_error, default_eps, richardson_error, thin_mesh
 from .corner import LEGENDRE_WATCH, edge_model, is_corner, limit_estimate, near_limit
@@ -241,6 +249,8 @@ class _Builder:
                 if end is not None and end.delta < sol.delta:
                     self.branch_end = lifted_pole_end_reason(end)
                     return end
+                if end is None:
+                    shown = self._before_fold(sol, kw)
         if shown.get("topology") == "cap" and edge_model(shown) != "pinned" and wall_contact_suspected(shown):
             wall = None
             if self.last_wall is not None:
@@ -250,6 +260,26 @@ class _Builder:
                 wall.cap_solution = shown
                 self.last_wall = shown = wall
         return shown
+
+    def _before_fold(self, cap, kw):
+        """Where no lifted state was found at the invalid ``cap``'s depth: has the lifted-pole
+        branch turned back in delta (a fold) before it?  Then the fold, recorded as the curve's
+        physical end (the shell snaps there); if the branch reaches this depth (near a fold the
+        warm starts of :func:`replace_invalid_cap` miss it), its state here, replacing the cap;
+        else the cap."""
+        last, before = self.last_liftoff, self.liftoff_before
+        # followed one curve step past this depth at most
+        fold, on_way = lifted_pole_fold(last, before, delta_limit=2 * cap.delta - last.delta, **kw)
+        if fold is not None and fold.delta < cap.delta:
+            self.branch_end = lifted_pole_fold_reason(fold)
+            return fold
+        lifted = lifted_state_at(cap.delta, on_way, fold, **kw)
+        if lifted is None:
+            return cap
+        lifted.cap_state = {k: cap[k] for k in ("delta", "force", "energy", "pressure_min", "Sc")}
+        lifted.cap_solution = cap
+        self.liftoff_before, self.last_liftoff = last, lifted
+        return lifted
 
     def add(self, sol: Solution, key: float):
         """Accept a point; ``key`` orders points along the branch."""
@@ -497,6 +527,11 @@ def _locate_switches(builder: _Builder, st):
             continue
         e1, e2 = sorted(ends, key=lambda e: e.delta)
         f1, f2 = (sign * (min(e[criterion], 1.0) if criterion == "wall_gap" else e[criterion]) for e in (e1, e2))
+        if not f1 * f2 < 0 and criterion == "penetration":
+            # a line recorded as valid may touch the tip already (penetration up to 10 tol): the
+            # touch-down lies between two of the line points before it
+            e1, e2 = _touchdown_bracket([r[3] for r in rows], min(s1.delta, s2.delta)) or (e1, e2)
+            f1, f2 = -e1.penetration, -e2.penetration
         if not f1 * f2 < 0:
             continue
         best = _regula_falsi(e1.delta, f1, e1, e2.delta, f2, e2, solve_at)
@@ -569,6 +604,17 @@ def _wall_line_at(sol, st):
     """The cap+line(cylinder) state at a band point's delta (from the band), or None."""
     line = wall_state(sol, "cap+line(cylinder)", tol=st["tol"], max_nodes=st["max_nodes"], bc_tol=st["bc_tol"])
     return line if line.success and "curvature_excess" in line else None
+
+
+def _touchdown_bracket(states, delta):
+    """The two line states, not deeper than ``delta``, between which a line's lifted pole comes
+    down onto the tip (its penetration crosses zero), or None."""
+    lines = sorted((s for s in states if s.get("topology") == "line" and s.get("success") and s.delta <= delta),
+                   key=lambda s: s.delta)
+    for a, b in reversed(list(zip(lines[:-1], lines[1:]))):
+        if a.penetration < 0 < b.penetration:
+            return a, b
+    return None
 
 
 def _line_state_at(sol, st):

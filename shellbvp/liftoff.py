@@ -39,8 +39,8 @@ from .solution import (
 __all__ = ["solve_liftoff", "solve_liftoff_from", "make_liftoff_system", "liftoff_guess_from_cap",
            "liftoff_warm_guess", "liftoff_state", "valid_liftoff_state", "lift_off_suspected",
            "replace_invalid_cap", "pole_legendre", "pole_clearance", "lifted_pole_branch_end", "lifted_pole_end_reason",
-           "pole_corner_partner",
-           "POLE_LEGENDRE_END"]
+           "pole_corner_partner", "POLE_LEGENDRE_END", "lifted_pole_fold", "lifted_pole_fold_reason",
+           "lifted_state_at"]
 
 
 def make_liftoff_system(scene, topology, control, value, eps):
@@ -100,12 +100,20 @@ def liftoff_warm_guess(sysm: ChainBVP, prev: Solution, before: Solution | None =
     """A neighbouring lift-off state of the same topology on its thinned mesh; with ``before``
     (the state before ``prev`` on the curve, same topology) and the target ``delta``, moved
     along their secant to that depth (states, unknowns and delta)."""
-    x = thin_mesh(prev.x)
-    q = dict(zip(prev.system.unknowns, prev.p), delta=prev.delta)
-    y = prev.sol(x)
+    a = None
     if before is not None and delta is not None and before.delta != prev.delta:
         a = (delta - prev.delta) / (prev.delta - before.delta)
-        qb = dict(zip(before.system.unknowns, before.p), delta=before.delta)
+    return _moved_guess(sysm, prev, before, a)
+
+
+def _moved_guess(sysm, prev, before=None, a=None):
+    """``prev`` on its thinned mesh, moved by ``a`` times (prev - before) when both are given
+    (states, unknowns, delta and lambda0 -- whichever the system takes)."""
+    x = thin_mesh(prev.x)
+    q = dict(zip(prev.system.unknowns, prev.p), delta=prev.delta, lambda0=prev.lambda0)
+    y = prev.sol(x)
+    if before is not None and a is not None:
+        qb = dict(zip(before.system.unknowns, before.p), delta=before.delta, lambda0=before.lambda0)
         q = {k: v + a * (v - qb[k]) for k, v in q.items()}
         y = y + a * (y - before.sol(x))
     return x, y, sysm.pack(**q)
@@ -530,8 +538,8 @@ def lifted_pole_branch_end(previous: Solution, before: Solution, *, tol=1e-6, ma
     corner continues it where the corner's other phase is a crease (:func:`pole_corner_partner`).
     A state of the continuation in delta that is not
     valid or whose pole determinant does not fall, or a step in lambda0 that does not lower
-    it by ``_END_MIN_GAIN``, ends the search (beta 0.2: it levels off near 0.01 and rises
-    again while the lifted cap comes down onto the tip).
+    it by ``_END_MIN_GAIN``, ends the search (beta 0.2: it levels off near 0.01 at delta 0.33
+    and rises again towards a fold of the branch, :func:`lifted_pole_fold`).
     """
     if previous is None or before is None or previous.get("topology") != before.get("topology") \
             or previous.get("topology") not in ("line", "annulus") or not previous.delta > before.delta:
@@ -627,3 +635,144 @@ def lifted_pole_end_reason(end: Solution) -> str:
             f"{pole_legendre(end):.2g} of the outer free region's, lambda0 = {end.lambda0:.5g}, kappa_s = "
             f"{float(prof['kappa_s'][0]):.4g} against the tip's {1 / rho:.4g}); delta is largest there "
             f"along the branch, and deeper the single cap pulls at the pole; {beyond}")
+
+
+# -- the fold of a lifted-pole branch: delta turns back -------------------------------------------
+#: Solves of :func:`lifted_pole_fold` at most; its smallest and largest steps in lambda0 (beta
+#: 0.2: Newton from a secant guess converges for steps up to 0.005-0.01 in lambda0 only)
+_FOLD_STEPS = 80
+_FOLD_MIN_STEP = 1e-4
+_FOLD_MAX_STEP = 0.006
+#: The fold is located when delta at the parabola's vertex changes by less than this (relative):
+#: delta is flat in lambda0 there, so lambda0* is known only to about sqrt(this)
+_FOLD_DTOL = 1e-8
+
+
+def _parabola_vertex(states):
+    """lambda0 at the maximum of the parabola delta(lambda0) through three states, or None."""
+    x = np.array([s.lambda0 for s in states])
+    c = np.polyfit(x - x[1], [s.delta for s in states], 2)
+    if not c[0] < 0:
+        return None
+    v = x[1] - c[1] / (2 * c[0])
+    return float(v) if min(x) < v < max(x) else None
+
+
+def lifted_pole_fold(previous: Solution, before: Solution, *, delta_limit=math.inf, tol=1e-6, max_nodes=10000,
+                     bc_tol=1e-10):
+    """Where a lifted-pole branch (line or annulus) turns back in delta: ``(fold, states)``, the
+    state at the fold (valid, deeper than ``previous``) and the branch's states found on the way
+    to it (increasing delta); ``(None, states)`` where the branch passes ``delta_limit`` before
+    any fold (its states up to there); ``(None, [])`` where the search ends otherwise.
+
+    The branch through ``before`` and ``previous`` (two valid states, ``previous`` the deeper)
+    is followed first in delta (secant steps, halved where one fails or leaps in lambda0: near
+    the fold the other side of the branch is close) until the steps stall, then in the lifted
+    pole's stretch lambda0, which the line and annulus take as control, until delta falls;
+    the maximum is then located by parabolas delta(lambda0) through the three deepest states.
+    Under displacement control the shell snaps through at such a fold (beta 0.2:
+    delta* = 0.356818, F 1.88275, lambda0 = 0.3758, the lifted pole sagging 0.011 below the
+    tip's apex and bent to kappa_s = 71 against the tip's 5; past the fold the branch runs back
+    in delta to where the pole loses convexity, lambda0 = 0.285 at delta 0.3523).  About 40
+    solves (10-15 s) from two states 0.01-0.02 below it.  The search
+    ends without a fold where a state is not valid, where delta passes ``delta_limit``, or after
+    ``_FOLD_STEPS`` solves.
+    """
+    if previous is None or before is None or previous.get("topology") != before.get("topology") \
+            or previous.get("topology") not in ("line", "annulus") or not previous.delta > before.delta \
+            or not (previous.get("valid") and before.get("valid")) \
+            or not (math.isfinite(previous.lambda0) and previous.lambda0 != before.lambda0):
+        return None, []
+    scene, topology = previous.scene, previous.topology
+    kw = dict(tol=tol, max_nodes=int(min(max_nodes, max(2000, WARM_NODES * previous.nodes))), bc_tol=bc_tol)
+    states, solves = [before, previous], 0
+
+    def at(control, value, prev, before):
+        """The state at ``control = value`` from prev, along the secant through before."""
+        nonlocal solves
+        solves += 1
+        sysm = make_liftoff_system(scene, topology, control, value, previous.system.eps)
+        a = (value - prev[control]) / (prev[control] - before[control])
+        return solve_liftoff_from(sysm, _moved_guess(sysm, prev, before, a), **kw)
+
+    # 1. in delta while the steps go through (far from the fold delta is the better control)
+    step = first = previous.delta - before.delta
+    while step > first / 16 and solves < _FOLD_STEPS:
+        b, a = states[-1], states[-2]
+        res = at("delta", b.delta + step, b, a)
+        expected = (b.lambda0 - a.lambda0) * step / (b.delta - a.delta)
+        if res.success and res.valid and abs(res.lambda0 - b.lambda0) <= 2 * abs(expected) + 1e-3:
+            states.append(res)
+            if res.delta > delta_limit:
+                return None, states
+            step *= 1.5
+        else:  # failed, invalid, or leapt in lambda0 (onto the branch beyond the fold)
+            step /= 2
+    # 2. in lambda0 until delta falls: the maximum is bracketed
+    step = math.copysign(min(_FOLD_MAX_STEP, abs(states[-1].lambda0 - states[-2].lambda0)),
+                         states[-1].lambda0 - states[-2].lambda0)
+    while solves < _FOLD_STEPS:
+        res = at("lambda0", states[-1].lambda0 + step, states[-1], states[-2])
+        if not (res.success and res.valid):
+            step /= 2
+            if abs(step) < _FOLD_MIN_STEP:
+                return None, []
+            continue
+        if res.delta > delta_limit:
+            return None, states + [res]
+        if res.delta < states[-1].delta:
+            triple = [states[-2], states[-1], res]
+            break
+        states.append(res)
+        step = math.copysign(min(_FOLD_MAX_STEP, 1.5 * abs(step)), step)
+    else:
+        return None, []
+    # 3. the vertex of parabolas through the deepest state and its neighbours in lambda0
+    pool, fold = states[-3:] + [res], None
+    while solves < _FOLD_STEPS:
+        top = max(pool, key=lambda s: s.delta)
+        left = [s for s in pool if s.lambda0 < top.lambda0]
+        right = [s for s in pool if s.lambda0 > top.lambda0]
+        if not (left and right):
+            return None, []
+        triple = [max(left, key=lambda s: s.lambda0), top, min(right, key=lambda s: s.lambda0)]
+        v = _parabola_vertex(triple)
+        if v is None:
+            return None, []
+        res = at("lambda0", v, top, max(triple, key=lambda s: abs(s.lambda0 - v)))
+        if not (res.success and res.valid):
+            return None, []
+        pool.append(res)
+        if fold is not None and abs(res.delta - fold.delta) < _FOLD_DTOL * (1 + res.delta):
+            fold = max(fold, res, key=lambda s: s.delta)
+            break
+        fold = res
+    if fold is None or not fold.delta > previous.delta:
+        return None, []
+    return fold, [s for s in states if s.delta < fold.delta]
+
+
+def lifted_state_at(delta, states, fold=None, *, tol=1e-6, max_nodes=10000, bc_tol=1e-10):
+    """The lifted state at ``delta`` on the branch through ``states`` (:func:`lifted_pole_fold`'s,
+    increasing delta), from the deepest of them not deeper than ``delta``; with ``fold`` (deeper
+    than ``delta``), on the side of the branch that leads to it.  None if not found: close to a
+    fold a warm start from afar misses the branch or lands on its other side."""
+    below = [s for s in states if s.delta <= delta]
+    if not below or (fold is not None and not delta < fold.delta):
+        return None
+    guess = max(below, key=lambda s: s.delta)
+    res = solve_liftoff(guess.scene, guess.topology, delta=delta, guess=guess, tol=tol,
+                        max_nodes=int(min(max_nodes, max(2000, WARM_NODES * guess.nodes))), bc_tol=bc_tol)
+    if not (res.success and res.valid):
+        return None
+    if fold is not None and not (res.lambda0 - fold.lambda0) * (guess.lambda0 - fold.lambda0) > 0:
+        return None
+    return res
+
+
+def lifted_pole_fold_reason(fold: Solution) -> str:
+    """The stop reason of a curve at the fold of its lifted-pole branch."""
+    return (f"the lifted-pole {fold.topology} branch turns back in delta at delta = {fold.delta:.6g} (F = "
+            f"{fold.force:.6g}, lambda0 = {fold.lambda0:.4g}; a fold, the lifted pole {pole_clearance(fold):.3g} "
+            f"below the tip's apex): under displacement control the shell snaps through there; deeper the single "
+            f"cap pulls and no lift-off or split state is found: the state it snaps to is not built")

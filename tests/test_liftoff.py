@@ -443,3 +443,72 @@ def test_the_cap_and_line_on_the_tip_are_followed_until_the_gap_closes():
     assert s.edge_forces[0] < 1e-4 < s.edge_forces[1]  # the inner edge's ring force vanishes with it
     assert s.force == pytest.approx(cap.force, rel=1e-5)
     assert s.energy == pytest.approx(cap.energy, rel=1e-7) and s.energy <= cap.energy + 1e-9
+
+
+@pytest.mark.slow  # 15-60 s: the branch followed to its fold in ~40 solves
+def test_the_lifted_pole_branch_of_a_thick_shell_folds():
+    """beta = 0.2: the lifted-pole line branch turns back in delta at delta* = 0.356818 (a regular
+    fold: the pole stays convex, its Legendre determinant 0.19 of the outer region's), with the
+    lifted pole sagging away from the tip (not coming down onto it) and lambda0 falling fast.
+    Located from two line states below it; F continuous through it along the branch; the
+    energy identity holds on the branch close to it (Richardson differences)."""
+    from shellbvp.liftoff import lifted_pole_fold, pole_clearance, pole_legendre, replace_invalid_cap, solve_liftoff
+
+    scene = sb.Scene.preset("base", beta=0.2)
+    a = replace_invalid_cap(sb.solve(scene, delta=0.33, topology="cap", estimate_error=False))
+    b = solve_liftoff(scene, "line", delta=0.34, guess=a)
+    assert a.topology == b.topology == "line" and a.valid and b.valid
+    fold, states = lifted_pole_fold(b, a)
+    assert fold is not None and fold.valid and fold.topology == "line"
+    assert 0.35681 < fold.delta < 0.35683  # 0.3568182 (three searches from different starts agree to 1e-9)
+    assert fold.force == pytest.approx(1.88275, abs=1e-4)
+    assert pole_legendre(fold) > 0.1 and pole_clearance(fold) > 0.01  # convex; the pole 0.011 below the apex
+    assert all(s.valid and s.delta < fold.delta for s in states)
+    assert np.all(np.diff([s.delta for s in states]) > 0)
+    # a maximum of delta along the branch: lower on both sides, F passing continuously through it
+    lo, hi = (solve_liftoff(scene, "line", lambda0=fold.lambda0 + dl, guess=fold) for dl in (-0.004, 0.004))
+    assert lo.success and hi.success and lo.delta < fold.delta and hi.delta < fold.delta
+    assert lo.force < fold.force < hi.force and hi.force - lo.force < 2e-3
+    # F = dE/ddelta on the branch before the fold, to the error estimate (lambda0 moves ~7x as
+    # fast as delta there: each state from its neighbour; tol 1e-7: these states need 3000-7000
+    # nodes, at 1e-8 up to 19000; slope - F was 2.4e-9)
+    h, d0 = 5e-4, 0.345
+    E = {0: solve_liftoff(scene, "line", delta=d0, guess=min(states, key=lambda s: abs(s.delta - d0)), tol=1e-7,
+                          estimate_error=True)}
+    for k in (-1, 1, -2, 2):
+        E[k] = solve_liftoff(scene, "line", delta=d0 + k * h, guess=E[k - int(np.sign(k))], tol=1e-7)
+    for s in E.values():
+        assert s.success and s.valid and s.lambda0 > fold.lambda0, s.flags
+    slope = (4 * (E[1].energy - E[-1].energy) / (2 * h) - (E[2].energy - E[-2].energy) / (4 * h)) / 3
+    assert abs(slope - E[0].force) < 1e-8 + 10 * E[0].force_error
+
+
+@pytest.mark.slow  # 30-50 s
+def test_a_curve_stops_at_the_fold_of_the_lifted_pole_branch():
+    """beta = 0.2: the curve ends at the fold of its lifted-pole line branch (recorded, valid) with
+    the physical reason, instead of 18 invalid caps that pull (delta 0.355-0.575) where the line
+    state's warm starts missed the steepening branch."""
+    c = sb.curve(sb.Scene.preset("base", beta=0.2), delta_max=1, delta_min=0.1, estimate_error=False)
+    assert c.complete and "turns back in delta" in c.stop_reason and "snaps through" in c.stop_reason
+    assert np.all(c.valid), c.flags
+    assert c.topology[-1] == "line" and 0.35681 < c.delta[-1] < 0.35683
+
+
+@pytest.mark.slow  # 5-7 s (the rotation bending's module loaded)
+def test_the_touchdown_is_located_where_a_line_recorded_valid_already_touches():
+    """beta = 0.2 with the rotation bending energy (no fold): the lifted pole comes down onto the tip
+    near delta 0.9366 and the curve passes line -> cap+line(tip).  The last line points touch the
+    tip within the validity tolerance (penetration up to 10 tol), so the two points either side of
+    the recorded change do not bracket the touch-down; it is bracketed among the line points and
+    located there (before: no switch listed)."""
+    scene = sb.Scene.preset("base", beta=0.2, bending=sb.RotationBending())
+    c = sb.curve(scene, delta_max=1, delta_start=0.85, delta_min=0.85, estimate_error=False)
+    assert c.complete and np.all(c.valid), c.flags
+    assert list(c.topology)[0] == "line" and list(c.topology)[-1] == "cap+line(tip)"
+    (sw,) = c.settings["topology_switches"]
+    assert (sw["from"], sw["to"], sw["criterion"]) == ("line", "cap+line(tip)", "penetration")
+    assert 0.93 < sw["delta"] < 0.94 and abs(sw["value"]) < 1e-6  # 0.936587; the pole touches to 1e-8
+    first_split = min(d for d, t in zip(c.delta, c.topology) if t == "cap+line(tip)")
+    assert sw["delta"] < first_split
+    # F(delta) smooth across (finite differences along the curve at this spacing: ~2e-3)
+    assert np.nanmax(np.abs(c.energy_residual)) < 3e-3
