@@ -182,6 +182,13 @@ def test_generated_functions_equal_direct_sympy_evaluation(name):
                 for key in ("tau_s", "M_s", "Q", "P", "axial_force_2pi", "energy_density"):
                     w = _sympy_eval(prog, prof[key], sub)
                     assert p[key][k] == pytest.approx(w, rel=1e-12, abs=1e-12)
+    # the interior corner's rows (two free states at one S)
+    (_, yl), (_, yr) = _random_free(rng, 1), _random_free(rng, 1)
+    SK, *yk = d.kink_inputs
+    sub = {**psub, SK: 0.4, **dict(zip(yk, np.r_[yl[:, 0], yr[:, 0]]))}
+    want = [_sympy_eval(d.kink, e, sub) for e in d.kink_res]
+    np.testing.assert_allclose(mod.kink_res(0.4, yl[:, 0], yr[:, 0], par), want, rtol=1e-12,
+                               atol=1e-12 * (1 + np.max(np.abs(want))))
 
 
 def _fd_jacobian(f, x, h):
@@ -236,6 +243,10 @@ def test_generated_jacobians_equal_finite_differences(name):
     # regular pole of a lifted-off free cap, d/d(y, S)
     check(mod.free_pole_jac(0.05, yf, par),
           _fd_jacobian(lambda v: mod.free_pole_res(v[6], v[:6], par), np.r_[yf, 0.05], h))
+    # interior corner of the free region, d/d(S_k, yl, yr)
+    yr = _random_free(rng, 1)[1][:, 0]
+    check(mod.kink_jac(0.4, yf, yr, par),
+          _fd_jacobian(lambda v: mod.kink_res(v[0], v[1:7], v[7:13], par), np.r_[0.4, yf, yr], h))
 
 
 def test_condition_counts_close_each_control_mode():
