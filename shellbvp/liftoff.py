@@ -24,7 +24,7 @@ import time
 
 import numpy as np
 
-from .chain import ChainBVP, FreePole, annulus_chain, cap_line_tip_chain, line_chain
+from .chain import SPLIT_TOPOLOGIES, ChainBVP, FreePole, annulus_chain, cap_line_tip_chain, line_chain
 from .diagnosis import diagnose
 from .pointload import solve_point_load
 from .solution import (
@@ -39,7 +39,7 @@ from .solution import (
 __all__ = ["solve_liftoff", "solve_liftoff_from", "make_liftoff_system", "liftoff_guess_from_cap",
            "liftoff_warm_guess", "liftoff_state", "valid_liftoff_state", "lift_off_suspected",
            "replace_invalid_cap", "pole_legendre", "pole_clearance", "lifted_pole_branch_end", "lifted_pole_end_reason",
-           "pole_corner_partner", "POLE_LEGENDRE_END", "lifted_pole_fold", "lifted_pole_fold_reason",
+           "pole_corner_partner", "split_state_from", "POLE_LEGENDRE_END", "lifted_pole_fold", "lifted_pole_fold_reason",
            "lifted_state_at"]
 
 
@@ -450,6 +450,22 @@ def _continue_in_delta(sysm, previous, before, delta, *, tol, max_nodes, bc_tol)
             return res
         before, previous = previous, res  # the step is kept: a longer one fails there
     return None
+
+
+def split_state_from(guess: Solution, control: str, value: float, *, tol=1e-6, max_nodes=10000, bc_tol=1e-10):
+    """The configuration of ``guess`` (a cap with a second zone on the tip, ``SPLIT_TOPOLOGIES``)
+    at another ``control`` value: under delta by natural continuation from it
+    (:func:`_continue_in_delta`: halved steps, valid states only; None where none is found),
+    under force or lambda0 by one solve from it (diagnosed, valid or not)."""
+    from .cylinder import solve_chain_from
+
+    if guess.get("topology") not in SPLIT_TOPOLOGIES:
+        raise ValueError(f"guess must be a {' or '.join(SPLIT_TOPOLOGIES)} state; got {guess.get('topology')!r}")
+    sysm = ChainBVP(guess.scene, guess.system.chain, control, value)
+    attach_tip_table(sysm)
+    if control == "delta":
+        return _continue_in_delta(sysm, guess, None, value, tol=tol, max_nodes=max_nodes, bc_tol=bc_tol)
+    return solve_chain_from(sysm, _moved_guess(sysm, guess), tol=tol, max_nodes=max_nodes, bc_tol=bc_tol)
 
 
 def _probe_then_solve(sysm, guess, solve_from, *, tol, max_nodes, bc_tol):

@@ -14,7 +14,7 @@ import time
 
 import numpy as np
 
-from .chain import FREE_STATES, ChainBVP, cap_chain
+from .chain import FREE_STATES, SPLIT_TOPOLOGIES, ChainBVP, cap_chain
 from .corner import edge_model, edge_null_jump, is_corner, limit_estimate, near_limit, other_edge_root
 from .diagnosis import as_failure, diagnose
 from .inflation import start_shape
@@ -269,7 +269,10 @@ def solve(scene, *, delta=None, lambda0=None, force=None, tol=1e-6, max_nodes=10
     max_nodes : int
         Largest number of mesh nodes.
     guess : Solution, optional
-        A neighbouring solution to start from (warm start on a thinned mesh).
+        A neighbouring solution to start from (warm start on a thinned mesh).  Its
+        configuration is solved again (a lift-off, split or wall state; under delta
+        control a split is continued to the depth), falling back to the single cap where
+        that fails.
     eps : float, optional
         Pole start ``zeta = eps*Sc``; default ``min(1e-3, 0.1 sqrt(tol))``.
     bc_tol : float
@@ -344,6 +347,18 @@ def solve(scene, *, delta=None, lambda0=None, force=None, tol=1e-6, max_nodes=10
         res = solve_liftoff(scene, guess.topology, delta=delta, force=force, lambda0=lambda0, guess=guess,
                             tol=tol, max_nodes=max_nodes, eps=eps, bc_tol=bc_tol, estimate_error=estimate_error)
         if topology in ("auto", guess.topology) and res.success:
+            return res
+        guess = None  # back to the cap
+
+    if guess is not None and guess.get("topology") in SPLIT_TOPOLOGIES:  # a cap and a second zone on the tip
+        from .liftoff import split_state_from
+
+        t0 = time.perf_counter()
+        res = split_state_from(guess, control, value, tol=tol, max_nodes=max_nodes, bc_tol=bc_tol)
+        if res is not None and res.success and topology == "auto":
+            if estimate_error:
+                richardson_error(res.system, res, tol, bc_tol)
+            res.wall_time = time.perf_counter() - t0
             return res
         guess = None  # back to the cap
 

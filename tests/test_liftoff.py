@@ -512,3 +512,17 @@ def test_the_touchdown_is_located_where_a_line_recorded_valid_already_touches():
     assert sw["delta"] < first_split
     # F(delta) smooth across (finite differences along the curve at this spacing: ~2e-3)
     assert np.nanmax(np.abs(c.energy_residual)) < 3e-3
+
+
+def test_solve_from_a_split_state_keeps_its_configuration():
+    """``sb.solve(guess=<cap+line(tip) state>)`` re-solves that configuration (it built a single
+    cap's system from it and failed in solve_bvp on the shapes): at a tighter tol at the same depth,
+    and under force control back to the same depth."""
+    c = sb.curve(sb.Scene.preset("base"), deltas=[0.1, 0.1125], estimate_error=False)
+    split = c.solutions[-1]
+    assert split.topology == "cap+line(tip)" and split.valid
+    tight = sb.solve(split.scene, delta=split.delta, tol=1e-8, guess=split)
+    assert tight.topology == "cap+line(tip)" and tight.valid
+    assert abs(tight.force - split.force) < 1e-8 and tight.force_error < 1e-10
+    back = sb.solve(split.scene, force=split.force, guess=split, estimate_error=False)
+    assert back.topology == "cap+line(tip)" and back.valid and abs(back.delta - split.delta) < 1e-7
