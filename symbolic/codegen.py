@@ -161,6 +161,19 @@ def _function_source(spec: FunctionSpec) -> str:
     return "\n".join(lines) + "\n"
 
 
+def _condition_specs(name, prog, args, res, wrt, wrt_names, par, pressurised, doc) -> list[FunctionSpec]:
+    """``<name>_res``, its Jacobian ``<name>_jac`` in ``wrt`` and, for a pressurised structure (the
+    pressure an unknown under volume control), ``<name>_jac_par``."""
+    n = len(res)
+    specs = [FunctionSpec(f"{name}_res", prog, args, [("res", res)], f"{doc}, ({n},)."),
+             FunctionSpec(f"{name}_jac", prog, args, [("dres", prog.jacobian(res, wrt))],
+                          f"{doc}: d/d({wrt_names}), ({n}, {len(wrt)}).")]
+    if pressurised:
+        specs.append(FunctionSpec(f"{name}_jac_par", prog, args, [("dres", prog.jacobian(res, par))],
+                                  f"{doc}: d/dpar ({n}, {len(par)})."))
+    return specs
+
+
 def function_specs(d: Derivation) -> list[FunctionSpec]:
     """Every function of a structure's module."""
     from .equations import DELTA, FORCE, LAMBDA0
@@ -264,16 +277,9 @@ def function_specs(d: Derivation) -> list[FunctionSpec]:
     if d.has_cylinder:
         E, (SS, *ye) = d.tip_end, d.tip_end_inputs
         eargs = [("S_end", (SS,)), ("yt", tuple(ye[:2])), ("yw", tuple(ye[2:])), ("par", par)]
-        specs += [
-            FunctionSpec("tip_end_res", E, eargs, [("res", d.tip_end_res)],
-                         "Tip | cylinder junction at S = S* (tip end state yt, cylinder start state yw): "
-                         "omega = omega_max on both sides and [lambda_s U_ls - U] = 0, (3,)."),
-            FunctionSpec("tip_end_jac", E, eargs, [("dres", E.jacobian(d.tip_end_res, [SS, *ye]))],
-                         "Tip | cylinder junction: d/d(S, yt, yw), (3, 5)."),
-        ]
-        if pressurised:
-            specs.append(FunctionSpec("tip_end_jac_par", E, eargs, [("dres", E.jacobian(d.tip_end_res, par))],
-                                      f"Tip | cylinder junction: d/dpar (3, {len(par)})."))
+        specs += _condition_specs("tip_end", E, eargs, d.tip_end_res, [SS, *ye], "S, yt, yw", par, pressurised,
+                                  "Tip | cylinder junction at S = S* (tip end state yt, cylinder start state "
+                                  "yw): omega = omega_max on both sides and [lambda_s U_ls - U] = 0")
     # point-load limit: pole conditions of the free region alone
     PL = d.point_load
     plargs = [("S", (PL.inputs[0],)), ("y", d.free_states), ("delta", (DELTA,)), ("par", par)]
@@ -303,16 +309,9 @@ def function_specs(d: Derivation) -> list[FunctionSpec]:
     # interior corner of the free region (left state yl, right state yr at S = S_k)
     K, (SK, *yk) = d.kink, d.kink_inputs
     kargs = [("S_k", (SK,)), ("yl", tuple(yk[:6])), ("yr", tuple(yk[6:])), ("par", par)]
-    specs += [
-        FunctionSpec("kink_res", K, kargs, [("res", d.kink_res)],
-                     "Interior corner of the free region at S = S_k: [tau_s], [M_s] and "
-                     "[lambda_s U_ls - U], (3,)."),
-        FunctionSpec("kink_jac", K, kargs, [("dres", K.jacobian(d.kink_res, [SK, *yk]))],
-                     "Interior corner: d/d(S_k, yl, yr), (3, 13)."),
-    ]
-    if pressurised:
-        specs.append(FunctionSpec("kink_jac_par", K, kargs, [("dres", K.jacobian(d.kink_res, par))],
-                                  f"Interior corner: d/dpar (3, {len(par)})."))
+    specs += _condition_specs("kink", K, kargs, d.kink_res, [SK, *yk], "S_k, yl, yr", par, pressurised,
+                              "Interior corner of the free region at S = S_k: [tau_s], [M_s] and "
+                              "[lambda_s U_ls - U]")
     # geometry of the scene (guesses, plots, penetration checks)
     specs += [
         FunctionSpec("reference_shell", d.geometry_prog, [("S", (d.geometry_S,)), ("par", par)],
