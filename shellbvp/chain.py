@@ -412,7 +412,6 @@ class ChainBVP:
         par[self._i_pressure] = p[self.col["pressure"]]
         return par
 
-
     def at(self, p) -> "ChainBVP":
         """This system with its parameters at the solution ``p`` (the pressure under volume
         control; ``self`` otherwise): what profiles and checks of that solution evaluate."""

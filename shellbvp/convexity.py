@@ -83,9 +83,7 @@ def convexity_limits(scene, stretches=(0.8, 1.0, 1.2, 1.5, 2.0), kappa_max=3.0, 
 def _stretched(a, b, n, fine=0.002):
     """n points on [a, b] (a < 0 < b) spaced ~``fine`` near 0 and growing geometrically outwards."""
     u = np.linspace(-1.0, 1.0, n)
-    c = np.arcsinh(max(-a, b) / fine) / 1.0
-    x = fine * np.sinh(c * u)
-    return np.clip(x, a, b)
+    return np.clip(fine * np.sinh(np.arcsinh(max(-a, b) / fine) * u), a, b)
 
 
 def envelope_partner(sysm, S, y, *, lambda_min=0.1, kappa_rho_max=100.0, n=(161, 201)) -> dict:
@@ -160,14 +158,14 @@ def weierstrass_gap(sol, points: int = 9, *, lambda_min=0.05, kappa_rho_max=1000
     dict
         ``gap``, and where it is largest: ``region``, ``S`` and the ``partner`` (lambda_s, kappa_s).
     """
-    sysm = sol.system
+    sysm = sol.system.at(sol.p)
     worst = {"gap": 0.0, "region": None, "S": math.nan, "partner": (math.nan, math.nan)}
     for k, reg in enumerate(sysm.regions):
         if reg.kind != "free":
             continue
         for t in np.linspace(0.0, 1.0, points):
             S = float(sysm.S(k, np.array([t]), sol.p)[0])
-            found = envelope_partner(sysm.at(sol.p), S, sol.sol(np.array([t]))[sysm.rows(k), 0],
+            found = envelope_partner(sysm, S, sol.sol(np.array([t]))[sysm.rows(k), 0],
                                      lambda_min=lambda_min, kappa_rho_max=kappa_rho_max)
             if found["gap"] > worst["gap"]:
                 worst = {"gap": found["gap"], "region": k, "S": S, "partner": found["partner"]}

@@ -177,6 +177,14 @@ def _seed_corner(sysm, guess, start, d_star, d_far):
     return _with_edge_jump(sysm, guess, -jump * (d_far - d_star) / (d_star - start.delta))
 
 
+def _finished(res, t0, estimate_error, tol, bc_tol):
+    """``res`` with its error estimate (if asked for) and its wall time since ``t0``."""
+    if estimate_error:
+        richardson_error(res.system, res, tol, bc_tol)
+    res.wall_time = time.perf_counter() - t0
+    return res
+
+
 def solve_from(sysm, guess, *, tol=1e-6, max_nodes=10000, bc_tol=None):
     """One solve_bvp run from a given (x, y, p) guess, diagnosed."""
     t0 = time.perf_counter()
@@ -356,10 +364,7 @@ def solve(scene, *, delta=None, lambda0=None, force=None, tol=1e-6, max_nodes=10
         t0 = time.perf_counter()
         res = split_state_from(guess, control, value, tol=tol, max_nodes=max_nodes, bc_tol=bc_tol)
         if res is not None and res.success and topology == "auto":
-            if estimate_error:
-                richardson_error(res.system, res, tol, bc_tol)
-            res.wall_time = time.perf_counter() - t0
-            return res
+            return _finished(res, t0, estimate_error, tol, bc_tol)
         guess = None  # back to the cap
 
     if guess is not None and guess.get("topology") in _WALL:
@@ -370,10 +375,7 @@ def solve(scene, *, delta=None, lambda0=None, force=None, tol=1e-6, max_nodes=10
         res = best_wall_state(guess, **kw) if topology == "auto" else (
             wall_state(guess, topology, **kw) if topology in _WALL else None)
         if res is not None and res.success:
-            if estimate_error:
-                richardson_error(res.system, res, tol, bc_tol)
-            res.wall_time = time.perf_counter() - t0
-            return res
+            return _finished(res, t0, estimate_error, tol, bc_tol)
         guess = None  # back to the cap
 
     near_point = None

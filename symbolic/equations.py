@@ -256,6 +256,12 @@ class Derivation:
         contact edge)."""
         return r * sin_phi * tau_s - r * cos_phi * Q + pressure_axial_force(r, self.structure.pressure)
 
+    @staticmethod
+    def _eshelby(prog: Program, U, ls):
+        """``lambda_s dU/dlambda_s - U`` (at fixed kappa_s): times R Psi, the Hamiltonian of
+        E = 2 pi Int U R Psi dS, continuous where S may move (an edge, the tip's end, a corner)."""
+        return ls * prog.derivative(U, ls) - U
+
     def _tip_steps(self, prog: Program, omega, tip, tag=""):
         d = tip.derived()
         sub = {OMEGA: omega}
@@ -449,8 +455,8 @@ class Derivation:
         # only a state with a jump is a corner (there the two rows are independent).
         U_c = contact_out["U"].xreplace(cmap)
         U_f = self.free_phys_out["U"].xreplace(fmap)
-        H_c = J.let("H_c", yc[1] * J.derivative(U_c, yc[1]) - U_c)
-        H_f = J.let("H_f", ls_f * J.derivative(U_f, ls_f) - U_f)
+        H_c = J.let("H_c", self._eshelby(J, U_c, yc[1]))
+        H_f = J.let("H_f", self._eshelby(J, U_f, ls_f))
         res = {
             "smooth": common + [J.let("res_ls", ls_f - oc["lambda_s"]),
                                 J.let("res_ks", ks_f - oc["kappa_s"])],
@@ -493,12 +499,8 @@ class Derivation:
         E.extend(tprog)
         E.extend(wprog)
 
-        def eshelby(out, ls, mapping, prog):
-            U = out["U"].xreplace(mapping)
-            return ls * prog.derivative(U, ls) - U
-
-        H_t = E.let("H_t", eshelby(self.contact_phys_out, yt[1], tmap, E))
-        H_w = E.let("H_w", eshelby(self.cylinder_phys_out, yw[1], wmap, E))
+        H_t = E.let("H_t", self._eshelby(E, self.contact_phys_out["U"].xreplace(tmap), yt[1]))
+        H_w = E.let("H_w", self._eshelby(E, self.cylinder_phys_out["U"].xreplace(wmap), yw[1]))
         self.tip_end = E
         self.tip_end_inputs = (SS, *yt, *yw)
         self.tip_end_res = [E.let("res_end_t", yt[0] - RHO * w0 / SS), E.let("res_end_w", yw[0] - RHO * w0 / SS),
@@ -566,7 +568,7 @@ class Derivation:
             ls = ys[FREE_STATES.index("ls")]
             sides.append(dict(tau_s=self.free_phys_out["tau_s"].xreplace(mapping),
                               M_s=self.free_phys_out["M_s"].xreplace(mapping),
-                              H=K.let(f"H{tag}", ls * K.derivative(U, ls) - U)))
+                              H=K.let(f"H{tag}", self._eshelby(K, U, ls))))
         left, right = sides
         self.kink = K
         self.kink_inputs = (SK, *yl, *yr)
