@@ -34,7 +34,7 @@ from .liftoff import (
     replace_invalid_cap,
 )
 from .pointload import SC_POINT, solve_point_load
-from .solution import Solution, calibrated_error, default_eps, richardson_error, thin_mesh
+from .solution import Solution, calibrated_error, default_eps, richardson_error, warm_mesh
 from .corner import LEGENDRE_WATCH, edge_model, is_corner, limit_estimate, near_limit
 from .state import check_delta, check_tol, cross_convexity_limit, make_system, solve, solve_from, system_like, \
     warm_guess
@@ -464,10 +464,10 @@ def _locate_switches(builder: _Builder, st):
                             bc_tol=st["bc_tol"])
         return (sol, -sol.curvature_excess) if sol.success else (None, None)
 
-    def line_touch_at(d, near):  # the line whose lifted cap comes down onto the tip
+    def line_touch_at(d, near):  # the line whose lifted pole comes down onto the tip
         sol = solve_liftoff(scene, "line", delta=d, guess=near, tol=st["tol"], max_nodes=st["max_nodes"],
                             bc_tol=st["bc_tol"])
-        return (sol, -sol.penetration) if sol.success else (None, None)
+        return (_with_pole_clearance(sol), sol.pole_clearance) if sol.success else (None, None)
 
     def cap_touch_at(d, near):  # the cap whose free shell just touches the cylinder
         sol = _solve_at_delta(scene, d, near, None, st)
@@ -503,9 +503,10 @@ def _locate_switches(builder: _Builder, st):
             continue
         if "cap" in pair and pair & {"line", "annulus", "cap+line(tip)"}:
             ends, criterion, sign, solve_at = [_cap_of(s1), _cap_of(s2)], "pressure_min", 1.0, cap_at
-        elif pair == {"line", "cap+line(tip)"}:  # the lifted cap touches down: a cap grows at the pole
-            ends = [s if s.get("topology") == "line" else _line_state_at(s, st) for s in (s1, s2)]
-            criterion, sign, solve_at = "penetration", -1.0, line_touch_at
+        elif pair == {"line", "cap+line(tip)"}:  # the lifted pole touches down: a cap grows there
+            ends = [_with_pole_clearance(s if s.get("topology") == "line" else _line_state_at(s, st))
+                    for s in (s1, s2)]
+            criterion, sign, solve_at = "pole_clearance", 1.0, line_touch_at
         elif pair == {"line", "annulus"}:
             ends = [s if s.get("topology") == "line" else _line_state_at(s, st) for s in (s1, s2)]
             criterion, sign, solve_at = "curvature_excess", -1.0, line_at
@@ -527,11 +528,11 @@ def _locate_switches(builder: _Builder, st):
             continue
         e1, e2 = sorted(ends, key=lambda e: e.delta)
         f1, f2 = (sign * (min(e[criterion], 1.0) if criterion == "wall_gap" else e[criterion]) for e in (e1, e2))
-        if not f1 * f2 < 0 and criterion == "penetration":
-            # a line recorded as valid may touch the tip already (penetration up to 10 tol): the
+        if not f1 * f2 < 0 and criterion == "pole_clearance":
+            # a line recorded as valid may have its pole down on the tip already (to 10 tol): the
             # touch-down lies between two of the line points before it
             e1, e2 = _touchdown_bracket([r[3] for r in rows], min(s1.delta, s2.delta)) or (e1, e2)
-            f1, f2 = -e1.penetration, -e2.penetration
+            f1, f2 = e1.pole_clearance, e2.pole_clearance
         if not f1 * f2 < 0:
             continue
         best = _regula_falsi(e1.delta, f1, e1, e2.delta, f2, e2, solve_at)
@@ -608,13 +609,26 @@ def _wall_line_at(sol, st):
 
 def _touchdown_bracket(states, delta):
     """The two line states, not deeper than ``delta``, between which a line's lifted pole comes
-    down onto the tip (its penetration crosses zero), or None."""
-    lines = sorted((s for s in states if s.get("topology") == "line" and s.get("success") and s.delta <= delta),
+    down onto the tip (its clearance crosses zero), or None."""
+    lines = sorted((_with_pole_clearance(s) for s in states
+                    if s.get("topology") == "line" and s.get("success") and s.delta <= delta),
                    key=lambda s: s.delta)
     for a, b in reversed(list(zip(lines[:-1], lines[1:]))):
-        if a.penetration < 0 < b.penetration:
+        if a.pole_clearance > 0 > b.pole_clearance:
             return a, b
     return None
+
+
+def _with_pole_clearance(line):
+    """``line`` with its ``pole_clearance`` set (None passes).  The touch-down of a lifted pole
+    is located on this gap, which closes transversally, not on the free shell's penetration:
+    that one is the largest over the shell and sits at the contact line, where the shell
+    touches tangentially, so near zero it is noise at the tabulated tip's accuracy."""
+    from .liftoff import pole_clearance
+
+    if line is not None and "pole_clearance" not in line:
+        line.pole_clearance = pole_clearance(line)
+    return line
 
 
 def _line_state_at(sol, st):
@@ -724,7 +738,7 @@ def _step_nodes(prev, settings):
 
 def _secant(sysm, cur, prev, a):
     """Guess cur + a (cur - prev) on cur's thinned mesh (states and parameters)."""
-    x = thin_mesh(cur.x)
+    x = warm_mesh(cur)
     y = cur.sol(x) + a * (cur.sol(x) - prev.sol(x))
     X = np.array([cur.p[0], cur.lambda0, cur.delta])
     Xp = np.array([prev.p[0], prev.lambda0, prev.delta])

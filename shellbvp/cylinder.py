@@ -37,7 +37,7 @@ from .chain import (
     cylinder_chain,
 )
 from .diagnosis import diagnose
-from .solution import Solution, attach_tip_table, richardson_error, thin_mesh
+from .solution import Solution, attach_tip_table, richardson_error, warm_mesh
 
 __all__ = ["WALL_TOPOLOGIES", "make_wall_system", "wall_contact_suspected", "solve_chain_from", "wall_state",
            "best_wall_state", "transfer_guess"]
@@ -169,7 +169,7 @@ def _guesses(sysm, start):
     configuration), best first."""
     topo, src = sysm.topology, start.get("topology")
     if src == topo:
-        x = thin_mesh(start.x)
+        x = warm_mesh(start)
         q = dict(zip(start.system.unknowns, start.p), lambda0=start.lambda0, delta=start.delta)
         return [(x, start.sol(x), sysm.pack(**q))]
     out = []

@@ -100,7 +100,7 @@ def diagnose(sysm, bvp, tol, converged_note: str = "") -> Solution:
     res = Solution(
         topology=sysm.topology, status=int(bvp.status), message=bvp.message, x=bvp.x, y=bvp.y,
         p=p if p is not None else np.empty(0), sol=bvp.sol,
-        rms_residuals=bvp.rms_residuals, niter=int(bvp.niter), nodes=int(bvp.x.size),
+        rms_residuals=bvp.rms_residuals, tol=tol, niter=int(bvp.niter), nodes=int(bvp.x.size),
         max_residual=float(np.max(bvp.rms_residuals)) if bvp.rms_residuals.size else nan,
         delta=float(delta), lambda0=float(lambda0), Sc=S_edges[-1], force=float(force), edge_S=S_edges,
         # where the contact starts from the pole's side: the pole itself, or a lifted pole's first edge

@@ -33,7 +33,7 @@ from .solution import (
     attach_tip_table,
     default_eps,
     richardson_error,
-    thin_mesh,
+    warm_mesh,
 )
 
 __all__ = ["solve_liftoff", "solve_liftoff_from", "make_liftoff_system", "liftoff_guess_from_cap",
@@ -109,7 +109,7 @@ def liftoff_warm_guess(sysm: ChainBVP, prev: Solution, before: Solution | None =
 def _moved_guess(sysm, prev, before=None, a=None):
     """``prev`` on its thinned mesh, moved by ``a`` times (prev - before) when both are given
     (states, unknowns, delta and lambda0 -- whichever the system takes)."""
-    x = thin_mesh(prev.x)
+    x = warm_mesh(prev)
     q = dict(zip(prev.system.unknowns, prev.p), delta=prev.delta, lambda0=prev.lambda0)
     y = prev.sol(x)
     if before is not None and a is not None:
@@ -478,7 +478,7 @@ def _probe_then_solve(sysm, guess, solve_from, *, tol, max_nodes, bc_tol):
     probe = solve_from(sysm, guess, tol=_PROBE_TOL, max_nodes=min(max_nodes, _PROBE_NODES), bc_tol=bc_tol)
     if not probe.success:
         return probe
-    x = thin_mesh(probe.x)
+    x = warm_mesh(probe, tol)
     return solve_from(sysm, (x, probe.sol(x), probe.p), tol=tol, max_nodes=max_nodes, bc_tol=bc_tol)
 
 

@@ -17,7 +17,7 @@ from .diagnosis import diagnose
 from .inflation import start_shape
 from .solution import (
     attach_tip_table,
-    thin_mesh,
+    warm_mesh,
 )
 
 __all__ = ["solve_point_load", "SC_POINT", "POINT_S0"]
@@ -33,7 +33,7 @@ POINT_S0 = 1e-12
 def _point_guess(sysm, prev):
     """Free states for the point-load problem from a cap or point solution."""
     if prev.get("topology") == "point":
-        x = thin_mesh(prev.x)
+        x = warm_mesh(prev)
         return x, prev.sol(x)
     x = np.linspace(0.0, 1.0, 61)
     cap = prev.system

@@ -25,7 +25,7 @@ from .solution import (
     attach_tip_table,
     default_eps,
     richardson_error,
-    thin_mesh,
+    warm_mesh,
 )
 
 __all__ = ["solve", "solve_from", "make_system", "system_like", "cross_convexity_limit", "warm_guess", "delta_bounds", "check_delta", "check_tol",
@@ -60,7 +60,7 @@ def _undeformed_guess(sysm: ChainBVP, ln_Sc, lambda0, delta, n=41):
 
 def warm_guess(sysm: ChainBVP, prev: "Solution", predictor=None):
     """Previous cap solution on a thinned mesh; optional predicted (y, p) shift."""
-    x = thin_mesh(prev.x)
+    x = warm_mesh(prev)
     y = prev.sol(x)
     p = sysm.pack(ln_Sc=prev.p[0], lambda0=prev.lambda0, delta=prev.delta)
     if predictor is not None:
