@@ -415,14 +415,30 @@ def _cap_of(sol):
 
 
 def _regula_falsi(a, fa, sa, b, fb, sb, solve_at):
-    """Root of f(delta) between a and b (Illinois); returns the last state with f >= 0."""
+    """Root of f(delta) between a and b (Illinois); returns the last state with f >= 0.
+
+    Where ``solve_at`` finds no state (e.g. the cap's contact has passed the tip's end, just
+    beyond a wall touch; beta 1e-3, paper model), that delta is taken as beyond the root: it
+    replaces the end where f < 0 (whose f stays as a proxy) and the next point bisects."""
     best = sa if fa >= 0 else sb
     side = 0
+    bisect, failures = False, 0
     for _ in range(40):
-        d = (a * fb - b * fa) / (fb - fa)
+        d = 0.5 * (a + b) if bisect else (a * fb - b * fa) / (fb - fa)
         sol, f = solve_at(d, sa if abs(d - a) < abs(d - b) else sb)
         if sol is None:
-            break
+            failures += 1
+            if failures > 3:
+                break
+            if fa < 0:
+                a = d
+            else:
+                b = d
+            bisect, side = True, 0
+            if abs(b - a) < 1e-7 * (1 + abs(d)):
+                break
+            continue
+        bisect = False
         if f >= 0:
             best = sol
         if f * fb > 0:

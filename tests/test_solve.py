@@ -106,6 +106,24 @@ def test_error_estimate_brackets_the_true_error(base):
     assert s.force_defect < 1e-5  # F is a first integral of the free region
 
 
+def test_warm_mesh_holds_its_state_to_tol_in_one_pass(base):
+    """The warm-start mesh equidistributes the state's residual at half of tol: solve_bvp
+    accepts the state itself on it without adding a node, and a tenth of tol asks for about
+    10^(1/3) times the intervals (the residual goes as h^3)."""
+    from shellbvp.solution import thin_mesh, warm_mesh
+
+    sol = sb.solve(base, delta=0.3, estimate_error=False)
+    x = warm_mesh(sol)
+    assert x[0] == sol.x[0] and x[-1] == sol.x[-1] and np.all(np.diff(x) > 0)
+    again = sol.system.solve(x, sol.sol(x), sol.p, tol=sol.tol, max_nodes=10000, bc_tol=1e-10)
+    assert again.status == 0 and again.x.size == x.size and again.rms_residuals.max() < sol.tol
+    assert abs(sb.solve(base, delta=0.3, tol=1e-9, estimate_error=False).force - sol.force) < sol.tol
+    ratio = (warm_mesh(sol, tol=sol.tol / 10).size - 1) / (x.size - 1)
+    assert 1.9 < ratio < 2.5, ratio
+    bare = dict(sol, rms_residuals=np.full(sol.x.size - 1, np.nan))  # e.g. a failed run's
+    assert np.array_equal(warm_mesh(bare), thin_mesh(sol.x))
+
+
 def test_pole_start_truncation_is_below_tolerance(base):
     """F is unchanged (to << tol) when the pole start zeta = eps*Sc varies over 6 decades."""
     forces = [sb.solve(base, delta=0.2, tol=1e-8, eps=eps, estimate_error=False).force
