@@ -401,7 +401,7 @@ def read_sweep(path) -> Sweep:
     >>> c = grid.curves[1]                                     # a Curve: rho = 0.25
     >>> c.scene.rho, len(c)
     (0.25, 2)
-    >>> bool(grid.force[1, -1] == c.force[-1])                 # F at delta_max, on the common grid
+    >>> bool(abs(grid.force[1, -1] - c.force[-1]) < 1e-12)     # F at delta_max, on the common grid
     True
     """
     import h5py

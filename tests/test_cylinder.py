@@ -330,7 +330,7 @@ def test_the_paper_cap_held_at_the_tip_end_takes_over_where_the_free_edge_reache
         sysm = make_system(scene, "delta", d, free[0.91].system.eps, edge="pinned")
         held[d] = solve_from(sysm, warm_guess(sysm, free[0.91]))
         assert held[d].success and held[d].contact_edge == "pinned"
-        assert abs(held[d].tip_end_margin) < 1e-12  # the edge is at the tip's end
+        assert abs(held[d].tip_end_margin) < 1e-10  # the edge is at the tip's end (a boundary condition: to bc_tol)
     n1, n2 = held[0.91].edge_forces[0], held[0.92].edge_forces[0]
     assert n1 < 0 < n2 and held[0.92].valid and not held[0.91].valid
     m1, m2 = free[0.91].tip_end_margin, free[0.92].tip_end_margin

@@ -134,7 +134,7 @@ def test_dome_snaps_at_a_fold_in_delta():
 
 # -- failed results ------------------------------------------------------------------------------
 #: Numbers of the run rather than of a state, and the last iterate kept for inspection.
-_RUN = {"status", "niter", "nodes", "max_residual", "wall_time", "x", "y", "p", "rms_residuals"}
+_RUN = {"status", "niter", "nodes", "max_residual", "wall_time", "x", "y", "p", "rms_residuals", "tol"}
 
 
 def _numbers(sol):
