@@ -65,17 +65,24 @@ def _edge_model(sysm) -> str:
     return "corner" if "corner" in models else (models.pop() if len(models) == 1 else "")
 
 
-def _edge_jumps(sysm, ya, yb, p):
-    """Jumps (free minus contact side) of lambda_s and kappa_s at the outermost contact edge."""
+_EDGE_FIELDS = ("axial_force_2pi", "r", "Q", "lambda_s", "kappa_s")  # what the edges' checks read
+
+
+def _pick(fields, i, n):
+    """The edge fields of a profile (arrays over n points, or constants) at point i."""
+    return {key: float(np.broadcast_to(fields[key], (n,))[i]) for key in _EDGE_FIELDS}
+
+
+def _edge_jumps(sysm, ends):
+    """Jumps (free minus contact side) of lambda_s and kappa_s at the outermost contact edge;
+    ``ends[k]``: region k's profile fields at its (start, end)."""
     edges = [j for j in sysm.junctions if isinstance(j, Edge)]
     if not edges:
         return 0.0, 0.0
     j = edges[-1]
-    S = sysm.S_point(sysm.regions[min(j.kc, j.kf)].end, p)
-    yc = yb[sysm.rows(j.kc)] if j.kc < j.kf else ya[sysm.rows(j.kc)]
-    yf = ya[sysm.rows(j.kf)] if j.kc < j.kf else yb[sysm.rows(j.kf)]
-    on = _at(sysm, sysm.regions[j.kc].kind, S, yc)
-    return (float(yf[_LS] - on["lambda_s"][0]), float(yf[FREE_STATES.index("ks")] - on["kappa_s"][0]))
+    side = (1, 0) if j.kc < j.kf else (0, 1)  # which end of the contact and the free region meet
+    on, free = ends[j.kc][side[0]], ends[j.kf][side[1]]
+    return free["lambda_s"] - on["lambda_s"], free["kappa_s"] - on["kappa_s"]
 
 
 def diagnose(sysm, bvp, tol, converged_note: str = "") -> Solution:
@@ -133,16 +140,15 @@ def diagnose(sysm, bvp, tol, converged_note: str = "") -> Solution:
                    ring_force=nan, ring_force_inner=nan, cap_force=nan, edge_forces=[], valid=False, flags=flags)
         return _without_iterate_numbers(res)
 
-    t = np.unique(np.r_[bvp.x, 0.5 * (bvp.x[1:] + bvp.x[:-1])])
+    t = np.unique(np.r_[bvp.x, 0.5 * (bvp.x[1:] + bvp.x[:-1])])  # from 0 to 1: the regions' ends
     parts = sysm.region_profiles(t, bvp.sol(t), p)
+    ends = {k: (_pick(f, 0, t.size), _pick(f, -1, t.size)) for k, _, f in parts}  # (start, end) of region k
     # ring forces: jumps of the axial force (2 pi G) and of r Q across each edge, outer minus inner
     axial, normal = [], []
-    for pt, inner, outer in edges:
-        S = sysm.S_point(pt, p)
-        fi = _at(sysm, sysm.regions[inner].kind, S, yb[sysm.rows(inner)])
-        fo = _at(sysm, sysm.regions[outer].kind, S, ya[sysm.rows(outer)])
-        axial.append(2 * np.pi * float(fo["axial_force_2pi"][0] - fi["axial_force_2pi"][0]))
-        normal.append(-2 * np.pi * float(fo["r"][0] * fo["Q"][0] - fi["r"][0] * fi["Q"][0]))
+    for _, inner, outer in edges:
+        fi, fo = ends[inner][1], ends[outer][0]
+        axial.append(2 * np.pi * float(fo["axial_force_2pi"] - fi["axial_force_2pi"]))
+        normal.append(-2 * np.pi * float(fo["r"] * fo["Q"] - fi["r"] * fi["Q"]))
     res.ring_force = axial[-1] if axial else float(force)  # no edge: a point force
     res.ring_force_inner = axial[0] if len(axial) > 1 else 0.0
     res.edge_forces = normal
@@ -164,7 +170,7 @@ def diagnose(sysm, bvp, tol, converged_note: str = "") -> Solution:
     res.edge_legendre = float(leg[0] / leg[1]) if leg[1] != 0 else nan
     res.legendre_min, res.legendre_min_S = _legendre_min(sysm, t, bvp.sol, p)
     res.contact_edge = _edge_model(sysm)
-    res.edge_jump_ls, res.edge_jump_ks = _edge_jumps(sysm, ya, yb, p)
+    res.edge_jump_ls, res.edge_jump_ks = _edge_jumps(sysm, ends)
     res.energy = sysm.energy(bvp.sol, bvp.x, p)
 
     admissible, vflags = [], []
