@@ -2,8 +2,9 @@
 
 Adaptive curves use pseudo-arclength continuation in ``X = (delta, lambda0, F)``
 (so folds in any of them are passed, not stopped at), with a secant predictor
-for the states and parameters, warm starts on a thinned mesh (every third
-node: solve_bvp only ever adds nodes), steps grown or shrunk with the Newton
+for the states and parameters, warm starts on a mesh that equidistributes the
+previous state's residual (``solution.warm_mesh``: solve_bvp only ever adds nodes, and
+on this mesh most steps converge in one pass), steps grown or shrunk with the Newton
 effort and the turning of the branch, and halved on failure.  The small-delta
 region is resolved by a leg from the first point down to ``delta_min``
 (geometric steps; caps shrink exponentially there, and once a cap leaves
@@ -753,7 +754,7 @@ def _step_nodes(prev, settings):
 
 
 def _secant(sysm, cur, prev, a):
-    """Guess cur + a (cur - prev) on cur's thinned mesh (states and parameters)."""
+    """Guess cur + a (cur - prev) on cur's warm-start mesh (states and parameters)."""
     x = warm_mesh(cur)
     y = cur.sol(x) + a * (cur.sol(x) - prev.sol(x))
     X = np.array([cur.p[0], cur.lambda0, cur.delta])

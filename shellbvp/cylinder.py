@@ -51,7 +51,11 @@ WALL_TOPOLOGIES = {"cap+line(cylinder)": cap_line_cylinder_chain, "cap+band(cyli
 NEAR_TIP_END = 0.7
 #: The smallest node budget of a wall state's solve (see :func:`wall_state`).
 WALL_MIN_NODES = 2000
-_BAND_HALF_WIDTH = 0.02  # relative half width of a band grown from a line
+#: relative half widths of the band guessed from a cap's touch point, and from a line (narrow first:
+#: a band is born from its line with zero width; beta 1e-5 just past the switch at 0.8381: 1e-4,
+#: and 0.02 ran away to the node budget)
+_BAND_HALF_WIDTH = 0.02
+_BAND_FROM_LINE_HALF_WIDTHS = (0.002, 0.02)
 _CAP_SPLITS = ((0.97, 1.15), (0.9, 1.3), (0.99, 1.05))  # (S*/Sc, Sc'/Sc) of cap+cylinder guesses from a cap
 
 
@@ -188,8 +192,8 @@ def _guesses(sysm, start):
     elif src == "cap+line(cylinder)" and topo == "cap+band(cylinder)":
         q = dict(zip(start.system.unknowns, start.p))
         S1 = math.exp(q["ln_S1"])
-        out.append(transfer_guess(sysm, start, ln_Sc=q["ln_Sc"], ln_S1=math.log(S1 * (1 - _BAND_HALF_WIDTH)),
-                                  ln_S2=math.log(S1 * (1 + _BAND_HALF_WIDTH))))
+        out += [transfer_guess(sysm, start, ln_Sc=q["ln_Sc"], ln_S1=math.log(S1 * (1 - w)), ln_S2=math.log(S1 * (1 + w)))
+                for w in _BAND_FROM_LINE_HALF_WIDTHS]
     elif src == "cap+band(cylinder)" and topo == "cap+cylinder":
         q = dict(zip(start.system.unknowns, start.p))
         Sc, S1, S2 = (math.exp(q[k]) for k in ("ln_Sc", "ln_S1", "ln_S2"))

@@ -97,7 +97,7 @@ def liftoff_guess_from_cap(sysm: ChainBVP, cap: Solution, S1_fraction: float, n:
 
 
 def liftoff_warm_guess(sysm: ChainBVP, prev: Solution, before: Solution | None = None, delta=None):
-    """A neighbouring lift-off state of the same topology on its thinned mesh; with ``before``
+    """A neighbouring lift-off state of the same topology on its warm-start mesh; with ``before``
     (the state before ``prev`` on the curve, same topology) and the target ``delta``, moved
     along their secant to that depth (states, unknowns and delta)."""
     a = None
@@ -107,7 +107,7 @@ def liftoff_warm_guess(sysm: ChainBVP, prev: Solution, before: Solution | None =
 
 
 def _moved_guess(sysm, prev, before=None, a=None):
-    """``prev`` on its thinned mesh, moved by ``a`` times (prev - before) when both are given
+    """``prev`` on its warm-start mesh, moved by ``a`` times (prev - before) when both are given
     (states, unknowns, delta and lambda0 -- whichever the system takes)."""
     x = warm_mesh(prev)
     q = dict(zip(prev.system.unknowns, prev.p), delta=prev.delta, lambda0=prev.lambda0)
@@ -385,8 +385,10 @@ def second_zone_state(cap: Solution, *, tol=1e-6, max_nodes=10000, bc_tol=1e-10,
         # near the closing of the gap (beta 0.1: S_c/S1 -> 1 at delta 0.394) the unknowns move
         # fast and a guess re-sampled from another state fails; the state itself on its mesh,
         # moved along the secant, and shorter steps towards the depth when that fails, do not
+        # (its own node budget, not one from the cap's mesh: since warm meshes the caps there have
+        # ~380 nodes, and the split needs ~2200 near the closing)
         res = _continue_in_delta(sysm, previous, before if _near(before, cap, sysm.topology) else None,
-                                 cap.delta, **kw)
+                                 cap.delta, tol=tol, max_nodes=max_nodes, bc_tol=bc_tol)
         if res is not None:
             res.wall_time = time.perf_counter() - t0
             return res
@@ -435,8 +437,8 @@ def _continue_in_delta(sysm, previous, before, delta, *, tol, max_nodes, bc_tol)
     budget = int(min(max_nodes, max(_CONTINUATION_NODES, WARM_NODES * previous.nodes)))
     step = delta - previous.delta
     for _ in range(_CONTINUATION_STEPS):
-        last = abs(delta - previous.delta) <= abs(step)
-        target = delta if last else previous.delta + step
+        last = abs(delta - previous.delta) <= abs(step) * (1 + 1e-9)  # (halved steps add up to delta
+        target = delta if last else previous.delta + step                 # only to rounding)
         stepper = ChainBVP(sysm.scene, sysm.chain, "delta", target, model=sysm.model, par=sysm.par)
         stepper.tip_A, stepper.tip_B = sysm.tip_A, sysm.tip_B
         secant = before if before is not None and abs(target - previous.delta) <= abs(previous.delta - before.delta) \

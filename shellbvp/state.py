@@ -59,7 +59,7 @@ def _undeformed_guess(sysm: ChainBVP, ln_Sc, lambda0, delta, n=41):
 
 
 def warm_guess(sysm: ChainBVP, prev: "Solution", predictor=None):
-    """Previous cap solution on a thinned mesh; optional predicted (y, p) shift."""
+    """Previous cap solution on its warm-start mesh; optional predicted (y, p) shift."""
     x = warm_mesh(prev)
     y = prev.sol(x)
     p = sysm.pack(ln_Sc=prev.p[0], lambda0=prev.lambda0, delta=prev.delta)
@@ -277,7 +277,8 @@ def solve(scene, *, delta=None, lambda0=None, force=None, tol=1e-6, max_nodes=10
     max_nodes : int
         Largest number of mesh nodes.
     guess : Solution, optional
-        A neighbouring solution to start from (warm start on a thinned mesh).  Its
+        A neighbouring solution to start from (warm start on a mesh equidistributing its
+        residual, ``shellbvp.solution.warm_mesh``).  Its
         configuration is solved again (a lift-off, split or wall state; under delta
         control a split is continued to the depth), falling back to the single cap where
         that fails.
