@@ -19,8 +19,9 @@ every 12th also at 1e-10 to show the reference's own error).
 * Variants of this commit with one change switched off by a private flag measure what each
   change bought: ``cold lift-off`` (lift-off states from the cap's guesses first, as before),
   ``no secant guard`` (the secant predictor in ln Sc unguarded), ``full Richardson``
-  (``estimate_error="full"``: a Richardson solve at every point, as at the baseline); these
-  on the three base curves only.
+  (``estimate_error="full"``: a Richardson solve at every point, as at the baseline),
+  ``thinned warm meshes`` (warm starts on every third node instead of a mesh equidistributing
+  the residual); these on the three base curves only.
 * Shooting (``benchmarks/shooting.py``, the paper's method) re-solves the reference's cap
   states (delta >= 0.15) at its rtol 1e-8 and 1e-9, each from its neighbour with the
   tangent predictor (the first from the reference's own unknowns: no cold start is counted);
@@ -81,6 +82,7 @@ VARIANTS = {
     "no split rule": ("new", {"shellbvp.liftoff": {"_SPLIT_RULE": False}}, {}, NUMPY),
     "no ln Sc guard": ("new", {"shellbvp.liftoff": {"WARM_MAX_LN_SC": math.inf}}, {}, NUMPY),
     "no tightening": ("new", {"shellbvp.continuation": {"_TIGHTEN": False}}, {}, NUMPY),
+    "thinned warm meshes": ("new", {"shellbvp.solution": {"_EQUIDISTRIBUTE": False}}, {}, NUMPY),
 }
 
 #: variant -> the curves it runs on (each change switched off where it acts; the others run everywhere)
@@ -91,6 +93,7 @@ ABLATIONS = {
     "no split rule": ("base default", "base 40 depths"),
     "no ln Sc guard": ("base default", "gent1 default", "dome default"),
     "no tightening": ("base default", "fit default", "flat default"),
+    "thinned warm meshes": ("base default", "base 40 depths", "base 40 depths, cap only"),
 }
 
 

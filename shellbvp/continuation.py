@@ -1022,7 +1022,9 @@ def _adaptive(scene, builder: _Builder, settings):
                 crossed_from = cur
         if sol is None:
             sysm = system_like(cur, "arclength", (Xhat, tangent, scale), st["eps"])
-            a = ds / max(norm, 1e-300)
+            # no secant across a change of configuration (e.g. the smooth edge to the corner:
+            # the states' difference is the jump forming, not the branch's direction)
+            a = ds / max(norm, 1e-300) if _configuration(cur) == _configuration(prev) else 0.0
             guess = _secant(sysm, cur, prev, a)
             sol = solve_from(sysm, guess, tol=st["tol"], max_nodes=_step_nodes(cur, st), bc_tol=st["bc_tol"])
             if not sol.success and crossing and crossed_from is not cur:
