@@ -386,7 +386,7 @@ def second_zone_state(cap: Solution, *, tol=1e-6, max_nodes=10000, bc_tol=1e-10,
         # fast and a guess re-sampled from another state fails; the state itself on its mesh,
         # moved along the secant, and shorter steps towards the depth when that fails, do not
         # (its own node budget, not one from the cap's mesh: since warm meshes the caps there have
-        # ~380 nodes, and the split needs ~2200 near the closing)
+        # ~380 nodes, so 4x that, and the split needs ~2200 near the closing)
         res = _continue_in_delta(sysm, previous, before if _near(before, cap, sysm.topology) else None,
                                  cap.delta, tol=tol, max_nodes=max_nodes, bc_tol=bc_tol)
         if res is not None:
@@ -420,9 +420,10 @@ def second_zone_state(cap: Solution, *, tol=1e-6, max_nodes=10000, bc_tol=1e-10,
 
 #: Solves of :func:`_continue_in_delta` at most (each a warm start of a few hundred to a few
 #: thousand nodes), and its node budget: near the closing of a gap the mesh needs a few
-#: thousand nodes for a while (beta 0.1: 2188 at delta 0.386)
+#: thousand nodes for a while (beta 0.1: 2188 at delta 0.386), and a step that fails refines
+#: up to it (gamma -2 from delta 0.82: 1.6-3.2 s per step with 5000)
 _CONTINUATION_STEPS = 16
-_CONTINUATION_NODES = 5000
+_CONTINUATION_NODES = 1200
 
 
 def _continue_in_delta(sysm, previous, before, delta, *, tol, max_nodes, bc_tol):
