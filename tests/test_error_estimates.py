@@ -104,3 +104,18 @@ def test_a_point_whose_estimate_exceeds_tol_is_solved_again_tighter(monkeypatch)
     assert loose.points["force_error"][i] > 1e-6 * loose.force[i]  # the estimate saw it
     # every estimate now at or below tol (the tightened points' own Richardson estimates)
     assert np.all(c.points["force_error"] <= 1e-6 * np.abs(c.force))
+
+
+def test_point_load_states_get_richardson_estimates():
+    """The point-load limit's F error per unit residual scatters (flat at delta 0.0065: a
+    calibrated 5.4e-7 for a true 2.1e-6), so "auto" estimates every point-load state by
+    Richardson: the estimate then matches the true error (and a point above tol is tightened)."""
+    scene = sb.Scene.preset("flat")
+    c = sb.curve(scene, deltas=[0.004, 0.0065, 0.009, 0.0115], estimate_error="auto")
+    assert set(c.topology) == {"point"}
+    assert list(c.points["error_method"]) == ["richardson"] * 4
+    s = c.solutions[1]
+    ref = sb.solve(scene, delta=float(s.delta), tol=1e-10, guess=s, max_nodes=30000, estimate_error=False)
+    assert ref.success and ref.topology == "point"
+    ratio = s.force_error / abs(s.force - ref.force)
+    assert 0.5 <= ratio <= 2, ratio
