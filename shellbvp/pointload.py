@@ -17,7 +17,7 @@ from .diagnosis import diagnose
 from .inflation import start_shape
 from .solution import (
     attach_tip_table,
-    warm_mesh,
+    thin_mesh,
 )
 
 __all__ = ["solve_point_load", "SC_POINT", "POINT_S0"]
@@ -33,7 +33,10 @@ POINT_S0 = 1e-12
 def _point_guess(sysm, prev):
     """Free states for the point-load problem from a cap or point solution."""
     if prev.get("topology") == "point":
-        x = warm_mesh(prev)
+        # every third node, not solution.warm_mesh: the march towards a larger depth fails
+        # often (the state passes through the tip), and a failed step refines from the whole
+        # mesh (base, a cap from a point-load guess: 28 s against 4.5 s)
+        x = thin_mesh(prev.x)
         return x, prev.sol(x)
     x = np.linspace(0.0, 1.0, 61)
     cap = prev.system
