@@ -431,30 +431,26 @@ def _regula_falsi(a, fa, sa, b, fb, sb, solve_at):
     for _ in range(40):
         d = 0.5 * (a + b) if bisect else (a * fb - b * fa) / (fb - fa)
         sol, f = solve_at(d, sa if abs(d - a) < abs(d - b) else sb)
+        bisect = sol is None
         if sol is None:
             failures += 1
-            if failures > 3:
-                break
             if fa < 0:
                 a = d
             else:
                 b = d
-            bisect, side = True, 0
-            if abs(b - a) < 1e-7 * (1 + abs(d)):
-                break
-            continue
-        bisect = False
-        if f >= 0:
-            best = sol
-        if f * fb > 0:
-            b, fb, sb = d, f, sol
-            fa = fa / 2 if side == -1 else fa
-            side = -1
+            side = 0
         else:
-            a, fa, sa = d, f, sol
-            fb = fb / 2 if side == 1 else fb
-            side = 1
-        if abs(b - a) < 1e-7 * (1 + abs(d)) or f == 0:  # on delta: criteria have very different slopes
+            if f >= 0:
+                best = sol
+            if f * fb > 0:
+                b, fb, sb = d, f, sol
+                fa = fa / 2 if side == -1 else fa
+                side = -1
+            else:
+                a, fa, sa = d, f, sol
+                fb = fb / 2 if side == 1 else fb
+                side = 1
+        if failures > 3 or abs(b - a) < 1e-7 * (1 + abs(d)) or f == 0:  # on delta: criteria's slopes differ
             break
     return best
 
@@ -760,7 +756,9 @@ def _step_nodes(prev, settings):
 def _secant(sysm, cur, prev, a):
     """Guess cur + a (cur - prev) on cur's warm-start mesh (states and parameters)."""
     x = warm_mesh(cur)
-    y = cur.sol(x) + a * (cur.sol(x) - prev.sol(x))
+    y = cur.sol(x)
+    if a:
+        y = y + a * (y - prev.sol(x))
     X = np.array([cur.p[0], cur.lambda0, cur.delta])
     Xp = np.array([prev.p[0], prev.lambda0, prev.delta])
     ln_Sc, lambda0, delta = X + a * (X - Xp)

@@ -255,9 +255,7 @@ def warm_mesh(sol, tol=None):
     density = np.maximum(r / target, 1e-3) ** (1.0 / RESIDUAL_ORDER) / h
     cum = np.r_[0.0, np.cumsum(density * h)]
     m = max(int(np.ceil(cum[-1])), _WARM_MESH_MIN_INTERVALS)
-    xn = np.interp(np.linspace(0.0, cum[-1], m + 1), cum, x)
-    xn[0], xn[-1] = x[0], x[-1]
-    return xn
+    return np.interp(np.linspace(0.0, cum[-1], m + 1), cum, x)  # the ends exactly: x[0] and x[-1]
 
 
 
