@@ -570,6 +570,19 @@ class ChainBVP:
         yin = yb[self.rows(j.k)]
         return self.regions[j.k].end, np.array([q["chi1"], yin[_LS]]), yin, ya[self.rows(j.k + 1)]
 
+    def _free_pole_scale(self, j: FreePole) -> np.ndarray:
+        """Row scales of a free pole's conditions (isotropy, rotation, G/S^2 at S = zeta).
+
+        G/zeta^2 is O(1), but its derivative in rQ is 1/zeta^2 (3e12 on base's line at delta
+        0.075, zeta = 1e-4 S1): Newton cannot bring it below bc_tol there (the last 1e-10 is
+        a change of rQ by 1e-23) and stalls through solve_bvp's 10 iterations (0.3-0.8 s, up to
+        44 % of a curve).  As G/S1^2 -- the same condition, G = 0, on the scale of the region it
+        holds in -- it is well conditioned; (zeta/S1)^2 is a constant, so the Jacobian scales alike."""
+        start, end = self.regions[j.k].start, self.regions[j.k].end
+        if start.unknown is None or start.unknown != end.unknown:
+            return np.ones(3)
+        return np.array([1.0, 1.0, math.exp(2 * (start.ln_offset - end.ln_offset))])
+
     def bc(self, ya, yb, p=None):
         mod, par = self.model, self.par_at(p)
         q = self.quantities(p)
@@ -579,7 +592,8 @@ class ChainBVP:
                 y0 = ya[self.rows(j.k)]
                 parts.append(mod.pole_res(y0[0], y0[1], q["lambda0"], par))
             elif isinstance(j, FreePole):
-                parts.append(mod.free_pole_res(self.S_point(self.regions[j.k].start, p), ya[self.rows(j.k)], par))
+                parts.append(self._free_pole_scale(j) * mod.free_pole_res(self.S_point(self.regions[j.k].start, p),
+                                                                           ya[self.rows(j.k)], par))
             elif isinstance(j, PointPole):
                 parts.append(mod.point_load_res(self.S_point(self.regions[j.k].start, p), ya[self.rows(j.k)],
                                                 q["delta"], par))
@@ -664,10 +678,11 @@ class ChainBVP:
                 point = self.regions[j.k].start
                 S = self.S_point(point, p)
                 if isinstance(j, FreePole):
-                    pj = mod.free_pole_jac(S, ya[self.rows(j.k)], par)  # d/d(y, S)
+                    scale = self._free_pole_scale(j)[:, None]
+                    pj = scale * mod.free_pole_jac(S, ya[self.rows(j.k)], par)  # d/d(y, S)
                     self._add_p(P, rows, point.unknown, pj[:, 6] * S)
                     if vc:
-                        self._pressure_column(P, rows, mod.free_pole_jac_par(S, ya[self.rows(j.k)], par))
+                        self._pressure_column(P, rows, scale * mod.free_pole_jac_par(S, ya[self.rows(j.k)], par))
                 else:
                     pj = mod.point_load_jac(S, ya[self.rows(j.k)], q["delta"], par)  # d/d(y, delta)
                     self._add_p(P, rows, "delta", pj[:, 6])
