@@ -33,9 +33,25 @@ class _NonFinite(Exception):
     """Raised inside solve_bvp by a Jacobian with NaN or inf entries (see :func:`solve_bvp`)."""
 
 
-def _finite_jacobian(jac, what):
-    """``jac`` that refuses to hand non-finite entries to solve_bvp's sparse LU."""
+class _OverBudget(Exception):
+    """Raised inside solve_bvp when a run asks for more Jacobians than ``max_jacobians``;
+    carries the unknowns of the last iterate a Jacobian was evaluated at."""
+
+    def __init__(self, p):
+        super().__init__()
+        self.p = p
+
+
+def _finite_jacobian(jac, what, max_evaluations=None):
+    """``jac`` that refuses to hand non-finite entries to solve_bvp's sparse LU (and, with
+    ``max_evaluations``, stops the run after that many calls)."""
+    calls = 0
+
     def checked(*args):
+        nonlocal calls
+        calls += 1
+        if max_evaluations is not None and calls > max_evaluations:
+            raise _OverBudget(None if len(args) < 3 or args[2] is None else np.array(args[2], float))
         out = jac(*args)
         for block in (out if isinstance(out, tuple) else (out,)):
             if block is not None and not np.all(np.isfinite(block)):
@@ -68,10 +84,16 @@ def _failed_run(x, y, p, status, message):
                           niter=0, status=status, message=message, success=False)
 
 
-def solve_bvp(fun, bc, x, y, p=None, *, fun_jac, bc_jac, **kwargs):
+def solve_bvp(fun, bc, x, y, p=None, *, fun_jac, bc_jac, max_jacobians=None, **kwargs):
     """scipy.integrate.solve_bvp, imported on first use (scipy.integrate is most of the
     import time of shellbvp, and reading files or loading a model does not need it),
     with a guard on what reaches its linear algebra.
+
+    ``max_jacobians``: stop the run (status 3) when Newton asks for more collocation
+    Jacobians than that -- for probes that have a fallback: solve_bvp restarts a Newton that
+    diverges on an unchanged mesh up to 10 times, ~35 Jacobians.  The result then keeps the
+    unknowns ``p`` of the last iterate (its states and numbers are NaN), for the caller to
+    see where Newton was going.
 
     A guess with NaN/inf or a mesh that is not strictly increasing, and a Jacobian
     that overflows during Newton (a state far outside the model's domain, e.g. an
@@ -87,8 +109,16 @@ def solve_bvp(fun, bc, x, y, p=None, *, fun_jac, bc_jac, **kwargs):
     if not np.all(np.isfinite(y)) or (p is not None and not np.all(np.isfinite(p))):
         return _failed_run(x, y, p, 2, "the initial guess has NaN or inf entries: no solve")
     try:
-        return _solve_bvp(fun, bc, x, y, p, fun_jac=_finite_jacobian(fun_jac, "fun_jac"),
-                          bc_jac=_finite_jacobian(bc_jac, "bc_jac"), **kwargs)
+        # solve_bvp evaluates fun_jac twice per Jacobian (at the nodes and the midpoints)
+        return _solve_bvp(fun, bc, x, y, p, fun_jac=_finite_jacobian(
+            fun_jac, "fun_jac", None if max_jacobians is None else 2 * max_jacobians),
+            bc_jac=_finite_jacobian(bc_jac, "bc_jac"), **kwargs)
+    except _OverBudget as exc:
+        res = _failed_run(x, y, p, 3, f"{STATUS_MESSAGES[3]}: Newton did not converge within {max_jacobians} "
+                                      f"Jacobians (the budget of a probe)")
+        if exc.p is not None:
+            res.p = exc.p
+        return res
     except _NonFinite as exc:
         return _failed_run(x, y, p, 2, f"the Jacobian ({exc}) overflowed to NaN/inf during Newton: the "
                                        f"iterate left the model's domain (no solve of the collocation system)")

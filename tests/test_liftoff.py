@@ -531,3 +531,66 @@ def test_solve_from_a_split_state_keeps_its_configuration():
     assert abs(tight.force - split.force) < 1e-8 and tight.force_error < 1e-10
     back = sb.solve(split.scene, force=split.force, guess=split, estimate_error=False)
     assert back.topology == "cap+line(tip)" and back.valid and abs(back.delta - split.delta) < 1e-7
+
+
+def test_the_free_pole_conditions_are_well_scaled_and_the_line_is_continued_without_a_failed_run(monkeypatch):
+    """The free pole's G = 0 row was G/zeta^2 (zeta = 1e-4 S1): its derivative in rQ reached
+    3e12 on base's line at delta 0.075, Newton could not take its residual below bc_tol and
+    the warm start from 0.0625 ran solve_bvp's ten Newton restarts to status 3 (0.3 s).
+    Scaled as G/S1^2, every condition's Jacobian row is moderate and no run fails."""
+    import shellbvp.liftoff
+
+    runs = []
+    orig = shellbvp.liftoff.solve_liftoff_from
+
+    def counted(*args, **kw):
+        r = orig(*args, **kw)
+        runs.append((r.status, r.get("delta")))
+        return r
+
+    monkeypatch.setattr(shellbvp.liftoff, "solve_liftoff_from", counted)
+    c = sb.curve(sb.Scene.preset("base"), deltas=[0.05, 0.0625, 0.075], estimate_error=False)
+    assert c.complete and list(c.topology) == ["line"] * 3
+    assert all(status == 0 for status, _ in runs), runs
+    line = c.solutions[-1]
+    sysm = line.system
+    A, B, P = sysm.bc_jac(line.y[:, 0], line.y[:, -1], line.p)
+    row_size = np.max(np.abs(np.hstack([A, B, P])), axis=1)
+    assert np.max(row_size) < 1e6, row_size
+
+
+def test_an_annulus_probe_that_runs_to_the_pole_stops_within_its_jacobian_budget(monkeypatch):
+    """At base delta 0.1125 (the line too curved) the annulus probes walk their inner edge to
+    the pole: they stop within the probe's Jacobian budget, not after ~35 Jacobians, and say
+    that the state is the cap."""
+    import shellbvp.liftoff
+    import shellbvp.solution
+
+    calls = []
+    orig = shellbvp.solution._finite_jacobian
+
+    def counting(jac, what, max_evaluations=None):
+        wrapped = orig(jac, what, max_evaluations)
+        if what != "fun_jac":
+            return wrapped
+
+        def counted(*args):
+            calls[-1] += 1
+            return wrapped(*args)
+        return counted
+
+    def probe(*args, **kw):
+        calls.append(0)
+        return orig_annulus(*args, **kw)
+
+    orig_annulus = shellbvp.liftoff.solve_liftoff_from
+    scene = sb.Scene.preset("base")
+    cap = sb.solve(scene, delta=0.1125, topology="cap", estimate_error=False)
+    line = liftoff_state(cap, "line")
+    monkeypatch.setattr(shellbvp.solution, "_finite_jacobian", counting)
+    monkeypatch.setattr(shellbvp.liftoff, "solve_liftoff_from", probe)
+    res = liftoff_state(cap, "annulus", previous=line)
+    assert not res.success and res.status == 4 and "reaches the pole" in res.message
+    # two fun_jac calls per Jacobian; without the budget each probe made 66-70 calls
+    assert len(calls) == 2 and max(calls) <= 2 * 12 + 1, calls
+    assert math.isnan(res.force)
