@@ -119,3 +119,17 @@ def test_point_load_states_get_richardson_estimates():
     assert ref.success and ref.topology == "point"
     ratio = s.force_error / abs(s.force - ref.force)
     assert 0.5 <= ratio <= 2, ratio
+
+
+def test_a_point_far_above_tol_is_tightened_until_it_meets_it():
+    """Flat's point-load state at delta 2e-4 (F ~ 5e-5) errs by 9.6e-5 relative at tol 1e-6 and
+    still by 5.3e-6 at tol 1e-7: one tightening by 10 was not enough.  The tolerance is now
+    tightened by the estimate's excess, repeatedly: the recorded F meets tol."""
+    scene = sb.Scene.preset("flat")
+    c = sb.curve(scene, deltas=[0.0002], estimate_error="auto")
+    assert list(c.topology) == ["point"]
+    for s in c.solutions:
+        ref = sb.solve(scene, delta=float(s.delta), tol=1e-10, guess=s, max_nodes=30000, estimate_error=False)
+        assert ref.success and ref.topology == "point"
+        assert abs(s.force - ref.force) <= 1e-6 * abs(ref.force), (s.delta, abs(s.force / ref.force - 1))
+        assert s.force_error <= 1e-6 * abs(s.force)
