@@ -212,11 +212,12 @@ def _guesses(sysm, start):
 
 
 # -- solving and choosing ---------------------------------------------------------------------------
-def solve_chain_from(sysm, guess, *, tol=1e-6, max_nodes=10000, bc_tol=1e-10):
+def solve_chain_from(sysm, guess, *, tol=1e-6, max_nodes=10000, bc_tol=1e-10, max_jacobians=None):
+    """One solve_bvp run of ``sysm`` from ``guess = (x, y, p)``, diagnosed."""
     x, y, p = guess
     t0 = time.perf_counter()
     with np.errstate(all="ignore"):
-        bvp = sysm.solve(x, y, p, tol=tol, bc_tol=bc_tol, max_nodes=max_nodes)
+        bvp = sysm.solve(x, y, p, tol=tol, bc_tol=bc_tol, max_nodes=max_nodes, max_jacobians=max_jacobians)
         res = diagnose(sysm, bvp, tol)
     res.wall_time = time.perf_counter() - t0
     return res

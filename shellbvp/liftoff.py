@@ -25,7 +25,7 @@ import time
 import numpy as np
 
 from .chain import SPLIT_TOPOLOGIES, ChainBVP, FreePole, annulus_chain, cap_line_tip_chain, line_chain
-from .diagnosis import diagnose
+from .cylinder import solve_chain_from, transfer_guess
 from .pointload import solve_point_load
 from .solution import (
     STATUS_MESSAGES,
@@ -145,14 +145,8 @@ def solve_liftoff(scene, topology, *, delta=None, force=None, lambda0=None, gues
     return res
 
 
-def solve_liftoff_from(sysm, guess, *, tol=1e-6, max_nodes=10000, bc_tol=1e-10, max_jacobians=None):
-    x, y, p = guess
-    t0 = time.perf_counter()
-    with np.errstate(all="ignore"):
-        bvp = sysm.solve(x, y, p, tol=tol, bc_tol=bc_tol, max_nodes=max_nodes, max_jacobians=max_jacobians)
-        res = diagnose(sysm, bvp, tol)
-    res.wall_time = time.perf_counter() - t0
-    return res
+#: One run of a lift-off system from ``(x, y, p)``, diagnosed (the same for every chain).
+solve_liftoff_from = solve_chain_from
 
 
 # -- topology selection ------------------------------------------------------------------------
@@ -254,10 +248,11 @@ def _closed_at_pole(res):
     return bool(math.isfinite(res.p[0]) and math.isfinite(res.p[1]) and ratio < ANNULUS_CLOSED_AT_POLE)
 
 
-#: The probe of an annulus: loose and small, so that one that runs to the pole is seen fast;
-#: and short: probes that converged took at most 4 Jacobians, those that ran to the pole
-#: took solve_bvp's whole 10 restarts of Newton (33-35 Jacobians, 0.15 s each on base at 0.1125).
-_PROBE_TOL, _PROBE_NODES, _PROBE_JACOBIANS = 1e-3, 600, 12
+#: Probes (an annulus; a second zone, :func:`_probe_then_solve`): loose and small, so that a
+#: guess that leads nowhere is seen fast; and short: probes that converged took at most 10
+#: Jacobians, those that ran an annulus to the pole or found no split took solve_bvp's whole 10
+#: restarts of Newton (33-39 Jacobians; 0.15 s each on base at 0.1125, 0.3 s on gamma -2).
+_PROBE_TOL, _PROBE_NODES, _PROBE_JACOBIANS = 1e-3, 600, 16
 
 
 def _solve_annulus(sysm, guess, *, tol, max_nodes, bc_tol):
@@ -374,8 +369,6 @@ def second_zone_state(cap: Solution, *, tol=1e-6, max_nodes=10000, bc_tol=1e-10,
     when that is one too) when given, else a few guesses from ``line`` (the line state at this
     depth, if one converged) and from the cap.  Returns a Solution (check ``success`` and
     ``valid``)."""
-    from .cylinder import solve_chain_from, transfer_guess
-
     t0 = time.perf_counter()
     control = cap.control if cap.control in ("force",) else "delta"
     value = cap.force if control == "force" else cap.delta
@@ -435,8 +428,6 @@ def _continue_in_delta(sysm, previous, before, delta, *, tol, max_nodes, bc_tol)
     narrow basin: beta 0.1 near the gap's closing, where Newton from a good guess finds another
     root with the gap nearly shut), at most ``_CONTINUATION_STEPS`` solves.  Returns the valid
     state at ``delta``, or None."""
-    from .cylinder import solve_chain_from
-
     budget = int(min(max_nodes, max(_CONTINUATION_NODES, WARM_NODES * previous.nodes)))
     step = delta - previous.delta
     for _ in range(_CONTINUATION_STEPS):
@@ -462,8 +453,6 @@ def split_state_from(guess: Solution, control: str, value: float, *, tol=1e-6, m
     at another ``control`` value: under delta by natural continuation from it
     (:func:`_continue_in_delta`: halved steps, valid states only; None where none is found),
     under force or lambda0 by one solve from it (diagnosed, valid or not)."""
-    from .cylinder import solve_chain_from
-
     if guess.get("topology") not in SPLIT_TOPOLOGIES:
         raise ValueError(f"guess must be a {' or '.join(SPLIT_TOPOLOGIES)} state; got {guess.get('topology')!r}")
     sysm = ChainBVP(guess.scene, guess.system.chain, control, value)
@@ -480,7 +469,8 @@ def _probe_then_solve(sysm, guess, solve_from, *, tol, max_nodes, bc_tol):
     zone exists: 3 s); one that converges is tightened from the probe."""
     if tol >= _PROBE_TOL:
         return solve_from(sysm, guess, tol=tol, max_nodes=max_nodes, bc_tol=bc_tol)
-    probe = solve_from(sysm, guess, tol=_PROBE_TOL, max_nodes=min(max_nodes, _PROBE_NODES), bc_tol=bc_tol)
+    probe = solve_from(sysm, guess, tol=_PROBE_TOL, max_nodes=min(max_nodes, _PROBE_NODES), bc_tol=bc_tol,
+                       max_jacobians=_PROBE_JACOBIANS)
     if not probe.success:
         return probe
     x = warm_mesh(probe, tol)

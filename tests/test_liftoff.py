@@ -592,5 +592,5 @@ def test_an_annulus_probe_that_runs_to_the_pole_stops_within_its_jacobian_budget
     res = liftoff_state(cap, "annulus", previous=line)
     assert not res.success and res.status == 4 and "reaches the pole" in res.message
     # two fun_jac calls per Jacobian; without the budget each probe made 66-70 calls
-    assert len(calls) == 2 and max(calls) <= 2 * 12 + 1, calls
+    assert len(calls) == 2 and max(calls) <= 2 * 16 + 1, calls
     assert math.isnan(res.force)
