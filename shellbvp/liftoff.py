@@ -28,6 +28,7 @@ from .chain import SPLIT_TOPOLOGIES, ChainBVP, FreePole, annulus_chain, cap_line
 from .cylinder import solve_chain_from, transfer_guess
 from .pointload import solve_point_load
 from .solution import (
+    RESIDUAL_ORDER,
     STATUS_MESSAGES,
     Solution,
     attach_tip_table,
@@ -428,7 +429,10 @@ def _continue_in_delta(sysm, previous, before, delta, *, tol, max_nodes, bc_tol)
     narrow basin: beta 0.1 near the gap's closing, where Newton from a good guess finds another
     root with the gap nearly shut), at most ``_CONTINUATION_STEPS`` solves.  Returns the valid
     state at ``delta``, or None."""
-    budget = int(min(max_nodes, max(_CONTINUATION_NODES, WARM_NODES * previous.nodes)))
+    # a tighter tol than the state's needs (previous.tol / tol)^(1/3) times its nodes
+    # (a split solved at 1e-6 with ~220 nodes asks ~2200 at 1e-9)
+    finer = max(1.0, previous.get("tol", tol) / tol) ** (1.0 / RESIDUAL_ORDER)
+    budget = int(min(max_nodes, max(_CONTINUATION_NODES, WARM_NODES * previous.nodes * finer)))
     step = delta - previous.delta
     for _ in range(_CONTINUATION_STEPS):
         last = abs(delta - previous.delta) <= abs(step) * (1 + 1e-9)  # (halved steps add up to delta
