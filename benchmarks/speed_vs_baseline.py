@@ -21,7 +21,9 @@ every 12th also at 1e-10 to show the reference's own error).
   ``no secant guard`` (the secant predictor in ln Sc unguarded), ``full Richardson``
   (``estimate_error="full"``: a Richardson solve at every point, as at the baseline),
   ``thinned warm meshes`` (warm starts on every third node instead of a mesh equidistributing
-  the residual); these on the three base curves only.
+  the residual), ``explicit zeros kept`` (solve_bvp's Jacobian factorised with its stored zeros,
+  with the numpy functions and with numba's: compare with ``this commit, numba``); these on the
+  three base curves only.
 * Shooting (``benchmarks/shooting.py``, the paper's method) re-solves the reference's cap
   states (delta >= 0.15) at its rtol 1e-8 and 1e-9, each from its neighbour with the
   tangent predictor (the first from the reference's own unknowns: no cold start is counted);
@@ -83,6 +85,8 @@ VARIANTS = {
     "no ln Sc guard": ("new", {"shellbvp.liftoff": {"WARM_MAX_LN_SC": math.inf}}, {}, NUMPY),
     "no tightening": ("new", {"shellbvp.continuation": {"_TIGHTEN": False}}, {}, NUMPY),
     "thinned warm meshes": ("new", {"shellbvp.solution": {"_EQUIDISTRIBUTE": False}}, {}, NUMPY),
+    "explicit zeros kept": ("new", {"shellbvp.solution": {"_DROP_EXPLICIT_ZEROS": False}}, {}, NUMPY),
+    "explicit zeros kept, numba": ("new", {"shellbvp.solution": {"_DROP_EXPLICIT_ZEROS": False}}, {}, NUMBA),
 }
 
 #: variant -> the curves it runs on (each change switched off where it acts; the others run everywhere)
@@ -94,6 +98,8 @@ ABLATIONS = {
     "no ln Sc guard": ("base default", "gent1 default", "dome default"),
     "no tightening": ("base default", "fit default", "flat default"),
     "thinned warm meshes": ("base default", "base 40 depths", "base 40 depths, cap only"),
+    "explicit zeros kept": ("base default", "base 40 depths", "base 40 depths, cap only"),
+    "explicit zeros kept, numba": ("base default", "base 40 depths", "base 40 depths, cap only"),
 }
 
 

@@ -368,3 +368,33 @@ def test_smooth_branch_end_is_detected_by_the_legendre_determinant(base):
         s = sb.solve(base, delta=d, guess=s, estimate_error=False)
         assert s.success
     assert 0 < s.edge_legendre < 2e-3
+
+
+def test_solve_bvp_factorises_its_jacobian_without_the_explicit_zeros(base, monkeypatch):
+    """solve_bvp's collocation Jacobian is assembled from dense blocks, block-diagonal over the
+    stacked regions: about half its entries are exact zeros.  The LU that shellbvp installs in
+    scipy.integrate._bvp factorises the same matrix without them: the state is the same to
+    rounding, and what reaches SuperLU has no stored zero."""
+    import scipy.integrate._bvp as bvp
+
+    import shellbvp.solution
+
+    stored = []
+
+    def spy(J, *args, **kw):
+        stored.append((J.nnz, int(np.count_nonzero(J.data == 0))))
+        return original(J, *args, **kw)
+
+    sol = sb.solve(base, delta=0.1, estimate_error=False)  # installs the wrapper
+    original = bvp.splu.wrapped  # SuperLU's splu, behind the installed wrapper
+    monkeypatch.setattr(bvp, "splu", shellbvp.solution._splu_without_explicit_zeros(spy))
+    dropped = sb.solve(base, delta=0.1, guess=sol, tol=1e-8, estimate_error=False)
+    assert stored and all(zeros == 0 for _, zeros in stored)
+    monkeypatch.setattr(shellbvp.solution, "_DROP_EXPLICIT_ZEROS", False)
+    stored.clear()
+    kept = sb.solve(base, delta=0.1, guess=sol, tol=1e-8, estimate_error=False)
+    with_zeros = list(stored)
+    assert all(zeros > 0.3 * nnz for nnz, zeros in with_zeros), with_zeros
+    assert dropped.success and kept.success and dropped.nodes == kept.nodes
+    assert abs(dropped.force - kept.force) <= 1e-12 * abs(kept.force)
+    np.testing.assert_allclose(dropped.y, kept.y, rtol=1e-9, atol=1e-12)
