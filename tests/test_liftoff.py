@@ -350,15 +350,17 @@ def test_no_failed_step_where_the_cap_grows_exponentially(monkeypatch):
     assert not any(failed), failed
 
 
-@pytest.mark.slow  # two gent1 curves, 5-10 s
+@pytest.mark.slow  # two base curves to delta 0.2, ~5 s
 def test_no_warm_start_from_a_line_whose_contact_circle_is_far_off(monkeypatch):
-    """gent1's small-delta leg: the line at delta 0.03 (Sc 1.3e-5) is a poor guess for the line
-    at 0.018 (Sc 1.4e-8): Newton stalls from it (10 iterations) before the cap's guess
-    converges.  Past WARM_MAX_LN_SC in ln Sc the cap's guess is used at once: the same curve,
-    one lift-off solve and some 10 Newton iterations fewer."""
+    """base's small-delta leg: the line at delta 0.03 (Sc 1.4e-5) is a poor guess for the line
+    at 0.018 (Sc 1.6e-8): Newton from it does not converge (status 3 after solve_bvp's ten
+    restarts) before the cap's guess does.  Past WARM_MAX_LN_SC in ln Sc the cap's guess is
+    used at once: the same curve, one lift-off solve and 7 Newton iterations fewer.  (gent1's
+    stall, which this guard was made for, was the free pole's badly scaled G row: since that
+    is scaled, gent1's warm start converges and the guard costs it 6 iterations.)"""
     import shellbvp.liftoff as lo
 
-    scene = sb.Scene.preset("gent1")
+    scene = sb.Scene.preset("base")
     curves, counts = {}, {}
     for limit in (lo.WARM_MAX_LN_SC, math.inf):
         with monkeypatch.context() as m:
@@ -370,7 +372,7 @@ def test_no_warm_start_from_a_line_whose_contact_circle_is_far_off(monkeypatch):
     np.testing.assert_allclose(guarded.delta, unguarded.delta, rtol=0, atol=1e-12)
     np.testing.assert_allclose(guarded.force, unguarded.force, rtol=1e-7)
     c, u = counts[lo.WARM_MAX_LN_SC], counts[math.inf]
-    assert u.calls - c.calls == 1 and u.niter - c.niter >= 8, ((c.calls, c.niter), (u.calls, u.niter))
+    assert u.calls - c.calls == 1 and u.niter - c.niter >= 5, ((c.calls, c.niter), (u.calls, u.niter))
 
 
 # -- the ends of the lifted and split branches on the stability grid (issues 12, 13) ---------------------
