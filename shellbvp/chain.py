@@ -570,18 +570,16 @@ class ChainBVP:
         yin = yb[self.rows(j.k)]
         return self.regions[j.k].end, np.array([q["chi1"], yin[_LS]]), yin, ya[self.rows(j.k + 1)]
 
-    def _free_pole_scale(self, j: FreePole) -> np.ndarray:
-        """Row scales of a free pole's conditions (isotropy, rotation, G/S^2 at S = zeta).
+    @staticmethod
+    def _free_pole_scale(S) -> np.ndarray:
+        """Row scales of a free pole's conditions (isotropy, rotation, G/S^2) at S = zeta.
 
-        G/zeta^2 is O(1), but its derivative in rQ is 1/zeta^2 (3e12 on base's line at delta
-        0.075, zeta = 1e-4 S1): Newton cannot bring it below bc_tol there (the last 1e-10 is
-        a change of rQ by 1e-23) and stalls through solve_bvp's 10 iterations (0.3-0.8 s, up to
-        44 % of a curve).  As G/S1^2 -- the same condition, G = 0, on the scale of the region it
-        holds in -- it is well conditioned; (zeta/S1)^2 is a constant, so the Jacobian scales alike."""
-        start, end = self.regions[j.k].start, self.regions[j.k].end
-        if start.unknown is None or start.unknown != end.unknown:
-            return np.ones(3)
-        return np.array([1.0, 1.0, math.exp(2 * (start.ln_offset - end.ln_offset))])
+        The generated G/S^2 is O(1) at the pole, but its derivative in rQ is 1/zeta^2 (3e12
+        on base's line at delta 0.075, 4e15 at 0.018): solve_bvp's absolute bc_tol then asks
+        rQ to 1e-23, below what the linear solves resolve, and Newton stalled through its ten
+        restarts (0.3-0.8 s each; up to 44 % of a curve).  Imposed as G = 0 -- a force, like
+        the other force conditions, to bc_tol -- the row is O(1)."""
+        return np.array([1.0, 1.0, S * S])
 
     def bc(self, ya, yb, p=None):
         mod, par = self.model, self.par_at(p)
@@ -592,8 +590,8 @@ class ChainBVP:
                 y0 = ya[self.rows(j.k)]
                 parts.append(mod.pole_res(y0[0], y0[1], q["lambda0"], par))
             elif isinstance(j, FreePole):
-                parts.append(self._free_pole_scale(j) * mod.free_pole_res(self.S_point(self.regions[j.k].start, p),
-                                                                           ya[self.rows(j.k)], par))
+                S = self.S_point(self.regions[j.k].start, p)
+                parts.append(self._free_pole_scale(S) * mod.free_pole_res(S, ya[self.rows(j.k)], par))
             elif isinstance(j, PointPole):
                 parts.append(mod.point_load_res(self.S_point(self.regions[j.k].start, p), ya[self.rows(j.k)],
                                                 q["delta"], par))
@@ -678,8 +676,9 @@ class ChainBVP:
                 point = self.regions[j.k].start
                 S = self.S_point(point, p)
                 if isinstance(j, FreePole):
-                    scale = self._free_pole_scale(j)[:, None]
+                    scale = self._free_pole_scale(S)[:, None]
                     pj = scale * mod.free_pole_jac(S, ya[self.rows(j.k)], par)  # d/d(y, S)
+                    pj[2, 6] += 2 * S * mod.free_pole_res(S, ya[self.rows(j.k)], par)[2]  # d(S^2)/dS G/S^2
                     self._add_p(P, rows, point.unknown, pj[:, 6] * S)
                     if vc:
                         self._pressure_column(P, rows, scale * mod.free_pole_jac_par(S, ya[self.rows(j.k)], par))

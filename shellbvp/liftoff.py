@@ -176,19 +176,11 @@ WARM_REACH = 0.5
 #: needs about its own mesh, and a start that does not converge must fail fast.
 WARM_NODES = 3
 _WARM_FIRST = True  # False: the cap's guesses first, as before issue 14 (benchmarks measure the gain)
-#: ... and when their contact radii differ by at most this much in ln Sc.  Near the point-load
-#: limit the contact circle shrinks exponentially (base: Sc 1.4e-5 at delta 0.03, 1.6e-8 at
-#: 0.018 on the small-delta leg); a neighbour that far off is a guess from which Newton does
-#: not converge (status 3 after solve_bvp's 10 restarts) before the cap's guess does; the base
-#: and dome default curves each lose one such failed run.  Steps that converged warm moved ln
-#: Sc by up to 2.  (gent1's stall that first motivated it was the free pole's badly scaled row.)
-WARM_MAX_LN_SC = 3.0
 
 
 def _near(state, cap, topology):
     return (state is not None and state.get("topology") == topology and state.get("success")
-            and abs(state.delta - cap.delta) <= WARM_REACH * max(state.delta, cap.delta)
-            and state.Sc > 0 and cap.Sc > 0 and abs(math.log(state.Sc / cap.Sc)) <= WARM_MAX_LN_SC)
+            and abs(state.delta - cap.delta) <= WARM_REACH * max(state.delta, cap.delta))
 
 
 def liftoff_state(cap: Solution, topology: str, *, tol=1e-6, max_nodes=10000, bc_tol=1e-10,

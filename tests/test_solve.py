@@ -398,3 +398,34 @@ def test_solve_bvp_factorises_its_jacobian_without_the_explicit_zeros(base, monk
     assert dropped.success and kept.success and dropped.nodes == kept.nodes
     assert abs(dropped.force - kept.force) <= 1e-12 * abs(kept.force)
     np.testing.assert_allclose(dropped.y, kept.y, rtol=1e-9, atol=1e-12)
+
+
+def test_solve_bvp_stops_when_newton_exceeds_its_jacobian_budget():
+    """``max_jacobians``: a run that asks for more Jacobians stops with status 3, NaN states
+    and the unknowns of its last iterate; without the budget the same run converges.
+    (scipy's eigenvalue example: y'' + k^2 y = 0, y(0) = y(1) = 0, y'(0) = k, from k = 6.)"""
+    from shellbvp.solution import solve_bvp
+
+    def fun(x, y, p):
+        return np.vstack((y[1], -p[0] ** 2 * y[0]))
+
+    def fun_jac(x, y, p):
+        df_dy = np.zeros((2, 2, x.size))
+        df_dy[0, 1] = 1.0
+        df_dy[1, 0] = -p[0] ** 2
+        return df_dy, np.vstack((np.zeros(x.size), -2 * p[0] * y[0]))[:, None, :]
+
+    def bc(ya, yb, p):
+        return np.array([ya[0], yb[0], ya[1] - p[0]])
+
+    def bc_jac(ya, yb, p):
+        return (np.array([[1.0, 0.0], [0.0, 0.0], [0.0, 1.0]]), np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 0.0]]),
+                np.array([[0.0], [0.0], [-1.0]]))
+
+    x = np.linspace(0, 1, 5)
+    y = np.vstack((np.sin(2 * np.pi * x), 2 * np.pi * np.cos(2 * np.pi * x)))
+    free = solve_bvp(fun, bc, x, y, p=[6.0], fun_jac=fun_jac, bc_jac=bc_jac, tol=1e-5)
+    assert free.status == 0 and abs(free.p[0] - 2 * np.pi) < 1e-6
+    short = solve_bvp(fun, bc, x, y, p=[6.0], fun_jac=fun_jac, bc_jac=bc_jac, tol=1e-5, max_jacobians=1)
+    assert short.status == 3 and not short.success and "within 1 Jacobians" in short.message
+    assert np.all(np.isnan(short.y)) and np.all(np.isfinite(short.p)) and short.p[0] != 6.0
