@@ -570,17 +570,6 @@ class ChainBVP:
         yin = yb[self.rows(j.k)]
         return self.regions[j.k].end, np.array([q["chi1"], yin[_LS]]), yin, ya[self.rows(j.k + 1)]
 
-    @staticmethod
-    def _free_pole_scale(S) -> np.ndarray:
-        """Row scales of a free pole's conditions (isotropy, rotation, G/S^2) at S = zeta.
-
-        The generated G/S^2 is O(1) at the pole, but its derivative in rQ is 1/zeta^2 (3e12
-        on base's line at delta 0.075, 4e15 at 0.018): solve_bvp's absolute bc_tol then asks
-        rQ to 1e-23, below what the linear solves resolve, and Newton stalled through its ten
-        restarts (0.3-0.8 s each; up to 44 % of a curve).  Imposed as G = 0 -- a force, like
-        the other force conditions, to bc_tol -- the row is O(1)."""
-        return np.array([1.0, 1.0, S * S])
-
     def bc(self, ya, yb, p=None):
         mod, par = self.model, self.par_at(p)
         q = self.quantities(p)
@@ -590,8 +579,7 @@ class ChainBVP:
                 y0 = ya[self.rows(j.k)]
                 parts.append(mod.pole_res(y0[0], y0[1], q["lambda0"], par))
             elif isinstance(j, FreePole):
-                S = self.S_point(self.regions[j.k].start, p)
-                parts.append(self._free_pole_scale(S) * mod.free_pole_res(S, ya[self.rows(j.k)], par))
+                parts.append(mod.free_pole_res(self.S_point(self.regions[j.k].start, p), ya[self.rows(j.k)], par))
             elif isinstance(j, PointPole):
                 parts.append(mod.point_load_res(self.S_point(self.regions[j.k].start, p), ya[self.rows(j.k)],
                                                 q["delta"], par))
@@ -676,12 +664,10 @@ class ChainBVP:
                 point = self.regions[j.k].start
                 S = self.S_point(point, p)
                 if isinstance(j, FreePole):
-                    scale = self._free_pole_scale(S)[:, None]
-                    pj = scale * mod.free_pole_jac(S, ya[self.rows(j.k)], par)  # d/d(y, S)
-                    pj[2, 6] += 2 * S * mod.free_pole_res(S, ya[self.rows(j.k)], par)[2]  # d(S^2)/dS G/S^2
+                    pj = mod.free_pole_jac(S, ya[self.rows(j.k)], par)  # d/d(y, S)
                     self._add_p(P, rows, point.unknown, pj[:, 6] * S)
                     if vc:
-                        self._pressure_column(P, rows, scale * mod.free_pole_jac_par(S, ya[self.rows(j.k)], par))
+                        self._pressure_column(P, rows, mod.free_pole_jac_par(S, ya[self.rows(j.k)], par))
                 else:
                     pj = mod.point_load_jac(S, ya[self.rows(j.k)], q["delta"], par)  # d/d(y, delta)
                     self._add_p(P, rows, "delta", pj[:, 6])
