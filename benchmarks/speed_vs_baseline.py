@@ -84,8 +84,8 @@ VARIANTS = {
     "no split rule": ("new", {"shellbvp.liftoff": {"_SPLIT_RULE": False}}, {}, NUMPY),
     "no tightening": ("new", {"shellbvp.continuation": {"_TIGHTEN": False}}, {}, NUMPY),
     "thinned warm meshes": ("new", {"shellbvp.solution": {"_EQUIDISTRIBUTE": False}}, {}, NUMPY),
-    "explicit zeros kept": ("new", {"shellbvp.solution": {"_DROP_EXPLICIT_ZEROS": False}}, {}, NUMPY),
-    "explicit zeros kept, numba": ("new", {"shellbvp.solution": {"_DROP_EXPLICIT_ZEROS": False}}, {}, NUMBA),
+    "explicit zeros kept": ("new", {"shellbvp.collocation": {"ENABLED": False}}, {}, NUMPY),
+    "explicit zeros kept, numba": ("new", {"shellbvp.collocation": {"ENABLED": False}}, {}, NUMBA),
 }
 
 #: variant -> the curves it runs on (each change switched off where it acts; the others run everywhere)

@@ -12,6 +12,8 @@ import math
 
 import numpy as np
 
+from . import collocation
+
 __all__ = ["STATUS_MESSAGES", "Solution", "solve_bvp", "set_status", "thin_mesh", "warm_mesh", "richardson_error",
            "penetration", "wall_gap", "attach_tip_table", "default_eps"]
 
@@ -84,39 +86,6 @@ def _failed_run(x, y, p, status, message):
                           niter=0, status=status, message=message, success=False)
 
 
-#: Drop the explicit zeros of solve_bvp's collocation Jacobian before SuperLU factorises it
-#: (False: as scipy does; benchmarks measure the gain).
-_DROP_EXPLICIT_ZEROS = True
-
-
-def _splu_without_explicit_zeros(splu):
-    """``splu`` that first drops the explicit zeros of the matrix (the same matrix).
-
-    solve_bvp assembles its Jacobian from dense m x m blocks per node, but the regions of a
-    chain are stacked into one system and each region's equations involve its own states
-    only: the blocks are block-diagonal, and 40-60 % of the entries are exact zeros, which
-    SuperLU stores, orders and factorises as nonzeros (with their fill-in).  Without them
-    the factorisation is about twice as fast and a base curve 1.25x (F equal to 2e-13)."""
-    def splu_sparse(J, *args, **kwargs):
-        if _DROP_EXPLICIT_ZEROS:
-            J = J.tocsc(copy=False)
-            J.eliminate_zeros()
-        return splu(J, *args, **kwargs)
-
-    splu_sparse.wrapped = splu
-    return splu_sparse
-
-
-def _install_sparse_lu():
-    """Wrap the ``splu`` that scipy.integrate._bvp calls (once; a scipy that no longer calls
-    it there keeps its own, which is only slower)."""
-    from scipy.integrate import _bvp
-
-    splu = getattr(_bvp, "splu", None)
-    if callable(splu) and not hasattr(splu, "wrapped"):
-        _bvp.splu = _splu_without_explicit_zeros(splu)
-
-
 def solve_bvp(fun, bc, x, y, p=None, *, fun_jac, bc_jac, max_jacobians=None, **kwargs):
     """scipy.integrate.solve_bvp, imported on first use (scipy.integrate is most of the
     import time of shellbvp, and reading files or loading a model does not need it),
@@ -136,7 +105,7 @@ def solve_bvp(fun, bc, x, y, p=None, *, fun_jac, bc_jac, max_jacobians=None, **k
     """
     from scipy.integrate import solve_bvp as _solve_bvp
 
-    _install_sparse_lu()
+    collocation.install()  # the collocation Jacobian without its stored zeros
     xa = np.asarray(x, float)
     if xa.ndim != 1 or xa.size < 2 or not np.all(np.isfinite(xa)) or not np.all(np.diff(xa) > 0):
         return _failed_run(x, y, p, 2, "degenerate mesh (not strictly increasing and finite): no solve")

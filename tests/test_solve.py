@@ -370,34 +370,43 @@ def test_smooth_branch_end_is_detected_by_the_legendre_determinant(base):
     assert 0 < s.edge_legendre < 2e-3
 
 
-def test_solve_bvp_factorises_its_jacobian_without_the_explicit_zeros(base, monkeypatch):
+def test_collocation_jacobian_is_scipys_without_its_stored_zeros(base, monkeypatch):
     """solve_bvp's collocation Jacobian is assembled from dense blocks, block-diagonal over the
-    stacked regions: about half its entries are exact zeros.  The LU that shellbvp installs in
-    scipy.integrate._bvp factorises the same matrix without them: the state is the same to
-    rounding, and what reaches SuperLU has no stored zero."""
+    stacked regions: about half its entries are exact zeros.  shellbvp.collocation assembles
+    the same matrix without them: entry for entry scipy's, with the zeros eliminated, on every
+    Jacobian of a lift-off solve (three regions, free boundaries); the states are the same."""
     import scipy.integrate._bvp as bvp
 
-    import shellbvp.solution
+    from shellbvp import collocation
 
-    stored = []
+    scipys = collocation._ORIGINAL["construct_global_jac"] if collocation.install() else None
+    assert scipys is not None and bvp.construct_global_jac is collocation.collocation_jacobian
+    compared = []
 
-    def spy(J, *args, **kw):
-        stored.append((J.nnz, int(np.count_nonzero(J.data == 0))))
-        return original(J, *args, **kw)
+    def both(n, m, k, i_jac, j_jac, h, *blocks):
+        copies = [None if b is None else np.array(b) for b in blocks]  # scipy updates df_dp_middle in place
+        ours = collocation.collocation_jacobian(n, m, k, None, None, h, *blocks)
+        theirs = scipys(n, m, k, *collocation._ORIGINAL["compute_jac_indices"](n, m, k), h, *copies)
+        theirs.eliminate_zeros()
+        theirs.sort_indices()
+        assert ours.has_sorted_indices and np.count_nonzero(ours.data == 0) == 0
+        assert np.array_equal(ours.indptr, theirs.indptr) and np.array_equal(ours.indices, theirs.indices)
+        assert np.array_equal(ours.data, theirs.data)
+        compared.append((k, theirs.nnz, m * n * 2 * n))
+        return ours
 
-    sol = sb.solve(base, delta=0.1, estimate_error=False)  # installs the wrapper
-    original = bvp.splu.wrapped  # SuperLU's splu, behind the installed wrapper
-    monkeypatch.setattr(bvp, "splu", shellbvp.solution._splu_without_explicit_zeros(spy))
-    dropped = sb.solve(base, delta=0.1, guess=sol, tol=1e-8, estimate_error=False)
-    assert stored and all(zeros == 0 for _, zeros in stored)
-    monkeypatch.setattr(shellbvp.solution, "_DROP_EXPLICIT_ZEROS", False)
-    stored.clear()
-    kept = sb.solve(base, delta=0.1, guess=sol, tol=1e-8, estimate_error=False)
-    with_zeros = list(stored)
-    assert all(zeros > 0.3 * nnz for nnz, zeros in with_zeros), with_zeros
-    assert dropped.success and kept.success and dropped.nodes == kept.nodes
-    assert abs(dropped.force - kept.force) <= 1e-12 * abs(kept.force)
-    np.testing.assert_allclose(dropped.y, kept.y, rtol=1e-9, atol=1e-12)
+    monkeypatch.setattr(bvp, "construct_global_jac", both)
+    lifted = sb.solve(base, delta=0.075, estimate_error=False)
+    assert lifted.success and lifted.topology != "cap" and compared
+    assert any(k > 0 for k, _, _ in compared)
+    assert all(nnz < 0.75 * blocks for _, nnz, blocks in compared)  # the zeros were many
+    monkeypatch.setattr(bvp, "construct_global_jac", collocation.collocation_jacobian)
+    ours = sb.solve(base, delta=0.1, tol=1e-8, estimate_error=False)
+    monkeypatch.setattr(collocation, "ENABLED", False)
+    theirs = sb.solve(base, delta=0.1, tol=1e-8, estimate_error=False)
+    assert ours.success and theirs.success and ours.nodes == theirs.nodes
+    assert abs(ours.force - theirs.force) <= 1e-12 * abs(theirs.force)
+    np.testing.assert_allclose(ours.y, theirs.y, rtol=1e-9, atol=1e-12)
 
 
 def test_solve_bvp_stops_when_newton_exceeds_its_jacobian_budget():
