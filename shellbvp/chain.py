@@ -764,11 +764,13 @@ class ChainBVP:
         return 2 * np.pi * float(G), float(self.quantities(p)["delta"])
 
     def region_profiles(self, t, y, p):
-        """[(k, S, fields)] of every region on ``t``: the generated ``*_profile`` dicts."""
+        """[(k, S, fields)] of every region on ``t`` (1-D): the generated ``*_profile`` dicts,
+        from the kernel set (diagnosis and energy evaluate them at every state)."""
         out = []
         for k, reg in enumerate(self.regions):
             S = self.S(k, t, p)
-            out.append((k, S, getattr(self.model, f"{reg.kind}_profile")(S, y[self.rows(k)], self.par_at(p))))
+            out.append((k, S, getattr(self.kernels.active, f"{reg.kind}_profile")(S, y[self.rows(k)],
+                                                                                   self.par_at(p))))
         return out
 
     def profile(self, t, y, p, z_tip: float) -> dict:

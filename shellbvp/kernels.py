@@ -1,7 +1,8 @@
 """Compiled kernels (optional): a structure's hot functions compiled by numba.
 
 A curve spends about 40 % of its time in the generated right-hand sides and
-Jacobians, most of it NumPy's fixed cost per array operation on a few hundred
+Jacobians, and 7-10 % in the regions' profiles (diagnosis and energy at every
+state), most of it NumPy's fixed cost per array operation on a few hundred
 nodes.  The code generator also prints them as loops over the nodes
 (``symbolic.codegen_numba``, ``kernels_<key>.py`` beside the numpy module
 ``model_<key>.py``).  With numba installed (``pip install shellbvp[fast]``) they

@@ -201,7 +201,8 @@ def function_specs(d: Derivation) -> list[FunctionSpec]:
             FunctionSpec(f"{region}_jac_par", prog, args, [("dg_dpar", prog.jacobian(rhs, par))],
                          f"{region} region: dg/dpar ({n}, {len(par)}, m).", "S", node_args=("S", "y")),
             FunctionSpec(f"{region}_profile", prog, args, [("out", profile)],
-                         f"{region} region: physical fields at the nodes (dict of arrays).", "S"),
+                         f"{region} region: physical fields at the nodes (dict of arrays).", "S",
+                         node_args=("S", "y")),  # diagnosis and energy, at every state
         ]
         if d.structure.pressurised:  # volume control (a sealed shell): V = Int dV/dS dS
             vol = [Ssym * profile["volume_density"]]

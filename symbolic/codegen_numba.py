@@ -9,7 +9,9 @@ explicit signature, so that the module compiles (or loads numba's on-disk
 cache) when it is imported and never again on a call.
 
 Only the functions whose :class:`~symbolic.codegen.FunctionSpec` has
-``node_args`` are printed (the regions' ``*_rhs``, ``*_jac`` and ``*_jac_par``);
+``node_args`` are printed (the regions' ``*_rhs``, ``*_jac``, ``*_jac_par`` and
+``*_profile``; a profile's fields are computed as the rows of one array by
+``<name>_rows`` and made the numpy module's dict by a plain ``<name>``);
 boundary and junction conditions are scalar and cheap (about 1 % of a curve)
 and stay in the numpy module.  The signatures take C- or otherwise-ordered
 float64 arrays (layout ``A``): solve_bvp hands over both.  Arguments that are not
@@ -65,12 +67,16 @@ def _signature(spec: FunctionSpec) -> str:
 def _kernel_source(spec: FunctionSpec) -> str:
     if not spec.node_args or spec.shape_of not in spec.node_args:
         raise ValueError(f"{spec.name} has no node axis; only node functions are compiled")
-    if any(isinstance(val, dict) for _, val in spec.outputs):
-        raise ValueError(f"{spec.name} returns a dict; only array outputs are compiled")
+    fields = _fields(spec)
+    if fields is not None and len(spec.outputs) != 1:
+        raise ValueError(f"{spec.name} returns a dict among other outputs; only a dict alone is compiled")
     assignments, outs = lower(spec)
+    name = spec.name if fields is None else _rows_name(spec)
     lines = [f"@numba.njit({_signature(spec)!r}, {KERNEL_OPTIONS})",
-             f"def {spec.name}({', '.join(_arg_name(a) for a, _ in spec.args)}):"]
+             f"def {name}({', '.join(_arg_name(a) for a, _ in spec.args)}):"]
     doc = docstring(spec) + ["", "Compiled loop over the nodes; the same values as the numpy module's."]
+    if fields is not None:
+        doc = [f"Rows of {spec.name}'s fields, {_fields_name(spec)} (the dict is made by {spec.name}).", ""] + doc
     lines.append(textwrap.indent('"""' + "\n".join(doc).rstrip() + '\n"""', "    "))
     for a, syms in spec.args:  # the same at every node
         if a in spec.node_args:
@@ -83,7 +89,11 @@ def _kernel_source(spec: FunctionSpec) -> str:
     stores, k, ret = [], 0, []
     for name, val in spec.outputs:
         out = f"_out_{name}"
-        dims, entries, k = matrix_entries(val, outs, k)
+        if fields is not None:  # a profile: one row per field, in the dict's order
+            dims = (len(fields),)
+            entries = [(f"{i}", outs[i]) for i in range(len(fields)) if outs[i] is not None]
+        else:
+            dims, entries, k = matrix_entries(val, outs, k)
         lines.append(f"    {out} = numpy.zeros(({', '.join(map(str, dims))}, _m))")
         stores += [f"        {out}[{idx}, {_NODE}] = {text}" for idx, text in entries]
         ret.append(out)
@@ -98,7 +108,26 @@ def _kernel_source(spec: FunctionSpec) -> str:
     lines += [f"        {name} = {text}" for name, text in assignments]
     lines += stores
     lines.append(f"    return {', '.join(ret)}")
+    if fields is not None:
+        lines += ["", "", f"{_fields_name(spec)} = {fields!r}", "", "",
+                  f"def {spec.name}({', '.join(a for a, _ in spec.args)}):",
+                  f'    """{spec.doc.strip()} Compiled ({_rows_name(spec)})."""',
+                  f"    return dict(zip({_fields_name(spec)}, {_rows_name(spec)}({', '.join(a for a, _ in spec.args)})))"]
     return "\n".join(lines) + "\n"
+
+
+def _fields(spec: FunctionSpec):
+    """The field names of a profile (a function whose output is a dict), else None."""
+    dicts = [val for _, val in spec.outputs if isinstance(val, dict)]
+    return tuple(dicts[0]) if dicts else None
+
+
+def _rows_name(spec: FunctionSpec) -> str:
+    return f"{spec.name}_rows"
+
+
+def _fields_name(spec: FunctionSpec) -> str:
+    return f"{spec.name.upper()}_FIELDS"
 
 
 def kernel_source(d: Derivation, description: str, specs: list[FunctionSpec] | None = None) -> str:
