@@ -14,6 +14,10 @@ nonzeros.  On the first solve this module replaces two private functions of
   eliminated (a test compares them entry by entry);
 * ``compute_jac_indices``, whose COO index arrays that needs no more.
 
+With a structure's compiled kernels active (``shellbvp.kernels``), the assembly is their
+``collocation_csc`` (:mod:`symbolic.collocation_kernel`, loops that skip the zero blocks)
+instead of numpy's array operations.
+
 A scipy whose ``_bvp`` lacks them or calls them differently keeps its own
 functions: only slower.  ``ENABLED = False`` restores scipy's path at run time
 (the benchmarks' ablation).
@@ -21,11 +25,13 @@ functions: only slower.  ``ENABLED = False`` restores scipy's path at run time
 
 from __future__ import annotations
 
+import contextlib
 import inspect
+import threading
 
 import numpy as np
 
-__all__ = ["ENABLED", "collocation_jacobian", "install"]
+__all__ = ["ENABLED", "assembling", "collocation_jacobian", "install"]
 
 #: Assemble without the zeros (False: scipy's own assembly; benchmarks measure the gain)
 ENABLED = True
@@ -72,6 +78,13 @@ def collocation_jacobian(n, m, k, i_jac, j_jac, h, df_dy, df_dy_middle, df_dp, d
     if not ENABLED:
         return _ORIGINAL["construct_global_jac"](n, m, k, i_jac, j_jac, h, df_dy, df_dy_middle, df_dp,
                                                  df_dp_middle, dbc_dya, dbc_dyb, dbc_dp)
+    compiled = getattr(_CURRENT, "assembler", None)
+    if compiled is not None:
+        if k == 0:
+            df_dp = df_dp_middle = np.empty((n, 0, m))
+            dbc_dp = np.empty((n, 0))
+        data, indices, indptr = compiled(h, df_dy, df_dy_middle, df_dp, df_dp_middle, dbc_dya, dbc_dyb, dbc_dp)
+        return csc_matrix((data, indices, indptr), shape=(n * m + k, n * m + k))
     df_dy = np.transpose(df_dy, (2, 0, 1))
     df_dy_middle = np.transpose(df_dy_middle, (2, 0, 1))
     h = h[:, np.newaxis, np.newaxis]
@@ -100,6 +113,22 @@ def collocation_jacobian(n, m, k, i_jac, j_jac, h, df_dy, df_dy_middle, df_dp, d
     np.cumsum(np.add.reduceat(stored, pointers[:-1]), out=kept[1:])
     size = n * m + k
     return csc_matrix((values[stored], rows[stored], kept), shape=(size, size))
+
+
+_CURRENT = threading.local()
+
+
+@contextlib.contextmanager
+def assembling(assembler):
+    """Within the block, :func:`collocation_jacobian` calls ``assembler`` (a compiled
+    :func:`symbolic.collocation_kernel.collocation_csc`, from a structure's kernel set) instead
+    of its numpy assembly; None: numpy.  Per thread."""
+    before = getattr(_CURRENT, "assembler", None)
+    _CURRENT.assembler = assembler
+    try:
+        yield
+    finally:
+        _CURRENT.assembler = before
 
 
 def _jac_indices(n, m, k):

@@ -86,7 +86,7 @@ def _failed_run(x, y, p, status, message):
                           niter=0, status=status, message=message, success=False)
 
 
-def solve_bvp(fun, bc, x, y, p=None, *, fun_jac, bc_jac, max_jacobians=None, **kwargs):
+def solve_bvp(fun, bc, x, y, p=None, *, fun_jac, bc_jac, max_jacobians=None, assembler=None, **kwargs):
     """scipy.integrate.solve_bvp, imported on first use (scipy.integrate is most of the
     import time of shellbvp, and reading files or loading a model does not need it),
     with a guard on what reaches its linear algebra.
@@ -95,7 +95,8 @@ def solve_bvp(fun, bc, x, y, p=None, *, fun_jac, bc_jac, max_jacobians=None, **k
     Jacobians than that -- for probes that have a fallback: solve_bvp restarts a Newton that
     diverges on an unchanged mesh up to 10 times, ~35 Jacobians.  The result then keeps the
     unknowns ``p`` of the last iterate (its states and numbers are NaN), for the caller to
-    see where Newton was going.
+    see where Newton was going.  ``assembler``: a compiled assembly of the collocation
+    Jacobian (``shellbvp.collocation.assembling``), or None.
 
     A guess with NaN/inf or a mesh that is not strictly increasing, and a Jacobian
     that overflows during Newton (a state far outside the model's domain, e.g. an
@@ -113,9 +114,10 @@ def solve_bvp(fun, bc, x, y, p=None, *, fun_jac, bc_jac, max_jacobians=None, **k
         return _failed_run(x, y, p, 2, "the initial guess has NaN or inf entries: no solve")
     try:
         # solve_bvp evaluates fun_jac twice per Jacobian (at the nodes and the midpoints)
-        return _solve_bvp(fun, bc, x, y, p, fun_jac=_finite_jacobian(
-            fun_jac, "fun_jac", None if max_jacobians is None else 2 * max_jacobians),
-            bc_jac=_finite_jacobian(bc_jac, "bc_jac"), **kwargs)
+        with collocation.assembling(assembler):
+            return _solve_bvp(fun, bc, x, y, p, fun_jac=_finite_jacobian(
+                fun_jac, "fun_jac", None if max_jacobians is None else 2 * max_jacobians),
+                bc_jac=_finite_jacobian(bc_jac, "bc_jac"), **kwargs)
     except _OverBudget as exc:
         res = _failed_run(x, y, p, 3, f"{STATUS_MESSAGES[3]}: Newton did not converge within {max_jacobians} "
                                       f"Jacobians (the budget of a probe)")

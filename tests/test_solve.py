@@ -409,6 +409,35 @@ def test_collocation_jacobian_is_scipys_without_its_stored_zeros(base, monkeypat
     np.testing.assert_allclose(ours.y, theirs.y, rtol=1e-9, atol=1e-12)
 
 
+def test_the_collocation_loops_assemble_scipys_jacobian(base, monkeypatch):
+    """symbolic.collocation_kernel.collocation_csc (compiled with a structure's kernels; here
+    as plain Python) gives scipy's collocation Jacobian, zeros eliminated, on the Jacobians of
+    a lift-off solve (two regions, unknowns) and on random block-diagonal ones with and
+    without unknowns."""
+    import scipy.integrate._bvp as bvp
+
+    from collocation_cases import collocation_loops_against_scipy, random_collocation_blocks
+
+    from shellbvp import collocation
+    from symbolic.collocation_kernel import collocation_csc
+
+    collocation.install()
+    caught = []
+
+    def catch(n, m, k, i_jac, j_jac, h, *blocks):
+        if len(caught) < 2 and m <= 120:
+            caught.append((n, m, k, np.array(h), *[None if b is None else np.array(b) for b in blocks]))
+        return collocation.collocation_jacobian(n, m, k, i_jac, j_jac, h, *blocks)
+
+    monkeypatch.setattr(bvp, "construct_global_jac", catch)
+    lifted = sb.solve(base, delta=0.075, estimate_error=False)
+    assert lifted.success and caught and all(c[2] > 0 for c in caught)
+    for n, m, k, h, *blocks in caught:
+        assert collocation_loops_against_scipy(collocation_csc, n, m, k, h, *blocks) <= 1e-14
+    for k in (0, 2):
+        assert collocation_loops_against_scipy(collocation_csc, *random_collocation_blocks(k)) <= 1e-14
+
+
 def test_solve_bvp_stops_when_newton_exceeds_its_jacobian_budget():
     """``max_jacobians``: a run that asks for more Jacobians stops with status 3, NaN states
     and the unknowns of its last iterate; without the budget the same run converges.
