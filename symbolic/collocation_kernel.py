@@ -29,6 +29,30 @@ def collocation_csc(h, df_dy, df_dy_middle, df_dp, df_dp_middle, dbc_dya, dbc_dy
     n = df_dy.shape[0]
     m = df_dy.shape[2]
     k = df_dp.shape[1]
+    # d(residual j)/d(y_j) and d(residual j)/d(y_j+1), as scipy forms them
+    left = numpy.empty((m - 1, n, n))
+    right = numpy.empty((m - 1, n, n))
+    t_left = numpy.empty(n)
+    t_right = numpy.empty(n)
+    for j in range(m - 1):
+        h6 = h[j] / 6
+        h12 = h[j] ** 2 / 12
+        for r in range(n):
+            for c in range(n):
+                unit = 1.0 if r == c else 0.0
+                left[j, r, c] = -unit - h6 * (df_dy[r, c, j] + 2 * df_dy_middle[r, c, j])
+                right[j, r, c] = unit - h6 * (df_dy[r, c, j + 1] + 2 * df_dy_middle[r, c, j])
+                t_left[c] = 0.0
+                t_right[c] = 0.0
+            for q in range(n):  # row r of df_dy_middle times df_dy at both nodes, zeros skipped
+                a = df_dy_middle[r, q, j]
+                if a != 0.0:
+                    for c in range(n):
+                        t_left[c] += a * df_dy[q, c, j]
+                        t_right[c] += a * df_dy[q, c, j + 1]
+            for c in range(n):
+                left[j, r, c] -= h12 * t_left[c]
+                right[j, r, c] += h12 * t_right[c]
     bc0 = (m - 1) * n  # first row of the boundary conditions
     room = 2 * n * (2 * n + k) + (m - 2) * n * 2 * n + k * (m * n + k)
     data = numpy.empty(room)
@@ -39,23 +63,19 @@ def collocation_csc(h, df_dy, df_dy_middle, df_dp, df_dp_middle, dbc_dya, dbc_dy
     for i in range(m):  # the states at node i: intervals i-1 and i, and the conditions at the ends
         for c in range(n):
             indptr[col] = nnz
-            for j in range(max(i - 1, 0), min(i + 1, m - 1)):
-                hj = h[j]
+            if i > 0:
                 for r in range(n):
-                    t = 0.0
-                    for q in range(n):
-                        a = df_dy_middle[r, q, j]
-                        if a != 0.0:
-                            t += a * df_dy[q, c, i]
-                    if j == i:  # diagonal block of interval j (the states at its left node)
-                        v = (-1.0 if r == c else 0.0) - hj / 6 * (df_dy[r, c, i] + 2 * df_dy_middle[r, c, j])
-                        v -= hj ** 2 / 12 * t
-                    else:  # off-diagonal block (its right node)
-                        v = (1.0 if r == c else 0.0) - hj / 6 * (df_dy[r, c, i] + 2 * df_dy_middle[r, c, j])
-                        v += hj ** 2 / 12 * t
+                    v = right[i - 1, r, c]
                     if v != 0.0:
                         data[nnz] = v
-                        indices[nnz] = j * n + r
+                        indices[nnz] = (i - 1) * n + r
+                        nnz += 1
+            if i < m - 1:
+                for r in range(n):
+                    v = left[i, r, c]
+                    if v != 0.0:
+                        data[nnz] = v
+                        indices[nnz] = i * n + r
                         nnz += 1
             if i == 0 or i == m - 1:
                 dbc = dbc_dya if i == 0 else dbc_dyb
