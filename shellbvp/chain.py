@@ -448,8 +448,9 @@ class ChainBVP:
         from .solution import solve_bvp
 
         y, p = self.complete(x, y, p)
+        active = self.kernels.active
         return solve_bvp(self.fun, self.bc, x, y, p, fun_jac=self.fun_jac, bc_jac=self.bc_jac,
-                         assembler=getattr(self.kernels.active, "collocation_csc", None), **kwargs)
+                         kernels=active if hasattr(active, "collocation_factor") else None, **kwargs)
 
     def ln_S(self, point: Point, p) -> float:
         return point.ln_offset + (p[self.col[point.unknown]] if point.unknown else 0.0)

@@ -1,22 +1,26 @@
-"""solve_bvp's collocation Jacobian, handed to SuperLU without its stored zeros.
+"""solve_bvp's collocation Jacobian: assembled without its stored zeros, and, with
+compiled kernels, factorised by an elimination that knows its structure.
 
 scipy.integrate.solve_bvp assembles the Jacobian of its collocation system from
 dense n x n blocks per mesh interval (COO, then CSC) and factorises it with
 SuperLU.  The regions of a chain are stacked into one system and each region's
 equations involve its own states only, so the blocks are block-diagonal: 40-60 %
-of the entries are exact zeros, which SuperLU stores, orders and factorises as
-nonzeros.  On the first solve this module replaces two private functions of
+of the entries are exact zeros, which SuperLU would store, order and factorise
+as nonzeros.  On the first solve this module replaces three private functions of
 ``scipy.integrate._bvp``:
 
-* ``construct_global_jac`` by :func:`collocation_jacobian`: the same blocks by
-  the same arithmetic, written straight into CSC form (columns in order, rows
-  sorted) without the zeros -- the matrix scipy builds, with its zeros
-  eliminated (a test compares them entry by entry);
-* ``compute_jac_indices``, whose COO index arrays that needs no more.
-
-With a structure's compiled kernels active (``shellbvp.kernels``), the assembly is their
-``collocation_csc`` (:mod:`symbolic.collocation_kernel`, loops that skip the zero blocks)
-instead of numpy's array operations.
+* ``construct_global_jac`` by :func:`collocation_jacobian`: with numpy, the same
+  blocks by the same arithmetic, written straight into CSC form without the
+  zeros (:func:`assemble_csc`: scipy's matrix with its zeros eliminated, entry
+  for entry, a test); with a structure's compiled kernels active
+  (``shellbvp.kernels``), the blocks' arguments alone, for ``splu``;
+* ``splu`` by :func:`factorise`: SuperLU for a sparse matrix; for the compiled
+  case the kernels' ``collocation_factor`` and ``collocation_solve``
+  (:mod:`symbolic.collocation_kernel`: Gaussian elimination with partial
+  pivoting, node by node, skipping the zero blocks; 2-3x faster than SuperLU
+  there).  Factors whose entries grow beyond ``MAX_GROWTH`` times the matrix's
+  are not trusted: SuperLU factorises that matrix instead;
+* ``compute_jac_indices``, whose COO index arrays nothing needs any more.
 
 A scipy whose ``_bvp`` lacks them or calls them differently keeps its own
 functions: only slower.  ``ENABLED = False`` restores scipy's path at run time
@@ -31,12 +35,14 @@ import threading
 
 import numpy as np
 
-__all__ = ["ENABLED", "assembling", "collocation_jacobian", "install"]
+__all__ = ["ENABLED", "MAX_GROWTH", "CollocationBlocks", "CollocationLU", "assemble_csc", "collocation_jacobian",
+           "factorise", "install", "solving_with"]
 
 #: Assemble without the zeros (False: scipy's own assembly; benchmarks measure the gain)
 ENABLED = True
 
 _SIGNATURES = {
+    "splu": None,  # SuperLU's: any parameters
     "compute_jac_indices": ("n", "m", "k"),
     "construct_global_jac": ("n", "m", "k", "i_jac", "j_jac", "h", "df_dy", "df_dy_middle", "df_dp",
                              "df_dp_middle", "dbc_dya", "dbc_dyb", "dbc_dp"),
@@ -69,22 +75,26 @@ def _block_pattern(n: int, m: int, k: int):
 
 def collocation_jacobian(n, m, k, i_jac, j_jac, h, df_dy, df_dy_middle, df_dp, df_dp_middle, dbc_dya, dbc_dyb,
                          dbc_dp):
-    """``scipy.integrate._bvp.construct_global_jac`` (same arguments, same values: the blocks
-    of Kierzenka & Shampine's collocation formula), as a CSC matrix without stored zeros.
-    ``i_jac``, ``j_jac`` are not used."""
-    from scipy.integrate._bvp import stacked_matmul
-    from scipy.sparse import csc_matrix
-
+    """``scipy.integrate._bvp.construct_global_jac`` (the same arguments; ``i_jac``, ``j_jac``
+    are not used): :func:`assemble_csc`, or, with compiled kernels (:func:`solving_with`), a
+    :class:`CollocationBlocks` for :func:`factorise`."""
     if not ENABLED:
         return _ORIGINAL["construct_global_jac"](n, m, k, i_jac, j_jac, h, df_dy, df_dy_middle, df_dp,
                                                  df_dp_middle, dbc_dya, dbc_dyb, dbc_dp)
-    compiled = getattr(_CURRENT, "assembler", None)
-    if compiled is not None:
-        if k == 0:
-            df_dp = df_dp_middle = np.empty((n, 0, m))
-            dbc_dp = np.empty((n, 0))
-        data, indices, indptr = compiled(h, df_dy, df_dy_middle, df_dp, df_dp_middle, dbc_dya, dbc_dyb, dbc_dp)
-        return csc_matrix((data, indices, indptr), shape=(n * m + k, n * m + k))
+    kernels = getattr(_CURRENT, "kernels", None)
+    if kernels is not None:
+        return CollocationBlocks(kernels, n, m, k, h, df_dy, df_dy_middle, df_dp, df_dp_middle, dbc_dya, dbc_dyb,
+                                 dbc_dp)
+    return assemble_csc(n, m, k, h, df_dy, df_dy_middle, df_dp, df_dp_middle, dbc_dya, dbc_dyb, dbc_dp)
+
+
+def assemble_csc(n, m, k, h, df_dy, df_dy_middle, df_dp, df_dp_middle, dbc_dya, dbc_dyb, dbc_dp):
+    """The collocation Jacobian as ``construct_global_jac`` computes it (the blocks of
+    Kierzenka & Shampine's formula, by scipy's arithmetic), as a CSC matrix without stored
+    zeros, rows sorted."""
+    from scipy.integrate._bvp import stacked_matmul
+    from scipy.sparse import csc_matrix
+
     df_dy = np.transpose(df_dy, (2, 0, 1))
     df_dy_middle = np.transpose(df_dy_middle, (2, 0, 1))
     h = h[:, np.newaxis, np.newaxis]
@@ -115,20 +125,80 @@ def collocation_jacobian(n, m, k, i_jac, j_jac, h, df_dy, df_dy_middle, df_dp, d
     return csc_matrix((values[stored], rows[stored], kept), shape=(size, size))
 
 
+#: Partial pivoting's growth (the factors' largest entry over the matrix's) above which the
+#: compiled factors are not trusted and SuperLU factorises the matrix (on the stability grid
+#: and the presets the growth stayed below 50)
+MAX_GROWTH = 1e6
+
+
+class CollocationBlocks:
+    """solve_bvp's collocation Jacobian as the arguments of its blocks, with the compiled
+    kernels that factorise it (solve_bvp hands its Jacobian to ``splu`` only)."""
+
+    def __init__(self, kernels, n, m, k, h, df_dy, df_dy_middle, df_dp, df_dp_middle, dbc_dya, dbc_dyb, dbc_dp):
+        self.kernels, self.n, self.m, self.k = kernels, n, m, k
+        self.blocks = (h, df_dy, df_dy_middle, df_dp, df_dp_middle, dbc_dya, dbc_dyb, dbc_dp)
+
+    @property
+    def shape(self):
+        return (self.n * self.m + self.k,) * 2
+
+    def tocsc(self):
+        """The same matrix, assembled (:func:`assemble_csc`)."""
+        return assemble_csc(self.n, self.m, self.k, *self.blocks)
+
+    def factorise(self, max_growth=None):
+        """:class:`CollocationLU`; RuntimeError for an exactly singular matrix (as SuperLU);
+        None when the factors grew beyond ``max_growth`` (default ``MAX_GROWTH``)."""
+        h, df_dy, df_dy_middle, df_dp, df_dp_middle, dbc_dya, dbc_dyb, dbc_dp = self.blocks
+        if self.k == 0:  # the kernels take arrays with no columns
+            df_dp = df_dp_middle = np.empty((self.n, 0, self.m))
+            dbc_dp = np.empty((self.n, 0))
+        *factors, growth, status = self.kernels.collocation_factor(
+            h, df_dy, df_dy_middle, df_dp, df_dp_middle, dbc_dya, dbc_dyb, dbc_dp,
+            MAX_GROWTH if max_growth is None else float(max_growth))
+        if status == 1:
+            raise RuntimeError("Factor is exactly singular")
+        if status == 2:
+            return None
+        return CollocationLU(self.kernels.collocation_solve, self.n, factors, growth)
+
+
+class CollocationLU:
+    """The factors of a :class:`CollocationBlocks`; ``solve(b)`` as SuperLU's."""
+
+    def __init__(self, solve, n, factors, growth):
+        self._solve, self.n, self.factors, self.growth = solve, n, factors, growth
+
+    def solve(self, b):
+        return self._solve(self.n, *self.factors, np.asarray(b, dtype=float))
+
+
+def factorise(J, *args, **kwargs):
+    """The ``splu`` solve_bvp calls: the compiled elimination for :class:`CollocationBlocks`
+    (SuperLU if its factors grew too much), SuperLU for anything else."""
+    if isinstance(J, CollocationBlocks):
+        lu = J.factorise()
+        if lu is not None:
+            return lu
+        J = J.tocsc()
+    return _ORIGINAL["splu"](J, *args, **kwargs)
+
+
 _CURRENT = threading.local()
 
 
 @contextlib.contextmanager
-def assembling(assembler):
-    """Within the block, :func:`collocation_jacobian` calls ``assembler`` (a compiled
-    :func:`symbolic.collocation_kernel.collocation_csc`, from a structure's kernel set) instead
-    of its numpy assembly; None: numpy.  Per thread."""
-    before = getattr(_CURRENT, "assembler", None)
-    _CURRENT.assembler = assembler
+def solving_with(kernels):
+    """Within the block, :func:`collocation_jacobian` leaves the Jacobian to ``kernels``'
+    ``collocation_factor`` and ``collocation_solve`` (a structure's compiled kernel set,
+    ``shellbvp.kernels``); None: numpy assembly and SuperLU.  Per thread."""
+    before = getattr(_CURRENT, "kernels", None)
+    _CURRENT.kernels = kernels
     try:
         yield
     finally:
-        _CURRENT.assembler = before
+        _CURRENT.kernels = before
 
 
 def _jac_indices(n, m, k):
@@ -139,11 +209,12 @@ def _jac_indices(n, m, k):
 
 
 _ORIGINAL: dict = {}
-_REPLACEMENT = {"compute_jac_indices": _jac_indices, "construct_global_jac": collocation_jacobian}
+_REPLACEMENT = {"compute_jac_indices": _jac_indices, "construct_global_jac": collocation_jacobian,
+                "splu": factorise}
 
 
 def install() -> bool:
-    """Replace the two functions in ``scipy.integrate._bvp`` (once); False if that scipy does
+    """Replace the three functions in ``scipy.integrate._bvp`` (once); False if that scipy does
     not have them with the expected parameters (it keeps its own)."""
     from scipy.integrate import _bvp
 
@@ -152,7 +223,8 @@ def install() -> bool:
     found = {name: getattr(_bvp, name, None) for name in _SIGNATURES}
     for name, fn in found.items():
         try:
-            if not callable(fn) or tuple(inspect.signature(fn).parameters) != _SIGNATURES[name]:
+            if not callable(fn) or (_SIGNATURES[name] is not None
+                                    and tuple(inspect.signature(fn).parameters) != _SIGNATURES[name]):
                 return False
         except (TypeError, ValueError):
             return False

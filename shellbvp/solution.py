@@ -86,7 +86,7 @@ def _failed_run(x, y, p, status, message):
                           niter=0, status=status, message=message, success=False)
 
 
-def solve_bvp(fun, bc, x, y, p=None, *, fun_jac, bc_jac, max_jacobians=None, assembler=None, **kwargs):
+def solve_bvp(fun, bc, x, y, p=None, *, fun_jac, bc_jac, max_jacobians=None, kernels=None, **kwargs):
     """scipy.integrate.solve_bvp, imported on first use (scipy.integrate is most of the
     import time of shellbvp, and reading files or loading a model does not need it),
     with a guard on what reaches its linear algebra.
@@ -95,8 +95,8 @@ def solve_bvp(fun, bc, x, y, p=None, *, fun_jac, bc_jac, max_jacobians=None, ass
     Jacobians than that -- for probes that have a fallback: solve_bvp restarts a Newton that
     diverges on an unchanged mesh up to 10 times, ~35 Jacobians.  The result then keeps the
     unknowns ``p`` of the last iterate (its states and numbers are NaN), for the caller to
-    see where Newton was going.  ``assembler``: a compiled assembly of the collocation
-    Jacobian (``shellbvp.collocation.assembling``), or None.
+    see where Newton was going.  ``kernels``: compiled kernels that factorise the collocation
+    Jacobian (``shellbvp.collocation.solving_with``), or None (SuperLU).
 
     A guess with NaN/inf or a mesh that is not strictly increasing, and a Jacobian
     that overflows during Newton (a state far outside the model's domain, e.g. an
@@ -106,7 +106,7 @@ def solve_bvp(fun, bc, x, y, p=None, *, fun_jac, bc_jac, max_jacobians=None, ass
     """
     from scipy.integrate import solve_bvp as _solve_bvp
 
-    collocation.install()  # the collocation Jacobian without its stored zeros
+    collocation.install()  # the collocation Jacobian without its stored zeros, or compiled
     xa = np.asarray(x, float)
     if xa.ndim != 1 or xa.size < 2 or not np.all(np.isfinite(xa)) or not np.all(np.diff(xa) > 0):
         return _failed_run(x, y, p, 2, "degenerate mesh (not strictly increasing and finite): no solve")
@@ -114,7 +114,7 @@ def solve_bvp(fun, bc, x, y, p=None, *, fun_jac, bc_jac, max_jacobians=None, ass
         return _failed_run(x, y, p, 2, "the initial guess has NaN or inf entries: no solve")
     try:
         # solve_bvp evaluates fun_jac twice per Jacobian (at the nodes and the midpoints)
-        with collocation.assembling(assembler):
+        with collocation.solving_with(kernels):
             return _solve_bvp(fun, bc, x, y, p, fun_jac=_finite_jacobian(
                 fun_jac, "fun_jac", None if max_jacobians is None else 2 * max_jacobians),
                 bc_jac=_finite_jacobian(bc_jac, "bc_jac"), **kwargs)

@@ -18,9 +18,9 @@ float64 arrays (layout ``A``): solve_bvp hands over both.  Arguments that are no
 node arguments (``par``) are 1-D arrays unpacked once before the loop, so new
 run-time parameters pass through without any change here.
 
-The module also holds ``collocation_csc`` (:mod:`symbolic.collocation_kernel`, not
-derived): solve_bvp's collocation Jacobian assembled in CSC form, compiled and cached
-with the structure's kernels.
+The module also holds ``collocation_factor`` and ``collocation_solve``
+(:mod:`symbolic.collocation_kernel`, not derived): solve_bvp's collocation system
+factorised and solved, compiled and cached with the structure's kernels.
 
 Output is deterministic: the same structure gives byte-identical text.  It is
 a second module rather than a section of the numpy one so that the numpy
@@ -33,6 +33,7 @@ from __future__ import annotations
 import inspect
 import textwrap
 
+from . import collocation_kernel
 from .codegen import (
     FunctionSpec,
     docstring,
@@ -154,15 +155,14 @@ def kernel_source(d: Derivation, description: str, specs: list[FunctionSpec] | N
         "",
         f"KEY = {key!r}",
         f"PARAMS = {tuple(p.name for p in d.params)!r}",
-        f"KERNELS = {tuple(s.name for s in kernels) + ('collocation_csc',)!r}",
+        f"KERNELS = {tuple(s.name for s in kernels) + tuple(collocation_kernel.SIGNATURES)!r}",
         "",
     ]
     return "\n".join(head) + "\n" + "\n\n".join([_kernel_source(s) for s in kernels] + [_collocation_source()])
 
 
 def _collocation_source() -> str:
-    """:func:`symbolic.collocation_kernel.collocation_csc`, compiled with the structure's kernels."""
-    from . import collocation_kernel
-
-    return (f"@numba.njit({collocation_kernel.SIGNATURE!r}, {KERNEL_OPTIONS})\n"
-            + inspect.getsource(collocation_kernel.collocation_csc))
+    """The functions of :mod:`symbolic.collocation_kernel`, compiled with the structure's kernels."""
+    return "\n\n".join(f"@numba.njit({signature!r}, {KERNEL_OPTIONS})\n"
+                       + inspect.getsource(getattr(collocation_kernel, name))
+                       for name, signature in collocation_kernel.SIGNATURES.items())

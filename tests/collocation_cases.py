@@ -1,38 +1,34 @@
-"""Collocation Jacobians to compare with scipy's assembly (test_solve: the loops as plain
-Python; test_kernels: compiled)."""
+"""Collocation systems to solve with symbolic.collocation_kernel's elimination and with
+SuperLU (test_solve: the elimination as plain Python; test_kernels: compiled)."""
+
+import types
 
 import numpy as np
 
+from symbolic import collocation_kernel
 
-def _scipys_collocation_jacobian(n, m, k, h, *blocks):
-    """scipy's own assembly with its zeros eliminated (the reference)."""
+#: the elimination's functions as plain Python (what the kernel modules compile)
+PLAIN = types.SimpleNamespace(collocation_factor=collocation_kernel.collocation_factor,
+                              collocation_solve=collocation_kernel.collocation_solve)
+
+
+def elimination_against_superlu(kernels, n, m, k, h, *blocks):
+    """(max relative difference of the solutions of two right-hand sides, growth) of the
+    elimination in ``kernels`` against SuperLU on scipy's own assembly of the same matrix."""
     from shellbvp import collocation
 
     collocation.install()
-    theirs = collocation._ORIGINAL["construct_global_jac"](
+    J = collocation._ORIGINAL["construct_global_jac"](
         n, m, k, *collocation._ORIGINAL["compute_jac_indices"](n, m, k), h,
         *[None if b is None else np.array(b) for b in blocks])  # scipy updates df_dp_middle in place
-    theirs.eliminate_zeros()
-    theirs.sort_indices()
-    return theirs
-
-
-def collocation_loops_against_scipy(collocation_csc, n, m, k, h, *blocks):
-    """max |difference| / max |entry| of ``collocation_csc`` (the loops of
-    symbolic.collocation_kernel, plain or compiled) against scipy's assembly; asserts the
-    same sparsity and sorted rows without stored zeros."""
-    from scipy.sparse import csc_matrix
-
-    df_dy, df_dy_middle, df_dp, df_dp_middle, dbc_dya, dbc_dyb, dbc_dp = blocks
-    if k == 0:
-        df_dp = df_dp_middle = np.empty((n, 0, m))
-        dbc_dp = np.empty((n, 0))
-    data, indices, indptr = collocation_csc(h, df_dy, df_dy_middle, df_dp, df_dp_middle, dbc_dya, dbc_dyb, dbc_dp)
-    ours = csc_matrix((data, indices, indptr), shape=(n * m + k, n * m + k))
-    theirs = _scipys_collocation_jacobian(n, m, k, h, *blocks)
-    assert ours.has_sorted_indices and np.count_nonzero(ours.data == 0) == 0
-    assert np.array_equal(ours.indptr, theirs.indptr) and np.array_equal(ours.indices, theirs.indices)
-    return float(np.max(np.abs(ours.data - theirs.data)) / np.max(np.abs(theirs.data)))
+    superlu = collocation._ORIGINAL["splu"](J.tocsc())
+    lu = collocation.CollocationBlocks(kernels, n, m, k, h, *blocks).factorise()
+    rng = np.random.default_rng(5)
+    worst = 0.0
+    for b in (rng.standard_normal(J.shape[0]), J @ rng.standard_normal(J.shape[0])):
+        ours, theirs = lu.solve(b), superlu.solve(b)
+        worst = max(worst, float(np.max(np.abs(ours - theirs)) / np.max(np.abs(theirs))))
+    return worst, lu.growth
 
 
 def random_collocation_blocks(k, n=5, m=9, seed=3):

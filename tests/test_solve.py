@@ -385,7 +385,7 @@ def test_collocation_jacobian_is_scipys_without_its_stored_zeros(base, monkeypat
 
     def both(n, m, k, i_jac, j_jac, h, *blocks):
         copies = [None if b is None else np.array(b) for b in blocks]  # scipy updates df_dp_middle in place
-        ours = collocation.collocation_jacobian(n, m, k, None, None, h, *blocks)
+        ours = collocation.assemble_csc(n, m, k, h, *blocks)
         theirs = scipys(n, m, k, *collocation._ORIGINAL["compute_jac_indices"](n, m, k), h, *copies)
         theirs.eliminate_zeros()
         theirs.sort_indices()
@@ -409,17 +409,17 @@ def test_collocation_jacobian_is_scipys_without_its_stored_zeros(base, monkeypat
     np.testing.assert_allclose(ours.y, theirs.y, rtol=1e-9, atol=1e-12)
 
 
-def test_the_collocation_loops_assemble_scipys_jacobian(base, monkeypatch):
-    """symbolic.collocation_kernel.collocation_csc (compiled with a structure's kernels; here
-    as plain Python) gives scipy's collocation Jacobian, zeros eliminated, on the Jacobians of
-    a lift-off solve (two regions, unknowns) and on random block-diagonal ones with and
-    without unknowns."""
+def test_the_collocation_elimination_solves_as_superlu(base, monkeypatch):
+    """symbolic.collocation_kernel's factor and solve (compiled with a structure's kernels;
+    here as plain Python) solve scipy's collocation system as SuperLU does, on the Jacobians
+    of a lift-off solve (two regions, unknowns) and on random block-diagonal ones with and
+    without unknowns; an exactly singular one raises as SuperLU does, and factors that grow
+    beyond the limit are handed back to SuperLU."""
     import scipy.integrate._bvp as bvp
 
-    from collocation_cases import collocation_loops_against_scipy, random_collocation_blocks
+    from collocation_cases import PLAIN, elimination_against_superlu, random_collocation_blocks
 
     from shellbvp import collocation
-    from symbolic.collocation_kernel import collocation_csc
 
     collocation.install()
     caught = []
@@ -427,15 +427,29 @@ def test_the_collocation_loops_assemble_scipys_jacobian(base, monkeypatch):
     def catch(n, m, k, i_jac, j_jac, h, *blocks):
         if len(caught) < 2 and m <= 120:
             caught.append((n, m, k, np.array(h), *[None if b is None else np.array(b) for b in blocks]))
-        return collocation.collocation_jacobian(n, m, k, i_jac, j_jac, h, *blocks)
+        return collocation.assemble_csc(n, m, k, h, *blocks)
 
     monkeypatch.setattr(bvp, "construct_global_jac", catch)
     lifted = sb.solve(base, delta=0.075, estimate_error=False)
     assert lifted.success and caught and all(c[2] > 0 for c in caught)
-    for n, m, k, h, *blocks in caught:
-        assert collocation_loops_against_scipy(collocation_csc, n, m, k, h, *blocks) <= 1e-14
-    for k in (0, 2):
-        assert collocation_loops_against_scipy(collocation_csc, *random_collocation_blocks(k)) <= 1e-14
+    for case in caught + [random_collocation_blocks(0), random_collocation_blocks(2)]:
+        difference, growth = elimination_against_superlu(PLAIN, *case)
+        assert difference <= 1e-12 and 0 < growth < 1e3
+    n, m, k, h, *blocks = random_collocation_blocks(2)
+    blocks[1][:, 3, 4] = blocks[0][:, 3, 4] = 0.0  # state 3 enters no equation and no condition:
+    blocks[0][:, 3, :] = blocks[1][:, 3, :] = 0.0
+    blocks[4][:, 3] = blocks[5][:, 3] = 0.0
+    singular = collocation.CollocationBlocks(PLAIN, n, m, k, h, *blocks)
+    with pytest.raises(RuntimeError, match="exactly singular"):
+        collocation.factorise(singular)
+    with pytest.raises(RuntimeError, match="exactly singular"):  # SuperLU agrees
+        collocation._ORIGINAL["splu"](singular.tocsc())
+    blocks = random_collocation_blocks(2)[4:]
+    grown = collocation.CollocationBlocks(PLAIN, n, m, k, h, *blocks)
+    growth = grown.factorise().growth
+    assert grown.factorise(max_growth=growth / 2) is None
+    monkeypatch.setattr(collocation, "MAX_GROWTH", growth / 2)
+    assert type(collocation.factorise(grown)).__name__ == "SuperLU"
 
 
 def test_solve_bvp_stops_when_newton_exceeds_its_jacobian_budget():
