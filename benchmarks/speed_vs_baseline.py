@@ -21,9 +21,11 @@ every 12th also at 1e-10 to show the reference's own error).
   ``no secant guard`` (the secant predictor in ln Sc unguarded), ``full Richardson``
   (``estimate_error="full"``: a Richardson solve at every point, as at the baseline),
   ``thinned warm meshes`` (warm starts on every third node instead of a mesh equidistributing
-  the residual), ``explicit zeros kept`` (solve_bvp's Jacobian factorised with its stored zeros,
-  with the numpy functions and with numba's: compare with ``this commit, numba``); these on the
-  three base curves only.
+  the residual), ``explicit zeros kept`` (scipy's own assembly of solve_bvp's Jacobian, with its
+  stored zeros, and SuperLU, with the numpy functions and with numba's: compare with ``this
+  commit, numba``), ``SuperLU, numba`` (numba's kernels, but the Jacobian assembled and
+  factorised by SuperLU instead of the kernels' elimination); these on the three base curves
+  only.
 * Shooting (``benchmarks/shooting.py``, the paper's method) re-solves the reference's cap
   states (delta >= 0.15) at its rtol 1e-8 and 1e-9, each from its neighbour with the
   tangent predictor (the first from the reference's own unknowns: no cold start is counted);
@@ -86,6 +88,7 @@ VARIANTS = {
     "thinned warm meshes": ("new", {"shellbvp.solution": {"_EQUIDISTRIBUTE": False}}, {}, NUMPY),
     "explicit zeros kept": ("new", {"shellbvp.collocation": {"ENABLED": False}}, {}, NUMPY),
     "explicit zeros kept, numba": ("new", {"shellbvp.collocation": {"ENABLED": False}}, {}, NUMBA),
+    "SuperLU, numba": ("new", {"shellbvp.collocation": {"COMPILED_ELIMINATION": False}}, {}, NUMBA),
 }
 
 #: variant -> the curves it runs on (each change switched off where it acts; the others run everywhere)
@@ -98,6 +101,7 @@ ABLATIONS = {
     "thinned warm meshes": ("base default", "base 40 depths", "base 40 depths, cap only"),
     "explicit zeros kept": ("base default", "base 40 depths", "base 40 depths, cap only"),
     "explicit zeros kept, numba": ("base default", "base 40 depths", "base 40 depths, cap only"),
+    "SuperLU, numba": ("base default", "base 40 depths", "base 40 depths, cap only"),
 }
 
 

@@ -35,11 +35,13 @@ import threading
 
 import numpy as np
 
-__all__ = ["ENABLED", "MAX_GROWTH", "CollocationBlocks", "CollocationLU", "assemble_csc", "collocation_jacobian",
+__all__ = ["ENABLED", "COMPILED_ELIMINATION", "MAX_GROWTH", "CollocationBlocks", "CollocationLU", "assemble_csc", "collocation_jacobian",
            "factorise", "install", "solving_with"]
 
-#: Assemble without the zeros (False: scipy's own assembly; benchmarks measure the gain)
+#: Assemble without the zeros (False: scipy's own assembly and SuperLU; benchmarks measure the gain)
 ENABLED = True
+#: With compiled kernels, factorise by their elimination (False: assembly and SuperLU, as with numpy)
+COMPILED_ELIMINATION = True
 
 _SIGNATURES = {
     "splu": None,  # SuperLU's: any parameters
@@ -82,7 +84,7 @@ def collocation_jacobian(n, m, k, i_jac, j_jac, h, df_dy, df_dy_middle, df_dp, d
         return _ORIGINAL["construct_global_jac"](n, m, k, i_jac, j_jac, h, df_dy, df_dy_middle, df_dp,
                                                  df_dp_middle, dbc_dya, dbc_dyb, dbc_dp)
     kernels = getattr(_CURRENT, "kernels", None)
-    if kernels is not None:
+    if kernels is not None and COMPILED_ELIMINATION:
         return CollocationBlocks(kernels, n, m, k, h, df_dy, df_dy_middle, df_dp, df_dp_middle, dbc_dya, dbc_dyb,
                                  dbc_dp)
     return assemble_csc(n, m, k, h, df_dy, df_dy_middle, df_dp, df_dp_middle, dbc_dya, dbc_dyb, dbc_dp)

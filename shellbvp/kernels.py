@@ -3,12 +3,15 @@
 A curve spends about 40 % of its time in the generated right-hand sides and
 Jacobians, and 7-10 % in the regions' profiles (diagnosis and energy at every
 state), most of it NumPy's fixed cost per array operation on a few hundred
-nodes.  The code generator also prints them as loops over the nodes
+nodes; and SuperLU, 20-30 %, on a matrix whose structure it does not know.
+The code generator also prints them as loops over the nodes
 (``symbolic.codegen_numba``, ``kernels_<key>.py`` beside the numpy module
 ``model_<key>.py``).  With numba installed (``pip install shellbvp[fast]``) they
 are compiled once per structure, kept in numba's on-disk cache (``__pycache__``
 beside the generated modules, so keyed the same way), and the solver
-(:mod:`shellbvp.chain`) calls them in place of the numpy ones.  The numpy module
+(:mod:`shellbvp.chain`) calls them in place of the numpy ones; the module also
+holds the elimination that solves solve_bvp's collocation system in place of
+SuperLU (:mod:`shellbvp.collocation`).  The numpy module
 stays the reference and the fallback: without numba nothing changes.
 
 The choice is the environment variable ``SHELLBVP_KERNELS``:
@@ -19,7 +22,7 @@ The choice is the environment variable ``SHELLBVP_KERNELS``:
     process, about what loading compiled kernels costs, so a single solve never pays
     for them and a curve is repaid.  Then the kernels are loaded from the cache in a
     background thread (~0.5 s) or, the first time for a structure, compiled in a
-    background process (once per structure, ~10 s on the other core; it finishes
+    background process (once per structure, ~15 s on the other core; it finishes
     even if this process ends first, so the next run finds them), and the solver
     switches when they are ready.  A process, not a thread, compiles: compiling is
     Python work that would hold the interpreter lock and slow the solve it is meant
@@ -31,7 +34,7 @@ The choice is the environment variable ``SHELLBVP_KERNELS``:
     ImportError if numba is missing.
 
 Compilation is logged at INFO level ("compiling kernels for this scene, once:
-~10 s"); ``kernels_<key>.ready`` records a finished compilation (numba and
+~15 s"); ``kernels_<key>.ready`` records a finished compilation (numba and
 Python versions, the source's time stamp and size), ``kernels_<key>.log`` the
 background process's output.  numba's cache files are loaded code (pickles), so
 they are used only from a directory that passes the code cache's trust checks
@@ -63,7 +66,7 @@ ENV = "SHELLBVP_KERNELS"
 CHOICES = ("auto", "numpy", "numba")
 #: What the compile log line announces (derivation if needed + numba compile; measured in
 #: benchmarks/results/kernels.md on the 2-core machine)
-COMPILE_ESTIMATE_S = 10
+COMPILE_ESTIMATE_S = 15
 #: auto starts the compiled kernels once the numpy ones have taken this long in this process:
 #: loading them costs about as much (numba's start-up and cache; benchmarks/results/kernels.md),
 #: so a single solve never pays it and a curve is repaid

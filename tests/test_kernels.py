@@ -45,8 +45,8 @@ def _states(kind, rng, m):
         S = np.sort(rng.uniform(0.05, 1.5, m))
         y = np.vstack([rng.uniform(0.8, 1.2, m), rng.uniform(0.3, 1.5, m), rng.uniform(0.8, 1.25, m),
                        rng.uniform(0.3, 3, m), rng.uniform(-0.3, 0.3, m), rng.uniform(-1, 0, m)])
-    else:
-        S = np.sort(rng.uniform(1e-3, 0.3, m))
+    else:  # on the cylinder (r = rho = 0.2) lambda_theta = rho / R(S) is O(1) only for S near 0.2
+        S = np.sort(rng.uniform(1e-3, 0.3, m) if kind == "contact" else rng.uniform(0.12, 0.3, m))
         y = np.vstack([rng.uniform(0.8, 1.2, m), rng.uniform(0.8, 1.25, m)])
     return S, y
 
