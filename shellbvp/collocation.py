@@ -31,12 +31,15 @@ from __future__ import annotations
 
 import contextlib
 import inspect
+import logging
 import threading
 
 import numpy as np
 
-__all__ = ["ENABLED", "COMPILED_ELIMINATION", "MAX_GROWTH", "CollocationBlocks", "CollocationLU", "assemble_csc", "collocation_jacobian",
-           "factorise", "install", "solving_with"]
+__all__ = ["ENABLED", "COMPILED_ELIMINATION", "MAX_GROWTH", "CollocationBlocks", "CollocationLU", "assemble_csc",
+           "collocation_jacobian", "factorise", "install", "solving_with"]
+
+log = logging.getLogger(__name__)
 
 #: Assemble without the zeros (False: scipy's own assembly and SuperLU; benchmarks measure the gain)
 ENABLED = True
@@ -183,6 +186,7 @@ def factorise(J, *args, **kwargs):
         lu = J.factorise()
         if lu is not None:
             return lu
+        log.debug("collocation factors grew beyond %g times the matrix: SuperLU instead", MAX_GROWTH)
         J = J.tocsc()
     return _ORIGINAL["splu"](J, *args, **kwargs)
 
