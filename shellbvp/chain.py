@@ -762,7 +762,8 @@ class ChainBVP:
         (a first integral of a free region, so the indenter's force)."""
         k = len(self.regions) - 1
         S = self.S_point(self.regions[k].start, p)
-        G = self.model.free_profile(np.array([S]), ya[self.rows(k), None], self.par_at(p))["axial_force_2pi"][0]
+        G = self.kernels.active.free_profile(np.array([S]), ya[self.rows(k), None],
+                                             self.par_at(p))["axial_force_2pi"][0]
         return 2 * np.pi * float(G), float(self.quantities(p)["delta"])
 
     def region_profiles(self, t, y, p):
@@ -845,7 +846,7 @@ class ChainBVP:
         for j in self.junctions:
             if isinstance(j, (ContactPole, FreePole)):
                 zeta = self.S_point(self.regions[j.k].start, p)
-                prof = getattr(self.model, f"{self.regions[j.k].kind}_profile")
+                prof = getattr(self.kernels.active, f"{self.regions[j.k].kind}_profile")
                 density = prof(np.array([zeta]), sol(np.array([0.0]))[self.rows(j.k)], self.par_at(p))["energy_density"]
                 total += 0.5 * float(density[0]) * zeta
         return 2 * np.pi * total

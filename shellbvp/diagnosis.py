@@ -35,8 +35,8 @@ def _edges(sysm):
 
 
 def _at(sysm, kind, S, y):
-    """The generated profile of a ``kind`` region at one point S with state y."""
-    return getattr(sysm.model, f"{kind}_profile")(np.array([S]), y[:, None], sysm.par)
+    """The generated profile of a ``kind`` region at one point S with state y (kernel set's)."""
+    return getattr(sysm.kernels.active, f"{kind}_profile")(np.array([S], dtype=float), y[:, None], sysm.par)
 
 
 def _legendre_min(sysm, t, sol, p):
