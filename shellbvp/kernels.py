@@ -18,11 +18,10 @@ The choice is the environment variable ``SHELLBVP_KERNELS``:
 
 ``auto`` (default)
     numba's kernels when numba is installed, never waited for.  The numpy
-    functions serve, timed, until they have taken ``START_AFTER_S`` (0.2 s) in this
-    process: by then the work done at numpy's pace has cost about what loading the
-    compiled kernels costs, so a single solve never pays for them and a curve is
-    repaid.  Then the kernels are loaded from the cache in a background thread
-    (~0.35 s) or, the first time for a structure, compiled in a
+    functions serve, timed, until they have taken ``START_AFTER_S`` (0.5 s) in this
+    process, about what loading compiled kernels costs, so a single solve never pays
+    for them and a curve is repaid.  Then the kernels are loaded from the cache in a
+    background thread (~0.5 s) or, the first time for a structure, compiled in a
     background process (once per structure, ~15 s on the other core; it finishes
     even if this process ends first, so the next run finds them), and the solver
     switches when they are ready.  A process, not a thread, compiles: compiling is
@@ -68,12 +67,10 @@ CHOICES = ("auto", "numpy", "numba")
 #: What the compile log line announces (derivation if needed + numba compile; measured in
 #: benchmarks/results/kernels.md on the 2-core machine)
 COMPILE_ESTIMATE_S = 15
-#: auto starts the compiled kernels once the numpy ones have taken this long in this process.
-#: Break-even: loading them costs ~0.35 s (benchmarks/results/kernels.md); a curve spends ~40 %
-#: of its numpy time in these functions and runs ~3.3x faster compiled, so each second in them
-#: is ~1.7 s of time the compiled path would have saved: 0.35 / 1.7 ~ 0.2 s.  A single solve
-#: (~0.04 s in them) never reaches it.
-START_AFTER_S = 0.2
+#: auto starts the compiled kernels once the numpy ones have taken this long in this process:
+#: loading them costs about as much (numba's start-up and cache; benchmarks/results/kernels.md),
+#: so a single solve never pays it and a curve is repaid
+START_AFTER_S = 0.5
 _BUSY = 3  # exit status of the compile process when another process is compiling the same structure
 _LOCK_STALE_S = 1800.0  # a lock older than this is from a compile that died
 _WAIT_S = 1800.0  # how long a process waits for another one's compilation before giving up
