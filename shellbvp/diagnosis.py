@@ -49,7 +49,7 @@ def _legendre_min(sysm, t, sol, p):
         if reg.kind != "free":
             continue
         S = sysm.S(k, t, p)
-        det = sysm.model.free_legendre(S, y[sysm.rows(k)], sysm.par)[0]
+        det = sysm.kernels.active.free_legendre(S, y[sysm.rows(k)], sysm.par)[0]
         scale = float(np.median(np.abs(det)))
         if not scale > 0:
             continue
@@ -166,7 +166,7 @@ def diagnose(sysm, bvp, tol, converged_note: str = "") -> Solution:
     res.wall_gap = min(wall_gap(sysm, f["r"], f["z"], res.z_tip) for _, f in free)
     last = len(sysm.regions) - 1
     t_leg = np.array([0.0, 0.5])
-    leg = mod.free_legendre(sysm.S(last, t_leg, p), bvp.sol(t_leg)[sysm.rows(last)], par)[0]
+    leg = sysm.kernels.active.free_legendre(sysm.S(last, t_leg, p), bvp.sol(t_leg)[sysm.rows(last)], par)[0]
     res.edge_legendre = float(leg[0] / leg[1]) if leg[1] != 0 else nan
     res.legendre_min, res.legendre_min_S = _legendre_min(sysm, t, bvp.sol, p)
     res.contact_edge = _edge_model(sysm)

@@ -221,7 +221,8 @@ def function_specs(d: Derivation) -> list[FunctionSpec]:
     specs.append(FunctionSpec("free_legendre", d.free, [("S", (d.free.inputs[0],)), ("y", d.free_states),
                                                         ("par", par)], [("out", legendre)],
                               "det d(tau_s, M_s)/d(lambda_s, kappa_s) over the free region, (1, m): "
-                              "the ODE is singular where it vanishes (loss of convexity of U)", "S"))
+                              "the ODE is singular where it vanishes (loss of convexity of U)", "S",
+                              node_args=("S", "y")))  # diagnosis, at every state
     # pole
     chi, ls = d.pole_states
     pargs = [("chi", (chi,)), ("ls", (ls,)), ("lambda0", (LAMBDA0,)), ("par", par)]
