@@ -165,4 +165,5 @@ def _collocation_source() -> str:
     """The functions of :mod:`symbolic.collocation_kernel`, compiled with the structure's kernels."""
     return "\n\n".join(f"@numba.njit({signature!r}, {KERNEL_OPTIONS})\n"
                        + inspect.getsource(getattr(collocation_kernel, name))
-                       for name, signature in collocation_kernel.SIGNATURES.items())
+                       for name, signature in {**collocation_kernel.HELPERS,
+                                               **collocation_kernel.SIGNATURES}.items())

@@ -19,6 +19,8 @@ zeros of the stacked regions' block-diagonal blocks.
 
 import numpy
 
+#: numba signatures of the helpers the kernels call (printed first, not kernels themselves)
+HELPERS = {"pivot_row": "int64(float64[:, :], int64, int64)"}
 #: numba signatures (the unknowns' arrays have k = 0 columns when there are none)
 SIGNATURES = {
     "collocation_factor": "(float64[:], float64[:, :, :], float64[:, :, :], float64[:, :, :], float64[:, :, :], "
@@ -26,6 +28,17 @@ SIGNATURES = {
     "collocation_solve": "(int64, int64[:], float64[:], int64[:], int64[:], float64[:], int64[:], int64[:], "
                          "float64[:], float64[:, :], int64[:], float64[:])",
 }
+
+
+def pivot_row(a, c, rows):
+    """The row (c <= row < rows) of the largest |a[row, c]|, the first of equals."""
+    p = c
+    best = abs(a[c, c])
+    for r in range(c + 1, rows):
+        if abs(a[r, c]) > best:
+            best = abs(a[r, c])
+            p = r
+    return p
 
 
 def collocation_factor(h, df_dy, df_dy_middle, df_dp, df_dp_middle, dbc_dya, dbc_dyb, dbc_dp, max_growth):
@@ -119,12 +132,8 @@ def collocation_factor(h, df_dy, df_dy_middle, df_dp, df_dp_middle, dbc_dya, dbc
             for c in range(cols):
                 biggest = max(biggest, abs(w[r, c]))
         for c in range(n):  # partial pivoting over every row that holds y_i's column c
-            p = c
-            best = abs(w[c, c])
-            for r in range(c + 1, rows):
-                if abs(w[r, c]) > best:
-                    best = abs(w[r, c])
-                    p = r
+            p = pivot_row(w, c, rows)
+            best = abs(w[p, c])
             if best == 0.0:
                 return piv, diag, l_ptr, l_row, l_val, u_ptr, u_col, u_val, last, lpiv, 0.0, 1
             s = i * n + c
@@ -167,13 +176,8 @@ def collocation_factor(h, df_dy, df_dy_middle, df_dp, df_dp_middle, dbc_dya, dbc
         for u in range(k):
             last[r, n + u] = w[n + r, 3 * n + u]
     for c in range(size):
-        p = c
-        best = abs(last[c, c])
-        for r in range(c + 1, size):
-            if abs(last[r, c]) > best:
-                best = abs(last[r, c])
-                p = r
-        if best == 0.0:
+        p = pivot_row(last, c, size)
+        if last[p, c] == 0.0:
             return piv, diag, l_ptr, l_row, l_val, u_ptr, u_col, u_val, last, lpiv, 0.0, 1
         lpiv[c] = p
         if p != c:

@@ -140,7 +140,7 @@ def test_the_kernel_module_is_generated_beside_the_numpy_one_and_deterministic()
     kernels.add("free_legendre")
     elimination = ("collocation_factor", "collocation_solve")
     assert f"KERNELS = {tuple(sorted(kernels, key=text.index)) + elimination!r}" in text
-    assert text.count("@numba.njit(") == len(kernels) + 2 and "for _node in range(_m):" in text
+    assert text.count("@numba.njit(") == len(kernels) + 3 and "for _node in range(_m):" in text
     assert text.count("_profile_rows(S, y, par)))") == 3  # a profile's dict is made outside the kernel
     mtime = path.stat().st_mtime_ns
     assert sbm.kernel_source_path(desc) == path and path.stat().st_mtime_ns == mtime  # never rewritten
