@@ -98,7 +98,7 @@ def diagnose(sysm, bvp, tol, converged_note: str = "") -> Solution:
     q = sysm.quantities(p) if sysm.k else sysm.quantities(None)
     ya, yb = bvp.y[:, 0], bvp.y[:, -1]
     force, delta = sysm.end_values(ya, yb, p)
-    mod, par = sysm.model, sysm.par
+    par = sysm.par
     first = sysm.chain.junctions[0]
     lambda0 = (q["lambda0"] if isinstance(first, ContactPole)
                else ya[sysm.rows(0)][_LS] if isinstance(first, FreePole) else nan)

@@ -7,7 +7,6 @@ satisfy the energy identity F = dE/ddelta, and that curves switch topology
 without a jump in F(delta).
 """
 
-import math
 
 import numpy as np
 import pytest
