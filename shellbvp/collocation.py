@@ -144,10 +144,6 @@ class CollocationBlocks:
         self.kernels, self.n, self.m, self.k = kernels, n, m, k
         self.blocks = (h, df_dy, df_dy_middle, df_dp, df_dp_middle, dbc_dya, dbc_dyb, dbc_dp)
 
-    @property
-    def shape(self):
-        return (self.n * self.m + self.k,) * 2
-
     def tocsc(self):
         """The same matrix, assembled (:func:`assemble_csc`)."""
         return assemble_csc(self.n, self.m, self.k, *self.blocks)
