@@ -56,7 +56,7 @@ import time
 import types
 from pathlib import Path
 
-from .model import description_key, holds_key, kernel_path, untrusted_reason, write_atomic
+from .model import description_key, holds_key, kernel_path, untrusted_reason, write_atomic, write_bytecode
 
 __all__ = ["CHOICES", "ENV", "KernelSet", "kernel_choice", "kernel_set", "compile_kernels"]
 
@@ -132,6 +132,7 @@ def _import_kernels(src: Path, key: str):
     if why := untrusted_reason(src) or _untrusted_cache(src):
         raise ImportError(f"not loading compiled kernels: {why}")
     (src.parent / "__pycache__").mkdir(mode=0o700, exist_ok=True)  # before numba makes it with the umask's
+    write_bytecode(src)  # the module's own Python (numba's dispatchers): ~35 ms to compile from source
     name = f"shellbvp_kernels_{key[:20]}"
     spec = importlib.util.spec_from_file_location(name, src)
     mod = importlib.util.module_from_spec(spec)

@@ -16,7 +16,11 @@ loop-over-nodes kernels for numba (``symbolic.codegen_numba``; imported only by
 Cached modules are code that is imported, so a cache directory or file that
 another user owns or may write is never imported from: the module is
 regenerated, into a private temporary directory if the directory itself is
-not trusted (a warning says so).
+not trusted (a warning says so).  The same holds for their bytecode
+(``__pycache__`` beside them), which is written when a module is first imported
+even under ``PYTHONDONTWRITEBYTECODE``: it is part of this cache, and compiling a
+structure's numpy module from source costs ~0.1 s of every process's start
+(``benchmarks/results/kernels.md``).
 """
 
 from __future__ import annotations
@@ -26,6 +30,7 @@ import importlib.metadata
 import importlib.util
 import logging
 import os
+import py_compile
 import stat
 import sys
 import tempfile
@@ -35,7 +40,8 @@ from pathlib import Path
 from symbolic.version import CODEGEN_VERSION, description_key, source_fingerprint
 
 __all__ = ["cache_dir", "structure_description", "description_key", "load_module", "module_path",
-           "kernel_path", "kernel_source_path", "holds_key", "write_atomic", "untrusted_reason"]
+           "kernel_path", "kernel_source_path", "holds_key", "write_atomic", "untrusted_reason",
+           "untrusted_bytecode", "write_bytecode"]
 
 log = logging.getLogger(__name__)
 _loaded: dict[str, object] = {}
@@ -82,6 +88,7 @@ def module_path(desc: dict) -> Path:
 
 def _import_file(path: Path, key: str):
     name = f"shellbvp_generated_{key[:20]}"
+    write_bytecode(path)
     spec = importlib.util.spec_from_file_location(name, path)
     mod = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(mod)
@@ -106,6 +113,34 @@ def untrusted_reason(path: Path) -> str | None:
     if st.st_mode & (stat.S_IWGRP | stat.S_IWOTH):
         return f"it is writable by other users (mode {stat.filemode(st.st_mode)})"
     return None
+
+
+def untrusted_bytecode(path: Path) -> str | None:
+    """Why the bytecode beside the generated module ``path`` (``__pycache__``, which the import
+    reads when it is current) must not be used, or None."""
+    pycache = path.parent / "__pycache__"
+    if not pycache.exists():
+        return None
+    if why := untrusted_reason(pycache):
+        return f"{pycache}: {why}"
+    pyc = Path(importlib.util.cache_from_source(str(path)))
+    if pyc.exists() and (why := untrusted_reason(pyc)):
+        return f"{pyc}: {why}"
+    return None
+
+
+def write_bytecode(path: Path) -> None:
+    """Compile the generated module ``path`` into its ``__pycache__`` unless that holds a file
+    as new as the source (the import checks the source's time stamp and size itself); atomic
+    (py_compile), never fatal: without it the import compiles from source."""
+    pyc = Path(importlib.util.cache_from_source(str(path)))
+    try:
+        if pyc.exists() and pyc.stat().st_mtime_ns >= path.stat().st_mtime_ns:
+            return
+        pyc.parent.mkdir(mode=0o700, exist_ok=True)
+        py_compile.compile(str(path), cfile=str(pyc), doraise=True)
+    except (OSError, py_compile.PyCompileError) as exc:
+        log.debug("no bytecode written for %s: %s", path, exc)
 
 
 def _private_dir() -> Path:
@@ -137,7 +172,7 @@ def load_module(desc: dict, *, regenerate: bool = False):
     if not regenerate and key in _loaded:
         return _loaded[key]
     path = module_path(desc)
-    if path.parent.exists() and (why := untrusted_reason(path.parent)):
+    if path.parent.exists() and (why := untrusted_reason(path.parent) or untrusted_bytecode(path)):
         log.warning("not using the code cache %s: %s; generating into a private directory", path.parent, why)
         path = _private_dir() / path.name
     elif path.exists() and (why := untrusted_reason(path)):

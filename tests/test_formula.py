@@ -5,11 +5,13 @@ creates a marker file.  The tests assert the marker never appears and that
 the only exceptions are ValueError/TypeError naming the formula.
 """
 
+import importlib.util
 import json
 import logging
 import os
 import subprocess
 import sys
+from pathlib import Path
 
 import h5py
 import pytest
@@ -230,6 +232,51 @@ def test_cache_directory_writable_by_others_is_not_used(tmp_path, monkeypatch, c
     assert "not using the code cache" in caplog.text
     assert not any(cache.iterdir())  # nothing written to, nothing read from the shared directory
     assert model.untrusted_reason(__import__("pathlib").Path(mod.__file__).parent) is None
+
+
+@pytest.fixture
+def cache_with_base_module(tmp_path, monkeypatch):
+    """An empty private cache holding only the base structure's numpy module (copied: no derivation)."""
+    desc = sb.Scene.preset("base").structure()
+    src = Path(model.load_module(desc).__file__)
+    cache = tmp_path / "cache"
+    cache.mkdir(mode=0o700)
+    (cache / src.name).write_bytes(src.read_bytes())
+    monkeypatch.setenv("SHELLBVP_CACHE_DIR", str(cache))
+    monkeypatch.setattr(model, "_loaded", {})
+    return cache, desc
+
+
+def test_generated_module_bytecode_is_written_even_under_dont_write_bytecode(cache_with_base_module, monkeypatch):
+    cache, desc = cache_with_base_module
+    monkeypatch.setattr(sys, "dont_write_bytecode", True)  # as PYTHONDONTWRITEBYTECODE=1 sets it
+    src = Path(model.load_module(desc).__file__)
+    assert src.parent == cache
+    pyc = Path(importlib.util.cache_from_source(str(src)))
+    head, st = pyc.read_bytes()[:16], src.stat()
+    # the header the import checks: magic, flags 0 (time stamp based), the source's mtime and size
+    assert head[:4] == importlib.util.MAGIC_NUMBER and int.from_bytes(head[4:8], "little") == 0
+    assert int.from_bytes(head[8:12], "little") == int(st.st_mtime) & 0xFFFFFFFF
+    assert int.from_bytes(head[12:16], "little") == st.st_size & 0xFFFFFFFF
+    assert model.untrusted_reason(pyc) is None and model.untrusted_reason(pyc.parent) is None
+
+
+@pytest.mark.parametrize("what", ["__pycache__", "pyc"])
+def test_bytecode_writable_by_others_is_not_used(cache_with_base_module, monkeypatch, caplog, what):
+    cache, desc = cache_with_base_module
+    pyc = Path(importlib.util.cache_from_source(str(Path(model.load_module(desc).__file__))))
+    os.chmod(pyc.parent if what == "__pycache__" else pyc, 0o777 if what == "__pycache__" else 0o666)
+    private = cache.parent / "private"  # the private directory, with the module too: no derivation
+    private.mkdir(mode=0o700)
+    src = next(cache.glob("model_*.py"))
+    (private / src.name).write_bytes(src.read_bytes())
+    monkeypatch.setattr(model, "_private", private)
+    monkeypatch.setattr(model, "_loaded", {})
+    with caplog.at_level(logging.WARNING, logger="shellbvp.model"):
+        mod = model.load_module(desc)
+    assert "not using the code cache" in caplog.text and "writable by other users" in caplog.text
+    assert Path(mod.__file__).parent == private
+    assert hasattr(mod, "free_rhs")
 
 
 @pytest.mark.parametrize("W", [
