@@ -24,6 +24,7 @@ base curve only, no "never slower" runs, ``kernels-quick.*``).  Without numba it
 from __future__ import annotations
 
 import argparse
+import compileall
 import datetime
 import importlib.util
 import json
@@ -118,14 +119,32 @@ def _cold_kernels_copy(warm, dest):
     shutil.copytree(warm, dest, ignore=shutil.ignore_patterns("__pycache__", "*.ready", "*.lock", "*.log"))
 
 
+#: the floor under every start: what shellbvp's import cannot avoid (solve_bvp's package)
+SCIPY_FLOOR = """
+import time, json
+t0 = time.perf_counter()
+import scipy.integrate
+print(json.dumps(dict(import_s=time.perf_counter() - t0)))
+"""
+
+
 def startup(repeat):
+    """Fresh processes, cold and warm; the package's own bytecode compiled first, as pip does
+    when it installs a wheel (else, under PYTHONDONTWRITEBYTECODE, every start compiles its
+    sources: ~0.1 s), and, per repeat, ``import scipy.integrate`` alone (the floor)."""
+    for package in ("shellbvp", "symbolic"):
+        compileall.compile_dir(str(ROOT / package), quiet=1)
     rows = {"cold": [], "warm numpy": [], "warm auto": [], "warm numba": []}
+    floor = []
     for _ in range(repeat):
         with tempfile.TemporaryDirectory() as cache:
             rows["cold"].append(_probe(START, cache, "numba"))
             for kind in ("numpy", "auto", "numba"):
                 rows[f"warm {kind}"].append(_probe(START, cache, kind))
-    return {k: _medians(v) for k, v in rows.items()}
+            floor.append(_probe(SCIPY_FLOOR, cache, "numpy"))
+    out = {k: _medians(v) for k, v in rows.items()}
+    out["floor"] = _medians(floor)
+    return out
 
 
 NEVER_SLOWER = (  # label, SHELLBVP_KERNELS, kernels compiled beforehand?, compile in a thread of the process?
@@ -286,11 +305,21 @@ def markdown(data):
           "| case | import shellbvp (s) | numpy module (s) | kernels (s) | first solve (s) | "
           "process start to first solve (s) | kernels in use |", "|---|---|---|---|---|---|---|"]
     for label, r in st.items():
+        if label == "floor":
+            continue
         L.append(f"| {label} | {r['import_s']:.2f} | {r['model_s']:.2f} | {r['kernels_s']:.2f} | "
                  f"{r['first_solve_s']:.2f} | {r['start_to_first_solve_s']:.2f} | {r['status']} after "
                  f"{r['settled_s']:.1f} s |")
     L += ["", "cold: empty cache, `SHELLBVP_KERNELS=numba` (derive and generate both modules, then compile "
-          "in the foreground).  warm auto: numpy serves (a single solve never loads the kernels).", ""]
+          "in the foreground).  warm auto: numpy serves (a single solve never loads the kernels).  The "
+          "package's bytecode is compiled before (as pip installs a wheel); the generated modules' bytecode "
+          "is written by the package into its cache."]
+    if "floor" in st:
+        fl, warm = st["floor"]["import_s"], st["warm numpy"]["import_s"]
+        L += [f"`import scipy.integrate` alone, in the same fresh processes (the floor: solve_bvp's package "
+              f"imports scipy.optimize, linalg and sparse): {fl:.2f} s (median of {st['floor']['runs']}); "
+              f"`import shellbvp` adds {warm - fl:.2f} s to it."]
+    L += [""]
     ns = data.get("never_slower")
     if ns is None:
         return "\n".join(L) + "\n"

@@ -139,3 +139,20 @@ def test_speed_vs_baseline_compares_points_of_the_same_depth_and_topology():
     assert list(sv._distinct([0.3, 0.1, 0.1 * (1 + 1e-14), 0.2])) == [0.1, 0.2, 0.3]
     with pytest.raises(SystemExit):
         sv.parse_args(["--repeat", "0"])
+
+
+def test_speed_vs_baseline_shooting_ratio_takes_the_cheapest_shooting_at_equal_or_better_error():
+    sv = _load("speed_vs_baseline")
+    shots = [dict(rtol=1e-6, per_point_ms=100.0, max_rel=5e-7, converged=20, points=20),  # too inaccurate
+             dict(rtol=1e-7, per_point_ms=150.0, max_rel=2e-7, converged=19, points=20),  # one failed
+             dict(rtol=1e-8, per_point_ms=200.0, max_rel=4e-8, converged=20, points=20),
+             dict(rtol=1e-9, per_point_ms=300.0, max_rel=2e-9, converged=20, points=20)]
+    case = dict(shooting=shots, rows={"this commit": dict(ms_per_point=20.0, f_error=3e-7)},
+                same_states={"this commit": dict(ms_per_point=5.0, f_error=3e-7),
+                             "this commit, numba": dict(ms_per_point=2.0, f_error=1e-8)})
+    assert sv.shooting_ratio(case) == pytest.approx(10.0)  # 200 / 20: rtol 1e-8
+    assert sv.shooting_ratio(case, same=True) == pytest.approx(40.0)  # 200 / 5
+    assert sv.shooting_ratio(case, "this commit, numba", same=True) == pytest.approx(150.0)  # 1e-9: 300 / 2
+    assert sv.shooting_ratio(case, "this commit, numba") is None  # not run
+    case["same_states"]["this commit"]["f_error"] = 1e-10  # no shooting rtol is as accurate
+    assert sv.shooting_ratio(case, same=True) is None
