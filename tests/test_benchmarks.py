@@ -150,9 +150,12 @@ def test_speed_vs_baseline_shooting_ratio_takes_the_cheapest_shooting_at_equal_o
     case = dict(shooting=shots, rows={"this commit": dict(ms_per_point=20.0, f_error=3e-7)},
                 same_states={"this commit": dict(ms_per_point=5.0, f_error=3e-7),
                              "this commit, numba": dict(ms_per_point=2.0, f_error=1e-8)})
-    assert sv.shooting_ratio(case) == pytest.approx(10.0)  # 200 / 20: rtol 1e-8
-    assert sv.shooting_ratio(case, same=True) == pytest.approx(40.0)  # 200 / 5
-    assert sv.shooting_ratio(case, "this commit, numba", same=True) == pytest.approx(150.0)  # 1e-9: 300 / 2
-    assert sv.shooting_ratio(case, "this commit, numba") is None  # not run
-    case["same_states"]["this commit"]["f_error"] = 1e-10  # no shooting rtol is as accurate
-    assert sv.shooting_ratio(case, same=True) is None
+    assert sv.shooting_ratio(case) == (pytest.approx(10.0), False)  # 200 / 20: rtol 1e-8
+    assert sv.shooting_ratio(case, same=True) == (pytest.approx(40.0), False)  # 200 / 5
+    assert sv.shooting_ratio(case, "this commit, numba", same=True) == (pytest.approx(150.0), False)  # 300 / 2
+    assert sv.shooting_ratio(case, "this commit, numba") == (None, False)  # not run
+    # no shooting rtol as accurate: its most accurate one's time, a lower bound
+    case["same_states"]["this commit"]["f_error"] = 1e-10
+    assert sv.shooting_ratio(case, same=True) == (pytest.approx(60.0), True)  # 300 / 5
+    sv.ratios(case)
+    assert case["shooting_ratio_same_bound"] and not case["shooting_ratio_bound"]
