@@ -20,7 +20,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy.optimize import fsolve
 
 from .chain import Edge
 
@@ -105,6 +104,8 @@ def other_edge_root(sol):
     the corner continues with the opposite sign (a transcritical crossing), so a jump of the
     opposite sign, scaled with the distance to the limit, seeds the corner's Newton iteration.
     """
+    from scipy.optimize import fsolve  # here: at module level it made `import shellbvp` load scipy.optimize
+
     G, v0, null = _edge_conditions(sol)
     n = null * (1 + np.abs(v0))  # null direction, scaled to the variables
     best = None

@@ -73,3 +73,17 @@ def test_the_cycle_check_can_fail(tmp_path, monkeypatch):
     (pkg / "b.py").write_text("def f():\n    from .a import y\n")
     monkeypatch.setattr(__import__(__name__), "PKG", pkg)
     assert graph() == {"a": {"b"}, "b": {"a"}}
+
+
+def test_import_loads_no_scipy_solver():
+    """``import shellbvp`` stays light (the CLI's --version, reading files): scipy's solvers are
+    imported when first used (docs/benchmarking.md: 0.48 -> 0.13 s)."""
+    import subprocess
+    import sys
+
+    code = ("import sys, shellbvp\n"
+            "print(sorted(m for m in ('scipy.optimize', 'scipy.integrate', 'scipy.interpolate', 'sympy', 'h5py')"
+            " if m in sys.modules))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,
+                         cwd=PKG.parent).stdout.strip()
+    assert out == "[]", f"import shellbvp loaded {out}"
