@@ -70,6 +70,9 @@ DELTAS40 = np.linspace(0.0125, 0.5, 40)
 #: still reaches the collocation curve's error is the one compared, so looser ones are tried too
 SHOOT_RTOLS = (1e-6, 1e-7, 1e-8, 1e-9)
 SHOOT_FROM = 0.15  # shooting solves single caps: from where every preset's curve is a cap
+#: collocation tolerances of the curves through shooting's states: each side at its cheapest setting
+#: that reaches the other's error (1e-6, the default, first: the rows compared at default settings)
+SAME_TOLS = (1e-6, 1e-5, 1e-4)
 
 #: (id, preset, kind): the curves compared
 CASES = [("base default", "base", "default"), ("base 40 depths", "base", "deltas40"),
@@ -319,20 +322,48 @@ def shooting_states(ref):
 def same_states(sides, entry, variants, repeat, log):
     """This commit's cap-only curve through exactly shooting's states (their depths, each from its
     neighbour by natural continuation, error estimates as by default; the first point's cold
-    solve counted, which shooting's is not): per variant, CPU ms per point and max F error."""
+    solve counted, which shooting's is not), at each of SAME_TOLS: per variant, CPU ms per point
+    and max F error at the default tol, and the same per tol (``tols``)."""
     ref = entry["_ref"]
     depths = [ref["delta"][i] for i in shooting_states(ref)]
     if not depths:
         return {}
     out = {}
     for v in variants:
-        runs = [sides.run(v, (entry["id"], entry["preset"], "same-states"), {"deltas": depths}) for _ in range(repeat)]
-        err, compared, left = f_error(runs[0], ref)
-        cpu = statistics.median(r["cpu"] for r in runs)
-        out[v] = dict(points=runs[0]["points"], depths=len(depths), cpu_median=cpu, f_error=err, compared=compared,
-                      left_out=left, ms_per_point=1e3 * cpu / max(runs[0]["points"], 1), stop=runs[0]["stop"])
-        log(f"  same states {entry['preset']} | {v}: {out[v]['points']} points, {out[v]['ms_per_point']:.1f} ms/point, "
-            f"max F error {err:.1e}")
+        rows = []
+        for tol in SAME_TOLS:
+            runs = [sides.run(v, (entry["id"], entry["preset"], "same-states"), {"deltas": depths, "tol": tol})
+                    for _ in range(repeat)]
+            err, compared, left = f_error(runs[0], ref)
+            cpu = statistics.median(r["cpu"] for r in runs)
+            rows.append(dict(tol=tol, points=runs[0]["points"], depths=len(depths), cpu_median=cpu, f_error=err,
+                             compared=compared, left_out=left, ms_per_point=1e3 * cpu / max(runs[0]["points"], 1),
+                             stop=runs[0]["stop"], complete=runs[0]["complete"]))
+            log(f"  same states {entry['preset']} | {v} | tol {tol:g}: {rows[-1]['points']} points, "
+                f"{rows[-1]['ms_per_point']:.1f} ms/point, max F error {err:.1e}")
+        out[v] = dict(rows[0], tols=rows)
+    return out
+
+
+def equal_error(case, variant):
+    """Per shooting rtol that converged at every state: (rtol, its ms/point and F error, the
+    cheapest collocation tol on the same states at least as accurate, its ms/point, the ratio);
+    the collocation cells None where no tol measured is that accurate."""
+    same = (case.get("same_states") or {}).get(variant)
+    if not same:
+        return []
+    tols = [t for t in same.get("tols", [same]) if t.get("complete", True) and t["compared"] == t["depths"]
+            and math.isfinite(t["f_error"])]
+    out = []
+    for s in case["shooting"]:
+        if s["converged"] != s["points"] or not math.isfinite(s["max_rel"]):
+            continue
+        good = [t for t in tols if t["f_error"] <= s["max_rel"]]
+        best = min(good, key=lambda t: t["ms_per_point"]) if good else None
+        out.append(dict(rtol=s["rtol"], shooting_ms=s["per_point_ms"], shooting_error=s["max_rel"],
+                        tol=best and best.get("tol", SAME_TOLS[0]), ms=best and best["ms_per_point"],
+                        error=best and best["f_error"],
+                        ratio=best and s["per_point_ms"] / best["ms_per_point"]))
     return out
 
 
@@ -485,6 +516,25 @@ def markdown(data):
                          f"{cell(same.get('this commit'), case, 'shooting_ratio_same')} | "
                          f"{cell(same.get('this commit, numba'), case, 'shooting_ratio_numba_same')} |")
         lines.append("")
+        lines += ["Equal error both ways, on the same cap states: for each shooting rtol that converged at "
+                  "every state, the cheapest collocation tol (of " + ", ".join(f"{t:g}" for t in SAME_TOLS) +
+                  ") whose F error is at most shooting's, and shooting's CPU ms/point over collocation's; "
+                  "'smallest' is the least favourable of them to collocation.", "",
+                  "| preset | kernels | shooting rtol (F error): collocation tol (F error, ms/point): ratio | "
+                  "smallest |", "|---|---|---|---|"]
+        for case in sh:
+            for v, key, label in (("this commit", "shooting_ratio", "numpy"),
+                                  ("this commit, numba", "shooting_ratio_numba", "numba")):
+                pairs = case.get(key + "_pairs") or []
+                if not pairs:
+                    continue
+                cells = "; ".join(
+                    f"{q['rtol']:g} ({q['shooting_error']:.0e}): " +
+                    (f"{q['tol']:g} ({q['error']:.0e}, {q['ms']:.1f}): {q['ratio']:.1f}x" if q["ratio"] is not None
+                     else "no tol as accurate") for q in pairs)
+                both = case.get(key + "_both")
+                lines.append(f"| {case['preset']} | {label} | {cells} | {_fmt(both, '.1f') + 'x' if both else '–'} |")
+        lines.append("")
     lines += ["| target (issue 14) | measured | met |", "|---|---|---|"]
     for t in data["targets"]:
         lines.append(f"| {t['target']} | {t['measured']} | {t['met']} |")
@@ -533,6 +583,18 @@ def targets(data):
                                 measured=f"median {statistics.median(eqs):.1f}x ({min(eqs):.1f}x–{max(eqs):.1f}x "
                                          f"over {len(eqs)} presets{note})", met="yes" if min(eqs) >= 40 else
                                 ("at the median, not on every preset" if statistics.median(eqs) >= 40 else "no")))
+    for key, label in (("shooting_ratio", "numpy"), ("shooting_ratio_numba", "numba kernels")):
+        eqs = [c[key + "_both"] for c in data["cases"] if c.get(key + "_both") is not None]
+        missing = sum(1 for c in data["cases"] if c.get(key + "_both") is not None and c.get(key + "_both_missing"))
+        if eqs:
+            note = (f"; on {missing} of them a shooting rtol more accurate than every collocation tol measured is "
+                    f"left out" if missing else "")
+            out.append(dict(target=f">= 40x faster than shooting at equal or better F error, per point, on the same "
+                                   f"cap states, each at its cheapest setting, at every accuracy both reached "
+                                   f"({label})",
+                            measured=f"median {statistics.median(eqs):.1f}x ({min(eqs):.1f}x–{max(eqs):.1f}x over "
+                                     f"{len(eqs)} presets{note})", met="yes" if min(eqs) >= 40 else
+                            ("at the median, not on every preset" if statistics.median(eqs) >= 40 else "no")))
     return out
 
 
@@ -555,10 +617,17 @@ def shooting_ratio(case, variant="this commit", same=False):
 
 
 def ratios(entry):
-    """Set the entry's shooting ratios (and whether each is a lower bound) from its rows."""
+    """Set the entry's shooting ratios (and whether each is a lower bound) from its rows, and the
+    equal-error pairs both ways with their smallest ratio (``_both``: over every accuracy shooting
+    reached, the least favourable to collocation)."""
     for v, key in (("this commit", "shooting_ratio"), ("this commit, numba", "shooting_ratio_numba")):
         for suffix, same in (("", False), ("_same", True)):
             entry[key + suffix], entry[key + suffix + "_bound"] = shooting_ratio(entry, v, same)
+        pairs = equal_error(entry, v)
+        entry[key + "_pairs"] = pairs
+        found = [q["ratio"] for q in pairs if q["ratio"] is not None]
+        entry[key + "_both"] = min(found) if found else None
+        entry[key + "_both_missing"] = len(pairs) - len(found)  # shooting rtols no collocation tol matched
 
 
 def this_commit():

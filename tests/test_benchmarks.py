@@ -148,8 +148,8 @@ def test_speed_vs_baseline_shooting_ratio_takes_the_cheapest_shooting_at_equal_o
              dict(rtol=1e-8, per_point_ms=200.0, max_rel=4e-8, converged=20, points=20),
              dict(rtol=1e-9, per_point_ms=300.0, max_rel=2e-9, converged=20, points=20)]
     case = dict(shooting=shots, rows={"this commit": dict(ms_per_point=20.0, f_error=3e-7)},
-                same_states={"this commit": dict(ms_per_point=5.0, f_error=3e-7),
-                             "this commit, numba": dict(ms_per_point=2.0, f_error=1e-8)})
+                same_states={"this commit": dict(ms_per_point=5.0, f_error=3e-7, compared=20, depths=20),
+                             "this commit, numba": dict(ms_per_point=2.0, f_error=1e-8, compared=20, depths=20)})
     assert sv.shooting_ratio(case) == (pytest.approx(10.0), False)  # 200 / 20: rtol 1e-8
     assert sv.shooting_ratio(case, same=True) == (pytest.approx(40.0), False)  # 200 / 5
     assert sv.shooting_ratio(case, "this commit, numba", same=True) == (pytest.approx(150.0), False)  # 300 / 2
@@ -159,3 +159,22 @@ def test_speed_vs_baseline_shooting_ratio_takes_the_cheapest_shooting_at_equal_o
     assert sv.shooting_ratio(case, same=True) == (pytest.approx(60.0), True)  # 300 / 5
     sv.ratios(case)
     assert case["shooting_ratio_same_bound"] and not case["shooting_ratio_bound"]
+
+
+def test_speed_vs_baseline_equal_error_both_ways_pairs_each_shooting_rtol_with_the_cheapest_tol():
+    sv = _load("speed_vs_baseline")
+    shots = [dict(rtol=1e-6, per_point_ms=100.0, max_rel=5e-6, converged=20, points=20),
+             dict(rtol=1e-8, per_point_ms=200.0, max_rel=4e-8, converged=20, points=20),
+             dict(rtol=1e-9, per_point_ms=300.0, max_rel=2e-9, converged=20, points=20)]
+    tols = [dict(tol=1e-6, ms_per_point=8.0, f_error=4e-9, compared=20, depths=20),
+            dict(tol=1e-5, ms_per_point=6.0, f_error=3e-8, compared=20, depths=20),
+            dict(tol=1e-4, ms_per_point=4.0, f_error=2e-6, compared=19, depths=20)]  # one point not compared
+    case = dict(shooting=shots, rows={}, same_states={"this commit": dict(tols[0], tols=tols)})
+    pairs = sv.equal_error(case, "this commit")
+    assert [(q["rtol"], q["tol"]) for q in pairs] == [(1e-6, 1e-5), (1e-8, 1e-5), (1e-9, None)]
+    assert pairs[0]["ratio"] == pytest.approx(100 / 6) and pairs[1]["ratio"] == pytest.approx(200 / 6)
+    sv.ratios(case)  # the smallest ratio over the accuracies both reached; the one left out counted
+    assert case["shooting_ratio_both"] == pytest.approx(100 / 6) and case["shooting_ratio_both_missing"] == 1
+    tols[0].update(f_error=1e-9, ms_per_point=20.0)
+    sv.ratios(case)
+    assert case["shooting_ratio_both"] == pytest.approx(15.0) and case["shooting_ratio_both_missing"] == 0  # 300/20
