@@ -35,7 +35,7 @@ from .liftoff import (
     replace_invalid_cap,
 )
 from .pointload import SC_POINT, solve_point_load
-from .solution import Solution, calibrated_error, default_eps, richardson_error, warm_mesh
+from .solution import Solution, calibrated_error, default_eps, richardson_error, secant_ratio, warm_mesh
 from .corner import LEGENDRE_WATCH, edge_model, is_corner, limit_estimate, near_limit
 from .state import check_delta, check_tol, cross_convexity_limit, make_system, solve, solve_from, system_like, \
     warm_guess
@@ -745,11 +745,10 @@ def _solve_at_delta(scene, delta, prev, prev2, settings):
         return _step_from_point(scene, delta, prev, settings)
     sysm = system_like(prev, "delta", delta, settings["eps"])
     guess = warm_guess(sysm, prev)
-    if prev2 is not None and prev2.delta != prev.delta and prev2.get("topology") != "point" \
-            and edge_model(prev2) == edge_model(prev):
-        a = (delta - prev.delta) / (prev.delta - prev2.delta)
-        if abs(a * (prev.p[0] - prev2.p[0])) <= SECANT_MAX_LN_SC:
-            guess = _secant(sysm, prev, prev2, a)
+    a = secant_ratio(delta, prev, prev2)
+    if a is not None and prev2.get("topology") != "point" and edge_model(prev2) == edge_model(prev) \
+            and abs(a * (prev.p[0] - prev2.p[0])) <= SECANT_MAX_LN_SC:
+        guess = _secant(sysm, prev, prev2, a)
     kw = dict(tol=settings["tol"], max_nodes=_step_nodes(prev, settings), bc_tol=settings["bc_tol"])
     sol = solve_from(sysm, guess, **kw)
     if not sol.success and delta > prev.delta and near_limit(prev):

@@ -34,6 +34,7 @@ from .solution import (
     attach_tip_table,
     default_eps,
     richardson_error,
+    secant_ratio,
     warm_mesh,
 )
 
@@ -101,9 +102,7 @@ def liftoff_warm_guess(sysm: ChainBVP, prev: Solution, before: Solution | None =
     """A neighbouring lift-off state of the same topology on its warm-start mesh; with ``before``
     (the state before ``prev`` on the curve, same topology) and the target ``delta``, moved
     along their secant to that depth (states, unknowns and delta)."""
-    a = None
-    if before is not None and delta is not None and before.delta != prev.delta:
-        a = (delta - prev.delta) / (prev.delta - before.delta)
+    a = secant_ratio(delta, prev, before) if delta is not None else None
     return _moved_guess(sysm, prev, before, a)
 
 

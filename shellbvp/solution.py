@@ -14,8 +14,8 @@ import numpy as np
 
 from . import collocation
 
-__all__ = ["STATUS_MESSAGES", "Solution", "solve_bvp", "set_status", "thin_mesh", "warm_mesh", "richardson_error",
-           "penetration", "wall_gap", "attach_tip_table", "default_eps"]
+__all__ = ["STATUS_MESSAGES", "Solution", "solve_bvp", "set_status", "thin_mesh", "warm_mesh", "secant_ratio",
+           "richardson_error", "penetration", "wall_gap", "attach_tip_table", "default_eps"]
 
 
 #: What each ``Solution.status`` means and what to try: ``{status: message}``.
@@ -267,6 +267,25 @@ WARM_MESH_SAFETY = 0.5
 RESIDUAL_ORDER = 3
 _WARM_MESH_MIN_INTERVALS = 10
 _EQUIDISTRIBUTE = True  # False: every third node, as before (benchmarks/speed_vs_baseline.py's ablation)
+
+
+#: A secant predictor ``cur + a (cur - prev)`` is made only while the step is at most this many
+#: times the previous one: the two states' difference holds their solver error (~tol) besides
+#: the slope, and the secant multiplies it by ``a``.  Through depths a hair apart (two curves'
+#: depths merged: 5e-11) ``a`` reached 3e7, the guesses needed 2-3 times the nodes, and at
+#: tol 1e-5 half of the steps failed at the node budget (base-xi0: 2.8 s for 47 points, 0.33 s
+#: with this bound).  Steps of a curve's own making keep ``a`` <= 1.5.
+SECANT_MAX_RATIO = 4.0
+
+
+def secant_ratio(delta, cur, prev):
+    """``a = (delta - cur.delta) / (cur.delta - prev.delta)``, the secant's step ratio from
+    ``prev`` through ``cur`` to ``delta``; None where the two depths are equal or the ratio
+    exceeds ``SECANT_MAX_RATIO`` (the guess is then ``cur`` itself)."""
+    if prev is None or cur.delta == prev.delta:
+        return None
+    a = (delta - cur.delta) / (cur.delta - prev.delta)
+    return a if abs(a) <= SECANT_MAX_RATIO else None
 
 
 def warm_mesh(sol, tol=None):

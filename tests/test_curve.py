@@ -47,6 +47,31 @@ def test_requested_deltas_are_computed_exactly():
     assert c.force[2] == pytest.approx(single.force, abs=1e-8)
 
 
+def test_depths_a_hair_apart_do_not_blow_up_the_next_step():
+    """Depths of two curves merged come in pairs 3e-10 apart: the secant through such a pair,
+    extrapolated 6e7 times its length, made the guess at the next depth need twice the mesh
+    (191 nodes among 91-98; at tol 1e-5 half of a 47-depth curve's steps failed)."""
+    deltas = [0.16726326494928925, 0.16726326525383617, 0.18683651542859195, 0.18683651598855072,
+              0.20546494944470345, 0.20546494979551597]
+    c = sb.curve(sb.Scene.preset("base-xi0"), deltas=deltas, topology="cap", tol=1e-5, estimate_error=False)
+    assert c.complete
+    nodes = np.asarray(c.points["nodes"])
+    assert nodes.max() <= 1.25 * np.median(nodes), f"meshes {nodes.tolist()}"
+
+
+def test_secant_ratio_is_bounded():
+    from types import SimpleNamespace as S
+
+    from shellbvp.solution import SECANT_MAX_RATIO, secant_ratio
+
+    assert secant_ratio(0.3, S(delta=0.2), S(delta=0.1)) == pytest.approx(1.0)
+    assert secant_ratio(0.2 + 0.99 * SECANT_MAX_RATIO * 0.1, S(delta=0.2), S(delta=0.1)) == pytest.approx(
+        0.99 * SECANT_MAX_RATIO)
+    assert secant_ratio(0.2 + 1.01 * SECANT_MAX_RATIO * 0.1, S(delta=0.2), S(delta=0.1)) is None
+    assert secant_ratio(0.3, S(delta=0.2), S(delta=0.2 - 1e-10)) is None  # 1e9 times a hair: no secant
+    assert secant_ratio(0.3, S(delta=0.2), S(delta=0.2)) is None and secant_ratio(0.3, S(delta=0.2), None) is None
+
+
 def test_fold_in_lambda0_is_passed_by_pseudo_arclength():
     """On the dome, lambda0(delta) has a minimum near delta ~ 0.1: a fold for lambda0
     control, which the arclength continuation in (delta, lambda0, F) passes."""
