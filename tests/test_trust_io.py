@@ -197,9 +197,14 @@ def old_file(tmp_path):
 
 
 def _start_curve_and_wait_for_checkpoint(tmp_path, *extra):
+    import signal
+
     env = dict(os.environ, SHELLBVP_CHECKPOINT_SECONDS="0")
+    # SIGINT's default disposition in the child: a suite started in the background (nohup, `cmd &`)
+    # passes SIGINT on ignored, and Python then installs no KeyboardInterrupt handler
     proc = subprocess.Popen([sys.executable, "-m", "shellbvp", "curve", "--force", "-o", "X.h5", "-q", *extra],
-                            cwd=tmp_path, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+                            cwd=tmp_path, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     partial = tmp_path / "X.h5.partial"
     deadline = time.monotonic() + 120
     while not partial.exists():
