@@ -56,7 +56,8 @@ import time
 import types
 from pathlib import Path
 
-from .model import description_key, holds_key, kernel_path, untrusted_reason, write_atomic, write_bytecode
+from .model import (description_key, holds_key, kernel_path, untrusted_bytecode, untrusted_reason, write_atomic,
+                    write_bytecode)
 
 __all__ = ["CHOICES", "ENV", "KernelSet", "kernel_choice", "kernel_set", "compile_kernels"]
 
@@ -113,18 +114,10 @@ def _compiled(src: Path) -> bool:
 
 
 def _untrusted_cache(src: Path) -> str | None:
-    """Why numba's cache files of ``src`` must not be loaded, or None."""
-    if os.environ.get("NUMBA_CACHE_DIR"):
-        return None  # the user's own choice of location
-    pycache = src.parent / "__pycache__"
-    if not pycache.exists():
-        return None
-    if why := untrusted_reason(pycache):
-        return f"{pycache}: {why}"
-    for f in pycache.glob(src.stem + ".*"):
-        if why := untrusted_reason(f):
-            return f"{f}: {why}"
-    return None
+    """Why the cache files of ``src`` (numba's, and the module's own bytecode) must not be
+    loaded, or None.  With ``NUMBA_CACHE_DIR`` set numba's files are the user's choice of
+    location, but the import still reads the module's bytecode beside it."""
+    return untrusted_bytecode(src, every_cache_file=not os.environ.get("NUMBA_CACHE_DIR"))
 
 
 def _import_kernels(src: Path, key: str):

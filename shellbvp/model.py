@@ -115,17 +115,20 @@ def untrusted_reason(path: Path) -> str | None:
     return None
 
 
-def untrusted_bytecode(path: Path) -> str | None:
+def untrusted_bytecode(path: Path, every_cache_file: bool = False) -> str | None:
     """Why the bytecode beside the generated module ``path`` (``__pycache__``, which the import
-    reads when it is current) must not be used, or None."""
+    reads when it is current) must not be used, or None.  ``every_cache_file``: every file
+    there named after the module (numba's index and data files too), not only the import's."""
     pycache = path.parent / "__pycache__"
     if not pycache.exists():
         return None
     if why := untrusted_reason(pycache):
         return f"{pycache}: {why}"
-    pyc = Path(importlib.util.cache_from_source(str(path)))
-    if pyc.exists() and (why := untrusted_reason(pyc)):
-        return f"{pyc}: {why}"
+    files = (pycache.glob(path.stem + ".*") if every_cache_file
+             else [Path(importlib.util.cache_from_source(str(path)))])
+    for f in files:
+        if f.exists() and (why := untrusted_reason(f)):
+            return f"{f}: {why}"
     return None
 
 
