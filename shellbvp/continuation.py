@@ -25,6 +25,7 @@ import numpy as np
 
 from .cylinder import best_wall_state, wall_contact_suspected, wall_state
 from .io import POINT_FIELDS, Curve, point_record
+from .kernels import LONG_CURVE_POINTS, kernel_set
 from .liftoff import (
     lift_off_suspected,
     lifted_pole_branch_end,
@@ -154,6 +155,8 @@ def curve(scene, delta_max: float = 0.5, *, deltas=None, force_max=None, lambda0
     out = Curve(scene=scene, points={k: [] for k in POINT_FIELDS}, flags=[], stop_reason="",
                 complete=False, interrupted=False, settings=settings, version=VERSION)
     builder = _Builder(out, callback, estimate_error, settings)
+    if deltas is None or deltas.size >= LONG_CURVE_POINTS:  # long enough to repay compiled kernels
+        kernel_set(scene.model(), scene.structure).start_now()
     t0 = time.perf_counter()
     try:
         if deltas is not None:

@@ -20,7 +20,10 @@ The choice is the environment variable ``SHELLBVP_KERNELS``:
     numba's kernels when numba is installed, never waited for.  The numpy
     functions serve, timed, until they have taken ``START_AFTER_S`` (0.5 s) in this
     process, about what loading compiled kernels costs, so a single solve never pays
-    for them and a curve is repaid.  Then the kernels are loaded from the cache in a
+    for them and a curve is repaid; a curve of ``LONG_CURVE_POINTS`` or more (every
+    adaptive curve) loads kernels already compiled at its start (waiting would only add its
+    numpy time: loading in a thread holds the interpreter lock as the solve does).  Then the
+    kernels are loaded from the cache in a
     background thread (~0.5 s) or, the first time for a structure, compiled in a
     background process (once per structure, ~15 s on the other core; it finishes
     even if this process ends first, so the next run finds them), and the solver
@@ -59,7 +62,7 @@ from pathlib import Path
 from .model import (description_key, holds_key, kernel_path, untrusted_bytecode, untrusted_reason, write_atomic,
                     write_bytecode)
 
-__all__ = ["CHOICES", "ENV", "KernelSet", "kernel_choice", "kernel_set", "compile_kernels"]
+__all__ = ["CHOICES", "ENV", "LONG_CURVE_POINTS", "KernelSet", "kernel_choice", "kernel_set", "compile_kernels"]
 
 log = logging.getLogger(__name__)
 
@@ -72,6 +75,10 @@ COMPILE_ESTIMATE_S = 15
 #: loading them costs about as much (numba's start-up and cache; benchmarks/results/kernels.md),
 #: so a single solve never pays it and a curve is repaid
 START_AFTER_S = 0.5
+#: A curve of at least this many points (adaptive curves: ~35) starts the compiled kernels at
+#: once (:meth:`KernelSet.start_now`): ~30 ms of numpy per point against ~10 with the kernels
+#: and ~0.6 s to load them (import numba included) repay from about 30 points
+LONG_CURVE_POINTS = 30
 _BUSY = 3  # exit status of the compile process when another process is compiling the same structure
 _LOCK_STALE_S = 1800.0  # a lock older than this is from a compile that died
 _WAIT_S = 1800.0  # how long a process waits for another one's compilation before giving up
@@ -300,8 +307,26 @@ class KernelSet:
     def _charge(self, seconds):
         """Count time in the numpy kernels; past ``START_AFTER_S`` start the compiled ones."""
         self.numpy_seconds += seconds
-        if self.numpy_seconds < START_AFTER_S or self.status != "counting":
+        if self.numpy_seconds >= START_AFTER_S and self.status == "counting":
+            self._begin()
+
+    def start_now(self):
+        """auto: load compiled kernels now, not after ``START_AFTER_S`` of numpy work -- for a
+        run known to repay them, a curve of :data:`LONG_CURVE_POINTS` or more.  Loading in a
+        thread does not overlap the solve (both hold the interpreter lock), so for such a run
+        the wait only adds its numpy time (default base curve in a fresh process: 1.95 s with
+        the kernels loaded after ``START_AFTER_S``, 1.10-1.22 s from the start, 1.46-1.56 s
+        numpy only; docs/benchmarking.md).  Kernels not compiled yet are left to the
+        threshold: compiling from the start, beside the whole curve, made it slower than
+        numpy (1.67 s against 1.56 s)."""
+        if self.status != "counting":
             return
+        src = kernel_path(self._structure())
+        if holds_key(src, self.numpy.KEY) and _compiled(src):
+            self._begin()
+
+    def _begin(self):
+        """Counting ends: load (or compile, in a process) the kernels in a background thread."""
         with self._lock:
             if self.status != "counting":
                 return

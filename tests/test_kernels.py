@@ -12,6 +12,7 @@ import json
 import os
 import subprocess
 import sys
+import threading
 import time
 from pathlib import Path
 from unittest import mock
@@ -289,3 +290,50 @@ def test_compiled_kernels_equal_numpy(name, monkeypatch):
     assert ks.status == "numba" and time.perf_counter() - t0 < 120
     worst = compare_with_numpy(scene, ks.active)
     assert max(worst.values()) <= RTOL, worst
+
+
+@pytest.mark.parametrize("compiled", [True, False])
+def test_start_now_loads_compiled_kernels_of_a_counting_set_once(compiled, monkeypatch):
+    scene = SCENES["base"]
+    ks = sk.KernelSet(scene.model(), "auto")
+    started = []
+    monkeypatch.setattr(ks, "_background", lambda: started.append(1))
+    monkeypatch.setattr(sk, "holds_key", lambda src, key: True)
+    monkeypatch.setattr(sk, "_compiled", lambda src: compiled)
+    ks.start_now()  # not counting yet: nothing to start
+    assert ks.status == "numpy" and not started
+    monkeypatch.setattr(sk, "_numba_version", lambda: "0.0")
+    ks.start(scene.structure)
+    assert ks.status == "counting"
+    ks.start_now()
+    ks.start_now()  # once only
+    for t in threading.enumerate():
+        if t.name.startswith("shellbvp-kernels-"):
+            t.join(10)
+    if compiled:
+        assert started == [1] and ks.status == "waiting" and ks.active is ks.numpy
+    else:  # compiling is left to the threshold: beside a whole curve it slows the curve
+        assert not started and ks.status == "counting"
+        ks._charge(sk.START_AFTER_S)  # the threshold still starts them
+        for t in threading.enumerate():
+            if t.name.startswith("shellbvp-kernels-"):
+                t.join(10)
+        assert started == [1] and ks.status == "waiting"
+
+
+@pytest.mark.parametrize("kw, starts", [({}, True), ({"deltas": np.linspace(0.01, 0.5, sk.LONG_CURVE_POINTS)}, True),
+                                        ({"deltas": np.linspace(0.01, 0.5, sk.LONG_CURVE_POINTS - 1)}, False)])
+def test_a_long_curve_starts_the_compiled_kernels_at_once(kw, starts, monkeypatch):
+    import shellbvp.continuation as sc
+
+    calls = []
+
+    class Recorder:
+        def start_now(self):
+            calls.append(1)
+
+    monkeypatch.setattr(sc, "kernel_set", lambda model, structure: Recorder())
+    monkeypatch.setattr(sc, "_adaptive", lambda *a: None)  # the decision only: no solve
+    monkeypatch.setattr(sc, "_natural", lambda *a: None)
+    sb.curve(SCENES["base"], **kw)
+    assert calls == ([1] if starts else [])
