@@ -22,12 +22,11 @@ The choice is the environment variable ``SHELLBVP_KERNELS``:
     process, about what loading compiled kernels costs, so a single solve never pays
     for them and a curve is repaid; a curve of ``LONG_CURVE_POINTS`` or more (every
     adaptive curve) loads kernels already compiled at its start (waiting would only add its
-    numpy time: loading in a thread holds the interpreter lock as the solve does).  Then the
-    kernels are loaded from the cache in a
-    background thread (~0.5 s) or, the first time for a structure, compiled in a
-    background process (once per structure, ~15 s on the other core; it finishes
-    even if this process ends first, so the next run finds them), and the solver
-    switches when they are ready.  A process, not a thread, compiles: compiling is
+    numpy time: loading in a thread holds the interpreter lock as the solve does).  Then
+    the kernels are loaded from the cache in a background thread (~0.5 s) or, the first
+    time for a structure, compiled in a background process (once per structure, ~15 s
+    on the other core; it finishes even if this process ends first, so the next run
+    finds them), and the solver switches when they are ready.  A process, not a thread, compiles: compiling is
     Python work that would hold the interpreter lock and slow the solve it is meant
     to speed up (benchmarks/results/kernels.md has the numbers).
 ``numpy``
@@ -120,6 +119,11 @@ def _compiled(src: Path) -> bool:
         return False
 
 
+def _ready(src: Path, key: str) -> bool:
+    """``src`` holds the kernels of ``key`` and numba's cache holds them compiled."""
+    return holds_key(src, key) and _compiled(src)
+
+
 def _untrusted_cache(src: Path) -> str | None:
     """Why the cache files of ``src`` (numba's, and the module's own bytecode) must not be
     loaded, or None.  With ``NUMBA_CACHE_DIR`` set numba's files are the user's choice of
@@ -210,7 +214,7 @@ def compile_kernels(src: Path, desc: dict) -> int:
     if not _acquire(lock):
         return _BUSY
     try:
-        if not (holds_key(src, key) and _compiled(src)):
+        if not _ready(src, key):
             _, seconds = _compile_here(src, key, desc)
             log.info("compiled %s in %.1f s", src.name, seconds)
     finally:
@@ -321,8 +325,7 @@ class KernelSet:
         numpy (1.67 s against 1.56 s)."""
         if self.status != "counting":
             return
-        src = kernel_path(self._structure())
-        if holds_key(src, self.numpy.KEY) and _compiled(src):
+        if _ready(kernel_path(self._structure()), self.numpy.KEY):
             self._begin()
 
     def _begin(self):
@@ -341,7 +344,7 @@ class KernelSet:
         if foreground:
             if _numba_version() is None:
                 raise ImportError(f"{ENV}=numba needs numba: pip install 'shellbvp[fast]' (or numba)")
-            fresh = not (holds_key(src, key) and _compiled(src))
+            fresh = not _ready(src, key)
             if fresh:
                 log.info("compiling kernels for this scene, once: ~%d s", COMPILE_ESTIMATE_S)
                 mod, seconds = _compile_here(src, key, desc)
@@ -350,7 +353,7 @@ class KernelSet:
                 mod = _import_kernels(src, key)
             self._use(mod)
             return
-        if not (holds_key(src, key) and _compiled(src)):
+        if not _ready(src, key):
             log.info("compiling kernels for this scene, once: ~%d s, in the background (numpy meanwhile)",
                      COMPILE_ESTIMATE_S)
             lock, deadline = src.with_suffix(".lock"), time.monotonic() + _WAIT_S

@@ -292,6 +292,12 @@ def test_compiled_kernels_equal_numpy(name, monkeypatch):
     assert max(worst.values()) <= RTOL, worst
 
 
+def _join_kernel_threads():
+    for t in threading.enumerate():
+        if t.name.startswith("shellbvp-kernels-"):
+            t.join(10)
+
+
 @pytest.mark.parametrize("compiled", [True, False])
 def test_start_now_loads_compiled_kernels_of_a_counting_set_once(compiled, monkeypatch):
     scene = SCENES["base"]
@@ -307,17 +313,13 @@ def test_start_now_loads_compiled_kernels_of_a_counting_set_once(compiled, monke
     assert ks.status == "counting"
     ks.start_now()
     ks.start_now()  # once only
-    for t in threading.enumerate():
-        if t.name.startswith("shellbvp-kernels-"):
-            t.join(10)
+    _join_kernel_threads()
     if compiled:
         assert started == [1] and ks.status == "waiting" and ks.active is ks.numpy
     else:  # compiling is left to the threshold: beside a whole curve it slows the curve
         assert not started and ks.status == "counting"
         ks._charge(sk.START_AFTER_S)  # the threshold still starts them
-        for t in threading.enumerate():
-            if t.name.startswith("shellbvp-kernels-"):
-                t.join(10)
+        _join_kernel_threads()
         assert started == [1] and ks.status == "waiting"
 
 
