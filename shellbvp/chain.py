@@ -838,15 +838,16 @@ class ChainBVP:
 
         t, w = gauss_points(x)
         y = sol(t)
+        par = self.par_at(p)
         total = 0.0
-        for k, S, fields in self.region_profiles(t, y, p):
-            reg = self.regions[k]
-            width = self.ln_S(reg.end, p) - self.ln_S(reg.start, p)
-            total += float(np.sum(w * fields["energy_density"] * S)) * width
+        for k, reg in enumerate(self.regions):  # the generated energy density alone, not the profile
+            S = self.S(k, t, p)
+            density = getattr(self.kernels.active, f"{reg.kind}_energy")(S, y[self.rows(k)], par)[0]
+            total += float(np.sum(w * density * S)) * (self.ln_S(reg.end, p) - self.ln_S(reg.start, p))
         for j in self.junctions:
             if isinstance(j, (ContactPole, FreePole)):
                 zeta = self.S_point(self.regions[j.k].start, p)
-                prof = getattr(self.kernels.active, f"{self.regions[j.k].kind}_profile")
-                density = prof(np.array([zeta]), sol(np.array([0.0]))[self.rows(j.k)], self.par_at(p))["energy_density"]
+                energy = getattr(self.kernels.active, f"{self.regions[j.k].kind}_energy")
+                density = energy(np.array([zeta]), sol(np.array([0.0]))[self.rows(j.k)], par)[0]
                 total += 0.5 * float(density[0]) * zeta
         return 2 * np.pi * total

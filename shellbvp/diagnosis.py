@@ -39,18 +39,18 @@ def _at(sysm, kind, S, y):
     return getattr(sysm.kernels.active, f"{kind}_profile")(np.array([S], dtype=float), y[:, None], sysm.par)
 
 
-def _legendre_min(sysm, t, sol, p):
+def _legendre_min(sysm, t, y, p):
     """(min, where) over every free region of the Legendre determinant det d(tau_s, M_s)/d(lambda_s,
     kappa_s), relative to its median magnitude there (scale-free; < 0: U is not convex in
-    (lambda_s, kappa_s) there, the free equations are singular where it crosses 0)."""
+    (lambda_s, kappa_s) there, the free equations are singular where it crosses 0); ``y``: the
+    solution on ``t``."""
     best, where = math.inf, math.nan
-    y = sol(t)
     for k, reg in enumerate(sysm.regions):
         if reg.kind != "free":
             continue
         S = sysm.S(k, t, p)
         det = sysm.kernels.active.free_legendre(S, y[sysm.rows(k)], sysm.par)[0]
-        scale = float(np.median(np.abs(det)))
+        scale = _median(np.abs(det))
         if not scale > 0:
             continue
         i = int(np.argmin(det))
@@ -68,9 +68,23 @@ def _edge_model(sysm) -> str:
 _EDGE_FIELDS = ("axial_force_2pi", "r", "Q", "lambda_s", "kappa_s")  # what the edges' checks read
 
 
-def _pick(fields, i, n):
-    """The edge fields of a profile (arrays over n points, or constants) at point i."""
-    return {key: float(np.broadcast_to(fields[key], (n,))[i]) for key in _EDGE_FIELDS}
+def _median(a) -> float:
+    """np.median of a 1-D array, the same value (the middle one, or the mean of the two middle
+    ones), by one partition: np.median's own dispatch costs more than the work at a few hundred
+    points, and the diagnosis takes one per state."""
+    n = a.size
+    if n == 0:
+        return math.nan
+    h = n // 2
+    if n % 2:
+        return float(np.partition(a, h)[h])
+    part = np.partition(a, (h - 1, h))
+    return float(np.mean(part[h - 1:h + 1]))
+
+
+def _pick(fields, i):
+    """The edge fields of a profile (arrays over the points, or constants) at point i."""
+    return {key: float(v[i] if np.ndim(v) else v) for key, v in ((key, fields[key]) for key in _EDGE_FIELDS)}
 
 
 def _edge_jumps(sysm, ends):
@@ -141,8 +155,9 @@ def diagnose(sysm, bvp, tol, converged_note: str = "") -> Solution:
         return _without_iterate_numbers(res)
 
     t = np.unique(np.r_[bvp.x, 0.5 * (bvp.x[1:] + bvp.x[:-1])])  # from 0 to 1: the regions' ends
-    parts = sysm.region_profiles(t, bvp.sol(t), p)
-    ends = {k: (_pick(f, 0, t.size), _pick(f, -1, t.size)) for k, _, f in parts}  # (start, end) of region k
+    y_t = bvp.sol(t)
+    parts = sysm.region_profiles(t, y_t, p)
+    ends = {k: (_pick(f, 0), _pick(f, -1)) for k, _, f in parts}  # (start, end) of region k
     # ring forces: jumps of the axial force (2 pi G) and of r Q across each edge, outer minus inner
     axial, normal = [], []
     for _, inner, outer in edges:
@@ -168,7 +183,7 @@ def diagnose(sysm, bvp, tol, converged_note: str = "") -> Solution:
     t_leg = np.array([0.0, 0.5])
     leg = sysm.kernels.active.free_legendre(sysm.S(last, t_leg, p), bvp.sol(t_leg)[sysm.rows(last)], par)[0]
     res.edge_legendre = float(leg[0] / leg[1]) if leg[1] != 0 else nan
-    res.legendre_min, res.legendre_min_S = _legendre_min(sysm, t, bvp.sol, p)
+    res.legendre_min, res.legendre_min_S = _legendre_min(sysm, t, y_t, p)
     res.contact_edge = _edge_model(sysm)
     res.edge_jump_ls, res.edge_jump_ks = _edge_jumps(sysm, ends)
     res.energy = sysm.energy(bvp.sol, bvp.x, p)

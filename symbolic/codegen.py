@@ -202,7 +202,12 @@ def function_specs(d: Derivation) -> list[FunctionSpec]:
                          f"{region} region: dg/dpar ({n}, {len(par)}, m).", "S", node_args=("S", "y")),
             FunctionSpec(f"{region}_profile", prog, args, [("out", profile)],
                          f"{region} region: physical fields at the nodes (dict of arrays).", "S",
-                         node_args=("S", "y")),  # diagnosis and energy, at every state
+                         node_args=("S", "y")),  # diagnosis, at every state
+            # the energy's integrand alone: the profile computes all its fields at 4 Gauss points
+            # per mesh interval for one of them (a third of a state's diagnosis)
+            FunctionSpec(f"{region}_energy", prog, args, [("e", [profile["energy_density"]])],
+                         f"{region} region: the energy density U R Psi (profile's energy_density), (1, m).",
+                         "S", node_args=("S", "y")),
         ]
         if d.structure.pressurised:  # volume control (a sealed shell): V = Int dV/dS dS
             vol = [Ssym * profile["volume_density"]]
