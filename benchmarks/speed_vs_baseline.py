@@ -24,8 +24,9 @@ every 12th also at 1e-10 to show the reference's own error).
   the residual), ``explicit zeros kept`` (scipy's own assembly of solve_bvp's Jacobian, with its
   stored zeros, and SuperLU, with the numpy functions and with numba's: compare with ``this
   commit, numba``), ``SuperLU, numba`` (numba's kernels, but the Jacobian assembled and
-  factorised by SuperLU instead of the kernels' elimination); these on the three base curves
-  only.
+  factorised by SuperLU instead of the kernels' elimination), ``annulus before split`` (where
+  the line's pole is down on the tip, the annulus probed before the split cap+line(tip)); these
+  on the base curves only.
 * Shooting (``benchmarks/shooting.py``, the paper's method) re-solves the reference's cap
   states (delta >= 0.15) at its rtol 1e-6 to 1e-9, each from its neighbour with the
   tangent predictor (the first from the reference's own unknowns: no cold start is counted);
@@ -92,6 +93,7 @@ VARIANTS = {
     "no secant guard": ("new", {"shellbvp.continuation": {"SECANT_MAX_LN_SC": math.inf}}, {}, NUMPY),
     "full Richardson": ("new", {}, {"estimate_error": "full"}, NUMPY),
     "no split rule": ("new", {"shellbvp.liftoff": {"_SPLIT_RULE": False}}, {}, NUMPY),
+    "annulus before split": ("new", {"shellbvp.liftoff": {"_SPLIT_FIRST": False}}, {}, NUMPY),
     "no tightening": ("new", {"shellbvp.continuation": {"_TIGHTEN": False}}, {}, NUMPY),
     "thinned warm meshes": ("new", {"shellbvp.solution": {"_EQUIDISTRIBUTE": False}}, {}, NUMPY),
     "explicit zeros kept": ("new", {"shellbvp.collocation": {"ENABLED": False}}, {}, NUMPY),
@@ -105,6 +107,7 @@ ABLATIONS = {
     "no secant guard": ("base default", "base 40 depths", "base 40 depths, cap only"),
     "full Richardson": ("base default", "base 40 depths", "base 40 depths, cap only"),
     "no split rule": ("base default", "base 40 depths"),
+    "annulus before split": ("base 40 depths",),
     "no tightening": ("base default", "fit default", "flat default"),
     "thinned warm meshes": ("base default", "base 40 depths", "base 40 depths, cap only"),
     "explicit zeros kept": ("base default", "base 40 depths", "base 40 depths, cap only"),

@@ -281,6 +281,25 @@ def test_where_the_lifted_pole_comes_down_the_split_grows_from_the_line():
     assert not cap.valid and c.force[1] == pytest.approx(cap.force, rel=1e-6)  # the gap is ~1e-8 wide
 
 
+def test_where_the_lines_pole_is_down_the_split_is_tried_before_the_annulus(monkeypatch):
+    """base at delta 0.1125 after the line at 0.1: the line there is too curved and its pole is
+    down on the tip.  The split is probed first and found; the annulus (whose probes run onto
+    the pole, the cap) is not tried.  In the old order (annulus first) the same state results."""
+    import shellbvp.liftoff as lo
+
+    scene = sb.Scene.preset("base")
+    line = sb.curve(scene, deltas=[0.1], estimate_error=False).solutions[0]
+    cap = sb.solve(scene, delta=0.1125, topology="cap", estimate_error=False)
+    assert line.topology == "line" and line.valid and not cap.valid
+    split, tried = lo.valid_liftoff_state(cap, previous=line, last=line)
+    assert split.topology == "cap+line(tip)" and split.valid
+    assert [t.split(":")[0] for t in tried] == ["line"], tried
+    monkeypatch.setattr(lo, "_SPLIT_FIRST", False)
+    again, tried_old = lo.valid_liftoff_state(cap, previous=line, last=line)
+    assert [t.split(":")[0] for t in tried_old] == ["line", "annulus"], tried_old
+    assert again.topology == "cap+line(tip)" and abs(again.force - split.force) < 1e-9
+
+
 # -- warm starts of lift-off states (issue 14 item 1) -------------------------------------------------
 class _Count:
     """solve_bvp runs and Newton iterations of the lift-off solves (counts are deterministic)."""
