@@ -367,7 +367,7 @@ class _Builder:
             return None
         richardson_error(fine.system, fine, tol)
         fine.error_method = "richardson"
-        for k in ("cap_state", "cap_solution"):  # what the lift-off and wall searches attached
+        for k in ("cap_state", "cap_solution", "line_state"):  # what the lift-off and wall searches attached
             if k in sol:
                 fine[k] = sol[k]
         return fine
@@ -672,9 +672,13 @@ def _with_pole_clearance(line):
 
 
 def _line_state_at(sol, st):
-    """The line state at a lift-off point's delta (from its cap), or None."""
+    """The line state at a lift-off point's delta (the one its search converged, else from its
+    cap), or None."""
     from .liftoff import liftoff_state
 
+    line = sol.get("line_state")
+    if line is not None and line.success and "curvature_excess" in line and line.delta == sol.delta:
+        return line
     cap = _cap_of(sol)
     if cap is None:
         return None

@@ -294,7 +294,7 @@ def valid_liftoff_state(cap: Solution, *, tol=1e-6, max_nodes=10000, bc_tol=1e-1
             split = second_zone_state(cap, tol=tol, max_nodes=max_nodes, bc_tol=bc_tol, previous=previous,
                                       before=before, line=line)
             if split.success and split.valid:
-                return split, tried
+                return _with_line(split, line), tried
             tried.append(f"{split.topology}: {split.message if not split.success else '; '.join(split.flags)}")
         res = liftoff_state(cap, topology, tol=tol, max_nodes=max_nodes, bc_tol=bc_tol, previous=previous,
                             before=before)
@@ -313,7 +313,7 @@ def valid_liftoff_state(cap: Solution, *, tol=1e-6, max_nodes=10000, bc_tol=1e-1
         res = second_zone_state(cap, tol=tol, max_nodes=max_nodes, bc_tol=bc_tol, previous=previous,
                                  before=before, line=line)
         if res.success and res.valid:
-            return res, tried
+            return _with_line(res, line), tried
         tried.append(f"{res.topology}: {res.message if not res.success else '; '.join(res.flags)}")
     return None, tried
 
@@ -321,6 +321,14 @@ def valid_liftoff_state(cap: Solution, *, tol=1e-6, max_nodes=10000, bc_tol=1e-1
 _SPLIT_RULE = True  # False: the split probed wherever the cap is pressed at the pole (benchmarks measure the gain)
 #: False: the annulus before the split, as before issue 14 (benchmarks measure the gain)
 _SPLIT_FIRST = True
+
+
+def _with_line(split, line):
+    """``split`` with ``line_state``: the (invalid) line converged at its depth, where the switch
+    line -> cap+line(tip) is located from (``continuation._line_state_at``), not solved again."""
+    if line is not None and line.get("success"):
+        split.line_state = line
+    return split
 
 
 def _pole_down(line, tol) -> bool:

@@ -294,6 +294,12 @@ def test_where_the_lines_pole_is_down_the_split_is_tried_before_the_annulus(monk
     split, tried = lo.valid_liftoff_state(cap, previous=line, last=line)
     assert split.topology == "cap+line(tip)" and split.valid
     assert [t.split(":")[0] for t in tried] == ["line"], tried
+    # the line converged there is kept: the switch line -> cap+line(tip) is located from it
+    line_here = split.line_state
+    assert line_here.topology == "line" and line_here.delta == split.delta and not line_here.valid
+    from shellbvp.continuation import _line_state_at
+
+    assert _line_state_at(split, {}) is line_here  # (no settings needed: nothing is solved)
     monkeypatch.setattr(lo, "_SPLIT_FIRST", False)
     again, tried_old = lo.valid_liftoff_state(cap, previous=line, last=line)
     assert [t.split(":")[0] for t in tried_old] == ["line", "annulus"], tried_old
