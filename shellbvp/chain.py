@@ -304,6 +304,14 @@ def line_kink_chain(eps: float, L: float) -> Chain:
 
 
 # -- the assembler -------------------------------------------------------------------------------
+def _same_arguments(key, t, y, p, par) -> bool:
+    """Whether ``fun``'s arguments (t, y, p) and the parameters are those of a cached call."""
+    kt, ky, kp, kpar = key
+    return (kt.shape == np.shape(t) and ky.shape == np.shape(y) and (kp is None) == (p is None)
+            and np.array_equal(kt, t) and np.array_equal(ky, y) and (p is None or np.array_equal(kp, p))
+            and np.array_equal(kpar, par))
+
+
 class ChainBVP:
     """fun, fun_jac, bc, bc_jac of one chain, scene, control mode and prescribed value.
 
@@ -419,6 +427,7 @@ class ChainBVP:
             return self
         other = object.__new__(type(self))
         other.__dict__.update(self.__dict__)
+        other.__dict__.pop("_fun_cache", None)
         other.par = self.par_at(p)
         return other
 
@@ -513,25 +522,53 @@ class ChainBVP:
         return getattr(self.model, f"junction_{self._prefix(self.regions[j.kc].kind)}{j.model}_{what}")
 
     # -- ODE ------------------------------------------------------------------------------------
+    #: fun's last results kept, by their arguments' values: after each Newton run solve_bvp
+    #: evaluates again, at the nodes and the midpoints, the iterate its last step evaluated, and
+    #: fun_jac, at the iterate fun was last called at, needs the right-hand sides too (for the
+    #: derivatives by the regions' ends)
+    _FUN_CACHE = 2
+
+    def _cached(self, t, y, p):
+        """(f, [g of each region]) of an earlier ``fun`` call at these arguments, or None."""
+        for key, value in self.__dict__.get("_fun_cache", ()):
+            if _same_arguments(key, t, y, p, self.par):
+                return value
+        return None
+
     def fun(self, t, y, p=None):
+        hit = self._cached(t, y, p)
+        if hit is not None:
+            return hit[0].copy()
+        f, g = self._fun(t, y, p)
+        cache = self.__dict__.setdefault("_fun_cache", [])
+        key = (t.copy(), y.copy(), None if p is None else np.array(p, float), self.par.copy())
+        cache.insert(0, (key, (f.copy(), g)))
+        del cache[self._FUN_CACHE:]
+        return f
+
+    def _fun(self, t, y, p=None):
+        """(f, [g_k]): the right-hand side, and each region's generated g = S dy/dS."""
         f = np.empty_like(y)
         par = self.par_at(p)
+        gs = []
         if self.volume_control:
             f[self.n_shell] = 0.0
         for k, reg in enumerate(self.regions):
             a, b = self.ln_S(reg.start, p), self.ln_S(reg.end, p)
             rows = self.rows(k)
             S = np.exp(a + t * (b - a))
-            f[rows] = (b - a) * self._rhs(k)(S, y[rows], par)
+            gs.append(self._rhs(k)(S, y[rows], par))
+            f[rows] = (b - a) * gs[-1]
             if self.volume_control:
                 f[self.n_shell] += (b - a) * self._vol[k](S, y[rows], par)[0]
-        return f
+        return f, gs
 
     def fun_jac(self, t, y, p=None):
         n, m = self.n, t.size
         dfdy = np.zeros((n, n, m))
         dfdp = np.zeros((n, self.k, m)) if self.k else None
         par = self.par_at(p)
+        hit = self._cached(t, y, p) if dfdp is not None else None
         for k, reg in enumerate(self.regions):
             a, b = self.ln_S(reg.start, p), self.ln_S(reg.end, p)
             rows = self.rows(k)
@@ -552,7 +589,7 @@ class ChainBVP:
                 if point.unknown is None:
                     continue
                 if g is None:
-                    g = self._rhs(k)(S, y[rows], par)
+                    g = hit[1][k] if hit is not None else self._rhs(k)(S, y[rows], par)
                     if self.volume_control:
                         rate = self._vol[k](S, y[rows], par)[0]
                 dfdp[rows, self.col[point.unknown]] += sign * g + (b - a) * gS * S * dS_dln

@@ -92,6 +92,31 @@ def test_analytic_jacobians_equal_central_differences(kind, contact, control, se
         assert rel(P[0], central_difference(lambda v: sysm.bc(ya, yb, v), p)) < 1e-6
 
 
+@pytest.mark.parametrize("kind, sealed", [("tip_line", False), ("cap", True)])
+def test_fun_kept_results_are_those_of_its_arguments(kind, sealed):
+    """fun's last results are reused for equal arguments only (values, not identity: an array
+    changed in place is evaluated again), and fun_jac with them equals fun_jac without, bit for bit."""
+    sysm = system(kind, "smooth", "delta", sealed)
+    t, y, p = state(sysm, np.random.default_rng(3))
+    fresh = ch.ChainBVP(sysm.scene, sysm.chain, "delta", 0.3)
+    f0 = sysm.fun(t, y, p)
+    assert np.array_equal(sysm.fun(t, y.copy(), p.copy()), f0)  # equal values: kept
+    f0[:] = 0.0  # a caller changing its result does not change what is kept
+    assert np.array_equal(sysm.fun(t, y, p), fresh.fun(t, y, p))
+    y2 = y.copy()
+    y2[0, 1] += 1e-3  # changed in place: evaluated again
+    assert np.array_equal(sysm.fun(t, y2, p), fresh._fun(t, y2, p)[0])
+    p2 = p.copy()
+    p2[0] += 1e-3
+    assert np.array_equal(sysm.fun(t, y2, p2), fresh._fun(t, y2, p2)[0])
+    sysm.fun(t, y, p)  # kept at y: fun_jac takes the right-hand sides from it
+    with_kept = sysm.fun_jac(t, y, p)
+    fresh.__dict__.pop("_fun_cache", None)  # nothing kept: fun_jac evaluates them
+    without = fresh.fun_jac(t, y, p)
+    for a, b in zip(with_kept, without):
+        assert np.array_equal(a, b)
+
+
 def test_layout_table_is_generated_from_the_declaration():
     text = ch.annulus_chain(EPS, 1.5).layout()
     assert "y[0:6]  region 0 free" in text and "y[6:8]  region 1 contact" in text and "y[8:14]" in text
