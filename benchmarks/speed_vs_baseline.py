@@ -10,8 +10,10 @@ every 12th also at 1e-10 to show the reference's own error).
   imported from there (``PYTHONPATH``); this commit is the checkout this script lives in.
   Each side has its own code cache (``XDG_CACHE_HOME`` and ``SHELLBVP_CACHE_DIR``), warmed
   before timing, so the generated modules of the two never collide.
-* Every curve is a fresh process (``--worker``) that loads the cached model, then times the
-  curve alone; solve_bvp runs and Newton iterations are counted by wrapping
+* Every curve is a fresh process (``--worker``) that imports scipy.integrate and
+  scipy.interpolate (which solve_bvp's first run imports; timed apart, ``interpolate_import_s``:
+  until e4383b6 it was inside the first curve's time, on both sides) and loads the cached model,
+  then times the curve alone; solve_bvp runs and Newton iterations are counted by wrapping
   ``scipy.integrate.solve_bvp`` in that process (both sides import it on first use).
 * Runs alternate: each repeat runs every case on every variant, the variants' order rotating,
   so that a noisy shared machine weighs on both sides alike; a ratio is the median of the
@@ -137,6 +139,13 @@ def worker(spec):
 
     import scipy.integrate
 
+    # what solve_bvp's first run imports (scipy.interpolate, for its PPoly): a cost of the
+    # process, like importing scipy.integrate, not of the curve; timed apart (~25-30 ms, each side)
+    t0 = time.perf_counter()
+    import scipy.interpolate  # noqa: F401
+
+    interpolate_import = time.perf_counter() - t0
+
     import shellbvp as sb
 
     import sys as _sys
@@ -184,7 +193,8 @@ def worker(spec):
                delta=[float(v) for v in c.delta], force=[float(v) for v in c.force],
                topology=[str(s.get("topology", "cap")) for s in sols] or ["cap"] * len(c),
                valid=[bool(v) for v in c.valid], nodes=[int(v) for v in c.points["nodes"]],
-               shellbvp=str(Path(sb.__file__).parent), kernel_load_s=kernel_load, **counts)
+               shellbvp=str(Path(sb.__file__).parent), kernel_load_s=kernel_load,
+               interpolate_import_s=interpolate_import, **counts)
     print(json.dumps(out))
 
 
@@ -435,6 +445,12 @@ def _kernel_load(data):
     return f"median {statistics.median(loads):.2f} s, at most {max(loads):.2f} s" if loads else "not run"
 
 
+def _interpolate_import(data):
+    times = [r["interpolate_import_s"] for c in data["cases"] for runs in c["runs"].values() for r in runs
+             if "interpolate_import_s" in r]
+    return f"median {1e3 * statistics.median(times):.0f} ms" if times else "not recorded"
+
+
 def _check_text(data):
     checks = [ch for c in data["cases"] for ch in c.get("reference", {}).get("check", [])]
     ok = [ch["rel"] for ch in checks if ch["converged"]]
@@ -456,7 +472,9 @@ def markdown(data):
              f"{m['repeat']} repeats alternating the variants; this commit with the numpy functions "
              f"(SHELLBVP_KERNELS=numpy; every ablation too) and with numba's compiled kernels (compiled "
              f"beforehand; loaded from numba's cache before the curve is timed, once per process and "
-             f"structure: {_kernel_load(data)}); time: median over repeats of the curve's CPU time "
+             f"structure: {_kernel_load(data)}); scipy.integrate and scipy.interpolate (which solve_bvp's "
+             f"first run imports) imported before the curve is timed, on both sides (scipy.interpolate: "
+             f"{_interpolate_import(data)}); time: median over repeats of the curve's CPU time "
              f"(the process's, the measure least disturbed by other users of a shared machine) and wall time; "
              f"ratio: median over repeats of (variant time / this commit's time in the same repeat); speed-ups "
              f"and per-point times use CPU time; counts (solve_bvp runs, "
