@@ -304,12 +304,16 @@ def line_kink_chain(eps: float, L: float) -> Chain:
 
 
 # -- the assembler -------------------------------------------------------------------------------
-def _same_arguments(key, t, y, p, par) -> bool:
-    """Whether ``fun``'s arguments (t, y, p) and the parameters are those of a cached call."""
-    kt, ky, kp, kpar = key
-    return (kt.shape == np.shape(t) and ky.shape == np.shape(y) and (kp is None) == (p is None)
-            and np.array_equal(kt, t) and np.array_equal(ky, y) and (p is None or np.array_equal(kp, p))
-            and np.array_equal(kpar, par))
+def _call_key(t, y, p, par):
+    """What identifies a ``fun`` call: (shapes, the unknowns' and parameters' bytes) to compare
+    first, cheaply, then t and y (compared by value, :func:`_same_call`)."""
+    small = (np.shape(y), np.shape(t), None if p is None else np.asarray(p, float).tobytes(), par.tobytes())
+    return small, t, y
+
+
+def _same_call(key, small, t, y) -> bool:
+    k_small, kt, ky = key
+    return k_small == small and np.array_equal(ky, y) and np.array_equal(kt, t)
 
 
 class ChainBVP:
@@ -528,21 +532,22 @@ class ChainBVP:
     #: derivatives by the regions' ends)
     _FUN_CACHE = 2
 
-    def _cached(self, t, y, p):
+    def _cached(self, t, y, p, small=None):
         """(f, [g of each region]) of an earlier ``fun`` call at these arguments, or None."""
+        small = _call_key(t, y, p, self.par)[0] if small is None else small
         for key, value in self.__dict__.get("_fun_cache", ()):
-            if _same_arguments(key, t, y, p, self.par):
+            if _same_call(key, small, t, y):
                 return value
         return None
 
     def fun(self, t, y, p=None):
-        hit = self._cached(t, y, p)
+        small = _call_key(t, y, p, self.par)[0]
+        hit = self._cached(t, y, p, small)
         if hit is not None:
             return hit[0].copy()
         f, g = self._fun(t, y, p)
         cache = self.__dict__.setdefault("_fun_cache", [])
-        key = (t.copy(), y.copy(), None if p is None else np.array(p, float), self.par.copy())
-        cache.insert(0, (key, (f.copy(), g)))
+        cache.insert(0, ((small, t.copy(), y.copy()), (f.copy(), g)))
         del cache[self._FUN_CACHE:]
         return f
 
