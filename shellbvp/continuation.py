@@ -442,8 +442,16 @@ def _cap_of(sol):
     return sol.get("cap_solution")
 
 
+def _secant_distance(d, f, last):
+    """|d - root| by the secant through (d, f) and ``last`` = (d0, f0); inf without a slope."""
+    d0, f0 = last
+    return abs(f * (d - d0) / (f - f0)) if f != f0 and d != d0 else math.inf
+
+
 def _regula_falsi(a, fa, sa, b, fb, sb, solve_at):
-    """Root of f(delta) between a and b (Illinois); returns the last state with f >= 0.
+    """Root of f(delta) between a and b (Illinois); returns the last state with f >= 0: where
+    the bracket is below 1e-7 (1 + delta) wide, or where the secant puts that state within a
+    tenth of it from the root.
 
     Where ``solve_at`` finds no state (e.g. the cap's contact has passed the tip's end, just
     beyond a wall touch; beta 1e-3, paper model), that delta is taken as beyond the root: it
@@ -451,6 +459,7 @@ def _regula_falsi(a, fa, sa, b, fb, sb, solve_at):
     best = sa if fa >= 0 else sb
     side = 0
     bisect, failures = False, 0
+    last = (a, fa) if abs(fa) < abs(fb) else (b, fb)  # the latest true value of f (Illinois halves the ends')
     for _ in range(40):
         d = 0.5 * (a + b) if bisect else (a * fb - b * fa) / (fb - fa)
         sol, f = solve_at(d, sa if abs(d - a) < abs(d - b) else sb)
@@ -465,6 +474,12 @@ def _regula_falsi(a, fa, sa, b, fb, sb, solve_at):
         else:
             if f >= 0:
                 best = sol
+                # the secant through the last two values puts the root within a tenth of the
+                # tolerance of this state: another solve would only confirm it (2 of 9 solves
+                # of base d40's two switch searches)
+                if _secant_distance(d, f, last) < 1e-8 * (1 + abs(d)):
+                    break
+            last = (d, f)
             if f * fb > 0:
                 b, fb, sb = d, f, sol
                 fa = fa / 2 if side == -1 else fa

@@ -1,6 +1,7 @@
 """Curves by continuation, their HDF5 files (issue: curves, HDF5, CLI)."""
 
 import json
+from unittest import mock
 
 import h5py
 import numpy as np
@@ -178,3 +179,31 @@ def test_curve_bad_input(kwargs, match):
     kw.update(kwargs)
     with pytest.raises(ValueError, match=match):
         sb.curve(sb.Scene.preset("base"), **kw)
+
+
+def test_switch_search_stops_where_the_secant_puts_the_root_within_its_tolerance():
+    """_regula_falsi (Illinois) on a smooth criterion: it stops at a state with f >= 0 that the
+    secant puts within 1e-8 (1 + delta) of the root -- before the bracket is 1e-7 wide, which
+    the state it returns already satisfies (f = (d - r) e^(d - r): Illinois's iterates)."""
+    import math
+
+    from shellbvp.continuation import _regula_falsi
+
+    root = 0.1117
+    calls = []
+
+    def f(d):
+        return (root - d) * math.exp(d - root)  # decreasing: f >= 0 below the root
+
+    def solve_at(d, near):
+        calls.append(d)
+        return {"d": d}, f(d)
+
+    best = _regula_falsi(0.1, f(0.1), {"d": 0.1}, 0.1125, f(0.1125), {"d": 0.1125}, solve_at)
+    assert best["d"] <= root and root - best["d"] < 1e-8 * (1 + root)
+    assert calls[-1] == best["d"], calls  # it stopped at the state it returns
+    stopped = len(calls)
+    calls.clear()
+    with mock.patch("shellbvp.continuation._secant_distance", return_value=math.inf):  # the bracket alone
+        assert _regula_falsi(0.1, f(0.1), {"d": 0.1}, 0.1125, f(0.1125), {"d": 0.1125}, solve_at) is not None
+    assert len(calls) > stopped, (stopped, calls)
