@@ -305,10 +305,9 @@ def line_kink_chain(eps: float, L: float) -> Chain:
 
 # -- the assembler -------------------------------------------------------------------------------
 def _call_key(t, y, p, par):
-    """What identifies a ``fun`` call: (shapes, the unknowns' and parameters' bytes) to compare
-    first, cheaply, then t and y (compared by value, :func:`_same_call`)."""
-    small = (np.shape(y), np.shape(t), None if p is None else np.asarray(p, float).tobytes(), par.tobytes())
-    return small, t, y
+    """The cheap part of what identifies a ``fun`` call (shapes, the unknowns' and parameters'
+    bytes), compared before t and y are compared by value (:func:`_same_call`)."""
+    return np.shape(y), np.shape(t), None if p is None else np.asarray(p, float).tobytes(), par.tobytes()
 
 
 def _same_call(key, small, t, y) -> bool:
@@ -532,17 +531,17 @@ class ChainBVP:
     #: derivatives by the regions' ends)
     _FUN_CACHE = 2
 
-    def _cached(self, t, y, p, small=None):
-        """(f, [g of each region]) of an earlier ``fun`` call at these arguments, or None."""
-        small = _call_key(t, y, p, self.par)[0] if small is None else small
+    def _cached(self, small, t, y):
+        """(f, [g of each region]) of an earlier ``fun`` call at these arguments (``small``: their
+        :func:`_call_key`), or None."""
         for key, value in self.__dict__.get("_fun_cache", ()):
             if _same_call(key, small, t, y):
                 return value
         return None
 
     def fun(self, t, y, p=None):
-        small = _call_key(t, y, p, self.par)[0]
-        hit = self._cached(t, y, p, small)
+        small = _call_key(t, y, p, self.par)
+        hit = self._cached(small, t, y)
         if hit is not None:
             return hit[0].copy()
         f, g = self._fun(t, y, p)
@@ -573,7 +572,7 @@ class ChainBVP:
         dfdy = np.zeros((n, n, m))
         dfdp = np.zeros((n, self.k, m)) if self.k else None
         par = self.par_at(p)
-        hit = self._cached(t, y, p) if dfdp is not None else None
+        hit = self._cached(_call_key(t, y, p, self.par), t, y) if dfdp is not None else None
         for k, reg in enumerate(self.regions):
             a, b = self.ln_S(reg.start, p), self.ln_S(reg.end, p)
             rows = self.rows(k)

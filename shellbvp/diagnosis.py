@@ -50,7 +50,7 @@ def _legendre_min(sysm, t, y, p):
             continue
         S = sysm.S(k, t, p)
         det = sysm.kernels.active.free_legendre(S, y[sysm.rows(k)], sysm.par)[0]
-        scale = _median(np.abs(det))
+        scale = float(np.median(np.abs(det)))
         if not scale > 0:
             continue
         i = int(np.argmin(det))
@@ -68,23 +68,13 @@ def _edge_model(sysm) -> str:
 _EDGE_FIELDS = ("axial_force_2pi", "r", "Q", "lambda_s", "kappa_s")  # what the edges' checks read
 
 
-def _median(a) -> float:
-    """np.median of a 1-D array, the same value (the middle one, or the mean of the two middle
-    ones), by one partition: np.median's own dispatch costs more than the work at a few hundred
-    points, and the diagnosis takes one per state."""
-    n = a.size
-    if n == 0:
-        return math.nan
-    h = n // 2
-    if n % 2:
-        return float(np.partition(a, h)[h])
-    part = np.partition(a, (h - 1, h))
-    return float(np.mean(part[h - 1:h + 1]))
-
-
 def _pick(fields, i):
     """The edge fields of a profile (arrays over the points, or constants) at point i."""
-    return {key: float(v[i] if np.ndim(v) else v) for key, v in ((key, fields[key]) for key in _EDGE_FIELDS)}
+    picked = {}
+    for key in _EDGE_FIELDS:
+        v = fields[key]
+        picked[key] = float(v[i] if np.ndim(v) else v)
+    return picked
 
 
 def _edge_jumps(sysm, ends):

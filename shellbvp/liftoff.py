@@ -283,7 +283,17 @@ def valid_liftoff_state(cap: Solution, *, tol=1e-6, max_nodes=10000, bc_tol=1e-1
     if previous is not None and previous.get("topology") in order:
         order = (previous.topology,) + tuple(t for t in order if t != previous.topology)
     line_too_curved = False
-    line = split = None
+    line = None
+    split_tried = False
+
+    def split_here():  # the cap+line(tip) state from the cap and the line tried here, if valid
+        res = second_zone_state(cap, tol=tol, max_nodes=max_nodes, bc_tol=bc_tol, previous=previous,
+                                before=before, line=line)
+        if res.success and res.valid:
+            return _with_line(res, line)
+        tried.append(f"{res.topology}: {res.message if not res.success else '; '.join(res.flags)}")
+        return None
+
     for topology in order:
         if topology == "annulus" and not (line_too_curved or _pressed_somewhere(cap)):
             # an annulus needs a pressed band: where the whole cap pulls and the line is not
@@ -291,11 +301,10 @@ def valid_liftoff_state(cap: Solution, *, tol=1e-6, max_nodes=10000, bc_tol=1e-1
             tried.append("annulus: not tried (the cap pulls everywhere)")
             continue
         if topology == "annulus" and _SPLIT_FIRST and _pole_down(line, tol) and _pressed_at_the_pole(cap):
-            split = second_zone_state(cap, tol=tol, max_nodes=max_nodes, bc_tol=bc_tol, previous=previous,
-                                      before=before, line=line)
-            if split.success and split.valid:
-                return _with_line(split, line), tried
-            tried.append(f"{split.topology}: {split.message if not split.success else '; '.join(split.flags)}")
+            split_tried = True
+            split = split_here()
+            if split is not None:
+                return split, tried
         res = liftoff_state(cap, topology, tol=tol, max_nodes=max_nodes, bc_tol=bc_tol, previous=previous,
                             before=before)
         if res.success and res.valid:
@@ -304,18 +313,13 @@ def valid_liftoff_state(cap: Solution, *, tol=1e-6, max_nodes=10000, bc_tol=1e-1
         line = res if topology == "line" else line
         why = res.message if not res.success else "; ".join(res.flags)
         tried.append(f"{topology}: {why}")
-    if split is not None or not _pressed_at_the_pole(cap):  # (split: tried before the annulus)
+    if split_tried or not _pressed_at_the_pole(cap):
         return None, tried
     if _SPLIT_RULE and not _split_possible(last, line, tol):
         tried.append("cap+line(tip): not tried (the pole was lifted at the previous point and the line here "
                      "keeps it above the tip)")
-    else:
-        res = second_zone_state(cap, tol=tol, max_nodes=max_nodes, bc_tol=bc_tol, previous=previous,
-                                 before=before, line=line)
-        if res.success and res.valid:
-            return _with_line(res, line), tried
-        tried.append(f"{res.topology}: {res.message if not res.success else '; '.join(res.flags)}")
-    return None, tried
+        return None, tried
+    return split_here(), tried
 
 
 _SPLIT_RULE = True  # False: the split probed wherever the cap is pressed at the pole (benchmarks measure the gain)
