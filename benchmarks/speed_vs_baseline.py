@@ -36,7 +36,9 @@ every 12th also at 1e-10 to show the reference's own error).
   collocation measures: the default curve's time per point (lift-off states, switches and the
   small-delta leg included, which shooting does not solve), and the time per point of a
   cap-only curve through exactly shooting's states (natural continuation, default error
-  estimates, its cold first point counted): the same work on both sides.
+  estimates, its cold first point counted): the same work on both sides.  Shooting and those
+  cap-only curves run interleaved, one round per repeat, each side's time the median over
+  rounds (until session 14 shooting ran once, apart from them).
 
 Writes benchmarks/results/speed_vs_baseline.json and .md (``--quick``: base default curve, one
 repeat, no shooting, ``speed_vs_baseline-quick.*``).
@@ -150,7 +152,7 @@ def worker(spec):
 
     import sys as _sys
 
-    counts = dict(calls=0, niter=0, richardson=0, failed=0, max_nodes=0)
+    counts = dict(calls=0, niter=0, richardson=0, failed=0, max_nodes=0, fixed_mesh=0)
     orig = scipy.integrate.solve_bvp
 
     def counted(*args, **kw):
@@ -167,6 +169,23 @@ def worker(spec):
         counts["max_nodes"] = max(counts["max_nodes"], int(r.x.size))
         return r
 
+    # Richardson estimates since session 14: a Newton on the fixed halved mesh, solve_bvp only
+    # where that does not converge; counted as runs too (one Newton iteration each)
+    from shellbvp import collocation as _collocation
+
+    fixed_mesh = getattr(_collocation, "newton_on_mesh", None)
+
+    def counted_fixed_mesh(*args, **kw):
+        r = fixed_mesh(*args, **kw)
+        counts["calls"] += 1
+        counts["niter"] += 1
+        counts["richardson"] += 1
+        counts["fixed_mesh"] += 1
+        counts["max_nodes"] = max(counts["max_nodes"], int(np.size(args[4])))
+        return r
+
+    if fixed_mesh is not None:
+        _collocation.newton_on_mesh = counted_fixed_mesh
     scene = sb.Scene.preset(spec["preset"])
     scene.model()  # the cached generated code: loaded, not timed
     kernel_load = 0.0
@@ -332,30 +351,61 @@ def shooting_states(ref):
     return [i for i, (d, s) in enumerate(zip(ref["delta"], ref["start"])) if s is not None and d >= SHOOT_FROM]
 
 
-def same_states(sides, entry, variants, repeat, log):
+def same_states_and_shooting(sides, entry, variants, repeat, shoot, log):
     """This commit's cap-only curve through exactly shooting's states (their depths, each from its
     neighbour by natural continuation, error estimates as by default; the first point's cold
-    solve counted, which shooting's is not), at each of SAME_TOLS: per variant, CPU ms per point
-    and max F error at the default tol, and the same per tol (``tols``)."""
+    solve counted, which shooting's is not), at each of SAME_TOLS, and (``shoot``) shooting at
+    those states (:func:`shooting`), interleaved: each of ``repeat`` rounds runs every
+    collocation curve, then shooting at every rtol, so that both sides' medians sample the same
+    stretch of a shared machine's load (until session 14 shooting ran once, apart).
+
+    Returns (per variant: CPU ms per point and max F error at the default tol, and the same per
+    tol (``tols``); shooting's rows, per rtol the median CPU time over rounds, [] without
+    ``shoot``)."""
     ref = entry["_ref"]
     depths = [ref["delta"][i] for i in shooting_states(ref)]
     if not depths:
-        return {}
+        return {}, []
+    runs = {(v, tol): [] for v in variants for tol in SAME_TOLS}
+    shots = []
+    for rnd in range(repeat):
+        for v in variants:
+            for tol in SAME_TOLS:
+                runs[v, tol].append(sides.run(v, (entry["id"], entry["preset"], "same-states"),
+                                              {"deltas": depths, "tol": tol}))
+        if shoot:
+            shots.append(shooting(entry["preset"], ref, lambda msg: log(f"round {rnd + 1}: {msg}")))
     out = {}
     for v in variants:
         rows = []
         for tol in SAME_TOLS:
-            runs = [sides.run(v, (entry["id"], entry["preset"], "same-states"), {"deltas": depths, "tol": tol})
-                    for _ in range(repeat)]
-            err, compared, left = f_error(runs[0], ref)
-            cpu = statistics.median(r["cpu"] for r in runs)
-            rows.append(dict(tol=tol, points=runs[0]["points"], depths=len(depths), cpu_median=cpu, f_error=err,
-                             compared=compared, left_out=left, ms_per_point=1e3 * cpu / max(runs[0]["points"], 1),
-                             stop=runs[0]["stop"], complete=runs[0]["complete"]))
+            rs = runs[v, tol]
+            err, compared, left = f_error(rs[0], ref)
+            cpu = statistics.median(r["cpu"] for r in rs)
+            rows.append(dict(tol=tol, points=rs[0]["points"], depths=len(depths), cpu_median=cpu, f_error=err,
+                             compared=compared, left_out=left, ms_per_point=1e3 * cpu / max(rs[0]["points"], 1),
+                             stop=rs[0]["stop"], complete=rs[0]["complete"], cpu_runs=[r["cpu"] for r in rs]))
             log(f"  same states {entry['preset']} | {v} | tol {tol:g}: {rows[-1]['points']} points, "
                 f"{rows[-1]['ms_per_point']:.1f} ms/point, max F error {err:.1e}")
         out[v] = dict(rows[0], tols=rows)
-    return out
+    return out, _median_shots(shots)
+
+
+def _median_shots(shots):
+    """Shooting's rows of several rounds as one: per rtol, the median CPU and wall time (the
+    states, convergence and errors are the same in every round)."""
+    if not shots:
+        return []
+    rows = []
+    for per_round in zip(*shots):
+        row = dict(per_round[0])
+        row["cpu"] = statistics.median(r["cpu"] for r in per_round)
+        row["wall"] = statistics.median(r["wall"] for r in per_round)
+        row["per_point_ms"] = 1e3 * row["cpu"] / row["points"]
+        row["cpu_runs"] = [r["cpu"] for r in per_round]
+        row["same_every_round"] = len({(r["converged"], r["max_rel"]) for r in per_round}) == 1
+        rows.append(row)
+    return rows
 
 
 def equal_error(case, variant):
@@ -477,15 +527,17 @@ def markdown(data):
              f"{_interpolate_import(data)}); time: median over repeats of the curve's CPU time "
              f"(the process's, the measure least disturbed by other users of a shared machine) and wall time; "
              f"ratio: median over repeats of (variant time / this commit's time in the same repeat); speed-ups "
-             f"and per-point times use CPU time; counts (solve_bvp runs, "
-             f"of them Richardson estimates, failed runs other than those (a Richardson estimate is one Newton "
-             f"iteration on the halved mesh, 'too many nodes' by design), Newton iterations, largest mesh) "
+             f"and per-point times use CPU time; counts (runs: solve_bvp runs and, since session 14, "
+             f"fixed-mesh Newton runs; of them Richardson estimates (one Newton run on the halved mesh: at the "
+             f"baseline a solve_bvp run, 'too many nodes' by design; now a fixed-mesh Newton, solve_bvp where "
+             f"that does not converge); failed runs other than those; Newton iterations (solve_bvp's outer "
+             f"iterations, 1 per fixed-mesh run); largest mesh) "
              f"{same}; F error: max relative error "
              f"against states solved at tol {REF_TOL:g} at the same depths (points of another topology than the "
              f"reference's left out; {_check_text(data)}). Total {m['total_s']:.0f} s.", ""]
     variants = list(VARIANTS)
     lines += ["| curve | variant | CPU time (s) | x this commit | wall time (s) | x this commit | points | "
-              "solve_bvp runs (Richardson) | failed | Newton its | max nodes | CPU ms/point | "
+              "runs (Richardson) | failed | Newton its | max nodes | CPU ms/point | "
               "max F error (compared/left out) |",
               "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for case in data["cases"]:
@@ -508,6 +560,8 @@ def markdown(data):
                   "point (lift-off states, switches and the small-delta leg included, which shooting does not "
                   "solve), and this commit's cap-only curve through exactly shooting's states (their depths, "
                   "natural continuation, error estimates as by default, its cold first point counted). "
+                  "Shooting and the cap-only curves run interleaved, in rounds (each round every collocation "
+                  "curve, then shooting at every rtol), and each side's time is the median over the rounds. "
                   "'equal error': the loosest shooting rtol whose max F error is at most the collocation "
                   "run's; ratio: shooting's CPU ms/point over collocation's.", "",
                   "| preset | shooting rtol: CPU ms/point (max F error, converged) | default curve: ms/point "
@@ -763,13 +817,13 @@ def main(argv=None):
     for entry in data["cases"]:
         if entry["kind"] != "default":
             continue
-        if entry["preset"] in reused:
-            entry["shooting"] = reused[entry["preset"]]
-        elif not (args.quick or args.no_shooting):
-            entry["shooting"] = shooting(entry["preset"], entry["_ref"], log)
-        if not entry.get("shooting"):
+        if args.quick or (args.no_shooting and entry["preset"] not in reused):
             continue
-        entry["same_states"] = same_states(sides, entry, collocation, args.repeat, log)
+        shoot = entry["preset"] not in reused
+        entry["same_states"], shots = same_states_and_shooting(sides, entry, collocation, args.repeat, shoot, log)
+        entry["shooting"] = shots if shoot else reused[entry["preset"]]
+        if not entry["shooting"]:
+            continue
         ratios(entry)
     for entry in data["cases"]:
         entry.pop("_ref")

@@ -464,6 +464,35 @@ class ChainBVP:
         return solve_bvp(self.fun, self.bc, x, y, p, fun_jac=self.fun_jac, bc_jac=self.bc_jac,
                          kernels=active if hasattr(active, "collocation_factor") else None, **kwargs)
 
+    def newton_on_mesh(self, x, y, p=None, *, tol, bc_tol):
+        """``shellbvp.collocation.newton_on_mesh`` of this system from a guess (completed, see
+        :meth:`complete`) on the fixed mesh ``x``: ``(y, p)`` (``p`` None when there are no
+        unknowns), or None where that Newton does not converge."""
+        from .collocation import newton_on_mesh
+
+        y, p = self.complete(x, y, p)
+        if self.k:
+            fun, fun_jac, bc, bc_jac = self.fun, self.fun_jac, self.bc, self.bc_jac
+        else:  # solve_bvp's calling convention without unknowns, as newton_on_mesh takes it
+            def fun(t, y, _):
+                return self.fun(t, y)
+
+            def fun_jac(t, y, _):
+                return self.fun_jac(t, y), None
+
+            def bc(ya, yb, _):
+                return self.bc(ya, yb)
+
+            def bc_jac(ya, yb, _):
+                return (*self.bc_jac(ya, yb), None)
+        active = self.kernels.active
+        out = newton_on_mesh(fun, bc, fun_jac, bc_jac, np.asarray(x, float), np.array(y, float),
+                             np.empty(0) if p is None else np.array(p, float), tol=tol, bc_tol=bc_tol,
+                             kernels=active if hasattr(active, "collocation_factor") else None)
+        if out is None:
+            return None
+        return out[0], (out[1] if self.k else None)
+
     def ln_S(self, point: Point, p) -> float:
         return point.ln_offset + (p[self.col[point.unknown]] if point.unknown else 0.0)
 

@@ -25,6 +25,10 @@ as nonzeros.  On the first solve this module replaces three private functions of
 A scipy whose ``_bvp`` lacks them or calls them differently keeps its own
 functions: only slower.  ``ENABLED = False`` restores scipy's path at run time
 (the benchmarks' ablation).
+
+:func:`newton_on_mesh` solves the same collocation system on a mesh that stays fixed,
+by Newton's method without solve_bvp's line search: Richardson estimates need no
+more (see its docstring).
 """
 
 from __future__ import annotations
@@ -37,7 +41,7 @@ import threading
 import numpy as np
 
 __all__ = ["ENABLED", "COMPILED_ELIMINATION", "MAX_GROWTH", "CollocationBlocks", "CollocationLU", "assemble_csc",
-           "collocation_jacobian", "factorise", "install", "solving_with"]
+           "collocation_jacobian", "factorise", "install", "newton_on_mesh", "solving_with"]
 
 log = logging.getLogger(__name__)
 
@@ -201,6 +205,91 @@ def solving_with(kernels):
         yield
     finally:
         _CURRENT.kernels = before
+
+
+def collocation_residuals(fun, x, h, y, p):
+    """solve_bvp's collocation residuals (Lobatto IIIA: the cubic spline through the nodes with
+    the right-hand side's slopes, at the midpoints), as ``scipy.integrate._bvp.collocation_fun``
+    computes them: (residuals (n, m-1), midpoint states, f at the nodes, f at the midpoints)."""
+    f = fun(x, y, p)
+    y_middle = 0.5 * (y[:, 1:] + y[:, :-1]) - 0.125 * h * (f[:, 1:] - f[:, :-1])
+    f_middle = fun(x[:-1] + 0.5 * h, y_middle, p)
+    return y[:, 1:] - y[:, :-1] - h / 6 * (f[:, :-1] + f[:, 1:] + 4 * f_middle), y_middle, f, f_middle
+
+
+def newton_on_mesh(fun, bc, fun_jac, bc_jac, x, y, p, *, tol, bc_tol, kernels=None, max_jacobians=2,
+                   max_steps=6):
+    """The collocation system of solve_bvp on the fixed mesh ``x``, solved by Newton's method
+    from ``(y, p)`` (``p`` an array, possibly empty; ``fun(x, y, p)``, ``fun_jac`` returning
+    ``(df_dy, df_dp)``, ``bc(ya, yb, p)``, ``bc_jac`` returning three blocks, as solve_bvp
+    calls them once it has wrapped them).
+
+    Full steps only, each taken only while it reduces the largest residual at least twofold
+    (a Jacobian is evaluated again once a step with the current one does not), until
+    solve_bvp's own test of convergence at ``tol`` and ``bc_tol`` holds: at most
+    ``max_jacobians`` Jacobians and ``max_steps`` steps.  Returns the converged ``(y, p)``,
+    or None (no convergence within that, a singular Jacobian, a NaN): the caller then has
+    solve_bvp, with its line search, to fall back on.
+
+    What this is for: a start that is already near the solution (a converged state on its
+    mesh with every interval halved).  solve_bvp's line search tests each step by the norm
+    of the next Newton step, which an ill-conditioned Jacobian (a state at a switch, one
+    region ~1e-8 long) keeps large after the residual has reached rounding level: it then
+    halves converged steps and evaluates up to four Jacobians.  And its mesh refinement
+    and residual estimate after Newton are work a fixed mesh does not need.
+    """
+    n, m = y.shape
+    k = p.size
+    h = np.diff(x)
+    x_middle = x[:-1] + 0.5 * h
+    tol_r = 2 / 3 * h * 5e-2 * tol  # solve_bvp's (solve_newton's) termination test, the same numbers
+
+    def residuals(y, p):
+        col, y_middle, f, f_middle = collocation_residuals(fun, x, h, y, p)
+        bc_res = bc(y[:, 0], y[:, -1], p)
+        done = bool(np.all(np.abs(col) < tol_r * (1 + np.abs(f_middle))) and np.all(np.abs(bc_res) < bc_tol))
+        r = np.hstack((col.ravel(order="F"), bc_res))
+        return r, done, (y_middle, f, f_middle, bc_res)
+
+    r, done, at = residuals(y, p)
+    if done:
+        return y, p
+    size, jacobians, lu, fresh = float(np.max(np.abs(r))), 0, None, False
+    if not np.isfinite(size):
+        return None
+    with solving_with(kernels):
+        for _ in range(max_steps):
+            if lu is None:
+                if jacobians == max_jacobians:
+                    return None
+                jacobians, fresh = jacobians + 1, True
+                df_dy, df_dp = fun_jac(x, y, p)
+                df_dy_middle, df_dp_middle = fun_jac(x_middle, at[0], p)
+                dbc_dya, dbc_dyb, dbc_dp = bc_jac(y[:, 0], y[:, -1], p)
+                blocks = (df_dy, df_dy_middle, df_dp, df_dp_middle, dbc_dya, dbc_dyb, dbc_dp)
+                if not all(b is None or np.all(np.isfinite(b)) for b in blocks):
+                    return None
+                i_jac, j_jac = (None, None) if ENABLED else _ORIGINAL["compute_jac_indices"](n, m, k)
+                try:
+                    lu = factorise(collocation_jacobian(n, m, k, i_jac, j_jac, h, *blocks))
+                except RuntimeError:  # exactly singular
+                    return None
+            step = lu.solve(r)
+            y_new = y - step[:m * n].reshape((n, m), order="F")
+            p_new = p - step[m * n:]
+            r_new, done, at_new = residuals(y_new, p_new)
+            if done:
+                return y_new, p_new
+            size_new = float(np.max(np.abs(r_new)))
+            if not size_new < size:  # worse, or NaN
+                if fresh:  # a full step of a new Jacobian: this needs a line search
+                    return None
+                lu = None  # the kept Jacobian has gone stale: a new one, here
+                continue
+            if not size_new <= 0.5 * size:  # slow progress: a new Jacobian at the new iterate
+                lu = None
+            y, p, r, at, size, fresh = y_new, p_new, r_new, at_new, size_new, False
+    return None
 
 
 def _jac_indices(n, m, k):

@@ -371,23 +371,29 @@ def richardson_error(sysm, res, tol, bc_tol=1e-10):
 
     The collocation solution (Lobatto IIIA, order 4) is recomputed on the
     converged mesh with every interval halved, without further refinement
-    (``max_nodes`` pins the mesh; Newton converges to tol/100 and bc_tol/100, so the
-    coarse solve's iteration and boundary errors are included); the error of
-    the coarse value is then ``|X_h - X_h/2| * 16/15``.  Costs one Newton
-    solve on twice the nodes.  ``sysm.end_values`` gives (F, delta) of a solution.
+    (Newton converges to tol/100 and bc_tol/100, so the coarse solve's iteration and
+    boundary errors are included); the error of the coarse value is then
+    ``|X_h - X_h/2| * 16/15``.  Costs one Newton solve on twice the nodes: the system's
+    ``newton_on_mesh`` (full steps; usually one Jacobian), or, where that does not
+    converge, solve_bvp with its line search on the pinned mesh (``max_nodes``).
+    ``sysm.end_values`` gives (F, delta) of a solution.
     """
     x = res.x
     x2 = np.sort(np.r_[x, 0.5 * (x[1:] + x[:-1])])
     p = np.asarray(res.p, float)
+    p = p if p.size else None
     with np.errstate(all="ignore"):
-        fine = sysm.solve(x2, res.sol(x2), p if p.size else None, tol=tol / 100, bc_tol=bc_tol / 100,
-                          max_nodes=x2.size)
-        if fine.status == 2 or not np.all(np.isfinite(fine.y)) \
-                or (fine.p is not None and not np.all(np.isfinite(fine.p))):
-            res.force_error = res.delta_error = float("nan")
-            res.flags = list(res.flags) + ["error estimate failed (Newton on the halved mesh did not converge)"]
-            return
-        force, delta = sysm.end_values(fine.y[:, 0], fine.y[:, -1], fine.p)
+        fine = sysm.newton_on_mesh(x2, res.sol(x2), p, tol=tol / 100, bc_tol=bc_tol / 100) \
+            if hasattr(sysm, "newton_on_mesh") else None
+        if fine is None:
+            run = sysm.solve(x2, res.sol(x2), p, tol=tol / 100, bc_tol=bc_tol / 100, max_nodes=x2.size)
+            if run.status == 2 or not np.all(np.isfinite(run.y)) \
+                    or (run.p is not None and not np.all(np.isfinite(run.p))):
+                res.force_error = res.delta_error = float("nan")
+                res.flags = list(res.flags) + ["error estimate failed (Newton on the halved mesh did not converge)"]
+                return
+            fine = run.y, run.p
+        force, delta = sysm.end_values(fine[0][:, 0], fine[0][:, -1], fine[1])
     res.force_error = abs(force - res.force) * 16 / 15
     res.delta_error = abs(delta - res.delta) * 16 / 15
 

@@ -48,3 +48,19 @@ def random_collocation_blocks(k, n=5, m=9, seed=3):
     dbc_dya, dbc_dyb = rng.standard_normal((n + k, n)), rng.standard_normal((n + k, n))
     dbc_dya[:, 2:] = dbc_dyb[:, :2] = 0.0  # conditions at the ends that a chain does not couple
     return n, m, k, h, jac(m), jac(m - 1), dp, dp_middle, dbc_dya, dbc_dyb, rng.standard_normal((n + k, k)) if k else None
+
+
+def switch_state_estimate():
+    """(state, its F error estimate, its F error against the state solved at tol 1e-9) of the
+    switch to cap+line(tip) on the base curve through the first 9 of the 40 depths
+    linspace(0.0125, 0.5, 40) (delta 0.1125: one region ~1e-8 long, an ill-conditioned
+    collocation Jacobian), with the kernels the environment selects."""
+    import shellbvp as sb
+    from shellbvp.state import solve_from
+
+    c = sb.curve(sb.Scene.preset("base"), deltas=np.linspace(0.0125, 0.5, 40)[:9])
+    s = c.solutions[-1]
+    assert s.topology == "cap+line(tip)" and s.error_method == "richardson"
+    ref = solve_from(s.system, (s.x, s.y, s.p), tol=1e-9, max_nodes=30000, bc_tol=1e-12)
+    assert ref.success and ref.topology == s.topology
+    return s, float(s.force_error), abs(ref.force - s.force)

@@ -161,6 +161,22 @@ def test_speed_vs_baseline_shooting_ratio_takes_the_cheapest_shooting_at_equal_o
     assert case["shooting_ratio_same_bound"] and not case["shooting_ratio_bound"]
 
 
+def test_speed_vs_baseline_shooting_rounds_are_merged_by_their_median_time():
+    sv = _load("speed_vs_baseline")
+
+    def row(rtol, cpu):
+        return dict(rtol=rtol, points=20, converged=20, max_rel=1e-8, cpu=cpu, wall=cpu + 0.1, per_point_ms=50 * cpu)
+
+    rounds = [[row(1e-6, 1.0), row(1e-8, 4.0)], [row(1e-6, 3.0), row(1e-8, 2.0)], [row(1e-6, 2.0), row(1e-8, 9.0)]]
+    merged = sv._median_shots(rounds)
+    assert [r["rtol"] for r in merged] == [1e-6, 1e-8]
+    assert [r["cpu"] for r in merged] == [2.0, 4.0] and merged[1]["per_point_ms"] == pytest.approx(200.0)
+    assert merged[0]["cpu_runs"] == [1.0, 3.0, 2.0] and all(r["same_every_round"] for r in merged)
+    rounds[1][0]["converged"] = 19
+    assert not sv._median_shots(rounds)[0]["same_every_round"]
+    assert sv._median_shots([]) == []
+
+
 def test_speed_vs_baseline_equal_error_both_ways_pairs_each_shooting_rtol_with_the_cheapest_tol():
     sv = _load("speed_vs_baseline")
     shots = [dict(rtol=1e-6, per_point_ms=100.0, max_rel=5e-6, converged=20, points=20),

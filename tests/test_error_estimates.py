@@ -133,3 +133,50 @@ def test_a_point_far_above_tol_is_tightened_until_it_meets_it():
         assert ref.success and ref.topology == "point"
         assert abs(s.force - ref.force) <= 1e-6 * abs(ref.force), (s.delta, abs(s.force / ref.force - 1))
         assert s.force_error <= 1e-6 * abs(s.force)
+
+
+# -- the Newton on the halved mesh ------------------------------------------------------------
+def _halved(s):
+    x = np.sort(np.r_[s.x, 0.5 * (s.x[1:] + s.x[:-1])])
+    return x, s.sol(x)
+
+
+def test_newton_on_the_halved_mesh_takes_the_step_solve_bvp_takes():
+    """Where solve_bvp's first full step is accepted and converges, the fixed-mesh Newton
+    Richardson estimates use ends at the same iterate; it satisfies solve_bvp's test at tol/100."""
+    from shellbvp.collocation import collocation_residuals
+
+    s = sb.solve(SCENE, delta=0.25, estimate_error=False)
+    x, y = _halved(s)
+    ours = s.system.newton_on_mesh(x, y, s.p, tol=s.tol / 100, bc_tol=1e-12)
+    assert ours is not None
+    run = s.system.solve(x, y, s.p, tol=s.tol / 100, bc_tol=1e-12, max_nodes=x.size)
+    assert run.niter == 1
+    np.testing.assert_allclose(ours[0], run.y, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(ours[1], run.p, rtol=0, atol=1e-12)
+    h = np.diff(x)
+    col, _, _, f_mid = collocation_residuals(s.system.fun, x, h, ours[0], ours[1])
+    assert np.all(np.abs(col) < 2 / 3 * h * 5e-2 * s.tol / 100 * (1 + np.abs(f_mid)))
+    assert np.max(np.abs(s.system.bc(ours[0][:, 0], ours[0][:, -1], ours[1]))) < 1e-12
+
+
+def test_newton_on_the_halved_mesh_gives_up_on_a_far_start():
+    """A start far from any solution gives None (richardson_error then falls back to
+    solve_bvp with its line search), not an iterate."""
+    s = sb.solve(SCENE, delta=0.25, estimate_error=False)
+    x, y = _halved(s)
+    far = y * (1 + 0.5 * np.sin(40 * x))
+    assert s.system.newton_on_mesh(x, far, s.p * 1.5, tol=s.tol / 100, bc_tol=1e-12) is None
+
+
+def test_the_estimate_at_a_switch_state_is_its_true_error():
+    """At the switch to cap+line(tip) on the 40 base depths (delta 0.1125, one region ~1e-8
+    long) the fixed-mesh Newton converges, and the estimate is within 2 % of the error
+    against the state solved at tol 1e-9 (test_kernels: the same with compiled kernels,
+    where solve_bvp's line search stopped short of convergence: 5.1e-9 for a true 6.9e-9)."""
+    from collocation_cases import switch_state_estimate
+
+    s, estimate, true = switch_state_estimate()
+    x, y = _halved(s)
+    assert s.system.newton_on_mesh(x, y, s.p, tol=s.tol / 100, bc_tol=1e-12) is not None
+    assert abs(estimate / true - 1) < 0.02, (estimate, true)
