@@ -982,6 +982,10 @@ def _land_on_delta_max(scene, cur, prev, builder, st, key):
     return sol
 
 
+#: the adaptive curve's first arclength step, in units of the chord from the point below the first
+FIRST_STEP = 1.0
+
+
 def _adaptive(scene, builder: _Builder, settings):
     st = settings
     first = _first_point(scene, st["delta_start"], st)
@@ -1027,7 +1031,9 @@ def _adaptive(scene, builder: _Builder, settings):
         if not below.success:
             raise _Stop(f"no second point near delta = {first.delta:g}: {below.message}")
     prev = below
-    ds = min(st["ds_max"], 2 * np.linalg.norm((_X(cur) - _X(prev)) / scale))
+    # the first step as long as the chord to the state below, which converged: twice that
+    # failed on base, flat and dome (a solve_bvp run refining to the node budget, ~20 ms)
+    ds = min(st["ds_max"], FIRST_STEP * np.linalg.norm((_X(cur) - _X(prev)) / scale))
     ds_min = 1e-4  # in (delta, lambda0, F): below this the branch is taken to end here
     tangent = None
     crossed_from = None  # the smooth cap from which the corner was last tried
