@@ -811,8 +811,12 @@ def main(argv=None):
         rows = {c["preset"]: c.get("shooting") for c in earlier["cases"] if c.get("kind") == "default"}
         keep = set(args.reuse_presets.split(",")) if args.reuse_presets else set(rows)
         reused = {p: r for p, r in rows.items() if p in keep and r}
-        data["shooting_from"] = dict(file=str(args.reuse_shooting), date=earlier["meta"]["date"],
-                                     commit=earlier["meta"]["this_commit"], presets=sorted(reused))
+        # rows that run itself reused keep the run where they were measured
+        origin = earlier.get("shooting_from") or {}
+        if not set(reused) <= set(origin.get("presets", ())):
+            origin = dict(date=earlier["meta"]["date"], commit=earlier["meta"]["this_commit"])
+        data["shooting_from"] = dict(file=str(args.reuse_shooting), date=origin["date"], commit=origin["commit"],
+                                     presets=sorted(reused))
     collocation = [v for v in ("this commit", "this commit, numba") if v in variants]
     for entry in data["cases"]:
         if entry["kind"] != "default":
