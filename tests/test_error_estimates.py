@@ -180,3 +180,16 @@ def test_the_estimate_at_a_switch_state_is_its_true_error():
     x, y = _halved(s)
     assert s.system.newton_on_mesh(x, y, s.p, tol=s.tol / 100, bc_tol=1e-12) is not None
     assert abs(estimate / true - 1) < 0.02, (estimate, true)
+
+
+def test_where_the_fixed_mesh_newton_gives_up_solve_bvp_gives_the_estimate(monkeypatch):
+    from shellbvp.chain import ChainBVP
+    from shellbvp.solution import richardson_error
+
+    s = sb.solve(SCENE, delta=0.25, estimate_error=False)
+    richardson_error(s.system, s, s.tol)
+    fast = s.force_error
+    monkeypatch.setattr(ChainBVP, "newton_on_mesh", lambda self, *a, **kw: None)
+    richardson_error(s.system, s, s.tol)
+    assert np.isfinite(fast) and s.force_error == pytest.approx(fast, rel=1e-6)
+    assert not any("error estimate failed" in f for f in s.flags)
