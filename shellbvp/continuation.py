@@ -579,15 +579,19 @@ def _locate_switches(builder: _Builder, st):
             criterion, sign, solve_at = "curvature_excess", -1.0, wall_line_at
         else:
             continue
+        if criterion == "pole_clearance" and (any(e is None for e in ends)
+                                              or not ends[0].pole_clearance * ends[1].pole_clearance < 0):
+            # a line recorded as valid may have its pole down on the tip already (to 10 tol), and the
+            # split state may have no line at its depth: the touch-down then lies between two of the
+            # line points before it
+            bracket = _touchdown_bracket([r[3] for r in rows], min(s1.delta, s2.delta))
+            if bracket is not None:  # the switch point goes between those two, in branch order
+                ends = list(bracket)
+                k1, k2 = (next(r[0] for r in rows if r[3] is e) for e in bracket)
         if any(e is None for e in ends):
             continue
         e1, e2 = sorted(ends, key=lambda e: e.delta)
         f1, f2 = (sign * (min(e[criterion], 1.0) if criterion == "wall_gap" else e[criterion]) for e in (e1, e2))
-        if not f1 * f2 < 0 and criterion == "pole_clearance":
-            # a line recorded as valid may have its pole down on the tip already (to 10 tol): the
-            # touch-down lies between two of the line points before it
-            e1, e2 = _touchdown_bracket([r[3] for r in rows], min(s1.delta, s2.delta)) or (e1, e2)
-            f1, f2 = e1.pole_clearance, e2.pole_clearance
         if not f1 * f2 < 0:
             continue
         best = _regula_falsi(e1.delta, f1, e1, e2.delta, f2, e2, solve_at)

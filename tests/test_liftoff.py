@@ -520,6 +520,19 @@ def test_the_touchdown_is_located_where_a_line_recorded_valid_already_touches():
     assert np.nanmax(np.abs(c.energy_residual)) < 3e-3
 
 
+@pytest.mark.slow  # 4 s with numba, ~15 s with numpy
+def test_the_touchdown_is_located_where_the_split_state_has_no_line_at_its_depth():
+    """beta = 0.1 (the stability grid's scene): the last line point before the split has its pole
+    down on the tip within 10 tol, and no line converges at the first split state's depth, so the
+    two points either side of the change give no bracket.  The touch-down is bracketed among the
+    line points and the switch point recorded between them in branch order (before: no switch
+    listed; and a switch point from that bracket went after the line point deeper than it)."""
+    c = sb.curve(sb.Scene.preset("base", beta=0.1), delta_max=1.0, delta_min=1e-4)
+    sw = [s for s in c.settings["topology_switches"] if (s["from"], s["to"]) == ("line", "cap+line(tip)")]
+    assert len(sw) == 1 and 0.3249 < sw[0]["delta"] < 0.3250 and sw[0]["criterion"] == "pole_clearance"
+    assert np.all(np.diff(c.delta) > 0)
+
+
 def test_solve_from_a_split_state_keeps_its_configuration():
     """``sb.solve(guess=<cap+line(tip) state>)`` re-solves that configuration (it built a single
     cap's system from it and failed in solve_bvp on the shapes): at a tighter tol at the same depth
