@@ -13,29 +13,7 @@ from shellbvp.io import POINT_FIELDS
 
 @pytest.fixture(scope="module")
 def base_curve():
-    """The default base curve, with the outcome of each pseudo-arclength solve (``arc_runs``)."""
-    from shellbvp import continuation
-
-    runs, solve_from = [], continuation.solve_from
-
-    def recorded(sysm, guess, **kw):
-        res = solve_from(sysm, guess, **kw)
-        if sysm.extra == "arclength":
-            runs.append(bool(res.success))
-        return res
-
-    continuation.solve_from = recorded
-    try:
-        c = sb.curve(sb.Scene.preset("base"), delta_max=0.5)
-    finally:
-        continuation.solve_from = solve_from
-    c.arc_runs = runs
-    return c
-
-
-def test_the_first_arclength_step_converges(base_curve):
-    # it was twice the chord to the point below: that solve refined to its node budget and failed
-    assert base_curve.arc_runs[0] and len(base_curve.arc_runs) >= 20
+    return sb.curve(sb.Scene.preset("base"), delta_max=0.5)
 
 
 def test_adaptive_base_curve_reaches_delta_max_with_increasing_force(base_curve):

@@ -521,12 +521,16 @@ def test_the_touchdown_is_located_where_a_line_recorded_valid_already_touches():
 
 
 @pytest.mark.slow  # 4 s with numba, ~15 s with numpy
-def test_the_touchdown_is_located_where_the_split_state_has_no_line_at_its_depth():
-    """beta = 0.1 (the stability grid's scene): the last line point before the split has its pole
+def test_the_touchdown_is_located_where_the_split_state_has_no_line_at_its_depth(monkeypatch):
+    """beta = 0.1 (the stability grid's scene), the adaptive curve's first step as long as the
+    chord below (which places its points so): the last line point before the split has its pole
     down on the tip within 10 tol, and no line converges at the first split state's depth, so the
     two points either side of the change give no bracket.  The touch-down is bracketed among the
     line points and the switch point recorded between them in branch order (before: no switch
     listed; and a switch point from that bracket went after the line point deeper than it)."""
+    from shellbvp import continuation
+
+    monkeypatch.setattr(continuation, "FIRST_STEP", 1.0)
     c = sb.curve(sb.Scene.preset("base", beta=0.1), delta_max=1.0, delta_min=1e-4)
     sw = [s for s in c.settings["topology_switches"] if (s["from"], s["to"]) == ("line", "cap+line(tip)")]
     assert len(sw) == 1 and 0.3249 < sw[0]["delta"] < 0.3250 and sw[0]["criterion"] == "pole_clearance"
