@@ -224,12 +224,15 @@ def newton_on_mesh(fun, bc, fun_jac, bc_jac, x, y, p, *, tol, bc_tol, kernels=No
     ``(df_dy, df_dp)``, ``bc(ya, yb, p)``, ``bc_jac`` returning three blocks, as solve_bvp
     calls them once it has wrapped them).
 
-    Full steps only, each taken only while it reduces the largest residual at least twofold
-    (a Jacobian is evaluated again once a step with the current one does not), until
-    solve_bvp's own test of convergence at ``tol`` and ``bc_tol`` holds: at most
-    ``max_jacobians`` Jacobians and ``max_steps`` steps.  Returns the converged ``(y, p)``,
-    or None (no convergence within that, a singular Jacobian, a NaN): the caller then has
-    solve_bvp, with its line search, to fall back on.
+    Full steps only, until solve_bvp's own test of convergence at ``tol`` and ``bc_tol``
+    holds.  A step that reduces the largest residual is taken; the Jacobian is kept while
+    steps reduce it at least twofold, else evaluated again at the new iterate; a step of a
+    kept Jacobian that does not reduce it is dropped and the Jacobian evaluated again where
+    it was.  At most ``max_jacobians`` Jacobians and ``max_steps`` steps.  Returns the
+    converged ``(y, p)``, or None (no convergence within that, a full step of a new Jacobian
+    that does not reduce the residual, a singular Jacobian, a NaN, a scipy whose private
+    functions :func:`install` does not find): the caller then has solve_bvp, with its line
+    search, to fall back on.
 
     What this is for: a start that is already near the solution (a converged state on its
     mesh with every interval halved).  solve_bvp's line search tests each step by the norm
@@ -238,6 +241,8 @@ def newton_on_mesh(fun, bc, fun_jac, bc_jac, x, y, p, *, tol, bc_tol, kernels=No
     halves converged steps and evaluates up to four Jacobians.  And its mesh refinement
     and residual estimate after Newton are work a fixed mesh does not need.
     """
+    if not install():  # factorise needs scipy's splu as install() finds it
+        return None
     n, m = y.shape
     k = p.size
     h = np.diff(x)
@@ -248,10 +253,9 @@ def newton_on_mesh(fun, bc, fun_jac, bc_jac, x, y, p, *, tol, bc_tol, kernels=No
         col, y_middle, f, f_middle = collocation_residuals(fun, x, h, y, p)
         bc_res = bc(y[:, 0], y[:, -1], p)
         done = bool(np.all(np.abs(col) < tol_r * (1 + np.abs(f_middle))) and np.all(np.abs(bc_res) < bc_tol))
-        r = np.hstack((col.ravel(order="F"), bc_res))
-        return r, done, (y_middle, f, f_middle, bc_res)
+        return np.hstack((col.ravel(order="F"), bc_res)), done, y_middle
 
-    r, done, at = residuals(y, p)
+    r, done, y_middle = residuals(y, p)
     if done:
         return y, p
     size, jacobians, lu, fresh = float(np.max(np.abs(r))), 0, None, False
@@ -264,7 +268,7 @@ def newton_on_mesh(fun, bc, fun_jac, bc_jac, x, y, p, *, tol, bc_tol, kernels=No
                     return None
                 jacobians, fresh = jacobians + 1, True
                 df_dy, df_dp = fun_jac(x, y, p)
-                df_dy_middle, df_dp_middle = fun_jac(x_middle, at[0], p)
+                df_dy_middle, df_dp_middle = fun_jac(x_middle, y_middle, p)
                 dbc_dya, dbc_dyb, dbc_dp = bc_jac(y[:, 0], y[:, -1], p)
                 blocks = (df_dy, df_dy_middle, df_dp, df_dp_middle, dbc_dya, dbc_dyb, dbc_dp)
                 if not all(b is None or np.all(np.isfinite(b)) for b in blocks):
@@ -277,7 +281,7 @@ def newton_on_mesh(fun, bc, fun_jac, bc_jac, x, y, p, *, tol, bc_tol, kernels=No
             step = lu.solve(r)
             y_new = y - step[:m * n].reshape((n, m), order="F")
             p_new = p - step[m * n:]
-            r_new, done, at_new = residuals(y_new, p_new)
+            r_new, done, y_middle_new = residuals(y_new, p_new)
             if done:
                 return y_new, p_new
             size_new = float(np.max(np.abs(r_new)))
@@ -288,7 +292,7 @@ def newton_on_mesh(fun, bc, fun_jac, bc_jac, x, y, p, *, tol, bc_tol, kernels=No
                 continue
             if not size_new <= 0.5 * size:  # slow progress: a new Jacobian at the new iterate
                 lu = None
-            y, p, r, at, size, fresh = y_new, p_new, r_new, at_new, size_new, False
+            y, p, r, y_middle, size, fresh = y_new, p_new, r_new, y_middle_new, size_new, False
     return None
 
 
