@@ -460,9 +460,14 @@ class ChainBVP:
         from .solution import solve_bvp
 
         y, p = self.complete(x, y, p)
-        active = self.kernels.active
         return solve_bvp(self.fun, self.bc, x, y, p, fun_jac=self.fun_jac, bc_jac=self.bc_jac,
-                         kernels=active if hasattr(active, "collocation_factor") else None, **kwargs)
+                         kernels=self._elimination, **kwargs)
+
+    @property
+    def _elimination(self):
+        """The compiled kernels that factorise the collocation Jacobian, or None (SuperLU)."""
+        active = self.kernels.active
+        return active if hasattr(active, "collocation_factor") else None
 
     def newton_on_mesh(self, x, y, p=None, *, tol, bc_tol):
         """``shellbvp.collocation.newton_on_mesh`` of this system from a guess (completed, see
@@ -485,10 +490,9 @@ class ChainBVP:
 
             def bc_jac(ya, yb, _):
                 return (*self.bc_jac(ya, yb), None)
-        active = self.kernels.active
         out = newton_on_mesh(fun, bc, fun_jac, bc_jac, np.asarray(x, float), np.array(y, float),
                              np.empty(0) if p is None else np.array(p, float), tol=tol, bc_tol=bc_tol,
-                             kernels=active if hasattr(active, "collocation_factor") else None)
+                             kernels=self._elimination)
         if out is None:
             return None
         return out[0], (out[1] if self.k else None)

@@ -207,14 +207,17 @@ def solving_with(kernels):
         _CURRENT.kernels = before
 
 
-def collocation_residuals(fun, x, h, y, p):
-    """solve_bvp's collocation residuals (Lobatto IIIA: the cubic spline through the nodes with
-    the right-hand side's slopes, at the midpoints), as ``scipy.integrate._bvp.collocation_fun``
-    computes them: (residuals (n, m-1), midpoint states, f at the nodes, f at the midpoints)."""
-    f = fun(x, y, p)
-    y_middle = 0.5 * (y[:, 1:] + y[:, :-1]) - 0.125 * h * (f[:, 1:] - f[:, :-1])
-    f_middle = fun(x[:-1] + 0.5 * h, y_middle, p)
-    return y[:, 1:] - y[:, :-1] - h / 6 * (f[:, :-1] + f[:, 1:] + 4 * f_middle), y_middle, f, f_middle
+def _scipy_collocation_fun():
+    """``scipy.integrate._bvp.collocation_fun`` (solve_bvp's collocation residuals, the same
+    arithmetic), or None where that scipy has none with the parameters expected."""
+    from scipy.integrate import _bvp
+
+    fn = getattr(_bvp, "collocation_fun", None)
+    try:
+        ok = callable(fn) and tuple(inspect.signature(fn).parameters) == ("fun", "y", "p", "x", "h")
+    except (TypeError, ValueError):
+        ok = False
+    return fn if ok else None
 
 
 def newton_on_mesh(fun, bc, fun_jac, bc_jac, x, y, p, *, tol, bc_tol, kernels=None, max_jacobians=2,
@@ -230,8 +233,8 @@ def newton_on_mesh(fun, bc, fun_jac, bc_jac, x, y, p, *, tol, bc_tol, kernels=No
     kept Jacobian that does not reduce it is dropped and the Jacobian evaluated again where
     it was.  At most ``max_jacobians`` Jacobians and ``max_steps`` steps.  Returns the
     converged ``(y, p)``, or None (no convergence within that, a full step of a new Jacobian
-    that does not reduce the residual, a singular Jacobian, a NaN, a scipy whose private
-    functions :func:`install` does not find): the caller then has solve_bvp, with its line
+    that does not reduce the residual, a singular Jacobian, a NaN, a scipy without the
+    private functions this calls: its ``collocation_fun`` and those :func:`install` replaces): the caller then has solve_bvp, with its line
     search, to fall back on.
 
     What this is for: a start that is already near the solution (a converged state on its
@@ -241,7 +244,8 @@ def newton_on_mesh(fun, bc, fun_jac, bc_jac, x, y, p, *, tol, bc_tol, kernels=No
     halves converged steps and evaluates up to four Jacobians.  And its mesh refinement
     and residual estimate after Newton are work a fixed mesh does not need.
     """
-    if not install():  # factorise needs scipy's splu as install() finds it
+    collocation_fun = _scipy_collocation_fun()
+    if collocation_fun is None or not install():  # factorise needs scipy's splu as install() finds it
         return None
     n, m = y.shape
     k = p.size
@@ -250,7 +254,7 @@ def newton_on_mesh(fun, bc, fun_jac, bc_jac, x, y, p, *, tol, bc_tol, kernels=No
     tol_r = 2 / 3 * h * 5e-2 * tol  # solve_bvp's (solve_newton's) termination test, the same numbers
 
     def residuals(y, p):
-        col, y_middle, f, f_middle = collocation_residuals(fun, x, h, y, p)
+        col, y_middle, _, f_middle = collocation_fun(fun, y, p, x, h)
         bc_res = bc(y[:, 0], y[:, -1], p)
         done = bool(np.all(np.abs(col) < tol_r * (1 + np.abs(f_middle))) and np.all(np.abs(bc_res) < bc_tol))
         return np.hstack((col.ravel(order="F"), bc_res)), done, y_middle

@@ -383,10 +383,10 @@ def richardson_error(sysm, res, tol, bc_tol=1e-10):
     p = np.asarray(res.p, float)
     p = p if p.size else None
     with np.errstate(all="ignore"):
-        fine = sysm.newton_on_mesh(x2, res.sol(x2), p, tol=tol / 100, bc_tol=bc_tol / 100) \
-            if hasattr(sysm, "newton_on_mesh") else None
+        y2 = res.sol(x2)
+        fine = sysm.newton_on_mesh(x2, y2, p, tol=tol / 100, bc_tol=bc_tol / 100)
         if fine is None:
-            run = sysm.solve(x2, res.sol(x2), p, tol=tol / 100, bc_tol=bc_tol / 100, max_nodes=x2.size)
+            run = sysm.solve(x2, y2, p, tol=tol / 100, bc_tol=bc_tol / 100, max_nodes=x2.size)
             if run.status == 2 or not np.all(np.isfinite(run.y)) \
                     or (run.p is not None and not np.all(np.isfinite(run.p))):
                 res.force_error = res.delta_error = float("nan")
