@@ -36,7 +36,7 @@ from .liftoff import (
     replace_invalid_cap,
 )
 from .pointload import SC_POINT, solve_point_load
-from .solution import Solution, calibrated_error, default_eps, richardson_error, secant_ratio, warm_mesh
+from .solution import SECANT_MAX_RATIO, Solution, calibrated_error, default_eps, richardson_error, secant_ratio, warm_mesh
 from .corner import LEGENDRE_WATCH, edge_model, is_corner, limit_estimate, near_limit
 from .state import check_delta, check_tol, cross_convexity_limit, make_system, solve, solve_from, system_like, \
     warm_guess
@@ -765,16 +765,20 @@ def _physical_end(sol):
 SECANT_MAX_LN_SC = 1.0
 
 
-def _solve_at_delta(scene, delta, prev, prev2, settings):
-    """Delta-controlled solve warm-started from prev with a secant predictor from prev2."""
+def _solve_at_delta(scene, delta, prev, prev2, settings, prev3=None):
+    """Delta-controlled solve warm-started from prev: with the quadratic predictor through
+    prev, prev2 and prev3 where it applies, else the secant through prev and prev2."""
     if prev.get("topology") == "point":
         return _step_from_point(scene, delta, prev, settings)
     sysm = system_like(prev, "delta", delta, settings["eps"])
-    guess = warm_guess(sysm, prev)
+    guess = None
     a = secant_ratio(delta, prev, prev2)
     if a is not None and prev2.get("topology") != "point" and edge_model(prev2) == edge_model(prev) \
             and abs(a * (prev.p[0] - prev2.p[0])) <= SECANT_MAX_LN_SC:
-        guess = _secant(sysm, prev, prev2, a)
+        guess = (prev3 is not None and _quadratic(sysm, (prev, prev2, prev3), (prev.delta, prev2.delta, prev3.delta),
+                                                  delta)) or _secant(sysm, prev, prev2, a)
+    if guess is None:
+        guess = warm_guess(sysm, prev)
     kw = dict(tol=settings["tol"], max_nodes=_step_nodes(prev, settings), bc_tol=settings["bc_tol"])
     sol = solve_from(sysm, guess, **kw)
     if not sol.success and delta > prev.delta and near_limit(prev):
@@ -798,6 +802,41 @@ def _step_nodes(prev, settings):
     return int(min(settings["max_nodes"], max(2000, 4 * prev.nodes)))
 
 
+#: The quadratic predictor of a step of natural continuation in delta: where three converged
+#: states of one configuration precede it, their quadratic in delta, extrapolated.  Its error is
+#: a step's cube, the secant's its square: on the cap curves through shooting's depths
+#: (benchmarks/speed_vs_baseline.py) solve_bvp's Newton takes 15-20 % fewer steps.  Not on the
+#: adaptive curve's arclength steps, whose steps grow: there the chord length as the parameter
+#: saved 2-6 % of the steps and cost a Jacobian more on 4 of 6 presets.
+QUADRATIC_PREDICTOR = True
+
+
+def _quadratic(sysm, states, where, at):
+    """Guess at the parameter value ``at`` from the quadratic through ``states`` (three, newest
+    first) at the values ``where``, on the newest one's warm-start mesh; None where it does not
+    apply: a missing state or one of another configuration, values not monotone towards ``at``,
+    a step more than ``SECANT_MAX_RATIO`` times the one before, or ln Sc moved by more than
+    ``SECANT_MAX_LN_SC`` (the secant's guards)."""
+    s1, s2, s3 = states
+    if not QUADRATIC_PREDICTOR or s3 is None or s3.get("topology") == "point" \
+            or not _configuration(s3) == _configuration(s2) == _configuration(s1):
+        return None
+    u1, u2, u3 = where
+    if not ((u3 < u2 < u1 < at) or (u3 > u2 > u1 > at)) \
+            or max(abs((at - u1) / (u1 - u2)), abs((u1 - u2) / (u2 - u3))) > SECANT_MAX_RATIO:
+        return None
+    w1 = (at - u2) * (at - u3) / ((u1 - u2) * (u1 - u3))  # Lagrange's weights (they sum to 1)
+    w2 = (at - u1) * (at - u3) / ((u2 - u1) * (u2 - u3))
+    w3 = (at - u1) * (at - u2) / ((u3 - u1) * (u3 - u2))
+    X = [np.array([s.p[0], s.lambda0, s.delta]) for s in states]
+    ln_Sc, lambda0, delta = w1 * X[0] + w2 * X[1] + w3 * X[2]
+    if not abs(ln_Sc - X[0][0]) <= SECANT_MAX_LN_SC:
+        return None
+    x = warm_mesh(s1)
+    y = w1 * s1.sol(x) + w2 * s2.sol(x) + w3 * s3.sol(x)
+    return x, y, sysm.pack(ln_Sc=ln_Sc, lambda0=lambda0, delta=delta)
+
+
 def _secant(sysm, cur, prev, a):
     """Guess cur + a (cur - prev) on cur's warm-start mesh (states and parameters)."""
     x = warm_mesh(cur)
@@ -812,7 +851,7 @@ def _secant(sysm, cur, prev, a):
 
 def _natural(scene, deltas, builder: _Builder, settings, first=None, key0=0):
     """Natural continuation through ``deltas`` (from ``first``, already recorded, if given)."""
-    prev2 = None
+    prev2 = prev3 = None
     if first is None:
         prev = _first_point(scene, float(deltas[0]), settings)
         builder.add(prev, key0)
@@ -823,9 +862,9 @@ def _natural(scene, deltas, builder: _Builder, settings, first=None, key0=0):
         step = target - d
         while prev.delta < target:
             nd = min(target, prev.delta + step)
-            sol = _solve_at_delta(scene, nd, prev, prev2, settings)
+            sol = _solve_at_delta(scene, nd, prev, prev2, settings, prev3)
             if sol.success:
-                prev2, prev = prev, sol
+                prev3, prev2, prev = prev2, prev, sol
                 if nd == target:
                     builder.add(sol, i)
                 step *= 1.5

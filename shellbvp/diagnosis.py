@@ -59,6 +59,15 @@ def _legendre_min(sysm, t, y, p):
     return (best, where) if math.isfinite(best) else (math.nan, math.nan)
 
 
+def _nodes_and_midpoints(x):
+    """The mesh and its intervals' midpoints, sorted, without repeats (a midpoint equals a node
+    where an interval is within rounding of zero width)."""
+    t = np.empty(2 * x.size - 1)
+    t[0::2] = x
+    t[1::2] = 0.5 * (x[1:] + x[:-1])
+    return t if np.all(t[1:] > t[:-1]) else np.unique(t)
+
+
 def _edge_model(sysm) -> str:
     """"corner" if any contact edge is a Weierstrass-Erdmann corner, else the edges' model."""
     models = {j.model for j in sysm.junctions if isinstance(j, Edge)}
@@ -144,7 +153,7 @@ def diagnose(sysm, bvp, tol, converged_note: str = "") -> Solution:
                    ring_force=nan, ring_force_inner=nan, cap_force=nan, edge_forces=[], valid=False, flags=flags)
         return _without_iterate_numbers(res)
 
-    t = np.unique(np.r_[bvp.x, 0.5 * (bvp.x[1:] + bvp.x[:-1])])  # from 0 to 1: the regions' ends
+    t = _nodes_and_midpoints(bvp.x)  # from 0 to 1: the regions' ends
     y_t = bvp.sol(t)
     parts = sysm.region_profiles(t, y_t, p)
     ends = {k: (_pick(f, 0), _pick(f, -1)) for k, _, f in parts}  # (start, end) of region k

@@ -85,8 +85,14 @@ def make_system(scene, control, value, eps, edge=None):
 
 
 def system_like(prev, control, value, eps):
-    """The cap system of ``prev``'s scene with ``prev``'s contact edge (smooth or corner)."""
-    return make_system(prev.scene, control, value, eps, edge_model(prev))
+    """The cap system of ``prev``'s scene with ``prev``'s contact edge (smooth or corner):
+    ``prev``'s own system with the new value where it is that system, else a new one."""
+    edge, sysm = edge_model(prev), prev.get("system")
+    if (isinstance(sysm, ChainBVP) and sysm.control == control and not sysm.volume_control
+            and sysm.scene is prev.scene and hasattr(sysm, "tip_A")
+            and sysm.chain == cap_chain(eps, prev.scene.shell_length, edge)):
+        return sysm.with_value(value)
+    return make_system(prev.scene, control, value, eps, edge)
 
 
 def cross_convexity_limit(prev, prev2, delta, *, eps, tol, max_nodes, bc_tol, exact=True):

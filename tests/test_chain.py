@@ -190,3 +190,23 @@ def test_a_run_that_does_not_converge_reports_nan_numbers_not_its_last_iterate()
     for key in ("force", "lambda0", "Sc", "energy", "ring_force", "pressure_min"):
         assert np.isnan(bad[key]), key
     assert not bad.valid and bad.y.shape[0] == sysm.n  # the last iterate stays for inspection
+
+
+def test_the_diagnosis_points_are_the_mesh_and_its_midpoints_sorted_without_repeats():
+    from shellbvp.diagnosis import _nodes_and_midpoints
+
+    x = np.array([0.0, 0.1, 0.25, 0.7, 1.0])
+    np.testing.assert_array_equal(_nodes_and_midpoints(x), np.unique(np.r_[x, 0.5 * (x[1:] + x[:-1])]))
+    tiny = np.array([0.0, 0.5, np.nextafter(0.5, 1.0), 1.0])  # an interval of one ulp: its midpoint is a node
+    np.testing.assert_array_equal(_nodes_and_midpoints(tiny), np.unique(np.r_[tiny, 0.5 * (tiny[1:] + tiny[:-1])]))
+
+
+def test_the_pole_height_is_kept_but_not_across_parameters():
+    s = sb.solve(sb.Scene.preset("balloon", sealed=True), delta=0.1, estimate_error=False)
+    sysm = s.system
+    h = sysm.pole_height
+    assert sysm.__dict__["_pole_height"] == h
+    other = sysm.at(s.p * 1.0)
+    assert "_pole_height" not in other.__dict__ or other.par is sysm.par
+    assert other.pole_height == float(other.model.reference_shell(0.0, other.par)["Z"]) + other._param("pole_rise")
+
