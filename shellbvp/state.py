@@ -58,9 +58,10 @@ def _undeformed_guess(sysm: ChainBVP, ln_Sc, lambda0, delta, n=41):
     return t, y, p
 
 
-def warm_guess(sysm: ChainBVP, prev: "Solution", predictor=None):
-    """Previous cap solution on its warm-start mesh; optional predicted (y, p) shift."""
-    x = warm_mesh(prev)
+def warm_guess(sysm: ChainBVP, prev: "Solution", predictor=None, tol=None):
+    """Previous cap solution on its warm-start mesh (for ``tol``, default the one ``prev`` was
+    solved at; :func:`shellbvp.solution.warm_mesh`); optional predicted (y, p) shift."""
+    x = warm_mesh(prev, tol)
     y = prev.sol(x)
     p = sysm.pack(ln_Sc=prev.p[0], lambda0=prev.lambda0, delta=prev.delta)
     if predictor is not None:
@@ -395,7 +396,7 @@ def solve(scene, *, delta=None, lambda0=None, force=None, tol=1e-6, max_nodes=10
     kw = dict(tol=tol, max_nodes=max_nodes, bc_tol=bc_tol)
     if guess is not None:
         sysm = system_like(guess, control, value, eps)
-        res = solve_from(sysm, warm_guess(sysm, guess), **kw)
+        res = solve_from(sysm, warm_guess(sysm, guess, tol=tol), **kw)
         if not res.success and control == "delta" and near_limit(guess):
             res = cross_convexity_limit(guess, None, value, eps=eps, **kw) or res
         sysm = res.system if res.success else sysm
@@ -463,7 +464,7 @@ def _loose(kw):
 def _tighten(sysm, res, **kw):
     if not res.success or kw["tol"] >= _CRUDE_TOL:
         return res
-    return solve_from(sysm, warm_guess(sysm, res), **kw)
+    return solve_from(sysm, warm_guess(sysm, res, tol=kw["tol"]), **kw)
 
 
 def _cold_delta(sysm, delta, near_point=None, **kw):

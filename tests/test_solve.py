@@ -481,3 +481,15 @@ def test_solve_bvp_stops_when_newton_exceeds_its_jacobian_budget():
     short = solve_bvp(fun, bc, x, y, p=[6.0], fun_jac=fun_jac, bc_jac=bc_jac, tol=1e-5, max_jacobians=1)
     assert short.status == 3 and not short.success and "within 1 Jacobians" in short.message
     assert np.all(np.isnan(short.y)) and np.all(np.isfinite(short.p)) and short.p[0] != 6.0
+
+
+def test_a_guess_from_a_looser_tolerance_starts_on_a_mesh_for_the_tolerance_asked():
+    """solve(guess=state at tol 1e-6, tol=1e-9): the warm mesh is equidistributed for 1e-9 (the
+    residual model h^3 from the guess's own residuals), so solve_bvp converges in one or two
+    iterations (from the guess's mesh for 1e-6 it took 4, refining 3 times)."""
+    scene = sb.Scene.preset("base")
+    loose = sb.solve(scene, delta=0.3, estimate_error=False)
+    tight = sb.solve(scene, delta=0.3, tol=1e-9, guess=loose, max_nodes=30000, estimate_error=False)
+    assert tight.success and tight.niter <= 2, (tight.niter, tight.nodes)
+    assert tight.nodes > 3 * loose.nodes
+    assert tight.force == pytest.approx(loose.force, rel=1e-6)
