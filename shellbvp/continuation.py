@@ -775,8 +775,7 @@ def _solve_at_delta(scene, delta, prev, prev2, settings, prev3=None):
     a = secant_ratio(delta, prev, prev2)
     if a is not None and prev2.get("topology") != "point" and edge_model(prev2) == edge_model(prev) \
             and abs(a * (prev.p[0] - prev2.p[0])) <= SECANT_MAX_LN_SC:
-        guess = (prev3 is not None and _quadratic(sysm, (prev, prev2, prev3), (prev.delta, prev2.delta, prev3.delta),
-                                                  delta)) or _secant(sysm, prev, prev2, a)
+        guess = _quadratic(sysm, (prev, prev2, prev3), delta) or _secant(sysm, prev, prev2, a)
     if guess is None:
         guess = warm_guess(sysm, prev)
     kw = dict(tol=settings["tol"], max_nodes=_step_nodes(prev, settings), bc_tol=settings["bc_tol"])
@@ -811,17 +810,17 @@ def _step_nodes(prev, settings):
 QUADRATIC_PREDICTOR = True
 
 
-def _quadratic(sysm, states, where, at):
-    """Guess at the parameter value ``at`` from the quadratic through ``states`` (three, newest
-    first) at the values ``where``, on the newest one's warm-start mesh; None where it does not
-    apply: a missing state or one of another configuration, values not monotone towards ``at``,
-    a step more than ``SECANT_MAX_RATIO`` times the one before, or ln Sc moved by more than
-    ``SECANT_MAX_LN_SC`` (the secant's guards)."""
+def _quadratic(sysm, states, at):
+    """Guess at delta = ``at`` from the quadratic in delta through ``states`` (three, newest
+    first), on the newest one's warm-start mesh; None where it does not apply: a missing state
+    or one of another configuration, depths not monotone towards ``at``, a step more than
+    ``SECANT_MAX_RATIO`` times the one before, or ln Sc moved by more than ``SECANT_MAX_LN_SC``
+    (the secant's guards)."""
     s1, s2, s3 = states
     if not QUADRATIC_PREDICTOR or s3 is None or s3.get("topology") == "point" \
             or not _configuration(s3) == _configuration(s2) == _configuration(s1):
         return None
-    u1, u2, u3 = where
+    u1, u2, u3 = s1.delta, s2.delta, s3.delta
     if not ((u3 < u2 < u1 < at) or (u3 > u2 > u1 > at)) \
             or max(abs((at - u1) / (u1 - u2)), abs((u1 - u2) / (u2 - u3))) > SECANT_MAX_RATIO:
         return None

@@ -87,7 +87,7 @@ def test_the_quadratic_predictor_is_nearer_the_next_state_than_the_secant():
         sysm = system_like(s1, "delta", nxt.delta, s1.system.eps)
         want = sysm.pack(ln_Sc=nxt.p[0], lambda0=nxt.lambda0, delta=nxt.delta)
         errors = []
-        for x, y, p in (_quadratic(sysm, (s1, s2, s3), (s1.delta, s2.delta, s3.delta), nxt.delta),
+        for x, y, p in (_quadratic(sysm, (s1, s2, s3), nxt.delta),
                         _secant(sysm, s1, s2, secant_ratio(nxt.delta, s1, s2))):
             errors.append((np.max(np.abs(y - nxt.sol(x))), np.max(np.abs(p - want))))
         (qy, qp), (ly, lp) = errors
@@ -101,16 +101,16 @@ def test_the_quadratic_predictor_keeps_the_secants_guards():
 
     c = sb.curve(sb.Scene.preset("base"), deltas=[0.2, 0.22, 0.24], topology="cap", estimate_error=False)
     s3, s2, s1 = c.solutions
-    states, where = (s1, s2, s3), (0.24, 0.22, 0.2)
-    assert _quadratic(s1.system, states, where, 0.26) is not None
-    assert _quadratic(s1.system, states, where, 0.23) is None  # not beyond the newest state
-    assert _quadratic(s1.system, states, (0.24, 0.2, 0.22), 0.26) is None  # not monotone
-    assert _quadratic(s1.system, states, where, 0.24 + 1.01 * SECANT_MAX_RATIO * 0.02) is None  # too far
-    assert _quadratic(s1.system, (s1, s2, None), where, 0.26) is None
+    states = (s1, s2, s3)
+    assert _quadratic(s1.system, states, 0.26) is not None
+    assert _quadratic(s1.system, states, 0.23) is None  # not beyond the newest state
+    assert _quadratic(s1.system, (s1, s3, s2), 0.26) is None  # not monotone
+    assert _quadratic(s1.system, states, 0.24 + 1.01 * SECANT_MAX_RATIO * 0.02) is None  # too far
+    assert _quadratic(s1.system, (s1, s2, None), 0.26) is None
     other = type(s3)(s3, contact_edge="corner")  # another configuration
-    assert _quadratic(s1.system, (s1, s2, other), where, 0.26) is None
+    assert _quadratic(s1.system, (s1, s2, other), 0.26) is None
     with mock.patch.object(continuation, "QUADRATIC_PREDICTOR", False):
-        assert _quadratic(s1.system, states, where, 0.26) is None
+        assert _quadratic(s1.system, states, 0.26) is None
 
 
 def test_a_steps_system_is_the_previous_one_at_the_new_depth():
