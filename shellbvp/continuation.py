@@ -36,7 +36,8 @@ from .liftoff import (
     replace_invalid_cap,
 )
 from .pointload import SC_POINT, solve_point_load
-from .solution import SECANT_MAX_RATIO, Solution, calibrated_error, default_eps, richardson_error, secant_ratio, warm_mesh
+from .solution import (SECANT_MAX_RATIO, Solution, calibrated_error, default_eps, passed_tip_end, richardson_error,
+                       secant_ratio, warm_mesh)
 from .corner import LEGENDRE_WATCH, edge_model, is_corner, limit_estimate, near_limit
 from .state import check_delta, check_tol, cross_convexity_limit, make_system, solve, solve_from, system_like, \
     warm_guess
@@ -867,7 +868,7 @@ def _natural(scene, deltas, builder: _Builder, settings, first=None, key0=0):
                 if nd == target:
                     builder.add(sol, i)
                 step *= 1.5
-            elif sol.status == 4 and "end of the tip" in sol.message:
+            elif passed_tip_end(sol):
                 _wall_leg(scene, builder, settings, sol, i, deltas=[d for d in deltas if d > prev.delta],
                           reason=f"the contact reached the end of the tip (the indenter's cylinder) just after "
                                  f"delta = {prev.delta:.6g}")
@@ -1134,7 +1135,7 @@ def _adaptive(scene, builder: _Builder, settings):
             _land_on_delta_max(scene, cur, prev, builder, st, steps)
             ds /= 2
             continue
-        if not sol.success and sol.status == 4 and "end of the tip" in sol.message:
+        if not sol.success and passed_tip_end(sol):
             _wall_leg(scene, builder, st, sol, steps,
                       reason=f"the contact reached the end of the tip (the indenter's cylinder) just after "
                              f"delta = {cur.delta:.6g}")

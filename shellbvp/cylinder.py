@@ -37,7 +37,7 @@ from .chain import (
     cylinder_chain,
 )
 from .diagnosis import diagnose
-from .solution import Solution, attach_tip_table, richardson_error, warm_mesh
+from .solution import Solution, attach_tip_table, passed_tip_end, richardson_error, warm_mesh
 
 __all__ = ["WALL_TOPOLOGIES", "make_wall_system", "wall_contact_suspected", "solve_chain_from", "wall_state",
            "best_wall_state", "transfer_guess"]
@@ -77,7 +77,7 @@ def wall_contact_suspected(cap: Solution) -> bool:
     indenter with its contact edge near the tip's end."""
     if cap.get("topology") != "cap" or cap.get("system") is None or cap.scene.model().OMEGA_MAX is None:
         return False
-    passed = cap.get("status") == 4 and "end of the tip" in cap.get("message", "")
+    passed = passed_tip_end(cap)
     omega_max = cap.scene.tip_omega_max
     near = bool(cap.get("success") and cap.get("penetration", -1.0) > 0
                 and omega_max - cap.tip_end_margin > NEAR_TIP_END * omega_max)  # the edge's omega

@@ -191,10 +191,12 @@ def diagnose(sysm, bvp, tol, converged_note: str = "") -> Solution:
     omega_max = sysm.scene.tip_omega_max
     on_tip = [float(np.max(f["omega"])) for k, f in contact if sysm.regions[k].kind == "contact"]
     res.tip_end_margin = omega_max - max(on_tip) if on_tip else float("nan")  # < 0: past the tip's end
+    past_end = False
     for k, f in contact:
         lo, hi = float(np.min(f["omega"])), float(np.max(f["omega"]))
         if sysm.regions[k].kind == "contact" and hi > omega_max * (1 + 1e-9):
             admissible.append("the contact has passed the end of the tip (the indenter's cylinder)")
+            past_end = True
         if sysm.regions[k].kind == "cylinder" and lo < omega_max * (1 - 1e-9):
             admissible.append("the contact on the cylinder runs back onto the tip")
     for j in sysm.junctions:
@@ -202,11 +204,13 @@ def diagnose(sysm, bvp, tol, converged_note: str = "") -> Solution:
             w = q["chi1"] * sysm.S_point(sysm.regions[j.k].end, p) / sysm.scene.rho
             if j.on == "contact" and w > omega_max * (1 + 1e-9):
                 admissible.append("the contact has passed the end of the tip (the indenter's cylinder)")
+                past_end = True
             if j.on == "cylinder" and w < omega_max * (1 - 1e-9):
                 admissible.append("the contact line on the cylinder runs back onto the tip")
     if admissible and bvp.status == 0:
         set_status(res, bvp, flags + admissible, converged_note)
         flags = flags + admissible
+        res.past_tip_end = past_end  # a reason of its status 4, for the callers that go on on the cylinder
     if isinstance(first, PointPole) and force < 0:
         vflags.append(f"negative point force ({force:.3g})")
     scale = 10 * tol * (1 + abs(force))

@@ -180,6 +180,9 @@ class Solution(dict):
         Why the state is not valid (empty when valid).
     force_defect : float
         ``max |F(S) - F|`` over the free region (F is a first integral there).
+    past_tip_end : bool
+        Set on a state of status 4 whose contact has passed the end of the tip (onto the
+        indenter's cylinder): :func:`passed_tip_end`.
     force_error, delta_error : float
         Richardson error estimates (halved mesh; NaN if not estimated).
     wall_time : float
@@ -311,6 +314,13 @@ def warm_mesh(sol, tol=None):
     m = max(int(np.ceil(cum[-1])), _WARM_MESH_MIN_INTERVALS)
     return np.interp(np.linspace(0.0, cum[-1], m + 1), cum, x)  # the ends exactly: x[0] and x[-1]
 
+
+
+def passed_tip_end(sol) -> bool:
+    """Whether a state is inadmissible (status 4) because its contact has passed the end of the
+    tip onto the indenter's cylinder (diagnosis sets ``past_tip_end``): where a curve goes on
+    on the cylinder."""
+    return sol.get("status") == 4 and bool(sol.get("past_tip_end", False))
 
 
 def set_status(res, bvp, flags, converged_note=""):

@@ -24,6 +24,7 @@ from .solution import (
     Solution,
     attach_tip_table,
     default_eps,
+    passed_tip_end,
     richardson_error,
     warm_mesh,
 )
@@ -425,7 +426,7 @@ def _onto_wall(cap, topology, kw):
 
     if cap.get("system") is None or cap.scene.model().OMEGA_MAX is None:
         return cap
-    if not (cap.success or (cap.status == 4 and "end of the tip" in cap.message)):
+    if not (cap.success or passed_tip_end(cap)):
         return cap
     if topology in _WALL:
         alt = wall_state(cap, topology, **kw)
@@ -661,7 +662,7 @@ def _cold_other(scene, sysm, control, value, eps, **kw):
         if nxt.success:
             prev, cur, d = cur, nxt, nd
             step = min(1.5 * step, 0.05)
-        elif nxt.status == 4 and "end of the tip" in nxt.message:
+        elif passed_tip_end(nxt):
             return fail(f"{control} = {value:g} not reached before the contact reaches the end "
                         f"of the tip (the indenter's cylinder) near delta = {nd:.3g}")
         else:

@@ -317,6 +317,7 @@ def test_the_paper_cap_held_at_the_tip_end_takes_over_where_the_free_edge_reache
     """The paper's cap with its edge held at the tip's end (contact_edge "pinned"): shallower than
     where the free cap's edge reaches the end its ring force would pull, deeper it pushes; it
     vanishes where the free cap's edge is at the end, and there the two caps agree in F."""
+    from shellbvp.solution import passed_tip_end
     from shellbvp.state import make_system, solve_from, warm_guess
 
     scene = sb.Scene.preset("base", contact="paper", beta=1e-3)
@@ -325,6 +326,9 @@ def test_the_paper_cap_held_at_the_tip_end_takes_over_where_the_free_edge_reache
     free[0.92] = solve_from(sysm, warm_guess(sysm, free[0.91]))  # past the end: inadmissible, status 4
     assert free[0.91].success and free[0.92].status == 4
     assert free[0.91].tip_end_margin > 0 > free[0.92].tip_end_margin
+    assert passed_tip_end(free[0.92]) and not passed_tip_end(free[0.91])  # the diagnosis' flag
+    told = sb.Solution(dict(free[0.92], past_tip_end=False))
+    assert not passed_tip_end(told)  # the flag decides, not the message's words
     held = {}
     for d in (0.91, 0.92):
         sysm = make_system(scene, "delta", d, free[0.91].system.eps, edge="pinned")
