@@ -686,8 +686,6 @@ def fit(scene, displacement, force, *, R_L, fit_offset=True, fit_beta=False, fit
     ...
     ValueError: ...
     """
-    from .materials import MooneyRivlin
-
     weights = DEFAULT_WEIGHTS if weights is None else weights
     if weights not in WEIGHTS:
         raise ValueError(f"weights must be one of {WEIGHTS}; got {weights!r}")
@@ -709,29 +707,7 @@ def fit(scene, displacement, force, *, R_L, fit_offset=True, fit_beta=False, fit
     d, f = _check_data(d, f, k, float(origin))
     if not (isinstance(R_L, (int, float)) and math.isfinite(R_L) and R_L > 0):
         raise ValueError(f"R_L (rim radius, m) must be a finite number > 0; got {R_L!r}")
-    if fit_beta:
-        lo, hi = _check_bounds("beta", beta_bounds, lambda v: v > 0, lambda v: True, scene.beta)
-        name, bounds = "beta", (math.log(lo), math.log(hi))
-        step, theta0 = math.log(2.0), math.log(scene.beta)
-        scene_at = (lambda th: scene.replace(beta=math.exp(th)))
-    elif fit_alpha:
-        if not isinstance(scene.material, MooneyRivlin):
-            raise ValueError(f"fit_alpha needs a Mooney-Rivlin material (alpha); the scene's material is "
-                             f"{scene.material.family}")
-        name, bounds = "alpha", _check_bounds("alpha", alpha_bounds, lambda v: v >= 0, lambda v: v <= 1,
-                                              scene.material.alpha)
-        step, theta0 = 0.2, float(scene.material.alpha)
-        scene_at = (lambda th: scene.replace(material=MooneyRivlin(float(min(max(th, 0.0), 1.0)))))
-    elif fit_pressure:
-        scale = 4 * math.sqrt(3 * scene.beta)  # tau = 1 at a pole of unit curvature
-        p0 = float(scene.pressure)
-        default = (0.0, max(4 * abs(p0), 10 * scale))
-        name, bounds = "pressure", _check_bounds("pressure", default if pressure_bounds is None else pressure_bounds,
-                                                 lambda v: True, lambda v: True, p0)
-        step, theta0 = max(0.25 * abs(p0), 0.5 * scale), p0
-        scene_at = (lambda th: scene.replace(pressure=float(th)))
-    else:
-        name = None
+    sp = _shape_parameter(scene, fit_beta, fit_alpha, fit_pressure, beta_bounds, alpha_bounds, pressure_bounds)
     depth = (np.max(d) - origin) / R_L  # the deepest datum's delta, if the contact is at the guess
     dm = 1.2 * depth if delta_max is None else float(delta_max)
     if not (math.isfinite(dm) and dm > 0):
@@ -739,111 +715,175 @@ def fit(scene, displacement, force, *, R_L, fit_offset=True, fit_beta=False, fit
     grid = dm * np.arange(1, N_DEPTHS + 1) / N_DEPTHS
     counter = [0]
     mdl = _Model(d, f, R_L, fit_offset, baseline, loss)
-    notes = []
+    noise = _Noise(weights, floor)
+    if sp is None:
+        shape = _Shape(lambda th: scene, grid, tol, depth, counter, progress)
+        shape.add(None)
+        P, dP, top = shape.at(None)
+        res, rss, J, w = noise.irls(mdl, P, dP, top)
+        fitted = _Fitted(res, rss, J, w, scene, shape.nodes[None], P, top)
+        notes = []
+    else:
+        search = _ProfileSearch(sp, _Shape(sp.scene_at, grid, tol, depth, counter, progress), mdl, depth)
+        fitted = search.run(noise, k)
+        notes = search.notes
+    return _fit_result(fitted, mdl, sp, k, notes, keep, weights, baseline, counter[0])
 
-    def irls(P, dP, top):
-        """Fit at a fixed shape, iteratively reweighted: the weights from the model force."""
-        w = np.ones_like(f)
+
+@dataclass
+class _ShapeParameter:
+    """The shape parameter fitted with mu*H: its name, its search range, step and start in
+    theta (ln beta, alpha or the pressure) and the scene at a theta."""
+    name: str
+    bounds: tuple
+    step: float
+    theta0: float
+    scene_at: object
+
+
+def _shape_parameter(scene, fit_beta, fit_alpha, fit_pressure, beta_bounds, alpha_bounds, pressure_bounds):
+    """The :class:`_ShapeParameter` asked for (its bounds checked), or None."""
+    from .materials import MooneyRivlin
+
+    if fit_beta:
+        lo, hi = _check_bounds("beta", beta_bounds, lambda v: v > 0, lambda v: True, scene.beta)
+        return _ShapeParameter("beta", (math.log(lo), math.log(hi)), math.log(2.0), math.log(scene.beta),
+                               lambda th: scene.replace(beta=math.exp(th)))
+    if fit_alpha:
+        if not isinstance(scene.material, MooneyRivlin):
+            raise ValueError(f"fit_alpha needs a Mooney-Rivlin material (alpha); the scene's material is "
+                             f"{scene.material.family}")
+        bounds = _check_bounds("alpha", alpha_bounds, lambda v: v >= 0, lambda v: v <= 1, scene.material.alpha)
+        return _ShapeParameter("alpha", bounds, 0.2, float(scene.material.alpha),
+                               lambda th: scene.replace(material=MooneyRivlin(float(min(max(th, 0.0), 1.0)))))
+    if fit_pressure:
+        scale = 4 * math.sqrt(3 * scene.beta)  # tau = 1 at a pole of unit curvature
+        p0 = float(scene.pressure)
+        default = (0.0, max(4 * abs(p0), 10 * scale))
+        bounds = _check_bounds("pressure", default if pressure_bounds is None else pressure_bounds,
+                               lambda v: True, lambda v: True, p0)
+        return _ShapeParameter("pressure", bounds, max(0.25 * abs(p0), 0.5 * scale), p0,
+                               lambda th: scene.replace(pressure=float(th)))
+    return None
+
+
+@dataclass
+class _Noise:
+    """The noise model's weights, re-estimated from the model force (IRLS)."""
+    kind: str
+    floor: float
+
+    def reweight(self, mdl, P, top, q, w):
+        """(new weights, their largest relative change from ``w``)."""
+        w_new = _weights(self.kind, mdl.indentation(P, top, mdl.d, q), mdl.f - mdl.baseline(mdl.d, q), self.floor, w)
+        return w_new, np.max(np.abs(w_new / w - 1))
+
+    def irls(self, mdl, P, dP, top):
+        """Fit at a fixed shape, iteratively reweighted: (result, RSS, Jacobian, weights)."""
+        w = np.ones_like(mdl.f)
         res, rss, J = mdl.fit(P, dP, top, w)
         for it in range(8):
-            if weights == "uniform":
+            if self.kind == "uniform":
                 break
-            q = mdl.full(res.x)
-            w_new = _weights(weights, mdl.indentation(P, top, d, q), f - mdl.baseline(d, q), floor, w)
-            change = np.max(np.abs(w_new / w - 1)) if it > 0 else np.inf
-            w = w_new
+            w, change = self.reweight(mdl, P, top, mdl.full(res.x), w)
+            change = change if it > 0 else np.inf
             res, rss, J = mdl.fit(P, dP, top, w, start=res.x)
             if change < 1e-6:
                 break
         return res, rss, J, w
 
-    if name is None:
-        shape = _Shape(lambda th: scene, grid, tol, depth, counter, progress)
-        shape.add(None)
-        P, dP, top = shape.at(None)
-        res, rss, J, w = irls(P, dP, top)
-        theta_hat, theta_ci, interp_err, fit_scene, c = None, None, None, scene, shape.nodes[None]
-        model_P = (P, top)
-    else:
-        shape = _Shape(scene_at, grid, tol, depth, counter, progress)
-        lim = [bounds[0], bounds[1]]  # shrinks where node curves do not reach the data
-        if not shape.add(theta0):
-            raise ValueError(f"the model curve at the scene's {name} ends before the deepest data point "
+
+@dataclass
+class _Fitted:
+    """What a fit found: the least-squares result at the fitted shape, its weighted RSS and
+    Jacobian (a column for the shape parameter too), the weights, the scene and model curve
+    reported, the shape F(delta) fitted, and the shape parameter's estimate and interval."""
+    res: object
+    rss: float
+    J: np.ndarray
+    w: np.ndarray
+    scene: object
+    curve: object
+    P: object
+    top: float
+    theta: float | None = None
+    theta_ci: tuple | None = None
+    interpolation_error: float | None = None
+
+
+class _ProfileSearch:
+    """The shape parameter by its profile likelihood: the weighted RSS with mu*H (and the
+    offset and baseline) fitted at each theta, on model curves at nodes in theta (a
+    :class:`_Shape`) added where the search needs them; its 95 % interval where the RSS
+    crosses the likelihood-ratio threshold."""
+
+    def __init__(self, sp, shape, mdl, depth):
+        self.sp, self.shape, self.mdl = sp, shape, mdl
+        self.lim = [sp.bounds[0], sp.bounds[1]]  # shrinks where node curves do not reach the data
+        self.notes = []
+        self.w = None
+        if not shape.add(sp.theta0):
+            raise ValueError(f"the model curve at the scene's {sp.name} ends before the deepest data point "
                              f"(delta = {depth:.4g}): fit shallower data, or check the units and R_L")
 
-        def extend(side):
-            """Add the next node beyond the nodes on side -1 (low) or +1 (high); False at the limit."""
-            th = shape.thetas
-            edge = th[0] if side < 0 else th[-1]
-            if (edge <= lim[0] + 1e-12) if side < 0 else (edge >= lim[1] - 1e-12):
-                return False
-            if counter[0] >= _MAX_CURVES:
-                notes.append(("max_curves", f"stopped adding model curves at {_MAX_CURVES}"))
-                return False
-            new = edge + side * step
-            if side < 0:
-                new = lim[0] if new < lim[0] + 0.25 * step else new
-            else:
-                new = lim[1] if new > lim[1] - 0.25 * step else new
-            if shape.add(new):
-                return True
-            # this curve ends before the data: the range ends between edge and new
-            lim[0 if side < 0 else 1] = edge
-            notes.append(("search_range", f"model curves at {name} = {_show(name, new)} end before the deepest "
-                          f"data point; searched {name} up to {_show(name, edge)}"))
+    def extend(self, side):
+        """Add the next node beyond the nodes on side -1 (low) or +1 (high); False at the limit."""
+        shape, lim, step, name = self.shape, self.lim, self.sp.step, self.sp.name
+        th = shape.thetas
+        edge = th[0] if side < 0 else th[-1]
+        if (edge <= lim[0] + 1e-12) if side < 0 else (edge >= lim[1] - 1e-12):
             return False
+        if shape.counter[0] >= _MAX_CURVES:
+            self.notes.append(("max_curves", f"stopped adding model curves at {_MAX_CURVES}"))
+            return False
+        new = edge + side * step
+        if side < 0:
+            new = lim[0] if new < lim[0] + 0.25 * step else new
+        else:
+            new = lim[1] if new > lim[1] - 0.25 * step else new
+        if shape.add(new):
+            return True
+        # this curve ends before the data: the range ends between edge and new
+        lim[0 if side < 0 else 1] = edge
+        self.notes.append(("search_range", f"model curves at {name} = {_show(name, new)} end before the deepest "
+                           f"data point; searched {name} up to {_show(name, edge)}"))
+        return False
 
-        extend(-1)
-        extend(+1)
-        w = irls(*shape.at(theta0))[3]  # the noise model's weights at the start value
-        state = {"start": None}
+    def profile(self, theta):
+        """(weighted RSS, least-squares result) at ``theta``, with the current weights."""
+        P, dP, top = self.shape.at(theta)
+        res, rss, J = self.mdl.fit(P, dP, top, self.w)
+        return rss, res
 
-        def profile(theta):
-            P, dP, top = shape.at(theta)
-            res, rss, J = mdl.fit(P, dP, top, w, start=state["start"])
-            return rss, res
+    def estimate(self):
+        """The theta of least profiled RSS (nodes added while it lies at the end of them)."""
+        while True:
+            th = self.shape.thetas
+            vals = [self.profile(t)[0] for t in th]
+            i = int(np.argmin(vals))
+            if i == 0 and self.extend(-1):
+                continue
+            if i == len(th) - 1 and self.extend(+1):
+                continue
+            a, b = th[max(i - 1, 0)], th[min(i + 1, len(th) - 1)]
+            if a == b:
+                return th[i]
+            r = optimize.minimize_scalar(lambda t: self.profile(t)[0], bounds=(a, b), method="bounded",
+                                         options={"xatol": 1e-5 * self.sp.step})
+            return float(r.x) if r.fun <= vals[i] else th[i]
 
-        def estimate():
-            while True:
-                th = shape.thetas
-                vals = [profile(t)[0] for t in th]
-                i = int(np.argmin(vals))
-                if i == 0 and extend(-1):
-                    continue
-                if i == len(th) - 1 and extend(+1):
-                    continue
-                a, b = th[max(i - 1, 0)], th[min(i + 1, len(th) - 1)]
-                if a == b:
-                    return th[i]
-                r = optimize.minimize_scalar(lambda t: profile(t)[0], bounds=(a, b), method="bounded",
-                                             options={"xatol": 1e-5 * step})
-                return float(r.x) if r.fun <= vals[i] else th[i]
-
-        theta_hat = estimate()
-        for it in range(8):
-            if weights == "uniform":
-                break
-            rss, res = profile(theta_hat)
-            P, dP, top = shape.at(theta_hat)
-            q = mdl.full(res.x)
-            w_new = _weights(weights, mdl.indentation(P, top, d, q), f - mdl.baseline(d, q), floor, w)
-            change = np.max(np.abs(w_new / w - 1)) if it > 0 else np.inf
-            w = w_new
-            theta_hat = estimate()
-            if change < 1e-6:
-                break
-        # the curve at the estimate itself: measures the interpolation error, then joins the nodes.
-        # The estimate moves onto that node when the node's profiled RSS is within 1 % of the
-        # interval's likelihood-ratio margin of the minimum (indistinguishable from it; the
-        # reported curve is then the fitted one); otherwise one more curve at the new estimate.
-        n_par = k
-        dof = max(d.size - n_par, 1)
-        margin = stats.f.ppf(0.95, 1, dof) / dof  # thr = RSS_min (1 + margin)
+    def _on_a_node(self, theta_hat, margin):
+        """The estimate with the curve at it: it moves onto the nearest node when that node's
+        profiled RSS is within 1 % of the interval's likelihood-ratio margin of the minimum
+        (indistinguishable from it; the reported curve is then the fitted one); otherwise one
+        more curve at the estimate, which measures the interpolation error (the first such
+        curve's, before any exact one) and joins the nodes.  (theta, interpolation error)."""
+        shape, grid = self.shape, self.shape.grid
         interp_err = None
         for _ in range(3):
-            rss_hat = profile(theta_hat)[0]
+            rss_hat = self.profile(theta_hat)[0]
             near = min(shape.thetas, key=lambda t: abs(t - theta_hat))
-            if profile(near)[0] - rss_hat <= 0.01 * margin * rss_hat:
+            if self.profile(near)[0] - rss_hat <= 0.01 * margin * rss_hat:
                 theta_hat = near
                 break
             P_old, _, top_old = shape.at(theta_hat)
@@ -852,47 +892,74 @@ def fit(scene, displacement, force, *, R_L, fit_offset=True, fit_beta=False, fit
             ce = shape.nodes[theta_hat]
             m = min(len(ce), int(np.sum(grid <= top_old + 1e-15)))
             err = float(np.max(np.abs(P_old(ce.delta[:m]) - ce.force[:m])) / np.max(np.abs(ce.force[:m])))
-            interp_err = err if interp_err is None else interp_err  # the first one: before any exact curve
-            theta_hat = estimate()
-        interp_err = 0.0 if interp_err is None else interp_err
-        rss_min, res = profile(theta_hat)
+            interp_err = err if interp_err is None else interp_err
+            theta_hat = self.estimate()
+        return theta_hat, 0.0 if interp_err is None else interp_err
+
+    def crossing(self, side, theta_hat, thr):
+        """Where the profiled RSS crosses ``thr`` on ``side`` of the estimate: (theta, True if
+        the search range ended first)."""
+        while True:
+            th = self.shape.thetas
+            pts = [t for t in th if (t < theta_hat if side < 0 else t > theta_hat)]
+            pts = pts[::-1] if side < 0 else pts
+            inner = theta_hat
+            for t in pts:
+                if self.profile(t)[0] > thr:
+                    return float(optimize.brentq(lambda u: self.profile(u)[0] - thr, min(inner, t), max(inner, t),
+                                                 xtol=1e-6 * self.sp.step)), False
+                inner = t
+            if not self.extend(side):
+                return (th[0] if side < 0 else th[-1]), True
+
+    def run(self, noise, k):
+        """The fit with the shape parameter (``k`` parameters in all): :class:`_Fitted`."""
+        sp, shape, mdl = self.sp, self.shape, self.mdl
+        self.extend(-1)
+        self.extend(+1)
+        self.w = noise.irls(mdl, *shape.at(sp.theta0))[3]  # the noise model's weights at the start value
+        theta_hat = self.estimate()
+        for it in range(8):
+            if noise.kind == "uniform":
+                break
+            rss, res = self.profile(theta_hat)
+            P, dP, top = shape.at(theta_hat)
+            self.w, change = noise.reweight(mdl, P, top, mdl.full(res.x), self.w)
+            change = change if it > 0 else np.inf
+            theta_hat = self.estimate()
+            if change < 1e-6:
+                break
+        dof = max(mdl.d.size - k, 1)
+        margin = stats.f.ppf(0.95, 1, dof) / dof  # thr = RSS_min (1 + margin)
+        theta_hat, interp_err = self._on_a_node(theta_hat, margin)
+        rss_min, res = self.profile(theta_hat)
         thr = rss_min * (1 + margin)
-
-        def crossing(side):
-            while True:
-                th = shape.thetas
-                pts = [t for t in th if (t < theta_hat if side < 0 else t > theta_hat)]
-                pts = pts[::-1] if side < 0 else pts
-                inner = theta_hat
-                for t in pts:
-                    if profile(t)[0] > thr:
-                        return float(optimize.brentq(lambda u: profile(u)[0] - thr, min(inner, t), max(inner, t),
-                                                     xtol=1e-6 * step)), False
-                    inner = t
-                if not extend(side):
-                    return (th[0] if side < 0 else th[-1]), True
-
-        (c_lo, open_lo), (c_hi, open_hi) = crossing(-1), crossing(+1)
+        (c_lo, open_lo), (c_hi, open_hi) = self.crossing(-1, theta_hat, thr), self.crossing(+1, theta_hat, thr)
         if open_lo or open_hi:
-            notes.append(("search_range", f"the 95% interval of {name} reaches the end of the searched range "
-                          f"({_show(name, lim[0])}, {_show(name, lim[1])}); {name} is not determined "
-                          f"by the data on that side"))
-        theta_ci = (c_lo, c_hi)
-        theta_hat_final = theta_hat
-        P, dP, top = shape.at(theta_hat_final)
-        res, rss, J = mdl.fit(P, dP, top, w, start=res.x)
+            name, lim = sp.name, self.lim
+            self.notes.append(("search_range", f"the 95% interval of {name} reaches the end of the searched range "
+                               f"({_show(name, lim[0])}, {_show(name, lim[1])}); {name} is not determined "
+                               f"by the data on that side"))
+        P, dP, top = shape.at(theta_hat)
+        res, rss, J = mdl.fit(P, dP, top, self.w, start=res.x)
         # the shape parameter's column of the Jacobian (finite differences across the interpolated curves)
         # (central; one-sided at the end of the nodes)
-        h = 1e-4 * step
+        h = 1e-4 * sp.step
         ths = [min(max(t, shape.thetas[0]), shape.thetas[-1]) for t in (theta_hat - h, theta_hat + h)]
-        Fp = [mdl.force(*_drop(shape.at(t)), d, mdl.full(res.x)) for t in ths]
-        col = w * np.nan_to_num((Fp[1] - Fp[0]) / (ths[1] - ths[0]))
-        J = np.column_stack([J, col])
+        Fp = [mdl.force(*_drop(shape.at(t)), mdl.d, mdl.full(res.x)) for t in ths]
+        col = self.w * np.nan_to_num((Fp[1] - Fp[0]) / (ths[1] - ths[0]))
         near = min(shape.thetas, key=lambda t: abs(t - theta_hat))
-        c = shape.nodes[near]
-        fit_scene = shape.scene_at(near)
-        model_P = (P, top)
-    # intervals of the free parameters (Wald, t), from the weighted Jacobian
+        return _Fitted(res, rss, np.column_stack([J, col]), self.w, shape.scene_at(near), shape.nodes[near], P, top,
+                       theta_hat, (c_lo, c_hi), interp_err)
+
+
+def _fit_result(fitted, mdl, sp, k, notes, keep, weights, baseline, curves_computed):
+    """The :class:`FitResult` of what a fit found: Wald (t) intervals of the free parameters
+    from the weighted Jacobian, the shape parameter's profile interval, status and warnings."""
+    from .materials import MooneyRivlin
+
+    res, rss, J, w, P, top, R_L = fitted.res, fitted.rss, fitted.J, fitted.w, fitted.P, fitted.top, mdl.R_L
+    d, f = mdl.d, mdl.f
     n = d.size
     dof = max(n - k, 1)
     cov = None
@@ -907,14 +974,15 @@ def fit(scene, displacement, force, *, R_L, fit_offset=True, fit_beta=False, fit
     ci = [(float(v - h), float(v + h)) for v, h in zip(q, half)]
     mu_H, d0, b0, b1 = (float(v) for v in q)
     off_ci = ci[1]
-    P, top = model_P
 
     def model(disp, mu_H, d0, b0=b0, b1=b1):
         disp = np.asarray(disp, float)
         return mu_H * R_L * _Model.shape(P, top, (disp - d0) / R_L) + b0 + b1 * (disp - d0)
 
     resid = model(d, mu_H, d0) - f
-    fitted = tuple(nm for nm, free in zip(MODEL_PARAMETERS, mdl.free) if free) + ((name,) if name else ())
+    name = sp.name if sp is not None else None
+    fitted_names = tuple(nm for nm, free in zip(MODEL_PARAMETERS, mdl.free) if free) + ((name,) if name else ())
+    fit_scene, theta_hat, theta_ci = fitted.scene, fitted.theta, fitted.theta_ci
     mat = fit_scene.material
     alpha = float(mat.alpha) if isinstance(mat, MooneyRivlin) else None
     beta = float(fit_scene.beta)
@@ -941,12 +1009,12 @@ def fit(scene, displacement, force, *, R_L, fit_offset=True, fit_beta=False, fit
     point_weights[keep] = w / np.max(w)
     return FitResult(mu_H=mu_H, mu_H_ci95=mu_ci, offset=d0,
                      offset_ci95=off_ci, residual_rms=float(np.sqrt(np.mean(np.nan_to_num(resid, nan=mdl.big) ** 2))),
-                     n=n, status=status, message=message, R_L=float(R_L), curve=c, _model=model,
-                     beta=beta, beta_ci95=beta_ci, alpha=alpha, alpha_ci95=alpha_ci, fitted=fitted,
+                     n=n, status=status, message=message, R_L=float(R_L), curve=fitted.curve, _model=model,
+                     beta=beta, beta_ci95=beta_ci, alpha=alpha, alpha_ci95=alpha_ci, fitted=fitted_names,
                      pressure=pressure, pressure_ci95=pressure_ci, pressure_Pa=pressure_Pa,
                      pressure_Pa_ci95=pressure_Pa_ci,
-                     weights=weights, scene=fit_scene, curves_computed=counter[0],
-                     interpolation_error=interp_err, warnings=[t for _, t in found],
+                     weights=weights, scene=fit_scene, curves_computed=curves_computed,
+                     interpolation_error=fitted.interpolation_error, warnings=[t for _, t in found],
                      warning_codes=[code for code, _ in found], baseline_model=baseline, baseline=b0,
                      baseline_ci95=ci[2], baseline_slope=b1, baseline_slope_ci95=ci[3],
                      point_weights=point_weights)
