@@ -79,7 +79,10 @@ def curve(scene, delta_max: float = 0.5, *, deltas=None, force_max=None, lambda0
     tol, max_nodes : float, int
         solve_bvp settings for every point (see :func:`solve`).
     ds_max : float, optional
-        Largest arclength step in (delta, lambda0, F) (default ``delta_max/10``).
+        Largest arclength step in (delta, lambda0, F) (default ``delta_max/10``).  A step
+        that would turn the plotted curve (delta / delta_max, F / its largest |F|) by more
+        than ``MAX_PLOT_TURN`` is halved, so that a force maximum is resolved whatever
+        the scale of F.
     estimate_error : {"auto", "full", False}
         Error estimates ``force_error``, ``delta_error`` at every point (``True`` means
         ``"auto"``).  ``"full"``: a Richardson estimate (one Newton solve on the halved
@@ -1033,6 +1036,27 @@ def _land_on_delta_max(scene, cur, prev, builder, st, key):
 FIRST_STEP = 2.0
 
 
+#: The adaptive curve's steps also follow the force-displacement curve as it is plotted, on axes
+#: (delta / delta_max, F / the largest |F| so far): a step whose chord turns by more than
+#: MAX_PLOT_TURN (radians) from the previous chord is refused and halved, down to PLOT_TURN_MIN_DS
+#: times ds_max.  The arclength itself is measured in (delta, lambda0, F), in which a shell whose
+#: F is small (a thin dome: F ~ 1e-4) shows no turn where its force peaks: the dome's arclength
+#: curve stepped over its force maximum (3.28e-4) from 2.93e-4 to 2.96e-4.
+MAX_PLOT_TURN = 0.3
+PLOT_TURN_MIN_DS = 1 / 16
+
+
+def _plot_turn(prev, cur, new, delta_max, force_scale):
+    """Angle between the chords prev -> cur and cur -> new in (delta / delta_max, F / scale)."""
+    scale = np.array([delta_max, max(force_scale, abs(new.force), 1e-300)])
+    a = np.array([cur.delta - prev.delta, cur.force - prev.force]) / scale
+    b = np.array([new.delta - cur.delta, new.force - cur.force]) / scale
+    na, nb = np.linalg.norm(a), np.linalg.norm(b)
+    if not (na > 0 and nb > 0):
+        return 0.0
+    return math.acos(min(1.0, max(-1.0, float(np.dot(a, b) / (na * nb)))))
+
+
 def _adaptive(scene, builder: _Builder, settings):
     st = settings
     first = _first_point(scene, st["delta_start"], st)
@@ -1080,6 +1104,7 @@ def _adaptive(scene, builder: _Builder, settings):
     prev = below
     ds = min(st["ds_max"], FIRST_STEP * np.linalg.norm((_X(cur) - _X(prev)) / scale))
     ds_min = 1e-4  # in (delta, lambda0, F): below this the branch is taken to end here
+    force_scale = max(abs(cur.force), abs(prev.force))
     tangent = None
     crossed_from = None  # the smooth cap from which the corner was last tried
     while True:
@@ -1139,8 +1164,13 @@ def _adaptive(scene, builder: _Builder, settings):
             _wall_leg(scene, builder, st, sol, steps,
                       reason=f"the contact reached the end of the tip (the indenter's cylinder) just after "
                              f"delta = {cur.delta:.6g}")
+        if sol.success and sol.delta > 0 and ds > PLOT_TURN_MIN_DS * st["ds_max"] \
+                and _plot_turn(prev, cur, sol, st["delta_max"], force_scale) > MAX_PLOT_TURN:
+            ds /= 2  # the force-displacement curve would bend too much in one step: a shorter one
+            continue
         if sol.success and sol.delta > 0:
             builder.add(sol, steps)
+            force_scale = max(force_scale, abs(sol.force))
             prev, cur = cur, sol
             if sol.y[0, -1] * sol.Sc / scene.rho > scene.tip_omega_max:
                 _wall_leg(scene, builder, st, sol, steps,

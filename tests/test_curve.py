@@ -276,3 +276,24 @@ def test_switch_search_stops_where_the_secant_puts_the_root_within_its_tolerance
     with mock.patch("shellbvp.continuation._secant_distance", return_value=math.inf):  # the bracket alone
         assert _regula_falsi(0.1, f(0.1), {"d": 0.1}, 0.1125, f(0.1125), {"d": 0.1125}, solve_at) is not None
     assert len(calls) > stopped, (stopped, calls)
+
+
+def test_the_plot_turn_is_the_angle_of_the_plotted_curve_whatever_the_force_scale():
+    """The adaptive curve's refusal of a step that bends the plotted F(delta) too much
+    (continuation._plot_turn) measures the angle on axes scaled by delta_max and the largest
+    |F|: a force peak of a thin dome (F ~ 1e-4) turns as much as one of F ~ 1."""
+    from types import SimpleNamespace as St
+
+    from shellbvp.continuation import MAX_PLOT_TURN, _plot_turn
+
+    for f in (1.0, 1e-4):
+        up, top, down = St(delta=0.15, force=0.5 * f), St(delta=0.2, force=1.0 * f), St(delta=0.25, force=0.5 * f)
+        # chords (0.1, 0.5) and (0.1, -0.5) on the scaled axes
+        assert _plot_turn(up, top, down, 0.5, f) == pytest.approx(2 * np.arctan2(0.5, 0.1), rel=1e-12)
+        assert _plot_turn(up, top, down, 0.5, f) > MAX_PLOT_TURN
+        straight = St(delta=0.25, force=1.5 * f)
+        assert _plot_turn(up, top, straight, 0.5, f) == pytest.approx(0.0, abs=1e-7)
+    # with F's own unit (as in the arclength's (delta, lambda0, F)) the thin dome's peak is a turn
+    # of 0.002 rad: its chords are nearly parallel
+    up, top, down = St(delta=0.15, force=0.5e-4), St(delta=0.2, force=1e-4), St(delta=0.25, force=0.5e-4)
+    assert _plot_turn(up, top, down, 1.0, 1.0) == pytest.approx(2e-3, rel=1e-3)
