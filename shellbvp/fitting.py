@@ -222,9 +222,10 @@ class FitResult:
         """True when the fit converged and passed its checks (``status == 0``)."""
         return self.status == 0
 
-    def model_force(self, displacement):
-        """Fitted model force (N) at displacements (m)."""
-        return self._model(np.asarray(displacement, float), self.mu_H, self.offset)
+    def model_force(self, displacement, mu_H=None):
+        """Fitted model force (N) at displacements (m); with ``mu_H`` (N/m), the same model at
+        that mu*H (e.g. an end of ``mu_H_ci95``), offset and baseline as fitted."""
+        return self._model(np.asarray(displacement, float), self.mu_H if mu_H is None else float(mu_H), self.offset)
 
     def to_dict(self):
         """A JSON-ready dict (non-finite numbers as None, so the JSON is strict)."""

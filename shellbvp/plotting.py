@@ -102,8 +102,8 @@ def plot_fit(result, displacement, force, ax=None):
     ax.plot(d, np.asarray(force) * 1e3, "k.", ms=3, label="data")
     x = np.linspace(max(result.offset, 0), np.max(displacement), 300)
     ax.plot(x * 1e3, result.model_force(x) * 1e3, "-", label=f"model, mu*H = {result.mu_H:.3g} N/m")
-    lo = result._model(x, result.mu_H_ci95[0], result.offset) * 1e3
-    hi = result._model(x, result.mu_H_ci95[1], result.offset) * 1e3
+    lo = result.model_force(x, mu_H=result.mu_H_ci95[0]) * 1e3
+    hi = result.model_force(x, mu_H=result.mu_H_ci95[1]) * 1e3
     ax.fill_between(x * 1e3, lo, hi, alpha=0.3, label="95% interval of mu*H")
     ax.set_xlabel("displacement (mm)")
     ax.set_ylabel("force (mN)")

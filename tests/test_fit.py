@@ -272,3 +272,27 @@ def test_fit_example_shipped_with_the_package():
     out = json.loads(r.stdout)
     assert out["mu_H_ci95"][0] < 52.0 < out["mu_H_ci95"][1]
     assert abs(out["offset"] - 10e-6) < 1e-6
+
+
+def test_model_force_at_another_mu_h_scales_the_shell_force_only(monkeypatch):
+    """FitResult.model_force(x, mu_H=...) (the band of plot_fit): the shell's force scales with
+    mu*H, the fitted offset and baseline stay."""
+    def fake(scene, deltas, tol, counter=None, progress=None):
+        if counter is not None:
+            counter[0] += 1
+        return _FakeCurve(scene, deltas)
+
+    import shellbvp.fitting as fitting
+
+    monkeypatch.setattr(fitting, "_model_curve", fake)
+    scene = sb.Scene.preset("fit")
+    x = np.linspace(-0.05, 0.4, 46)
+    rng = np.random.default_rng(2)
+    shell = MU_H * R_L * np.where(x > 0, _FakeCurve(scene, np.clip(x, 1e-9, None)).force, 0.0)
+    force = shell * (1 + 0.02 * rng.standard_normal(x.size)) + 3e-6
+    r = sb.fit(scene, R_L * x + D0, force, R_L=R_L, baseline="constant", contact_guess=D0)
+    d = R_L * np.linspace(0.0, 0.35, 20) + r.offset
+    base = r.baseline
+    assert base != 0.0 and r.success, r.message
+    np.testing.assert_allclose(r.model_force(d, mu_H=2 * r.mu_H) - base, 2 * (r.model_force(d) - base), rtol=1e-12)
+    np.testing.assert_array_equal(r.model_force(d, mu_H=r.mu_H), r.model_force(d))
