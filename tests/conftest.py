@@ -9,7 +9,7 @@ def pytest_addoption(parser):
 
 #: Workers of ``-n auto`` (pytest-xdist, pyproject's addopts): one per core, at most this many --
 #: each worker derives and generates the code of every structure it meets in its own cache, so
-#: more workers than this repeat more derivation than they save (2 cores: 10.3 -> 6.0 min).
+#: more workers than this repeat more derivation than they save (2 cores: 10.3 -> 5.7-7.6 min).
 MAX_WORKERS = 4
 
 
