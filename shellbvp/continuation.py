@@ -1054,7 +1054,12 @@ def _plot_turn(prev, cur, new, delta_max, force_scale):
     na, nb = np.linalg.norm(a), np.linalg.norm(b)
     if not (na > 0 and nb > 0):
         return 0.0
-    return math.acos(min(1.0, max(-1.0, float(np.dot(a, b) / (na * nb)))))
+    return _angle(np.dot(a, b) / (na * nb))
+
+
+def _angle(cosine):
+    """The angle (radians) of a cosine that rounding may have put just outside [-1, 1]."""
+    return math.acos(min(1.0, max(-1.0, float(cosine))))
 
 
 def _adaptive(scene, builder: _Builder, settings):
@@ -1122,7 +1127,7 @@ def _adaptive(scene, builder: _Builder, settings):
         new_tangent = chord / norm
         if tangent is not None and np.dot(new_tangent, tangent) < 0:
             new_tangent = -new_tangent  # never reverse along the branch
-        turn = 0.0 if tangent is None else math.acos(min(1.0, max(-1.0, float(np.dot(new_tangent, tangent)))))
+        turn = 0.0 if tangent is None else _angle(np.dot(new_tangent, tangent))
         tangent = new_tangent
         Xhat = _X(cur) + ds * tangent * scale
         if Xhat[0] >= st["delta_max"]:
@@ -1164,11 +1169,11 @@ def _adaptive(scene, builder: _Builder, settings):
             _wall_leg(scene, builder, st, sol, steps,
                       reason=f"the contact reached the end of the tip (the indenter's cylinder) just after "
                              f"delta = {cur.delta:.6g}")
-        if sol.success and sol.delta > 0 and ds > PLOT_TURN_MIN_DS * st["ds_max"] \
-                and _plot_turn(prev, cur, sol, st["delta_max"], force_scale) > MAX_PLOT_TURN:
-            ds /= 2  # the force-displacement curve would bend too much in one step: a shorter one
-            continue
         if sol.success and sol.delta > 0:
+            if ds > PLOT_TURN_MIN_DS * st["ds_max"] \
+                    and _plot_turn(prev, cur, sol, st["delta_max"], force_scale) > MAX_PLOT_TURN:
+                ds /= 2  # the force-displacement curve would bend too much in one step: a shorter one
+                continue
             builder.add(sol, steps)
             force_scale = max(force_scale, abs(sol.force))
             prev, cur = cur, sol
