@@ -194,3 +194,31 @@ def test_speed_vs_baseline_equal_error_both_ways_pairs_each_shooting_rtol_with_t
     tols[0].update(f_error=1e-9, ms_per_point=20.0)
     sv.ratios(case)
     assert case["shooting_ratio_both"] == pytest.approx(15.0) and case["shooting_ratio_both_missing"] == 0  # 300/20
+
+
+def test_point_budget_charges_each_category_its_exclusive_time():
+    pb = _load("point_budget")
+
+    class Spin:
+        @staticmethod
+        def inner():
+            t0 = time.process_time()
+            while time.process_time() - t0 < 0.02:
+                pass
+
+        @staticmethod
+        def outer():
+            t0 = time.process_time()
+            while time.process_time() - t0 < 0.01:
+                pass
+            Spin.inner()
+
+    timers = pb.Timers()
+    timers.wrap(Spin, "inner", pb.KERNELS)
+    timers.wrap(Spin, "outer", pb.CALLBACKS)
+    Spin.outer()
+    timers.remove()
+    assert not hasattr(Spin.outer, "__wrapped__") and Spin.outer.__name__ == "outer"  # restored
+    assert timers.calls[pb.KERNELS] == timers.calls[pb.CALLBACKS] == 1
+    assert 0.02 <= timers.spent[pb.KERNELS] < 0.03
+    assert 0.01 <= timers.spent[pb.CALLBACKS] < 0.02  # the inner call's time is not charged twice
