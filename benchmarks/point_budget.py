@@ -42,6 +42,7 @@ import time
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
+ROOT = HERE.parent
 DEPTHS = (0.15, 0.5, 47)  # linspace arguments
 TOL = 1e-6
 REGION_KINDS = ("free_", "contact_", "cylinder_")
@@ -217,7 +218,9 @@ def main(argv=None):
     rows = []
     for kernels in args.kernels.split(","):
         for preset in args.presets.split(","):
-            env = dict(os.environ, SHELLBVP_KERNELS=kernels)
+            # the worker measures this checkout's package, the commit meta records (not whatever is installed)
+            env = dict(os.environ, SHELLBVP_KERNELS=kernels,
+                       PYTHONPATH=os.pathsep.join(filter(None, (str(ROOT), os.environ.get("PYTHONPATH")))))
             proc = subprocess.run([sys.executable, __file__, "--worker", preset, "--repeat", str(args.repeat)],
                                   env=env, capture_output=True, text=True)
             if proc.returncode != 0:
