@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import subprocess
 import sys
 import time
@@ -128,11 +129,13 @@ def main(argv=None):
             print(f"{s.name:>15}: {' '.join(a[1:])}")
         return 0
     summary, failed = [], False
+    # every step, and the processes it starts, measures this checkout's package, not whatever is installed
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(filter(None, (str(HERE.parent), os.environ.get("PYTHONPATH")))))
     t_all = time.perf_counter()
     for s, a in steps:
         print(f"== {s.name}: {' '.join(a[1:])}", flush=True)
         t0 = time.perf_counter()
-        rc = subprocess.run(a, cwd=HERE.parent).returncode
+        rc = subprocess.run(a, cwd=HERE.parent, env=env).returncode
         dt = time.perf_counter() - t0
         summary.append(dict(step=s.name, argv=a[1:], seconds=dt, returncode=rc))
         print(f"== {s.name}: {'ok' if rc == 0 else f'FAILED (exit {rc})'} in {dt:.0f} s", flush=True)
