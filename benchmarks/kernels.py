@@ -39,6 +39,8 @@ import time
 import timeit
 from pathlib import Path
 
+from checkout import checkout_env  # benchmarks/ is on sys.path when run as a script
+
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent
 
@@ -52,9 +54,7 @@ CURVES = {
 
 
 def _env(cache, kernels):
-    env = dict(os.environ, SHELLBVP_CACHE_DIR=str(cache), SHELLBVP_KERNELS=kernels)
-    env["PYTHONPATH"] = str(ROOT) + (os.pathsep + env["PYTHONPATH"] if env.get("PYTHONPATH") else "")
-    return env
+    return checkout_env(SHELLBVP_CACHE_DIR=str(cache), SHELLBVP_KERNELS=kernels)
 
 
 def _probe(code, cache, kernels):

@@ -42,7 +42,6 @@ import time
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
-ROOT = HERE.parent
 DEPTHS = (0.15, 0.5, 47)  # linspace arguments
 TOL = 1e-6
 REGION_KINDS = ("free_", "contact_", "cylinder_")
@@ -207,6 +206,7 @@ def main(argv=None):
     if args.worker:
         return worker(args.worker, args.repeat)
     sys.path.insert(0, str(HERE))
+    from checkout import checkout_env
     from speed_vs_baseline import cpu_model, this_commit, write_atomic
 
     import datetime
@@ -218,9 +218,7 @@ def main(argv=None):
     rows = []
     for kernels in args.kernels.split(","):
         for preset in args.presets.split(","):
-            # the worker measures this checkout's package, the commit meta records (not whatever is installed)
-            env = dict(os.environ, SHELLBVP_KERNELS=kernels,
-                       PYTHONPATH=os.pathsep.join(filter(None, (str(ROOT), os.environ.get("PYTHONPATH")))))
+            env = checkout_env(SHELLBVP_KERNELS=kernels)  # this checkout's package: the commit meta names
             proc = subprocess.run([sys.executable, __file__, "--worker", preset, "--repeat", str(args.repeat)],
                                   env=env, capture_output=True, text=True)
             if proc.returncode != 0:

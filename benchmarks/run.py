@@ -21,11 +21,12 @@ from __future__ import annotations
 
 import argparse
 import json
-import os
 import subprocess
 import sys
 import time
 from pathlib import Path
+
+from checkout import checkout_env  # benchmarks/ is on sys.path when run as a script
 
 HERE = Path(__file__).resolve().parent
 
@@ -129,8 +130,7 @@ def main(argv=None):
             print(f"{s.name:>15}: {' '.join(a[1:])}")
         return 0
     summary, failed = [], False
-    # every step, and the processes it starts, measures this checkout's package, not whatever is installed
-    env = dict(os.environ, PYTHONPATH=os.pathsep.join(filter(None, (str(HERE.parent), os.environ.get("PYTHONPATH")))))
+    env = checkout_env()  # every step, and the processes it starts, measures this checkout's package
     t_all = time.perf_counter()
     for s, a in steps:
         print(f"== {s.name}: {' '.join(a[1:])}", flush=True)
