@@ -6,7 +6,7 @@ change, so that stale cached modules are never loaded.  Kept free of imports
 so that reading it does not import SymPy.
 """
 
-CODEGEN_VERSION = "11"
+CODEGEN_VERSION = "12"
 
 
 def source_fingerprint() -> str:
