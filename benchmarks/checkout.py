@@ -18,3 +18,24 @@ def checkout_env(**extra) -> dict:
     env = dict(os.environ, **extra)
     env["PYTHONPATH"] = os.pathsep.join(filter(None, (str(ROOT), os.environ.get("PYTHONPATH"))))
     return env
+
+
+#: What a benchmark writes: changes there do not make the measured code "dirty"
+RESULTS = ("benchmarks/results", "benchmarks/figures")
+
+
+def commit_label(src=ROOT) -> str | None:
+    """``git describe --always`` of the checkout at ``src``, with ``-dirty`` only for changes
+    outside :data:`RESULTS` (a run that writes one result before measuring the next must not
+    label the code it measures dirty); None where ``src`` is not a git checkout."""
+    import subprocess
+
+    def git(*args):
+        return subprocess.run(["git", "-C", str(src), *args], capture_output=True, text=True)
+
+    head = git("describe", "--always")
+    if head.returncode != 0:
+        return None
+    changed = git("status", "--porcelain", "--untracked-files=no", "--", ".",
+                  *(f":(exclude){path}" for path in RESULTS))
+    return head.stdout.strip() + ("-dirty" if changed.stdout.strip() else "")

@@ -32,12 +32,13 @@ import datetime
 import json
 import math
 import os
-import subprocess
 import tempfile
 import time
 from pathlib import Path
 
 import numpy as np
+
+from checkout import commit_label  # benchmarks/ is on sys.path when run as a script
 
 HERE = Path(__file__).resolve().parent
 RESULTS = HERE / "results"
@@ -233,9 +234,9 @@ def meta():
     import shellbvp as sb
 
     src = Path(sb.__file__).resolve().parent.parent
-    git = subprocess.run(["git", "-C", str(src), "describe", "--always", "--dirty"], capture_output=True, text=True)
+    git = commit_label(src)
     return dict(date=datetime.date.today().isoformat(), cpus=os.cpu_count(), shellbvp=sb.__version__,
-                git=git.stdout.strip() if git.returncode == 0 else "not a git checkout")
+                git=git if git is not None else "not a git checkout")
 
 
 def main(argv=None):

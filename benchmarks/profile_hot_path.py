@@ -31,6 +31,8 @@ from pathlib import Path
 
 import numpy as np
 
+from checkout import commit_label  # benchmarks/ is on sys.path when run as a script
+
 HERE = Path(__file__).resolve().parent
 
 CATEGORIES = (
@@ -354,12 +356,12 @@ def main(argv=None):
         imports=import_times(),
     )
     src = Path(sb.__file__).resolve().parent.parent
-    git = subprocess.run(["git", "-C", str(src), "describe", "--always", "--dirty"], capture_output=True, text=True)
+    git = commit_label(src)
     data["meta"] = dict(date=datetime.date.today().isoformat(), machine=platform.machine(), cpus=os.cpu_count(),
                         python=platform.python_version(), numpy=numpy.__version__, scipy=scipy.__version__,
                         shellbvp=sb.__version__, quick=args.quick,
                         git=os.environ.get("SHELLBVP_SOURCE_NOTE") or (
-                            git.stdout.strip() if git.returncode == 0 else "not a git checkout"))
+                            git if git is not None else "not a git checkout"))
     out = (Path(args.out_dir) if args.out_dir else HERE) / "results"
     out.mkdir(parents=True, exist_ok=True)
     name = "profile-quick" if args.quick else "profile"

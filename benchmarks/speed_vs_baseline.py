@@ -710,8 +710,9 @@ def ratios(entry):
 
 
 def this_commit():
-    return subprocess.run(["git", "describe", "--always", "--dirty"], cwd=REPO, capture_output=True,
-                          text=True).stdout.strip()
+    from checkout import commit_label
+
+    return commit_label(REPO) or ""
 
 
 def cpu_model() -> str:

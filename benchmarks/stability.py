@@ -38,6 +38,8 @@ import tempfile
 import time
 from pathlib import Path
 
+from checkout import commit_label  # benchmarks/ is on sys.path when run as a script
+
 RESULTS = Path(__file__).parent / "results"
 
 BASE = dict(gamma=1.0, rho=0.2, beta=0.01, xi=1, material=("mooney-rivlin", 0.1))
@@ -430,9 +432,8 @@ def main():
     total = time.perf_counter() - t_all
 
     src = Path(sb.__file__).resolve().parent.parent
-    git = subprocess.run(["git", "-C", str(src), "describe", "--always", "--dirty"], capture_output=True,
-                         text=True)
-    meta = dict(source=str(src), git=git.stdout.strip() if git.returncode == 0 else
+    git = commit_label(src)
+    meta = dict(source=str(src), git=git if git is not None else
                 os.environ.get("STABILITY_SOURCE_NOTE", "not a git checkout"), date=datetime.date.today().isoformat(), machine=f"{platform.machine()} {platform.node()}",
                 cpus=os.cpu_count(), python=platform.python_version(), numpy=numpy.__version__,
                 scipy=scipy.__version__, shellbvp=sb.__version__, delta_max=delta_max,

@@ -61,6 +61,8 @@ from pathlib import Path
 
 import numpy as np
 
+from checkout import commit_label  # benchmarks/ is on sys.path when run as a script
+
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 
@@ -760,12 +762,12 @@ def meta(args, total):
     import shellbvp as sb
 
     src = Path(sb.__file__).resolve().parent.parent
-    git = subprocess.run(["git", "-C", str(src), "describe", "--always", "--dirty"], capture_output=True, text=True)
+    git = commit_label(src)
     return dict(date=datetime.date.today().isoformat(), machine=platform.machine(), node=platform.node(),
                 cpus=os.cpu_count(), python=platform.python_version(), numpy=numpy.__version__,
                 scipy=scipy.__version__, shellbvp=sb.__version__,
                 git=os.environ.get("SHELLBVP_SOURCE_NOTE") or (
-                    git.stdout.strip() if git.returncode == 0 else "not a git checkout"),
+                    git if git is not None else "not a git checkout"),
                 quick=args.quick, repeat=args.repeat, shoot_from=args.shoot_from, every_1e10=args.every_1e10,
                 source_note=os.environ.get("SHELLBVP_SOURCE_NOTE", ""), n_points=args.points, tols=list(args.tols),
                 shoot_rtols=list(args.shoot_rtols), repeat_cold_solve=args.repeat_cold, total_s=total)
