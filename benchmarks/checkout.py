@@ -24,10 +24,10 @@ def checkout_env(**extra) -> dict:
 RESULTS = ("benchmarks/results", "benchmarks/figures")
 
 
-def commit_label(src=ROOT) -> str | None:
+def commit_label(src=ROOT, default=None):
     """``git describe --always`` of the checkout at ``src``, with ``-dirty`` only for changes
     outside :data:`RESULTS` (a run that writes one result before measuring the next must not
-    label the code it measures dirty); None where ``src`` is not a git checkout."""
+    label the code it measures dirty); ``default`` where ``src`` is not a git checkout."""
     import subprocess
 
     def git(*args):
@@ -35,7 +35,7 @@ def commit_label(src=ROOT) -> str | None:
 
     head = git("describe", "--always")
     if head.returncode != 0:
-        return None
+        return default
     changed = git("status", "--porcelain", "--untracked-files=no", "--", ".",
                   *(f":(exclude){path}" for path in RESULTS))
     return head.stdout.strip() + ("-dirty" if changed.stdout.strip() else "")

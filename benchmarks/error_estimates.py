@@ -234,9 +234,8 @@ def meta():
     import shellbvp as sb
 
     src = Path(sb.__file__).resolve().parent.parent
-    git = commit_label(src)
     return dict(date=datetime.date.today().isoformat(), cpus=os.cpu_count(), shellbvp=sb.__version__,
-                git=git if git is not None else "not a git checkout")
+                git=commit_label(src, "not a git checkout"))
 
 
 def main(argv=None):

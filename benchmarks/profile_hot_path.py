@@ -337,7 +337,6 @@ def main(argv=None):
     import platform
     import datetime
     import os
-    import subprocess
 
     import numpy
     import scipy
@@ -356,12 +355,10 @@ def main(argv=None):
         imports=import_times(),
     )
     src = Path(sb.__file__).resolve().parent.parent
-    git = commit_label(src)
     data["meta"] = dict(date=datetime.date.today().isoformat(), machine=platform.machine(), cpus=os.cpu_count(),
                         python=platform.python_version(), numpy=numpy.__version__, scipy=scipy.__version__,
                         shellbvp=sb.__version__, quick=args.quick,
-                        git=os.environ.get("SHELLBVP_SOURCE_NOTE") or (
-                            git if git is not None else "not a git checkout"))
+                        git=os.environ.get("SHELLBVP_SOURCE_NOTE") or commit_label(src, "not a git checkout"))
     out = (Path(args.out_dir) if args.out_dir else HERE) / "results"
     out.mkdir(parents=True, exist_ok=True)
     name = "profile-quick" if args.quick else "profile"

@@ -64,6 +64,8 @@ from pathlib import Path
 
 import numpy as np
 
+from checkout import commit_label  # benchmarks/ is on sys.path when run as a script
+
 HERE = Path(__file__).resolve().parent
 REPO = HERE.parent
 #: The reference: every depth at tol 1e-9 (at 1e-10 a state costs ~10x: 3-10 s and 5000-7000 nodes
@@ -710,9 +712,7 @@ def ratios(entry):
 
 
 def this_commit():
-    from checkout import commit_label
-
-    return commit_label(REPO) or ""
+    return commit_label(REPO, "")
 
 
 def cpu_model() -> str:

@@ -432,9 +432,7 @@ def main():
     total = time.perf_counter() - t_all
 
     src = Path(sb.__file__).resolve().parent.parent
-    git = commit_label(src)
-    meta = dict(source=str(src), git=git if git is not None else
-                os.environ.get("STABILITY_SOURCE_NOTE", "not a git checkout"), date=datetime.date.today().isoformat(), machine=f"{platform.machine()} {platform.node()}",
+    meta = dict(source=str(src), git=commit_label(src, os.environ.get("STABILITY_SOURCE_NOTE", "not a git checkout")), date=datetime.date.today().isoformat(), machine=f"{platform.machine()} {platform.node()}",
                 cpus=os.cpu_count(), python=platform.python_version(), numpy=numpy.__version__,
                 scipy=scipy.__version__, shellbvp=sb.__version__, delta_max=delta_max,
                 delta_min=args.delta_min, time_limit=time_limit, total_s=total,

@@ -762,12 +762,10 @@ def meta(args, total):
     import shellbvp as sb
 
     src = Path(sb.__file__).resolve().parent.parent
-    git = commit_label(src)
     return dict(date=datetime.date.today().isoformat(), machine=platform.machine(), node=platform.node(),
                 cpus=os.cpu_count(), python=platform.python_version(), numpy=numpy.__version__,
                 scipy=scipy.__version__, shellbvp=sb.__version__,
-                git=os.environ.get("SHELLBVP_SOURCE_NOTE") or (
-                    git if git is not None else "not a git checkout"),
+                git=os.environ.get("SHELLBVP_SOURCE_NOTE") or commit_label(src, "not a git checkout"),
                 quick=args.quick, repeat=args.repeat, shoot_from=args.shoot_from, every_1e10=args.every_1e10,
                 source_note=os.environ.get("SHELLBVP_SOURCE_NOTE", ""), n_points=args.points, tols=list(args.tols),
                 shoot_rtols=list(args.shoot_rtols), repeat_cold_solve=args.repeat_cold, total_s=total)
