@@ -32,11 +32,14 @@ every 12th also at 1e-10 to show the reference's own error).
 * Shooting (``benchmarks/shooting.py``, the paper's method) re-solves the reference's cap
   states (delta >= 0.15) at its rtol 1e-6 to 1e-9, each from its neighbour with the
   tangent predictor (the first from the reference's own unknowns: no cold start is counted);
-  its time per point at its loosest rtol with equal or better F error is compared with two
+  its time per point at its loosest rtol with equal or better F error is compared with three
   collocation measures: the default curve's time per point (lift-off states, switches and the
-  small-delta leg included, which shooting does not solve), and the time per point of a
-  cap-only curve through exactly shooting's states (natural continuation, default error
-  estimates, its cold first point counted): the same work on both sides.  Shooting and those
+  small-delta leg included, which shooting does not solve); the time per point of a cap-only
+  curve through exactly shooting's states (natural continuation, default error estimates, its
+  cold first point counted); and that curve's time per point after its first point (the first
+  point's curve timed alone after it, in the same process), against shooting's, which starts
+  warm: the same work on both sides.  States closer than SAME_STATE_RTOL count once (until
+  session 20 the union of the curves' depths kept pairs 1e-10 apart).  Shooting and those
   cap-only curves run interleaved, one round per repeat, each side's time the median over
   rounds (until session 14 shooting ran once, apart from them).
 
@@ -77,6 +80,9 @@ DELTAS40 = np.linspace(0.0125, 0.5, 40)
 #: still reaches the collocation curve's error is the one compared, so looser ones are tried too
 SHOOT_RTOLS = (1e-6, 1e-7, 1e-8, 1e-9)
 SHOOT_FROM = 0.15  # shooting solves single caps: from where every preset's curve is a cap
+#: depths closer than this (relative) are one state to shooting and the same-states curves: the
+#: curves' depths agree to ~1e-10 where they are the same point; their real spacing is ~1e-2
+SAME_STATE_RTOL = 1e-7
 #: collocation tolerances of the curves through shooting's states: each side at its cheapest setting
 #: that reaches the other's error (1e-6, the default, first: the rows compared at default settings)
 SAME_TOLS = (1e-6, 1e-5, 1e-4)
@@ -213,13 +219,21 @@ def worker(spec):
     c = sb.curve(scene, **kw)
     wall, cpu = time.perf_counter() - t0, time.process_time() - c0
     scipy.integrate.solve_bvp = orig
+    first_cpu = None
+    if spec["kind"] == "same-states" and kw.get("deltas"):
+        # the first point alone (its cold solve and estimate), after the curve: what the curve's
+        # time per point of the continuation leaves out -- shooting starts from the reference's
+        # own unknowns.  In this warmer process it costs at most what it cost in the curve.
+        c0 = time.process_time()
+        sb.curve(scene, **dict(kw, deltas=list(kw["deltas"])[:1]))
+        first_cpu = time.process_time() - c0
     sols = getattr(c, "solutions", None) or []
     out = dict(wall=wall, cpu=cpu, points=len(c), stop=c.stop_reason, complete=bool(c.complete),
                delta=[float(v) for v in c.delta], force=[float(v) for v in c.force],
                topology=[str(s.get("topology", "cap")) for s in sols] or ["cap"] * len(c),
                valid=[bool(v) for v in c.valid], nodes=[int(v) for v in c.points["nodes"]],
                shellbvp=str(Path(sb.__file__).parent), kernel_load_s=kernel_load,
-               interpolate_import_s=interpolate_import, **counts)
+               interpolate_import_s=interpolate_import, first_point_cpu=first_cpu, **counts)
     print(json.dumps(out))
 
 
@@ -353,8 +367,17 @@ def f_error(run, ref):
 
 
 def shooting_states(ref):
-    """Indices of the reference's states that shooting solves: caps with delta >= SHOOT_FROM."""
-    return [i for i, (d, s) in enumerate(zip(ref["delta"], ref["start"])) if s is not None and d >= SHOOT_FROM]
+    """Indices of the reference's states that shooting solves: caps with delta >= SHOOT_FROM, each
+    more than SAME_STATE_RTOL deeper than the one before (the reference's depths are the union of
+    the curves' depths, where the same point of two curves can differ by ~1e-10: until session 20
+    half the states of some presets were such pairs, one shot each for shooting's Newton, which
+    accepts its predictor there, and a whole solve_bvp run each for collocation)."""
+    out, last = [], -math.inf
+    for i, (d, s) in enumerate(zip(ref["delta"], ref["start"])):
+        if s is not None and d >= SHOOT_FROM and d - last > SAME_STATE_RTOL * abs(d):
+            out.append(i)
+            last = d
+    return out
 
 
 def same_states_and_shooting(sides, entry, variants, repeat, shoot, log):
@@ -390,11 +413,21 @@ def same_states_and_shooting(sides, entry, variants, repeat, shoot, log):
             cpu = statistics.median(r["cpu"] for r in rs)
             rows.append(dict(tol=tol, points=rs[0]["points"], depths=len(depths), cpu_median=cpu, f_error=err,
                              compared=compared, left_out=left, ms_per_point=1e3 * cpu / max(rs[0]["points"], 1),
-                             stop=rs[0]["stop"], complete=rs[0]["complete"], cpu_runs=[r["cpu"] for r in rs]))
+                             stop=rs[0]["stop"], complete=rs[0]["complete"], cpu_runs=[r["cpu"] for r in rs],
+                             continuation_ms_per_point=_continuation_ms(rs)))
             log(f"  same states {entry['preset']} | {v} | tol {tol:g}: {rows[-1]['points']} points, "
                 f"{rows[-1]['ms_per_point']:.1f} ms/point, max F error {err:.1e}")
         out[v] = dict(rows[0], tols=rows)
     return out, _median_shots(shots)
+
+
+def _continuation_ms(runs):
+    """CPU ms per point of a same-states curve after its first point (the median over the runs of
+    the curve's time less its first point's, timed alone after it), or None."""
+    n = runs[0]["points"]
+    if n < 2 or any(r.get("first_point_cpu") is None for r in runs):
+        return None
+    return 1e3 * statistics.median(r["cpu"] - r["first_point_cpu"] for r in runs) / (n - 1)
 
 
 def _median_shots(shots):
@@ -569,24 +602,32 @@ def markdown(data):
                   "Shooting and the cap-only curves run interleaved, in rounds (each round every collocation "
                   "curve, then shooting at every rtol), and each side's time is the median over the rounds. "
                   "'equal error': the loosest shooting rtol whose max F error is at most the collocation "
-                  "run's; ratio: shooting's CPU ms/point over collocation's.", "",
+                  "run's; ratio: shooting's CPU ms/point over collocation's. 'continuation': the same-states "
+                  "curve's time less its first point's (that point's curve timed alone after it, in the same "
+                  "process), per point after the first, against shooting's time per point over all its "
+                  f"states. States closer than {SAME_STATE_RTOL:g} in delta (relative) count once (the "
+                  "curves' depths agree to ~1e-10 where they are the same point).", "",
                   "| preset | shooting rtol: CPU ms/point (max F error, converged) | default curve: ms/point "
                   "(F error): ratio, numpy | the same, numba | same states: ms/point (F error): ratio, numpy "
-                  "| the same, numba |", "|---|---|---|---|---|---|"]
+                  "| the same, numba | continuation: ms/point: ratio, numpy | the same, numba |",
+                  "|---|---|---|---|---|---|---|---|"]
         if data.get("shooting_from"):
             sf = data["shooting_from"]
             lines[-2:-2] = [f"Shooting's rows of {', '.join(sf.get('presets') or ['every preset'])} are from the "
                             f"run of {sf['date']} (at {sf['commit']}; `benchmarks/shooting.py` unchanged since), "
                             f"not measured again in this run; the collocation side is this run's.", ""]
 
-        def cell(r, case, key):
-            if r is None:
+        def cell(r, case, key, per="ms_per_point"):
+            if r is None or r.get(per) is None:
                 return "–"
             ratio = case.get(key)
             text = ("no shooting rtol converged everywhere" if ratio is None else
                     f">= {ratio:.1f}x (no shooting rtol as accurate)" if case.get(key + "_bound") else f"{ratio:.1f}x")
+            if per != "ms_per_point":
+                return f"{r[per]:.1f}: {text}"
             return f"{r['ms_per_point']:.1f} ({_fmt(r['f_error'], '.0e')}): {text}"
 
+        cont = "continuation_ms_per_point"
         for case in sh:
             shots = "; ".join(f"{s['rtol']:g}: {s['per_point_ms']:.0f} ({_fmt(s['max_rel'], '.0e')}, "
                               f"{s['converged']}/{s['points']})" for s in case["shooting"])
@@ -595,7 +636,9 @@ def markdown(data):
                          f"{cell(case['rows'].get('this commit'), case, 'shooting_ratio')} | "
                          f"{cell(case['rows'].get('this commit, numba'), case, 'shooting_ratio_numba')} | "
                          f"{cell(same.get('this commit'), case, 'shooting_ratio_same')} | "
-                         f"{cell(same.get('this commit, numba'), case, 'shooting_ratio_numba_same')} |")
+                         f"{cell(same.get('this commit, numba'), case, 'shooting_ratio_numba_same')} | "
+                         f"{cell(same.get('this commit'), case, 'shooting_ratio_same_cont', cont)} | "
+                         f"{cell(same.get('this commit, numba'), case, 'shooting_ratio_numba_same_cont', cont)} |")
         lines.append("")
         lines += ["Equal error both ways, on the same cap states: for each shooting rtol that converged at "
                   "every state, the cheapest collocation tol (of " + ", ".join(f"{t:g}" for t in SAME_TOLS) +
@@ -653,8 +696,7 @@ def targets(data):
     ratio_target("base default", 5, "default base curve to delta 0.5, F error <= 1e-6: >= 5x faster than the baseline")
     ratio_target("base 40 depths", 8, "40-depth curve with lift-off: >= 8x")
     ratio_target("base 40 depths, cap only", 2.5, "cap-only 40-depth curve: >= 2.5x")
-    for suffix, what in (("", "per point of the default curve"),
-                         ("_same", "per point, on the same cap states")):
+    for suffix, _, _, what in SHOOTING_MEASURES:
         for key, label in (("shooting_ratio", "numpy"), ("shooting_ratio_numba", "numba kernels")):
             eqs = [c[key + suffix] for c in data["cases"] if c.get(key + suffix) is not None]
             bounds = sum(bool(c.get(key + suffix + "_bound")) for c in data["cases"] if c.get(key + suffix) is not None)
@@ -679,22 +721,33 @@ def targets(data):
     return out
 
 
-def shooting_ratio(case, variant="this commit", same=False):
+def shooting_ratio(case, variant="this commit", same=False, per="ms_per_point"):
     """(ratio, lower bound?): shooting's CPU time per point at its loosest rtol whose F error is at
     most collocation's, over collocation's -- per point of the default curve, or (``same``) of the
-    cap-only curve through shooting's own states; where no rtol measured is that accurate, its
-    most accurate one's time, a lower bound (shooting's time grows as its rtol tightens);
-    (None, False) without a collocation run or a shooting rtol that converged everywhere."""
+    cap-only curve through shooting's own states (``per="continuation_ms_per_point"``: after its
+    first point; shooting's time stays its total over all its states, its first one included);
+    where no rtol measured is that accurate, its most accurate one's time, a lower bound
+    (shooting's time grows as its rtol tightens); (None, False) without a collocation run or a
+    shooting rtol that converged everywhere."""
     r = (case.get("same_states") or {}).get(variant) if same else case["rows"].get(variant)
-    if r is None or r.get("f_error") is None or not math.isfinite(r["f_error"]):
+    if r is None or r.get("f_error") is None or not math.isfinite(r["f_error"]) or not r.get(per):
         return None, False
     converged = [s for s in case["shooting"] if s["converged"] == s["points"] and math.isfinite(s["max_rel"])]
     good = [s for s in converged if s["max_rel"] <= r["f_error"]]
     if good:
-        return min(s["per_point_ms"] for s in good) / r["ms_per_point"], False
+        return min(s["per_point_ms"] for s in good) / r[per], False
     if not converged:
         return None, False
-    return min(converged, key=lambda s: s["max_rel"])["per_point_ms"] / r["ms_per_point"], True
+    return min(converged, key=lambda s: s["max_rel"])["per_point_ms"] / r[per], True
+
+
+#: the per-point measures against shooting: (suffix of the entry's keys, on the same states?,
+#: collocation's time per point, what the targets' rows call it)
+SHOOTING_MEASURES = (("", False, "ms_per_point", "per point of the default curve"),
+                     ("_same", True, "ms_per_point", "per point, on the same cap states"),
+                     ("_same_cont", True, "continuation_ms_per_point",
+                      "per point, on the same cap states, collocation's cold first point left out as "
+                      "shooting's is"))
 
 
 def ratios(entry):
@@ -702,8 +755,8 @@ def ratios(entry):
     equal-error pairs both ways with their smallest ratio (``_both``: over every accuracy shooting
     reached, the least favourable to collocation)."""
     for v, key in (("this commit", "shooting_ratio"), ("this commit, numba", "shooting_ratio_numba")):
-        for suffix, same in (("", False), ("_same", True)):
-            entry[key + suffix], entry[key + suffix + "_bound"] = shooting_ratio(entry, v, same)
+        for suffix, same, per, _ in SHOOTING_MEASURES:
+            entry[key + suffix], entry[key + suffix + "_bound"] = shooting_ratio(entry, v, same, per)
         pairs = equal_error(entry, v)
         entry[key + "_pairs"] = pairs
         found = [q["ratio"] for q in pairs if q["ratio"] is not None]
@@ -828,12 +881,21 @@ def main(argv=None):
             continue
         if args.quick or (args.no_shooting and entry["preset"] not in reused):
             continue
+        old_rows = reused.get(entry["preset"])
+        if old_rows and {r["points"] for r in old_rows} != {len(shooting_states(entry["_ref"]))}:
+            log(f"  {entry['preset']}: the reused shooting rows solved {old_rows[0]['points']} states, this run's "
+                f"reference has {len(shooting_states(entry['_ref']))}: shooting runs again")
+            del reused[entry["preset"]]
         shoot = entry["preset"] not in reused
         entry["same_states"], shots = same_states_and_shooting(sides, entry, collocation, args.repeat, shoot, log)
         entry["shooting"] = shots if shoot else reused[entry["preset"]]
         if not entry["shooting"]:
             continue
         ratios(entry)
+    if "shooting_from" in data:  # the presets whose rows were reused after all
+        data["shooting_from"]["presets"] = sorted(reused)
+        if not reused:
+            del data["shooting_from"]
     for entry in data["cases"]:
         entry.pop("_ref")
         for rs in entry["runs"].values():  # keep the measurements, not every point

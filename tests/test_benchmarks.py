@@ -161,6 +161,30 @@ def test_speed_vs_baseline_shooting_ratio_takes_the_cheapest_shooting_at_equal_o
     assert case["shooting_ratio_same_bound"] and not case["shooting_ratio_bound"]
 
 
+def test_speed_vs_baseline_shooting_states_count_near_repeats_once():
+    sv = _load("speed_vs_baseline")
+    d = [0.1, 0.16, 0.16 + 1e-10, 0.2, 0.2 * (1 + 2e-7), 0.25 + 3e-11, 0.25 + 5e-11]
+    start = [dict(Sc=0.1, u=0.0)] * len(d)
+    start[3] = None  # not a cap: not shot, and the next state is not its repeat
+    assert sv.shooting_states(dict(delta=d, start=start)) == [1, 4, 5]
+
+
+def test_speed_vs_baseline_continuation_time_leaves_the_first_point_out():
+    sv = _load("speed_vs_baseline")
+    runs = [dict(points=11, cpu=1.2, first_point_cpu=0.2), dict(points=11, cpu=1.5, first_point_cpu=0.1),
+            dict(points=11, cpu=1.1, first_point_cpu=0.3)]
+    assert sv._continuation_ms(runs) == pytest.approx(1e3 * 1.0 / 10)  # median of 1.0, 1.4, 0.8
+    runs[1]["first_point_cpu"] = None  # a run without it: no measure
+    assert sv._continuation_ms(runs) is None
+    shots = [dict(rtol=1e-8, per_point_ms=200.0, max_rel=4e-8, converged=20, points=20)]
+    case = dict(shooting=shots, rows={}, same_states={"this commit": dict(
+        ms_per_point=5.0, continuation_ms_per_point=4.0, f_error=1e-7, compared=20, depths=20)})
+    sv.ratios(case)
+    assert case["shooting_ratio_same"] == pytest.approx(40.0)
+    assert case["shooting_ratio_same_cont"] == pytest.approx(50.0)
+    assert case["shooting_ratio_numba_same_cont"] is None  # not run
+
+
 def test_speed_vs_baseline_shooting_rounds_are_merged_by_their_median_time():
     sv = _load("speed_vs_baseline")
 
