@@ -8,6 +8,7 @@ for a state that does not converge (``success=False``, a ``status`` and a
 
 from __future__ import annotations
 
+import functools
 import logging
 import math
 import time
@@ -245,12 +246,25 @@ def delta_bounds(scene, tol: float) -> tuple[float, float]:
     >>> low, round(high, 2)
     (1e-06, 4.93)
     """
+    try:
+        return float(tol), _delta_high_cached(scene)
+    except TypeError:  # a scene holding something unhashable: computed each time
+        return float(tol), _delta_high(scene)
+
+
+def _delta_high(scene) -> float:
+    """``high`` of :func:`delta_bounds`."""
     mod = scene.model()
     S = np.linspace(0.0, scene.shell_length, 4001)
     ref = mod.reference_shell(S, scene.parameters(mod))
     R, Z = np.broadcast_to(ref["R"], S.shape), np.broadcast_to(ref["Z"], S.shape)
     length = float(np.sum(np.hypot(np.diff(R), np.diff(Z))))
-    return float(tol), float(Z[0] - Z[-1] + MEAN_STRETCH_LIMIT * length)
+    return float(Z[0] - Z[-1] + MEAN_STRETCH_LIMIT * length)
+
+
+#: a scene is frozen: its reference shell, tabulated at 4001 points, is measured once (each
+#: curve checks up to five depths against it, each solve one: ~0.2 ms each)
+_delta_high_cached = functools.lru_cache(maxsize=64)(_delta_high)
 
 
 def check_tol(tol):
