@@ -50,13 +50,25 @@ def _legendre_min(sysm, t, y, p):
             continue
         S = sysm.S(k, t, p)
         det = sysm.kernels.active.free_legendre(S, y[sysm.rows(k)], sysm.par)[0]
-        scale = float(np.median(np.abs(det)))
+        scale = _median(np.abs(det))
         if not scale > 0:
             continue
         i = int(np.argmin(det))
         if det[i] / scale < best:
             best, where = float(det[i] / scale), float(S[i])
     return (best, where) if math.isfinite(best) else (math.nan, math.nan)
+
+
+def _median(a) -> float:
+    """np.median of a 1-D array, the same value, by one partition (np.median's generic path
+    cost ~25 µs a state at ~400 points, the partition ~7 µs)."""
+    if a.size == 0 or np.isnan(a).any():
+        return math.nan
+    m = a.size // 2
+    if a.size % 2:
+        return float(np.partition(a, m)[m])
+    q = np.partition(a, (m - 1, m))
+    return float(0.5 * (q[m - 1] + q[m]))
 
 
 def _nodes_and_midpoints(x):

@@ -7,6 +7,8 @@ declaration; the states of the hand-written classes the assembler replaced
 the assembled fun/fun_jac/bc/bc_jac equalled theirs to 4e-15 at random points.)
 """
 
+import math
+
 import numpy as np
 import pytest
 
@@ -210,3 +212,13 @@ def test_the_pole_height_is_kept_but_not_across_parameters():
     assert "_pole_height" not in other.__dict__ or other.par is sysm.par
     assert other.pole_height == float(other.model.reference_shell(0.0, other.par)["Z"]) + other._param("pole_rise")
 
+
+
+def test_diagnosis_median_is_numpys():
+    from shellbvp.diagnosis import _median
+
+    rng = np.random.default_rng(7)
+    for n in (1, 2, 3, 4, 407, 408):
+        a = np.abs(rng.standard_normal(n)) * 10.0 ** rng.uniform(-8, 8, n)
+        assert _median(a) == float(np.median(a))
+    assert math.isnan(_median(np.array([1.0, np.nan, 2.0]))) and math.isnan(_median(np.empty(0)))
