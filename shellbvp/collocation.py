@@ -213,19 +213,17 @@ def _scipy_collocation_fun():
     from scipy.integrate import _bvp
 
     fn = getattr(_bvp, "collocation_fun", None)
-    checked = _COLLOCATION_FUN_CHECKED.get(id(fn))
-    if checked is not None and checked[0] is fn:  # inspect.signature costs ~30 µs a Richardson estimate
-        return fn if checked[1] else None
-    try:
-        ok = callable(fn) and tuple(inspect.signature(fn).parameters) == ("fun", "y", "p", "x", "h")
-    except (TypeError, ValueError):
-        ok = False
-    _COLLOCATION_FUN_CHECKED.clear()
-    _COLLOCATION_FUN_CHECKED[id(fn)] = (fn, ok)
-    return fn if ok else None
+    global _collocation_fun_checked
+    if _collocation_fun_checked[0] is not fn:  # inspect.signature costs ~30 µs a Richardson estimate
+        try:
+            ok = callable(fn) and tuple(inspect.signature(fn).parameters) == ("fun", "y", "p", "x", "h")
+        except (TypeError, ValueError):
+            ok = False
+        _collocation_fun_checked = (fn, ok)
+    return fn if _collocation_fun_checked[1] else None
 
 
-_COLLOCATION_FUN_CHECKED: dict = {}  # id -> (the function, whether its parameters are the expected)
+_collocation_fun_checked = (None, False)  # (the function last checked, whether its parameters are right)
 
 
 def newton_on_mesh(fun, bc, fun_jac, bc_jac, x, y, p, *, tol, bc_tol, kernels=None, max_jacobians=2,
