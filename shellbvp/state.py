@@ -246,25 +246,19 @@ def delta_bounds(scene, tol: float) -> tuple[float, float]:
     >>> low, round(high, 2)
     (1e-06, 4.93)
     """
-    try:
-        return float(tol), _delta_high_cached(scene)
-    except TypeError:  # a scene holding something unhashable: computed each time
-        return float(tol), _delta_high(scene)
+    return float(tol), _delta_high(scene)
 
 
+@functools.lru_cache(maxsize=64)  # a scene is frozen and hashable, as for scene._reference_volume
 def _delta_high(scene) -> float:
-    """``high`` of :func:`delta_bounds`."""
+    """``high`` of :func:`delta_bounds`, measured once per scene (each curve checks up to five
+    depths against it, each solve one; tabulating the shell at 4001 points costs ~0.2 ms)."""
     mod = scene.model()
     S = np.linspace(0.0, scene.shell_length, 4001)
     ref = mod.reference_shell(S, scene.parameters(mod))
     R, Z = np.broadcast_to(ref["R"], S.shape), np.broadcast_to(ref["Z"], S.shape)
     length = float(np.sum(np.hypot(np.diff(R), np.diff(Z))))
     return float(Z[0] - Z[-1] + MEAN_STRETCH_LIMIT * length)
-
-
-#: a scene is frozen: its reference shell, tabulated at 4001 points, is measured once (each
-#: curve checks up to five depths against it, each solve one: ~0.2 ms each)
-_delta_high_cached = functools.lru_cache(maxsize=64)(_delta_high)
 
 
 def check_tol(tol):
