@@ -16,7 +16,7 @@ pi p R/ln(2 tau)).  In shellbvp's units B = beta and Y = Eh = 3 (incompressible,
 
 The scene: a hemispherical dome (gamma = -1, R = 1) indented from outside at its pole by
 a sphere of radius 0.05, Mooney-Rivlin 0.1, at a depth delta = f h (h = sqrt(12 beta),
-the thickness of a linearly elastic sheet).  The formula's assumptions: bending length
+the paper's thickness for this beta; twice sqrt(3 beta), the 3D map's).  The formula's assumptions: bending length
 (beta/3)^(1/4) and the tension's length much smaller than R, pre-strain p R/(2 Y) small,
 delta << h.  Reported: k = F/delta against the formula with R = 1 and with the inflated
 pole's own radius of curvature.

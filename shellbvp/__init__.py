@@ -24,7 +24,8 @@ _LAZY = {"fit": "fitting", "FitResult": "fitting", "read_force_csv": "fitting", 
          "read_instrument": "instrument", "fit_files": "batch", "read_fit": "fitrecord",
          "sweep": "sweep", "read_sweep": "sweep", "Sweep": "sweep",
          "fit_with_geometry": "uncertainty", "GeometryFit": "uncertainty", "convexity_limits": "convexity",
-         "inflate": "inflation"}
+         "inflate": "inflation", "fe_curve": "fe", "FECurve": "fe", "validate": "validation",
+         "Validation": "validation"}
 
 
 def __getattr__(name):
@@ -44,6 +45,10 @@ __all__ = [
     "delta_bounds",
     "inflate",
     "curve",
+    "fe_curve",
+    "FECurve",
+    "validate",
+    "Validation",
     "Curve",
     "read_curve",
     "fit",

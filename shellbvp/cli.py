@@ -99,6 +99,18 @@ def _pressure(text):
         raise argparse.ArgumentTypeError(str(exc)) from None
 
 
+def _thickness(text):
+    """argparse type: eps = H / R_L as a plain number, or the thickness with its unit (``50um``)."""
+    from .units import Quantity, plain_number, split_quantity
+
+    try:
+        if split_quantity(text, "length", "the value")[1]:
+            return Quantity.parse(text, "length", "the value")
+        return plain_number(text, "the value")
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+
+
 def _scene_options(p, uncertain=False):
     g = p.add_argument_group("scene (overrides of the preset)")
     g.add_argument("--preset", default="base", help="built-in scene (see `shellbvp presets`; default base)")
@@ -106,6 +118,9 @@ def _scene_options(p, uncertain=False):
     g.add_argument("--gamma", type=kind, help=f"spheroid aspect parameter (< 1/rho; >0 bowl, <0 dome){note}")
     g.add_argument("--rho", type=kind, help=f"indenter radius / rim radius (> 0){note}")
     g.add_argument("--beta", type=kind, help=f"bending stiffness B/(mu R_L^2) (> 0){note}")
+    g.add_argument("--thickness", type=_thickness,
+                   help="shell thickness: H/R_L in (0, 0.5], or with a unit (50um) together with --radius; "
+                        "sets beta = (H/R_L)^2/3, the bending stiffness of a 3D plate")
     m = g.add_mutually_exclusive_group()
     m.add_argument("--alpha", type=kind, help=f"Mooney-Rivlin alpha in [0, 1]{note}")
     m.add_argument("--gent-jm", type=_number, dest="gent_jm", help="Gent model with this Jm (> 0)")
@@ -146,7 +161,22 @@ def _scene(args):
         over["bending"] = sb.BendingEnergy(args.bending_formula)
     if getattr(args, "pressure", None) is not None:
         over["pressure"] = _nondimensional_pressure(args)
+    if getattr(args, "thickness", None) is not None:
+        over["thickness"] = _nondimensional_thickness(args)
     return sb.Scene.preset(args.preset, **over)
+
+
+def _nondimensional_thickness(args):
+    """``--thickness`` as ``H / R_L``: a plain number as it is, a length through ``--radius``."""
+    from .units import Quantity
+
+    if not isinstance(args.thickness, Quantity):
+        return args.thickness
+    radius = getattr(args, "radius", None)
+    if radius is None:
+        raise ValueError(f"--thickness {args.thickness} has a unit: it needs --radius (the nondimensional "
+                         f"thickness is H / R_L); or give that number itself")
+    return args.thickness.si / radius.si
 
 
 def _nondimensional_pressure(args):
@@ -568,6 +598,14 @@ def _print_fit(res, record, used, args):
           f"{int(used.sum())} rows")
     lo, hi = res.mu_H_ci95
     print(f"mu*H   = {res.mu_H:.4g} N/m (um*MPa)   95% CI [{lo:.4g}, {hi:.4g}]")
+    if res.mu is not None:
+        eps = res.scene.thickness
+        m1, m2 = res.mu_ci95
+        print(f"mu     = {res.mu / 1e6:.4g} MPa   95% CI [{m1 / 1e6:.4g}, {m2 / 1e6:.4g}] (H = "
+              f"{format_in(res.thickness, 'um', 'length')}, eps = H/R_L = {eps:.3g}, beta = eps^2/3)")
+        print(f"model  = beside this interval, the shell model's own error, O(eps): measured 2-3 eps too stiff "
+              f"at depths <= H on a hemisphere (eps <= 0.1; docs: How accurate is the shell model?); "
+              f"`shellbvp validate` with these options measures it for this scene")
     show = (lambda v, unit, kind: format_in(v, unit, kind).split(" ")[0])
     if "offset" in res.fitted:
         o1, o2 = res.offset_ci95
@@ -827,6 +865,44 @@ def _cmd_presets(args):
     return 0
 
 
+def _cmd_validate(args):
+    import time
+
+    from .validation import validate
+
+    scene = _scene(args)
+    if scene.thickness is None:
+        raise ValueError("validate needs --thickness (H/R_L, or with a unit and --radius)")
+    if scene.pressurised:
+        raise ValueError("validate: the 3D model has no internal pressure yet; use a scene without --pressure")
+    if not (0 < args.delta_max <= 2):
+        raise ValueError(f"--delta-max must be in (0, 2]; got {args.delta_max:g}")
+    deltas = None
+    if args.deltas:
+        deltas = _numbers(args.deltas, "--deltas")
+        if any(not 0 < d <= 2 for d in deltas) or any(b <= a for a, b in zip(deltas, deltas[1:])):
+            raise ValueError("--deltas must be increasing pole displacements in (0, 2]")
+    from .paths import check_output_path
+
+    out = check_output_path(args.output if args.output is not None
+                            else _free_default_name(f"{args.preset}-validate", args.force), overwrite=args.force)
+    try:
+        import felupe  # noqa: F401
+    except ImportError:
+        raise ValueError("validate needs FElupe: pip install 'shellbvp[fe]'") from None
+    t0 = time.perf_counter()
+    print(f"scene: {args.preset}, eps = H/R_L = {scene.thickness:.4g}, beta = {scene.beta:.4g}; "
+          f"3D model (FElupe) and shell model at the same pole displacements", flush=True)
+    result = validate(scene, deltas=deltas, delta_max=args.delta_max, mesh_check=args.mesh_check, tol=args.tol,
+                      progress=lambda i, d, f: print(f"  FE: delta = {d:.4g}, F = {f:.5g}", flush=True))
+    print(result.table())
+    if not result.fe.success:
+        print(f"FE: {result.fe.message}")
+    result.to_hdf5(out, overwrite=args.force)
+    print(f"wrote {out} ({time.perf_counter() - t0:.1f} s)")
+    return 0 if result.fe.success else 1
+
+
 def build_parser():
     from .version import __version__
 
@@ -972,6 +1048,19 @@ def build_parser():
                                           "(the Legendre condition; beyond it the contact edge becomes a corner)")
     _scene_options(cv)
     cv.set_defaults(func=_cmd_convexity)
+    v = sub.add_parser("validate", help="the shell model against a 3D finite-element model of the same scene "
+                       "(needs FElupe: pip install 'shellbvp[fe]')")
+    _scene_options(v)
+    v.add_argument("--delta-max", type=_number, default=0.5, dest="delta_max",
+                   help="largest pole displacement (default 0.5); the depths are delta/H = 0.25, 0.5, 1, 2, 5, "
+                        "10, 25 below it and delta-max")
+    v.add_argument("--deltas", help="these pole displacements instead, comma-separated (/R_L)")
+    v.add_argument("--radius", type=quantity("length"), help="rim radius with its unit, for --thickness with a unit")
+    v.add_argument("--mesh-check", action="store_true", dest="mesh_check",
+                   help="also solve the 3D model on a coarser mesh and report the difference (~1.5x the time)")
+    v.add_argument("-o", "--output", help="output file (default <preset>-validate.h5, or -2, ... if that exists)")
+    v.add_argument("--force", action="store_true", help="replace an existing output file")
+    v.set_defaults(func=_cmd_validate)
     r = sub.add_parser("presets", help="list the built-in scenes")
     r.set_defaults(func=_cmd_presets)
     return p

@@ -222,6 +222,25 @@ class FitResult:
         """True when the fit converged and passed its checks (``status == 0``)."""
         return self.status == 0
 
+    @property
+    def thickness(self):
+        """The shell's thickness H (m) when the scene was given one (``Scene(thickness=H/R_L)``,
+        ``--thickness``): then beta is the 3D plate's and mu follows from mu*H; None otherwise."""
+        eps = getattr(self.scene, "thickness", None)
+        return None if eps is None else eps * self.R_L
+
+    @property
+    def mu(self):
+        """The shear modulus mu = mu*H / H (Pa), with the thickness known (else None)."""
+        H = self.thickness
+        return None if H is None else self.mu_H / H
+
+    @property
+    def mu_ci95(self):
+        """mu's 95 % interval (Pa): mu*H's over H (the thickness taken as exact)."""
+        H = self.thickness
+        return None if H is None else (self.mu_H_ci95[0] / H, self.mu_H_ci95[1] / H)
+
     def model_force(self, displacement, mu_H=None):
         """Fitted model force (N) at displacements (m); with ``mu_H`` (N/m), the same model at
         that mu*H (e.g. an end of ``mu_H_ci95``), offset and baseline as fitted."""

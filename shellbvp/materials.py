@@ -168,9 +168,16 @@ class StrainEnergy(Material):
 
 
 class Bending:
-    """Base class of bending energies ``B`` (U = W + beta B; formulas in ``symbolic.bending``)."""
+    """Base class of bending energies ``B`` (U = W + beta B; formulas in ``symbolic.bending``).
+
+    ``plate_stiffness`` and ``plate_poisson``: B's small-strain plate limit,
+    ``B ~ plate_stiffness/2 (kappa_s^2 + kappa_theta^2 + 2 plate_poisson kappa_s kappa_theta)``
+    (``symbolic.bending.plate_limit``; a test derives the built-ins' values).
+    """
 
     family: str = ""
+    plate_stiffness: float = 1.0
+    plate_poisson: float = 1.0
 
     def description(self) -> dict:
         """The structural choice (family, a user formula): what generated code is keyed on."""
@@ -247,9 +254,14 @@ class BendingEnergy(Bending):
         with evaluation_errors("B"):
             expr = parse_formula(B, sbend.BENDING_SYMBOLS, name="B", legacy_srepr=legacy_srepr)
             stiffness = sbend.check_bending(expr, name="B")
+            plate_stiffness, plate_poisson = sbend.plate_limit(expr)
+        if not (plate_stiffness.is_number and float(plate_stiffness) > 0 and plate_poisson.is_number):
+            raise ValueError(f"B must bend a flat plate with a positive stiffness; its plate limit is "
+                             f"d2B/dkappa_s2 = {plate_stiffness}")
         self.B = expr
         self.name = str(name)
         self.stiffness = float(stiffness) if stiffness.is_number else str(stiffness)
+        self.plate_stiffness, self.plate_poisson = float(plate_stiffness), float(plate_poisson)
         self._text = formula_text(expr)
 
     def description(self):

@@ -1,8 +1,8 @@
 """A scene: shell, indenter, material, bending stiffness and model choices.
 
 Nondimensional (SPEC section 2): lengths by the rim radius R_L, forces and
-moments by mu R_L H, ``beta = B/(mu R_L^2)`` (``eps^2/12`` for a linearly
-elastic sheet of thickness ``eps = H/R_L``).
+moments by mu R_L H, ``beta = B/(mu R_L^2)`` (``eps^2/3`` for a shell of thickness
+``eps = H/R_L``: :func:`shellbvp.beta_from_thickness`).
 """
 
 from __future__ import annotations
@@ -43,7 +43,7 @@ class Scene:
     rho : float
         Indenter radius / rim radius, > 0.
     beta : float
-        Bending stiffness ``B/(mu R_L^2)``, > 0.
+        Bending stiffness ``B/(mu R_L^2)``, > 0 (default 0.01, or from ``thickness``).
     material : Material
         ``MooneyRivlin(alpha)``, ``NeoHookean()``, ``Gent(Jm)`` or ``StrainEnergy(W)``.
     xi : {0, 1}
@@ -69,6 +69,12 @@ class Scene:
         state at ``pressure`` (then the pressure before indenting).  While indenting,
         the pressure is an unknown of every solve (``Solution.pressure``) with the
         constraint ``V = V0``.  Default False (pressure control).
+    thickness : float, optional
+        The shell's thickness ``eps = H/R_L`` in (0, 0.5]: sets ``beta`` to the 3D plate's
+        (:func:`shellbvp.beta_from_thickness`, ``eps^2/3`` for the built-in bending energies)
+        and is kept for the 3D reference (:func:`shellbvp.fe_curve`).  Give it or ``beta``:
+        both only when they agree.  ``replace(beta=...)`` drops it, ``replace(thickness=...)``
+        sets beta anew.
 
     Raises
     ------
@@ -87,6 +93,8 @@ class Scene:
     True
     >>> scene.replace(contact="paper").contact
     'paper'
+    >>> round(sb.Scene(thickness=0.05).beta, 6)              # beta = eps^2/3
+    0.000833
     >>> sb.Scene(rho=0)
     Traceback (most recent call last):
     ...
@@ -95,7 +103,7 @@ class Scene:
 
     gamma: float = 1.0
     rho: float = 0.2
-    beta: float = 0.01
+    beta: float = None
     material: Material = field(default_factory=lambda: MooneyRivlin(0.1))
     xi: int = 1
     contact: str = "smooth"
@@ -104,12 +112,29 @@ class Scene:
     bending: Bending = field(default_factory=TraceBending)
     pressure: float = 0.0
     sealed: bool = False
+    thickness: float = None
 
     def __post_init__(self):
         rho = _finite("rho", self.rho)
         if rho <= 0:
             raise ValueError(f"rho (indenter radius / rim radius) must be > 0; got {self.rho!r}")
-        beta = _finite("beta", self.beta)
+        if not isinstance(self.bending, Bending):
+            raise ValueError(f"bending must be TraceBending(), RotationBending() or BendingEnergy(...); "
+                             f"got {self.bending!r}")
+        beta = self.beta
+        if self.thickness is not None:
+            eps = _finite("thickness", self.thickness)
+            if not 0 < eps <= 0.5:
+                raise ValueError(f"thickness (H / R_L) must be in (0, 0.5]; got {self.thickness!r}")
+            from .units import beta_from_thickness
+
+            from_eps = beta_from_thickness(eps, 1.0, self.bending)
+            if beta is not None and not math.isclose(_finite("beta", beta), from_eps, rel_tol=1e-12):
+                raise ValueError(f"beta = {beta!r} and thickness = {eps!r} disagree (the thickness gives beta = "
+                                 f"{from_eps:.6g}): give one of them")
+            beta = from_eps
+            object.__setattr__(self, "thickness", eps)
+        beta = _finite("beta", 0.01 if beta is None else beta)
         if beta <= 0:
             raise ValueError(f"beta (bending stiffness) must be > 0; got {self.beta!r}")
         gamma = _finite("gamma", self.gamma)
@@ -124,9 +149,6 @@ class Scene:
             raise ValueError(f"shell must be Spheroid() or UserShell(...); got {self.shell!r}")
         if not isinstance(self.tip, (SphereTip, UserTip)):
             raise ValueError(f"tip must be SphereTip() or UserTip(...); got {self.tip!r}")
-        if not isinstance(self.bending, Bending):
-            raise ValueError(f"bending must be TraceBending(), RotationBending() or BendingEnergy(...); "
-                             f"got {self.bending!r}")
         # First contact at the pole: kappa_theta^R(0) < B''(0)/(rho A'(0)^2).
         k_shell = self.shell.pole_curvature({"gamma": gamma})
         k_tip = self.tip.apex_curvature() / rho
@@ -165,17 +187,29 @@ class Scene:
         -1.0
         >>> Scene.preset("base", material=Gent(Jm=97.2), contact="paper").material
         Gent(Jm=97.2)
+        >>> round(Scene.preset("fit", thickness=50 / 300).beta, 5)   # 50 um on R_L = 0.3 mm
+        0.00926
         """
         if name not in PRESETS:
             raise ValueError(f"unknown preset {name!r}; choose one of {sorted(PRESETS)}")
         base = dict(PRESETS[name]["scene"])
         if isinstance(base.get("shell"), tuple):
             base["shell"] = UserShell(*base["shell"])
+        if overrides.get("thickness") is not None and "beta" not in overrides:
+            base.pop("beta", None)  # the thickness sets it
         base.update(overrides)
         return cls(**base)
 
     def replace(self, **changes) -> "Scene":
-        """A copy with some fields changed (validated again)."""
+        """A copy with some fields changed (validated again).
+
+        A new ``beta`` drops the thickness; a new ``thickness`` (or bending energy, with a
+        thickness) sets beta from it.
+        """
+        if "beta" in changes and "thickness" not in changes:
+            changes["thickness"] = None
+        elif "beta" not in changes and ("thickness" in changes or "bending" in changes and self.thickness):
+            changes["beta"] = None
         return replace(self, **changes)
 
     # -- serialisation -------------------------------------------------------------
@@ -189,6 +223,7 @@ class Scene:
             "bending": self.bending.description(),
             **({"pressure": self.pressure} if self.pressure else {}),  # files of unpressurised scenes as before
             **({"sealed": True} if self.sealed else {}),
+            **({"thickness": self.thickness} if self.thickness is not None else {}),
         }
 
     @classmethod
@@ -254,7 +289,8 @@ class Scene:
                    beta=field(d, "beta", number, ""), material=material, xi=field(d, "xi", (int,), ""),
                    contact=field(d, "contact", text, ""), shell=shell, tip=tip, bending=bend,
                    pressure=field(d, "pressure", number, "") if "pressure" in d else 0.0,
-                   sealed=field(d, "sealed", (bool,), "") if "sealed" in d else False)
+                   sealed=field(d, "sealed", (bool,), "") if "sealed" in d else False,
+                   thickness=field(d, "thickness", number, "") if "thickness" in d else None)
 
     def to_json(self) -> str:
         """:meth:`to_dict` as a JSON string (sorted keys)."""
@@ -365,12 +401,12 @@ PRESETS = {
                 "scene": dict(shell=("2*sin(S/2)", "2*cos(S/2)", "2*asin(1/2)"), rho=0.2, beta=1e-4,
                               material=MooneyRivlin(0.1), xi=1, pressure=0.1)},
     "cell": {"doc": "walled cell with turgor: a near-complete sphere held on a ring 144 degrees from the pole "
-                    "(sphere radius 1.70), colloidal probe rho 0.34, beta 3.9e-4, pressure 0.089 (yeast-like: "
-                    "radius 2.5 um, wall 0.1 um, mu H 3.3 N/m, turgor 0.2 MPa)",
-             "scene": dict(shell=("sin(S)", "cos(S)", "4*pi/5"), rho=0.34, beta=3.9e-4,
+                    "(sphere radius 1.70), colloidal probe rho 0.34, beta 1.55e-3, pressure 0.089 (yeast-like: "
+                    "radius 2.5 um, wall 0.1 um: eps = H/R_L = 0.068, beta = eps^2/3; mu H 3.3 N/m, turgor 0.2 MPa)",
+             "scene": dict(shell=("sin(S)", "cos(S)", "4*pi/5"), rho=0.34, beta=1.55e-3,
                            material=MooneyRivlin(0.1), xi=1, pressure=0.089)},
     "capsule": {"doc": "sealed liquid-filled capsule: the cell's near-complete sphere with no pressure before "
                        "indenting, under volume control (the pressure rises as it is indented)",
-                "scene": dict(shell=("sin(S)", "cos(S)", "4*pi/5"), rho=0.34, beta=3.9e-4,
+                "scene": dict(shell=("sin(S)", "cos(S)", "4*pi/5"), rho=0.34, beta=1.55e-3,
                               material=MooneyRivlin(0.1), xi=1, sealed=True)},
 }

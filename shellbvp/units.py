@@ -2,13 +2,15 @@
 
 Lengths scale with the rim radius ``R_L``, forces with ``mu H R_L``:
 ``delta_SI = R_L delta``, ``F_SI = mu_H R_L F`` (``mu_H`` = shear modulus times
-thickness, N/m = um*MPa).  A linearly elastic sheet of thickness H has
-``beta = (H/R_L)^2 / 12``.
+thickness, N/m = um*MPa).  A shell of thickness H bends as a 3D plate of an
+incompressible solid (``D = mu H^3/3``) with ``beta = (H/R_L)^2 / 3``
+(:func:`beta_from_thickness`).
 """
 
 from __future__ import annotations
 
 import math
+import numbers
 import re
 from dataclasses import dataclass
 
@@ -204,18 +206,25 @@ def force_unit_of(mu_H_unit: str) -> str:
     return top if unit_kind(top) == "force" else "N"
 
 
-def beta_from_thickness(H: float, R_L: float) -> float:
-    """The bending stiffness of a shell of thickness H: ``beta = (H/R_L)^2/12``.
+def beta_from_thickness(H: float, R_L: float = 1.0, bending=None) -> float:
+    """The bending stiffness of a shell of thickness H: ``beta = (H/R_L)^2 / 3`` for the built-in
+    bending energies.
 
-    The paper's relation for an incompressible, linearly elastic sheet; a
-    starting value when the thickness is known.
+    A plate of an incompressible solid (Poisson ratio 1/2, shear modulus mu) has the bending
+    stiffness ``D = E H^3/(12 (1 - nu^2)) = mu H^3/3``; the shell model's ``U = W + beta B``
+    bends a flat sheet with ``mu H R_L^2 beta k``, k = d2B/dkappa_s2 at rest (1 for the trace and
+    rotation energies; ``symbolic.bending.plate_limit`` derives both).  So ``beta = eps^2/(3 k)``,
+    ``eps = H/R_L``.  A 3D finite-element model agrees (``shellbvp validate``; the docs' page on
+    the model's accuracy).  Builds before issue 41 returned the paper's ``eps^2/12``, 4x too small.
 
     Parameters
     ----------
     H : float
         Shell thickness (any length unit).
     R_L : float
-        Rim radius, in the same unit as H.
+        Rim radius, in the same unit as H (default 1: H is then eps = H/R_L).
+    bending : Bending, optional
+        The scene's bending energy (default the trace energy).
 
     Returns
     -------
@@ -226,12 +235,13 @@ def beta_from_thickness(H: float, R_L: float) -> float:
     --------
     >>> from shellbvp import beta_from_thickness
     >>> round(beta_from_thickness(H=50e-6, R_L=0.3e-3), 6)   # a 50 um endosperm, R_L = 0.3 mm
-    0.002315
+    0.009259
     """
     for name, v in (("H", H), ("R_L", R_L)):
-        if not (math.isfinite(v) and v > 0):
+        if isinstance(v, bool) or not isinstance(v, numbers.Real) or not (math.isfinite(v) and v > 0):
             raise ValueError(f"{name} must be a finite length > 0; got {v!r}")
-    return (H / R_L) ** 2 / 12
+    stiffness = 1.0 if bending is None else float(bending.plate_stiffness)
+    return (H / R_L) ** 2 / (3 * stiffness)
 
 
 @dataclass(frozen=True)

@@ -30,7 +30,7 @@ import sympy as sp
 from .materials import FLOAT_ZERO, LS, LT
 
 __all__ = ["KS", "KT", "KS0", "KT0", "BENDING_SYMBOLS", "trace_bending", "rotation_bending", "bending_energy",
-           "check_bending", "legendre_determinant"]
+           "check_bending", "legendre_determinant", "plate_limit", "plate_3d"]
 
 KS, KT = sp.symbols("kappa_s kappa_theta", real=True)
 KS0, KT0 = sp.symbols("kappa_s0 kappa_theta0", real=True)
@@ -109,3 +109,34 @@ def legendre_determinant(W, B, beta=sp.Symbol("beta", positive=True)):
     H = sp.hessian(U, (psi, dphi))
     det = (H[0, 0] * H[1, 1] - H[0, 1] ** 2) * Psi**4
     return sp.simplify(det.xreplace({psi: LS * Psi, dphi: KS * LS * Psi}))
+
+
+def plate_3d():
+    """The bending of a 3D plate of an incompressible isotropic solid, per ``mu H^3`` and with its
+    Poisson ratio: ``D = E H^3 / (12 (1 - nu^2))`` with ``E = 2 (1 + nu) mu``, ``nu = 1/2``, i.e.
+    ``(1/3, 1/2)``.  Its energy per area is ``D/2 (kappa_s^2 + kappa_theta^2 + 2 nu kappa_s kappa_theta)``."""
+    nu, mu, H = sp.Rational(1, 2), sp.Symbol("mu", positive=True), sp.Symbol("H", positive=True)
+    D = 2 * (1 + nu) * mu * H**3 / (12 * (1 - nu**2))
+    return sp.simplify(D / (mu * H**3)), nu
+
+
+def plate_limit(B):
+    """The small-strain plate limit of a bending energy: ``(stiffness, poisson)`` with
+    ``B ~ stiffness/2 (kappa_s^2 + kappa_theta^2 + 2 poisson kappa_s kappa_theta)`` at
+    ``lambda = 1`` on a flat reference (``kappa_0 = 0``).
+
+    Against :func:`plate_3d` the shell model with ``U = W + beta B`` (energy per ``mu H``) bends as
+    a 3D plate of thickness ``eps = H/R_L`` when ``beta * stiffness = eps^2 * D/(mu H^3)``, i.e.
+    ``beta = eps^2 / (3 stiffness)``: ``eps^2/3`` for the trace and rotation energies (both
+    ``(1, 1)``: their bending Poisson ratio is 1, the plate's 1/2, which matters where the
+    Gaussian curvature's energy does: at a free or simply supported edge).
+    """
+    flat = {LS: 1, LT: 1, KS0: 0, KT0: 0}
+    B = sp.sympify(B).subs(flat)
+    at_rest = {KS: 0, KT: 0}
+    ss = sp.simplify(sp.diff(B, KS, 2).subs(at_rest))
+    st = sp.simplify(sp.diff(B, KS, KT).subs(at_rest))
+    tt = sp.simplify(sp.diff(B, KT, 2).subs(at_rest))
+    if sp.simplify(ss - tt) != 0:
+        raise ValueError(f"B's plate limit is not isotropic: d2B/dkappa_s2 = {ss}, d2B/dkappa_theta2 = {tt}")
+    return ss, sp.simplify(st / ss)

@@ -3,7 +3,8 @@ test (tests/test_solve.py) turned over into a dome, a spheroidal dome, and what 
 failed result carries.
 
 The dome: ``R = 5 sin(S/5)``, ``Z = 5 cos(S/5)`` (rescaled to R(L) = 1, Z(L) = 0: a cap of
-radius 5 and rise 0.101), rho 0.05, beta 1e-5 (thickness h = sqrt(12 beta) = 0.011).  Its
+radius 5 and rise 0.101), rho 0.05, beta 1e-5 (thickness sqrt(3 beta) = 0.0055; depths below are in units of
+h = sqrt(12 beta) = 0.011, the paper's thickness for this beta).  Its
 contact stays exponentially small through delta 0.05 (the cap that exists is 4e-28 at
 delta 0.01 and 2e-13 at 0.05, and pulls), so its states are the point-load limit
 (docs/limits.md).

@@ -183,7 +183,7 @@ def test_dimensional_round_trip_and_units():
     assert sb.parse_quantity("0.3mm") == pytest.approx(3e-4)
     assert sb.parse_quantity("2 mN", "force") == pytest.approx(2e-3)
     assert sb.parse_quantity(5, "length", default_unit="um") == pytest.approx(5e-6)
-    assert sb.beta_from_thickness(50e-6, 0.3e-3) == pytest.approx((50 / 300) ** 2 / 12)
+    assert sb.beta_from_thickness(50e-6, 0.3e-3) == pytest.approx((50 / 300) ** 2 / 3)
     with pytest.raises(ValueError, match="unit"):
         sb.parse_quantity("3 furlongs")
     with pytest.raises(ValueError, match="R_L"):

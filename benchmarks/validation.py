@@ -1,0 +1,189 @@
+"""The shell model's error against 3D elasticity, mapped (issue 41).
+
+For each scene (shell gamma, indenter rho) and thickness eps, the 3D reference
+(``shellbvp.fe_curve``: FElupe, axisymmetric u/p/J quadratic elements, neo-Hookean) is
+solved at the mid-surface pole displacements delta/H = 0.25, 0.5, 1, 2, 5, 10, 25 (up to
+delta 0.5); the shell model at the same depths with beta = eps^2/3, for both contact models
+(smooth, paper) and both bending energies (trace, rotation), and with the paper's old map
+eps^2/12 for comparison.  Reported: ``F_shell / F_FE - 1``, the contact radius of both, the
+FE's own mesh error (``--mesh-check``).
+
+FE curves are cached in ``results/validation.json`` (keyed by scene and eps): a second run
+recomputes only what is missing (``--recompute`` to start afresh).  ``--quick``: eps 0.1 and
+0.05 on the hemisphere with rho 0.2.
+
+    python benchmarks/validation.py [--quick] [--workers 2] [--mesh-check]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import platform
+import sys
+import time
+from concurrent.futures import ProcessPoolExecutor
+from pathlib import Path
+
+import numpy as np
+
+HERE = Path(__file__).resolve().parent
+sys.path.insert(0, str(HERE.parent))  # this checkout's package
+
+import shellbvp as sb  # noqa: E402
+from shellbvp.validation import default_depths  # noqa: E402
+
+EPS = (0.1, 0.05, 0.02, 0.01)
+#: (gamma, rho): hemisphere and a prolate Lepidium-like shell at three indenter sizes (the
+#: prolate one needs gamma < 1/rho), and a dome indented from its convex side.
+SCENES = ((1.0, 0.1), (1.0, 0.2), (1.0, 0.5), (2.5, 0.1), (2.5, 0.2), (-1.0, 0.2))
+VARIANTS = {  # shell-model variants compared with the same FE curve
+    "smooth": dict(contact="smooth", bending=sb.TraceBending()),
+    "smooth, rotation": dict(contact="smooth", bending=sb.RotationBending()),
+    "paper": dict(contact="paper", bending=sb.TraceBending()),
+    "paper, rotation": dict(contact="paper", bending=sb.RotationBending()),
+}
+DELTA_MAX = 0.5
+
+
+def scene_of(gamma, rho, eps, **over):
+    return sb.Scene(gamma=gamma, rho=rho, material=sb.NeoHookean(), thickness=eps, **over)
+
+
+def key(gamma, rho, eps):
+    return f"gamma={gamma:g} rho={rho:g} eps={eps:g}"
+
+
+def fe_case(args):
+    gamma, rho, eps, mesh_check = args
+    t0 = time.perf_counter()
+    depths = default_depths(eps, DELTA_MAX)
+    c = sb.fe_curve(scene_of(gamma, rho, eps), eps, depths, mesh_check=mesh_check)
+    return key(gamma, rho, eps), {
+        "gamma": gamma, "rho": rho, "eps": eps, "delta": c.delta.tolist(), "force": c.force.tolist(),
+        "indenter": c.indenter.tolist(), "contact_radius": c.contact_radius.tolist(),
+        "mesh_error": c.mesh_error.tolist(), "success": c.success, "message": c.message,
+        "elements": list(c.elements), "seconds": time.perf_counter() - t0}
+
+
+def shell_rows(fe):
+    """The shell model's variants at the FE's depths."""
+    gamma, rho, eps = fe["gamma"], fe["rho"], fe["eps"]
+    d = np.asarray(fe["delta"])
+    rows = {}
+    plans = dict(VARIANTS)
+    plans["smooth, eps^2/12"] = dict(contact="smooth", bending=sb.TraceBending(), beta=eps**2 / 12)
+    for name, over in plans.items():
+        over = dict(over)
+        if "beta" in over:
+            scene = sb.Scene(gamma=gamma, rho=rho, material=sb.NeoHookean(), **over)
+        else:
+            scene = scene_of(gamma, rho, eps, **over)
+        t0 = time.perf_counter()
+        c = sb.curve(scene, deltas=d, estimate_error=False)
+        F = np.full(d.size, np.nan)
+        rc = np.full(d.size, np.nan)
+        topo = [""] * d.size
+        for i, x in enumerate(d):
+            j = np.flatnonzero(np.isclose(c.points["delta"], x, rtol=1e-9))
+            if j.size and c.points["status"][j[0]] == 0:
+                F[i] = c.points["force"][j[0]]
+                topo[i] = str(c.points["topology"][j[0]])
+                sol = c.solutions[j[0]] if j[0] < len(c.solutions) else None
+                if sol is not None and topo[i] == "cap":
+                    p = sol.profile()
+                    rc[i] = float(np.interp(c.points["Sc"][j[0]], p["S"], p["r"]))
+        rows[name] = {"force": F.tolist(), "contact_radius": rc.tolist(), "topology": topo,
+                      "seconds": time.perf_counter() - t0}
+    return rows
+
+
+def pct(x):
+    return f"{100 * x:+.1f}" if np.isfinite(x) else "-"
+
+
+def report(cache, plan, args):
+    from checkout import commit_label
+
+    lines = [f"Measured {time.strftime('%Y-%m-%d')} on {platform.machine()}, shellbvp {sb.__version__} at "
+             f"{commit_label() or 'unknown commit'}; `python benchmarks/validation.py"
+             f"{' --quick' if args.quick else ''}{' --mesh-check' if args.mesh_check else ''}`.", "",
+             "F_shell / F_FE - 1 in percent, at the same mid-surface pole displacement delta; the 3D "
+             "model is `shellbvp.fe_curve` (FElupe: 9-node u/p/J elements, neo-Hookean, bulk 5000 mu, "
+             "3 elements through H, H/2 along the meridian, H/4 near the pole; rim pinned at "
+             "mid-thickness; frictionless penalty contact on the surface facing the indenter).  Shell "
+             "model: beta = eps^2/3 (`beta_from_thickness`) unless the column says eps^2/12; "
+             "'smooth' is the default variational contact, 'paper' the paper's contact conditions; "
+             "trace bending unless 'rotation'.", ""]
+    summary = []
+    for gamma, rho in plan["scenes"]:
+        lines += [f"## gamma {gamma:g}, rho {rho:g}", ""]
+        for eps in plan["eps"]:
+            fe = cache.get(key(gamma, rho, eps))
+            if fe is None:
+                continue
+            d = np.asarray(fe["delta"])
+            ff = np.asarray(fe["force"])
+            lines += [f"eps = {eps:g} (FE {fe['elements'][0]}x{fe['elements'][1]} elements, "
+                      f"{fe['seconds']:.0f} s{'' if fe['success'] else '; ' + fe['message']})", "",
+                      "| delta/H | delta | F_FE | " + " | ".join(fe["shell"]) + " | FE mesh | r_c FE | r_c smooth |",
+                      "|" + "---|" * (len(fe["shell"]) + 6)]
+            for i, x in enumerate(d):
+                errs = [np.asarray(v["force"])[i] / ff[i] - 1 for v in fe["shell"].values()]
+                me = fe["mesh_error"][i]
+                rs = fe["shell"]["smooth"]["contact_radius"][i]
+                lines.append(f"| {x / eps:.3g} | {x:.4g} | {ff[i]:.5g} | " + " | ".join(pct(e) for e in errs)
+                             + f" | {'-' if not np.isfinite(me) else f'{100 * me:.2f}'} | "
+                             f"{fe['contact_radius'][i]:.4f} | {'-' if not np.isfinite(rs) else f'{rs:.4f}'} |")
+                summary.append((gamma, rho, eps, x / eps, {k: errs[j] for j, k in enumerate(fe["shell"])}))
+            lines.append("")
+    # the domain where the default model is within 2 % and 5 %
+    lines += ["## Summary: |F_shell / F_FE - 1| / eps, smooth contact, beta = eps^2/3", "",
+              "| depth | max over scenes and eps | max |error| | where |", "|---|---|---|---|"]
+    for lo, label in ((1.0, "delta >= H"), (5.0, "delta >= 5 H")):
+        sel = [(g, r, e, k, v["smooth"]) for g, r, e, k, v in summary if k >= lo - 1e-9 and np.isfinite(v["smooth"])]
+        if sel:
+            worst = max(sel, key=lambda t: abs(t[4]) / t[2])
+            worst_abs = max(sel, key=lambda t: abs(t[4]))
+            lines.append(f"| {label} | {abs(worst[4]) / worst[2]:.2f} eps (gamma {worst[0]:g}, rho {worst[1]:g}, "
+                         f"eps {worst[2]:g}, delta/H {worst[3]:g}) | {100 * abs(worst_abs[4]):.1f} % | "
+                         f"gamma {worst_abs[0]:g}, rho {worst_abs[1]:g}, eps {worst_abs[2]:g}, "
+                         f"delta/H {worst_abs[3]:g} |")
+    return "\n".join(lines) + "\n"
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--quick", action="store_true", help="eps 0.1 and 0.05 on the hemisphere, rho 0.2")
+    ap.add_argument("--workers", type=int, default=2, help="FE curves in parallel (default 2)")
+    ap.add_argument("--mesh-check", action="store_true", dest="mesh_check",
+                    help="each FE curve also on a coarser mesh (FECurve.mesh_error)")
+    ap.add_argument("--recompute", action="store_true", help="ignore the cached FE curves")
+    ap.add_argument("--out-dir", default=None, help="write results/ under this directory (default benchmarks/)")
+    args = ap.parse_args(argv)
+    plan = {"scenes": ((1.0, 0.2),), "eps": (0.1, 0.05)} if args.quick else {"scenes": SCENES, "eps": EPS}
+    suffix = "-quick" if args.quick else ""
+    out = (Path(args.out_dir) if args.out_dir else HERE) / "results"
+    out.mkdir(parents=True, exist_ok=True)
+    store = out / f"validation{suffix}.json"
+    cache = {} if args.recompute or not store.exists() else json.loads(store.read_text())
+    todo = [(g, r, e, args.mesh_check) for g, r in plan["scenes"] for e in plan["eps"]
+            if key(g, r, e) not in cache or not cache[key(g, r, e)].get("success")]
+    todo.sort(key=lambda t: t[2])  # thinnest (slowest) first
+    with ProcessPoolExecutor(max_workers=max(1, args.workers)) as pool:
+        for k, fe in pool.map(fe_case, todo):
+            fe["shell"] = shell_rows(fe)
+            cache[k] = fe
+            print(f"{k}: FE {fe['seconds']:.0f} s, {fe['message']}; smooth "
+                  + " ".join(pct(a / b - 1) for a, b in zip(fe["shell"]["smooth"]["force"], fe["force"])), flush=True)
+            store.write_text(json.dumps(cache, indent=1, default=float))  # no finished curve is lost
+    for k, fe in cache.items():
+        if "shell" not in fe:
+            fe["shell"] = shell_rows(fe)
+    store.write_text(json.dumps(cache, indent=1, default=float))
+    (out / f"validation{suffix}.md").write_text(report(cache, plan, args))
+    print(f"wrote {out / f'validation{suffix}.md'}")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,623 @@
+"""A 3D reference: the scene's shell as an axisymmetric, nearly incompressible solid (FElupe).
+
+The shell model reduces a solid of thickness H to its mid-surface.  This module solves
+the solid itself, so that a user sees the model's error for his own scene:
+
+* the solid: the scene's reference meridian as the mid-surface, thickness ``eps = H/R_L``
+  on either side of it by eps/2 along the normal; 9-node quadratic elements (FElupe's
+  ``RegionBiQuadraticQuad``) with the mixed u/p/J (Hu-Washizu) formulation of
+  ``ThreeFieldVariation``, bulk modulus ``bulk`` (5000 mu by default: a Poisson ratio of
+  0.4999); the scene's Mooney-Rivlin, neo-Hookean or Gent energy on the isochoric
+  invariants (user energies ``W(lambda_s, lambda_theta)`` have no unique 3D form: refused);
+* the rim: pinned at its mid-thickness point (the shell model's simple support);
+* the indenter: rigid and frictionless, the scene's tip on its cylinder, pressed on the
+  surface that faces it (the shell model presses the mid-surface); a penalty on the
+  penetration at Gauss points of that surface with the exact (consistent) tangent;
+* delta: the mid-surface pole's displacement, as in the shell model; each requested delta
+  is reached by a secant iteration on the indenter's position;
+* the force ``F / (mu R_L H)`` (nondimensional as in :func:`shellbvp.curve`).
+
+Needs FElupe (``pip install 'shellbvp[fe]'``).  Nondimensional: mu = 1, R_L = 1.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+__all__ = ["fe_curve", "FECurve", "TipSurface", "FE_DEFAULTS"]
+
+#: Mesh, material and contact settings of :func:`fe_curve` (all nondimensional).
+FE_DEFAULTS = {
+    "through_thickness": 3,     # elements through H
+    "element_length": 0.5,      # meridian element length / H (away from the pole)
+    "pole_refinement": 2,       # elements near the pole this many times shorter (contact zone)
+    "bulk": 5000.0,             # bulk modulus / mu
+    "penalty": 1e4,             # contact penalty * H / mu (penetration ~ pressure H / penalty)
+    "gauss_points": 4,          # per element edge of the contact surface
+    "band": 1e-5,               # the penalty is smoothed over penetrations below band * H
+    "tol": 1e-9,                # Newton: residual norm / contact force
+    "delta_tol": 1e-7,          # secant on the indenter: |delta - target| / max(target, H)
+}
+
+
+def _felupe():
+    try:
+        import felupe
+    except ImportError as exc:  # optional extra
+        raise ImportError("the 3D reference needs FElupe: pip install 'shellbvp[fe]'") from exc
+    return felupe
+
+
+# ---------------------------------------------------------------- the indenter's surface
+class TipSurface:
+    """Signed distance to the rigid indenter (tip ``r = rho A(omega)``, ``z = z_apex + rho B(omega)``
+    joined to the cylinder ``r = rho``) in the meridian plane, with its gradient and Hessian.
+
+    Points are ``(z, r)`` (FElupe's axisymmetric order: axial first).  ``distance(x)`` returns
+    ``(d, n, H)``: ``d < 0`` inside the indenter, ``n = grad d`` (unit, pointing out of the
+    indenter), ``H = grad grad d``.  The sphere is written in closed form; other tips by the
+    closest point on their meridian (Newton in omega).
+    """
+
+    def __init__(self, scene):
+        self.rho = float(scene.rho)
+        self.sphere = scene.tip.description()["kind"] == "sphere"
+        self.omega_max = float(scene.tip_omega_max)
+        if not self.sphere:
+            import sympy as sp
+
+            from symbolic.geometry import OMEGA
+
+            A, B = scene.tip.geometry.A, scene.tip.geometry.B
+            # SymPy expressions parsed by the formula whitelist; lambdify prints them as numpy
+            self._curve = sp.lambdify(OMEGA, [A, B, sp.diff(A, OMEGA), sp.diff(B, OMEGA),
+                                              sp.diff(A, OMEGA, 2), sp.diff(B, OMEGA, 2)], "numpy")
+            om = np.linspace(0.0, self.omega_max, 2001)
+            a, b = (np.broadcast_to(np.asarray(v, float), om.shape) for v in self._curve(om)[:2])
+            self._table = (om, self.rho * a, self.rho * b)
+            self._top = self.rho * float(b[-1])  # where the tip meets the cylinder, above the apex
+
+    def distance(self, x, apex):
+        z, r = x[:, 0] - apex, np.abs(x[:, 1])
+        if self.sphere:
+            return self._capsule(z, r)
+        return self._profile(z, r)
+
+    def _capsule(self, z, r):
+        # points within rho of the half-line {r = 0, z >= rho}: a sphere on its cylinder
+        zc = self.rho
+        above = z > zc
+        vz, vr = np.where(above, 0.0, z - zc), r
+        dist = np.hypot(vz, vr)
+        dist = np.maximum(dist, 1e-300)
+        n = np.stack([vz / dist, vr / dist], axis=1)
+        H = (np.eye(2)[None] - n[:, :, None] * n[:, None, :]) / dist[:, None, None]
+        H[above] = 0.0  # the cylinder is straight in the meridian plane
+        return dist - self.rho, n, H
+
+    def _profile(self, z, r):
+        om, ta, tb = self._table
+        d = np.empty(z.size)
+        n = np.zeros((z.size, 2))
+        H = np.zeros((z.size, 2, 2))
+        on_cyl = z > self._top
+        # cylinder: horizontal distance
+        d[on_cyl] = r[on_cyl] - self.rho
+        n[on_cyl] = [0.0, 1.0]
+        idx = np.flatnonzero(~on_cyl)
+        if idx.size:
+            zz, rr = z[idx], r[idx]
+            k = np.argmin((ta[None, :] - rr[:, None]) ** 2 + (tb[None, :] - zz[:, None]) ** 2, axis=1)
+            w = om[k]
+            for _ in range(30):  # Newton on (p(w) - x) . p'(w) = 0
+                a, b, da, db, dda, ddb = (np.broadcast_to(np.asarray(v, float), w.shape) for v in self._curve(w))
+                pr, pz = self.rho * a - rr, self.rho * b - zz
+                f = pr * da + pz * db
+                fp = self.rho * (da * da + db * db) + pr * dda + pz * ddb
+                step = f / fp
+                w = np.clip(w - step, 0.0, self.omega_max)
+                if np.max(np.abs(step)) < 1e-14:
+                    break
+            a, b, da, db, dda, ddb = (np.broadcast_to(np.asarray(v, float), w.shape) for v in self._curve(w))
+            pr, pz = rr - self.rho * a, zz - self.rho * b
+            dist = np.hypot(pr, pz)
+            # outward normal of the tip (r grows, z falls on the outside): (dB, -dA) in (r, z) / |p'|
+            sp_ = np.hypot(da, db)
+            nr, nz = db / sp_, -da / sp_
+            sign = np.where(pr * nr + pz * nz >= 0, 1.0, -1.0)
+            d[idx] = sign * dist
+            n[idx, 0], n[idx, 1] = nz, nr
+            # curvature of the meridian (positive: convex tip); grad grad d = kappa/(1 + kappa d) t t
+            kappa = (da * ddb - db * dda) / (self.rho * sp_**3)
+            t = np.stack([db / sp_, da / sp_], axis=1)  # (z, r) components of the unit tangent
+            coef = kappa / (1.0 + kappa * d[idx])
+            H[idx] = coef[:, None, None] * t[:, :, None] * t[:, None, :]
+        return d, n, H
+
+
+# ---------------------------------------------------------------- the solid's mesh
+def _meridian(scene, n_table=4001):
+    """Arclength-parametrised reference mid-surface: s -> (R, Z, Phi), with the total length."""
+    mod = scene.model()
+    par = scene.parameters(mod, pole_rise=0.0)
+    S = np.linspace(0.0, scene.shell_length, n_table)
+    ref = mod.reference_shell(S, par)
+    R, Z = np.asarray(ref["R"], float), np.asarray(ref["Z"], float)
+    ds = np.hypot(np.diff(R), np.diff(Z))
+    s = np.concatenate([[0.0], np.cumsum(ds)])
+    # chords of 4000 intervals: the arclength to ~1e-8, nodes placed by linear interpolation
+    return s, R, Z, np.asarray(ref["Phi"], float)
+
+
+def _node_positions(total, h, pole_h, pole_zone):
+    """Meridian nodes of the element corners: length pole_h up to pole_zone, growing to h."""
+    s, x = [0.0], 0.0
+    while x < total - 1e-12:
+        step = pole_h if x < pole_zone else min(h, pole_h * (1 + (x - pole_zone) / max(pole_zone, h)) ** 2)
+        x = min(total, x + step)
+        if total - x < 0.3 * step:  # no sliver at the rim
+            x = total
+        s.append(x)
+    return np.array(s)
+
+
+@dataclass
+class _Model:
+    mesh: object
+    region: object
+    field: object
+    solid: object
+    contact: "_PenaltyContact"
+    fixed: np.ndarray      # constrained dofs of the displacement field
+    pole_mid: int          # the mid-surface pole's point
+    eps: float
+    elements: tuple
+
+
+def _build(scene, eps, *, through_thickness, element_length, pole_refinement, bulk, penalty, gauss_points,
+           band=1e-5):
+    fem = _felupe()
+    s_tab, R_tab, Z_tab, Phi_tab = _meridian(scene)
+    total = s_tab[-1]
+    h = element_length * eps
+    corners = _node_positions(total, h, h / pole_refinement, 4 * eps)
+    n_s, n_t = corners.size - 1, int(through_thickness)
+    # quadratic nodes: element corners plus midpoints, along s and through t
+    s_nodes = np.empty(2 * n_s + 1)
+    s_nodes[0::2] = corners
+    s_nodes[1::2] = 0.5 * (corners[:-1] + corners[1:])
+    t_nodes = np.linspace(-0.5 * eps, 0.5 * eps, 2 * n_t + 1)
+    R, Z, Phi = (np.interp(s_nodes, s_tab, v) for v in (R_tab, Z_tab, Phi_tab))
+    # the unit normal towards the indenter: (r, z) = (-sin Phi, cos Phi)
+    nr, nz = -np.sin(Phi), np.cos(Phi)
+    tt, ss = np.meshgrid(t_nodes, np.arange(s_nodes.size), indexing="ij")
+    points = np.stack([(Z[ss] + tt * nz[ss]).ravel(), (R[ss] + tt * nr[ss]).ravel()], axis=1)
+    points[np.isclose(points[:, 1], 0.0, atol=1e-14), 1] = 0.0
+    ncol = s_nodes.size
+
+    def node(i, j):  # i through the thickness, j along the meridian (quadratic grid)
+        return i * ncol + j
+
+    cells = []
+    for a in range(n_t):
+        for b in range(n_s):
+            i, j = 2 * a, 2 * b
+            # FElupe's quad9: corners counter-clockwise, edge midpoints, centre
+            cells.append([node(i, j), node(i, j + 2), node(i + 2, j + 2), node(i + 2, j),
+                          node(i, j + 1), node(i + 1, j + 2), node(i + 2, j + 1), node(i + 1, j),
+                          node(i + 1, j + 1)])
+    cells = np.array(cells)
+    # FElupe wants counter-clockwise cells in (z, r); (s, t) maps clockwise where the normal turns
+    e = points[cells[0, 1]] - points[cells[0, 0]]
+    f = points[cells[0, 3]] - points[cells[0, 0]]
+    if e[0] * f[1] - e[1] * f[0] < 0:
+        cells = cells[:, [0, 3, 2, 1, 7, 6, 5, 4, 8]]
+    mesh = fem.Mesh(points, cells, cell_type="quad9")
+    region = fem.RegionBiQuadraticQuad(mesh)
+    field = fem.FieldsMixed(region, n=3, axisymmetric=True)
+    solid = fem.SolidBody(fem.NearlyIncompressible(_material(scene, fem), bulk=bulk), field)
+    # boundary: the axis (r = 0) cannot move radially; the rim's mid-thickness point is pinned
+    axis = np.flatnonzero(points[:, 1] == 0.0)
+    rim_mid = node(n_t, ncol - 1)
+    fixed = np.unique(np.concatenate([2 * axis + 1, [2 * rim_mid, 2 * rim_mid + 1]]))
+    top = np.array([node(2 * n_t, j) for j in range(ncol)])  # t = +eps/2: faces the indenter
+    contact = _PenaltyContact(TipSurface(scene), points, top, penalty / eps, gauss_points, field, band * eps)
+    return _Model(mesh, region, field, solid, contact, fixed, node(n_t, 0), eps, (n_s, n_t))
+
+
+def _check_material(scene):
+    if scene.material.description()["family"] not in ("neo-hookean", "mooney-rivlin", "gent"):
+        raise ValueError(f"material: the 3D reference knows Mooney-Rivlin, neo-Hookean and Gent; a user energy "
+                         f"W(lambda_s, lambda_theta) of a sheet has no unique 3D form ({scene.material!r})")
+
+
+def _material(scene, fem):
+    _check_material(scene)
+    family = scene.material.description()["family"]
+    if family == "neo-hookean":
+        return fem.NeoHooke(mu=1.0)
+    import felupe.constitution.tensortrax as mat
+
+    if family == "mooney-rivlin":
+        alpha = scene.material.values()["alpha"]
+        return mat.Hyperelastic(mat.models.hyperelastic.mooney_rivlin, C10=(1 - alpha) / 2, C01=alpha / 2)
+    return mat.Hyperelastic(_gent, Jm=scene.material.values()["Jm"])
+
+
+def _gent(C, Jm):
+    """Gent's energy on the isochoric first invariant, as the shell model's (shear modulus 1)."""
+    from tensortrax.math import log, trace
+    from tensortrax.math.linalg import det
+
+    I1 = det(C) ** (-1 / 3) * trace(C)
+    return -Jm / 2 * log(1 - (I1 - 3) / Jm)
+
+
+class _PenaltyContact:
+    """Frictionless penalty contact of the surface edge ``top`` with the rigid tip.
+
+    Energy ``(k/2) Int psi(-d) dA`` over the reference surface (dA = 2 pi R ds), ``psi(g) ~ g^2``
+    for penetrations g beyond a small band (smoothed inside it), at Gauss points of each
+    quadratic edge; gradient and exact Hessian (the distance's curvature included).
+    """
+
+    def __init__(self, tip, points, top, k, n_gauss, field, band):
+        self.tip, self.k, self.band = tip, k, band
+        self.ndof_u = points.shape[0] * 2
+        self.ndof = int(np.sum(field.fieldsizes))
+        edges = np.stack([top[0:-1:2], top[1::2], top[2::2]], axis=1)  # quadratic edges (3 nodes)
+        xi, w = np.polynomial.legendre.leggauss(n_gauss)
+        N = np.stack([xi * (xi - 1) / 2, 1 - xi**2, xi * (xi + 1) / 2], axis=1)       # (g, 3)
+        dN = np.stack([xi - 0.5, -2 * xi, xi + 0.5], axis=1)
+        X = points[edges]                                                           # (e, 3, 2)
+        Xq = np.einsum("ga,ead->egd", N, X)
+        dX = np.einsum("ga,ead->egd", dN, X)
+        self.weight = (w[None, :] * np.hypot(dX[..., 0], dX[..., 1]) * 2 * np.pi * Xq[..., 1]).ravel()
+        self.edges, self.N = edges, N
+        self.z0 = float(points[top[0], 0])  # the surface's pole: where the tip first touches
+        self.apex = self.z0
+
+    def _at_points(self, u):
+        x = (np.asarray(u).reshape(-1, 2))[self.edges] + self.X_ref
+        xq = np.einsum("ga,ead->egd", self.N, x).reshape(-1, 2)
+        return xq
+
+    def bind(self, points):
+        self.X_ref = points[self.edges]
+
+    def evaluate(self, u, with_matrix=True):
+        from scipy.sparse import coo_matrix
+
+        xq = self._at_points(u)
+        d, n, H = self.tip.distance(xq, self.apex)
+        # penetration g = -d through (k/2) psi(g): g^2 - s g + s^2/3 beyond a band s, g^3/(3 s) in it,
+        # 0 outside -- twice differentiable, so Newton does not chatter as points enter and leave
+        g, s = -d, self.band
+        active = g > 0
+        dpsi = np.where(g >= s, 2 * g - s, np.where(active, g * g / s, 0.0))
+        d2psi = np.where(g >= s, 2.0, np.where(active, 2 * g / s, 0.0))
+        force = -0.5 * self.k * self.weight * dpsi            # (q,) minus the normal force * weight
+        e, ng = self.edges.shape[0], self.N.shape[0]
+        dof = (2 * self.edges[:, None, :, None] + np.arange(2)[None, None, None, :])     # (e, 1, 3, 2)
+        dof = np.broadcast_to(dof, (e, ng, 3, 2)).reshape(-1, 6)
+        Nq = np.broadcast_to(self.N[None], (e, ng, 3)).reshape(-1, 3)
+        vec = (force[:, None, None] * Nq[:, :, None] * n[:, None, :]).reshape(-1, 6)
+        r = np.zeros(self.ndof)
+        np.add.at(r, dof.ravel(), vec.ravel())
+        # the indenter's force: minus the shell's reaction in z, positive pushing down
+        F = float(np.sum(force * n[:, 0]))
+        K = None
+        if with_matrix:
+            kq = 0.5 * self.k * self.weight
+            block = kq[:, None, None] * (d2psi[:, None, None] * n[:, :, None] * n[:, None, :]
+                                         - dpsi[:, None, None] * H)                        # (q, 2, 2)
+            full = np.einsum("qa,qb,qij->qaibj", Nq, Nq, block).reshape(-1, 6, 6)
+            rows = np.broadcast_to(dof[:, :, None], full.shape).ravel()
+            cols = np.broadcast_to(dof[:, None, :], full.shape).ravel()
+            K = coo_matrix((full.ravel(), (rows, cols)), shape=(self.ndof, self.ndof)).tocsr()
+        rq = xq[active, 1]
+        return r, K, F, (float(rq.max()) if rq.size else 0.0)
+
+
+# ---------------------------------------------------------------- Newton and the path
+#: A Newton that can no longer reduce its residual by a line search has met rounding; below
+#: this residual relative to the contact force it is converged (F to about this accuracy).
+STALL = 1e-6
+
+class _Solver:
+    """Newton on the solid + contact at a given apex height, with the state kept for warm starts."""
+
+    def __init__(self, model, tol, max_iterations=15):
+        from scipy.sparse.linalg import splu  # noqa: F401  (checked here: imported in _step)
+
+        self.m, self.tol, self.max_iterations = model, tol, max_iterations
+        ndof = int(np.sum(model.field.fieldsizes))
+        free = np.ones(ndof, bool)
+        free[model.fixed] = False
+        self.free = np.flatnonzero(free)
+        self.newton_iterations = 0
+        self.history = [self.save()]  # converged states (values, indenter) for the predictor
+
+    def save(self):
+        return [f.values.copy() for f in self.m.field.fields], self.indenter
+
+    def restore(self, saved):
+        values, self.indenter = saved
+        for f, v in zip(self.m.field.fields, values):
+            f.values[...] = v
+        self.m.contact.apex = self.m.contact.z0 - self.indenter
+
+    @property
+    def indenter(self):
+        """The indenter's displacement from first touch, positive down."""
+        return self.m.contact.z0 - self.m.contact.apex
+
+    @indenter.setter
+    def indenter(self, a):
+        self.m.contact.apex = self.m.contact.z0 - a
+
+    def _remember(self):
+        self.history = (self.history + [self.save()])[-3:]
+
+    def _predict(self, a):
+        """The secant predictor: the field extrapolated from the two converged states nearest in
+        the indenter's position (without it the tip's step lands as a deep penetration)."""
+        if len(self.history) < 2:
+            return
+        (v0, a0), (v1, a1) = sorted(self.history, key=lambda h: abs(h[1] - a))[:2]
+        if a1 == a0:
+            return
+        t = (a - a1) / (a1 - a0)
+        for f, x0, x1 in zip(self.m.field.fields, v0, v1):
+            f.values[...] = x1 + t * (x1 - x0)
+
+    def _residual(self):
+        m = self.m
+        with np.errstate(invalid="ignore", divide="ignore", over="ignore"):  # trial states may invert
+            r = np.asarray(m.solid.assemble.vector(m.field).todense()).ravel()
+        rc, Kc, F, _ = m.contact.evaluate(m.field[0].values.ravel())
+        return r + rc, rc, Kc, F
+
+    def delta(self):
+        """The mid-surface pole's displacement, positive down."""
+        return -float(self.m.field[0].values[self.m.pole_mid, 0])
+
+    def solve(self, a):
+        """Newton with the indenter at ``a``, from the current state; True when converged (the
+        state kept), else False (the state restored)."""
+        from scipy.sparse.linalg import splu
+
+        m, saved = self.m, self.save()
+        self._predict(a)
+        self.indenter = a
+        r, rc, Kc, F = self._residual()
+        du = np.inf
+        for it in range(self.max_iterations):
+            rf = r[self.free]
+            norm = np.linalg.norm(rf)
+            if not np.isfinite(norm):
+                break
+            # converged: the residual small against the contact force, or (at loads so small that
+            # the residual meets rounding first) a full Newton step that moved nothing
+            if it > 0 and (norm <= self.tol * np.linalg.norm(rc) or du <= 1e-13):
+                self.newton_iterations += it
+                self.force = F
+                self._remember()
+                return True
+            K = (m.solid.assemble.matrix(m.field) + Kc).tocsc()
+            try:
+                dx = splu(K[self.free][:, self.free].tocsc()).solve(-rf)
+            except RuntimeError:  # singular: no equilibrium from here
+                break
+            full = np.zeros(r.size)
+            full[self.free] = dx
+            if not np.all(np.isfinite(full)) or np.max(np.abs(full[: m.contact.ndof_u])) > 0.5:
+                break
+            # backtracking on the residual's norm: contact enters and leaves the active set
+            step, du = 1.0, np.inf
+            for _ in range(8):
+                m.field += step * full
+                r, rc, Kc, F = self._residual()
+                new = np.linalg.norm(r[self.free])
+                if np.isfinite(new) and new <= (1 - 1e-4 * step) * norm:
+                    du = np.max(np.abs(full[: m.contact.ndof_u])) if step == 1.0 else np.inf
+                    break
+                m.field -= step * full
+                step *= 0.5
+            else:
+                r, rc, Kc, F = self._residual()
+                if norm <= STALL * np.linalg.norm(rc):  # stalled at rounding, well converged
+                    self.newton_iterations += it + 1
+                    self.force = F
+                    self._remember()
+                    return True
+                m.field += step * full  # no descent: take the short step and go on
+                r, rc, Kc, F = self._residual()
+        self.restore(saved)
+        return False
+
+    def move(self, a, min_fraction=1e-3):
+        """From the current state to the indenter at ``a``: steps that grow after a success and
+        halve after a failure, down to ``min_fraction`` of the way."""
+        start = self.indenter
+        step = a - start
+        while abs(a - self.indenter) > 1e-15:
+            target = self.indenter + step if abs(a - self.indenter) > abs(step) else a
+            if self.solve(target):
+                step *= 1.5
+            else:
+                step *= 0.5
+                if abs(step) < min_fraction * abs(a - start):
+                    return False
+        return True
+
+
+@dataclass
+class FECurve:
+    """The solid's force-displacement curve (nondimensional like :class:`shellbvp.Curve`).
+
+    Attributes
+    ----------
+    scene : Scene
+    thickness : float
+        eps = H / R_L.
+    delta : ndarray
+        Mid-surface pole displacement (the shell model's delta).
+    force : ndarray
+        Indenter force / (mu R_L H).
+    indenter : ndarray
+        The indenter's displacement from first touch.
+    contact_radius : ndarray
+        Radius of the outermost surface point in contact (deformed), / R_L.
+    mesh_error : ndarray
+        ``|F - F_coarse| / F``: the force on a mesh with 2/3 the elements each way (NaN unless
+        ``mesh_check``); quadratic elements converge at least like h^2, so this bounds the
+        fine mesh's error by about 1.25x itself.
+    success : bool
+    message : str
+    elements : tuple
+        Elements along the meridian and through the thickness.
+    settings : dict
+    wall_time : float
+
+    Examples
+    --------
+    >>> import numpy as np, shellbvp as sb
+    >>> c = sb.fe_curve(sb.Scene.preset("base", material=sb.NeoHookean()), thickness=0.1, deltas=[0.05, 0.1])
+    >>> c.success, c.elements                     # elements along the meridian, through H
+    (True, (41, 3))
+    >>> print(np.round(c.indenter, 3))            # the indenter goes deeper: the wall thins under it
+    [0.052 0.103]
+    """
+
+    scene: object
+    thickness: float
+    delta: np.ndarray
+    force: np.ndarray
+    indenter: np.ndarray
+    contact_radius: np.ndarray
+    mesh_error: np.ndarray
+    success: bool
+    message: str
+    elements: tuple
+    settings: dict = field(default_factory=dict)
+    wall_time: float = 0.0
+
+    def summary(self) -> str:
+        ok = np.isfinite(self.force)
+        return (f"FE, eps {self.thickness:g}: {int(ok.sum())} of {self.delta.size} depths, "
+                f"{self.elements[0]}x{self.elements[1]} elements, {self.wall_time:.1f} s; {self.message}")
+
+
+def fe_curve(scene, thickness, deltas, *, mesh_check=False, progress=None, **settings) -> FECurve:
+    """Indent the scene's shell as a 3D axisymmetric solid of thickness ``eps`` (FElupe).
+
+    Parameters
+    ----------
+    scene : Scene
+        Shell, indenter and material (Mooney-Rivlin, neo-Hookean or Gent); beta, xi, the
+        bending energy and the contact model are the shell model's and play no part here.
+        Pressurised scenes are refused.
+    thickness : float
+        eps = H / R_L, in (0, 0.5].
+    deltas : array_like
+        Mid-surface pole displacements, increasing, > 0.
+    mesh_check : bool
+        Also solve on a mesh with 2/3 the elements each way and report the difference
+        (``mesh_error``).
+    progress : callable, optional
+        Called as ``progress(i, delta, force)`` after each depth.
+    **settings
+        Override :data:`FE_DEFAULTS`.
+
+    Returns
+    -------
+    FECurve
+        Depths not reached are NaN, with ``success`` False and a message saying where it stopped.
+
+    Examples
+    --------
+    >>> import numpy as np, shellbvp as sb
+    >>> scene = sb.Scene.preset("base", material=sb.NeoHookean())
+    >>> c = sb.fe_curve(scene, thickness=0.1, deltas=[0.05, 0.1])
+    >>> print(np.round(c.force, 4))               # F / (mu R_L H) of the 3D solid
+    [0.0354 0.0886]
+    """
+    t0 = time.perf_counter()
+    eps = float(thickness)
+    if not (math.isfinite(eps) and 0 < eps <= 0.5):
+        raise ValueError(f"thickness (H / R_L) must be in (0, 0.5]; got {thickness!r}")
+    deltas = np.atleast_1d(np.asarray(deltas, dtype=float))
+    if deltas.size == 0 or not np.all(np.isfinite(deltas)) or np.any(deltas <= 0) or np.any(np.diff(deltas) <= 0):
+        raise ValueError("deltas must be finite, > 0 and increasing")
+    if scene.pressurised:
+        raise ValueError("pressure: the 3D reference has no internal pressure yet; use a scene with pressure 0")
+    _check_material(scene)
+    unknown = set(settings) - set(FE_DEFAULTS)
+    if unknown:
+        raise ValueError(f"unknown FE setting(s) {sorted(unknown)}; known: {sorted(FE_DEFAULTS)}")
+    opts = {**FE_DEFAULTS, **settings}
+    F, apex, rc, ok, msg, elements = _path(scene, eps, deltas, opts, progress)
+    err = np.full(deltas.size, np.nan)
+    if mesh_check:
+        coarse = {**opts, "element_length": opts["element_length"] * 1.5,
+                  "through_thickness": max(2, round(opts["through_thickness"] * 2 / 3))}
+        Fc = _path(scene, eps, deltas, coarse, None)[0]
+        err = np.abs(F - Fc) / np.abs(F)
+    return FECurve(scene, eps, deltas, F, apex, rc, err, ok, msg, elements,
+                   settings=opts, wall_time=time.perf_counter() - t0)
+
+
+def _path(scene, eps, deltas, opts, progress):
+    model = _build(scene, eps, through_thickness=opts["through_thickness"],
+                      element_length=opts["element_length"], pole_refinement=opts["pole_refinement"],
+                      bulk=opts["bulk"], penalty=opts["penalty"], gauss_points=opts["gauss_points"],
+                      band=opts["band"])
+    model.contact.bind(model.mesh.points)
+    solver = _Solver(model, opts["tol"])
+    n = deltas.size
+    F, apex, rc = (np.full(n, np.nan) for _ in range(3))
+    done_delta, done_apex, slope = 0.0, 0.0, 1.0
+    step = 0.5 * eps
+    if solver.move(min(0.02 * eps, 0.5 * deltas[0])):  # a first touch: the predictor's second state
+        done_delta, done_apex = solver.delta(), solver.indenter
+        slope = done_apex / max(done_delta, 1e-15)
+    for i, target in enumerate(deltas):
+        # march towards the target in steps the Newton can take, then a secant on the apex
+        while target - done_delta > 1.5 * step:
+            a = done_apex + slope * step
+            if not solver.move(a):
+                return F, apex, rc, False, f"no equilibrium beyond delta = {done_delta:.4g}", model.elements
+            d = solver.delta()
+            slope = (a - done_apex) / max(d - done_delta, 1e-12)
+            done_delta, done_apex = d, a
+            step = min(1.5 * step, 0.25 * max(d, eps) + 0.5 * eps)
+        tol = opts["delta_tol"] * max(target, eps)
+        a = done_apex + slope * (target - done_delta)
+        points = [(done_apex, done_delta)]
+        for _ in range(12):
+            base = solver.save()
+            if not solver.move(a):
+                return F, apex, rc, False, f"no equilibrium at delta = {target:.4g}", model.elements
+            d = solver.delta()
+            if abs(d - target) <= tol:
+                break
+            points.append((a, d))
+            (a0, d0), (a1, d1) = points[-2], points[-1]
+            slope = (a1 - a0) / (d1 - d0) if d1 != d0 else slope
+            a = a1 + slope * (target - d1)
+            solver.restore(base) if abs(d - target) > abs(points[-2][1] - target) else None
+        else:
+            return F, apex, rc, False, f"the secant on the indenter did not reach delta = {target:.4g}", model.elements
+        _, _, F_i, rc_i = model.contact.evaluate(model.field[0].values.ravel(), with_matrix=False)
+        F[i], apex[i], rc[i] = F_i / eps, a, rc_i
+        if done_delta > 0 and d != done_delta:
+            slope = (a - done_apex) / (d - done_delta)
+        done_delta, done_apex = d, a
+        if progress is not None:
+            progress(i, target, F[i])
+    return F, apex, rc, True, "all requested depths computed", model.elements

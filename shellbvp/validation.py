@@ -1,0 +1,192 @@
+"""The shell model against the 3D solid it stands for: one scene, one thickness.
+
+:func:`validate` computes the shell model's curve (beta from the thickness) and the 3D
+finite-element reference (:func:`shellbvp.fe.fe_curve`) at the same pole displacements and
+reports ``F_shell / F_FE - 1`` at each: the model's error for this scene, which is
+O(eps) (``docs/accuracy.md``).  ``shellbvp validate`` is the command line of it.
+"""
+
+from __future__ import annotations
+
+import datetime as _dt
+import json
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+__all__ = ["validate", "Validation", "default_depths", "FORMAT"]
+
+FORMAT = "shellbvp-validation"
+FORMAT_VERSION = 1
+#: Depths of a validation, in units of the thickness (delta / H).
+DEPTHS_PER_THICKNESS = (0.25, 0.5, 1.0, 2.0, 5.0, 10.0, 25.0)
+
+
+def default_depths(thickness: float, delta_max: float) -> np.ndarray:
+    """delta / H in :data:`DEPTHS_PER_THICKNESS` up to ``delta_max``, and ``delta_max`` itself."""
+    d = np.array([k * thickness for k in DEPTHS_PER_THICKNESS if k * thickness < delta_max * (1 - 1e-9)])
+    return np.append(d, delta_max)
+
+
+@dataclass
+class Validation:
+    """The shell model and the 3D solid at the same depths.
+
+    Attributes
+    ----------
+    scene : Scene
+        With ``thickness`` set (beta from it unless given and equal).
+    shell : Curve
+        The shell model's curve at ``delta``.
+    fe : FECurve
+        The 3D reference at ``delta``.
+    delta, force_shell, force_fe, error : ndarray
+        ``error = F_shell / F_FE - 1`` (NaN where either is missing).
+
+    Examples
+    --------
+    >>> import shellbvp as sb
+    >>> v = sb.validate(sb.Scene.preset("base", material=sb.NeoHookean()), thickness=0.1, deltas=[0.1])
+    >>> print(v.table())
+        delta  delta/H     F_shell        F_FE    error  FE mesh
+          0.1        1     0.10418    0.088595  +17.59%        -
+    """
+
+    scene: object
+    shell: object
+    fe: object
+
+    @property
+    def delta(self):
+        return self.fe.delta
+
+    @property
+    def force_fe(self):
+        return self.fe.force
+
+    @property
+    def force_shell(self):
+        d, f = np.asarray(self.shell.points["delta"], float), np.asarray(self.shell.points["force"], float)
+        out = np.full(self.delta.size, np.nan)
+        for i, x in enumerate(self.delta):
+            j = np.flatnonzero(np.isclose(d, x, rtol=1e-9, atol=1e-12))
+            if j.size:
+                out[i] = f[j[0]]
+        return out
+
+    @property
+    def error(self):
+        return self.force_shell / self.force_fe - 1
+
+    def table(self) -> str:
+        """The comparison as aligned text, one depth a line."""
+        eps = self.scene.thickness
+        lines = [f"{'delta':>9} {'delta/H':>8} {'F_shell':>11} {'F_FE':>11} {'error':>8} {'FE mesh':>8}"]
+        for d, fs, ff, e, m in zip(self.delta, self.force_shell, self.force_fe, self.error, self.fe.mesh_error):
+            mesh = f"{100 * m:7.2f}%" if np.isfinite(m) else f"{'-':>8}"
+            err = f"{100 * e:+7.2f}%" if np.isfinite(e) else f"{'-':>8}"
+            lines.append(f"{d:9.4g} {d / eps:8.3g} {fs:11.5g} {ff:11.5g} {err} {mesh}")
+        return "\n".join(lines)
+
+    def to_hdf5(self, path, *, overwrite: bool = False):
+        """Both curves and the comparison in one NeXus file, written atomically.
+
+        Layout: ``/entry`` (NXentry) with ``comparison`` (NXdata: delta, force_shell, force_fe,
+        error; the default plot), ``shell`` (the shell model's curve as in a curve file) and
+        ``fe`` (NXdata: delta, force, indenter, contact_radius, mesh_error; the FE settings).
+        """
+        import h5py
+
+        from .io import write_curve_group
+        from .nexus import label_units, number_dataset
+        from .paths import atomic_file, check_output_path
+        from .version import __version__
+
+        path = Path(path)
+        if path.exists() and not overwrite:
+            raise FileExistsError(f"{path} exists; pass overwrite=True (CLI: --force) to replace it")
+        check_output_path(path, overwrite=True)
+        with atomic_file(path) as tmp:
+            with h5py.File(tmp, "w") as f:
+                f.attrs["format"] = FORMAT
+                f.attrs["format_version"] = FORMAT_VERSION
+                f.attrs["package_version"] = __version__
+                f.attrs["created"] = _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds")
+                f.attrs["default"] = "entry"
+                entry = f.create_group("entry")
+                entry.attrs["NX_class"] = "NXentry"
+                entry.attrs["default"] = "comparison"
+                entry.attrs["thickness"] = float(self.scene.thickness)
+                cmp_ = entry.create_group("comparison")
+                cmp_.attrs.update({"NX_class": "NXdata", "signal": "error", "axes": "delta"})
+                number_dataset(cmp_, "delta", self.delta, "1", "mid-surface pole displacement / R_L")
+                number_dataset(cmp_, "force_shell", self.force_shell, "1", "shell model's F / (mu H R_L)")
+                number_dataset(cmp_, "force_fe", self.force_fe, "1", "3D solid's F / (mu H R_L)")
+                number_dataset(cmp_, "error", self.error, "1", "F_shell / F_FE - 1")
+                write_curve_group(entry.create_group("shell"), self.shell)
+                fe = entry.create_group("fe")
+                fe.attrs.update({"NX_class": "NXdata", "signal": "force", "axes": "delta",
+                                 "success": bool(self.fe.success), "message": self.fe.message,
+                                 "elements": np.asarray(self.fe.elements),
+                                 "settings": json.dumps(self.fe.settings, sort_keys=True),
+                                 "wall_time_s": float(self.fe.wall_time)})
+                number_dataset(fe, "delta", self.fe.delta, "1", "mid-surface pole displacement / R_L")
+                number_dataset(fe, "force", self.fe.force, "1", "indenter force F / (mu H R_L)")
+                number_dataset(fe, "indenter", self.fe.indenter, "1", "indenter displacement / R_L")
+                number_dataset(fe, "contact_radius", self.fe.contact_radius, "1",
+                               "radius of the outermost contact point / R_L")
+                number_dataset(fe, "mesh_error", self.fe.mesh_error, "1",
+                               "|F - F on a mesh with 2/3 the elements| / F")
+            label_units(tmp)
+
+
+def validate(scene, thickness=None, deltas=None, *, delta_max=0.5, mesh_check=False, progress=None,
+             tol=1e-6, **fe_settings) -> Validation:
+    """The shell model's error for ``scene`` at thickness ``eps``: both curves at the same depths.
+
+    Parameters
+    ----------
+    scene : Scene
+        Its ``thickness`` is used when ``thickness`` is not given; beta comes from the thickness.
+    thickness : float, optional
+        eps = H / R_L in (0, 0.5].
+    deltas : array_like, optional
+        Mid-surface pole displacements; default :func:`default_depths` up to ``delta_max``.
+    mesh_check : bool
+        Also solve the 3D model on a coarser mesh (``FECurve.mesh_error``).
+    progress : callable, optional
+        ``progress(i, delta, F_FE)`` after each FE depth.
+    tol : float
+        The shell model's collocation tolerance.
+    **fe_settings
+        :data:`shellbvp.fe.FE_DEFAULTS` overrides.
+
+    Returns
+    -------
+    Validation
+        The shell model's curve, the 3D curve and ``error = F_shell / F_FE - 1``.
+
+    Examples
+    --------
+    >>> import shellbvp as sb
+    >>> v = sb.validate(sb.Scene.preset("base", material=sb.NeoHookean()), thickness=0.1, deltas=[0.05, 0.1])
+    >>> print(f"{v.error[-1]:+.3f}")             # the shell model 18 % stiffer at delta = H, eps = 0.1
+    +0.176
+    """
+    from .continuation import curve
+    from .fe import fe_curve
+
+    if thickness is not None:
+        scene = scene.replace(thickness=thickness)
+    if scene.thickness is None:
+        raise ValueError("thickness: give the shell's thickness eps = H / R_L (or a scene with one)")
+    eps = scene.thickness
+    if deltas is None:
+        if not (np.isfinite(delta_max) and 0 < delta_max <= 2):
+            raise ValueError(f"delta_max must be in (0, 2]; got {delta_max!r}")
+        deltas = default_depths(eps, delta_max)
+    deltas = np.asarray(deltas, dtype=float)
+    fe = fe_curve(scene, eps, deltas, mesh_check=mesh_check, progress=progress, **fe_settings)
+    shell = curve(scene, deltas=deltas, tol=tol, estimate_error=False)
+    return Validation(scene, shell, fe)
