@@ -264,10 +264,12 @@ class FitResult:
                 "baseline_model": self.baseline_model, "baseline": num(self.baseline),
                 "baseline_ci95": ci(self.baseline_ci95), "baseline_slope": num(self.baseline_slope),
                 "baseline_slope_ci95": ci(self.baseline_slope_ci95),
+                "thickness": None if self.thickness is None else num(self.thickness), "mu": None if self.mu is None
+                else num(self.mu), "mu_ci95": ci(self.mu_ci95),
                 "units": {"mu_H": "N/m (= um*MPa)", "offset": "m", "residual": "N (rms)",
                           "residual_rms": "N", "R_L": "m", "beta": "1 (B/(mu R_L^2))", "alpha": "1",
                           "pressure": "1 (p R_L/(mu H))", "pressure_Pa": "Pa",
-                          "baseline": "N", "baseline_slope": "N/m"}}
+                          "baseline": "N", "baseline_slope": "N/m", "thickness": "m", "mu": "Pa"}}
 
 
 # -- model curves ------------------------------------------------------------------------------

@@ -198,6 +198,11 @@ def fit_summary_lines(record):
         lines.append(f"{name} = {p[name]:.5g} {units.get(name, '')}   95% CI [{lo:.5g}, {hi:.5g}]")
     lines.append(f"rms residual = {p['residual_rms']:.4g} N; R_L = {p['R_L']:.4g} m")
     s = record.scene
+    if s.thickness is not None and "beta" not in record.fitted:
+        H = s.thickness * p["R_L"]
+        lo, hi = iv["mu_H"]
+        lines.append(f"mu = {p['mu_H'] / H / 1e6:.5g} MPa   95% CI [{lo / H / 1e6:.5g}, {hi / H / 1e6:.5g}] "
+                     f"(thickness H = {H * 1e6:.4g} um, eps = {s.thickness:.3g}; the model's own error is O(eps))")
     lines.append(f"scene: {scene_label(s)}")
     lines += [f"warning: {w}" for w in record.warnings] or ["warnings: none"]
     lines.append(f"shellbvp {record.version}; {record.message}")
