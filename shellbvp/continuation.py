@@ -80,7 +80,7 @@ def curve(scene, delta_max: float = 0.5, *, deltas=None, force_max=None, lambda0
         solve_bvp settings for every point (see :func:`solve`).
     ds_max : float, optional
         Largest arclength step in (delta, lambda0, F) (default ``delta_max/10``).  A step
-        that would turn the plotted curve (delta / delta_max, F / its largest |F|) by more
+        that would turn the plotted curve (``delta / delta_max``, ``F / max |F|``) by more
         than ``MAX_PLOT_TURN`` is halved, so that a force maximum is resolved whatever
         the scale of F.
     estimate_error : {"auto", "full", False}
@@ -1037,7 +1037,7 @@ FIRST_STEP = 2.0
 
 
 #: The adaptive curve's steps also follow the force-displacement curve as it is plotted, on axes
-#: (delta / delta_max, F / the largest |F| so far): a step whose chord turns by more than
+#: (``delta / delta_max``, ``F / max |F|`` so far): a step whose chord turns by more than
 #: MAX_PLOT_TURN (radians) from the previous chord is refused and halved, down to PLOT_TURN_MIN_DS
 #: times ds_max.  The arclength itself is measured in (delta, lambda0, F), in which a shell whose
 #: F is small (a thin dome: F ~ 1e-4) shows no turn where its force peaks: the dome's arclength
