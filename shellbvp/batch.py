@@ -20,6 +20,8 @@ from pathlib import Path
 
 import numpy as np
 
+from .textdata import table_cell
+
 log = logging.getLogger(__name__)
 
 __all__ = ["BatchRow", "fit_files", "expand_inputs", "write_table", "TABLE_COLUMNS", "DATA_SUFFIXES"]
@@ -62,7 +64,9 @@ class BatchRow:
     def table_row(self, segment: str) -> dict:
         """This file's row of the results table (:data:`TABLE_COLUMNS`)."""
         row = dict.fromkeys(TABLE_COLUMNS, "")
-        row.update({"file": self.file, "status": self.status, "segment": segment, "message": self.message})
+        # names and messages are text from files: escaped for terminals and spreadsheets
+        row.update({"file": table_cell(self.file), "status": self.status, "segment": segment,
+                    "message": table_cell(self.message)})
         if self.record is not None:
             row["sha256"] = self.record.sha256
         r = self.result

@@ -99,6 +99,14 @@ def _pressure(text):
         raise argparse.ArgumentTypeError(str(exc)) from None
 
 
+def _say(line=""):
+    """Print a line that may hold text from a file or a user: control characters escaped
+    (shellbvp.textdata), so that a file cannot drive the terminal or forge a result line."""
+    from .textdata import printable
+
+    print(printable(line))
+
+
 def _thickness(text):
     """argparse type: eps = H / R_L as a plain number, or the thickness with its unit (``50um``)."""
     from .units import Quantity, plain_number, split_quantity
@@ -552,7 +560,7 @@ def _fit_batch(args, files):
                     text += f"  ({len(r.result.warnings)} warning{'s' * (len(r.result.warnings) > 1)})"
             else:
                 text = r.message
-            print(f"{r.file:<{width}}  {r.status:<6s}  {text}")
+            _say(f"{r.file:<{width}}  {r.status:<6s}  {text}")
         n_ok = sum(r.status == "ok" for r in rows)
         print(f"{n_ok} of {len(rows)} files fitted" + (f"; table: {args.table}" if args.table else ""))
     return 0 if ok else 1
@@ -591,47 +599,47 @@ def _print_fit(res, record, used, args):
 
     du, fu = record.units["displacement"], record.units["force"]
     if not res.success:
-        print(f"fit failed (status {res.status}): {res.message}")
+        _say(f"fit failed (status {res.status}): {res.message}")
     counts = ", ".join(f"{k} {v}" for k, v in record.counts().items())
     name = Path(record.path).name if args.example else record.path
-    print(f"data   = {name}: {len(record)} rows ({counts}); fitted the {args.segment} segment, "
+    _say(f"data   = {name}: {len(record)} rows ({counts}); fitted the {args.segment} segment, "
           f"{int(used.sum())} rows")
     lo, hi = res.mu_H_ci95
-    print(f"mu*H   = {res.mu_H:.4g} N/m (um*MPa)   95% CI [{lo:.4g}, {hi:.4g}]")
+    _say(f"mu*H   = {res.mu_H:.4g} N/m (um*MPa)   95% CI [{lo:.4g}, {hi:.4g}]")
     if res.mu is not None:
         eps = res.scene.thickness
         m1, m2 = res.mu_ci95
-        print(f"mu     = {res.mu / 1e6:.4g} MPa   95% CI [{m1 / 1e6:.4g}, {m2 / 1e6:.4g}] (H = "
+        _say(f"mu     = {res.mu / 1e6:.4g} MPa   95% CI [{m1 / 1e6:.4g}, {m2 / 1e6:.4g}] (H = "
               f"{format_in(res.thickness, 'um', 'length')}, eps = H/R_L = {eps:.3g}, beta = eps^2/3)")
-        print(f"model  = beside this interval, the shell model's own error, O(eps): measured 2-3 eps too stiff "
+        _say(f"model  = beside this interval, the shell model's own error, O(eps): measured 2-3 eps too stiff "
               f"at depths <= H on a hemisphere (eps <= 0.1; docs: How accurate is the shell model?); "
               f"`shellbvp validate` with these options measures it for this scene")
     show = (lambda v, unit, kind: format_in(v, unit, kind).split(" ")[0])
     if "offset" in res.fitted:
         o1, o2 = res.offset_ci95
-        print(f"offset = {format_in(res.offset, du, 'length')}   95% CI [{show(o1, du, 'length')}, "
+        _say(f"offset = {format_in(res.offset, du, 'length')}   95% CI [{show(o1, du, 'length')}, "
               f"{show(o2, du, 'length')}] {du} (the contact point)")
     if res.baseline_model != "none":
         b1, b2 = res.baseline_ci95
-        print(f"baseline = {format_in(res.baseline, fu, 'force')}   95% CI [{show(b1, fu, 'force')}, "
+        _say(f"baseline = {format_in(res.baseline, fu, 'force')}   95% CI [{show(b1, fu, 'force')}, "
               f"{show(b2, fu, 'force')}] {fu} ({res.baseline_model})")
     if res.baseline_model == "linear":
         s1, s2 = res.baseline_slope_ci95
-        print(f"baseline slope = {res.baseline_slope:.4g} N/m   95% CI [{s1:.4g}, {s2:.4g}]")
+        _say(f"baseline slope = {res.baseline_slope:.4g} N/m   95% CI [{s1:.4g}, {s2:.4g}]")
     for name in ("beta", "alpha", "pressure"):
         if name in res.fitted:
             v, (c1, c2) = getattr(res, name), getattr(res, name + "_ci95")
-            print(f"{name:<6s} = {v:.4g}   95% CI [{c1:.4g}, {c2:.4g}] (profile likelihood; "
+            _say(f"{name:<6s} = {v:.4g}   95% CI [{c1:.4g}, {c2:.4g}] (profile likelihood; "
                   f"{res.curves_computed} model curves)" + ("; nondimensional p R_L/(mu H)" if name == "pressure"
                                                             else ""))
     if "pressure" in res.fitted:
         (c1, c2) = res.pressure_Pa_ci95
-        print(f"p      = {res.pressure_Pa / 1e3:.4g} kPa   95% CI [{c1 / 1e3:.4g}, {c2 / 1e3:.4g}] "
+        _say(f"p      = {res.pressure_Pa / 1e3:.4g} kPa   95% CI [{c1 / 1e3:.4g}, {c2 / 1e3:.4g}] "
               f"(p mu_H/R_L; linearised)")
-    print(f"rms residual = {format_in(res.residual_rms, fu, 'force')} over {res.n} points; R_L = "
+    _say(f"rms residual = {format_in(res.residual_rms, fu, 'force')} over {res.n} points; R_L = "
           f"{args.radius}; {res.weights} weights")
     for text in res.warnings:
-        print(f"warning: {text}")
+        _say(f"warning: {text}")
 
 
 def _check_report_path(path, overwrite):
@@ -779,26 +787,26 @@ def _sweep_info(path):
 
     sw = read_sweep(path)
     s = sw.base_scene
-    print(f"file:      {path} (shellbvp sweep)")
-    print(f"base:      gamma={s.gamma:g} rho={s.rho:g} beta={s.beta:g} xi={s.xi} contact={s.contact} "
+    _say(f"file:      {path} (shellbvp sweep)")
+    _say(f"base:      gamma={s.gamma:g} rho={s.rho:g} beta={s.beta:g} xi={s.xi} contact={s.contact} "
           f"material={s.material!r}")
     for name in sw.parameters:
-        print(f"sweeps:    {name} = {', '.join(f'{v:g}' for v in sw.values[name])}")
-    print(f"settings:  delta_max={sw.delta_max:g} {json.dumps(sw.settings, sort_keys=True)}")
+        _say(f"sweeps:    {name} = {', '.join(f'{v:g}' for v in sw.values[name])}")
+    _say(f"settings:  delta_max={sw.delta_max:g} {json.dumps(sw.settings, sort_keys=True)}")
     counts = ", ".join(f"{v} {k}" for k, v in sw.counts().items())
     wall = np.asarray(sw.index["wall_time"], float)
     done = np.isfinite(wall)
-    print(f"curves:    {len(sw.index['status'])} combinations: {counts}")
+    _say(f"curves:    {len(sw.index['status'])} combinations: {counts}")
     if np.any(done):
-        print(f"time:      {np.sum(wall[done]):.1f} s of curves in workers; slowest {np.max(wall[done]):.1f} s, "
+        _say(f"time:      {np.sum(wall[done]):.1f} s of curves in workers; slowest {np.max(wall[done]):.1f} s, "
               f"median {np.median(wall[done]):.1f} s")
     head = " ".join(f"{n:>10s}" for n in sw.parameters)
-    print(f"{head} {'status':>9s} {'points':>6s} {'delta_end':>9s} {'F_end':>10s} {'time(s)':>8s}  stop reason")
+    _say(f"{head} {'status':>9s} {'points':>6s} {'delta_end':>9s} {'F_end':>10s} {'time(s)':>8s}  stop reason")
     for i, st in enumerate(sw.index["status"]):
         c = sw.curves.get(i)
         end = (f"{c.delta[-1]:9.4g} {c.force[-1]:10.5g}" if c is not None and len(c) else f"{'':9s} {'':10s}")
         why = sw.index["stop_reason"][i] or sw.index["message"][i]
-        print(" ".join(f"{sw.index[n][i]:10.5g}" for n in sw.parameters)
+        _say(" ".join(f"{sw.index[n][i]:10.5g}" for n in sw.parameters)
               + f" {st:>9s} {int(sw.index['points'][i]):6d} {end} {float(sw.index['wall_time'][i]):8.2f}  {why}")
     return 0
 
@@ -821,31 +829,31 @@ def _cmd_info(args):
     if is_fit_file(args.file):
         from .plotting import fit_summary_lines
 
-        print(f"file:      {args.file} (a fit)")
+        _say(f"file:      {args.file} (a fit)")
         for line in fit_summary_lines(read_fit(args.file)):
-            print(f"  {line}")
+            _say(f"  {line}")
         return 0
     if os.path.isfile(args.file) and is_sweep_file(args.file):
         return _sweep_info(args.file)
     c = read_curve(args.file)
     s = c.scene
     mat = s.material
-    print(f"file:      {args.file} (shellbvp {c.version})")
-    print(f"scene:     gamma={s.gamma:g} rho={s.rho:g} beta={s.beta:g} xi={s.xi} contact={s.contact} "
+    _say(f"file:      {args.file} (shellbvp {c.version})")
+    _say(f"scene:     gamma={s.gamma:g} rho={s.rho:g} beta={s.beta:g} xi={s.xi} contact={s.contact} "
           f"material={mat!r} bending={s.bending!r} shell={s.shell!r} tip={s.tip!r}"
           + (f" pressure={s.pressure:g} (delta from the inflated pole)" if s.pressure else "")
           + (" sealed (volume control: the pressure is per point)" if s.sealed else ""))
-    print(f"curve:     {c.summary()}")
-    print(f"complete:  {c.complete}  interrupted: {c.interrupted}")
+    _say(f"curve:     {c.summary()}")
+    _say(f"complete:  {c.complete}  interrupted: {c.interrupted}")
     res = c.energy_residual
     if np.any(np.isfinite(res)):
-        print(f"energy identity: max |dE/ddelta - F| = {np.nanmax(np.abs(res)):.3g}")
+        _say(f"energy identity: max |dE/ddelta - F| = {np.nanmax(np.abs(res)):.3g}")
     if len(c):
-        print(f"topology:  {c.topology_summary()}")
-        print(f"{'delta':>10s} {'force':>12s} {'lambda0':>9s} {'S1':>10s} {'Sc':>10s} {'topology':>8s} "
+        _say(f"topology:  {c.topology_summary()}")
+        _say(f"{'delta':>10s} {'force':>12s} {'lambda0':>9s} {'S1':>10s} {'Sc':>10s} {'topology':>8s} "
               f"{'status':>6s} {'valid':>5s}" + (f" {'pressure':>10s}" if s.sealed else ""))
         for i in range(len(c)):
-            print(f"{c.delta[i]:10.5f} {c.force[i]:12.6g} {c.lambda0[i]:9.5f} {c.S1[i]:10.4g} {c.Sc[i]:10.4g} "
+            _say(f"{c.delta[i]:10.5f} {c.force[i]:12.6g} {c.lambda0[i]:9.5f} {c.S1[i]:10.4g} {c.Sc[i]:10.4g} "
                   f"{c.topology[i]:>8s} {int(c.status[i]):6d} {str(bool(c.valid[i])):>5s}"
                   + (f" {c.points['pressure'][i]:10.5g}" if s.sealed else ""))
     return 0
@@ -1082,7 +1090,9 @@ def main(argv=None):
     except (ValueError, FileExistsError) as exc:
         if getattr(args, "json", False):
             _print_json_error(exc)
-        print(f"shellbvp: error: {' '.join(str(exc).split())}", file=sys.stderr)  # one line, always
+        from .textdata import printable
+
+        print(f"shellbvp: error: {printable(' '.join(str(exc).split()))}", file=sys.stderr)  # one line, always
         return 2
     except KeyboardInterrupt:
         print("shellbvp: interrupted", file=sys.stderr)

@@ -10,6 +10,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from .textdata import printable
+
 __all__ = ["plot_curves", "plot_profiles", "plot_fit", "plot_fit_record", "fit_report", "fit_summary_lines",
            "require_matplotlib", "scene_label", "save_figure"]
 
@@ -88,7 +90,7 @@ def plot_profiles(scene, deltas, ax=None, solutions=None):
     ax.set_aspect("equal")
     ax.set_xlabel("r / R_L")
     ax.set_ylabel("z / R_L")
-    ax.set_title(scene_label(scene), fontsize=7)
+    ax.set_title(printable(scene_label(scene)), fontsize=7)
     ax.legend(fontsize=7)
     return ax
 
@@ -172,7 +174,7 @@ def plot_fit_record(record, axes=None):
         ax.axvline(p["offset"], color="0.5", lw=0.6, ls=":", label="contact point")
     _si_axis(ax, "y", "N")
     ax.set_ylabel("force")
-    ax.set_title(f"{record.source['file_name'].split('/')[-1]}: {'fit' if record.success else 'FAILED fit'}",
+    ax.set_title(f"{printable(record.source['file_name'].split('/')[-1])}: {'fit' if record.success else 'FAILED fit'}",
                  fontsize=9)
     ax.legend(fontsize=7)
     axr.axhline(0, color="0.6", lw=0.6)
@@ -206,7 +208,7 @@ def fit_summary_lines(record):
     lines.append(f"scene: {scene_label(s)}")
     lines += [f"warning: {w}" for w in record.warnings] or ["warnings: none"]
     lines.append(f"shellbvp {record.version}; {record.message}")
-    return lines
+    return [printable(line) for line in lines]  # text from the file: shown, never obeyed
 
 
 def fit_report(record, path):

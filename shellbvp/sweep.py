@@ -35,6 +35,7 @@ from __future__ import annotations
 import contextlib
 import datetime as _dt
 import inspect
+import glob
 import itertools
 import json
 import logging
@@ -533,7 +534,9 @@ class _Writer:
         """Write the metadata and the index (every combination pending or as found)."""
         if self.path is None:
             return
-        for debris in self.path.parent.glob(f".{self.path.name}.*.tmp"):  # of a killed writer (we hold the lock)
+        # a killed writer's temporary files (we hold the lock); the name is escaped: run[12].h5 is
+        # a name, not a pattern that matches other writers' files
+        for debris in self.path.parent.glob(f".{glob.escape(self.path.name)}.*.tmp"):
             debris.unlink(missing_ok=True)
 
         def edit(f):

@@ -1,0 +1,67 @@
+"""Text from files is data (issue 42): escapes, not terminal control; cells, not formulas."""
+
+import csv
+
+import numpy as np
+import pytest
+
+import shellbvp as sb
+from shellbvp.cli import main
+from shellbvp.textdata import printable, table_cell
+
+HOSTILE = "ok\x1b[2J\x1b[1;1Hmu*H = 1 N/m\u202e\x07\r\n\x9b"
+
+
+def test_printable_escapes_every_control_and_format_character():
+    out = printable(HOSTILE)
+    assert not any(ord(c) < 0x20 or 0x7f <= ord(c) < 0xa0 or c == "\u202e" for c in out)
+    assert out.startswith("ok\\x1b[2J") and "\\u202e" in out and "\\x9b" in out
+    for ordinary in ("µm, mN — Lepidium (2018)", "a/b\\c", "naïve ΔF"):
+        assert printable(ordinary) == ordinary
+
+
+@pytest.mark.parametrize("text", ["=HYPERLINK(\"http://x\",\"y\")", "+1", "-1+2", "@SUM(A1)", "\tx", "\rx"])
+def test_table_cells_never_start_a_formula(text):
+    assert table_cell(text).startswith("'")
+    assert table_cell("seed1.csv") == "seed1.csv"
+
+
+def test_a_fit_file_with_escape_sequences_prints_them_as_data(tmp_path, capsys):
+    import h5py
+
+    out = tmp_path / "f.h5"
+    assert main(["fit", "--example", "--preset", "fit", "--radius", "0.3mm", "-o", str(out)]) == 0
+    with h5py.File(out, "r+") as h:
+        h["fit"].attrs["message"] = HOSTILE
+        del h["fit/source/file_name"]
+        h["fit/source"].create_dataset("file_name", data=HOSTILE, dtype=h5py.string_dtype())
+    capsys.readouterr()
+    assert main(["info", str(out)]) == 0
+    text = capsys.readouterr().out
+    assert "\x1b" not in text and "\u202e" not in text and "\x07" not in text
+    assert text.count("\\x1b[2J") == 2                      # message and source name, shown escaped
+
+
+def test_batch_table_escapes_hostile_file_names(tmp_path, monkeypatch):
+    from shellbvp.fitting import example_data_path
+
+    monkeypatch.chdir(tmp_path)
+    name = '=HYPERLINK("http:x","y").csv'
+    (tmp_path / name).write_bytes(open(example_data_path(), "rb").read())
+    table = tmp_path / "t.csv"
+    assert main(["fit", name, "--preset", "fit", "--radius", "0.3mm", "--table", str(table)]) == 0
+    with open(table, newline="") as f:
+        rows = list(csv.DictReader(f))
+    assert rows and all(r["file"].startswith("'=") for r in rows)
+
+
+def test_sweep_cleanup_treats_the_output_name_as_a_name(tmp_path):
+    """-o 'run[12].h5' must not delete .run1.h5.*.tmp, another writer's file in flight."""
+    other = tmp_path / ".run1.h5.abc.tmp"
+    other.write_text("another writer")
+    out = tmp_path / "run[12].h5"
+    from shellbvp.sweep import sweep
+
+    grid = sweep(sb.Scene.preset("base"), {"beta": [0.01]}, delta_max=0.05, out=out, workers=1)
+    assert np.all(np.asarray(grid.index["status"]) == "complete")
+    assert other.exists()
