@@ -741,7 +741,7 @@ def _cmd_sweep(args):
     (the index says which), 2 bad input, 130 interrupted (the file keeps the finished curves)."""
     import shellbvp as sb
 
-    from .sweep import dask_executor, sweep
+    from .sweep import check_grid, dask_executor, sweep
 
     grid = {}
     for name, text in (("beta", args.beta), ("rho", args.rho), ("gamma", args.gamma), ("alpha", args.alpha),
@@ -756,6 +756,7 @@ def _cmd_sweep(args):
     elif args.neo_hookean:
         over["material"] = sb.NeoHookean()
     base = sb.Scene.preset(args.preset, **over)
+    check_grid(base, grid, args.max_cells)  # before a scheduler is asked for anything
     settings = {"tol": args.tol, "max_nodes": args.max_nodes, "max_steps": args.max_steps, "topology": args.topology}
     if args.points is not None:
         if not 2 <= args.points <= MAX_POINTS:
@@ -773,7 +774,7 @@ def _cmd_sweep(args):
 
     t0 = time.perf_counter()
     res = sweep(base, grid, delta_max=args.delta_max, executor=executor, out=args.output, workers=args.workers,
-                extend=args.extend, restart=args.force, progress=progress, **settings)
+                extend=args.extend, restart=args.force, progress=progress, max_cells=args.max_cells, **settings)
     counts = ", ".join(f"{v} {k}" for k, v in res.counts().items())
     print(f"wrote {args.output}: {res.status.size} combinations ({counts}); {res.computed} curves computed "
           f"in {time.perf_counter() - t0:.1f} s" + (f"; {res.lost} lost (still pending)" if res.lost else ""))
@@ -1030,6 +1031,8 @@ def build_parser():
     w.add_argument("--topology", choices=("auto", "cap"), default="auto")
     w.add_argument("-o", "--output", required=True, help="the sweep file (HDF5); an existing one is resumed")
     w.add_argument("--workers", type=int, help="local worker processes (default: all cores)")
+    w.add_argument("--max-cells", type=int, default=10_000, dest="max_cells",
+                   help="the most combinations the grid may have (default 10000; checked before any work)")
     w.add_argument("--scheduler", help="address of a running Dask scheduler, e.g. tcp://host:8786 (needs "
                                        "shellbvp[dask])")
     w.add_argument("--extend", action="store_true", help="add the new combinations of a changed grid to the file")

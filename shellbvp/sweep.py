@@ -58,7 +58,7 @@ from .version import __version__
 
 log = logging.getLogger(__name__)
 
-__all__ = ["sweep", "read_sweep", "run_curve", "Sweep", "SWEEP_PARAMETERS", "STATUSES", "FORMAT",
+__all__ = ["sweep", "check_grid", "MAX_CELLS", "read_sweep", "run_curve", "Sweep", "SWEEP_PARAMETERS", "STATUSES", "FORMAT",
            "FORMAT_VERSION", "is_sweep_file", "dask_executor", "local_pool", "scene_at"]
 
 FORMAT = "shellbvp-sweep"
@@ -84,11 +84,29 @@ def scene_at(base_scene, values: dict):
     return base_scene.replace(**changes)
 
 
-def _check_grid(base_scene, grid) -> dict:
-    """The grid as {name: tuple of floats}, checked; ValueError naming the parameter."""
+#: The most combinations a sweep takes unless told otherwise (``max_cells``, ``--max-cells``): a
+#: grid is counted before anything is allocated for it; 1e8 combinations would take GBs first.
+MAX_CELLS = 10_000
+
+
+def check_grid(base_scene, grid, max_cells=MAX_CELLS) -> dict:
+    """The grid as {name: tuple of floats}, checked (its size first, against ``max_cells``);
+    ValueError naming the parameter."""
     if not isinstance(grid, dict) or not grid:
         raise ValueError(f"grid must be a non-empty mapping of parameter names to values, names from "
                          f"{SWEEP_PARAMETERS}; got {grid!r}")
+    if isinstance(max_cells, bool) or not isinstance(max_cells, int) or max_cells < 1:
+        raise ValueError(f"max_cells must be an integer >= 1; got {max_cells!r}")
+    sizes = {}
+    for name, values in grid.items():
+        try:
+            sizes[name] = len(values) if hasattr(values, "__len__") else 1
+        except TypeError:
+            sizes[name] = 1
+    if math.prod(sizes.values()) > max_cells:
+        shape = " x ".join(f"{sizes[n]} {n}" for n in sizes)
+        raise ValueError(f"grid: {math.prod(sizes.values())} combinations ({shape}) exceed max_cells = {max_cells}; "
+                         f"pass max_cells= (CLI: --max-cells) to allow more")
     out = {}
     for name, values in grid.items():
         if name not in SWEEP_PARAMETERS:
@@ -636,7 +654,7 @@ def _plan(base_scene, grid, delta_max, settings, path, extend, restart):
 
 # -- the sweep -----------------------------------------------------------------------------------
 def sweep(base_scene, grid, *, delta_max, executor=None, out=None, workers=None, extend=False,
-          restart=False, progress=None, **curve_settings) -> Sweep:
+          restart=False, progress=None, max_cells=MAX_CELLS, **curve_settings) -> Sweep:
     """One curve per combination of ``grid`` values, through an executor, into one file.
 
     Parameters
@@ -667,6 +685,9 @@ def sweep(base_scene, grid, *, delta_max, executor=None, out=None, workers=None,
         ``progress(record, done, total)`` in this process after each curve (``record`` is
         what :func:`run_curve` returned).  Raising ``KeyboardInterrupt`` there stops the
         sweep like Ctrl-C: the file keeps every curve written so far.
+    max_cells : int
+        The most combinations the grid may have (:data:`MAX_CELLS`, 10,000), counted before
+        anything is allocated.
     **curve_settings
         Passed on to :func:`shellbvp.curve` (``tol``, ``max_steps``, ``topology``, ...).
 
@@ -707,7 +728,7 @@ def sweep(base_scene, grid, *, delta_max, executor=None, out=None, workers=None,
     from .model import load_module
     from .paths import check_output_path
 
-    grid = _check_grid(base_scene, grid)
+    grid = check_grid(base_scene, grid, max_cells)
     settings = _check_settings(curve_settings)
     if executor is not None and workers is not None:
         raise ValueError("workers sets the size of the default local pool; an executor given has its own workers")

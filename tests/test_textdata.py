@@ -65,3 +65,22 @@ def test_sweep_cleanup_treats_the_output_name_as_a_name(tmp_path):
     grid = sweep(sb.Scene.preset("base"), {"beta": [0.01]}, delta_max=0.05, out=out, workers=1)
     assert np.all(np.asarray(grid.index["status"]) == "complete")
     assert other.exists()
+
+
+def test_a_sweep_grid_is_counted_before_anything_is_allocated(capsys):
+    """1e8 combinations ended in MemoryError after 9 s: now one line, at once (issue 42)."""
+    import time
+
+    from shellbvp.sweep import sweep
+
+    t0 = time.perf_counter()
+    v = ",".join(str(0.005 + i * 1e-5) for i in range(100))
+    rc = main(["sweep", "--beta", v, "--rho", "0.1:0.3:100", "--gamma", "0.5:1.5:100", "--alpha", "0:1:100",
+               "-o", "never.h5"])
+    err = capsys.readouterr().err
+    assert rc == 2 and "100000000 combinations" in err and "--max-cells" in err
+    assert time.perf_counter() - t0 < 5
+    with pytest.raises(ValueError, match="exceed max_cells = 3"):
+        sweep(sb.Scene.preset("base"), {"beta": [0.01, 0.02], "rho": [0.2, 0.25]}, delta_max=0.1, max_cells=3)
+    with pytest.raises(ValueError, match="max_cells must be an integer"):
+        sweep(sb.Scene.preset("base"), {"beta": [0.01]}, delta_max=0.1, max_cells=0)
