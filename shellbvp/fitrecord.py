@@ -264,39 +264,60 @@ def read_fit(path) -> FitRecord:
     (40, (40,))
     """
 
+    from . import schema as sc
     from .scene import Scene
 
     path = Path(path)
     with open_hdf5(path, fmt=FIT_FORMAT, group="fit", kind="fit") as h:
         try:
-            e = h["fit"]
-            data = {k: v[()] for k, v in e["data"].items()}
-            data["segment"] = np.array([_text(s) for s in data["segment"]])
-            data["used"] = np.asarray(data["used"], bool)
-            n = data["displacement"].shape[0]
-            for k, v in data.items():
-                if np.ndim(v) != 1 or len(v) != n:
-                    raise ValueError(f"data/{k} must be a 1-D array of {n} values")
-            model = {k: np.asarray(v[()], float) for k, v in e["model"].items()}
-            p = e["parameters"]
-            params = {k: float(p[k][()]) if k in p or k not in _NEWER_PARAMETERS else math.nan
-                      for k in PARAMETER_UNITS}
-            fitted = [_text(s) for s in p.attrs["fitted"]]
-            intervals = {k: tuple(float(x) for x in p[f"{k}_ci95"][()]) for k in fitted}
-            settings = {k: _text(p.attrs[k]) for k in ("baseline_model", "weights", "segment")}
-            warnings = [_text(s) for s in e["warnings"][()]]
-            codes = [_text(s) for s in e["warnings"].attrs.get("codes", [])]
-            scene = Scene.from_dict(json.loads(_text(e["sample"].attrs["scene"])))
-            src = e["source"]
-            source = {"file_name": _text(src["file_name"][()]), "sha256": _text(src["sha256"][()]),
-                      "columns": json.loads(_text(src["columns"][()])), "units": json.loads(_text(src["units"][()]))}
-            out = FitRecord(data=data, model=model, parameters=params, intervals=intervals, fitted=fitted,
-                            settings=settings, warnings=warnings, warning_codes=codes, scene=scene, source=source,
-                            success=bool(e.attrs["success"]), status=int(e.attrs["status"]),
-                            message=_text(e.attrs["message"]), version=_text(h.attrs.get("package_version", "")),
-                            path=str(path))
+            sc.format_version(h, FIT_FORMAT_VERSION)
         except ValueError as exc:
             raise ValueError(f"{path}: {exc}") from None
-        except (KeyError, TypeError, OSError, json.JSONDecodeError) as exc:
-            raise ValueError(f"{path}: incomplete or corrupt fit file ({type(exc).__name__}: {exc})") from None
+        try:
+            e = h["fit"]
+            g = e["data"]
+            n = sc.dataset(g, "displacement").shape[0]
+            data = {k: sc.dataset(g, k, length=n) for k in ("displacement", "force", "model_force", "residual",
+                                                             "weight")}
+            data["line"] = sc.dataset(g, "line", kind="int", length=n)
+            data["used"] = sc.dataset(g, "used", kind="bool", length=n)
+            data["segment"] = np.array(sc.text_dataset(g, "segment", length=n))
+            if "time" in g:
+                data["time"] = sc.dataset(g, "time", length=n)
+            gm = e["model"]
+            m = sc.dataset(gm, "delta").shape[0]
+            model = {k: sc.dataset(gm, k, length=m) for k in ("displacement", "force", "delta", "F")}
+            p = e["parameters"]
+            params = {k: sc.scalar(p, k, finite=False, required=k not in _NEWER_PARAMETERS)
+                      for k in PARAMETER_UNITS}
+            if not (params["R_L"] > 0 and math.isfinite(params["R_L"])):
+                raise ValueError(f"parameters/R_L must be a length > 0; got {params['R_L']!r}")
+            fitted = [sc._text(s, "parameters.fitted") for s in np.atleast_1d(p.attrs["fitted"])]
+            unknown = sorted(set(fitted) - set(PARAMETER_UNITS))
+            if unknown or "mu_H" not in fitted:
+                raise ValueError(f"parameters.fitted must name mu_H and known parameters; got {fitted}")
+            intervals = {k: tuple(sc.dataset(p, f"{k}_ci95", length=2)) for k in fitted}
+            settings = {k: sc.attr_text(p, k) for k in ("baseline_model", "weights", "segment")}
+            warnings = sc.text_dataset(e, "warnings")
+            codes = [sc._text(s, "warnings.codes") for s in np.atleast_1d(e["warnings"].attrs.get("codes", []))]
+            scene = Scene.from_dict(sc.parse_json(sc.attr_text(e["sample"], "scene"), "sample.scene"))
+            src = e["source"]
+            source = {"file_name": sc.text_dataset(src, "file_name", ndim=0),
+                      "sha256": sc.text_dataset(src, "sha256", ndim=0),
+                      "columns": sc.parse_json(sc.text_dataset(src, "columns", ndim=0), "source/columns"),
+                      "units": sc.parse_json(sc.text_dataset(src, "units", ndim=0), "source/units")}
+            success = sc.attr_bool(e, "success")
+            status = sc.attr_int(e, "status", low=0, high=99)
+            if success != (status == 0):
+                raise ValueError(f"success ({success}) and status ({status}) disagree")
+            if success and not (math.isfinite(params["mu_H"]) and params["mu_H"] > 0):
+                raise ValueError(f"a successful fit must have mu_H > 0; got {params['mu_H']!r}")
+            out = FitRecord(data=data, model=model, parameters=params, intervals=intervals, fitted=fitted,
+                            settings=settings, warnings=warnings, warning_codes=codes, scene=scene, source=source,
+                            success=success, status=status, message=sc.attr_text(e, "message"),
+                            version=sc.attr_text(h, "package_version") if "package_version" in h.attrs else "",
+                            path=str(path))
+        except (ValueError, KeyError, TypeError, OSError, RecursionError) as exc:
+            what = str(exc) if isinstance(exc, ValueError) else f"{type(exc).__name__}: {exc}"
+            raise ValueError(f"{path}: incomplete or corrupt fit file ({what})") from None
     return out
