@@ -83,6 +83,7 @@ FIT_WARNINGS = {
     "search_range": "a shape parameter's interval or search reached the end of its range",
     "max_curves": "the number of model curves reached its limit",
     "mixed_segments": "the fitted rows mix the loading and the retraction of an instrument record",
+    "several_loadings": "the record holds more than one loading pass; one was fitted, the others left out",
 }
 #: mu*H (N/m) of soft shells, from red-cell membranes (~1e-5) to thick rubber (~1e4); a fit
 #: outside this range gets a warning (a header in kN for data in mN gives 1e6 x the truth).
@@ -1152,5 +1153,13 @@ def fit_record(scene, record, *, R_L, segment="loading", baseline="auto", **opti
         res.warnings.append(text)
         res.warning_codes.append("mixed_segments")
     if segment == "loading":
+        others = record.other_pushes()
+        if others:
+            where = ", ".join(f"rows {a + 1}-{b + 1}" for a, b, _ in others)
+            rows = np.flatnonzero(used)
+            res.warnings.append(f"the record holds {len(others) + 1} loading passes: rows {rows[0] + 1}-{rows[-1] + 1} "
+                                f"(the longest push) were fitted, {where} left out; if the passes differ (a "
+                                f"sample that changed, a re-test), cut the file and fit each")
+            res.warning_codes.append("several_loadings")
         record.relabel(res.offset)
     return res, used

@@ -325,6 +325,24 @@ class InstrumentRecord:
         """Number of rows in each segment (those with any)."""
         return {s: int(np.sum(self.segments == s)) for s in SEGMENTS if np.any(self.segments == s)}
 
+    def other_pushes(self, share=0.25) -> list:
+        """Pushes the loading segment left out: runs of ``other`` rows over which the tip moves in
+        by at least ``share`` of the loading's depth span (a second loading pass, a re-test), as
+        ``(first row, last row, depth moved in)``, rows as indices of the record."""
+        load = np.flatnonzero(self.segments == "loading")
+        if load.size < 2:
+            return []
+        span = float(np.ptp(self.displacement[load]))
+        found = []
+        other = self.segments == "other"
+        edges = np.flatnonzero(np.diff(np.r_[0, other.astype(int), 0]))
+        for a, b in zip(edges[0::2], edges[1::2]):
+            d = self.displacement[a:b]
+            moved = float(np.max(d - np.minimum.accumulate(d))) if d.size else 0.0
+            if span > 0 and moved >= share * span:
+                found.append((int(a), int(b - 1), moved))
+        return found
+
     def relabel(self, contact):
         """Split the pushing rows at the contact point ``contact`` (m): before it 'approach'."""
         push = np.isin(self.segments, ("approach", "loading"))

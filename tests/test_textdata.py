@@ -84,3 +84,20 @@ def test_a_sweep_grid_is_counted_before_anything_is_allocated(capsys):
         sweep(sb.Scene.preset("base"), {"beta": [0.01, 0.02], "rho": [0.2, 0.25]}, delta_max=0.1, max_cells=3)
     with pytest.raises(ValueError, match="max_cells must be an integer"):
         sweep(sb.Scene.preset("base"), {"beta": [0.01]}, delta_max=0.1, max_cells=0)
+
+
+def test_a_second_loading_pass_is_never_dropped_silently(tmp_path, capsys):
+    """Two loading passes, the second at 3x the force: the fit names both (issue 42: it had
+    fitted 3x mu*H from the second alone, exit 0, no warning)."""
+    from shellbvp.fitting import example_data_path
+
+    d, F = np.loadtxt(example_data_path(), delimiter=",", skiprows=2, unpack=True)
+    down = d[::-1]
+    rows = [(x, y) for x, y in zip(d, F)] + [(x, 0.5 * y) for x, y in zip(down, F[::-1])] \
+        + [(x, 3 * y) for x, y in zip(d, F)]
+    path = tmp_path / "two.csv"
+    path.write_text("displacement (mm),force (mN)\n" + "\n".join(f"{x:.6f},{y:.6f}" for x, y in rows) + "\n")
+    rc = main(["fit", str(path), "--preset", "fit", "--radius", "0.3mm"])
+    out = capsys.readouterr().out
+    assert "2 loading passes" in out and "left out" in out, out
+    assert rc in (0, 1)
