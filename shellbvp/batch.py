@@ -113,7 +113,9 @@ def expand_inputs(inputs) -> list:
     for item in inputs:
         p = Path(item)
         if p.is_dir():
-            found = sorted(q for q in p.iterdir() if q.is_file() and q.suffix.lower() in DATA_SUFFIXES)
+            # every entry named like data, files or not: a FIFO, a folder named x.csv or a
+            # symlink loop gets its own row saying why it was not read, instead of vanishing
+            found = sorted(q for q in p.iterdir() if q.suffix.lower() in DATA_SUFFIXES)
             if not found:
                 raise ValueError(f"{item}: a directory without data files ({', '.join(DATA_SUFFIXES)})")
             out += [str(q) for q in found]

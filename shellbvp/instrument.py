@@ -151,11 +151,9 @@ def read_table(path) -> Table:
     ValueError
         The file cannot be read or decoded, or holds no data.
     """
-    try:
-        with open(path, "rb") as fh:
-            raw = fh.read()
-    except OSError as exc:
-        raise ValueError(f"{path}: cannot read ({exc.strerror})") from None
+    from .paths import read_input_bytes
+
+    raw = read_input_bytes(path)  # a regular file of bounded size: never a FIFO, a device or a folder
     text = _decode(raw, path)
     numbered = [(i, ln) for i, ln in enumerate(text.splitlines(), start=1)
                 if ln.strip() and not ln.lstrip().startswith(("#", "%"))]

@@ -8,7 +8,47 @@ import tempfile
 from contextlib import contextmanager
 from pathlib import Path
 
-__all__ = ["check_output_path", "partial_path", "atomic_file", "open_hdf5"]
+__all__ = ["check_output_path", "partial_path", "atomic_file", "open_hdf5", "read_input_bytes", "MAX_INPUT_BYTES"]
+
+#: The largest input file read whole (a measured curve is kilobytes to a few megabytes).
+MAX_INPUT_BYTES = 256 * 2**20
+
+
+def read_input_bytes(path, max_bytes=MAX_INPUT_BYTES) -> bytes:
+    """The bytes of the regular file ``path``; ValueError with one line for a FIFO, a device, a
+    directory, a socket (read without blocking: a FIFO with no writer must not hang a batch) or
+    a file larger than ``max_bytes``."""
+    import stat
+
+    kinds = ((stat.S_ISDIR, "a directory"), (stat.S_ISFIFO, "a FIFO (named pipe)"),
+             (stat.S_ISCHR, "a character device"), (stat.S_ISBLK, "a block device"), (stat.S_ISSOCK, "a socket"))
+    try:
+        fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))
+    except OSError as exc:
+        raise ValueError(f"{path}: cannot read ({exc.strerror})") from None
+    try:
+        mode = os.fstat(fd).st_mode
+        if not stat.S_ISREG(mode):
+            what = next((name for test, name in kinds if test(mode)), "not a regular file")
+            raise ValueError(f"{path}: is {what}, not a data file")
+        size = os.fstat(fd).st_size
+        if size > max_bytes:
+            raise ValueError(f"{path}: {size / 2**20:.0f} MiB, more than the {max_bytes / 2**20:.0f} MiB a curve file "
+                             f"may have")
+        chunks, total = [], 0
+        while True:
+            chunk = os.read(fd, 1 << 20)
+            if not chunk:
+                break
+            total += len(chunk)
+            if total > max_bytes:  # a file that grows while read
+                raise ValueError(f"{path}: more than {max_bytes / 2**20:.0f} MiB")
+            chunks.append(chunk)
+        return b"".join(chunks)
+    except OSError as exc:
+        raise ValueError(f"{path}: cannot read ({exc.strerror})") from None
+    finally:
+        os.close(fd)
 
 
 def open_hdf5(path, *, fmt: str, group: str, kind: str):

@@ -101,3 +101,29 @@ def test_a_second_loading_pass_is_never_dropped_silently(tmp_path, capsys):
     out = capsys.readouterr().out
     assert "2 loading passes" in out and "left out" in out, out
     assert rc in (0, 1)
+
+
+def test_inputs_that_are_not_files_get_a_row_each_and_never_hang_the_batch(tmp_path, capsys):
+    """A FIFO (no writer), /dev/zero, a folder named like data and a symlink loop: each is one
+    error row saying what it is; the good file's result and the table survive (issue 42)."""
+    import os
+    import shutil
+
+    from shellbvp.fitting import example_data_path
+
+    folder = tmp_path / "data"
+    folder.mkdir()
+    shutil.copy(example_data_path(), folder / "good.csv")
+    os.mkfifo(folder / "pipe.csv")
+    (folder / "sub.csv").mkdir()
+    os.symlink(folder / "loop.csv", folder / "loop.csv")
+    table = tmp_path / "t.csv"
+    rc = main(["fit", str(folder), "/dev/zero", "--preset", "fit", "--radius", "0.3mm", "--table", str(table)])
+    out = capsys.readouterr().out
+    assert rc == 1
+    with open(table, newline="") as f:
+        rows = {os.path.basename(r["file"]): r for r in csv.DictReader(f)}
+    assert rows["good.csv"]["status"] == "ok"
+    assert "FIFO" in rows["pipe.csv"]["message"] and "directory" in rows["sub.csv"]["message"]
+    assert "symbolic links" in rows["loop.csv"]["message"] and "character device" in rows["zero"]["message"]
+    assert "1 of 5 files fitted" in out
