@@ -300,6 +300,12 @@ def _cmd_curve(args):
                      max_nodes=args.max_nodes, callback=callback, topology=args.topology)
     finally:
         bar.close()
+    if c.interrupted and out.exists():
+        # Ctrl-C is as safe as kill -9: an earlier file stays; the finished points go to the checkpoint
+        write_curve(c, partial, profiles=args.profiles, overwrite=True, units=units)
+        print(f"shellbvp: interrupted; {out} is kept as it was; the {len(c)} finished points are in {partial}",
+              file=sys.stderr)
+        return 130
     write_curve(c, out, profiles=args.profiles, overwrite=True, units=units)
     partial.unlink(missing_ok=True)
     print(f"wrote {out}: {c.summary()} in {time.perf_counter() - t0:.1f} s")

@@ -228,7 +228,10 @@ def test_killed_run_leaves_the_old_file_intact_and_a_labelled_checkpoint(tmp_pat
     assert info.returncode == 0 and "running" in info.stdout and "complete:  False" in info.stdout
 
 
-def test_sigint_writes_the_final_file_labelled_interrupted(tmp_path, old_file):
+def test_sigint_keeps_the_old_file_as_kill_does_and_the_points_in_the_checkpoint(tmp_path, old_file):
+    """Ctrl-C is at least as safe as kill -9 (issue 42): a --force rerun interrupted keeps the
+    earlier complete file byte for byte; the finished points go to X.h5.partial, labelled
+    interrupted."""
     import signal
 
     path, before = old_file
@@ -237,10 +240,22 @@ def test_sigint_writes_the_final_file_labelled_interrupted(tmp_path, old_file):
     proc.send_signal(signal.SIGINT)
     out, err = proc.communicate(timeout=120)
     assert proc.returncode == 130, (out, err)
-    assert "Traceback" not in err and "interrupted" in err
-    c = sb.read_curve(path)
+    assert "Traceback" not in err and "interrupted" in err and "is kept" in err
+    assert path.read_bytes() == before
+    c = sb.read_curve(partial)
     assert c.interrupted and not c.complete and c.stop_reason == "interrupted"
     assert len(c) >= n_checkpoint and c.delta[0] != 0.1  # the new run's points, not the old file's
+
+
+def test_sigint_without_an_earlier_file_writes_the_finished_points(tmp_path):
+    import signal
+
+    proc, partial = _start_curve_and_wait_for_checkpoint(tmp_path, "--delta-max", "0.5")
+    proc.send_signal(signal.SIGINT)
+    out, err = proc.communicate(timeout=120)
+    assert proc.returncode == 130, (out, err)
+    c = sb.read_curve(tmp_path / "X.h5")
+    assert c.interrupted and not c.complete and len(c) >= 1
     assert not partial.exists()
 
 
