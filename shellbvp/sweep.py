@@ -354,37 +354,72 @@ def _new_index(names, combos) -> dict:
 
 
 def _read_attrs(path):
-    """(meta, index) of a sweep file; ValueError with one line naming what is wrong."""
+    """(meta, index) of a sweep file; ValueError with one line naming what is wrong.
+
+    Every item is checked before use (``shellbvp.schema``), and the file's claims are not taken
+    on trust: a cell is complete (or stopped) only with its own readable curve group
+    (``curves/curve_<i>``); one without is read as pending, so that a resume computes it.
+    """
+    import h5py
+
+    from . import schema as sc
 
     with open_hdf5(path, fmt=FORMAT, group="sweep", kind="sweep") as f:
-        version = f.attrs.get("format_version")
-        if version is None or int(version) != FORMAT_VERSION:
-            raise ValueError(f"{path}: sweep format version {version!r} is not one this shellbvp reads "
+        try:
+            version = sc.attr_int(f, "format_version")
+        except ValueError as exc:
+            raise ValueError(f"{path}: sweep {exc}") from None
+        if version != FORMAT_VERSION:
+            raise ValueError(f"{path}: sweep format version {version} is not one this shellbvp reads "
                              f"({FORMAT_VERSION})")
         s = f["sweep"]
         try:
-            meta = {k: json.loads(s.attrs[k]) for k in ("base_scene", "parameters", "grid", "settings")}
-            meta["delta_max"] = float(s.attrs["delta_max"])
-            meta["package_version"] = str(f.attrs.get("package_version", ""))
+            meta = {k: sc.parse_json(sc.attr_text(s, k), f"attribute {k}")
+                    for k in ("base_scene", "parameters", "grid", "settings")}
+            delta_max = s.attrs["delta_max"]
+            if isinstance(delta_max, (bool, np.bool_)) or not isinstance(delta_max, (int, float, np.number)) \
+                    or not math.isfinite(float(delta_max)):
+                raise ValueError(f"attribute delta_max must be a number; got {delta_max!r}")
+            meta["delta_max"] = float(delta_max)
+            meta["package_version"] = sc.attr_text(f, "package_version") if "package_version" in f.attrs else ""
             names = meta["parameters"]
             if not (isinstance(names, list) and set(names) <= set(SWEEP_PARAMETERS)
                     and isinstance(meta["grid"], dict) and list(meta["grid"]) == names):
                 raise ValueError("attributes parameters and grid do not agree")
+            for n in names:
+                if not (isinstance(meta["grid"][n], list) and all(isinstance(v, (int, float)) and
+                                                                  not isinstance(v, bool) for v in meta["grid"][n])):
+                    raise ValueError(f"attribute grid: {n} must be a list of numbers")
+            if math.prod(len(meta["grid"][n]) for n in names) > 10 * MAX_CELLS:
+                raise ValueError(f"the grid holds more than {10 * MAX_CELLS} combinations")
             ig = s["index"]
-            index = {name: ig[name][()].astype(float) for name in names}
-            for key in ("status", "stop_reason", "message", "group"):
-                index[key] = [v.decode() if isinstance(v, bytes) else str(v) for v in ig[key][()]]
-            index["points"] = ig["points"][()].astype(int).tolist()
-            index["wall_time"] = ig["wall_time"][()].astype(float).tolist()
-            n = len(index["status"])
-            if any(len(index[k]) != n for k in index):
-                raise ValueError("the index datasets differ in length")
+            status = sc.text_dataset(ig, "status")
+            n = len(status)
+            index = {name: sc.dataset(ig, name, length=n) for name in names}
+            for name in names:
+                off = [float(v) for v in index[name] if float(v) not in meta["grid"][name]]
+                if off:
+                    raise ValueError(f"index/{name} holds {off[0]!r}, which is not on the grid")
+            index["status"] = status
+            for key in ("stop_reason", "message", "group"):
+                index[key] = sc.text_dataset(ig, key, length=n)
+            index["points"] = sc.dataset(ig, "points", kind="int", length=n).tolist()
+            index["wall_time"] = sc.dataset(ig, "wall_time", length=n).tolist()
             bad = sorted(set(index["status"]) - set(STATUSES))
             if bad:
                 raise ValueError(f"index/status holds {bad[0]!r}; expected one of {STATUSES}")
+            for i, st in enumerate(index["status"]):
+                if st not in ("complete", "stopped"):
+                    continue
+                own = f"curves/curve_{i:06d}"
+                if index["group"][i] != own or not isinstance(s.get(own), h5py.Group):
+                    why = ("its curve is missing" if index["group"][i] in ("", own)
+                           else f"it names another curve ({index['group'][i]})")
+                    index["status"][i], index["group"][i] = "pending", ""
+                    index["message"][i] = f"read as pending: the file called it {st} but {why}"
         except KeyError as exc:
             raise ValueError(f"{path}: attribute or dataset {exc} missing") from None
-        except (json.JSONDecodeError, TypeError) as exc:
+        except (TypeError, RecursionError) as exc:
             raise ValueError(f"{path}: malformed sweep metadata ({exc})") from None
         except ValueError as exc:
             raise ValueError(f"{path}: {exc}") from None
@@ -520,7 +555,11 @@ class _Lock:
         except ImportError:
             return self
         while True:
-            fh = open(self.path, "a+")  # held open for the sweep: the lock lives with it
+            try:
+                fh = open(self.path, "a+")  # held open for the sweep: the lock lives with it
+            except OSError as exc:
+                raise ValueError(f"{self.path}: cannot be the sweep's lock file ({exc.strerror}); remove it or "
+                                 f"choose another output file") from None
             try:
                 fcntl.flock(fh, fcntl.LOCK_EX | fcntl.LOCK_NB)
             except BlockingIOError:
@@ -755,7 +794,9 @@ def sweep(base_scene, grid, *, delta_max, executor=None, out=None, workers=None,
                     done[0] += 1
                     progress(rec, done[0], len(todo))
 
-        todo = [i for i, st in enumerate(index["status"]) if st == "pending"]
+        # pending cells, and those in error: an exception may be passing (memory, a worker killed);
+        # a curve that stopped early is a result and stays
+        todo = [i for i, st in enumerate(index["status"]) if st in ("pending", "error")]
         done = [0]
         t0 = time.perf_counter()
         own = local_pool(workers) if executor is None and workers != 1 and todo else None

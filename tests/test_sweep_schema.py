@@ -1,0 +1,90 @@
+"""Sweep files that lie, and resumes that must not trust them (issue 42)."""
+
+import shutil
+
+import h5py
+import numpy as np
+import pytest
+
+import shellbvp as sb
+from shellbvp.cli import main
+from shellbvp.sweep import read_sweep, sweep
+
+KW = dict(delta_max=0.1, workers=1, deltas=[0.05, 0.1], estimate_error=False)
+GRID = {"beta": [0.005, 0.01]}
+
+
+@pytest.fixture(scope="module")
+def good(tmp_path_factory):
+    path = tmp_path_factory.mktemp("sweep") / "good.h5"
+    res = sweep(sb.Scene.preset("base"), GRID, out=path, **KW)
+    assert res.counts() == {"complete": 2}
+    return path
+
+
+def copy(good, tmp_path, edit=None):
+    bad = tmp_path / "bad.h5"
+    shutil.copy(good, bad)
+    if edit is not None:
+        with h5py.File(bad, "r+") as h:
+            edit(h)
+    return bad
+
+
+def _set_index(h, key, values, text=False):
+    del h[f"sweep/index/{key}"]
+    if text:
+        h["sweep/index"].create_dataset(key, data=np.array(values, dtype=object), dtype=h5py.string_dtype())
+    else:
+        h["sweep/index"].create_dataset(key, data=values)
+
+
+def test_a_complete_cell_without_its_curve_is_read_as_pending_and_recomputed(good, tmp_path):
+    bad = copy(good, tmp_path, lambda h: h.__delitem__("sweep/curves/curve_000001"))
+    back = read_sweep(bad)
+    assert list(back.index["status"]) == ["complete", "pending"] and "curve is missing" in back.index["message"][1]
+    res = sweep(sb.Scene.preset("base"), GRID, out=bad, **KW)
+    assert res.computed == 1 and res.counts() == {"complete": 2}
+
+
+def test_a_cell_pointing_at_another_cells_curve_is_not_shown_as_its_own(good, tmp_path):
+    def edit(h):
+        groups = [g.decode() if isinstance(g, bytes) else g for g in h["sweep/index/group"][()]]
+        _set_index(h, "group", [groups[0], groups[0]], text=True)
+
+    back = read_sweep(copy(good, tmp_path, edit))
+    assert back.index["status"][1] == "pending" and 1 not in back.curves
+    assert "names another curve" in back.index["message"][1]
+
+
+def test_cells_in_error_are_retried_on_resume(good, tmp_path):
+    bad = copy(good, tmp_path, lambda h: (h.__delitem__("sweep/curves/curve_000000"),
+                                          _set_index(h, "status", ["error", "complete"], text=True),
+                                          _set_index(h, "group", ["", "curves/curve_000001"], text=True)))
+    assert read_sweep(bad).index["status"][0] == "error"
+    res = sweep(sb.Scene.preset("base"), GRID, out=bad, **KW)
+    assert res.computed == 1 and res.counts() == {"complete": 2}
+
+
+@pytest.mark.parametrize("edit,match", [
+    (lambda h: _set_index(h, "beta", [0.005, 0.7]), "not on the grid"),
+    (lambda h: h.attrs.__setitem__("format_version", np.array([1, 1])), "must be an integer"),
+    (lambda h: h.attrs.__setitem__("format_version", "1"), "must be an integer"),
+    (lambda h: h["sweep"].attrs.__setitem__("grid", "{" * 100_000), "JSON nested deeper"),
+    (lambda h: _set_index(h, "points", np.array(["a", "b"], dtype=object)), "points"),
+])
+def test_a_malformed_sweep_file_is_one_line_naming_it(good, tmp_path, capsys, edit, match):
+    bad = copy(good, tmp_path, edit)
+    with pytest.raises(ValueError, match=match) as err:
+        read_sweep(bad)
+    assert "bad.h5" in str(err.value)
+    assert main(["info", str(bad)]) == 2
+    out = capsys.readouterr().err
+    assert out.count("\n") == 1 and "Traceback" not in out
+
+
+def test_a_lock_that_is_a_directory_is_one_line(good, tmp_path, capsys):
+    bad = copy(good, tmp_path)
+    (tmp_path / "bad.h5.lock").mkdir()
+    with pytest.raises(ValueError, match="lock file"):
+        sweep(sb.Scene.preset("base"), GRID, out=bad, **KW)
