@@ -768,9 +768,9 @@ def _cmd_sweep(args):
         if not 2 <= args.points <= MAX_POINTS:
             raise ValueError(f"--points must be in [2, {MAX_POINTS}]; got {args.points}")
         settings["deltas"] = [args.delta_max * (i + 1) / args.points for i in range(args.points)]
-    if args.scheduler and args.workers is not None:
+    if args.scheduler is not None and args.workers is not None:
         raise ValueError("--workers sets the local pool; with --scheduler the cluster has its own workers")
-    executor = dask_executor(args.scheduler) if args.scheduler else None
+    executor = dask_executor(args.scheduler) if args.scheduler is not None else None  # '' is an error, not local
 
     def progress(rec, done, total):
         if not args.quiet:

@@ -42,6 +42,7 @@ import logging
 import math
 import multiprocessing
 import os
+import re
 import shutil
 import time
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
@@ -512,18 +513,54 @@ def _reconcile(path, meta_new, extend) -> tuple[dict, dict] | None:
 
 
 # -- executors -----------------------------------------------------------------------------------
-def dask_executor(address: str):
-    """A ``concurrent.futures.Executor`` on the Dask cluster at ``address`` (needs ``shellbvp[dask]``)."""
+#: Scheduler addresses a sweep connects to: plain TCP (``tcp://host:port`` or ``host:port``).
+#: TLS needs certificates set up in Dask's own configuration, UCX a build of its own, inproc a
+#: scheduler in this process: each is refused with a line saying so.
+SCHEDULER_ADDRESS = re.compile(r"^(?:tcp://)?(?:\[[0-9A-Fa-f:.]+\]|[A-Za-z0-9_.-]+):([0-9]{1,5})$")
+
+
+def dask_executor(address: str, timeout: float = 10.0):
+    """A ``concurrent.futures.Executor`` on the Dask cluster at ``address`` (needs ``shellbvp[dask]``).
+
+    The address is checked before anything is imported or contacted; the connection, handshake
+    included, must succeed within ``timeout`` seconds (a peer that accepts and never answers, or
+    answers junk, is one line, not a hang or a traceback).
+    """
+    import threading
+
+    text = str(address).strip()
+    scheme = text.split("://", 1)[0] if "://" in text else "tcp"
+    if not text:
+        raise ValueError("--scheduler: the address is empty; give host:port or tcp://host:port")
+    if scheme != "tcp":
+        raise ValueError(f"--scheduler {text!r}: only tcp:// addresses are supported (host:port or "
+                         f"tcp://host:port); {scheme}:// is not")
+    m = SCHEDULER_ADDRESS.match(text)
+    if not m or not 0 < int(m.group(1)) < 65536:
+        raise ValueError(f"--scheduler {text!r}: not an address host:port or tcp://host:port (port 1-65535)")
     try:
         from dask.distributed import Client
     except ImportError:
         raise ValueError("a Dask scheduler needs the dask extra: pip install 'shellbvp[dask]' "
                          "(dask[distributed])") from None
-    try:
-        client = Client(address, timeout="10s")
-    except (OSError, TimeoutError) as exc:
-        raise ValueError(f"cannot connect to the Dask scheduler at {address!r}: {exc}") from None
-    return client.get_executor()
+    result = {}
+
+    def connect():  # in a daemon thread: a handshake that never ends must not keep the process
+        try:
+            result["client"] = Client(text, timeout=f"{timeout}s")
+        except BaseException as exc:  # noqa: BLE001 -- any failure of the peer is reported as one line
+            result["error"] = exc
+
+    worker = threading.Thread(target=connect, daemon=True, name="dask-connect")
+    worker.start()
+    worker.join(timeout + 5.0)
+    if worker.is_alive():
+        raise ValueError(f"the Dask scheduler at {text!r} did not answer within {timeout + 5:g} s")
+    if "error" in result:
+        exc = result["error"]
+        raise ValueError(f"cannot use the Dask scheduler at {text!r}: {type(exc).__name__}: "
+                         f"{' '.join(str(exc).split())[:200]}") from None
+    return result["client"].get_executor()
 
 
 def local_pool(workers=None):

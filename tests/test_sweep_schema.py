@@ -88,3 +88,42 @@ def test_a_lock_that_is_a_directory_is_one_line(good, tmp_path, capsys):
     (tmp_path / "bad.h5.lock").mkdir()
     with pytest.raises(ValueError, match="lock file"):
         sweep(sb.Scene.preset("base"), GRID, out=bad, **KW)
+
+
+def _peer(mode):
+    import os
+    import socket
+    import threading
+
+    srv = socket.socket()
+    srv.bind(("127.0.0.1", 0))
+    srv.listen(5)
+
+    def serve():
+        while True:
+            conn, _ = srv.accept()
+            if mode == "junk":
+                conn.sendall(os.urandom(1 << 14))
+
+    threading.Thread(target=serve, daemon=True).start()
+    return f"127.0.0.1:{srv.getsockname()[1]}"
+
+
+@pytest.mark.parametrize("mode,match", [("silent", "did not answer within"), ("junk", "cannot use the Dask")])
+def test_a_scheduler_that_never_answers_or_answers_junk_is_one_line(mode, match):
+    pytest.importorskip("dask.distributed")
+    from shellbvp.sweep import dask_executor
+
+    with pytest.raises(ValueError, match=match):
+        dask_executor(_peer(mode), timeout=1.0)
+
+
+@pytest.mark.parametrize("address,match", [("", "empty"), ("ucx://h:1", "only tcp://"), ("tls://h:8786", "only tcp://"),
+                                           ("inproc://foo", "only tcp://"), ("h:99999", "port 1-65535")])
+def test_scheduler_addresses_are_checked_first(address, match, capsys):
+    rc = main(["sweep", "--beta", "0.01", "--delta-max", "0.1", "--scheduler", address, "-o", "never.h5"])
+    err = capsys.readouterr().err
+    assert rc == 2 and err.count("\n") == 1 and "Traceback" not in err
+    import re
+
+    assert re.search(match, err)
