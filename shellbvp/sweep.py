@@ -59,7 +59,7 @@ from .version import __version__
 
 log = logging.getLogger(__name__)
 
-__all__ = ["sweep", "check_grid", "MAX_CELLS", "read_sweep", "run_curve", "Sweep", "SWEEP_PARAMETERS", "STATUSES", "FORMAT",
+__all__ = ["sweep", "check_grid", "MAX_CELLS", "die_with_parent", "read_sweep", "run_curve", "Sweep", "SWEEP_PARAMETERS", "STATUSES", "FORMAT",
            "FORMAT_VERSION", "is_sweep_file", "dask_executor", "local_pool", "scene_at"]
 
 FORMAT = "shellbvp-sweep"
@@ -564,12 +564,32 @@ def dask_executor(address: str, timeout: float = 10.0):
 
 
 def local_pool(workers=None):
-    """A process pool of ``workers`` processes (default: all cores), started by spawn."""
+    """A process pool of ``workers`` processes (default: all cores), started by spawn; each
+    worker ends when the process that started it does (:func:`die_with_parent`)."""
     if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
         raise ValueError(f"workers must be an integer >= 1; got {workers!r}")
     # spawn, not fork: workers start clean whatever threads the parent runs (Dask, h5py)
     return ProcessPoolExecutor(max_workers=workers or os.cpu_count() or 1,
-                               mp_context=multiprocessing.get_context("spawn"))
+                               mp_context=multiprocessing.get_context("spawn"),
+                               initializer=die_with_parent, initargs=(os.getpid(),))
+
+
+def die_with_parent(parent_pid: int, period: float = 0.5) -> None:
+    """In a worker: exit as soon as ``parent_pid`` is no longer this process's parent (the
+    parent was killed, even by ``kill -9``, and the worker was handed to init), instead of
+    living on with the dead parent's pipes open (a caller reading them would never see EOF).
+    A daemon thread polls ``os.getppid()``; ``prctl(PR_SET_PDEATHSIG)`` is not used: it fires
+    when the *thread* that started the worker ends, which a pool's thread may do early."""
+    import threading
+
+    def watch():
+        while os.getppid() == parent_pid:
+            time.sleep(period)
+        os._exit(1)
+
+    if os.getppid() != parent_pid:  # the parent died before the worker got here
+        os._exit(1)
+    threading.Thread(target=watch, daemon=True, name="die-with-parent").start()
 
 
 # -- the writer ----------------------------------------------------------------------------------

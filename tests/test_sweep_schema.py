@@ -127,3 +127,49 @@ def test_scheduler_addresses_are_checked_first(address, match, capsys):
     import re
 
     assert re.search(match, err)
+
+
+def test_workers_end_with_a_killed_parent(tmp_path):
+    """kill -9 of `sweep --workers 2`: its workers had lived on for 20 min holding the dead
+    parent's pipes (issue 42); now they exit within about a second."""
+    import os
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    proc = subprocess.Popen([sys.executable, "-m", "shellbvp", "sweep", "--beta", "0.005,0.01,0.02,0.03",
+                             "--delta-max", "0.5", "--workers", "2", "-q", "-o", "g.h5"], cwd=tmp_path,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, start_new_session=True)
+
+    def children():
+        out = []
+        for pid in os.listdir("/proc"):
+            if pid.isdigit():
+                try:
+                    with open(f"/proc/{pid}/stat") as f:
+                        fields = f.read().rsplit(")", 1)[1].split()
+                except OSError:
+                    continue
+                if int(fields[3]) == proc.pid or int(fields[2]) == proc.pid:  # ppid or process group
+                    out.append(int(pid))
+        return out
+
+    deadline = time.monotonic() + 60
+    while len(children()) < 2:
+        assert proc.poll() is None and time.monotonic() < deadline, "no workers started"
+        time.sleep(0.2)
+    group = os.getpgid(proc.pid)
+    proc.kill()
+    proc.wait()
+    deadline = time.monotonic() + 15
+    alive = True
+    while alive and time.monotonic() < deadline:
+        time.sleep(0.3)
+        try:
+            os.killpg(group, 0)
+        except ProcessLookupError:
+            alive = False
+    if alive:
+        os.killpg(group, signal.SIGKILL)
+    assert not alive, "workers outlived their parent by 15 s"
