@@ -1096,7 +1096,7 @@ def main(argv=None):
                         format="%(levelname)s %(name)s: %(message)s")
     try:
         return args.func(args)
-    except (ValueError, FileExistsError) as exc:
+    except (ValueError, FileExistsError, ImportError) as exc:  # ImportError: an optional part missing or refused
         if getattr(args, "json", False):
             _print_json_error(exc)
         from .textdata import printable

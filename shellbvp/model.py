@@ -105,7 +105,11 @@ def untrusted_reason(path: Path) -> str | None:
     another user owns or may write could hold anything.
     """
     try:
-        st = path.stat()
+        st = path.lstat()
+        if stat.S_ISLNK(st.st_mode):
+            if not path.is_dir():  # a file's link could be pointed anywhere; a linked cache folder is a choice
+                return "it is a symbolic link (imported code must be a file of its own)"
+            st = path.stat()
     except OSError as exc:
         return f"cannot stat it ({exc.strerror})"
     if hasattr(os, "getuid") and st.st_uid != os.getuid():

@@ -301,3 +301,48 @@ def test_small_but_real_defects_of_decimal_energies_are_still_refused(W, what):
 def test_numbers_too_large_to_evaluate_are_a_value_error():
     with pytest.raises(ValueError, match="cannot be evaluated"):
         sb.StrainEnergy("exp(exp(exp(exp(1000))))")
+
+
+def test_a_cached_module_that_is_a_symlink_is_not_imported(tmp_path, monkeypatch, caplog):
+    """The trust check followed links: a module linked to a 0644 file of ours in a world-writable
+    directory ran (issue 42).  A linked module is refused whatever it points to."""
+    cache = tmp_path / "cache"
+    cache.mkdir(mode=0o700)
+    shared = tmp_path / "shared"
+    shared.mkdir()
+    os.chmod(shared, 0o1777)
+    monkeypatch.setenv("SHELLBVP_CACHE_DIR", str(cache))
+    desc = sb.Scene.preset("base").structure()
+    path = model.module_path(desc)
+    marker = tmp_path / "PWNED"
+    target = shared / "m.py"
+    target.write_text(f"open({str(marker)!r}, 'w').close()\nKEY = {model.description_key(desc)!r}\n")
+    os.chmod(target, 0o644)
+    path.symlink_to(target)
+    assert "symbolic link" in model.untrusted_reason(path)
+    monkeypatch.setattr(model, "_loaded", {})
+    with caplog.at_level(logging.WARNING, logger="shellbvp.model"):
+        mod = model.load_module(desc)
+    assert not marker.exists() and hasattr(mod, "free_rhs")
+    assert "symbolic link" in caplog.text
+
+
+def test_an_import_error_of_an_optional_part_is_one_line(monkeypatch, capsys):
+    """SHELLBVP_KERNELS=numba with a refused cache raised a raw ImportError traceback (issue 42)."""
+    from shellbvp import cli
+
+    def refuse(args):
+        raise ImportError("not loading compiled kernels: it belongs to another user (uid 1234)")
+
+    monkeypatch.setattr(cli, "_cmd_solve", refuse)
+    parser = cli.build_parser
+    monkeypatch.setattr(cli, "build_parser", lambda: _with(parser(), refuse))
+    assert cli.main(["solve", "--delta", "0.1"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "another user" in err and "Traceback" not in err
+
+
+def _with(parser, func):
+    for action in parser._subparsers._group_actions:
+        action.choices["solve"].set_defaults(func=func)
+    return parser
