@@ -10,17 +10,18 @@ Quick use::
     grid = sb.sweep(scene, {"beta": [0.005, 0.01], "rho": [0.2, 0.25]}, delta_max=0.5, out="grid.h5")
 """
 
-from .continuation import curve
-from .geometry import SphereTip, Spheroid, UserShell, UserTip
-from .io import Curve, read_curve
-from .materials import BendingEnergy, Gent, MooneyRivlin, NeoHookean, RotationBending, StrainEnergy, TraceBending
-from .scene import PRESETS, Scene
-from .solution import STATUS_MESSAGES, Solution
-from .state import delta_bounds, solve
-from .units import Dimensions, beta_from_thickness, parse_quantity
 from .version import __version__  # noqa: F401  (sb.__version__)
 
-_LAZY = {"fit": "fitting", "FitResult": "fitting", "read_force_csv": "fitting", "fit_record": "fitting",
+# Every public name is imported on first use (PEP 562): `import shellbvp` and the command line's
+# parser cost next to nothing, so bad input is refused before numpy and SciPy load and Ctrl-C
+# finds the CLI's handler in place.
+_LAZY = {"curve": "continuation", "SphereTip": "geometry", "Spheroid": "geometry", "UserShell": "geometry",
+         "UserTip": "geometry", "Curve": "io", "read_curve": "io", "BendingEnergy": "materials", "Gent": "materials",
+         "MooneyRivlin": "materials", "NeoHookean": "materials", "RotationBending": "materials",
+         "StrainEnergy": "materials", "TraceBending": "materials", "PRESETS": "scene", "Scene": "scene",
+         "STATUS_MESSAGES": "solution", "Solution": "solution", "delta_bounds": "state", "solve": "state",
+         "Dimensions": "units", "beta_from_thickness": "units", "parse_quantity": "units",
+         "fit": "fitting", "FitResult": "fitting", "read_force_csv": "fitting", "fit_record": "fitting",
          "read_instrument": "instrument", "fit_files": "batch", "read_fit": "fitrecord",
          "sweep": "sweep", "read_sweep": "sweep", "Sweep": "sweep",
          "fit_with_geometry": "uncertainty", "GeometryFit": "uncertainty", "convexity_limits": "convexity",
@@ -29,8 +30,6 @@ _LAZY = {"fit": "fitting", "FitResult": "fitting", "read_force_csv": "fitting", 
 
 
 def __getattr__(name):
-    # Fitting pulls in scipy.optimize and friends (a third of the import time): load it
-    # on first use, so that solving and curves start faster.
     if name in _LAZY:
         import importlib
 

@@ -1084,6 +1084,14 @@ def build_parser():
 
 
 def main(argv=None):
+    try:
+        return _main(argv)
+    except KeyboardInterrupt:  # also while the parser is built: no traceback at any moment
+        print("shellbvp: interrupted", file=sys.stderr)
+        return 130
+
+
+def _main(argv=None):
     parser = build_parser()
     argv = sys.argv[1:] if argv is None else list(argv)
     if not argv:

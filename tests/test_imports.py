@@ -87,3 +87,18 @@ def test_import_loads_no_scipy_solver():
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,
                          cwd=PKG.parent).stdout.strip()
     assert out == "[]", f"import shellbvp loaded {out}"
+
+
+def test_the_command_line_parses_before_numpy_and_scipy_load():
+    """`import shellbvp` and the CLI's parser load no numerics (issue 46): a wrong option is
+    refused before numpy, SciPy and SymPy are imported, and Ctrl-C meets the CLI's handler."""
+    import subprocess
+    import sys
+
+    code = ("import sys, shellbvp, shellbvp.cli as c\n"
+            "heavy = [m for m in ('numpy', 'scipy', 'sympy', 'h5py') if m in sys.modules]\n"
+            "try:\n    rc = c.main(['curve', '--no-such-option'])\nexcept SystemExit as e:\n    rc = e.code\n"
+            "heavy += [m for m in ('numpy', 'scipy', 'sympy', 'h5py') if m in sys.modules]\n"
+            "print(rc, heavy)")
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert r.stdout.strip() == "2 []", (r.stdout, r.stderr)
