@@ -332,8 +332,6 @@ class _Solver:
     """Newton on the solid + contact at a given apex height, with the state kept for warm starts."""
 
     def __init__(self, model, tol, max_iterations=15):
-        from scipy.sparse.linalg import splu  # noqa: F401  (checked here: imported in _step)
-
         self.m, self.tol, self.max_iterations = model, tol, max_iterations
         ndof = int(np.sum(model.field.fieldsizes))
         free = np.ones(ndof, bool)

@@ -37,7 +37,6 @@ replaced unless ``overwrite=True``.
 
 from __future__ import annotations
 
-import datetime as _dt
 import json
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -45,9 +44,8 @@ from pathlib import Path
 import numpy as np
 
 from .chain import CONFIGURATION_NAMES
-from .nexus import label_units
+from .nexus import file_header, label_units
 from .paths import atomic_file, check_output_path, open_hdf5
-from .version import __version__
 
 __all__ = ["Curve", "POINT_FIELDS", "CAP_FIELD_DEFAULTS", "point_record", "energy_residual", "write_curve",
            "read_curve", "write_curve_group", "read_curve_group", "FORMAT",
@@ -282,10 +280,7 @@ def write_curve(curve, path, *, profiles=False, overwrite=False, units=None):
     check_output_path(path, overwrite=True)
     with atomic_file(path) as tmp:
         with h5py.File(tmp, "w") as f:
-            f.attrs["format"] = FORMAT
-            f.attrs["format_version"] = FORMAT_VERSION
-            f.attrs["package_version"] = __version__
-            f.attrs["created"] = _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds")
+            file_header(f, FORMAT, FORMAT_VERSION)
             write_curve_group(f.create_group("curve"), curve, profiles=profiles, units=units)
         label_units(tmp)  # every dataset says its unit (nondimensional: "1")
 

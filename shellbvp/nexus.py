@@ -9,7 +9,7 @@ of curve files; :func:`missing_units` is the check a test runs on every file.
 from __future__ import annotations
 
 __all__ = ["CURVE_DATASET_UNITS", "DIMENSIONLESS", "label_units", "missing_units", "string_dataset",
-           "number_dataset"]
+           "number_dataset", "file_header"]
 
 #: The unit of a nondimensional number.
 DIMENSIONLESS = "1"
@@ -83,3 +83,16 @@ def string_dataset(group, name, values, long_name=None):
     if long_name:
         ds.attrs["long_name"] = long_name
     return ds
+
+
+def file_header(f, fmt: str, version: int) -> None:
+    """The root attributes every file of the package carries: format, format_version,
+    package_version and the time it was created (UTC)."""
+    import datetime as _dt
+
+    from .version import __version__
+
+    f.attrs["format"] = fmt
+    f.attrs["format_version"] = version
+    f.attrs["package_version"] = __version__
+    f.attrs["created"] = _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds")

@@ -8,7 +8,6 @@ O(eps) (``docs/accuracy.md``).  ``shellbvp validate`` is the command line of it.
 
 from __future__ import annotations
 
-import datetime as _dt
 import json
 from dataclasses import dataclass
 from pathlib import Path
@@ -99,9 +98,8 @@ class Validation:
         import h5py
 
         from .io import write_curve_group
-        from .nexus import label_units, number_dataset
+        from .nexus import file_header, label_units, number_dataset
         from .paths import atomic_file, check_output_path
-        from .version import __version__
 
         path = Path(path)
         if path.exists() and not overwrite:
@@ -109,10 +107,7 @@ class Validation:
         check_output_path(path, overwrite=True)
         with atomic_file(path) as tmp:
             with h5py.File(tmp, "w") as f:
-                f.attrs["format"] = FORMAT
-                f.attrs["format_version"] = FORMAT_VERSION
-                f.attrs["package_version"] = __version__
-                f.attrs["created"] = _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds")
+                file_header(f, FORMAT, FORMAT_VERSION)
                 f.attrs["default"] = "entry"
                 entry = f.create_group("entry")
                 entry.attrs["NX_class"] = "NXentry"
