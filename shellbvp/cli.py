@@ -617,8 +617,8 @@ def _print_fit(res, record, used, args):
         m1, m2 = res.mu_ci95
         _say(f"mu     = {res.mu / 1e6:.4g} MPa   95% CI [{m1 / 1e6:.4g}, {m2 / 1e6:.4g}] (H = "
              f"{format_in(res.thickness, 'um', 'length')}, eps = H/R_L = {eps:.3g}, beta = eps^2/3)")
-        _say("model  = beside this interval, the shell model's own error, O(eps): measured 2-3 eps too stiff "
-             "at depths <= H on a hemisphere (eps <= 0.1; docs: How accurate is the shell model?); "
+        _say("model  = beside this interval, the shell model's own error, O(eps): measured 2-5 eps too stiff "
+             "at depths of a few H, less deeper (docs: How accurate is the shell model?); "
              "`shellbvp validate` with these options measures it for this scene")
     show = (lambda v, unit, kind: format_in(v, unit, kind).split(" ")[0])
     if "offset" in res.fitted:
