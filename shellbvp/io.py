@@ -45,6 +45,7 @@ import numpy as np
 
 from .chain import CONFIGURATION_NAMES
 from .nexus import file_header, label_units
+from .schema import MAX_DATASET_BYTES
 from .paths import atomic_file, check_output_path, open_hdf5
 
 __all__ = ["Curve", "POINT_FIELDS", "CAP_FIELD_DEFAULTS", "point_record", "energy_residual", "write_curve",
@@ -332,10 +333,9 @@ def _bool_attr(g, name):
 
 
 def _json_attr(g, name):
-    try:
-        v = json.loads(_text_attr(g, name))
-    except json.JSONDecodeError as exc:
-        raise ValueError(f"attribute {name} is not valid JSON ({exc})") from None
+    from .schema import parse_json
+
+    v = parse_json(_text_attr(g, name), f"attribute {name}")  # size and depth bounded before parsing
     if not isinstance(v, dict):
         raise ValueError(f"attribute {name} must be a JSON object; got {type(v).__name__}")
     return v
@@ -350,6 +350,8 @@ def _field(g, name, n):
         raise ValueError(f"{name} must be a dataset; got a group")
     if d.ndim != 1 or d.shape[0] != n:
         raise ValueError(f"{name} must be a 1-D array of {n} values (one per delta); got shape {d.shape}")
+    if n * d.dtype.itemsize > MAX_DATASET_BYTES:  # before a compressed dataset is expanded
+        raise ValueError(f"{name} would expand to {n * d.dtype.itemsize / 2**20:.0f} MiB")
     v = d[()]
     if name in _STRING_FIELDS:
         if v.dtype.kind not in "OSU" and n:  # files of empty curves stored an empty float array

@@ -169,7 +169,7 @@ def parse_json(text, name, *, max_bytes=MAX_JSON_BYTES, max_depth=MAX_JSON_DEPTH
     try:
         return json.loads(text)
     except json.JSONDecodeError as exc:
-        raise ValueError(f"{name}: not JSON ({exc})") from None
+        raise ValueError(f"{name} is not valid JSON ({exc})") from None
 
 
 def format_version(h, newest: int) -> int:

@@ -64,3 +64,23 @@ def test_a_tampered_fit_record_is_refused_with_one_line(good, tmp_path, capsys, 
 def test_the_good_record_still_reads(good):
     fr = sb.read_fit(good)
     assert fr.success and fr.status == 0 and fr.data["displacement"].shape == (40,)
+
+
+def test_a_curve_file_bomb_is_refused_before_it_expands(tmp_path):
+    """A curve file whose datasets claim GBs, or whose scene JSON nests 200,000 deep (issue 42)."""
+    path = tmp_path / "c.h5"
+    sb.curve(sb.Scene.preset("base"), deltas=[0.1, 0.12], estimate_error=False).to_hdf5(path)
+    bomb = tmp_path / "bomb.h5"
+    shutil.copy(path, bomb)
+    with h5py.File(bomb, "r+") as h:
+        for name in ("delta", "force"):
+            del h[f"curve/{name}"]
+            h["curve"].create_dataset(name, shape=(400_000_000,), dtype="f8", compression="gzip", chunks=(1_000_000,))
+    with pytest.raises(ValueError, match="MiB"):
+        sb.read_curve(bomb)
+    deep = tmp_path / "deep.h5"
+    shutil.copy(path, deep)
+    with h5py.File(deep, "r+") as h:
+        h["curve"].attrs["scene"] = "[" * 200_000 + "]" * 200_000
+    with pytest.raises(ValueError, match="nested deeper"):
+        sb.read_curve(deep)
