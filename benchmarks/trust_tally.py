@@ -70,6 +70,9 @@ KINDS = {
     "csv": "3. malformed CSV files",
     "scenes": "4. extreme scene values",
     "cli": "5. CLI calls",
+    "fitrecords": "6. tampered fit records",
+    "sweepfiles": "7. tampered sweep files",
+    "inputs": "8. hostile inputs to fit and batches",
 }
 FORMULA_LIMIT = 30.0  # s: a formula call that has not returned by then is recorded as a DEFECT (hang)
 SLOW_SOLVE = 30.0  # s: solves slower than this are listed in the report
@@ -105,6 +108,19 @@ KIND_NOTES = {
               "xi and contact mostly valid; a scene that is accepted is solved with max_nodes=3000, "
               "tol=1e-4, estimate_error=False. A successful solve must have finite force, delta and Sc "
               "(lambda0 finite except for a point load); 'warning' = success with validity flags.",
+    "fitrecords": "Inputs: copies of a valid fit record (`shellbvp fit --example -o`) with one item changed: any "
+                  "attribute or dataset deleted, or set to junk (text, payloads, numbers, NaN, lists, bools, "
+                  "bytes, deep JSON), or a dataset replaced by a compressed one that claims 3 GB. `read_fit` must "
+                  "return a record whose data are numeric and of one length, with success agreeing with status, "
+                  "or raise one line; every fifth also through `shellbvp info` with escape sequences in the "
+                  "message (the terminal must not see them).",
+    "sweepfiles": "Inputs: copies of a valid 2-cell sweep file with one item changed as for fit records, plus "
+                  "completeness lies (a complete cell whose curve is deleted, a cell naming another's curve). "
+                  "`read_sweep` must return or raise one line; a cell read as complete must have its own curve.",
+    "inputs": "Inputs: `shellbvp fit` on a FIFO with no writer, /dev/zero, a folder named x.csv, a symlink loop, "
+              "a file named =HYPERLINK(...) in a batch with a table (the cell must not start a formula), a "
+              "record with two loading passes (a warning must name them), `sweep` with 1e8 combinations and "
+              "bad --scheduler addresses (one line each, no hang).",
     "cli": "Inputs: hand-written calls (bad output paths, `5_0`/`inf`/`nan`/`1e999` for numbers, huge or "
            "negative point counts, `solve --json` with bad values, `fit` on malformed CSVs, `info` and "
            "`plot` on non-files, unknown commands) in a temporary directory, timeout 120 s; with --json "
@@ -856,6 +872,202 @@ def kind_cli(n, rng, tmp):
     return records
 
 
+# -- 6, 7. tampered fit records and sweep files ----------------------------------------------------------
+def _items(path):
+    out = []
+    with h5py.File(path, "r") as h:
+        out += [("attr", "", a) for a in h.attrs]
+
+        def visit(name, obj):
+            out.append(("dataset" if isinstance(obj, h5py.Dataset) else "group", name, None))
+            out.extend(("attr", name, a) for a in obj.attrs)
+
+        h.visititems(visit)
+    return out
+
+
+def _mutate(good, path, rng, marker, scene_dict, items):
+    """Copy ``good`` to ``path`` with one item deleted or set to junk; return its description."""
+    shutil.copyfile(good, path)
+    kind, name, attr = rng.choice(items)
+    with h5py.File(path, "r+") as h:
+        obj = h[name] if name else h
+        if kind == "attr":
+            if rng.random() < 0.2:
+                del obj.attrs[attr]
+                return f"attribute {name or '/'}:{attr} deleted"
+            v = junk_values(rng, marker, scene_dict) if rng.random() < 0.8 else "[" * 100_000 + "]" * 100_000
+            try:
+                set_attr(obj, attr, v)
+            except (TypeError, ValueError):
+                return "unchanged (h5py cannot store the junk)"
+            return f"attribute {name or '/'}:{attr} = {str(v)[:60]!r}"
+        parent, leaf = name.rsplit("/", 1) if "/" in name else ("", name)
+        del h[name]
+        g = h[parent] if parent else h
+        how = rng.choice(["delete", "strings", "scalar", "bomb"])
+        if how == "delete":
+            return f"{kind} /{name} deleted"
+        if how == "bomb":
+            g.create_dataset(leaf, shape=(400_000_000,), dtype="f8", compression="gzip", chunks=(1_000_000,))
+            return f"{kind} /{name} = a compressed dataset claiming 3.2 GB"
+        if how == "strings":
+            g.create_dataset(leaf, data=["x", payloads(marker)[0], "nan"], dtype=h5py.string_dtype())
+            return f"{kind} /{name} = strings"
+        v = rng.choice([0.1, float("nan"), -1.0, 99])
+        g[leaf] = v
+        return f"{kind} /{name} = scalar {v!r}"
+
+
+def _check_fit(fr):
+    bad = []
+    n = len(fr.data.get("displacement", []))
+    for k, v in fr.data.items():
+        if np.ndim(v) != 1 or len(v) != n:
+            bad.append(f"data/{k} of shape {np.shape(v)}")
+    for k in ("displacement", "force"):
+        if np.asarray(fr.data[k]).dtype.kind not in "fiu":
+            bad.append(f"data/{k} of dtype {np.asarray(fr.data[k]).dtype}")
+    if fr.success != (fr.status == 0):
+        bad.append(f"success {fr.success} with status {fr.status}")
+    if fr.success and not (np.isfinite(fr.parameters["mu_H"]) and fr.parameters["mu_H"] > 0):
+        bad.append(f"successful with mu_H {fr.parameters['mu_H']}")
+    if not fr.parameters["R_L"] > 0:
+        bad.append(f"R_L {fr.parameters['R_L']}")
+    return bad
+
+
+def kind_fitrecords(n, rng, tmp):
+    marker = tmp / "MARKER"
+    good = tmp / "good.h5"
+    r = subprocess.run([sys.executable, "-m", "shellbvp", "fit", "--example", "--preset", "fit", "--radius", "0.3mm",
+                        "-o", str(good)], cwd=tmp, capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    scene_dict = sb.read_fit(good).scene.to_dict()
+    items = _items(good)
+    records = []
+    for i in range(n):
+        path = tmp / f"mut{i:04d}.h5"
+        desc = _mutate(good, path, rng, marker, scene_dict, items) if i else "the untouched valid file"
+        if i == 0:
+            shutil.copyfile(good, path)
+        out = call(lambda: sb.read_fit(path), limit=60)
+        if marker.exists():
+            o, d = "DEFECT", "PAYLOAD RAN: marker file created"
+            marker.unlink()
+        elif out["exc"] is not None:
+            o, d = judge_exception(out)
+        else:
+            bad = _check_fit(out["result"])
+            o, d = ("DEFECT", "accepted: " + "; ".join(bad)) if bad else ("correct result", "read")
+        records.append(rec("fitrecords", "read_fit(path)", desc, o, d, out["seconds"]))
+        if i % 5 == 0:
+            with h5py.File(path, "r+") as h:
+                if "fit" in h and isinstance(h["fit"], h5py.Group):
+                    h["fit"].attrs["message"] = "\x1b[2J\x1b[1;1Hforged"
+            o, d, dt = run_cli(["info", str(path)], cwd=tmp)
+            r = subprocess.run([sys.executable, "-m", "shellbvp", "info", str(path)], cwd=tmp, capture_output=True)
+            if b"\x1b" in r.stdout + r.stderr:
+                o, d = "DEFECT", "an escape sequence from the file reached the terminal"
+            records.append(rec("fitrecords", "shellbvp info PATH (message with escapes)", desc, o, d, dt))
+    return records
+
+
+def kind_sweepfiles(n, rng, tmp):
+    from shellbvp.sweep import sweep
+
+    marker = tmp / "MARKER"
+    good = tmp / "good.h5"
+    sweep(sb.Scene.preset("base"), {"beta": [0.005, 0.01]}, delta_max=0.1, out=good, workers=1, deltas=[0.05, 0.1],
+          estimate_error=False)
+    scene_dict = sb.Scene.preset("base").to_dict()
+    items = _items(good)
+    cases = []
+    p = tmp / "nocurve.h5"
+    shutil.copyfile(good, p)
+    with h5py.File(p, "r+") as h:
+        del h["sweep/curves/curve_000001"]
+    cases.append((p, "a complete cell whose curve is deleted"))
+    p = tmp / "other.h5"
+    shutil.copyfile(good, p)
+    with h5py.File(p, "r+") as h:
+        g = [x.decode() if isinstance(x, bytes) else x for x in h["sweep/index/group"][()]]
+        del h["sweep/index/group"]
+        h["sweep/index"].create_dataset("group", data=[g[0], g[0]], dtype=h5py.string_dtype())
+    cases.append((p, "a cell naming another cell's curve"))
+    i = 0
+    while len(cases) < n:
+        p = tmp / f"mut{i:04d}.h5"
+        cases.append((p, _mutate(good, p, rng, marker, scene_dict, items)))
+        i += 1
+    records = []
+    for path, desc in cases:
+        out = call(lambda: sb.read_sweep(path), limit=60)
+        if marker.exists():
+            o, d = "DEFECT", "PAYLOAD RAN: marker file created"
+            marker.unlink()
+        elif out["exc"] is not None:
+            o, d = judge_exception(out)
+        else:
+            sw = out["result"]
+            lies = [i for i, st in enumerate(sw.index["status"]) if st == "complete" and i not in sw.curves]
+            o, d = (("DEFECT", f"cells {lies} read as complete without a curve") if lies else
+                    ("correct result", f"{sw.counts()}"))
+        records.append(rec("sweepfiles", "read_sweep(path)", desc, o, d, out["seconds"]))
+    return records
+
+
+# -- 8. hostile inputs to fit and batches ----------------------------------------------------------------
+def kind_inputs(n, rng, tmp):
+    import os
+
+    from shellbvp.fitting import example_data_path
+
+    good = tmp / "good.csv"
+    shutil.copyfile(example_data_path(), good)
+    os.mkfifo(tmp / "pipe.csv")
+    (tmp / "sub.csv").mkdir()
+    os.symlink(tmp / "loop.csv", tmp / "loop.csv")
+    formula = '=HYPERLINK("http:x","y").csv'
+    shutil.copyfile(example_data_path(), tmp / formula)
+    d, F = np.loadtxt(example_data_path(), delimiter=",", skiprows=2, unpack=True)
+    rows = [(x, y) for x, y in zip(d, F)] + [(x, 0.5 * y) for x, y in zip(d[::-1], F[::-1])] + \
+        [(x, 3 * y) for x, y in zip(d, F)]
+    (tmp / "two.csv").write_text("displacement (mm),force (mN)\n" + "\n".join(f"{x:.6f},{y:.6f}" for x, y in rows))
+    fit = ["fit", "--preset", "fit", "--radius", "0.3mm"]
+    calls = [(["fit", "pipe.csv", "--preset", "fit", "--radius", "0.3mm"], "a FIFO with no writer", None),
+             (["fit", "/dev/zero", "--preset", "fit", "--radius", "0.3mm"], "/dev/zero", None),
+             (["fit", "sub.csv", "--preset", "fit", "--radius", "0.3mm"], "a folder named sub.csv", None),
+             (["fit", "loop.csv", "--preset", "fit", "--radius", "0.3mm"], "a symlink loop", None),
+             (["sweep", "--beta", "0.005:0.02:100", "--rho", "0.1:0.3:100", "--gamma", "0.5:1.5:100",
+               "--alpha", "0:1:100", "-o", "g.h5"], "a sweep grid of 1e8 combinations", None)]
+    calls += [(["sweep", "--beta", "0.01", "--delta-max", "0.1", "--scheduler", a, "-o", "g.h5"],
+               f"--scheduler {a!r}", None) for a in ("", "ucx://h:1", "tls://h:1", "inproc://foo", "h:99999")]
+    records = []
+    for args, desc, _ in calls[:n]:
+        o, d, dt = run_cli(args, cwd=tmp, timeout=60)
+        records.append(rec("inputs", args[0], desc, o, d, dt))
+    # a batch with the bad inputs, the good file and a formula-named one: rows for all, table escaped
+    t0 = time.perf_counter()
+    r = subprocess.run([sys.executable, "-m", "shellbvp", *fit, ".", "/dev/zero", "--table", "t.csv"], cwd=tmp,
+                       capture_output=True, text=True, timeout=300)
+    table = (tmp / "t.csv").read_text() if (tmp / "t.csv").exists() else ""
+    cells = [ln.split(",")[0] for ln in table.splitlines()[1:]]
+    bad = [c for c in cells if c.startswith(("=", "+", "-", "@"))]
+    o = ("DEFECT", f"exit {r.returncode}; table cells starting a formula: {bad}" if bad or not table
+         else "") if (bad or not table or "Traceback" in r.stderr) else \
+        ("failed status", f"exit {r.returncode}: {len(cells)} rows, every bad input a row")
+    records.append(rec("inputs", "fit (batch)", "a folder with a FIFO, a folder, a loop, a formula name; and "
+                       "/dev/zero", o[0], o[1], time.perf_counter() - t0))
+    t0 = time.perf_counter()
+    r = subprocess.run([sys.executable, "-m", "shellbvp", *fit[:1], "two.csv", *fit[1:]], cwd=tmp, capture_output=True,
+                       text=True, timeout=300)
+    o = ("warning", "the two passes named") if "loading passes" in r.stdout else ("DEFECT", "no word of the passes")
+    records.append(rec("inputs", "fit", "two loading passes, the second at 3x the force", o[0], o[1],
+                       time.perf_counter() - t0))
+    return records
+
+
 # -- report -------------------------------------------------------------------------------------------------
 def tally(records):
     counts = {o: 0 for o in OUTCOMES}
@@ -966,15 +1178,18 @@ def main(argv=None):
     p.add_argument("--only", help="comma-separated kinds: " + ",".join(KINDS))
     p.add_argument("--out", type=Path, help="markdown report (default benchmarks/results/trust_tally[-quick].md)")
     args = p.parse_args(argv)
-    sizes = {"formulas": 300, "hdf5": 150, "csv": 200, "scenes": 80, "cli": 100}
+    sizes = {"formulas": 300, "hdf5": 150, "csv": 200, "scenes": 80, "cli": 100, "fitrecords": 120,
+             "sweepfiles": 80, "inputs": 20}
     if args.quick:
-        sizes = {"formulas": 60, "hdf5": 15, "csv": 20, "scenes": 8, "cli": 10}
+        sizes = {"formulas": 60, "hdf5": 15, "csv": 20, "scenes": 8, "cli": 10, "fitrecords": 15, "sweepfiles": 10,
+                 "inputs": 20}
     kinds = args.only.split(",") if args.only else list(KINDS)
     head = git("rev-parse", "--short", "HEAD")
     dirty = sorted({ln[3:].split("/")[0] for ln in git("status", "--porcelain").splitlines()
                     if ln[3:].startswith(("shellbvp/", "symbolic/"))})
     dirty = ", ".join(f"`{d}/`" for d in dirty)
-    funcs = {"formulas": kind_formulas, "hdf5": kind_hdf5, "csv": kind_csv, "scenes": kind_scenes, "cli": kind_cli}
+    funcs = {"formulas": kind_formulas, "hdf5": kind_hdf5, "csv": kind_csv, "scenes": kind_scenes, "cli": kind_cli,
+             "fitrecords": kind_fitrecords, "sweepfiles": kind_sweepfiles, "inputs": kind_inputs}
     records, kind_times = [], {}
     t0 = time.perf_counter()
     with tempfile.TemporaryDirectory(prefix="trust-tally-") as td:
