@@ -278,6 +278,11 @@ class _PenaltyContact:
         dX = np.einsum("ga,ead->egd", dN, X)
         self.weight = (w[None, :] * np.hypot(dX[..., 0], dX[..., 1]) * 2 * np.pi * Xq[..., 1]).ravel()
         self.edges, self.N = edges, N
+        # per Gauss point: the 6 displacement dofs of its edge and the 3 shape functions (fixed)
+        e, ng = edges.shape[0], N.shape[0]
+        dof = 2 * edges[:, None, :, None] + np.arange(2)[None, None, None, :]          # (e, 1, 3, 2)
+        self.dof = np.broadcast_to(dof, (e, ng, 3, 2)).reshape(-1, 6)
+        self.Nq = np.broadcast_to(N[None], (e, ng, 3)).reshape(-1, 3)
         self.z0 = float(points[top[0], 0])  # the surface's pole: where the tip first touches
         self.apex = self.z0
 
@@ -301,10 +306,7 @@ class _PenaltyContact:
         dpsi = np.where(g >= s, 2 * g - s, np.where(active, g * g / s, 0.0))
         d2psi = np.where(g >= s, 2.0, np.where(active, 2 * g / s, 0.0))
         force = -0.5 * self.k * self.weight * dpsi            # (q,) minus the normal force * weight
-        e, ng = self.edges.shape[0], self.N.shape[0]
-        dof = (2 * self.edges[:, None, :, None] + np.arange(2)[None, None, None, :])     # (e, 1, 3, 2)
-        dof = np.broadcast_to(dof, (e, ng, 3, 2)).reshape(-1, 6)
-        Nq = np.broadcast_to(self.N[None], (e, ng, 3)).reshape(-1, 3)
+        dof, Nq = self.dof, self.Nq
         vec = (force[:, None, None] * Nq[:, :, None] * n[:, None, :]).reshape(-1, 6)
         r = np.zeros(self.ndof)
         np.add.at(r, dof.ravel(), vec.ravel())

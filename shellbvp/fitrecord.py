@@ -292,14 +292,14 @@ def read_fit(path) -> FitRecord:
                       for k in PARAMETER_UNITS}
             if not (params["R_L"] > 0 and math.isfinite(params["R_L"])):
                 raise ValueError(f"parameters/R_L must be a length > 0; got {params['R_L']!r}")
-            fitted = [sc._text(s, "parameters.fitted") for s in np.atleast_1d(p.attrs["fitted"])]
+            fitted = [sc.text(s, "parameters.fitted") for s in np.atleast_1d(p.attrs["fitted"])]
             unknown = sorted(set(fitted) - set(PARAMETER_UNITS))
             if unknown or "mu_H" not in fitted:
                 raise ValueError(f"parameters.fitted must name mu_H and known parameters; got {fitted}")
             intervals = {k: tuple(sc.dataset(p, f"{k}_ci95", length=2)) for k in fitted}
             settings = {k: sc.attr_text(p, k) for k in ("baseline_model", "weights", "segment")}
             warnings = sc.text_dataset(e, "warnings")
-            codes = [sc._text(s, "warnings.codes") for s in np.atleast_1d(e["warnings"].attrs.get("codes", []))]
+            codes = [sc.text(s, "warnings.codes") for s in np.atleast_1d(e["warnings"].attrs.get("codes", []))]
             scene = Scene.from_dict(sc.parse_json(sc.attr_text(e["sample"], "scene"), "sample.scene"))
             src = e["source"]
             source = {"file_name": sc.text_dataset(src, "file_name", ndim=0),

@@ -44,9 +44,9 @@ from pathlib import Path
 import numpy as np
 
 from .chain import CONFIGURATION_NAMES
-from .nexus import file_header, label_units
+from .nexus import new_file
+from .paths import open_hdf5
 from .schema import MAX_DATASET_BYTES
-from .paths import atomic_file, check_output_path, open_hdf5
 
 __all__ = ["Curve", "POINT_FIELDS", "CAP_FIELD_DEFAULTS", "point_record", "energy_residual", "write_curve",
            "read_curve", "write_curve_group", "read_curve_group", "FORMAT",
@@ -272,18 +272,9 @@ def write_curve(curve, path, *, profiles=False, overwrite=False, units=None):
     units : dict, optional
         ``{"R_L": metres, "mu_H": N/m}``: also store ``delta_m`` and ``force_N``.
     """
-    import h5py
-
-    path = Path(path)
     _check_units(units)  # bad units refused before any file is made
-    if path.exists() and not overwrite:
-        raise FileExistsError(f"{path} exists; pass overwrite=True (CLI: --force) to replace it")
-    check_output_path(path, overwrite=True)
-    with atomic_file(path) as tmp:
-        with h5py.File(tmp, "w") as f:
-            file_header(f, FORMAT, FORMAT_VERSION)
-            write_curve_group(f.create_group("curve"), curve, profiles=profiles, units=units)
-        label_units(tmp)  # every dataset says its unit (nondimensional: "1")
+    with new_file(path, FORMAT, FORMAT_VERSION, overwrite=overwrite) as f:
+        write_curve_group(f.create_group("curve"), curve, profiles=profiles, units=units)
 
 
 def _missing_field(name, n):

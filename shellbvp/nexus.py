@@ -8,8 +8,10 @@ of curve files; :func:`missing_units` is the check a test runs on every file.
 
 from __future__ import annotations
 
+from contextlib import contextmanager
+
 __all__ = ["CURVE_DATASET_UNITS", "DIMENSIONLESS", "label_units", "missing_units", "string_dataset",
-           "number_dataset", "file_header"]
+           "number_dataset", "file_header", "new_file"]
 
 #: The unit of a nondimensional number.
 DIMENSIONLESS = "1"
@@ -96,3 +98,25 @@ def file_header(f, fmt: str, version: int) -> None:
     f.attrs["format_version"] = version
     f.attrs["package_version"] = __version__
     f.attrs["created"] = _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds")
+
+
+@contextmanager
+def new_file(path, fmt: str, version: int, *, overwrite: bool = False):
+    """An HDF5 file of the package written atomically: refused if ``path`` exists and not
+    ``overwrite``; yields the open file with its :func:`file_header`; on success the datasets get
+    their units (:func:`label_units`) and the file replaces ``path``, on any error nothing does."""
+    from pathlib import Path
+
+    import h5py
+
+    from .paths import atomic_file, check_output_path
+
+    path = Path(path)
+    if path.exists() and not overwrite:
+        raise FileExistsError(f"{path} exists; pass overwrite=True (CLI: --force) to replace it")
+    check_output_path(path, overwrite=True)
+    with atomic_file(path) as tmp:
+        with h5py.File(tmp, "w") as f:
+            file_header(f, fmt, version)
+            yield f
+        label_units(tmp)  # every dataset says its unit (nondimensional: "1")

@@ -14,7 +14,7 @@ import math
 import numpy as np
 
 __all__ = ["MAX_DATASET_BYTES", "MAX_JSON_BYTES", "MAX_JSON_DEPTH", "dataset", "text_dataset", "attr_text",
-           "attr_bool", "attr_int", "scalar", "parse_json", "format_version"]
+           "attr_bool", "attr_int", "text", "scalar", "parse_json", "format_version"]
 
 #: The most bytes one dataset may hold once expanded (a 27 KB file's compressed datasets
 #: claimed 3 GB each): 256 MiB, far above any curve or record the package writes.
@@ -73,11 +73,12 @@ def text_dataset(group, name, *, ndim=1, length=None, max_bytes=MAX_DATASET_BYTE
         raise ValueError(f"{name} holds too many strings ({item.shape})")
     value = item[()]
     if ndim == 0:
-        return _text(value, name, max_bytes)
-    return [_text(v, name, max_bytes) for v in value]
+        return text(value, name, max_bytes)
+    return [text(v, name, max_bytes) for v in value]
 
 
-def _text(v, name, max_bytes=MAX_JSON_BYTES):
+def text(v, name, max_bytes=MAX_JSON_BYTES):
+    """A string value (bytes decoded as UTF-8, undecodable bytes replaced), at most ``max_bytes`` long."""
     if isinstance(v, np.ndarray) and v.ndim == 0:
         v = v[()]
     if isinstance(v, bytes):
@@ -93,7 +94,7 @@ def attr_text(obj, name, *, max_bytes=MAX_JSON_BYTES) -> str:
     """A text attribute."""
     if name not in obj.attrs:
         raise ValueError(f"attribute {name} is missing")
-    return _text(obj.attrs[name], f"attribute {name}", max_bytes)
+    return text(obj.attrs[name], f"attribute {name}", max_bytes)
 
 
 def attr_bool(obj, name) -> bool:

@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import json
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 
@@ -95,45 +94,35 @@ class Validation:
         error; the default plot), ``shell`` (the shell model's curve as in a curve file) and
         ``fe`` (NXdata: delta, force, indenter, contact_radius, mesh_error; the FE settings).
         """
-        import h5py
-
         from .io import write_curve_group
-        from .nexus import file_header, label_units, number_dataset
-        from .paths import atomic_file, check_output_path
+        from .nexus import new_file, number_dataset
 
-        path = Path(path)
-        if path.exists() and not overwrite:
-            raise FileExistsError(f"{path} exists; pass overwrite=True (CLI: --force) to replace it")
-        check_output_path(path, overwrite=True)
-        with atomic_file(path) as tmp:
-            with h5py.File(tmp, "w") as f:
-                file_header(f, FORMAT, FORMAT_VERSION)
-                f.attrs["default"] = "entry"
-                entry = f.create_group("entry")
-                entry.attrs["NX_class"] = "NXentry"
-                entry.attrs["default"] = "comparison"
-                entry.attrs["thickness"] = float(self.scene.thickness)
-                cmp_ = entry.create_group("comparison")
-                cmp_.attrs.update({"NX_class": "NXdata", "signal": "error", "axes": "delta"})
-                number_dataset(cmp_, "delta", self.delta, "1", "mid-surface pole displacement / R_L")
-                number_dataset(cmp_, "force_shell", self.force_shell, "1", "shell model's F / (mu H R_L)")
-                number_dataset(cmp_, "force_fe", self.force_fe, "1", "3D solid's F / (mu H R_L)")
-                number_dataset(cmp_, "error", self.error, "1", "F_shell / F_FE - 1")
-                write_curve_group(entry.create_group("shell"), self.shell)
-                fe = entry.create_group("fe")
-                fe.attrs.update({"NX_class": "NXdata", "signal": "force", "axes": "delta",
-                                 "success": bool(self.fe.success), "message": self.fe.message,
-                                 "elements": np.asarray(self.fe.elements),
-                                 "settings": json.dumps(self.fe.settings, sort_keys=True),
-                                 "wall_time_s": float(self.fe.wall_time)})
-                number_dataset(fe, "delta", self.fe.delta, "1", "mid-surface pole displacement / R_L")
-                number_dataset(fe, "force", self.fe.force, "1", "indenter force F / (mu H R_L)")
-                number_dataset(fe, "indenter", self.fe.indenter, "1", "indenter displacement / R_L")
-                number_dataset(fe, "contact_radius", self.fe.contact_radius, "1",
-                               "radius of the outermost contact point / R_L")
-                number_dataset(fe, "mesh_error", self.fe.mesh_error, "1",
-                               "|F - F on a mesh with 2/3 the elements| / F")
-            label_units(tmp)
+        with new_file(path, FORMAT, FORMAT_VERSION, overwrite=overwrite) as f:
+            f.attrs["default"] = "entry"
+            entry = f.create_group("entry")
+            entry.attrs["NX_class"] = "NXentry"
+            entry.attrs["default"] = "comparison"
+            entry.attrs["thickness"] = float(self.scene.thickness)
+            cmp_ = entry.create_group("comparison")
+            cmp_.attrs.update({"NX_class": "NXdata", "signal": "error", "axes": "delta"})
+            number_dataset(cmp_, "delta", self.delta, "1", "mid-surface pole displacement / R_L")
+            number_dataset(cmp_, "force_shell", self.force_shell, "1", "shell model's F / (mu H R_L)")
+            number_dataset(cmp_, "force_fe", self.force_fe, "1", "3D solid's F / (mu H R_L)")
+            number_dataset(cmp_, "error", self.error, "1", "F_shell / F_FE - 1")
+            write_curve_group(entry.create_group("shell"), self.shell)
+            fe = entry.create_group("fe")
+            fe.attrs.update({"NX_class": "NXdata", "signal": "force", "axes": "delta",
+                             "success": bool(self.fe.success), "message": self.fe.message,
+                             "elements": np.asarray(self.fe.elements),
+                             "settings": json.dumps(self.fe.settings, sort_keys=True),
+                             "wall_time_s": float(self.fe.wall_time)})
+            number_dataset(fe, "delta", self.fe.delta, "1", "mid-surface pole displacement / R_L")
+            number_dataset(fe, "force", self.fe.force, "1", "indenter force F / (mu H R_L)")
+            number_dataset(fe, "indenter", self.fe.indenter, "1", "indenter displacement / R_L")
+            number_dataset(fe, "contact_radius", self.fe.contact_radius, "1",
+                           "radius of the outermost contact point / R_L")
+            number_dataset(fe, "mesh_error", self.fe.mesh_error, "1",
+                           "|F - F on a mesh with 2/3 the elements| / F")
 
 
 def validate(scene, thickness=None, deltas=None, *, delta_max=0.5, mesh_check=False, progress=None,

@@ -132,7 +132,7 @@ def plate_limit(B):
     Gaussian curvature's energy does: at a free or simply supported edge).
     """
     flat = {LS: 1, LT: 1, KS0: 0, KT0: 0}
-    B = sp.sympify(B).subs(flat)
+    B = sp.sympify(B, strict=True).subs(flat)  # an expression already, never text
     at_rest = {KS: 0, KT: 0}
     ss = sp.simplify(sp.diff(B, KS, 2).subs(at_rest))
     st = sp.simplify(sp.diff(B, KS, KT).subs(at_rest))
