@@ -207,6 +207,24 @@ def judge_exception(out):
     return "DEFECT", f"{type(exc).__name__}: {str(exc)[:200]} -- {tail(out['tb'])}"
 
 
+def judge_read(read, check, marker, describe):
+    """(outcome, detail, seconds) of ``read()`` on a possibly hostile file: a payload that ran or
+    a result ``check`` finds wrong (a list of problems) is a DEFECT; ``describe(result)`` says
+    what a correct read gave."""
+    out = call(read, limit=60)
+    if marker.exists():
+        marker.unlink()
+        return "DEFECT", "PAYLOAD RAN: marker file created", out["seconds"]
+    if out["exc"] is not None:
+        return (*judge_exception(out), out["seconds"])
+    bad = check(out["result"])
+    if bad:
+        return "DEFECT", "accepted: " + "; ".join(bad), out["seconds"]
+    if out["warned"]:
+        return "warning", "; ".join(out["warned"])[:300], out["seconds"]
+    return "correct result", describe(out["result"]), out["seconds"]
+
+
 def _strict(constant):
     raise ValueError(f"{constant} is not strict JSON")
 
@@ -561,21 +579,8 @@ def kind_hdf5(n, rng, tmp):
         i += 1
     records = []
     for j, (path, desc) in enumerate(cases):
-        out = call(lambda: sb.read_curve(path), limit=60)
-        if marker.exists():
-            o, d = "DEFECT", "PAYLOAD RAN: marker file created"
-            marker.unlink()
-        elif out["exc"] is not None:
-            o, d = judge_exception(out)
-        else:
-            bad = check_curve(out["result"])
-            if bad:
-                o, d = "DEFECT", "accepted: " + "; ".join(bad)
-            elif out["warned"]:
-                o, d = "warning", "; ".join(out["warned"])[:300]
-            else:
-                o, d = "correct result", f"{len(out['result'])} points"
-        records.append(rec("hdf5", "read_curve(path)", desc, o, d, out["seconds"]))
+        o, d, dt = judge_read(lambda: sb.read_curve(path), check_curve, marker, lambda c: f"{len(c)} points")
+        records.append(rec("hdf5", "read_curve(path)", desc, o, d, dt))
         if j % 5 == 0:
             o, d, dt = run_cli(["info", str(path)], cwd=tmp)
             if marker.exists():
@@ -951,16 +956,8 @@ def kind_fitrecords(n, rng, tmp):
         desc = _mutate(good, path, rng, marker, scene_dict, items) if i else "the untouched valid file"
         if i == 0:
             shutil.copyfile(good, path)
-        out = call(lambda: sb.read_fit(path), limit=60)
-        if marker.exists():
-            o, d = "DEFECT", "PAYLOAD RAN: marker file created"
-            marker.unlink()
-        elif out["exc"] is not None:
-            o, d = judge_exception(out)
-        else:
-            bad = _check_fit(out["result"])
-            o, d = ("DEFECT", "accepted: " + "; ".join(bad)) if bad else ("correct result", "read")
-        records.append(rec("fitrecords", "read_fit(path)", desc, o, d, out["seconds"]))
+        o, d, dt = judge_read(lambda: sb.read_fit(path), _check_fit, marker, lambda fr: "read")
+        records.append(rec("fitrecords", "read_fit(path)", desc, o, d, dt))
         if i % 5 == 0:
             with h5py.File(path, "r+") as h:
                 if "fit" in h and isinstance(h["fit"], h5py.Group):
@@ -971,6 +968,11 @@ def kind_fitrecords(n, rng, tmp):
                 o, d = "DEFECT", "an escape sequence from the file reached the terminal"
             records.append(rec("fitrecords", "shellbvp info PATH (message with escapes)", desc, o, d, dt))
     return records
+
+
+def _check_sweep(sw):
+    lies = [i for i, st in enumerate(sw.index["status"]) if st == "complete" and i not in sw.curves]
+    return [f"cells {lies} read as complete without a curve"] if lies else []
 
 
 def kind_sweepfiles(n, rng, tmp):
@@ -1002,18 +1004,8 @@ def kind_sweepfiles(n, rng, tmp):
         i += 1
     records = []
     for path, desc in cases:
-        out = call(lambda: sb.read_sweep(path), limit=60)
-        if marker.exists():
-            o, d = "DEFECT", "PAYLOAD RAN: marker file created"
-            marker.unlink()
-        elif out["exc"] is not None:
-            o, d = judge_exception(out)
-        else:
-            sw = out["result"]
-            lies = [i for i, st in enumerate(sw.index["status"]) if st == "complete" and i not in sw.curves]
-            o, d = (("DEFECT", f"cells {lies} read as complete without a curve") if lies else
-                    ("correct result", f"{sw.counts()}"))
-        records.append(rec("sweepfiles", "read_sweep(path)", desc, o, d, out["seconds"]))
+        o, d, dt = judge_read(lambda: sb.read_sweep(path), _check_sweep, marker, lambda sw: f"{sw.counts()}")
+        records.append(rec("sweepfiles", "read_sweep(path)", desc, o, d, dt))
     return records
 
 
