@@ -31,7 +31,7 @@ HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parent))  # this checkout's package
 
 import shellbvp as sb  # noqa: E402
-from shellbvp.validation import default_depths  # noqa: E402
+from shellbvp.validation import default_depths, shell_curve  # noqa: E402
 
 EPS = (0.1, 0.05, 0.02, 0.01)
 #: (gamma, rho): hemisphere and a prolate Lepidium-like shell at three indenter sizes (the
@@ -42,6 +42,8 @@ VARIANTS = {  # shell-model variants compared with the same FE curve
     "smooth, rotation": dict(contact="smooth", bending=sb.RotationBending()),
     "paper": dict(contact="paper", bending=sb.TraceBending()),
     "paper, rotation": dict(contact="paper", bending=sb.RotationBending()),
+    "smooth, shear": dict(contact="smooth", bending=sb.TraceBending(), transverse_shear=True),
+    "smooth, rotation, shear": dict(contact="smooth", bending=sb.RotationBending(), transverse_shear=True),
 }
 DELTA_MAX = 0.5
 
@@ -80,6 +82,10 @@ def shell_rows(fe):
         else:
             scene = scene_of(gamma, rho, eps, **over)
         t0 = time.perf_counter()
+        if scene.transverse_shear:  # forces at the thick shell's depths delta + shear_delta
+            c = shell_curve(scene, d)
+            rows[name] = {"force": c.force_at(d).tolist(), "seconds": time.perf_counter() - t0}
+            continue
         c = sb.curve(scene, deltas=d, estimate_error=False)
         F = np.full(d.size, np.nan)
         rc = np.full(d.size, np.nan)
@@ -143,7 +149,7 @@ def report(cache, plan, args):
              ("H < delta < 5H", lambda k, wrap: 1 + 1e-9 < k < 5 - 1e-9 and not wrap),
              ("delta >= 5H, contact short of the tip's equator", lambda k, wrap: k >= 5 - 1e-9 and not wrap),
              ("contact round the tip's equator (r_c >= 0.95 rho)", lambda k, wrap: wrap))
-    variants = ("smooth", "smooth, rotation", "paper")
+    variants = ("smooth", "smooth, shear", "smooth, rotation", "smooth, rotation, shear", "paper")
     lines += ["## Summary: the largest |F_shell / F_FE - 1| over the scenes, by depth", "",
               "Depth bands an experimenter can tell apart: delta against the thickness H, and whether the "
               "contact has spread round the indenter's equator (the FE's contact radius r_c at 0.95 rho or "
@@ -172,6 +178,8 @@ def main(argv=None):
     ap.add_argument("--mesh-check", action="store_true", dest="mesh_check",
                     help="each FE curve also on a coarser mesh (FECurve.mesh_error)")
     ap.add_argument("--recompute", action="store_true", help="ignore the cached FE curves")
+    ap.add_argument("--shell-only", action="store_true", dest="shell_only",
+                    help="no FE: recompute the shell model's rows of every cached FE curve")
     ap.add_argument("--eps", default=None, help="only these thicknesses, comma-separated (default: 0.1,0.05,0.02,0.01); "
                     "the report shows every cached one")
     ap.add_argument("--out-dir", default=None, help="write results/ under this directory (default benchmarks/)")
@@ -186,6 +194,10 @@ def main(argv=None):
     todo = [(g, r, e, args.mesh_check) for g, r in plan["scenes"] for e in todo_eps
             if key(g, r, e) not in cache or not cache[key(g, r, e)].get("success")]
     todo.sort(key=lambda t: t[2])  # thinnest (slowest) first
+    if args.shell_only:
+        todo = []
+        for fe in cache.values():
+            fe.pop("shell", None)
     with ProcessPoolExecutor(max_workers=max(1, args.workers)) as pool:
         for k, fe in pool.map(fe_case, todo):
             fe["shell"] = shell_rows(fe)
@@ -193,9 +205,10 @@ def main(argv=None):
             print(f"{k}: FE {fe['seconds']:.0f} s, {fe['message']}; smooth "
                   + " ".join(pct(a / b - 1) for a, b in zip(fe["shell"]["smooth"]["force"], fe["force"])), flush=True)
             store.write_text(json.dumps(cache, indent=1, default=float))  # no finished curve is lost
-    for k, fe in cache.items():
-        if "shell" not in fe:
-            fe["shell"] = shell_rows(fe)
+    missing = [k for k, fe in cache.items() if "shell" not in fe]
+    with ProcessPoolExecutor(max_workers=max(1, args.workers)) as pool:
+        for k, rows in zip(missing, pool.map(shell_rows, [cache[k] for k in missing])):
+            cache[k]["shell"] = rows
     store.write_text(json.dumps(cache, indent=1, default=float))
     (out / f"validation{suffix}.md").write_text(report(cache, plan, args))
     print(f"wrote {out / f'validation{suffix}.md'}")

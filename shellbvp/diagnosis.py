@@ -16,6 +16,7 @@ import numpy as np
 
 from .chain import FREE_STATES, ContactPole, Edge, FreePole, Line, PointPole, TipEnd
 from .solution import Solution, penetration, set_status, wall_gap
+from .thickness import shear_delta
 
 __all__ = ["diagnose", "STATE_NUMBERS", "as_failure"]
 
@@ -37,6 +38,15 @@ def _edges(sysm):
 def _at(sysm, kind, S, y):
     """The generated profile of a ``kind`` region at one point S with state y (kernel set's)."""
     return getattr(sysm.kernels.active, f"{kind}_profile")(np.array([S], dtype=float), y[:, None], sysm.par)
+
+
+def _shear_delta(sysm, parts, edges, ends):
+    """What transverse shear adds to the pole displacement (:mod:`shellbvp.thickness`), from the
+    free shell outside the outermost contact edge or ring (all of it under a point load)."""
+    start = edges[-1][2] if edges else 0
+    edge_r = ends[start][0]["r"] if edges else 0.0
+    kinds = [(sysm.regions[k].kind, f) for k, _, f in parts]
+    return shear_delta(kinds, start, edge_r, sysm.scene.thickness)
 
 
 def _legendre_min(sysm, t, y, p):
@@ -159,7 +169,7 @@ def diagnose(sysm, bvp, tol, converged_note: str = "") -> Solution:
             flags.append(f"collapsed state with delta = {delta:.3g} < 0")
     set_status(res, bvp, flags, converged_note)
     if not finite:
-        res.update(energy=nan, pressure_min=nan, penetration=nan, force_defect=nan, edge_legendre=nan,
+        res.update(energy=nan, shear_delta=nan, pressure_min=nan, penetration=nan, force_defect=nan, edge_legendre=nan,
                    legendre_min=nan, legendre_min_S=nan, edge_jump_ls=nan, edge_jump_ks=nan,
                    contact_edge=_edge_model(sysm),
                    ring_force=nan, ring_force_inner=nan, cap_force=nan, edge_forces=[], valid=False, flags=flags)
@@ -198,6 +208,7 @@ def diagnose(sysm, bvp, tol, converged_note: str = "") -> Solution:
     res.contact_edge = _edge_model(sysm)
     res.edge_jump_ls, res.edge_jump_ks = _edge_jumps(sysm, ends)
     res.energy = sysm.energy(bvp.sol, bvp.x, p)
+    res.shear_delta = _shear_delta(sysm, parts, edges, ends) if sysm.scene.transverse_shear else 0.0
 
     admissible, vflags = [], []
     omega_max = sysm.scene.tip_omega_max
@@ -258,7 +269,7 @@ def diagnose(sysm, bvp, tol, converged_note: str = "") -> Solution:
 
 #: The numbers of a state; a run that did not converge reports them as NaN, all but the
 #: prescribed one (its ``y``, ``x`` and ``p`` stay: the last iterate, for inspection).
-STATE_NUMBERS = ("delta", "force", "lambda0", "Sc", "S1", "S_end", "energy", "ring_force", "ring_force_inner",
+STATE_NUMBERS = ("delta", "force", "lambda0", "Sc", "S1", "S_end", "energy", "shear_delta", "ring_force", "ring_force_inner",
                  "cap_force", "pressure_min", "penetration", "wall_gap", "force_defect", "edge_legendre",
                  "curvature_excess", "tip_end_margin", "legendre_min", "legendre_min_S", "edge_jump_ls",
                  "edge_jump_ks")

@@ -301,11 +301,25 @@ def _model_curve(scene, deltas, tol, counter=None, progress=None):
     if counter is not None:
         counter[0] += 1
     c.solutions = []  # profiles are not needed here; keep the cache small
+    if scene.transverse_shear:
+        c = _with_shear(c)
     if key is not None:
         _CACHE[key] = c
         while len(_CACHE) > _CACHE_SIZE:
             _CACHE.popitem(last=False)
     return c
+
+
+def _with_shear(c):
+    """The model curve's force at its own depths taken as the thick shell's (``delta +
+    shear_delta``, :mod:`shellbvp.thickness`), up to the deepest one it reaches."""
+    import dataclasses
+
+    F = c.force_at(c.delta)
+    n = int(np.argmax(~np.isfinite(F))) if not np.all(np.isfinite(F)) else F.size
+    points = {k: np.asarray(v)[:n] for k, v in c.points.items()}
+    points["force"] = F[:n]
+    return dataclasses.replace(c, points=points, flags=list(c.flags[:n]))
 
 
 def _check_model_start(scene, delta, tol):

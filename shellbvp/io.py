@@ -60,7 +60,7 @@ POINT_FIELDS = (
     "delta", "force", "lambda0", "Sc", "status", "valid", "max_residual", "nodes", "niter",
     "force_error", "delta_error", "energy", "ring_force", "cap_force", "pressure_min",
     "penetration", "force_defect", "edge_legendre", "wall_time", "topology", "S1", "ring_force_inner",
-    "legendre_min", "contact_edge", "edge_jump_ls", "edge_jump_ks", "error_method", "pressure",
+    "legendre_min", "contact_edge", "edge_jump_ls", "edge_jump_ks", "error_method", "pressure", "shear_delta",
 )
 #: Fields a single-cap state does not carry, with their cap values (also what files of
 #: format version 1, which predate them, read as).
@@ -70,7 +70,8 @@ V2_FIELD_DEFAULTS = {"legendre_min": float("nan"), "contact_edge": "", "edge_jum
                      "edge_jump_ks": float("nan")}
 #: Fields added within format version 3 (additive: older readers ignore them), with what
 #: earlier files read as.  error_method: "richardson" | "calibrated" | "" (not estimated).
-V3_FIELD_DEFAULTS = {"error_method": "", "pressure": float("nan")}  # pressure: the scene's, filled in on reading
+V3_FIELD_DEFAULTS = {"error_method": "", "pressure": float("nan"),  # pressure: the scene's, filled in on reading
+                     "shear_delta": 0.0}
 _MISSING_FIELD_DEFAULTS = {**CAP_FIELD_DEFAULTS, **V2_FIELD_DEFAULTS, **V3_FIELD_DEFAULTS}
 
 
@@ -134,6 +135,13 @@ class Curve:
     def energy_residual(self):
         """``dE/ddelta - F`` at each point (see the class docstring)."""
         return energy_residual(self.points["delta"], self.points["energy"], self.points["force"])
+
+    def force_at(self, deltas):
+        """F at pole displacements ``deltas`` of the shell with its thickness: interpolated at
+        ``delta + shear_delta`` (:func:`shellbvp.thickness.force_at`); NaN outside the curve."""
+        from .thickness import force_at
+
+        return force_at(self, deltas)
 
     def to_hdf5(self, path, *, profiles: bool = False, overwrite: bool = False, units=None):
         """Write the curve to an HDF5 file atomically (see :func:`write_curve`)."""
@@ -223,6 +231,7 @@ def write_curve_group(g, curve, *, profiles=False, units=None):
     g.create_dataset("flags", data=np.array(curve.flags, dtype=object), dtype=h5py.string_dtype())
     g["delta"].attrs["long_name"] = "pole displacement delta / R_L"
     g["force"].attrs["long_name"] = "indenter force F / (mu H R_L)"
+    g["shear_delta"].attrs["long_name"] = "pole displacement added by transverse shear / R_L (0: not modelled)"
     if dims is None:
         g.attrs["units"] = "nondimensional"
     else:

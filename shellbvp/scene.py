@@ -75,6 +75,12 @@ class Scene:
         and is kept for the 3D reference (:func:`shellbvp.fe_curve`).  Give it or ``beta``:
         both only when they agree.  ``replace(beta=...)`` drops it, ``replace(thickness=...)``
         sets beta anew.
+    transverse_shear : bool
+        Add the transverse shear compliance of a shell of that ``thickness`` (Reissner-Mindlin,
+        shear factor 5/6; :mod:`shellbvp.thickness`): each state's ``shear_delta``, and fits
+        and :func:`shellbvp.validate` compare forces at ``delta + shear_delta``.  It removes
+        most of the model's O(eps) error against 3D elasticity (``docs/accuracy.md``).
+        Needs ``thickness``.  Default False.
 
     Raises
     ------
@@ -113,6 +119,7 @@ class Scene:
     pressure: float = 0.0
     sealed: bool = False
     thickness: float = None
+    transverse_shear: bool = False
 
     def __post_init__(self):
         rho = _finite("rho", self.rho)
@@ -166,6 +173,11 @@ class Scene:
             raise ValueError(f"sealed must be True (volume control) or False (pressure control); "
                              f"got {self.sealed!r}")
         object.__setattr__(self, "sealed", bool(self.sealed))
+        if not isinstance(self.transverse_shear, (bool, np.bool_)):
+            raise ValueError(f"transverse_shear must be True or False; got {self.transverse_shear!r}")
+        if self.transverse_shear and self.thickness is None:
+            raise ValueError("transverse_shear needs the shell's thickness (thickness = H / R_L in (0, 0.5])")
+        object.__setattr__(self, "transverse_shear", bool(self.transverse_shear))
 
     # -- presets -----------------------------------------------------------------
     @classmethod
@@ -203,11 +215,12 @@ class Scene:
     def replace(self, **changes) -> "Scene":
         """A copy with some fields changed (validated again).
 
-        A new ``beta`` drops the thickness; a new ``thickness`` (or bending energy, with a
-        thickness) sets beta from it.
+        A new ``beta`` drops the thickness (and the transverse shear that needs it); a new
+        ``thickness`` (or bending energy, with a thickness) sets beta from it.
         """
         if "beta" in changes and "thickness" not in changes:
             changes["thickness"] = None
+            changes.setdefault("transverse_shear", False)
         elif "beta" not in changes and ("thickness" in changes or "bending" in changes and self.thickness):
             changes["beta"] = None
         return replace(self, **changes)
@@ -224,6 +237,7 @@ class Scene:
             **({"pressure": self.pressure} if self.pressure else {}),  # files of unpressurised scenes as before
             **({"sealed": True} if self.sealed else {}),
             **({"thickness": self.thickness} if self.thickness is not None else {}),
+            **({"transverse_shear": True} if self.transverse_shear else {}),
         }
 
     @classmethod
@@ -290,7 +304,9 @@ class Scene:
                    contact=field(d, "contact", text, ""), shell=shell, tip=tip, bending=bend,
                    pressure=field(d, "pressure", number, "") if "pressure" in d else 0.0,
                    sealed=field(d, "sealed", (bool,), "") if "sealed" in d else False,
-                   thickness=field(d, "thickness", number, "") if "thickness" in d else None)
+                   thickness=field(d, "thickness", number, "") if "thickness" in d else None,
+                   transverse_shear=field(d, "transverse_shear", (bool,), "") if "transverse_shear" in d
+                   else False)
 
     def to_json(self) -> str:
         """:meth:`to_dict` as a JSON string (sorted keys)."""

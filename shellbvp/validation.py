@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["validate", "Validation", "default_depths", "FORMAT"]
+__all__ = ["validate", "Validation", "default_depths", "shell_curve", "FORMAT"]
 
 FORMAT = "shellbvp-validation"
 FORMAT_VERSION = 1
@@ -65,10 +65,13 @@ class Validation:
 
     @property
     def force_shell(self):
+        if self.scene.transverse_shear:  # the thick shell's delta + shear_delta, interpolated
+            return self.shell.force_at(self.delta)
         d, f = np.asarray(self.shell.points["delta"], float), np.asarray(self.shell.points["force"], float)
+        ok = np.asarray(self.shell.points["status"]) == 0
         out = np.full(self.delta.size, np.nan)
         for i, x in enumerate(self.delta):
-            j = np.flatnonzero(np.isclose(d, x, rtol=1e-9, atol=1e-12))
+            j = np.flatnonzero(np.isclose(d, x, rtol=1e-9, atol=1e-12) & ok)
             if j.size:
                 out[i] = f[j[0]]
         return out
@@ -158,7 +161,6 @@ def validate(scene, thickness=None, deltas=None, *, delta_max=0.5, mesh_check=Fa
     >>> print(f"{v.error[-1]:+.3f}")             # the shell model 18 % stiffer at delta = H, eps = 0.1
     +0.176
     """
-    from .continuation import curve
     from .fe import fe_curve
 
     if thickness is not None:
@@ -172,5 +174,23 @@ def validate(scene, thickness=None, deltas=None, *, delta_max=0.5, mesh_check=Fa
         deltas = default_depths(eps, delta_max)
     deltas = np.asarray(deltas, dtype=float)
     fe = fe_curve(scene, eps, deltas, mesh_check=mesh_check, progress=progress, **fe_settings)
+    return Validation(scene, shell_curve(scene, deltas, tol=tol), fe)
+
+
+def shell_curve(scene, deltas, *, tol=1e-6):
+    """The shell model's curve at ``deltas``; with ``scene.transverse_shear`` also at ``deltas -
+    shear_delta``, whose thick-shell depths ``delta + shear_delta`` fall next to ``deltas`` (then
+    :meth:`Curve.force_at` interpolates locally)."""
+    from .continuation import curve
+
+    deltas = np.asarray(deltas, dtype=float)
     shell = curve(scene, deltas=deltas, tol=tol, estimate_error=False)
-    return Validation(scene, shell, fe)
+    if not scene.transverse_shear:
+        return shell
+    d, sd = np.asarray(shell.points["delta"], float), np.asarray(shell.points["shear_delta"], float)
+    ok = (np.asarray(shell.points["status"]) == 0) & np.isfinite(sd)
+    shifted = np.interp(deltas, d[ok], d[ok] - sd[ok]) if np.count_nonzero(ok) else np.array([])
+    shifted = shifted[shifted > 0]
+    if not shifted.size:
+        return shell
+    return curve(scene, deltas=np.unique(np.r_[deltas, shifted]), tol=tol, estimate_error=False)
