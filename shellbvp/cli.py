@@ -622,16 +622,9 @@ def _print_fit(res, record, used, args):
         m1, m2 = res.mu_ci95
         _say(f"mu     = {res.mu / 1e6:.4g} MPa   95% CI [{m1 / 1e6:.4g}, {m2 / 1e6:.4g}] (H = "
              f"{format_in(res.thickness, 'um', 'length')}, eps = H/R_L = {eps:.3g}, beta = eps^2/3)")
-        if res.scene.transverse_shear:
-            _say("model  = beside this interval, the shell model's own error: with its transverse shear, "
-                 "measured within about 1.5 eps at depths up to a few H where the shell does not wrap the "
-                 "tip (docs: How accurate is the shell model?); `shellbvp validate` with these options "
-                 "measures it for this scene")
-        else:
-            _say("model  = beside this interval, the shell model's own error, O(eps): measured 2-5 eps too "
-                 "stiff at depths of a few H, less deeper; --transverse-shear removes most of it (docs: How "
-                 "accurate is the shell model?); `shellbvp validate` with these options measures it for "
-                 "this scene")
+        from .thickness import model_error_line
+
+        _say(model_error_line(res.scene))
     show = (lambda v, unit, kind: format_in(v, unit, kind).split(" ")[0])
     if "offset" in res.fitted:
         o1, o2 = res.offset_ci95

@@ -242,6 +242,15 @@ class FitResult:
         H = self.thickness
         return None if H is None else (self.mu_H_ci95[0] / H, self.mu_H_ci95[1] / H)
 
+    @property
+    def model_error(self):
+        """``(error, extrapolated)``: the shell model's largest measured error in F against 3D
+        elasticity at this thickness over the mapped scenes (:func:`shellbvp.thickness.model_error`),
+        to stand beside the statistical interval; None without a thickness or a map for the model."""
+        from .thickness import model_error
+
+        return model_error(self.scene)
+
     def model_force(self, displacement, mu_H=None):
         """Fitted model force (N) at displacements (m); with ``mu_H`` (N/m), the same model at
         that mu*H (e.g. an end of ``mu_H_ci95``), offset and baseline as fitted."""
@@ -267,10 +276,13 @@ class FitResult:
                 "baseline_slope_ci95": ci(self.baseline_slope_ci95),
                 "thickness": None if self.thickness is None else num(self.thickness), "mu": None if self.mu is None
                 else num(self.mu), "mu_ci95": ci(self.mu_ci95),
+                "model_error": None if self.model_error is None else num(self.model_error[0]),
+                "model_error_extrapolated": None if self.model_error is None else self.model_error[1],
                 "units": {"mu_H": "N/m (= um*MPa)", "offset": "m", "residual": "N (rms)",
                           "residual_rms": "N", "R_L": "m", "beta": "1 (B/(mu R_L^2))", "alpha": "1",
                           "pressure": "1 (p R_L/(mu H))", "pressure_Pa": "Pa",
-                          "baseline": "N", "baseline_slope": "N/m", "thickness": "m", "mu": "Pa"}}
+                          "baseline": "N", "baseline_slope": "N/m", "thickness": "m", "mu": "Pa",
+                          "model_error": "1 (fraction of F)"}}
 
 
 # -- model curves ------------------------------------------------------------------------------

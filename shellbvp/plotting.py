@@ -11,6 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from .textdata import printable
+from .thickness import model_error_line
 
 __all__ = ["plot_curves", "plot_profiles", "plot_fit", "plot_fit_record", "fit_report", "fit_summary_lines",
            "require_matplotlib", "scene_label", "save_figure"]
@@ -204,8 +205,8 @@ def fit_summary_lines(record):
         H = s.thickness * p["R_L"]
         lo, hi = iv["mu_H"]
         lines.append(f"mu = {p['mu_H'] / H / 1e6:.5g} MPa   95% CI [{lo / H / 1e6:.5g}, {hi / H / 1e6:.5g}] "
-                     f"(thickness H = {H * 1e6:.4g} um, eps = {s.thickness:.3g}; "
-                     f"{'with transverse shear' if s.transverse_shear else 'the model'}'s own error is O(eps))")
+                     f"(thickness H = {H * 1e6:.4g} um, eps = {s.thickness:.3g})")
+        lines.append(model_error_line(s))
     lines.append(f"scene: {scene_label(s)}")
     lines += [f"warning: {w}" for w in record.warnings] or ["warnings: none"]
     lines.append(f"shellbvp {record.version}; {record.message}")

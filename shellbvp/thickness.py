@@ -27,9 +27,12 @@ shell's bending round the tip; ``RotationBending`` does better there).
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
-__all__ = ["SHEAR_FACTOR", "shear_delta", "force_at"]
+__all__ = ["SHEAR_FACTOR", "shear_delta", "force_at", "model_error", "MEASURED_MODEL_ERROR", "MAPPED_EPS",
+           "model_error_line"]
 
 #: Reissner-Mindlin shear correction factor of a homogeneous plate.
 SHEAR_FACTOR = 5.0 / 6.0
@@ -96,3 +99,61 @@ def force_at(curve, deltas) -> np.ndarray:
     inside = (deltas >= x[0]) & (deltas <= x[-1])
     out[inside] = PchipInterpolator(x, y)(deltas[inside])
     return out
+
+
+#: Thicknesses of the map of the model's error (``benchmarks/results/validation.md``).
+MAPPED_EPS = (0.01, 0.02, 0.05, 0.1)
+#: The largest ``|F_shell / F_FE - 1|`` there over its six scenes (hemisphere and prolate shell,
+#: rho 0.1-0.5, a dome; neo-Hookean) at every depth from H/4 to 0.5 where the shell does not
+#: wrap the tip, by (contact model, bending energy, transverse shear) and eps.
+MEASURED_MODEL_ERROR = {
+    ("smooth", "trace", False): (0.080, 0.134, 0.242, 0.344),
+    ("smooth", "trace", True): (0.019, 0.028, 0.060, 0.076),
+    ("smooth", "rotation", False): (0.075, 0.126, 0.225, 0.319),
+    ("smooth", "rotation", True): (0.022, 0.034, 0.058, 0.077),
+    ("paper", "trace", False): (1.009, 1.026, 1.081, 1.168),
+}
+
+
+def model_error(scene):
+    """``(error, extrapolated)``: the shell model's largest measured error against 3D elasticity
+    at ``scene.thickness`` (a fraction of F; :data:`MEASURED_MODEL_ERROR`), or None where the
+    map has no such model (no thickness, a pressure, a user bending energy, the paper's contact
+    with transverse shear or rotation bending).
+
+    Between the mapped thicknesses the error is interpolated in log-log; outside them it is
+    extrapolated along the nearest two (``extrapolated`` True).  A bound over the mapped
+    scenes, not this scene's own error: ``shellbvp validate`` measures that.
+    """
+    eps = getattr(scene, "thickness", None)
+    if eps is None or scene.pressure or scene.sealed:
+        return None
+    bending = {"TraceBending": "trace", "RotationBending": "rotation"}.get(type(scene.bending).__name__)
+    row = MEASURED_MODEL_ERROR.get((scene.contact, bending, bool(scene.transverse_shear)))
+    if row is None:
+        return None
+    x, y = np.log(MAPPED_EPS), np.log(row)
+    t = float(np.log(eps))
+    i = int(np.clip(np.searchsorted(x, t) - 1, 0, len(x) - 2))
+    value = float(np.exp(y[i] + (y[i + 1] - y[i]) * (t - x[i]) / (x[i + 1] - x[i])))
+    return value, not MAPPED_EPS[0] <= eps <= MAPPED_EPS[-1]
+
+
+def model_error_line(scene) -> str:
+    """One line for a fit's summary: the model's measured error at the scene's thickness."""
+    found = model_error(scene)
+    tail = "`shellbvp validate` with these options measures it for this scene"
+    if found is None:
+        return f"model  = the shell model's own error against 3D elasticity is not mapped for this model; {tail}"
+    error, extrapolated = found
+    eps = scene.thickness
+    where = " (extrapolated beyond the mapped eps 0.01-0.1)" if extrapolated else ""
+    if scene.transverse_shear:
+        better = "with transverse shear"
+    else:
+        sheared = model_error(replace(scene, transverse_shear=True)) if scene.contact == "smooth" else None
+        better = ("without transverse shear; --transverse-shear: up to "
+                  f"{100 * sheared[0]:.2g} %" if sheared else "without transverse shear")
+    return (f"model  = beside this interval, the shell model's own error against 3D elasticity: up to "
+            f"{100 * error:.2g} % in F at eps = {eps:.3g} over the mapped scenes{where}, {better} "
+            f"(docs: How accurate is the shell model?); {tail}")

@@ -90,3 +90,32 @@ def test_fit_with_transverse_shear_recovers_a_thick_shells_modulus(capsys):
     assert "transverse_shear needs the shell's thickness" in capsys.readouterr().err
     assert main(["solve", "--transverse-shear", "--thickness", "0.05", "--delta", "0.1"]) == 0
     assert "shear_delta" in capsys.readouterr().out
+
+
+def test_the_measured_model_error_is_the_benchmarks():
+    """MEASURED_MODEL_ERROR is the maximum over the map's scenes in the benchmark's own results,
+    depths where the 3D contact has not reached 0.95 rho (the shell wrapping the tip) included."""
+    import json
+    from pathlib import Path
+
+    from shellbvp.thickness import MAPPED_EPS, MEASURED_MODEL_ERROR, model_error
+
+    cache = json.loads((Path(__file__).parents[1] / "benchmarks/results/validation.json").read_text())
+    names = {("smooth", "trace", False): "smooth", ("smooth", "trace", True): "smooth, shear",
+             ("smooth", "rotation", False): "smooth, rotation", ("smooth", "rotation", True): "smooth, rotation, shear",
+             ("paper", "trace", False): "paper"}
+    for key, row in MEASURED_MODEL_ERROR.items():
+        for eps, bound in zip(MAPPED_EPS, row):
+            worst = 0.0
+            for fe in (v for v in cache.values() if v["eps"] == eps):
+                shell = np.asarray(fe["shell"][names[key]]["force"], float)
+                err = np.abs(shell / np.asarray(fe["force"]) - 1)[np.asarray(fe["contact_radius"]) < 0.95 * fe["rho"]]
+                worst = max(worst, float(np.nanmax(err)))
+            assert bound == pytest.approx(worst, abs=6e-4), (key, eps)
+    scene = sb.Scene(thickness=0.05)
+    assert model_error(scene) == (pytest.approx(0.242), False)
+    assert model_error(scene.replace(transverse_shear=True)) == (pytest.approx(0.060), False)
+    assert model_error(sb.Scene(thickness=0.17))[1]                         # extrapolated
+    assert 0.060 < model_error(sb.Scene(thickness=0.03))[0] < 0.242          # between the mapped ones
+    assert model_error(sb.Scene(beta=0.01)) is None
+    assert model_error(sb.Scene(thickness=0.05, bending=sb.BendingEnergy("(kappa_s - kappa_s0)**2 + (kappa_theta - kappa_theta0)**2"))) is None
