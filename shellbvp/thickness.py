@@ -15,7 +15,10 @@ beyond the contact edge (a 45-degree spread): the integral starts there, ``H/2``
 the edge (at ``r = H/2`` under a point load, where the integral would diverge).
 
 A shell of thickness H under a force F is therefore at ``delta + shear_delta``, delta
-being the Kirchhoff shell's pole displacement.  Against the 3D finite-element reference
+being the Kirchhoff shell's pole displacement.  It is made for the default (smooth) contact,
+whose ring force is the concentrated load at the edge; with the paper's contact conditions
+Q outside the contact is small and the correction nearly nil (``benchmarks/results/
+validation_table.md``).  Against the 3D finite-element reference
 (:func:`shellbvp.fe_curve`; ``benchmarks/results/validation.md``) this removes most of
 the model's O(eps) error where the shell does not wrap the tip: over six scenes, the worst
 error at delta >= H falls from 17 % to 6 % at eps = 0.05 and from 4.7 % to 1.9 % at eps =
@@ -77,7 +80,8 @@ def force_at(curve, deltas) -> np.ndarray:
     """The force of a shell of thickness H at pole displacements ``deltas`` (nondimensional).
 
     A monotone cubic (PCHIP) through ``(0, 0)`` and the curve's converged points at
-    ``delta + shear_delta`` (just ``delta`` without transverse shear); NaN outside them.
+    ``delta + shear_delta`` (just ``delta`` without transverse shear); NaN outside them (beyond
+    the deepest by more than 1e-6 of it).
     """
     from scipy.interpolate import PchipInterpolator
 
@@ -96,8 +100,8 @@ def force_at(curve, deltas) -> np.ndarray:
     out = np.full(deltas.shape, np.nan)
     if x.size < 2:
         return out
-    inside = (deltas >= x[0]) & (deltas <= x[-1])
-    out[inside] = PchipInterpolator(x, y)(deltas[inside])
+    inside = (deltas >= x[0]) & (deltas <= x[-1] * (1 + 1e-6))  # a point placed at a depth lands within ~1e-8
+    out[inside] = PchipInterpolator(x, y, extrapolate=True)(deltas[inside])
     return out
 
 
