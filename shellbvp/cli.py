@@ -3,7 +3,7 @@
     shellbvp curve [--preset base] [scene options] [-o base.h5]   force-displacement curve -> HDF5
     shellbvp solve [scene options] --delta 0.2 [--profiles] [--json]   one state
     shellbvp sweep --beta 0.005,0.01 --rho 0.15:0.3:4 -o grid.h5   one curve per combination -> one file
-    shellbvp fit DATA.csv --radius 0.3mm [--units mm,mN] [--json]   mu*H from measured data
+    shellbvp fit DATA.csv --preset fit --radius 0.3mm [--json]         mu*H from measured data
     shellbvp plot A.h5 [B.h5 ...] -o fig.png [--profiles 0.1,0.3]   figures (matplotlib)
     shellbvp info FILE.h5                                            what a curve or sweep file holds
     shellbvp presets                                                 the built-in scenes
@@ -119,12 +119,22 @@ def _thickness(text):
         raise argparse.ArgumentTypeError(str(exc)) from None
 
 
-def _scene_options(p, uncertain=False):
+def _scene_options(p, uncertain=False, preset_required=False):
     g = p.add_argument_group("scene (overrides of the preset)")
-    g.add_argument("--preset", default="base", help="built-in scene (see `shellbvp presets`; default base)")
+    g.add_argument("--preset", default=None,
+                   help="built-in scene (see `shellbvp presets`); " + (
+                       "give it, or the sample's geometry: --indenter-radius (or --rho) and --rise (or --gamma) "
+                       "and --thickness (or --beta)" if preset_required else "default base"))
     kind, note = (_uncertain, "; VALUE+-U: with a standard uncertainty U") if uncertain else (_number, "")
-    g.add_argument("--gamma", type=kind, help=f"spheroid aspect parameter (< 1/rho; >0 bowl, <0 dome){note}")
-    g.add_argument("--rho", type=kind, help=f"indenter radius / rim radius (> 0){note}")
+    shape = g.add_mutually_exclusive_group()
+    shape.add_argument("--gamma", type=kind, help=f"spheroid aspect parameter (< 1/rho; >0 bowl, <0 dome){note}")
+    shape.add_argument("--rise", type=quantity("length"),
+                       help="the shell's depth from its rim's plane to its pole, with its unit (with --radius): "
+                            "gamma = rise / R_L (a bowl indented from inside; a dome: --gamma < 0)")
+    tip = g.add_mutually_exclusive_group()
+    tip.add_argument("--rho", type=kind, help=f"indenter radius / rim radius (> 0){note}")
+    tip.add_argument("--indenter-radius", type=quantity("length"), dest="indenter_radius",
+                     help="the indenter's tip radius with its unit (with --radius): rho = it / R_L")
     g.add_argument("--beta", type=kind, help=f"bending stiffness B/(mu R_L^2) (> 0){note}")
     g.add_argument("--thickness", type=_thickness,
                    help="shell thickness: H/R_L in (0, 0.5], or with a unit (50um) together with --radius; "
@@ -174,7 +184,33 @@ def _scene(args):
         over["pressure"] = _nondimensional_pressure(args)
     if getattr(args, "thickness", None) is not None:
         over["thickness"] = _nondimensional_thickness(args)
-    return sb.Scene.preset(args.preset, **over)
+    for name, length, what in (("rho", "indenter_radius", "--indenter-radius"), ("gamma", "rise", "--rise")):
+        if getattr(args, length, None) is not None:
+            over[name] = _over_rim_radius(args, getattr(args, length), what)
+    return sb.Scene.preset(args.preset or "base", **over)
+
+
+def _over_rim_radius(args, length, option):
+    """A lab length of the sample over the rim radius ``--radius``: the nondimensional number."""
+    radius = getattr(args, "radius", None)
+    if radius is None:
+        raise ValueError(f"{option} {length} is a length: it needs --radius (the rim radius R_L), or give "
+                         f"the ratio itself ({'--rho' if option == '--indenter-radius' else '--gamma'})")
+    return length.si / radius.si
+
+
+def _require_sample(args):
+    """``fit`` names its sample: a preset, or the geometry (no silent default hemisphere)."""
+    if args.preset is not None:
+        return
+    missing = [what for what, given in (
+        ("the indenter: --indenter-radius (or --rho)", args.rho is not None or args.indenter_radius is not None),
+        ("the shell's shape: --rise (or --gamma)", args.gamma is not None or args.rise is not None),
+        ("its bending stiffness: --thickness (or --beta)", args.thickness is not None or args.beta is not None))
+        if not given]
+    if missing:
+        raise ValueError("fit needs the sample: --preset NAME (`shellbvp presets`), or its geometry; missing "
+                         + "; ".join(missing))
 
 
 def _nondimensional_thickness(args):
@@ -261,7 +297,7 @@ def _cmd_curve(args):
     from .io import write_curve
     from .paths import check_output_path, partial_path
 
-    out = check_output_path(args.output if args.output is not None else _free_default_name(args.preset, args.force),
+    out = check_output_path(args.output if args.output is not None else _free_default_name(args.preset or "base", args.force),
                             overwrite=args.force)
     partial = partial_path(out)
     if partial.exists() and not args.force:
@@ -285,7 +321,7 @@ def _cmd_curve(args):
     every = _checkpoint_seconds()
     from .progress import curve_progress, wanted
 
-    bar, show = curve_progress(args.delta_max, f"curve {args.preset}", enabled=wanted(args.quiet))
+    bar, show = curve_progress(args.delta_max, f"curve {args.preset or 'base'}", enabled=wanted(args.quiet))
     last = [time.perf_counter()]
 
     def callback(curve, sol):
@@ -412,6 +448,7 @@ def _split_uncertain(args):
 
 def _fit_inputs(args):
     """The scene, R_L and the reading and fitting options of ``fit``, checked before any work."""
+    _require_sample(args)
     scene = _scene(args)
     units = None
     if args.units:
@@ -615,6 +652,7 @@ def _print_fit(res, record, used, args):
     name = Path(record.path).name if args.example else record.path
     _say(f"data   = {name}: {len(record)} rows ({counts}); fitted the {args.segment} segment, "
           f"{int(used.sum())} rows")
+    _say(f"scene  = {res.scene.describe(res.R_L)}")
     lo, hi = res.mu_H_ci95
     _say(f"mu*H   = {res.mu_H:.4g} N/m (um*MPa)   95% CI [{lo:.4g}, {hi:.4g}]")
     if res.mu is not None:
@@ -905,14 +943,14 @@ def _cmd_validate(args):
     from .paths import check_output_path
 
     out = check_output_path(args.output if args.output is not None
-                            else _free_default_name(f"{args.preset}-validate", args.force), overwrite=args.force)
+                            else _free_default_name(f"{args.preset or 'base'}-validate", args.force), overwrite=args.force)
     try:
         import felupe  # noqa: F401
     except ImportError:
         raise ValueError("validate needs FElupe: pip install 'shellbvp[fe]'") from None
     t0 = time.perf_counter()
     shell = "with its transverse shear" if scene.transverse_shear else "Kirchhoff (no transverse shear)"
-    print(f"scene: {args.preset}, eps = H/R_L = {scene.thickness:.4g}, beta = {scene.beta:.4g}; "
+    print(f"scene: {args.preset or 'base'}, eps = H/R_L = {scene.thickness:.4g}, beta = {scene.beta:.4g}; "
           f"3D model (FElupe) and shell model, {shell}, at the same pole displacements", flush=True)
     result = validate(scene, deltas=deltas, delta_max=args.delta_max, mesh_check=args.mesh_check, tol=args.tol,
                       progress=lambda i, d, f: print(f"  FE: delta = {d:.4g}, F = {f:.5g}", flush=True))
@@ -939,7 +977,7 @@ def build_parser():
     c.add_argument("--lambda0-max", type=_number, dest="lambda0_max", help="stop at this pole stretch")
     c.add_argument("--max-steps", type=int, default=400, dest="max_steps")
     c.add_argument("--profiles", action="store_true", help="store each point's profiles")
-    c.add_argument("--radius", type=quantity("length"),
+    c.add_argument("--radius", "--rim-radius", type=quantity("length"),
                    help="rim radius R_L with its unit, e.g. 0.3mm (with --muH: SI columns in the file)")
     c.add_argument("--muH", type=quantity("mu_H"), dest="mu_h", help="mu*H with its unit, e.g. 52N/m")
     c.add_argument("-o", "--output", help="output file (default <preset>.h5, or <preset>-2.h5, ... if that exists)")
@@ -956,7 +994,7 @@ def build_parser():
     g.add_argument("--delta", type=_number, help="pole displacement (default 0.2)")
     g.add_argument("--lambda0", type=_number, help="pole stretch")
     g.add_argument("--load", type=_number, help="indenter force F (force control)")
-    s.add_argument("--radius", type=quantity("length"), help="rim radius with its unit, e.g. 0.3mm (with --muH: "
+    s.add_argument("--radius", "--rim-radius", type=quantity("length"), help="rim radius with its unit, e.g. 0.3mm (with --muH: "
                    "the state also in these units)")
     s.add_argument("--muH", type=quantity("mu_H"), dest="mu_h", help="mu*H with its unit, e.g. 52N/m")
     s.add_argument("--profiles", action="store_true", help="print the fields over S")
@@ -976,11 +1014,11 @@ def build_parser():
                    "offset, baseline, residual, warnings, ...)")
     f.add_argument("--example", action="store_true",
                    help="use the synthetic Lepidium-like data shipped with shellbvp (README)")
-    _scene_options(f, uncertain=True)
+    _scene_options(f, uncertain=True, preset_required=True)
     f.add_argument("--workers", type=int, help="with VALUE+-U parameters: local processes for their fits "
                                                "(default: all cores)")
     f.add_argument("--scheduler", help="with VALUE+-U parameters: run their fits on this Dask scheduler")
-    f.add_argument("--radius", required=True, type=quantity("length"),
+    f.add_argument("--radius", "--rim-radius", required=True, type=quantity("length"),
                    help="rim radius R_L of the sample with its unit, e.g. 0.3mm")
     f.add_argument("--columns", help="displacement,force columns by name or 0-based index (default 0,1)")
     f.add_argument("--units", help="units of the two columns, e.g. mm,mN (default: from the header)")
@@ -1070,6 +1108,8 @@ def build_parser():
     cv = sub.add_parser("convexity", help="where the scene's energy is convex in stretch and curvature "
                                           "(the Legendre condition; beyond it the contact edge becomes a corner)")
     _scene_options(cv)
+    cv.add_argument("--radius", "--rim-radius", type=quantity("length"),
+                    help="rim radius with its unit, for the lengths of --indenter-radius, --rise, --thickness")
     cv.set_defaults(func=_cmd_convexity)
     v = sub.add_parser("validate", help="the shell model against a 3D finite-element model of the same scene "
                        "(needs FElupe: pip install 'shellbvp[fe]')")
@@ -1078,7 +1118,7 @@ def build_parser():
                    help="largest pole displacement (default 0.5); the depths are delta/H = 0.25, 0.5, 1, 2, 5, "
                         "10, 25 below it and delta-max")
     v.add_argument("--deltas", help="these pole displacements instead, comma-separated (/R_L)")
-    v.add_argument("--radius", type=quantity("length"), help="rim radius with its unit, for --thickness with a unit")
+    v.add_argument("--radius", "--rim-radius", type=quantity("length"), help="rim radius with its unit, for --thickness with a unit")
     v.add_argument("--mesh-check", action="store_true", dest="mesh_check",
                    help="also solve the 3D model on a coarser mesh and report the difference (~1.5x the time)")
     v.add_argument("-o", "--output", help="output file (default <preset>-validate.h5, or -2, ... if that exists)")

@@ -207,7 +207,7 @@ def fit_summary_lines(record):
         lines.append(f"mu = {p['mu_H'] / H / 1e6:.5g} MPa   95% CI [{lo / H / 1e6:.5g}, {hi / H / 1e6:.5g}] "
                      f"(thickness H = {H * 1e6:.4g} um, eps = {s.thickness:.3g})")
         lines.append(model_error_line(s))
-    lines.append(f"scene: {scene_label(s)}")
+    lines.append(f"scene: {s.describe(p['R_L'])}")
     lines += [f"warning: {w}" for w in record.warnings] or ["warnings: none"]
     lines.append(f"shellbvp {record.version}; {record.message}")
     return [printable(line) for line in lines]  # text from the file: shown, never obeyed

@@ -308,6 +308,47 @@ class Scene:
                    transverse_shear=field(d, "transverse_shear", (bool,), "") if "transverse_shear" in d
                    else False)
 
+    def describe(self, R_L: float | None = None) -> str:
+        """The scene in words, one line; with the rim radius ``R_L`` (m) its lengths in lab units.
+
+        >>> import shellbvp as sb
+        >>> print(sb.Scene.preset("fit", thickness=0.05).describe(R_L=0.3e-3))
+        preset fit with thickness; shell: spheroid, rise 750 um (gamma 2.5) on a rim radius of 300 um; indenter: sphere of radius 100 um (rho 0.3333); thickness 15 um (eps 0.05, beta 0.0008333); Mooney-Rivlin alpha 0.1; smooth contact
+        """
+        from .units import format_in
+
+        def length(x):
+            return "" if R_L is None else format_in(abs(x) * R_L, "um" if abs(x) * R_L < 1e-3 else "mm", "length")
+
+        named = [n for n in PRESETS if Scene.preset(n) == self]
+        extra = [n for n in PRESETS if self.thickness is not None and Scene.preset(n, thickness=self.thickness) ==
+                 replace(self, transverse_shear=False)]
+        parts = [f"preset {named[0]}" if named else f"preset {extra[0]} with thickness" if extra else "own scene"]
+        if isinstance(self.shell, Spheroid):
+            side = "dome indented from its convex side, " if self.gamma < 0 else ""
+            rise = f"rise {length(self.gamma)} (gamma {self.gamma:.4g})" if R_L else f"gamma {self.gamma:.4g}"
+            parts.append(f"shell: spheroid, {side}{rise}" + (f" on a rim radius of {length(1.0)}" if R_L else ""))
+        else:
+            parts.append("shell: user meridian" + (f" on a rim radius of {length(1.0)}" if R_L else ""))
+        tip = "sphere" if isinstance(self.tip, SphereTip) else "user tip"
+        parts.append(f"indenter: {tip} of radius {length(self.rho)} (rho {self.rho:.4g})" if R_L
+                     else f"indenter: {tip}, rho {self.rho:.4g}")
+        if self.thickness is not None:
+            parts.append(f"thickness {length(self.thickness) + ' (eps ' if R_L else 'eps '}{self.thickness:.4g}, "
+                         f"beta {self.beta:.4g}{')' if R_L else ''}"
+                         + ("; with transverse shear" if self.transverse_shear else ""))
+        else:
+            parts.append(f"beta {self.beta:.4g} (no thickness given)")
+        m = self.material
+        parts.append({"mooney-rivlin": lambda: f"Mooney-Rivlin alpha {m.alpha:g}", "neo-hookean": lambda: "neo-Hookean",
+                      "gent": lambda: f"Gent Jm {m.Jm:g}", "user": lambda: "user strain energy"}[m.family]())
+        if not isinstance(self.bending, TraceBending):
+            parts.append(f"{type(self.bending).__name__}()")
+        parts.append(f"{self.contact} contact" + ("" if self.xi == 1 else ", first approximation xi 0"))
+        if self.pressure or self.sealed:
+            parts.append(f"pressure p R_L/(mu H) {self.pressure:g}" + (", sealed" if self.sealed else ""))
+        return "; ".join(parts)
+
     def to_json(self) -> str:
         """:meth:`to_dict` as a JSON string (sorted keys)."""
         import json

@@ -107,7 +107,8 @@ def test_info_rejects_foreign_and_corrupt_files(tmp_path):
 
 @pytest.mark.parametrize("argv", [["solve", "--gamma", "5_0"], ["solve", "--delta", "inf"], ["solve", "--rho", "nan"],
                                   ["curve", "--delta-max", "1e999"], ["solve", "--beta", "１"],
-                                  ["fit", "--example", "--radius", "0.3mm", "--fit-beta", "--beta-range", "5_0,1"]])
+                                  ["fit", "--example", "--preset", "fit", "--radius", "0.3mm", "--fit-beta",
+                                   "--beta-range", "5_0,1"]])
 def test_numbers_python_reads_but_a_person_would_not_write_are_refused(argv, capsys):
     from shellbvp.cli import main
 
@@ -140,3 +141,27 @@ def test_version(capsys):
     with pytest.raises(SystemExit) as exc:
         main(["--version"])
     assert exc.value.code == 0 and capsys.readouterr().out.strip() == f"shellbvp {sb.__version__}"
+
+
+def test_fit_names_its_sample_in_lab_units(capsys):
+    """No silent default scene: fit needs a preset or the geometry; lengths in lab units give the
+    same scene as the ratios, and the summary names it in those units."""
+    from shellbvp.cli import main
+
+    assert main(["fit", "--example", "--radius", "0.3mm"]) == 2
+    err = capsys.readouterr().err
+    assert "fit needs the sample" in err and "--indenter-radius" in err and "--rise" in err
+    assert main(["fit", "--example", "--radius", "0.3mm", "--rho", "0.3333", "--gamma", "2.5"]) == 2
+    assert "missing its bending stiffness" in capsys.readouterr().err
+    assert main(["fit", "--example", "--rim-radius", "0.3mm", "--indenter-radius", "100um", "--rise", "0.75mm",
+                 "--thickness", "15um", "--json"]) == 0
+    lab = json.loads(capsys.readouterr().out)
+    assert main(["fit", "--example", "--radius", "0.3mm", "--preset", "fit", "--thickness", "0.05", "--json"]) == 0
+    preset = json.loads(capsys.readouterr().out)
+    assert lab["mu_H"] == pytest.approx(preset["mu_H"], rel=1e-9)
+    assert main(["fit", "--example", "--radius", "0.3mm", "--preset", "fit", "--thickness", "15um"]) == 0
+    out = capsys.readouterr().out
+    assert "scene  = preset fit with thickness; shell: spheroid, rise 750 um (gamma 2.5)" in out
+    assert "indenter: sphere of radius 100 um" in out and "thickness 15 um" in out
+    assert main(["solve", "--indenter-radius", "0.1mm"]) == 2
+    assert "--indenter-radius 0.1 mm is a length: it needs --radius" in capsys.readouterr().err
