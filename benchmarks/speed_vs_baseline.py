@@ -38,10 +38,10 @@ every 12th also at 1e-10 to show the reference's own error).
   curve through exactly shooting's states (natural continuation, default error estimates, its
   cold first point counted); and that curve's time per point after its first point (the first
   point's curve timed alone after it, in the same process), against shooting's, which starts
-  warm: the same work on both sides.  States closer than SAME_STATE_RTOL count once (until
-  session 20 the union of the curves' depths kept pairs 1e-10 apart).  Shooting and those
+  warm: the same work on both sides.  States closer than SAME_STATE_RTOL count once (before
+  695242b the union of the curves' depths kept pairs 1e-10 apart).  Shooting and those
   cap-only curves run interleaved, one round per repeat, each side's time the median over
-  rounds (until session 14 shooting ran once, apart from them).
+  rounds (before 425cc53 shooting ran once, apart from them).
 
 Writes benchmarks/results/speed_vs_baseline.json and .md (``--quick``: base default curve, one
 repeat, no shooting, ``speed_vs_baseline-quick.*``).
@@ -181,7 +181,7 @@ def worker(spec):
         counts["max_nodes"] = max(counts["max_nodes"], int(r.x.size))
         return r
 
-    # Richardson estimates since session 14: a Newton on the fixed halved mesh, solve_bvp only
+    # Richardson estimates since 425cc53: a Newton on the fixed halved mesh, solve_bvp only
     # where that does not converge; counted as runs too (one Newton iteration each)
     from shellbvp import collocation as _collocation
 
@@ -369,7 +369,7 @@ def f_error(run, ref):
 def shooting_states(ref):
     """Indices of the reference's states that shooting solves: caps with delta >= SHOOT_FROM, each
     more than SAME_STATE_RTOL deeper than the one before (the reference's depths are the union of
-    the curves' depths, where the same point of two curves can differ by ~1e-10: until session 20
+    the curves' depths, where the same point of two curves can differ by ~1e-10: before 695242b
     half the states of some presets were such pairs, one shot each for shooting's Newton, which
     accepts its predictor there, and a whole solve_bvp run each for collocation)."""
     out, last = [], -math.inf
@@ -386,7 +386,7 @@ def same_states_and_shooting(sides, entry, variants, repeat, shoot, log):
     solve counted, which shooting's is not), at each of SAME_TOLS, and (``shoot``) shooting at
     those states (:func:`shooting`), interleaved: each of ``repeat`` rounds runs every
     collocation curve, then shooting at every rtol, so that both sides' medians sample the same
-    stretch of a shared machine's load (until session 14 shooting ran once, apart).
+    stretch of a shared machine's load (before 425cc53 shooting ran once, apart).
 
     Returns (per variant: CPU ms per point and max F error at the default tol, and the same per
     tol (``tols``); shooting's rows, per rtol the median CPU time over rounds, [] without
@@ -566,7 +566,7 @@ def markdown(data):
              f"{_interpolate_import(data)}); time: median over repeats of the curve's CPU time "
              f"(the process's, the measure least disturbed by other users of a shared machine) and wall time; "
              f"ratio: median over repeats of (variant time / this commit's time in the same repeat); speed-ups "
-             f"and per-point times use CPU time; counts (runs: solve_bvp runs and, since session 14, "
+             f"and per-point times use CPU time; counts (runs: solve_bvp runs and, since 425cc53, "
              f"fixed-mesh Newton runs; of them Richardson estimates (one Newton run on the halved mesh: at the "
              f"baseline a solve_bvp run, 'too many nodes' by design; now a fixed-mesh Newton, solve_bvp where "
              f"that does not converge); failed runs other than those; Newton iterations (solve_bvp's outer "

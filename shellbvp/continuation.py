@@ -1030,7 +1030,7 @@ def _land_on_delta_max(scene, cur, prev, builder, st, key):
 
 #: The adaptive curve's first arclength step, in units of the chord from the point below the
 #: first.  Twice the chord fails on base, flat and dome (one solve_bvp run refined to its node
-#: budget, ~20 ms, then the step is halved); once the chord (tried in session 14) avoids that
+#: budget, ~20 ms, then the step is halved); once the chord (tried at 5e2d0fb) avoids that
 #: but, the steps growing from a smaller start, the stability grid's curves took 1-3 points
 #: more each (2659 against 2608, 80 s against 68 s): 2 is kept.
 FIRST_STEP = 2.0

@@ -114,7 +114,7 @@ def test_spheroidal_dome_pairs_with_its_bowl():
     assert r_dome < r_bowl and abs((r_dome + r_bowl) / 2 - 1) < 0.01, (r_dome, r_bowl)
 
 
-# in the default suite (~26 s): marked slow, it failed unseen for a session when the adaptive
+# in the default suite (~26 s): marked slow, it failed unseen until 69c371e, after the adaptive
 # curve's steps moved (a force maximum of F ~ 1e-4 stepped over; continuation.MAX_PLOT_TURN)
 def test_dome_snaps_at_a_fold_in_delta():
     """Past its force maximum (F 3.28e-4 near delta 0.169) the dome's branch turns back in
