@@ -137,7 +137,7 @@ def expand_inputs(inputs) -> list:
 
 
 def fit_files(scene, paths, *, R_L, segment="loading", baseline="auto", columns=None, units=None,
-              on_file=None, **options) -> list:
+              invert=(), on_file=None, **options) -> list:
     """Fit each file with the same scene and settings; one :class:`BatchRow` per file.
 
     Parameters
@@ -149,7 +149,7 @@ def fit_files(scene, paths, *, R_L, segment="loading", baseline="auto", columns=
         Rim radius (m), the same for every file.
     segment, baseline : str
         As :func:`shellbvp.fitting.fit_record`.
-    columns, units : sequence, optional
+    columns, units, invert : sequence, optional
         As :func:`shellbvp.instrument.read_instrument`.
     on_file : callable, optional
         Called as ``on_file(row)`` after each file (a progress bar over files).
@@ -193,7 +193,7 @@ def fit_files(scene, paths, *, R_L, segment="loading", baseline="auto", columns=
     records, rows = {}, {}
     for path in paths:  # read every file first: the common depth of the model curves
         try:
-            records[path] = read_instrument(path, columns=columns, units=units)
+            records[path] = read_instrument(path, columns=columns, units=units, invert=invert)
         except ValueError as exc:
             rows[path] = BatchRow(file=path, status="error", message=" ".join(str(exc).split()))
     depths = {}

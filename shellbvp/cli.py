@@ -474,7 +474,7 @@ def _fit_inputs(args):
                 raise ValueError(f"--{name}-range must be two numbers LOW,HIGH; got {text!r}")
             if not getattr(args, f"fit_{name}"):
                 raise ValueError(f"--{name}-range needs --fit-{name}")
-    return scene, args.radius.si, {"columns": columns, "units": units}, options
+    return scene, args.radius.si, {"columns": columns, "units": units, "invert": tuple(args.invert or ())}, options
 
 
 def _cmd_fit(args):
@@ -1022,6 +1022,9 @@ def build_parser():
                    help="rim radius R_L of the sample with its unit, e.g. 0.3mm")
     f.add_argument("--columns", help="displacement,force columns by name or 0-based index (default 0,1)")
     f.add_argument("--units", help="units of the two columns, e.g. mm,mN (default: from the header)")
+    f.add_argument("--invert", action="append", choices=("displacement", "force"),
+                   help="flip the sign of a column: an AFM height that falls as the tip goes in "
+                        "(displacement), compression recorded as negative (force); may be given twice")
     f.add_argument("--segment", choices=("loading", "retraction", "all"), default="loading",
                    help="rows to fit: loading (default: the approach and the loading, up to the deepest point; "
                         "segments by the direction of the displacement over time), retraction, or all "

@@ -27,7 +27,8 @@ SI units, ``"1"`` nondimensional, ``""`` text)::
                                baseline_model, weights, segment
     /fit/warnings              (k,) the fit's warnings (text); attr codes
     /fit/sample                NXsample; attrs: scene (JSON, rebuilds the Scene), scene_<key>
-    /fit/source                NXnote: file_name, sha256, columns (JSON), units (JSON) -- text
+    /fit/source                NXnote: file_name, sha256, columns (JSON), units (JSON), inverted
+                               (JSON list: the columns whose sign was flipped) -- text
 
 Written atomically (temporary file + rename); an existing file is replaced only with
 ``overwrite=True``.
@@ -83,7 +84,8 @@ class FitRecord:
     warning_codes : list of str
     scene : Scene
     source : dict
-        ``file_name``, ``sha256``, ``columns``, ``units`` (the units the file was in).
+        ``file_name``, ``sha256``, ``columns``, ``units`` (the units the file was in), ``inverted``
+        (the columns whose sign was flipped on reading).
     success : bool
     status : int
     message : str
@@ -201,6 +203,19 @@ def write_fit(path, result, record, used, *, segment="loading", overwrite=False)
             string_dataset(src, "sha256", record.sha256)
             string_dataset(src, "columns", json.dumps({k: str(v) for k, v in record.columns.items()}))
             string_dataset(src, "units", json.dumps(record.units, ensure_ascii=False))
+            string_dataset(src, "inverted", json.dumps(list(getattr(record, "inverted", ()))))
+
+
+def _inverted(src):
+    """The flipped columns of a record's source (files before the option: none)."""
+    from . import schema as sc
+
+    if "inverted" not in src:
+        return []
+    inv = sc.parse_json(sc.text_dataset(src, "inverted", ndim=0), "source/inverted")
+    if not (isinstance(inv, list) and all(x in ("displacement", "force") for x in inv)):
+        raise ValueError("source/inverted must be a JSON list of 'displacement' and 'force'")
+    return inv
 
 
 def _interval(result, name):
@@ -305,7 +320,8 @@ def read_fit(path) -> FitRecord:
             source = {"file_name": sc.text_dataset(src, "file_name", ndim=0),
                       "sha256": sc.text_dataset(src, "sha256", ndim=0),
                       "columns": sc.parse_json(sc.text_dataset(src, "columns", ndim=0), "source/columns"),
-                      "units": sc.parse_json(sc.text_dataset(src, "units", ndim=0), "source/units")}
+                      "units": sc.parse_json(sc.text_dataset(src, "units", ndim=0), "source/units"),
+                      "inverted": _inverted(src)}
             success = sc.attr_bool(e, "success")
             status = sc.attr_int(e, "status", low=0, high=99)
             if success != (status == 0):

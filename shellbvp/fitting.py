@@ -569,6 +569,11 @@ def _check_data(d, f, k, origin=0.0):
         raise ValueError(f"force is constant ({f[0]:g} N at every point): it must increase with the depth "
                          "of indentation")
     rho, p = stats.spearmanr(d, f, alternative="greater")
+    if not p < TREND_P and stats.spearmanr(d, f, alternative="less")[1] < TREND_P:
+        raise ValueError(f"force falls as the displacement grows (Spearman rank correlation {rho:.2f}): the "
+                         "displacement runs the other way (an AFM height falls as the tip goes in) or the "
+                         "compression is recorded as a negative force; flip one with --invert displacement or "
+                         "--invert force (read_instrument(..., invert=...))")
     if not p < TREND_P:
         raise ValueError(f"force does not increase with displacement (Spearman rank correlation {rho:.2f}, "
                          f"one-sided p = {p:.2g}, needed < {TREND_P:g}): these data show no indentation "

@@ -9,8 +9,8 @@ biases mu*H with a confident but wrong interval.  So a record is segmented
 first and the fit uses the loading segment by default.
 
 * :func:`read_table` -- the text layer: encodings, ``#``/``%`` comment lines,
-  ``,`` ``;`` or tab delimiters, decimal commas, one or two header rows
-  (names, then units), plain numbers only.
+  ``,`` ``;``, tab or whitespace delimiters, decimal commas, one or two header rows
+  (names, then units; also as comment lines just above the data), plain numbers only.
 * :func:`read_instrument` -- an :class:`InstrumentRecord`: displacement and
   force (and time) columns found by unit and name, converted to SI, in the
   file's (time) order, with the segment of every row.
@@ -141,10 +141,12 @@ def read_table(path) -> Table:
     """Split a delimited text file into header rows and data rows.
 
     ``#`` and ``%`` start comment lines; blank lines are skipped; the delimiter
-    (``,`` ``;`` or tab) is sniffed.  Leading rows that are not all numbers are
-    header rows: the last one before the data (or the last two, when the second
-    names units, e.g. ``um``, ``(µN)``, ``s``) -- earlier ones (an instrument's
-    preamble) are skipped.
+    (``,`` ``;`` or tab, else whitespace) is sniffed.  Leading rows that are not all
+    numbers are header rows: the last one before the data (or the last two, when the
+    second names units, e.g. ``um``, ``(µN)``, ``s``) -- earlier ones (an instrument's
+    preamble) are skipped.  Without such rows, the header may be in the comment lines
+    just above the data, as many cells as the data after an optional ``columns:`` or
+    ``units:`` label (``# columns: height vDeflection`` / ``# units: m N``).
 
     Raises
     ------
@@ -155,21 +157,28 @@ def read_table(path) -> Table:
 
     raw = read_input_bytes(path)  # a regular file of bounded size: never a FIFO, a device or a folder
     text = _decode(raw, path)
-    numbered = [(i, ln) for i, ln in enumerate(text.splitlines(), start=1)
+    all_lines = text.splitlines()
+    numbered = [(i, ln) for i, ln in enumerate(all_lines, start=1)
                 if ln.strip() and not ln.lstrip().startswith(("#", "%"))]
     if not numbered:
         raise ValueError(f"{path}: no data")
     lines = [ln for _, ln in numbered]
-    try:
-        delim = csv.Sniffer().sniff("\n".join(lines[:20]), delimiters=",;\t").delimiter
-    except csv.Error:
-        delim = "\t" if "\t" in lines[-1] else (";" if ";" in lines[-1] else ",")
-    rows = [next(csv.reader([ln], delimiter=delim), []) for ln in lines]
+    sample = lines[-20:]
+    if not any(c in ln for ln in sample for c in ",;\t"):
+        delim = " "  # whitespace-separated columns (e.g. JPK's ASCII export)
+    else:
+        try:
+            delim = csv.Sniffer().sniff("\n".join(lines[:20]), delimiters=",;\t").delimiter
+        except csv.Error:
+            delim = "\t" if "\t" in lines[-1] else (";" if ";" in lines[-1] else ",")
+    rows = [_split(ln, delim) for ln in lines]
     line_no = [i for i, _ in numbered]
     first = next((k for k, r in enumerate(rows) if r and all(_number(c) is not None for c in r)), len(rows))
     if first == len(rows):
         raise ValueError(f"{path}: fewer than 3 rows with numbers (no row is all numbers)")
     heads = rows[:first]
+    if not heads:  # no header among the data lines: one in the comment lines just above them
+        heads = _commented_header(all_lines[:line_no[0] - 1], delim, len(rows[first]))
     header, header_units = [], None
     if heads:
         width = len(rows[first]) if first < len(rows) else len(heads[-1])
@@ -180,6 +189,41 @@ def read_table(path) -> Table:
         else:
             header = [c.strip() for c in heads[-1]]
     return Table(header=header, header_units=header_units, rows=rows[first:], line=line_no[first:], delimiter=delim)
+
+
+def _split(line, delim):
+    """The cells of one line: ``delim``-separated, or whitespace-separated for ``" "``."""
+    if delim == " ":
+        return next(csv.reader([line.strip()], delimiter=" ", skipinitialspace=True), [])
+    return next(csv.reader([line], delimiter=delim), [])
+
+
+#: Labels an instrument puts before a commented header row (``# columns: height vDeflection``).
+_HEADER_LABELS = ("columns", "fancynames", "names", "units", "header")
+
+
+def _commented_header(comments, delim, width):
+    """Header rows from the comment lines above the data: those (nearest first, up to 40 lines)
+    with as many cells as the data once the comment mark and a ``label:`` are removed, as
+    [names] or [names, units] (a row of units only is the units row)."""
+    found = []
+    for line in reversed(comments[-40:]):
+        body = line.strip()
+        if not body.startswith(("#", "%")):
+            break  # the comment block above the data has ended
+        body = body.lstrip("#%").strip()
+        label, sep, rest = body.partition(":")
+        labelled = sep and label.strip().lower().replace(" ", "") in _HEADER_LABELS
+        cells = [c.strip() for c in _split(rest if labelled else body, delim)]
+        if len(cells) == width and all(cells):
+            found.append((label.strip().lower() if labelled else "", cells))
+    units = next((c for lab, c in found if all(unit_kind(x) for x in c)), None)
+    names = [c for lab, c in found if not all(unit_kind(x) for x in c) and not any(_number(x) is not None for x in c)]
+    preferred = [c for lab, c in found if lab in ("columns", "names", "header")]
+    if not names:
+        return []
+    best = next((c for c in preferred if c in names), names[0])
+    return [best, units] if units else [best]
 
 
 def _column_unit(table, i):
@@ -286,6 +330,8 @@ class InstrumentRecord:
         The units the file's columns were in (``displacement``, ``force``, ``time``): results
         are also printed in these.
     header : list of str
+    inverted : tuple of str
+        The columns whose sign was flipped on reading (``read_instrument(..., invert=...)``).
     contact_estimate : float or None
         First estimate of the contact point (m) from the baseline (:func:`estimate_contact`),
         None when the loading starts in contact.
@@ -302,6 +348,7 @@ class InstrumentRecord:
     units: dict
     header: list = field(default_factory=list)
     contact_estimate: object = None
+    inverted: tuple = ()
 
     def __len__(self):
         return self.displacement.size
@@ -347,7 +394,7 @@ class InstrumentRecord:
         self.segments = np.where(push, np.where(self.displacement < contact, "approach", "loading"), self.segments)
 
 
-def read_instrument(path, *, columns=None, units=None) -> InstrumentRecord:
+def read_instrument(path, *, columns=None, units=None, invert=()) -> InstrumentRecord:
     """Read an instrument's force–displacement export and segment it.
 
     Parameters
@@ -361,6 +408,10 @@ def read_instrument(path, *, columns=None, units=None) -> InstrumentRecord:
     units : sequence of str, optional
         Units of the displacement and force (and time) columns, e.g. ``("um", "uN")``,
         when the header gives none (micro as ``u``, µ or μ; ``pN`` .. ``kN``, ``nm`` .. ``m``).
+    invert : sequence of {"displacement", "force"}
+        Columns whose sign to flip: an AFM height that falls as the tip goes in, or a
+        compression recorded as a negative force.  The record is then in the package's
+        convention: displacement grows into the sample, the force pushing into it is positive.
 
     Returns
     -------
@@ -395,6 +446,7 @@ def read_instrument(path, *, columns=None, units=None) -> InstrumentRecord:
     >>> print(f"contact near {rec.contact_estimate * 1e6:.0f} um; first rows {rec.displacement[:2]} m")
     contact near 20 um; first rows [0.e+00 4.e-06] m
     """
+    flip = _check_invert(invert)
     table = read_table(path)
     dcol, fcol, tcol = _pick_columns(table, columns, path)
     roles = [("displacement", dcol), ("force", fcol)] + ([("time", tcol)] if tcol is not None else [])
@@ -438,7 +490,7 @@ def read_instrument(path, *, columns=None, units=None) -> InstrumentRecord:
     ok = np.all([np.isfinite(a) for a in arr.values()], axis=0) if lines else np.zeros(0, bool)
     if ok.sum() < 3:
         raise ValueError(f"{path}: fewer than 3 rows with numbers")
-    arr = {role: a[ok] for role, a in arr.items()}
+    arr = {role: -a[ok] if role in flip else a[ok] for role, a in arr.items()}
     line = np.array(lines)[ok]
     t = arr.get("time")
     if t is not None:
@@ -450,13 +502,25 @@ def read_instrument(path, *, columns=None, units=None) -> InstrumentRecord:
     rec = InstrumentRecord(path=str(path), sha256=sha256_of(path), displacement=arr["displacement"],
                            force=arr["force"], time=t, line=line, segments=labels,
                            columns={role: name(col) for role, col in roles}, units=unit_names,
-                           header=list(table.header))
+                           header=list(table.header), inverted=tuple(sorted(flip)))
     push = rec.mask("loading")
     if push.sum() >= 3:
         rec.contact_estimate = estimate_contact(rec.displacement[push], rec.force[push])
         if rec.contact_estimate is not None:
             rec.relabel(rec.contact_estimate)
     return rec
+
+
+def _check_invert(invert):
+    """The roles of ``invert`` (displacement, force) as a set; ValueError naming the parameter."""
+    if isinstance(invert, str):
+        invert = [invert]
+    roles = set()
+    for role in invert or ():
+        if role not in ("displacement", "force"):
+            raise ValueError(f"invert must name displacement and/or force; got {role!r}")
+        roles.add(role)
+    return roles
 
 
 def _runs(state):
@@ -586,8 +650,9 @@ def estimate_contact(displacement, force):
     if not rise > 0:
         return None
     base = f[:k]
-    slope = np.polyfit(d[:k], base, 1)[0]
-    if abs(slope) * np.ptp(d[:k]) > 0.05 * rise:
+    span = np.ptp(d[:k])
+    change = np.polyfit((d[:k] - d[0]) / span, base, 1)[0] if span > 0 else 0.0  # scaled: well conditioned
+    if abs(change) > 0.05 * rise:
         return None  # the force already rises: the record starts in contact
     thr = np.mean(base) + max(5 * np.std(base), 0.01 * rise)
     above = f > thr

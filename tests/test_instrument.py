@@ -63,11 +63,14 @@ def write(path, t, d, f, style):
         lines = ["Time (s),Displacement (mm),Force (mN)"]
         order = np.random.default_rng(0).permutation(t.size)
         lines += [f"{t[i]:.3f},{d[i] * 1e3:.8f},{f[i] * 1e3:.8f}" for i in order]
+    elif style == "spaces":  # whitespace columns, the header in comment lines (JPK's ASCII export style)
+        lines = ["# instrument: an AFM", "# columns: time displacement force", "# units: s um uN"]
+        lines += [f"{a:.3f}   {b * 1e6:.5f}  {c * 1e6:.5f}" for a, b, c in zip(t, d, f)]
     path.write_text("\n".join(lines) + "\n", encoding="utf-8")
     return path
 
 
-@pytest.mark.parametrize("style", ["tab", "two_rows", "nm_pN", "shuffled"])
+@pytest.mark.parametrize("style", ["tab", "two_rows", "nm_pN", "shuffled", "spaces"])
 def test_every_style_reads_to_the_same_si_record_and_segments(truth, tmp_path, style):
     _, t, d, f = truth
     rec = read_instrument(write(tmp_path / f"{style}.txt", t, d, f, style))
@@ -83,7 +86,7 @@ def test_every_style_reads_to_the_same_si_record_and_segments(truth, tmp_path, s
     assert abs(rec.contact_estimate - D0) < 10e-6
 
 
-@pytest.mark.parametrize("style", ["tab", "two_rows", "nm_pN"])
+@pytest.mark.parametrize("style", ["tab", "two_rows", "nm_pN", "spaces"])
 def test_fit_of_the_loading_recovers_mu_H_offset_and_baseline(truth, tmp_path, style):
     scene, t, d, f = truth
     rec = read_instrument(write(tmp_path / "rec.txt", t, d, f, style))
@@ -189,3 +192,32 @@ def test_no_loading_segment_is_a_clear_error(tmp_path):
     rec = read_instrument(p)
     with pytest.raises(ValueError, match=r"loading segment has 0 rows.*retraction.*--segment"):
         fit_record(sb.Scene.preset("fit"), rec, R_L=R_L)
+
+
+def test_an_afm_height_and_a_negative_compression_are_flipped_on_request(truth, tmp_path, capsys):
+    """A height that falls as the tip goes in and compression recorded as negative: the fit says
+    which option flips them; with them the record is the package's convention and fits."""
+    from shellbvp.cli import main
+
+    scene, t, d, f = truth
+    path = tmp_path / "afm.txt"
+    lines = ["# xPosition: 1e-6", "# fancyNames: \"Height\" \"Vertical deflection\" \"Series time\"",
+             "# columns: height vDeflection seriesTime", "# units: m N s"]
+    lines += [f"{-b:.8e} {-c:.8e} {a:.3f}" for a, b, c in zip(t, d, f)]
+    path.write_text("\n".join(lines) + "\n")
+    plain = read_instrument(path)
+    assert plain.columns == {"displacement": "height", "force": "vDeflection", "time": "seriesTime"}
+    with pytest.raises(ValueError, match="--invert displacement or --invert force"):
+        fit_record(scene, read_instrument(path, invert=["force"]), R_L=R_L)
+    rec = read_instrument(path, invert=("displacement", "force"))
+    np.testing.assert_allclose(rec.displacement, d, rtol=1e-8)
+    np.testing.assert_allclose(rec.force, f, rtol=1e-8)
+    assert rec.inverted == ("displacement", "force")
+    res, _ = fit_record(scene, rec, R_L=R_L)
+    assert res.success and res.mu_H_ci95[0] < MU_H < res.mu_H_ci95[1]
+    with pytest.raises(ValueError, match="invert must name displacement and/or force"):
+        read_instrument(path, invert=["height"])
+    out = tmp_path / "afm.h5"
+    assert main(["fit", str(path), "--preset", "fit", "--radius", "0.3mm", "--invert", "displacement",
+                 "--invert", "force", "-o", str(out)]) == 0
+    assert sb.read_fit(out).source["inverted"] == ["displacement", "force"]
