@@ -24,10 +24,11 @@ from .textdata import table_cell
 
 log = logging.getLogger(__name__)
 
-__all__ = ["BatchRow", "fit_files", "expand_inputs", "write_table", "TABLE_COLUMNS", "DATA_SUFFIXES"]
+__all__ = ["BatchRow", "fit_files", "fit_records", "fit_map", "read_record", "expand_inputs", "write_table",
+           "TABLE_COLUMNS", "DATA_SUFFIXES"]
 
 #: File names a directory given as input contributes (instrument exports are text tables).
-DATA_SUFFIXES = (".csv", ".tsv", ".txt", ".dat")
+DATA_SUFFIXES = (".csv", ".tsv", ".txt", ".dat", ".jpk-force", ".ibw")  # AFM single curves: shellbvp.afm
 #: Columns of the results table, with their units.
 TABLE_COLUMNS = ("file", "status", "mu_H (N/m)", "mu_H 95% low (N/m)", "mu_H 95% high (N/m)", "offset (m)",
                  "offset 95% low (m)", "offset 95% high (m)", "baseline (N)", "baseline 95% low (N)",
@@ -187,15 +188,48 @@ def fit_files(scene, paths, *, R_L, segment="loading", baseline="auto", columns=
     >>> out[2].message
     '...notes.csv: ...'
     """
-    from .fitting import fit_record
-    from .instrument import estimate_contact, read_instrument
-
-    records, rows = {}, {}
+    read = []
     for path in paths:  # read every file first: the common depth of the model curves
         try:
-            records[path] = read_instrument(path, columns=columns, units=units, invert=invert)
+            read.append((path, read_record(path, columns=columns, units=units, invert=invert)))
         except ValueError as exc:
-            rows[path] = BatchRow(file=path, status="error", message=" ".join(str(exc).split()))
+            read.append((path, exc))
+    return fit_records(scene, read, R_L=R_L, segment=segment, baseline=baseline, on_file=on_file, **options)
+
+
+def read_record(path, *, columns=None, units=None, invert=()):
+    """One record from a file: an AFM curve through afmformats (:mod:`shellbvp.afm`), a text
+    export through :func:`shellbvp.instrument.read_instrument`.  A force map is refused here
+    (it is fitted on its own: :func:`fit_map`)."""
+    from .afm import is_afm_file, read_afm
+    from .instrument import read_instrument
+
+    if not is_afm_file(path):
+        return read_instrument(path, columns=columns, units=units, invert=invert)
+    if columns or units or invert:
+        raise ValueError(f"{path}: an AFM file gives its own columns, units and signs: --columns, --units and "
+                         f"--invert are for text exports")
+    curves = read_afm(path)
+    if len(curves) > 1:
+        raise ValueError(f"{path}: a force map of {len(curves)} curves: fit it on its own "
+                         f"(shellbvp fit {Path(path).name} ... -o map.h5)")
+    return curves[0].record
+
+
+def fit_records(scene, named, *, R_L, segment="loading", baseline="auto", on_file=None, **options) -> list:
+    """:func:`fit_files` on records already read: ``named`` is a list of ``(name, record)``, a
+    ``ValueError`` in place of a record that could not be read (its row says why).  Records of
+    comparable depth share one model curve."""
+    from .fitting import fit_record
+    from .instrument import estimate_contact
+
+    paths = [name for name, _ in named]
+    records, rows = {}, {}
+    for path, rec in named:
+        if isinstance(rec, Exception):
+            rows[path] = BatchRow(file=path, status="error", message=" ".join(str(rec).split()))
+        else:
+            records[path] = rec
     depths = {}
     for path, rec in records.items():
         try:
@@ -228,6 +262,29 @@ def fit_files(scene, paths, *, R_L, segment="loading", baseline="auto", columns=
         if on_file is not None:
             on_file(rows[path])
     return out
+
+
+def fit_map(scene, curves, *, R_L, path=None, segment="loading", baseline="auto", on_curve=None, **options):
+    """Fit every curve of a force map (:func:`shellbvp.afm.read_afm`) with one scene: a
+    :class:`shellbvp.afm.ForceMap`.
+
+    Curves of comparable depth share one model curve (:func:`fit_records`), so a
+    map costs about one model curve plus a cheap least-squares fit per curve.
+    """
+    from .afm import AFMCurve, ForceMap
+
+    if not curves:
+        raise ValueError("fit_map: no curves")
+    path = path or curves[0].record.path
+    named = [(f"{path}#{c.index}", c.record) for c in curves]
+    rows = fit_records(scene, named, R_L=R_L, segment=segment, baseline=baseline, on_file=on_curve, **options)
+    grids = [c.grid for c in curves if c.grid is not None]
+    shape = (max(g[0] for g in grids) + 1, max(g[1] for g in grids) + 1) if grids else (len(curves), 1)
+    if not grids:  # no grid in the file: one row in file order
+        curves = [AFMCurve(c.record, c.index, (i, 0), c.position, c.grid_geometry) for i, c in enumerate(curves)]
+    settings = {"baseline": baseline, **{k: v for k, v in options.items() if k != "progress"}}
+    return ForceMap(path=str(path), curves=curves, rows=rows, shape=shape, scene=scene, R_L=R_L, segment=segment,
+                    settings=settings)
 
 
 def write_table(path, rows, segment="loading", *, overwrite=False):

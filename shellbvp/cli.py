@@ -481,10 +481,11 @@ def _cmd_fit(args):
     """``shellbvp fit``: exit 0 (fit succeeded; warnings allowed), 1 (the fit ran but failed its
     checks) or 2 (bad input: a ValueError, one line on stderr).  With ``--json`` stdout holds
     exactly one JSON document in every case (errors: see :func:`main`).  Several files (or a
-    directory, a pattern, or ``--table``): a batch, see :func:`_fit_batch`."""
-    from .batch import expand_inputs
+    directory, a pattern, or ``--table``): a batch, see :func:`_fit_batch`; an AFM force map: every
+    curve into a map, see :func:`_fit_map`."""
+    from .afm import is_afm_file, read_afm
+    from .batch import expand_inputs, read_record
     from .fitting import example_data_path, fit_record
-    from .instrument import read_instrument
     from .paths import check_output_path
 
     if args.example == bool(args.data):
@@ -492,7 +493,16 @@ def _cmd_fit(args):
     inputs = [str(example_data_path())] if args.example else args.data
     files = expand_inputs(inputs)
     uncertainty = _split_uncertain(args)
-    if len(files) > 1 or args.table or any(Path(x).is_dir() for x in inputs):
+    folder = any(Path(x).is_dir() for x in inputs)
+    map_curves = None
+    if len(files) == 1 and not folder and is_afm_file(files[0]):
+        _require_sample(args)  # its one-line error before the file is read
+        curves = read_afm(files[0])
+        if len(curves) > 1:  # a force map: every curve, into a map
+            if uncertainty:
+                raise ValueError("VALUE+-U (the geometry's uncertainty) is for one curve, not a force map")
+            map_curves = curves
+    if map_curves is None and (len(files) > 1 or args.table or folder):
         if uncertainty:
             raise ValueError("VALUE+-U (the geometry's uncertainty) is for one file at a time, not a batch")
         return _fit_batch(args, files)
@@ -502,7 +512,9 @@ def _cmd_fit(args):
         _check_report_path(args.report, overwrite=args.force)
     scene, R_L, reading, options = _fit_inputs(args)
     options["progress"] = _curve_bars(args)
-    record = read_instrument(files[0], **reading)
+    if map_curves is not None:
+        return _fit_map(args, files[0], map_curves, scene, R_L, reading, options)
+    record = read_record(files[0], **reading)
     res, used = fit_record(scene, record, R_L=R_L, segment=args.segment, baseline=args.baseline, **options)
     geometry = None
     if uncertainty and res.success:
@@ -611,6 +623,53 @@ def _fit_batch(args, files):
             _say(f"{r.file:<{width}}  {r.status:<6s}  {text}")
         n_ok = sum(r.status == "ok" for r in rows)
         print(f"{n_ok} of {len(rows)} files fitted" + (f"; table: {args.table}" if args.table else ""))
+    return 0 if ok else 1
+
+
+def _fit_map(args, path, curves, scene, R_L, reading, options):
+    """``shellbvp fit MAP.jpk-force-map [-o map.h5] [--table map.csv] [--report map.png]``: every
+    curve with the same scene; exit 0 when every curve was fitted, 1 otherwise."""
+    from .batch import fit_map, write_table
+    from .paths import check_output_path
+
+    if any(reading.values()):
+        raise ValueError(f"{path}: an AFM file gives its own columns, units and signs: --columns, --units and "
+                         f"--invert are for text exports")
+    if args.table is not None:
+        check_output_path(args.table, overwrite=args.force)
+    options = dict(options, progress=_curve_bars(args, leave=False))
+    bar = _progress_bar(len(curves), "curve", args)
+
+    def step(row):
+        bar.update(1)
+        bar.set_postfix_str(row.status)
+
+    try:
+        fm = fit_map(scene, curves, R_L=R_L, path=path, segment=args.segment, baseline=args.baseline,
+                     on_curve=step, **options)
+    finally:
+        bar.close()
+    ok = all(r.status == "ok" for r in fm.rows)
+    if args.table is not None:
+        write_table(args.table, fm.rows, args.segment, overwrite=args.force)
+    if args.output is not None:
+        fm.to_hdf5(args.output, overwrite=args.force)
+    if args.report is not None:
+        fm.plot(args.report)
+    wrote = [w for w in (args.table, args.output, args.report) if w is not None]
+    if args.json:
+        docs = [{"file": r.file, "grid_index": list(c.grid), "status": r.status, "message": r.message,
+                 **(r.result.to_dict() if r.result is not None else {})} for c, r in zip(fm.curves, fm.rows)]
+        print(json.dumps(_strict_json({"map": str(path), "shape": list(fm.shape), "curves": docs, "success": ok,
+                                       "exit_status": 0 if ok else 1}), allow_nan=False))
+        for w in wrote:
+            print(f"wrote {w}", file=sys.stderr)
+    else:
+        _say(f"data   = {path}: a force map of {len(curves)} curves; fitted the {args.segment} segment of each")
+        _say(f"scene  = {scene.describe(R_L)}")
+        _say(f"map    = {fm.summary()}")
+        for w in wrote:
+            _say(f"wrote {w}")
     return 0 if ok else 1
 
 

@@ -34,6 +34,7 @@ import numpy as np
 from .units import PLAIN_NUMBER, normalize_unit, unit_factor, unit_kind
 
 __all__ = ["InstrumentRecord", "Table", "read_table", "read_instrument", "read_force_csv", "segment",
+           "record_from_arrays",
            "estimate_contact", "SEGMENTS", "FIT_SEGMENTS", "sha256_of"]
 
 #: Labels of the rows of a record (:func:`segment`).
@@ -491,18 +492,28 @@ def read_instrument(path, *, columns=None, units=None, invert=()) -> InstrumentR
     if ok.sum() < 3:
         raise ValueError(f"{path}: fewer than 3 rows with numbers")
     arr = {role: -a[ok] if role in flip else a[ok] for role, a in arr.items()}
-    line = np.array(lines)[ok]
-    t = arr.get("time")
+    name = (lambda c: table.header[c] if c < len(table.header) and table.header[c] else c)
+    return record_from_arrays(path, arr["displacement"], arr["force"], arr.get("time"), np.array(lines)[ok],
+                              columns={role: name(col) for role, col in roles}, units=unit_names,
+                              header=list(table.header), inverted=tuple(sorted(flip)))
+
+
+def record_from_arrays(path, displacement, force, time, line, *, columns, units, header=(), inverted=(),
+                       sha256=None) -> InstrumentRecord:
+    """An :class:`InstrumentRecord` from SI arrays in the package's signs (any row order with a
+    time column): sorted by time, segmented, the contact estimated.  ``line``: each row's line
+    in the file (or its index)."""
+    arr = {"displacement": np.asarray(displacement, float), "force": np.asarray(force, float)}
+    line = np.asarray(line)
+    t = None if time is None else np.asarray(time, float)
     if t is not None:
         order = np.argsort(t, kind="stable")  # rows in time order: the segments follow time
         arr = {role: a[order] for role, a in arr.items()}
-        line, t = line[order], arr["time"]
-    name = (lambda c: table.header[c] if c < len(table.header) and table.header[c] else c)
+        line, t = line[order], t[order]
     labels = segment(arr["displacement"], t)
-    rec = InstrumentRecord(path=str(path), sha256=sha256_of(path), displacement=arr["displacement"],
-                           force=arr["force"], time=t, line=line, segments=labels,
-                           columns={role: name(col) for role, col in roles}, units=unit_names,
-                           header=list(table.header), inverted=tuple(sorted(flip)))
+    rec = InstrumentRecord(path=str(path), sha256=sha256 or sha256_of(path), displacement=arr["displacement"],
+                           force=arr["force"], time=t, line=line, segments=labels, columns=dict(columns),
+                           units=dict(units), header=list(header), inverted=tuple(inverted))
     push = rec.mask("loading")
     if push.sum() >= 3:
         rec.contact_estimate = estimate_contact(rec.displacement[push], rec.force[push])

@@ -88,10 +88,13 @@ def test_constant_force_is_an_error(good, no_model_curves):
         sb.fit(scene, disp, np.full(N, 1e-3), R_L=R_L)
 
 
-def test_decreasing_force_is_an_error(good, no_model_curves):
+def test_decreasing_force_is_an_error_that_names_the_remedy(good, no_model_curves):
     scene, disp, F, force = good
-    with pytest.raises(ValueError, match=r"does not increase.*-1\.00"):
+    with pytest.raises(ValueError, match=r"falls as the displacement grows.*-1\.00.*--invert displacement"):
         sb.fit(scene, disp, force[::-1], R_L=R_L)
+    rng = np.random.default_rng(3)
+    with pytest.raises(ValueError, match=r"does not increase"):   # no trend either way
+        sb.fit(scene, disp, rng.permutation(force), R_L=R_L)
 
 
 def test_all_displacements_equal_is_an_error(good, no_model_curves):

@@ -1,0 +1,305 @@
+"""AFM files through afmformats (optional extra ``[afm]``): single curves and force maps.
+
+afmformats, the AFM community's reader (nanite and PyJibe use it), reads JPK's
+``.jpk-force``, ``.jpk-force-map``, ``.jpk-qi-data`` and ``.jpk-qi-series`` and Asylum's
+``.ibw``: each curve's force (N), the cantilever's height (m), time and spring constant, and
+on a map each curve's grid index and position.  The tip's position is the height plus the
+cantilever's deflection ``force / spring constant`` (nanite's tip-sample separation, JPK's
+"Vertical Tip Position"); the height falls as the tip goes in, so the displacement into the
+sample is minus the tip's position: the package's signs, no ``--invert`` needed.
+
+* :func:`read_afm` -- the curves of a file as :class:`AFMCurve` (an
+  :class:`~shellbvp.instrument.InstrumentRecord` with its place on the map).
+* :class:`ForceMap` -- a force map fitted curve by curve (:func:`shellbvp.batch.fit_map`): the
+  per-curve rows of a batch, images of mu*H and its interval, a NeXus file, a figure.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+__all__ = ["AFM_SUFFIXES", "AFMCurve", "ForceMap", "is_afm_file", "read_afm", "curves_from_afm", "MAP_FORMAT"]
+
+#: File name endings read through afmformats (other text files go through shellbvp.instrument).
+AFM_SUFFIXES = (".jpk-force", ".jpk-force-map", ".jpk-qi-data", ".jpk-qi-series", ".ibw")
+MAP_FORMAT = "shellbvp-force-map"
+MAP_FORMAT_VERSION = 1
+
+
+def is_afm_file(path) -> bool:
+    return str(path).lower().endswith(AFM_SUFFIXES)
+
+
+@dataclass
+class AFMCurve:
+    """One curve of an AFM file.
+
+    Attributes
+    ----------
+    record : InstrumentRecord
+        Displacement into the sample (m), force (N), time (s), segments, contact estimate.
+    index : int
+        The curve's number in the file (afmformats' ``enum``).
+    grid : tuple of int or None
+        ``(ix, iy)`` on a force map.
+    position : tuple of float or None
+        ``(x, y)`` of the curve on the sample (m), as the file gives it.
+    grid_geometry : tuple or None
+        ``((center x, center y), (size x, size y))`` of the map's grid (m).
+    """
+
+    record: object
+    index: int
+    grid: tuple = None
+    position: tuple = None
+    grid_geometry: tuple = None  # ((center x, center y), (size x, size y)) of the map's grid, m
+
+
+def _afmformats():
+    try:
+        import afmformats
+    except ImportError:
+        raise ValueError("reading AFM files needs afmformats: pip install 'shellbvp[afm]'") from None
+    return afmformats
+
+
+def read_afm(path) -> list:
+    """The curves of an AFM file (:data:`AFM_SUFFIXES`) as :class:`AFMCurve`, in file order.
+
+    Raises
+    ------
+    ValueError
+        afmformats is not installed, or cannot read the file, or a curve lacks the force,
+        a height or the spring constant.
+    """
+    from .instrument import sha256_of
+    from .paths import read_input_bytes
+
+    afmformats = _afmformats()
+    read_input_bytes(path)  # a regular file of bounded size: never a FIFO, a device or a folder
+    from afmformats import errors, meta
+
+    # afmformats raises many kinds on a damaged or foreign file, some of them BaseExceptions
+    failures = (Exception, meta.MetaDataMissingError,
+                *(c for c in vars(errors).values() if isinstance(c, type) and issubclass(c, BaseException)
+                  and not issubclass(c, Exception)))
+    try:
+        datasets = afmformats.load_data(str(path))
+    except failures as exc:
+        raise ValueError(f"{path}: afmformats cannot read it ({type(exc).__name__}: {exc})") from None
+    if not datasets:
+        raise ValueError(f"{path}: afmformats found no force-distance curve in it")
+    return curves_from_afm(datasets, path, sha256=sha256_of(path))
+
+
+def _meta(md, key):
+    v = dict.get(md, key) if isinstance(md, dict) else None  # MetaData[key] raises a BaseException
+    return v if isinstance(v, (int, float, np.integer, np.floating)) and math.isfinite(v) else None
+
+
+def curves_from_afm(datasets, path, *, sha256=None) -> list:
+    """:class:`AFMCurve` from afmformats' curves (``AFMForceDistance``) of the file ``path``."""
+    from .instrument import record_from_arrays
+
+    out = []
+    for i, ds in enumerate(datasets):
+        columns = list(ds.columns)
+        md = ds.metadata
+        where = f"{path}, curve {i}"
+        if "force" not in columns:
+            raise ValueError(f"{where}: no force column (columns: {', '.join(columns)})")
+        force = np.asarray(ds["force"], float)
+        if "tip position" in columns:
+            tip, how = np.asarray(ds["tip position"], float), "-(tip position)"
+        else:
+            height = next((h for h in ("height (measured)", "height (piezo)") if h in columns), None)
+            k = _meta(md, "spring constant")
+            if height is None or k is None or not k > 0:
+                raise ValueError(f"{where}: needs a height column and the spring constant to place the tip "
+                                 f"(columns: {', '.join(columns)}; spring constant: {k})")
+            tip, how = np.asarray(ds[height], float) + force / k, f"-({height} + force / spring constant)"
+        time = np.asarray(ds["time"], float) if "time" in columns else None
+        ok = np.isfinite(tip) & np.isfinite(force) & (np.isfinite(time) if time is not None else True)
+        if ok.sum() < 3:
+            raise ValueError(f"{where}: fewer than 3 rows with numbers")
+        record = record_from_arrays(path, -tip[ok], force[ok], None if time is None else time[ok],
+                                    np.flatnonzero(ok), columns={"displacement": how, "force": "force",
+                                                                 **({"time": "time"} if time is not None else {})},
+                                    units={"displacement": "m", "force": "N", **({"time": "s"} if time is not None
+                                                                               else {})},
+                                    header=columns, sha256=sha256)
+        ix, iy = _meta(md, "grid index x"), _meta(md, "grid index y")
+        x, y = _meta(md, "position x"), _meta(md, "position y")
+        index = _meta(md, "enum")
+        geometry = [_meta(md, f"grid {a} {b}") for a in ("center", "size") for b in "xy"]
+        out.append(AFMCurve(record=record, index=int(index) if index is not None else i,
+                            grid=(int(ix), int(iy)) if ix is not None and iy is not None else None,
+                            position=(float(x), float(y)) if x is not None and y is not None else None,
+                            grid_geometry=((geometry[0], geometry[1]), (geometry[2], geometry[3]))
+                            if None not in geometry else None))
+    return out
+
+
+@dataclass
+class ForceMap:
+    """Every curve of a force map fitted with one scene (:func:`shellbvp.batch.fit_map`).
+
+    Attributes
+    ----------
+    path : str
+        The map's file.
+    curves : list of AFMCurve
+    rows : list of BatchRow
+        One per curve, in the same order (status ``ok``, ``failed`` or ``error``).
+    shape : tuple of int
+        ``(nx, ny)``: the grid's size (from the curves' indices).
+    scene : Scene
+    R_L : float
+    """
+
+    path: str
+    curves: list
+    rows: list
+    shape: tuple
+    scene: object
+    R_L: float
+    segment: str = "loading"
+    settings: dict = field(default_factory=dict)
+
+    def image(self, quantity="mu_H") -> np.ndarray:
+        """``(ny, nx)`` image of ``mu_H``, ``mu_H_low``, ``mu_H_high`` (N/m), ``offset`` (m) or
+        ``pressure_Pa``: NaN where a curve is missing or its fit did not succeed."""
+        nx, ny = self.shape
+        img = np.full((ny, nx), np.nan)
+        for c, row in zip(self.curves, self.rows):
+            if c.grid is None or row.status != "ok":
+                continue
+            r = row.result
+            value = {"mu_H": r.mu_H, "mu_H_low": r.mu_H_ci95[0], "mu_H_high": r.mu_H_ci95[1],
+                     "offset": r.offset, "pressure_Pa": r.pressure_Pa}[quantity]
+            img[c.grid[1], c.grid[0]] = np.nan if value is None else value
+        return img
+
+    def status_image(self) -> np.ndarray:
+        """``(ny, nx)`` codes: 0 fitted, 1 the fit failed its checks, 2 error, -1 no curve."""
+        nx, ny = self.shape
+        img = np.full((ny, nx), -1, dtype=np.int8)
+        code = {"ok": 0, "failed": 1, "error": 2}
+        for c, row in zip(self.curves, self.rows):
+            if c.grid is not None:
+                img[c.grid[1], c.grid[0]] = code.get(row.status, 2)
+        return img
+
+    def axes(self):
+        """``(x, y)``: the grid's cell centres (m) from the file's grid centre and size, else each
+        column's and row's mean curve position; ``(None, None)`` where neither is known."""
+        nx, ny = self.shape
+        geometry = {c.grid_geometry for c in self.curves}
+        if len(geometry) == 1 and None not in geometry:
+            (cx, cy), (sx, sy) = geometry.pop()
+            return (cx - sx / 2 + (np.arange(nx) + 0.5) * sx / nx, cy - sy / 2 + (np.arange(ny) + 0.5) * sy / ny)
+        xs, ys = [[] for _ in range(nx)], [[] for _ in range(ny)]
+        for c in self.curves:
+            if c.grid is not None and c.position is not None:
+                xs[c.grid[0]].append(c.position[0])
+                ys[c.grid[1]].append(c.position[1])
+        x = np.array([np.mean(v) if v else np.nan for v in xs])
+        y = np.array([np.mean(v) if v else np.nan for v in ys])
+        return (x, y) if np.all(np.isfinite(x)) and np.all(np.isfinite(y)) else (None, None)
+
+    def summary(self) -> str:
+        counts = {s: sum(r.status == s for r in self.rows) for s in ("ok", "failed", "error")}
+        mu = np.array([r.result.mu_H for r in self.rows if r.status == "ok"])
+        spread = (f"; mu*H median {np.median(mu):.4g} N/m, quartiles {np.percentile(mu, 25):.4g}.."
+                  f"{np.percentile(mu, 75):.4g}" if mu.size else "")
+        nx, ny = self.shape
+        return (f"{len(self.rows)} curves on a {nx} x {ny} grid: {counts['ok']} fitted, {counts['failed']} failed "
+                f"their checks, {counts['error']} errors{spread}")
+
+    def to_hdf5(self, out, *, overwrite=False):
+        """The map as a NeXus file, written atomically: ``/entry/map`` (NXdata: ``mu_H`` image
+        over ``y``, ``x``, its interval, offset, pressure where fitted, status codes) and
+        ``/entry/curves`` (one row per curve: index, grid, position, results, status, message)."""
+        import json
+
+        from .nexus import new_file, number_dataset, string_dataset
+        from .textdata import printable
+
+        x, y = self.axes()
+        with new_file(out, MAP_FORMAT, MAP_FORMAT_VERSION, overwrite=overwrite) as f:
+            f.attrs["default"] = "entry"
+            entry = f.create_group("entry")
+            entry.attrs.update({"NX_class": "NXentry", "default": "map"})
+            m = entry.create_group("map")
+            m.attrs.update({"NX_class": "NXdata", "signal": "mu_H", "axes": ["y", "x"] if x is not None else
+                            [".", "."]})
+            number_dataset(m, "mu_H", self.image("mu_H"), "N/m", "shear modulus x thickness, fitted per curve")
+            number_dataset(m, "mu_H_low", self.image("mu_H_low"), "N/m", "lower end of mu*H's 95 % interval")
+            number_dataset(m, "mu_H_high", self.image("mu_H_high"), "N/m", "upper end of mu*H's 95 % interval")
+            number_dataset(m, "offset", self.image("offset"), "m", "fitted contact point")
+            if any(r.status == "ok" and r.result.pressure_Pa is not None for r in self.rows):
+                number_dataset(m, "pressure_Pa", self.image("pressure_Pa"), "Pa", "fitted pressure")
+            number_dataset(m, "status", self.status_image(), "1", "0 fitted, 1 failed its checks, 2 error, -1 no curve")
+            if x is not None:
+                number_dataset(m, "x", x, "m", "position x of the grid's columns")
+                number_dataset(m, "y", y, "m", "position y of the grid's rows")
+            c = entry.create_group("curves")
+            c.attrs["NX_class"] = "NXcollection"
+            grid = np.array([cv.grid if cv.grid is not None else (-1, -1) for cv in self.curves], dtype=int)
+            pos = np.array([cv.position if cv.position is not None else (np.nan, np.nan) for cv in self.curves], float)
+            res = [r.result if r.status in ("ok", "failed") else None for r in self.rows]
+
+            def col(fn):
+                return np.array([np.nan if r is None or fn(r) is None else fn(r) for r in res], float)
+
+            number_dataset(c, "index", np.array([cv.index for cv in self.curves], dtype=int), "1", "curve in the file")
+            number_dataset(c, "grid_index", grid.reshape(-1, 2), "1", "(ix, iy) on the grid; -1: none")
+            number_dataset(c, "position", pos.reshape(-1, 2), "m", "(x, y) on the sample")
+            number_dataset(c, "mu_H", col(lambda r: r.mu_H), "N/m", "shear modulus x thickness")
+            number_dataset(c, "mu_H_ci95", np.column_stack([col(lambda r: r.mu_H_ci95[0]),
+                                                            col(lambda r: r.mu_H_ci95[1])]).reshape(-1, 2),
+                           "N/m", "95 % interval of mu*H")
+            number_dataset(c, "offset", col(lambda r: r.offset), "m", "fitted contact point")
+            string_dataset(c, "status", [r.status for r in self.rows], "ok, failed (its checks) or error")
+            string_dataset(c, "message", [printable(r.message) for r in self.rows], "the fit's message")
+            s = entry.create_group("sample")
+            s.attrs.update({"NX_class": "NXsample", "scene": self.scene.to_json(),
+                            "description": self.scene.describe(self.R_L), "R_L_m": float(self.R_L)})
+            src = entry.create_group("source")
+            src.attrs["NX_class"] = "NXnote"
+            string_dataset(src, "file_name", str(self.path))
+            string_dataset(src, "sha256", self.curves[0].record.sha256 if self.curves else "")
+            string_dataset(src, "settings", json.dumps({"segment": self.segment, **self.settings}, default=str))
+
+    def plot(self, out=None, ax=None):
+        """The mu*H image (curves whose fit did not succeed left blank), with a colour bar."""
+        from .plotting import require_matplotlib
+
+        plt = require_matplotlib()
+        fig = None
+        if ax is None:
+            fig, ax = plt.subplots(figsize=(5.5, 4.5))
+        x, y = self.axes()
+        img = self.image("mu_H")
+        nx, ny = self.shape
+        if x is not None and nx > 1 and ny > 1:
+            dx, dy = np.ptp(x) / (nx - 1) * 1e6, np.ptp(y) / (ny - 1) * 1e6
+            extent = (x.min() * 1e6 - dx / 2, x.max() * 1e6 + dx / 2, y.min() * 1e6 - dy / 2, y.max() * 1e6 + dy / 2)
+            ax.set_xlabel("x (um)")
+            ax.set_ylabel("y (um)")
+        else:
+            extent = None
+            ax.set_xlabel("grid index x")
+            ax.set_ylabel("grid index y")
+        im = ax.imshow(img, origin="lower", extent=extent, interpolation="nearest")
+        (fig or ax.figure).colorbar(im, ax=ax, label="mu*H (N/m)")
+        ax.set_title(f"{Path(self.path).name}: {sum(r.status == 'ok' for r in self.rows)} of {len(self.rows)} "
+                     "curves fitted", fontsize=9)
+        if out is not None:
+            (fig or ax.figure).savefig(out, dpi=150, bbox_inches="tight")
+            plt.close(fig or ax.figure)
+        return ax
