@@ -472,12 +472,12 @@ def mutate_file(good, path, rng, marker, scene_dict):
     """Copy ``good`` to ``path`` with one random mutation; return its description."""
     shutil.copyfile(good, path)
     with h5py.File(path, "r+") as f:
-        g = f["curve"]
+        g = f["entry/curve"]
         r = rng.random()
         if r < 0.55:
             key = rng.choice(ROOT_ATTRS + CURVE_ATTRS)
             obj = f if key in ROOT_ATTRS else g
-            where = "/" if key in ROOT_ATTRS else "/curve"
+            where = "/" if key in ROOT_ATTRS else "/entry/curve"
             if rng.random() < 0.2:
                 if key in obj.attrs:
                     del obj.attrs[key]
@@ -527,8 +527,8 @@ def not_hdf5_files(tmp, good, rng):
     p = tmp / "foreign.h5"
     with h5py.File(p, "w") as f:
         f.attrs["format"] = "shellbvp-curve"
-        f["curve"] = np.arange(3.0)
-    files.append((p, "format attribute right, /curve a dataset"))
+        f["entry/curve"] = np.arange(3.0)
+    files.append((p, "format attribute right, /entry/curve a dataset"))
     p = tmp / "adir.h5"
     p.mkdir()
     files.append((p, "a directory"))

@@ -2,12 +2,15 @@
 (atomic writes, a documented self-describing layout).  The continuation
 algorithm (``shellbvp.continuation``) fills a Curve; this module owns its shape.
 
-Layout (format ``shellbvp-curve``, version 3; version 1 lacked topology, S1 and
+Layout (format ``shellbvp-curve``, version 4, NeXus; versions 1-3 kept the same group at
+``/curve``, under the root, and read as before; version 1 lacked topology, S1 and
 ring_force_inner, which read as a single cap; version 2 lacked legendre_min,
 contact_edge and edge_jump_ls/ks, which read as NaN and "")::
 
-    /                       attrs: format, format_version, package_version, created (UTC ISO)
-    /curve                  NXdata group; attrs:
+    /                       attrs: format, format_version, package_version, created (UTC ISO),
+                            default = "entry"
+    /entry                  NXentry; attrs: default = "curve"
+    /entry/curve            NXdata group (below: /curve for short); attrs:
                               NX_class = "NXdata", signal = "force", axes = ["delta"],
                               scene (JSON: rebuilds the Scene exactly, user formulas as plain text),
                               scene_<key> (gamma, rho, beta, xi, contact, material_family, ...:
@@ -53,7 +56,7 @@ __all__ = ["Curve", "POINT_FIELDS", "CAP_FIELD_DEFAULTS", "point_record", "energ
            "FORMAT_VERSION"]
 
 FORMAT = "shellbvp-curve"
-FORMAT_VERSION = 3
+FORMAT_VERSION = 4
 
 #: Per-point fields of a curve (arrays of the Curve and datasets of its HDF5 file).
 POINT_FIELDS = (
@@ -283,7 +286,10 @@ def write_curve(curve, path, *, profiles=False, overwrite=False, units=None):
     """
     _check_units(units)  # bad units refused before any file is made
     with new_file(path, FORMAT, FORMAT_VERSION, overwrite=overwrite) as f:
-        write_curve_group(f.create_group("curve"), curve, profiles=profiles, units=units)
+        f.attrs["default"] = "entry"  # NeXus: root -> entry -> curve, the plottable F(delta)
+        entry = f.create_group("entry")
+        entry.attrs.update({"NX_class": "NXentry", "default": "curve"})
+        write_curve_group(entry.create_group("curve"), curve, profiles=profiles, units=units)
 
 
 def _missing_field(name, n):
@@ -439,7 +445,7 @@ def read_curve(path):
     Parameters
     ----------
     path : str or Path
-        An HDF5 curve file (format ``shellbvp-curve``, versions 1 and 2), or a
+        An HDF5 curve file (format ``shellbvp-curve``, versions 1 to 4), or a
         ``.partial`` checkpoint of a running curve.
 
     Returns
@@ -464,11 +470,15 @@ def read_curve(path):
     (True, 0.3639)
     """
 
+    import h5py
+
     path = Path(path)
-    with open_hdf5(path, fmt=FORMAT, group="curve", kind="curve") as f:
+    with open_hdf5(path, fmt=FORMAT, group=("entry/curve", "curve"), kind="curve") as f:
         try:
-            _format_version(f)
-            curve = read_curve_group(f["curve"], str(f.attrs.get("package_version", "")))
+            where = "entry/curve" if _format_version(f) >= 4 else "curve"  # version 4: NeXus, under an NXentry
+            if not isinstance(f.get(where), h5py.Group):
+                raise ValueError(f"format version {_format_version(f)} keeps its curve in /{where}, which is missing")
+            curve = read_curve_group(f[where], str(f.attrs.get("package_version", "")))
         except ValueError as exc:
             raise ValueError(f"{path}: {exc}") from None
         except (KeyError, TypeError, OSError) as exc:  # h5py's own errors on a damaged file

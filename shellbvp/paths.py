@@ -51,10 +51,11 @@ def read_input_bytes(path, max_bytes=MAX_INPUT_BYTES) -> bytes:
         os.close(fd)
 
 
-def open_hdf5(path, *, fmt: str, group: str, kind: str):
+def open_hdf5(path, *, fmt: str, group, kind: str):
     """The HDF5 file at ``path`` opened for reading (use it in ``with``), once it is known to be a
-    shellbvp ``kind`` file: attribute ``format == fmt`` and a group ``group``.  ValueError with one
-    line naming the path otherwise (missing, a directory, not HDF5, another format)."""
+    shellbvp ``kind`` file: attribute ``format == fmt`` and a group ``group`` (or one of several
+    paths, for a layout that changed between versions).  ValueError with one line naming the path
+    otherwise (missing, a directory, not HDF5, another format)."""
     import h5py
 
     path = Path(path)
@@ -68,7 +69,8 @@ def open_hdf5(path, *, fmt: str, group: str, kind: str):
         raise ValueError(f"{path}: not a readable HDF5 file ({' '.join(str(exc).split())})") from None
     found = f.attrs.get("format")
     found = found.decode("utf-8", "replace") if isinstance(found, bytes) else found
-    if not (isinstance(found, str) and found == fmt and isinstance(f.get(group), h5py.Group)):
+    groups = (group,) if isinstance(group, str) else tuple(group)
+    if not (isinstance(found, str) and found == fmt and any(isinstance(f.get(g), h5py.Group) for g in groups)):
         f.close()
         raise ValueError(f"{path}: not a shellbvp {kind} file (format attribute missing or different)")
     return f

@@ -40,7 +40,7 @@ def test_curve_with_options_and_points(tmp_path):
     assert r.returncode == 0, r.stderr
     assert "R_L = 1 mm and mu*H = 52 N/m: displacement up to 0.2 mm" in r.stdout, r.stdout
     with h5py.File(tmp_path / "f.h5") as f:
-        g = f["curve"]
+        g = f["entry/curve"]
         assert g.attrs["scene_beta"] == 0.02 and g.attrs["scene_contact"] == "paper"
         assert len(g["delta"]) == 4 and "force_N" in g and g.attrs["R_L_m"] == 0.001
 

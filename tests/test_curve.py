@@ -184,7 +184,7 @@ def test_hdf5_round_trip(base_curve, tmp_path):
     assert back.flags == base_curve.flags and back.stop_reason == base_curve.stop_reason
     assert back.complete and back.settings["tol"] == base_curve.settings["tol"]
     with h5py.File(path) as f:  # NXdata conventions for generic viewers
-        g = f["curve"]
+        g = f["entry/curve"]
         assert g.attrs["NX_class"] == "NXdata" and g.attrs["signal"] == "force"
         assert list(g.attrs["axes"]) == ["delta"]
         assert json.loads(g.attrs["scene"])["rho"] == 0.2
@@ -193,7 +193,7 @@ def test_hdf5_round_trip(base_curve, tmp_path):
         base_curve.to_hdf5(path)
     base_curve.to_hdf5(path, overwrite=True, profiles=True, units={"R_L": 1e-3, "mu_H": 50.0})
     with h5py.File(path) as f:
-        g = f["curve"]
+        g = f["entry/curve"]
         assert len(g["profiles"]) == len(base_curve)
         np.testing.assert_allclose(g["force_N"][()], 50.0 * 1e-3 * base_curve.force)
     assert not list(tmp_path.glob(".*.tmp"))  # no temporary files left behind

@@ -68,7 +68,7 @@ def test_error_method_round_trips_and_older_files_read_empty(auto_curve, tmp_pat
     back = sb.read_curve(path)
     assert list(back.points["error_method"]) == list(auto_curve.points["error_method"])
     with h5py.File(path, "a") as f:  # a file written before the field existed
-        del f["curve/error_method"]
+        del f["entry/curve/error_method"]
     assert list(sb.read_curve(path).points["error_method"]) == ["", "", ""]
 
 

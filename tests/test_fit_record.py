@@ -86,6 +86,18 @@ def test_nexusformat_loads_it_and_finds_the_plottable_signal(fit_file):
     assert root["fit"].nxclass == "NXentry" and root["fit/model"].nxclass == "NXdata"
 
 
+def test_a_curve_file_is_nexus_with_the_default_chain(tmp_path):
+    """Root -> NXentry -> NXdata F(delta), as nexusformat finds it (issue 45, item 4)."""
+    nx = pytest.importorskip("nexusformat.nexus")
+    path = tmp_path / "c.h5"
+    sb.curve(sb.Scene.preset("base"), deltas=[0.1, 0.15], estimate_error=False).to_hdf5(path)
+    root = nx.nxload(str(path))
+    assert root["entry"].nxclass == "NXentry" and root["entry/curve"].nxclass == "NXdata"
+    data = root.plottable_data
+    assert data.nxsignal.nxname == "force" and data.nxaxes[0].nxname == "delta"
+    assert [k for k in root if root[k].nxclass == "NXdata"] == []   # no NXdata under the root
+
+
 def test_every_file_the_package_writes_has_units_on_every_dataset(fit_file, tmp_path):
     curve = tmp_path / "c.h5"
     r = run("curve", "--preset", "base", "--points", "3", "--delta-max", "0.15", "--radius", "1mm", "--muH", "5N/m",
@@ -98,12 +110,12 @@ def test_every_file_the_package_writes_has_units_on_every_dataset(fit_file, tmp_
     for path in files:
         assert missing_units(path) == [], path
     with h5py.File(curve) as f:  # and the units are right, not just present
-        g = f["curve"]
+        g = f["entry/curve"]
         assert g["delta_m"].attrs["units"] == "m" and g["force_N"].attrs["units"] == "N"
         assert g["delta"].attrs["units"] == "1" and g["wall_time"].attrs["units"] == "s"
         assert g["topology"].attrs["units"] == ""
     with h5py.File(tmp_path / "profiles.h5") as f:
-        assert len(f["curve/profiles"]) == 2
+        assert len(f["entry/curve/profiles"]) == 2
     # the check can fail
     with h5py.File(tmp_path / "bare.h5", "w") as f:
         f["x"] = [1.0]

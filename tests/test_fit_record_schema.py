@@ -74,13 +74,13 @@ def test_a_curve_file_bomb_is_refused_before_it_expands(tmp_path):
     shutil.copy(path, bomb)
     with h5py.File(bomb, "r+") as h:
         for name in ("delta", "force"):
-            del h[f"curve/{name}"]
-            h["curve"].create_dataset(name, shape=(400_000_000,), dtype="f8", compression="gzip", chunks=(1_000_000,))
+            del h[f"entry/curve/{name}"]
+            h["entry/curve"].create_dataset(name, shape=(400_000_000,), dtype="f8", compression="gzip", chunks=(1_000_000,))
     with pytest.raises(ValueError, match="MiB"):
         sb.read_curve(bomb)
     deep = tmp_path / "deep.h5"
     shutil.copy(path, deep)
     with h5py.File(deep, "r+") as h:
-        h["curve"].attrs["scene"] = "[" * 200_000 + "]" * 200_000
+        h["entry/curve"].attrs["scene"] = "[" * 200_000 + "]" * 200_000
     with pytest.raises(ValueError, match="nested deeper"):
         sb.read_curve(deep)

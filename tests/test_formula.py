@@ -164,7 +164,7 @@ def curve_file(tmp_path_factory):
 def tamper(src, dst, scene_dict):
     dst.write_bytes(src.read_bytes())
     with h5py.File(dst, "r+") as f:
-        f["curve"].attrs["scene"] = json.dumps(scene_dict)
+        f["entry/curve"].attrs["scene"] = json.dumps(scene_dict)
 
 
 @pytest.mark.parametrize("where", ["material", "shell", "tip", "srepr"])

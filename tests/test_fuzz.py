@@ -168,7 +168,7 @@ def test_tampered_file_is_read_or_refused_with_one_line(good_curve, tmp_path_fac
     bad = tmp_path_factory.mktemp("bad") / "bad.h5"
     bad.write_bytes(good_curve.read_bytes())
     with h5py.File(bad, "r+") as f:
-        g = f["curve"]
+        g = f["entry/curve"]
         if where in ATTRS:
             _write_junk(f, where, value)
         elif where in CURVE_ATTRS:

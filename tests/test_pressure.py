@@ -156,7 +156,7 @@ def test_cli_pressure_with_a_unit_needs_the_scales(tmp_path, capsys):
     import h5py
 
     with h5py.File(out) as f:  # where the curve starts, with units
-        rise = f["curve/inflated/pole_rise"]
+        rise = f["entry/curve/inflated/pole_rise"]
         assert rise[()] == pytest.approx(inflate(c.scene).pole_rise) and rise.attrs["units"] == "1 (R_L)"
     assert main(["curve", "--preset", "dome", "--pressure", "5kPa", "-o", str(tmp_path / "x.h5")]) == 2
     assert "needs --radius and --muH" in capsys.readouterr().err

@@ -287,8 +287,8 @@ def good_file(tmp_path_factory):
 
 def _replace(name, data, **kw):
     def edit(f):
-        del f["curve"][name]
-        f["curve"].create_dataset(name, data=data, **kw)
+        del f["entry/curve"][name]
+        f["entry/curve"].create_dataset(name, data=data, **kw)
     return edit
 
 
@@ -299,11 +299,11 @@ def _strings(values):
 
 
 TAMPERED = {
-    "no_stop_reason": (lambda f: f["curve"].attrs.__delitem__("stop_reason"), "attribute stop_reason missing"),
-    "no_complete": (lambda f: f["curve"].attrs.__delitem__("complete"), "attribute complete missing"),
-    "no_interrupted": (lambda f: f["curve"].attrs.__delitem__("interrupted"), "attribute interrupted missing"),
-    "complete_text": (lambda f: f["curve"].attrs.__setitem__("complete", "yes"), "complete must be a boolean"),
-    "stop_reason_number": (lambda f: f["curve"].attrs.__setitem__("stop_reason", 3.0),
+    "no_stop_reason": (lambda f: f["entry/curve"].attrs.__delitem__("stop_reason"), "attribute stop_reason missing"),
+    "no_complete": (lambda f: f["entry/curve"].attrs.__delitem__("complete"), "attribute complete missing"),
+    "no_interrupted": (lambda f: f["entry/curve"].attrs.__delitem__("interrupted"), "attribute interrupted missing"),
+    "complete_text": (lambda f: f["entry/curve"].attrs.__setitem__("complete", "yes"), "complete must be a boolean"),
+    "stop_reason_number": (lambda f: f["entry/curve"].attrs.__setitem__("stop_reason", 3.0),
                            "stop_reason must be a string"),
     "version_array": (lambda f: f.attrs.__setitem__("format_version", np.array([2, 2])),
                       "format_version must be a scalar integer"),
@@ -314,14 +314,14 @@ TAMPERED = {
     "short_force": (_replace("force", [0.1, 0.2]), "force must be a 1-D array of 3 values"),
     "force_2d": (_replace("force", np.zeros((3, 2))), "force must be a 1-D array of 3 values"),
     "force_strings": (_strings(["a", "b", "c"]), "force must hold numbers; got strings"),
-    "no_lambda0": (lambda f: f["curve"].__delitem__("lambda0"), "dataset lambda0 missing"),
-    "no_flags": (lambda f: f["curve"].__delitem__("flags"), "dataset flags missing"),
+    "no_lambda0": (lambda f: f["entry/curve"].__delitem__("lambda0"), "dataset lambda0 missing"),
+    "no_flags": (lambda f: f["entry/curve"].__delitem__("flags"), "dataset flags missing"),
     "status_fraction": (_replace("status", [0.5, 0.0, 0.0]), "status must hold integers"),
     "topology_numbers": (_replace("topology", [1, 2, 3]), "topology must hold strings"),
-    "scene_not_json": (lambda f: f["curve"].attrs.__setitem__("scene", "{nope"), "attribute scene is not valid JSON"),
-    "scene_incomplete": (lambda f: f["curve"].attrs.__setitem__("scene", '{"gamma": 1}'),
+    "scene_not_json": (lambda f: f["entry/curve"].attrs.__setitem__("scene", "{nope"), "attribute scene is not valid JSON"),
+    "scene_incomplete": (lambda f: f["entry/curve"].attrs.__setitem__("scene", '{"gamma": 1}'),
                          "attribute scene does not describe a scene"),
-    "settings_list": (lambda f: f["curve"].attrs.__setitem__("settings", "[1, 2]"),
+    "settings_list": (lambda f: f["entry/curve"].attrs.__setitem__("settings", "[1, 2]"),
                       "attribute settings must be a JSON object"),
 }
 
