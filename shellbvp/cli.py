@@ -775,7 +775,8 @@ def _cmd_plot(args):
     from .fitrecord import is_fit_file, read_fit
     from .io import read_curve
     from .paths import check_output_path
-    from .plotting import plot_curves, plot_fit_record, plot_profiles, require_matplotlib, save_figure
+    from .plotting import plot_curves, plot_fit_record, plot_profiles, require_matplotlib, save_figure, scene_label
+    from .sweep import is_sweep_file, read_sweep
 
     fits = [f for f in args.files if is_fit_file(f)]
     if fits:
@@ -802,11 +803,22 @@ def _cmd_plot(args):
     args.output = "curves.png" if args.output is None else args.output
     check_output_path(args.output, overwrite=True)  # a figure is cheap to redraw: replaced
     plt = require_matplotlib()
-    curves = [read_curve(f) for f in args.files]
+    curves, labels = [], []
+    for name in args.files:
+        if is_sweep_file(name):  # a family: one curve per finished combination, labelled by its values
+            sw = read_sweep(name)
+            for i, c in sorted(sw.curves.items()):
+                curves.append(c)
+                labels.append(" ".join(f"{p}={sw.index[p][i]:.4g}" for p in sw.parameters))
+        else:
+            curves.append(read_curve(name))
+            labels.append(scene_label(curves[-1].scene))
+    if not curves:
+        raise ValueError(f"{', '.join(args.files)}: no finished curve to plot")
     deltas = _numbers(args.profiles, "--profiles") if args.profiles else []
     ncol = 2 if deltas else 1
     fig, axes = plt.subplots(1, ncol, figsize=(6 * ncol, 4.8), squeeze=False)
-    plot_curves(curves, ax=axes[0, 0])
+    plot_curves(curves, ax=axes[0, 0], labels=labels)
     if deltas:
         for d in deltas:
             if not d > 0:
@@ -1153,8 +1165,9 @@ def build_parser():
     w.add_argument("-q", "--quiet", action="store_true", help="no line per finished curve")
     w.set_defaults(func=_cmd_sweep)
     pl = sub.add_parser("plot", help="plot curves (and profiles) from HDF5 files (needs matplotlib)")
-    pl.add_argument("files", nargs="+", help="curve files (`shellbvp curve`) or fit files (`shellbvp fit -o`: data, "
-                    "model and residuals in SI units)")
+    pl.add_argument("files", nargs="+", help="curve files (`shellbvp curve`), sweep files (`shellbvp sweep`: one "
+                    "curve per finished combination) or fit files (`shellbvp fit -o`: data, model and residuals in "
+                    "SI units)")
     pl.add_argument("-o", "--output", help="PNG or PDF (default curves.png; for fit files <name>.png next to "
                     "each); for several fit files a directory (one <name>.png each)")
     pl.add_argument("--profiles", help="also draw the deformed shell of the first file at these depths, e.g. 0.1,0.3")

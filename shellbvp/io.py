@@ -176,7 +176,8 @@ def energy_residual(delta, energy, force):
     delta, energy, force = (np.asarray(a, float) for a in (delta, energy, force))
     if delta.size < 3 or np.any(np.diff(delta) == 0):
         return np.full(delta.shape, np.nan)
-    return np.gradient(energy, delta, edge_order=2) - force
+    with np.errstate(all="ignore"):  # a file's near-equal or non-finite depths: inf/NaN, not warnings
+        return np.gradient(energy, delta, edge_order=2) - force
 
 
 def point_record(sol) -> dict:

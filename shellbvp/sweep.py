@@ -336,6 +336,7 @@ def _write_index(s, names, index) -> None:
     if "index" in s:
         del s["index"]
     ig = s.create_group("index")
+    ig.attrs["NX_class"] = "NXcollection"
     for name in names:
         ig.create_dataset(name, data=np.asarray(index[name], float)).attrs["units"] = "nondimensional"
     for key in ("status", "stop_reason", "message", "group"):
@@ -344,6 +345,36 @@ def _write_index(s, names, index) -> None:
     ig.create_dataset("wall_time", data=np.asarray(index["wall_time"], float))
     for key, units in _INDEX_UNITS.items():
         ig[key].attrs["units"] = units
+
+
+def _write_overview(s, names, meta, index) -> None:
+    """``/sweep/overview``, the file's plottable NXdata: F at delta_max of every combination whose
+    curve reached it (NaN otherwise), over the swept parameters' values when the combinations are
+    their full product in grid order (an image for two), else over the combination number."""
+    if "overview" in s:
+        del s["overview"]
+    o = s.create_group("overview")
+    dmax = float(meta["delta_max"])
+    force = np.full(len(index["status"]), np.nan)
+    for i, (status, group) in enumerate(zip(index["status"], index["group"])):
+        if status == "complete" and group and group in s:
+            d, f = s[group]["delta"], s[group]["force"]
+            if d.shape[0] and abs(float(d[-1]) - dmax) <= 1e-9 * (1 + dmax):
+                force[i] = float(f[-1])
+    grid = meta["grid"]
+    full = list(itertools.product(*(grid[n] for n in names)))
+    here = list(zip(*(index[n] for n in names)))
+    axes = list(names) if here == [tuple(map(float, c)) for c in full] else ["combination"]
+    if axes == ["combination"]:
+        o.create_dataset("combination", data=np.arange(force.size)).attrs["units"] = "count"
+    else:
+        force = force.reshape([len(grid[n]) for n in names])
+        for n in names:
+            o.create_dataset(n, data=np.asarray(grid[n], float)).attrs["units"] = "nondimensional"
+    ds = o.create_dataset("force", data=force)
+    ds.attrs.update({"units": "nondimensional", "long_name": f"F / (mu H R_L) at delta = {dmax:g}"})
+    o.attrs.update({"NX_class": "NXdata", "signal": "force", "axes": axes})
+    s.attrs["default"] = "overview"
 
 
 def _new_index(names, combos) -> dict:
@@ -658,8 +689,10 @@ class _Writer:
             f.attrs["package_version"] = __version__
             if "created" not in f.attrs:
                 f.attrs["created"] = _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds")
+            f.attrs["default"] = "sweep"  # NeXus: root -> sweep (NXentry) -> overview (NXdata)
             s = f.require_group("sweep")
-            s.require_group("curves")
+            s.attrs["NX_class"] = "NXentry"
+            s.require_group("curves").attrs["NX_class"] = "NXcollection"
             for key in ("base_scene", "settings"):
                 s.attrs[key] = json.dumps(self.meta[key], sort_keys=True)
             for key in ("parameters", "grid"):  # in grid order
@@ -667,6 +700,7 @@ class _Writer:
             s.attrs["delta_max"] = self.meta["delta_max"]
             s.attrs["units"] = "nondimensional"
             _write_index(s, self.names, self.index)
+            _write_overview(s, self.names, self.meta, self.index)
 
         _rewrite(self.path, edit, fresh=fresh)
 
@@ -693,6 +727,7 @@ class _Writer:
                     write_curve_group(s.create_group(name), curves[rec["index"]])
                     _label_units(s[name])
             _write_index(s, self.names, self.index)
+            _write_overview(s, self.names, self.meta, self.index)
 
         _rewrite(self.path, edit)
 

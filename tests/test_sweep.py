@@ -239,6 +239,28 @@ def test_cli_sweep_and_info(tmp_path, capsys):
     assert main(["sweep", "--beta", "__import__('os')", "-o", str(tmp_path / "x.h5")]) == 2
 
 
+def test_a_sweep_file_is_nexus_with_f_over_the_grid_and_plots(tmp_path):
+    """Root -> sweep (NXentry) -> overview (NXdata): F at delta_max over the swept values, an image
+    for two (issue 45, item 4); over the combination number once an extension breaks the product."""
+    nx = pytest.importorskip("nexusformat.nexus")
+    pytest.importorskip("matplotlib")
+    from shellbvp.cli import main
+    from shellbvp.sweep import read_sweep, sweep
+
+    out = tmp_path / "g.h5"
+    kw = {"deltas": [0.05, 0.1], "estimate_error": False}
+    sweep(BASE, {"beta": [0.005, 0.01], "rho": [0.2, 0.25]}, delta_max=0.1, out=out, workers=1, **kw)
+    data = nx.nxload(str(out)).plottable_data
+    assert [a.nxname for a in data.nxaxes] == ["beta", "rho"] and data.nxsignal.shape == (2, 2)
+    np.testing.assert_allclose(data.nxsignal.nxvalue, read_sweep(out).force[..., -1], rtol=1e-12)
+    sweep(BASE, {"beta": [0.005, 0.01], "rho": [0.2, 0.25, 0.3]}, delta_max=0.1, out=out, workers=1, extend=True,
+          **kw)
+    data = nx.nxload(str(out)).plottable_data
+    assert [a.nxname for a in data.nxaxes] == ["combination"] and data.nxsignal.shape == (6,)
+    assert main(["plot", str(out), "-o", str(tmp_path / "g.png")]) == 0
+    assert (tmp_path / "g.png").stat().st_size > 0
+
+
 # -- the fit with an uncertain geometry ----------------------------------------------------------
 def test_geometry_uncertainty_widens_the_interval_to_the_truth():
     """Data made with rho = 0.35 (mu*H = 52), fitted with the nominal rho = 1/3 +- 0.02: the fit's own
