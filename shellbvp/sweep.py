@@ -9,8 +9,9 @@ the code cache instead of deriving it concurrently.
 
 Layout (format ``shellbvp-sweep``, version 1)::
 
-    /                      attrs: format, format_version, package_version, created, updated
-    /sweep                 attrs: base_scene (JSON), parameters (JSON list of the swept names),
+    /                      attrs: format, format_version, package_version, created, updated,
+                           default = "sweep" (NeXus)
+    /sweep                 NXentry, default = "overview"; attrs: base_scene (JSON), parameters (JSON list of the swept names),
                            grid (JSON {name: [values]}), delta_max, settings (JSON: the curve
                            settings), units = "nondimensional"
     /sweep/index/<name>    (n,) each swept parameter's value of combination i (units nondimensional)
@@ -20,7 +21,9 @@ Layout (format ``shellbvp-sweep``, version 1)::
     /sweep/index/points    (n,) points of each curve (units "count")
     /sweep/index/wall_time (n,) seconds spent on each curve in its worker (units "s")
     /sweep/curves/curve_<i>  the curve of combination i, in the layout of a curve file's
-                           ``/curve`` group (``shellbvp.io``), every dataset with a units attribute
+                           ``/entry/curve`` group (``shellbvp.io``), every dataset with a units attribute
+    /sweep/overview        NXdata: F at delta_max of every combination (NaN where its curve did not
+                           reach it) over the swept values, or over "combination" (_write_overview)
 
 Every write goes to a copy of the file in the same directory, which then replaces the file
 by ``os.replace`` (atomic on POSIX): a reader, a crash or a ``kill -9`` only ever sees the
