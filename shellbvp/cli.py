@@ -277,7 +277,7 @@ MAX_POINTS = 100_000  # --points: each is a solve (~0.05-0.5 s); more is a typo,
 
 
 def _free_default_name(preset, force):
-    """Without -o: ``<preset>.h5``, or (it exists, no --force) the first free ``<preset>-N.h5``,
+    """Without -o: ``<preset>.h5``, or (it exists, no --overwrite) the first free ``<preset>-N.h5``,
     so that running the quick start twice neither fails nor replaces the first result."""
     from pathlib import Path
 
@@ -302,7 +302,7 @@ def _cmd_curve(args):
     partial = partial_path(out)
     if partial.exists() and not args.force:
         raise ValueError(f"{partial} exists (the checkpoint of an unfinished run; `shellbvp info` reads "
-                         f"it); use --force to replace it")
+                         f"it); use --overwrite to replace it")
     check_output_path(partial, overwrite=True)
     scene = _scene(args)
     units = None
@@ -764,7 +764,7 @@ def _cmd_report(args):
     from .plotting import fit_report, require_matplotlib
 
     out = args.output or str(Path(args.file).with_suffix(".pdf"))
-    _check_report_path(out, overwrite=True)  # a report is redrawn from its record: replaced
+    _check_report_path(out, overwrite=args.force)
     require_matplotlib()
     fit_report(read_fit(args.file), out)
     print(f"wrote {out}")
@@ -1033,6 +1033,12 @@ def _cmd_validate(args):
     return 0 if result.fe.success else 1
 
 
+def _overwrite_option(p, what):
+    """``--overwrite`` (``--force`` too, the older name, not shown: scripts keep working)."""
+    p.add_argument("--overwrite", action="store_true", dest="force", help=what)
+    p.add_argument("--force", action="store_true", dest="force", help=argparse.SUPPRESS)
+
+
 def build_parser():
     from .version import __version__
 
@@ -1052,7 +1058,7 @@ def build_parser():
                    help="rim radius R_L with its unit, e.g. 0.3mm (with --muH: SI columns in the file)")
     c.add_argument("--muH", type=quantity("mu_H"), dest="mu_h", help="mu*H with its unit, e.g. 52N/m")
     c.add_argument("-o", "--output", help="output file (default <preset>.h5, or <preset>-2.h5, ... if that exists)")
-    c.add_argument("--force", action="store_true", help="replace an existing output file")
+    _overwrite_option(c, "replace an existing output file")
     c.add_argument("-q", "--quiet", action="store_true", help="no progress bar (there is none when stderr is not "
                    "a terminal or tqdm is not installed: pip install 'shellbvp[progress]')")
     c.add_argument("--topology", choices=("auto", "cap"), default="auto",
@@ -1064,7 +1070,8 @@ def build_parser():
     g = s.add_mutually_exclusive_group()
     g.add_argument("--delta", type=_number, help="pole displacement (default 0.2)")
     g.add_argument("--lambda0", type=_number, help="pole stretch")
-    g.add_argument("--load", type=_number, help="indenter force F (force control)")
+    g.add_argument("--force", "--load", type=_number, dest="load",
+                   help="indenter force F / (mu H R_L) (force control)")
     s.add_argument("--radius", "--rim-radius", type=quantity("length"), help="rim radius with its unit, e.g. 0.3mm (with --muH: "
                    "the state also in these units)")
     s.add_argument("--muH", type=quantity("mu_H"), dest="mu_h", help="mu*H with its unit, e.g. 52N/m")
@@ -1126,7 +1133,7 @@ def build_parser():
     f.add_argument("--report", help="write a one-page summary of the fit (.png or .pdf); a batch: a directory "
                    "(one <name>.pdf per file)")
     f.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
-    f.add_argument("--force", action="store_true", help="replace an existing output file")
+    _overwrite_option(f, "replace an existing output file (record, report, table)")
     f.set_defaults(func=_cmd_fit)
     w = sub.add_parser("sweep", help="one curve per combination of parameter values, into one resumable file",
                        description="One force-displacement curve per combination of the swept values, computed "
@@ -1160,8 +1167,7 @@ def build_parser():
     w.add_argument("--scheduler", help="address of a running Dask scheduler, e.g. tcp://host:8786 (needs "
                                        "shellbvp[dask])")
     w.add_argument("--extend", action="store_true", help="add the new combinations of a changed grid to the file")
-    w.add_argument("--force", action="store_true", help="start the file anew (its curves are discarded once the "
-                                                         "new file is first written)")
+    _overwrite_option(w, "start the file anew (its curves are discarded once the new file is first written)")
     w.add_argument("-q", "--quiet", action="store_true", help="no line per finished curve")
     w.set_defaults(func=_cmd_sweep)
     pl = sub.add_parser("plot", help="plot curves (and profiles) from HDF5 files (needs matplotlib)")
@@ -1176,6 +1182,7 @@ def build_parser():
     rp = sub.add_parser("report", help="one-page summary (PDF or PNG) of a fit file written by `shellbvp fit -o`")
     rp.add_argument("file", help="fit file (HDF5)")
     rp.add_argument("-o", "--output", help="PDF or PNG (default: the fit file's name with .pdf)")
+    _overwrite_option(rp, "replace an existing report")
     rp.set_defaults(func=_cmd_report)
     i = sub.add_parser("info", help="describe a curve file or a fit file")
     i.add_argument("file")
@@ -1197,7 +1204,7 @@ def build_parser():
     v.add_argument("--mesh-check", action="store_true", dest="mesh_check",
                    help="also solve the 3D model on a coarser mesh and report the difference (~1.5x the time)")
     v.add_argument("-o", "--output", help="output file (default <preset>-validate.h5, or -2, ... if that exists)")
-    v.add_argument("--force", action="store_true", help="replace an existing output file")
+    _overwrite_option(v, "replace an existing output file")
     v.set_defaults(func=_cmd_validate)
     r = sub.add_parser("presets", help="list the built-in scenes")
     r.set_defaults(func=_cmd_presets)

@@ -133,7 +133,7 @@ def write_fit(path, result, record, used, *, segment="loading", overwrite=False)
 
     path = Path(path)
     if path.exists() and not overwrite:
-        raise FileExistsError(f"{path} exists; pass overwrite=True (CLI: --force) to replace it")
+        raise FileExistsError(f"{path} exists; pass overwrite=True (CLI: --overwrite) to replace it")
     check_output_path(path, overwrite=True)
     d, f = record.displacement, record.force
     model_force = result.model_force(d)

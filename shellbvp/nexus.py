@@ -113,7 +113,7 @@ def new_file(path, fmt: str, version: int, *, overwrite: bool = False):
 
     path = Path(path)
     if path.exists() and not overwrite:
-        raise FileExistsError(f"{path} exists; pass overwrite=True (CLI: --force) to replace it")
+        raise FileExistsError(f"{path} exists; pass overwrite=True (CLI: --overwrite) to replace it")
     check_output_path(path, overwrite=True)
     with atomic_file(path) as tmp:
         with h5py.File(tmp, "w") as f:

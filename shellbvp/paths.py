@@ -135,7 +135,7 @@ def check_output_path(path, *, overwrite: bool) -> Path:
     if not parent.is_dir():
         raise ValueError(f"output directory {parent} is not a directory")
     if out.exists() and not overwrite:
-        raise ValueError(f"output {out} exists; use --force to replace it")
+        raise ValueError(f"output {out} exists; use --overwrite to replace it")
     if not os.access(parent, os.W_OK | os.X_OK):
         raise ValueError(f"output directory {parent} is not writable")
     try:

@@ -1,13 +1,17 @@
 """Progress bars (tqdm, an optional extra: ``pip install 'shellbvp[progress]'``).
 
-Bars are drawn on stderr only when it is a terminal and the caller did not ask for
-quiet (``-q``); without tqdm, or when not wanted, a silent stand-in with the same
-methods takes its place, so callers never test for it.
+Bars are drawn on stderr when it is a terminal and the caller did not ask for quiet
+(``-q``).  When stderr is a file or a pipe (a batch job, a log) a line is written there
+instead every :data:`LINE_SECONDS` (``SHELLBVP_PROGRESS_SECONDS``), none for a task shorter
+than that.  Without tqdm, or when quiet, a silent stand-in with the same methods takes the
+bar's place, so callers never test for it.
 """
 
 from __future__ import annotations
 
+import os
 import sys
+import time
 
 __all__ = ["progress_bar", "curve_progress", "wanted"]
 
@@ -38,10 +42,57 @@ class _Silent:
         return False
 
 
-def wanted(quiet: bool = False, stream=None) -> bool:
-    """Draw bars: not quiet, and the stream (stderr) is a terminal."""
+def _line_seconds() -> float:
+    try:
+        return max(float(os.environ.get("SHELLBVP_PROGRESS_SECONDS", "10")), 0.0)
+    except ValueError:
+        return 10.0
+
+
+#: Seconds between progress lines when stderr is not a terminal.
+LINE_SECONDS = _line_seconds()
+
+
+class _Lines(_Silent):
+    """Progress as a line on stderr every :data:`LINE_SECONDS` (for logs: no bar to redraw)."""
+
+    def __init__(self, total=None, desc="", unit=""):
+        super().__init__(total)
+        self.desc, self.unit, self.postfix = desc, unit, ""
+        self.start = self.last = time.monotonic()
+        self.written = False
+
+    def _write(self, note=""):
+        done = f"{self.n:.4g}" + (f"/{self.total:.4g}" if self.total else "")
+        extra = f", {self.postfix}" if self.postfix else ""
+        what = f"{self.unit} " if self.unit else ""
+        print(f"{self.desc}: {what}{done}{extra} ({time.monotonic() - self.start:.0f} s){note}", file=sys.stderr,
+              flush=True)
+        self.written = True
+
+    def update(self, n=1):
+        self.n += n
+        now = time.monotonic()
+        if now - self.last >= LINE_SECONDS:
+            self.last = now
+            self._write()
+
+    def set_postfix_str(self, text="", refresh=True):
+        self.postfix = text
+
+    def close(self):
+        if self.written:  # a task that reported progress reports its end too
+            self._write("; done")
+            self.written = False
+
+
+def wanted(quiet: bool = False, stream=None):
+    """How to show progress: ``"bar"`` (stderr is a terminal), ``"lines"`` (a file or a pipe:
+    a line now and then) or False (quiet)."""
     stream = sys.stderr if stream is None else stream
-    return not quiet and hasattr(stream, "isatty") and stream.isatty()
+    if quiet:
+        return False
+    return "bar" if hasattr(stream, "isatty") and stream.isatty() else "lines"
 
 
 def progress_bar(total=None, *, desc="", unit="it", enabled=True, leave=True, **kwargs):
@@ -52,8 +103,9 @@ def progress_bar(total=None, *, desc="", unit="it", enabled=True, leave=True, **
     total : float, optional
         The end of the bar (a count, or a depth for :func:`curve_progress`).
     desc, unit : str
-    enabled : bool
-        Draw it (see :func:`wanted`).
+    enabled : bool or str
+        Draw it (see :func:`wanted`): True or ``"bar"`` a tqdm bar, ``"lines"`` a line on stderr
+        every :data:`LINE_SECONDS`, False nothing.
     leave : bool
         Keep the finished bar on screen.
     **kwargs
@@ -68,6 +120,8 @@ def progress_bar(total=None, *, desc="", unit="it", enabled=True, leave=True, **
     """
     if not enabled:
         return _Silent(total)
+    if enabled == "lines":
+        return _Lines(total, desc, unit)
     try:
         from tqdm import tqdm
     except ImportError:  # the optional extra is not installed: no bar
@@ -86,7 +140,7 @@ def curve_progress(delta_max, desc="curve", enabled=True, leave=True):
         ``callback(curve, sol)``, the signature of :func:`shellbvp.curve`'s ``callback``.
     """
     fmt = "{desc}: {percentage:3.0f}%|{bar}| delta {n:.3f}/{total:.3f} [{elapsed}<{remaining}{postfix}]"
-    bar = progress_bar(float(delta_max), desc=desc, unit="", enabled=enabled, leave=leave, bar_format=fmt)
+    bar = progress_bar(float(delta_max), desc=desc, unit="delta", enabled=enabled, leave=leave, bar_format=fmt)
 
     def callback(curve, sol):
         d = float(sol.delta) if sol.delta == sol.delta else bar.n  # NaN delta: no move

@@ -525,7 +525,7 @@ def _reconcile(path, meta_new, extend) -> tuple[dict, dict] | None:
         if meta[key] != meta_new[key]:
             raise ValueError(f"{path} holds a sweep with another {what} ({json.dumps(meta[key], sort_keys=True)}; "
                              f"asked {json.dumps(meta_new[key], sort_keys=True)}): choose another output file "
-                             f"(or --force to start it anew)")
+                             f"(or --overwrite to start it anew)")
     old, new = meta["grid"], meta_new["grid"]
     if list(old) != list(new):
         raise ValueError(f"{path} sweeps {list(old)}; asked {list(new)}: the parameters of a sweep file cannot "

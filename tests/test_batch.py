@@ -110,13 +110,31 @@ def test_batch_outputs_are_checked_before_any_fit(folder):
 def test_progress_bar_is_silent_without_tqdm_or_when_not_wanted(monkeypatch, capsys):
     from shellbvp import progress
 
-    assert not progress.wanted(quiet=False, stream=open(os.devnull, "w"))
+    with open(os.devnull, "w") as null:
+        assert progress.wanted(quiet=False, stream=null) == "lines"   # a log, not a terminal
     assert not progress.wanted(quiet=True)
     monkeypatch.setitem(sys.modules, "tqdm", None)  # tqdm not installed
     bar = progress.progress_bar(3, enabled=True)
     bar.update(2)
     bar.close()
     assert bar.n == 2 and capsys.readouterr().err == ""
+
+
+def test_progress_lines_go_to_a_log_now_and_then(monkeypatch, capsys):
+    """Not a terminal: a line every LINE_SECONDS and one at the end, none for a short task."""
+    from shellbvp import progress
+
+    bar = progress.progress_bar(3, desc="fit", unit="file", enabled="lines")
+    bar.update(1)
+    bar.close()
+    assert capsys.readouterr().err == ""          # shorter than LINE_SECONDS: nothing
+    monkeypatch.setattr(progress, "LINE_SECONDS", 0.0)
+    bar = progress.progress_bar(3, desc="fit", unit="file", enabled="lines")
+    bar.set_postfix_str("a.csv: ok")
+    bar.update(2)
+    bar.close()
+    lines = capsys.readouterr().err.splitlines()
+    assert lines[0].startswith("fit: file 2/3, a.csv: ok (") and lines[-1].endswith("; done")
 
 
 def test_curve_progress_moves_with_delta(capsys):

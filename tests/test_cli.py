@@ -28,8 +28,8 @@ def test_curve_without_arguments_writes_base_h5(tmp_path):
     again = run(cwd=tmp_path)  # the quick start twice: a new name, the first result kept
     assert again.returncode == 0 and "wrote base-2.h5" in again.stdout, again.stderr
     assert (tmp_path / "base.h5").read_bytes() == first
-    taken = run("curve", "-o", "base.h5", cwd=tmp_path)  # a name given: never replaced without --force
-    assert taken.returncode == 2 and "exists" in taken.stderr and "--force" in taken.stderr
+    taken = run("curve", "-o", "base.h5", cwd=tmp_path)  # a name given: never replaced without --overwrite
+    assert taken.returncode == 2 and "exists" in taken.stderr and "--overwrite" in taken.stderr
     info = run("info", "base.h5", cwd=tmp_path)
     assert info.returncode == 0 and "delta_max = 0.5 reached" in info.stdout and "gamma=1" in info.stdout
 

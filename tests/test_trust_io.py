@@ -171,7 +171,7 @@ def test_check_output_path_api(tmp_path):
     target = tmp_path / "a.h5"
     assert check_output_path(target, overwrite=False) == target
     target.write_bytes(b"old")
-    with pytest.raises(ValueError, match="exists; use --force"):
+    with pytest.raises(ValueError, match="exists; use --overwrite"):
         check_output_path(target, overwrite=False)
     assert check_output_path(str(target), overwrite=True) == target
     assert partial_path(target) == tmp_path / "a.h5.partial"
@@ -262,7 +262,7 @@ def test_sigint_without_an_earlier_file_writes_the_finished_points(tmp_path):
 def test_finished_run_replaces_the_file_and_removes_the_checkpoint(tmp_path, old_file):
     path, before = old_file
     env = dict(os.environ, SHELLBVP_CHECKPOINT_SECONDS="0")
-    r = subprocess.run([sys.executable, "-m", "shellbvp", "curve", "--force", "-o", "X.h5", "--points", "3",
+    r = subprocess.run([sys.executable, "-m", "shellbvp", "curve", "--overwrite", "-o", "X.h5", "--points", "3",
                         "--delta-max", "0.15"], cwd=tmp_path, env=env, capture_output=True, text=True,
                        timeout=300)
     assert r.returncode == 0, r.stderr
@@ -270,10 +270,10 @@ def test_finished_run_replaces_the_file_and_removes_the_checkpoint(tmp_path, old
     assert c.complete and c.stop_reason == "all requested deltas computed"
     np.testing.assert_allclose(c.delta, [0.05, 0.1, 0.15])
     assert sorted(p.name for p in tmp_path.iterdir()) == ["X.h5"]
-    # a leftover checkpoint is somebody's finished work: replaced only with --force
+    # a leftover checkpoint is somebody's finished work: replaced only with --overwrite
     (tmp_path / "Y.h5.partial").write_bytes(b"points")
     r = run("curve", "-o", "Y.h5", cwd=tmp_path)
-    one_line_error(r, "Y.h5.partial exists", "--force")
+    one_line_error(r, "Y.h5.partial exists", "--overwrite")
 
 
 # -- malformed files -----------------------------------------------------------------------------------
