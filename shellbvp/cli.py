@@ -162,7 +162,7 @@ def _scene_options(p, uncertain=False, preset_required=False):
                         "kappa_s0, kappa_theta0 (the reference curvatures)")
     s = p.add_argument_group("solver")
     s.add_argument("--tol", type=_number, default=1e-6, help="collocation tolerance (default 1e-6)")
-    s.add_argument("--max-nodes", type=int, default=10000, dest="max_nodes")
+    s.add_argument("--max-nodes", type=int, default=10000, dest="max_nodes", help="largest collocation mesh of a state (default 10000)")
 
 
 def _scene(args):
@@ -1052,7 +1052,7 @@ def build_parser():
     c.add_argument("--points", type=int, help="N equally spaced depths up to delta-max (default: adaptive)")
     c.add_argument("--force-max", type=_number, dest="force_max", help="stop at this force")
     c.add_argument("--lambda0-max", type=_number, dest="lambda0_max", help="stop at this pole stretch")
-    c.add_argument("--max-steps", type=int, default=400, dest="max_steps")
+    c.add_argument("--max-steps", type=int, default=400, dest="max_steps", help="most continuation steps of a curve (default 400)")
     c.add_argument("--profiles", action="store_true", help="store each point's profiles")
     c.add_argument("--radius", "--rim-radius", type=quantity("length"),
                    help="rim radius R_L with its unit, e.g. 0.3mm (with --muH: SI columns in the file)")
@@ -1126,7 +1126,7 @@ def build_parser():
     f.add_argument("--weights", choices=("uniform", "relative", "mixed"),
                    help="noise model: uniform (same force noise everywhere), relative (noise proportional "
                         "to the force) or mixed (both, estimated; the default)")
-    f.add_argument("--json", action="store_true")
+    f.add_argument("--json", action="store_true", help="print the result as one JSON document (also on errors)")
     f.add_argument("-o", "--output", help="write the fit as a record (HDF5/NeXus: data, model, parameters with "
                    "intervals, weights, warnings, scene, source file and its SHA-256); a batch: a directory "
                    "(one <name>.h5 per file)")
@@ -1152,14 +1152,15 @@ def build_parser():
     m.add_argument("--gent-jm", dest="gent_jm", help="Gent material, Jm values to sweep")
     m.add_argument("--neo-hookean", action="store_true", help="neo-Hookean material")
     g.add_argument("--pressure", help="pressure below the shell, nondimensional p R_L/(mu H): values to sweep")
-    g.add_argument("--xi", type=int, choices=(0, 1))
-    g.add_argument("--contact", choices=("smooth", "paper"))
+    g.add_argument("--xi", type=int, choices=(0, 1), help="1: full generalised tensions; 0: first approximation")
+    g.add_argument("--contact", choices=("smooth", "paper"), help="contact-line model (default smooth)")
     w.add_argument("--delta-max", type=_number, default=0.5, dest="delta_max", help="depth of every curve (default 0.5)")
     w.add_argument("--points", type=int, help="N equally spaced depths up to delta-max (default: adaptive)")
     w.add_argument("--tol", type=_number, default=1e-6, help="collocation tolerance (default 1e-6)")
-    w.add_argument("--max-nodes", type=int, default=10000, dest="max_nodes")
-    w.add_argument("--max-steps", type=int, default=400, dest="max_steps")
-    w.add_argument("--topology", choices=("auto", "cap"), default="auto")
+    w.add_argument("--max-nodes", type=int, default=10000, dest="max_nodes", help="largest collocation mesh of a state (default 10000)")
+    w.add_argument("--max-steps", type=int, default=400, dest="max_steps", help="most continuation steps of a curve (default 400)")
+    w.add_argument("--topology", choices=("auto", "cap"), default="auto",
+                   help="auto (default): lifted-off contact where the cap would pull the shell; cap: single cap only")
     w.add_argument("-o", "--output", required=True, help="the sweep file (HDF5); an existing one is resumed")
     w.add_argument("--workers", type=int, help="local worker processes (default: all cores)")
     w.add_argument("--max-cells", type=int, default=10_000, dest="max_cells",
@@ -1177,7 +1178,7 @@ def build_parser():
     pl.add_argument("-o", "--output", help="PNG or PDF (default curves.png; for fit files <name>.png next to "
                     "each); for several fit files a directory (one <name>.png each)")
     pl.add_argument("--profiles", help="also draw the deformed shell of the first file at these depths, e.g. 0.1,0.3")
-    pl.add_argument("--dpi", type=int, default=150)
+    pl.add_argument("--dpi", type=int, default=150, help="resolution of a PNG (default 150)")
     pl.set_defaults(func=_cmd_plot)
     rp = sub.add_parser("report", help="one-page summary (PDF or PNG) of a fit file written by `shellbvp fit -o`")
     rp.add_argument("file", help="fit file (HDF5)")

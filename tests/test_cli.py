@@ -165,3 +165,12 @@ def test_fit_names_its_sample_in_lab_units(capsys):
     assert "indenter: sphere of radius 100 um" in out and "thickness 15 um" in out
     assert main(["solve", "--indenter-radius", "0.1mm"]) == 2
     assert "--indenter-radius 0.1 mm is a length: it needs --radius" in capsys.readouterr().err
+
+
+def test_every_option_has_help():
+    from shellbvp.cli import build_parser
+
+    p = build_parser()
+    bare = [(name, a.option_strings) for name, sp in p._subparsers._group_actions[0].choices.items()
+            for a in sp._actions if a.option_strings and a.help is None]
+    assert bare == []
