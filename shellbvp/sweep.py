@@ -574,6 +574,10 @@ def dask_executor(address: str, timeout: float = 10.0):
         raise ValueError(f"--scheduler {text!r}: not an address host:port or tcp://host:port (port 1-65535)")
     try:
         from dask.distributed import Client
+        # a lost scheduler is reported once, as the curves it leaves pending (_compute), not as the
+        # client's multi-line tracebacks of every reconnection attempt
+        for name in ("distributed.client", "distributed.core", "distributed.comm"):
+            logging.getLogger(name).setLevel(logging.CRITICAL)
     except ImportError:
         raise ValueError("a Dask scheduler needs the dask extra: pip install 'shellbvp[dask]' "
                          "(dask[distributed])") from None
@@ -735,12 +739,23 @@ class _Writer:
         _rewrite(self.path, edit)
 
 
+#: Seconds a sweep waits for a finished curve before it asks whether a Dask cluster is still there.
+HEALTH_SECONDS = 10.0
+
+
+def _executor_gone(executor) -> bool:
+    """A Dask executor whose client has closed (its scheduler gone, reconnection given up)."""
+    status = getattr(getattr(executor, "_client", None), "status", None)
+    return status is not None and status not in ("running", "connecting", "newly-created")
+
+
 def _compute(todo, args_of, executor, on_records):
     """Run :func:`run_curve` on ``args_of(i)`` for each i in ``todo``, through ``executor`` (None:
     in this process), passing finished records on in batches (whatever finished meanwhile).
 
-    Returns (computed, lost): tasks the executor could not run (a worker died) are lost, logged
-    and left pending.  On an interruption, tasks not yet started are cancelled.
+    Returns (computed, lost): tasks the executor could not run (a worker died, or a Dask client
+    closed: checked whenever :data:`HEALTH_SECONDS` pass without a finished curve) are lost,
+    logged and left pending.  On an interruption, tasks not yet started are cancelled.
     """
     if executor is None:
         for i in todo:
@@ -752,7 +767,12 @@ def _compute(todo, args_of, executor, on_records):
         futures = {executor.submit(run_curve, *args_of(i)): i for i in todo}
         pending = set(futures)
         while pending:
-            done, pending = wait(pending, return_when=FIRST_COMPLETED)
+            done, pending = wait(pending, timeout=HEALTH_SECONDS, return_when=FIRST_COMPLETED)
+            if not done and _executor_gone(executor):  # a cluster that went away never finishes them
+                lost += len(pending)
+                log.warning("the Dask client is %s: %d curves were not computed; they stay pending",
+                            executor._client.status, len(pending))
+                break
             records = []
             for fut in done:
                 try:

@@ -220,6 +220,30 @@ def test_the_same_2x2_sweep_on_a_dask_local_cluster(tmp_path, serial):
     _assert_same_curves(res, serial)
 
 
+def test_a_dask_cluster_that_goes_away_mid_run_leaves_its_curves_pending(tmp_path, monkeypatch):
+    """Futures that never finish on a client that has closed: the sweep stops waiting (issue 42),
+    reports them lost and keeps them pending for the next run, instead of hanging."""
+    from concurrent.futures import Future
+
+    import shellbvp.sweep as sw
+
+    class Client:
+        status = "closed"  # what a dask Client says once its scheduler is gone for good
+
+    class GoneExecutor:
+        _client = Client()
+
+        def submit(self, fn, *args):
+            return Future()  # never finishes
+
+    monkeypatch.setattr(sw, "HEALTH_SECONDS", 0.05)
+    res = sw.sweep(BASE, {"beta": [0.005, 0.01]}, delta_max=0.1, executor=GoneExecutor(), out=tmp_path / "g.h5",
+                   deltas=[0.1], estimate_error=False)
+    assert res.computed == 0 and res.lost == 2 and sw.read_sweep(tmp_path / "g.h5").counts() == {"pending": 2}
+    Client.status = "running"  # a live cluster that is merely slow is waited for
+    assert not sw._executor_gone(GoneExecutor())
+
+
 def test_cli_sweep_and_info(tmp_path, capsys):
     from shellbvp.cli import main
 
