@@ -88,3 +88,56 @@ def test_a_damaged_file_reads_or_is_refused_in_one_line(files, tmp_path, kind, p
         read(bad)
     except ValueError as exc:
         assert "bad-" in str(exc), (item, value, exc)
+
+
+# -- batches: folders of anything -------------------------------------------------------------------
+LINES = st.one_of(
+    st.text(max_size=60),
+    st.lists(st.one_of(st.floats(allow_nan=True, allow_infinity=True), st.integers(-10**20, 10**20),
+                       st.sampled_from(["", "nan", "1,5", "5_0", "\u00b5N", "(mm)", "=HYPERLINK(\"x\")", "\x1b[2J"])),
+             min_size=1, max_size=4).map(lambda cells: ",".join(str(c) for c in cells)),
+)
+CONTENTS = st.one_of(
+    st.binary(max_size=300),
+    st.lists(LINES, max_size=30).map(lambda lines: "\n".join(lines).encode("utf-8", "surrogatepass")),
+)
+
+
+@pytest.fixture(scope="module")
+def good_record(tmp_path_factory):
+    """The shipped example (a Lepidium-like record) and its fit on its own."""
+    from shellbvp.fitting import example_data_path
+
+    path = tmp_path_factory.mktemp("good") / "good.csv"
+    shutil.copy(example_data_path(), path)
+    (alone,) = sb.fit_files(sb.Scene.preset("fit"), [str(path)], R_L=0.3e-3)
+    assert alone.status == "ok"
+    return path, alone.result.mu_H
+
+
+@settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(contents=st.lists(CONTENTS, min_size=1, max_size=4), suffixes=st.lists(
+    st.sampled_from([".csv", ".tsv", ".txt", ".dat", ".jpk-force"]), min_size=4, max_size=4))
+def test_a_batch_of_random_files_costs_the_good_one_nothing(good_record, tmp_path_factory, contents, suffixes):
+    """Every file gets its row (ok, failed or error; an error row one line naming the file), the
+    table is written, and the good file's result is its result alone (issue 42, item 7)."""
+    from shellbvp.batch import write_table
+
+    good, mu_alone = good_record
+    folder = tmp_path_factory.mktemp("batch")
+    paths = []
+    for k, data in enumerate(contents):
+        p = folder / f"junk{k}{suffixes[k]}"
+        p.write_bytes(data)
+        paths.append(str(p))
+    paths.insert(len(paths) // 2, str(good))
+    rows = sb.fit_files(sb.Scene.preset("fit"), paths, R_L=0.3e-3)
+    assert [r.file for r in rows] == paths
+    for r in rows:
+        assert r.status in ("ok", "failed", "error")
+        if r.status == "error":
+            assert "\n" not in r.message and r.message
+    (mine,) = [r for r in rows if r.file == str(good)]
+    assert mine.status == "ok" and mine.result.mu_H == pytest.approx(mu_alone, rel=1e-9)
+    write_table(folder / "table.csv", rows)
+    assert (folder / "table.csv").read_text().count("\n") == len(rows) + 1
