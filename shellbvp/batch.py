@@ -30,7 +30,7 @@ __all__ = ["BatchRow", "fit_files", "fit_records", "fit_map", "read_record", "ex
 #: File names a directory given as input contributes (instrument exports are text tables).
 DATA_SUFFIXES = (".csv", ".tsv", ".txt", ".dat", ".jpk-force", ".ibw")  # AFM single curves: shellbvp.afm
 #: Columns of the results table, with their units.
-TABLE_COLUMNS = ("file", "status", "mu_H (N/m)", "mu_H 95% low (N/m)", "mu_H 95% high (N/m)", "offset (m)",
+TABLE_COLUMNS = ("file", "status", "quality", "mu_H (N/m)", "mu_H 95% low (N/m)", "mu_H 95% high (N/m)", "offset (m)",
                  "offset 95% low (m)", "offset 95% high (m)", "baseline (N)", "baseline 95% low (N)",
                  "baseline 95% high (N)", "baseline slope (N/m)", "baseline model", "beta", "beta 95% low",
                  "beta 95% high", "alpha", "alpha 95% low", "alpha 95% high", "residual rms (N)", "points",
@@ -90,6 +90,7 @@ class BatchRow:
         for name in ("beta", "alpha"):
             if name in r.fitted:
                 put(name, getattr(r, name), getattr(r, name + "_ci95"))
+        row["quality"] = r.quality
         row["baseline model"] = r.baseline_model
         row["residual rms (N)"] = _num(r.residual_rms)
         row["points"] = str(r.n)

@@ -746,6 +746,13 @@ def _print_fit(res, record, used, args):
               f"(p mu_H/R_L; linearised)")
     _say(f"rms residual = {format_in(res.residual_rms, fu, 'force')} over {res.n} points; R_L = "
           f"{args.radius}; {res.weights} weights")
+    from .fitting import diagnostics_lines
+
+    for line in diagnostics_lines(res.quality, res.fitted, res.correlation,
+                                  {k: getattr(res, k) for k in ("noise_sigma", "aic", "bic", "runs_p",
+                                                                "residual_autocorrelation")},
+                                  lambda v: format_in(v, fu, "force")):
+        _say(line)
     for text in res.warnings:
         _say(f"warning: {text}")
 

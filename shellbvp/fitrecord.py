@@ -22,8 +22,9 @@ SI units, ``"1"`` nondimensional, ``""`` text)::
       delta, F                 (m,) 1: the nondimensional curve
     /fit/parameters            NXparameters: mu_H (N/m), offset (m), baseline (N),
                                baseline_slope (N/m), beta (1), alpha (1, NaN for other materials),
-                               R_L (m), residual_rms (N), n_points (1) -- scalars; and
-                               <name>_ci95 (2,) for each parameter fitted; attrs: fitted,
+                               R_L (m), residual_rms (N), n_points (1), pressure, pressure_Pa,
+                               noise_sigma (N), aic, bic, runs_p, residual_autocorrelation -- scalars;
+                               correlation (k, k); <name>_ci95 (2,) for each parameter fitted; attrs: fitted,
                                baseline_model, weights, segment
     /fit/warnings              (k,) the fit's warnings (text); attr codes
     /fit/sample                NXsample; attrs: scene (JSON, rebuilds the Scene), scene_<key>
@@ -56,9 +57,10 @@ FIT_FORMAT_VERSION = 1
 #: Units of the scalar parameters in ``/fit/parameters``.
 PARAMETER_UNITS = {"mu_H": "N/m", "offset": "m", "baseline": "N", "baseline_slope": "N/m", "beta": DIMENSIONLESS,
                    "alpha": DIMENSIONLESS, "R_L": "m", "residual_rms": "N", "n_points": DIMENSIONLESS,
-                   "pressure": DIMENSIONLESS, "pressure_Pa": "Pa"}
+                   "pressure": DIMENSIONLESS, "pressure_Pa": "Pa", "noise_sigma": "N", "aic": DIMENSIONLESS,
+                   "bic": DIMENSIONLESS, "runs_p": DIMENSIONLESS, "residual_autocorrelation": DIMENSIONLESS}
 #: Parameters that files written before they existed lack (read as NaN).
-_NEWER_PARAMETERS = ("pressure", "pressure_Pa")
+_NEWER_PARAMETERS = ("pressure", "pressure_Pa", "noise_sigma", "aic", "bic", "runs_p", "residual_autocorrelation")
 
 
 @dataclass
@@ -108,8 +110,17 @@ class FitRecord:
     status: int
     message: str
     version: str = ""
+    correlation: object = None
     path: str = ""
     extra: dict = field(default_factory=dict)
+
+    @property
+    def quality(self) -> str:
+        """``good``, ``fair`` or ``poor`` (:func:`shellbvp.fitting.fit_quality`), from what the file holds."""
+        from .fitting import fit_quality
+
+        return fit_quality(self.success, self.warning_codes, self.parameters["mu_H"],
+                           self.intervals.get("mu_H", (math.nan, math.nan)), self.correlation, self.fitted)
 
 
 def write_fit(path, result, record, used, *, segment="loading", overwrite=False):
@@ -182,9 +193,14 @@ def write_fit(path, result, record, used, *, segment="loading", overwrite=False)
                       "alpha": np.nan if result.alpha is None else result.alpha, "R_L": result.R_L,
                       "residual_rms": result.residual_rms, "n_points": result.n,
                       "pressure": result.pressure if result.pressure is not None else np.nan,
-                      "pressure_Pa": np.nan if result.pressure_Pa is None else result.pressure_Pa}
+                      "pressure_Pa": np.nan if result.pressure_Pa is None else result.pressure_Pa,
+                      **{k: getattr(result, k) for k in ("noise_sigma", "aic", "bic", "runs_p",
+                                                          "residual_autocorrelation")}}
             for name, v in values.items():
                 number_dataset(p, name, float(v), PARAMETER_UNITS[name])
+            if result.correlation is not None:
+                number_dataset(p, "correlation", np.asarray(result.correlation, float), DIMENSIONLESS,
+                               "correlation of the fitted parameters (rows and columns in the order of fitted)")
             for name in result.fitted:
                 number_dataset(p, f"{name}_ci95", np.asarray(_interval(result, name), float), PARAMETER_UNITS[name],
                                f"95 % interval of {name}")
@@ -312,6 +328,12 @@ def read_fit(path) -> FitRecord:
             if unknown or "mu_H" not in fitted:
                 raise ValueError(f"parameters.fitted must name mu_H and known parameters; got {fitted}")
             intervals = {k: tuple(sc.dataset(p, f"{k}_ci95", length=2)) for k in fitted}
+            correlation = None
+            if "correlation" in p:  # files before the diagnostics have none
+                correlation = np.asarray(sc.dataset(p, "correlation", ndim=2, length=len(fitted)), float)
+                if correlation.shape != (len(fitted), len(fitted)):
+                    raise ValueError(f"parameters/correlation must be {len(fitted)} x {len(fitted)} (fitted); got "
+                                     f"{correlation.shape}")
             settings = {k: sc.attr_text(p, k) for k in ("baseline_model", "weights", "segment")}
             warnings = sc.text_dataset(e, "warnings")
             codes = [sc.text(s, "warnings.codes") for s in np.atleast_1d(e["warnings"].attrs.get("codes", []))]
@@ -332,7 +354,7 @@ def read_fit(path) -> FitRecord:
                             settings=settings, warnings=warnings, warning_codes=codes, scene=scene, source=source,
                             success=success, status=status, message=sc.attr_text(e, "message"),
                             version=sc.attr_text(h, "package_version") if "package_version" in h.attrs else "",
-                            path=str(path))
+                            path=str(path), correlation=correlation)
         except (ValueError, KeyError, TypeError, OSError, RecursionError) as exc:
             what = str(exc) if isinstance(exc, ValueError) else f"{type(exc).__name__}: {exc}"
             raise ValueError(f"{path}: incomplete or corrupt fit file ({what})") from None

@@ -48,8 +48,8 @@ from .instrument import read_force_csv
 
 log = logging.getLogger(__name__)
 
-__all__ = ["FitResult", "fit", "read_force_csv", "example_data_path", "WEIGHTS", "DEFAULT_WEIGHTS",
-           "FIT_STATUS", "FIT_WARNINGS", "PLAUSIBLE_MU_H", "runs_test", "BASELINES", "MODEL_PARAMETERS", "fit_record"]
+__all__ = ["FitResult", "fit", "fit_quality", "diagnostics_lines", "QUALITY_RULES", "read_force_csv", "example_data_path", "WEIGHTS",
+           "DEFAULT_WEIGHTS", "FIT_STATUS", "FIT_WARNINGS", "PLAUSIBLE_MU_H", "runs_test", "BASELINES", "MODEL_PARAMETERS", "fit_record"]
 
 #: Force baselines of :func:`fit` (none; a constant b0; b0 + b1 (d - d0)).
 BASELINES = ("none", "constant", "linear")
@@ -167,6 +167,21 @@ class FitResult:
     point_weights : ndarray
         The noise model's weight (1/sigma, largest 1) of each data point as given (NaN
         where a value was missing).
+    correlation : ndarray or None
+        Correlation matrix of the fitted parameters (order of ``fitted``), from the linearised
+        covariance.
+    noise_sigma : float
+        The estimated noise (N) of the most weighted point; the weighted reduced chi-square is 1
+        by construction, since the noise scale is estimated from the residuals.
+    aic, bic : float
+        Akaike and Bayesian information criteria (Gaussian noise with the noise model's
+        weights and an estimated scale): compare models fitted to the same rows with the
+        same weights (lower is better).
+    runs_p, residual_autocorrelation : float
+        The runs test's p of the residuals' signs in depth order (small: a pattern) and their
+        lag-1 autocorrelation (near 0 for independent noise).
+    quality : str
+        ``good``, ``fair`` or ``poor`` (:func:`fit_quality`).
 
     Examples
     --------
@@ -217,6 +232,12 @@ class FitResult:
     baseline_slope: float = 0.0
     baseline_slope_ci95: tuple = (0.0, 0.0)
     point_weights: object = field(repr=False, default=None)
+    correlation: object = field(repr=False, default=None)
+    noise_sigma: float = float("nan")
+    aic: float = float("nan")
+    bic: float = float("nan")
+    runs_p: float = float("nan")
+    residual_autocorrelation: float = float("nan")
 
     @property
     def success(self):
@@ -241,6 +262,12 @@ class FitResult:
         """mu's 95 % interval (Pa): mu*H's over H (the thickness taken as exact)."""
         H = self.thickness
         return None if H is None else (self.mu_H_ci95[0] / H, self.mu_H_ci95[1] / H)
+
+    @property
+    def quality(self) -> str:
+        """``good``, ``fair`` or ``poor`` by the transparent rules of :func:`fit_quality`."""
+        return fit_quality(self.success, self.warning_codes, self.mu_H, self.mu_H_ci95, self.correlation,
+                           self.fitted)
 
     @property
     def model_error(self):
@@ -276,13 +303,20 @@ class FitResult:
                 "baseline_slope_ci95": ci(self.baseline_slope_ci95),
                 "thickness": None if self.thickness is None else num(self.thickness), "mu": None if self.mu is None
                 else num(self.mu), "mu_ci95": ci(self.mu_ci95),
+                "quality": self.quality, "noise_sigma": num(self.noise_sigma), "aic": num(self.aic),
+                "bic": num(self.bic), "runs_p": num(self.runs_p),
+                "residual_autocorrelation": num(self.residual_autocorrelation),
+                "correlation": None if self.correlation is None else
+                [[num(v) for v in row] for row in np.asarray(self.correlation)],
                 "model_error": None if self.model_error is None else num(self.model_error[0]),
                 "model_error_extrapolated": None if self.model_error is None else self.model_error[1],
                 "units": {"mu_H": "N/m (= um*MPa)", "offset": "m", "residual": "N (rms)",
                           "residual_rms": "N", "R_L": "m", "beta": "1 (B/(mu R_L^2))", "alpha": "1",
                           "pressure": "1 (p R_L/(mu H))", "pressure_Pa": "Pa",
                           "baseline": "N", "baseline_slope": "N/m", "thickness": "m", "mu": "Pa",
-                          "model_error": "1 (fraction of F)"}}
+                          "model_error": "1 (fraction of F)", "noise_sigma": "N (of the most weighted point)",
+                          "aic": "1", "bic": "1", "runs_p": "1", "residual_autocorrelation": "1",
+                          "correlation": "1 (order of fitted)"}}
 
 
 # -- model curves ------------------------------------------------------------------------------
@@ -606,6 +640,80 @@ def runs_test(residual):
     mean = 2.0 * n1 * n2 / n + 1
     var = (mean - 1) * (mean - 2) / (n - 1)
     return runs, float(stats.norm.cdf((runs + 0.5 - mean) / math.sqrt(var))) if var > 0 else 1.0
+
+
+def _diagnostics(cov, rss, n, k, weighted_resid, disp) -> dict:
+    """The fit's correlation matrix (order of ``fitted``), the noise scale, AIC and BIC and two
+    residual diagnostics (the runs test's p, the lag-1 autocorrelation in depth order)."""
+    corr = None
+    if cov is not None and np.all(np.isfinite(cov)):
+        sd = np.sqrt(np.diag(cov))
+        if np.all(sd > 0):
+            corr = np.clip(cov / np.outer(sd, sd), -1.0, 1.0)
+    dof = max(n - k, 1)
+    out = {"correlation": corr, "noise_sigma": float(math.sqrt(rss / dof)) if rss >= 0 else float("nan"),
+           "aic": float("nan"), "bic": float("nan"), "runs_p": float("nan"), "residual_autocorrelation": float("nan")}
+    if rss > 0 and n > 0:  # Gaussian with the noise model's relative weights and an estimated scale (k + 1)
+        ll = n * math.log(rss / n)
+        out["aic"], out["bic"] = float(ll + 2 * (k + 1)), float(ll + (k + 1) * math.log(n))
+    r = np.asarray(weighted_resid, float)[np.argsort(disp, kind="stable")]
+    if r.size >= RUNS_MIN_POINTS and np.all(np.isfinite(r)):
+        out["runs_p"] = runs_test(r)[1]
+        c = r - r.mean()
+        if np.dot(c, c) > 0:
+            out["residual_autocorrelation"] = float(np.dot(c[1:], c[:-1]) / np.dot(c, c))
+    return out
+
+
+#: Rules of :func:`fit_quality`: mu*H's 95 % half-width relative to mu*H for "good" and "fair",
+#: the largest absolute correlation of mu*H with another fitted parameter for "good".
+QUALITY_RULES = {"good_halfwidth": 0.05, "fair_halfwidth": 0.20, "good_correlation": 0.98}
+
+
+def fit_quality(success, warning_codes, mu_H, mu_ci, correlation=None, fitted=()) -> str:
+    """A transparent rating of one fit: ``good``, ``fair`` or ``poor``.
+
+    * poor: the fit failed its checks, or mu*H's 95 % interval is wider than +-20 % of it;
+    * good: succeeded without warnings, the interval within +-5 %, and mu*H not correlated with
+      another fitted parameter beyond abs(r) = 0.98 (then the data cannot tell them apart);
+    * fair: everything between.
+
+    The rules are :data:`QUALITY_RULES`; nanite rates curves with a trained regressor instead.
+    """
+    if not success or not (mu_H > 0) or not all(math.isfinite(v) for v in mu_ci):
+        return "poor"
+    half = (mu_ci[1] - mu_ci[0]) / 2 / mu_H
+    if half > QUALITY_RULES["fair_halfwidth"]:
+        return "poor"
+    r = 0.0
+    if correlation is not None and "mu_H" in fitted and len(fitted) > 1:
+        i = list(fitted).index("mu_H")
+        row = np.abs(np.delete(np.asarray(correlation, float)[i], i))
+        r = float(np.nanmax(row)) if row.size else 0.0
+    if not warning_codes and half <= QUALITY_RULES["good_halfwidth"] and r <= QUALITY_RULES["good_correlation"]:
+        return "good"
+    return "fair"
+
+
+def diagnostics_lines(quality, fitted, correlation, values, show_force=lambda v: f"{v:.4g} N") -> list:
+    """Two lines for a fit's summary: its quality rating and its diagnostics (``values``: noise_sigma,
+    aic, bic, runs_p, residual_autocorrelation)."""
+    rules = (f"rules: mu*H's 95 % interval within +-{100 * QUALITY_RULES['good_halfwidth']:g} % (good) or "
+             f"+-{100 * QUALITY_RULES['fair_halfwidth']:g} % (fair), no warnings, |corr(mu_H, .)| <= "
+             f"{QUALITY_RULES['good_correlation']:g}")
+    parts = []
+    if math.isfinite(values.get("noise_sigma", math.nan)):
+        parts.append(f"noise {show_force(values['noise_sigma'])}")
+    if math.isfinite(values.get("aic", math.nan)):
+        parts.append(f"AIC {values['aic']:.1f}, BIC {values['bic']:.1f}")
+    if math.isfinite(values.get("runs_p", math.nan)):
+        parts.append(f"runs test p = {values['runs_p']:.2g}, lag-1 autocorrelation "
+                     f"{values['residual_autocorrelation']:.2f}")
+    if correlation is not None and len(fitted) > 1:
+        c = np.asarray(correlation, float)
+        parts += [f"corr({a}, {b}) = {c[i, j]:+.2f}" for i, a in enumerate(fitted) for j, b in enumerate(fitted)
+                  if i < j]
+    return [f"quality = {quality} ({rules})", "diagnostics = " + ("; ".join(parts) if parts else "none")]
 
 
 def _check_result(res_ok, mu_H, mu_ci, off_ci, resid_ok, disp, resid):
@@ -1061,6 +1169,7 @@ def _fit_result(fitted, mdl, sp, k, notes, keep, weights, baseline, curves_compu
     message = f"{FIT_STATUS[status]} (least squares: {res.message})"
     point_weights = np.full(keep.size, np.nan)
     point_weights[keep] = w / np.max(w)
+    diagnostics = _diagnostics(cov, rss, n, J.shape[1], w * np.nan_to_num(resid), d)
     return FitResult(mu_H=mu_H, mu_H_ci95=mu_ci, offset=d0,
                      offset_ci95=off_ci, residual_rms=float(np.sqrt(np.mean(np.nan_to_num(resid, nan=mdl.big) ** 2))),
                      n=n, status=status, message=message, R_L=float(R_L), curve=fitted.curve, _model=model,
@@ -1071,7 +1180,7 @@ def _fit_result(fitted, mdl, sp, k, notes, keep, weights, baseline, curves_compu
                      interpolation_error=fitted.interpolation_error, warnings=[t for _, t in found],
                      warning_codes=[code for code, _ in found], baseline_model=baseline, baseline=b0,
                      baseline_ci95=ci[2], baseline_slope=b1, baseline_slope_ci95=ci[3],
-                     point_weights=point_weights)
+                     point_weights=point_weights, **diagnostics)
 
 
 def _pressure_in_pascals(p, mu_H, R_L, cov, t):

@@ -11,6 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from .textdata import printable
+from .fitting import diagnostics_lines
 from .thickness import model_error_line
 
 __all__ = ["plot_curves", "plot_profiles", "plot_fit", "plot_fit_record", "fit_report", "fit_summary_lines",
@@ -200,6 +201,7 @@ def fit_summary_lines(record):
         lo, hi = iv[name]
         lines.append(f"{name} = {p[name]:.5g} {units.get(name, '')}   95% CI [{lo:.5g}, {hi:.5g}]")
     lines.append(f"rms residual = {p['residual_rms']:.4g} N; R_L = {p['R_L']:.4g} m")
+    lines += diagnostics_lines(record.quality, record.fitted, record.correlation, p)
     s = record.scene
     if s.thickness is not None and "beta" not in record.fitted:
         H = s.thickness * p["R_L"]
