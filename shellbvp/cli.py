@@ -268,9 +268,10 @@ def _curve_bars(args, leave=True):
     """``progress`` for :func:`shellbvp.fit`: one bar per model curve, over delta."""
     from .progress import curve_progress, wanted
 
-    if not wanted(getattr(args, "quiet", False)):
+    mode = wanted(getattr(args, "quiet", False))
+    if not mode:
         return None
-    return lambda desc, delta_max: curve_progress(delta_max, desc, leave=leave)
+    return lambda desc, delta_max: curve_progress(delta_max, desc, enabled=mode, leave=leave)
 
 
 MAX_POINTS = 100_000  # --points: each is a solve (~0.05-0.5 s); more is a typo, not a curve

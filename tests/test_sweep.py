@@ -223,9 +223,10 @@ def test_the_same_2x2_sweep_on_a_dask_local_cluster(tmp_path, serial):
 def test_a_dask_cluster_that_goes_away_mid_run_leaves_its_curves_pending(tmp_path, monkeypatch):
     """Futures that never finish on a client that has closed: the sweep stops waiting (issue 42),
     reports them lost and keeps them pending for the next run, instead of hanging."""
+    import importlib
     from concurrent.futures import Future
 
-    import shellbvp.sweep as sw
+    sw = importlib.import_module("shellbvp.sweep")  # the module (the package's attribute is the function)
 
     class Client:
         status = "closed"  # what a dask Client says once its scheduler is gone for good
