@@ -484,13 +484,15 @@ def _cmd_fit(args):
     exactly one JSON document in every case (errors: see :func:`main`).  Several files (or a
     directory, a pattern, or ``--table``): a batch, see :func:`_fit_batch`; an AFM force map: every
     curve into a map, see :func:`_fit_map`."""
+    if args.example == bool(args.data):
+        raise ValueError("give data files (or a directory) or --example (one of them)")
+    if len(args.data) == 1 and not any(ch in args.data[0] for ch in "*?[") and not Path(args.data[0]).exists():
+        raise ValueError(f"{args.data[0]}: no such file or directory")  # before the numerics are imported
     from .afm import is_afm_file, read_afm
     from .batch import expand_inputs, read_record
     from .fitting import example_data_path, fit_record
     from .paths import check_output_path
 
-    if args.example == bool(args.data):
-        raise ValueError("give data files (or a directory) or --example (one of them)")
     inputs = [str(example_data_path())] if args.example else args.data
     files = expand_inputs(inputs)
     uncertainty = _split_uncertain(args)

@@ -102,3 +102,6 @@ def test_the_command_line_parses_before_numpy_and_scipy_load():
             "print(rc, heavy)")
     r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     assert r.stdout.strip() == "2 []", (r.stdout, r.stderr)
+    missing = code.replace("['curve', '--no-such-option']", "['fit', 'missing.csv', '--preset', 'fit', '--radius', '0.3mm']")
+    r = subprocess.run([sys.executable, "-c", missing], capture_output=True, text=True)
+    assert r.stdout.strip() == "2 []" and "missing.csv: no such file" in r.stderr, (r.stdout, r.stderr)
