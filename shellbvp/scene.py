@@ -320,8 +320,13 @@ class Scene:
         def length(x):
             return "" if R_L is None else format_in(abs(x) * R_L, "um" if abs(x) * R_L < 1e-3 else "mm", "length")
 
-        named = [n for n in PRESETS if Scene.preset(n) == self]
-        extra = [n for n in PRESETS if self.thickness is not None and Scene.preset(n, thickness=self.thickness) ==
+        # only presets that could be this scene are built (a user meridian's preset parses formulas)
+        candidates = [n for n, spec in PRESETS.items()
+                      if isinstance(spec["scene"].get("shell"), tuple) == isinstance(self.shell, UserShell)
+                      and all(math.isclose(float(spec["scene"][k]), float(getattr(self, k)), rel_tol=1e-12)
+                              for k in ("gamma", "rho", "pressure") if k in spec["scene"])]
+        named = [n for n in candidates if Scene.preset(n) == self]
+        extra = [n for n in candidates if self.thickness is not None and Scene.preset(n, thickness=self.thickness) ==
                  replace(self, transverse_shear=False)]
         parts = [f"preset {named[0]}" if named else f"preset {extra[0]} with thickness" if extra else "own scene"]
         if isinstance(self.shell, Spheroid):
