@@ -124,6 +124,7 @@ class Curve:
     settings: dict
     solutions: list = field(default_factory=list, repr=False)
     version: str = ""
+    units: dict = None  # {"R_L": m, "mu_H": N/m} when the file had SI columns (to_hdf5(units=...))
 
     def __getattr__(self, name):
         points = self.__dict__.get("points", {})
@@ -147,8 +148,9 @@ class Curve:
         return force_at(self, deltas)
 
     def to_hdf5(self, path, *, profiles: bool = False, overwrite: bool = False, units=None):
-        """Write the curve to an HDF5 file atomically (see :func:`write_curve`)."""
-        write_curve(self, path, profiles=profiles, overwrite=overwrite, units=units)
+        """Write the curve to an HDF5 file atomically (see :func:`write_curve`); ``units`` default:
+        the lab scales it was read with, if any."""
+        write_curve(self, path, profiles=profiles, overwrite=overwrite, units=units or self.units)
 
     def topology_summary(self) -> str:
         """Runs of contact topology along the curve, e.g. 'point x2, line x6, cap x27'."""
@@ -435,9 +437,16 @@ def read_curve_group(g, version: str = ""):
     points, flags = _points(g)
     if "pressure" not in g:  # before volume control, every point had the scene's pressure
         points["pressure"] = np.full(points["delta"].shape, float(scene.pressure))
+    units = None
+    if "R_L_m" in g.attrs and "mu_H_N_per_m" in g.attrs:  # the file's SI columns: its lab scales
+        try:
+            units = _check_units({"R_L": g.attrs["R_L_m"], "mu_H": g.attrs["mu_H_N_per_m"]})
+        except ValueError as exc:
+            raise ValueError(f"attributes R_L_m, mu_H_N_per_m: {exc}") from None
+        units = {"R_L": units[0], "mu_H": units[1]}
     return Curve(scene=scene, points=points, flags=flags, stop_reason=_text_attr(g, "stop_reason"),
                  complete=_bool_attr(g, "complete"), interrupted=_bool_attr(g, "interrupted"),
-                 settings=settings, version=version)
+                 settings=settings, version=version, units=units)
 
 
 def read_curve(path):

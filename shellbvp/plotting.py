@@ -39,19 +39,26 @@ def scene_label(scene) -> str:
 
 
 def plot_curves(curves, ax=None, labels=None, mark_invalid=True):
-    """F against delta for each curve; invalid states (flags) drawn hollow."""
+    """F against delta for each curve; invalid states (flags) drawn hollow.  When every curve
+    carries its lab scales (a file written with ``units=``: SI columns), in mm and mN."""
     plt = require_matplotlib()
     if ax is None:
         _, ax = plt.subplots(figsize=(6, 4.5))
+    si = bool(curves) and all(getattr(c, "units", None) for c in curves)
     for i, c in enumerate(curves):
         label = labels[i] if labels else scene_label(c.scene)
-        (line,) = ax.plot(c.delta, c.force, "-", label=label)
+        sx, sy = (c.units["R_L"] * 1e3, c.units["mu_H"] * c.units["R_L"] * 1e3) if si else (1.0, 1.0)
+        (line,) = ax.plot(sx * c.delta, sy * c.force, "-", label=label)
         if mark_invalid and len(c):
             bad = ~np.asarray(c.valid, bool)
-            ax.plot(c.delta[bad], c.force[bad], "o", mfc="none", ms=4, color=line.get_color())
+            ax.plot(sx * c.delta[bad], sy * c.force[bad], "o", mfc="none", ms=4, color=line.get_color())
     ax.axhline(0, color="0.7", lw=0.5)
-    ax.set_xlabel(r"pole displacement $\delta$ / $R_L$")
-    ax.set_ylabel(r"force $F$ / ($\mu H R_L$)")
+    if si:
+        ax.set_xlabel("pole displacement (mm)")
+        ax.set_ylabel("force (mN)")
+    else:
+        ax.set_xlabel(r"pole displacement $\delta$ / $R_L$")
+        ax.set_ylabel(r"force $F$ / ($\mu H R_L$)")
     ax.legend(fontsize=7)
     return ax
 

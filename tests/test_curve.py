@@ -297,3 +297,28 @@ def test_the_plot_turn_is_the_angle_of_the_plotted_curve_whatever_the_force_scal
     # of 0.002 rad: its chords are nearly parallel
     up, top, down = St(delta=0.15, force=0.5e-4), St(delta=0.2, force=1e-4), St(delta=0.25, force=0.5e-4)
     assert _plot_turn(up, top, down, 1.0, 1.0) == pytest.approx(2e-3, rel=1e-3)
+
+
+def test_a_curve_file_with_si_columns_plots_in_mm_and_mn(tmp_path):
+    """The lab scales a file was written with come back with it, survive a rewrite, and its plot
+    is in mm and mN (issue 45, item 3): a nondimensional file stays nondimensional."""
+    pytest.importorskip("matplotlib")
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from shellbvp.plotting import plot_curves
+
+    c = sb.curve(sb.Scene.preset("base"), deltas=[0.1, 0.2], estimate_error=False)
+    c.to_hdf5(tmp_path / "si.h5", units={"R_L": 0.3e-3, "mu_H": 52.0})
+    back = sb.read_curve(tmp_path / "si.h5")
+    assert back.units == {"R_L": 0.3e-3, "mu_H": 52.0}
+    back.to_hdf5(tmp_path / "again.h5")
+    assert sb.read_curve(tmp_path / "again.h5").units == back.units
+    ax = plot_curves([back])
+    assert ax.get_xlabel() == "pole displacement (mm)" and ax.get_ylabel() == "force (mN)"
+    x, y = ax.lines[0].get_data()
+    np.testing.assert_allclose(x, back.delta * 0.3, rtol=1e-12)                  # mm
+    np.testing.assert_allclose(y, back.force * 52.0 * 0.3e-3 * 1e3, rtol=1e-12)  # mN
+    c.to_hdf5(tmp_path / "nondim.h5")
+    assert sb.read_curve(tmp_path / "nondim.h5").units is None
+    assert "R_L" in plot_curves([sb.read_curve(tmp_path / "nondim.h5")]).get_xlabel()
