@@ -22,7 +22,8 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["AFM_SUFFIXES", "AFMCurve", "ForceMap", "is_afm_file", "read_afm", "curves_from_afm", "MAP_FORMAT"]
+__all__ = ["AFM_SUFFIXES", "AFMCurve", "ForceMap", "is_afm_file", "read_afm", "curves_from_afm",
+           "refuse_text_options", "MAP_FORMAT"]
 
 #: File name endings read through afmformats (other text files go through shellbvp.instrument).
 AFM_SUFFIXES = (".jpk-force", ".jpk-force-map", ".jpk-qi-data", ".jpk-qi-series", ".ibw")
@@ -57,6 +58,13 @@ class AFMCurve:
     grid: tuple = None
     position: tuple = None
     grid_geometry: tuple = None  # ((center x, center y), (size x, size y)) of the map's grid, m
+
+
+def refuse_text_options(path, columns=None, units=None, invert=()):
+    """ValueError when reading options of text exports are given for an AFM file."""
+    if columns or units or invert:
+        raise ValueError(f"{path}: an AFM file gives its own columns, units and signs: --columns, --units and "
+                         f"--invert are for text exports")
 
 
 def _afmformats():

@@ -202,14 +202,12 @@ def read_record(path, *, columns=None, units=None, invert=()):
     """One record from a file: an AFM curve through afmformats (:mod:`shellbvp.afm`), a text
     export through :func:`shellbvp.instrument.read_instrument`.  A force map is refused here
     (it is fitted on its own: :func:`fit_map`)."""
-    from .afm import is_afm_file, read_afm
+    from .afm import is_afm_file, read_afm, refuse_text_options
     from .instrument import read_instrument
 
     if not is_afm_file(path):
         return read_instrument(path, columns=columns, units=units, invert=invert)
-    if columns or units or invert:
-        raise ValueError(f"{path}: an AFM file gives its own columns, units and signs: --columns, --units and "
-                         f"--invert are for text exports")
+    refuse_text_options(path, columns, units, invert)
     curves = read_afm(path)
     if len(curves) > 1:
         raise ValueError(f"{path}: a force map of {len(curves)} curves: fit it on its own "

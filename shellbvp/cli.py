@@ -632,12 +632,11 @@ def _fit_batch(args, files):
 def _fit_map(args, path, curves, scene, R_L, reading, options):
     """``shellbvp fit MAP.jpk-force-map [-o map.h5] [--table map.csv] [--report map.png]``: every
     curve with the same scene; exit 0 when every curve was fitted, 1 otherwise."""
+    from .afm import refuse_text_options
     from .batch import fit_map, write_table
     from .paths import check_output_path
 
-    if any(reading.values()):
-        raise ValueError(f"{path}: an AFM file gives its own columns, units and signs: --columns, --units and "
-                         f"--invert are for text exports")
+    refuse_text_options(path, **reading)
     if args.table is not None:
         check_output_path(args.table, overwrite=args.force)
     options = dict(options, progress=_curve_bars(args, leave=False))

@@ -642,9 +642,17 @@ def runs_test(residual):
     return runs, float(stats.norm.cdf((runs + 0.5 - mean) / math.sqrt(var))) if var > 0 else 1.0
 
 
-def _diagnostics(cov, rss, n, k, weighted_resid, disp) -> dict:
+def _runs_in_depth_order(resid, disp):
+    """``(runs, p)`` of :func:`runs_test` on the residuals in depth order (signs only: weights do
+    not matter); None for too few points or a non-finite residual."""
+    if resid.size < RUNS_MIN_POINTS or not np.all(np.isfinite(resid)):
+        return None
+    return runs_test(resid[np.argsort(disp, kind="stable")])
+
+
+def _diagnostics(cov, rss, n, k, weighted_resid, disp, runs) -> dict:
     """The fit's correlation matrix (order of ``fitted``), the noise scale, AIC and BIC and two
-    residual diagnostics (the runs test's p, the lag-1 autocorrelation in depth order)."""
+    residual diagnostics (the runs test's p, ``runs``, and the lag-1 autocorrelation in depth order)."""
     corr = None
     if cov is not None and np.all(np.isfinite(cov)):
         sd = np.sqrt(np.diag(cov))
@@ -656,10 +664,10 @@ def _diagnostics(cov, rss, n, k, weighted_resid, disp) -> dict:
     if rss > 0 and n > 0:  # Gaussian with the noise model's relative weights and an estimated scale (k + 1)
         ll = n * math.log(rss / n)
         out["aic"], out["bic"] = float(ll + 2 * (k + 1)), float(ll + (k + 1) * math.log(n))
-    r = np.asarray(weighted_resid, float)[np.argsort(disp, kind="stable")]
-    if r.size >= RUNS_MIN_POINTS and np.all(np.isfinite(r)):
-        out["runs_p"] = runs_test(r)[1]
-        c = r - r.mean()
+    if runs is not None:
+        out["runs_p"] = runs[1]
+        c = np.asarray(weighted_resid, float)[np.argsort(disp, kind="stable")]
+        c = c - c.mean()
         if np.dot(c, c) > 0:
             out["residual_autocorrelation"] = float(np.dot(c[1:], c[:-1]) / np.dot(c, c))
     return out
@@ -716,7 +724,7 @@ def diagnostics_lines(quality, fitted, correlation, values, show_force=lambda v:
     return [f"quality = {quality} ({rules})", "diagnostics = " + ("; ".join(parts) if parts else "none")]
 
 
-def _check_result(res_ok, mu_H, mu_ci, off_ci, resid_ok, disp, resid):
+def _check_result(res_ok, mu_H, mu_ci, off_ci, resid_ok, n, runs):
     """Status and warnings of a fitted result (see :data:`FIT_STATUS`, :data:`FIT_WARNINGS`)."""
     warnings = []
     if not res_ok:
@@ -731,12 +739,10 @@ def _check_result(res_ok, mu_H, mu_ci, off_ci, resid_ok, disp, resid):
         status = 5
     else:
         status = 0
-    if resid.size >= RUNS_MIN_POINTS and np.all(np.isfinite(resid)):  # signs only: weights do not matter
-        runs, p = runs_test(resid[np.argsort(disp, kind="stable")])
-        if p < RUNS_P:
-            warnings.append(("residual_runs", f"the residuals' signs form {runs} runs over {resid.size} points "
-                             f"(runs test p = {p:.2g} < {RUNS_P:g}): a pattern the noise model does not explain; "
-                             "the model (scene, contact point, weights) does not follow the data"))
+    if runs is not None and runs[1] < RUNS_P:
+        warnings.append(("residual_runs", f"the residuals' signs form {runs[0]} runs over {n} points "
+                         f"(runs test p = {runs[1]:.2g} < {RUNS_P:g}): a pattern the noise model does not explain; "
+                         "the model (scene, contact point, weights) does not follow the data"))
     lo, hi = PLAUSIBLE_MU_H
     if status != 2 and math.isfinite(mu_H) and not lo <= mu_H <= hi:
         warnings.append(("implausible_mu_H", f"mu*H = {mu_H:.3g} N/m is far outside the range of soft shells "
@@ -1161,15 +1167,16 @@ def _fit_result(fitted, mdl, sp, k, notes, keep, weights, baseline, curves_compu
         pressure_Pa, pressure_Pa_ci = _pressure_in_pascals(pressure, q[0], R_L, cov,
                                                            stats.t.ppf(0.975, dof))
     mu_ci = ci[0]
-    status, checks = _check_result(bool(res.success), mu_H, mu_ci, off_ci, bool(np.all(np.isfinite(resid))), d,
-                                   resid)
+    runs = _runs_in_depth_order(resid, d)
+    status, checks = _check_result(bool(res.success), mu_H, mu_ci, off_ci, bool(np.all(np.isfinite(resid))),
+                                   resid.size, runs)
     found = notes + checks
     for _, text in found:
         log.info("fit: warning: %s", text)
     message = f"{FIT_STATUS[status]} (least squares: {res.message})"
     point_weights = np.full(keep.size, np.nan)
     point_weights[keep] = w / np.max(w)
-    diagnostics = _diagnostics(cov, rss, n, J.shape[1], w * np.nan_to_num(resid), d)
+    diagnostics = _diagnostics(cov, rss, n, J.shape[1], w * resid, d, runs)
     return FitResult(mu_H=mu_H, mu_H_ci95=mu_ci, offset=d0,
                      offset_ci95=off_ci, residual_rms=float(np.sqrt(np.mean(np.nan_to_num(resid, nan=mdl.big) ** 2))),
                      n=n, status=status, message=message, R_L=float(R_L), curve=fitted.curve, _model=model,

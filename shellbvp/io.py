@@ -485,9 +485,10 @@ def read_curve(path):
     path = Path(path)
     with open_hdf5(path, fmt=FORMAT, group=("entry/curve", "curve"), kind="curve") as f:
         try:
-            where = "entry/curve" if _format_version(f) >= 4 else "curve"  # version 4: NeXus, under an NXentry
+            version = _format_version(f)
+            where = "entry/curve" if version >= 4 else "curve"  # version 4: NeXus, under an NXentry
             if not isinstance(f.get(where), h5py.Group):
-                raise ValueError(f"format version {_format_version(f)} keeps its curve in /{where}, which is missing")
+                raise ValueError(f"format version {version} keeps its curve in /{where}, which is missing")
             curve = read_curve_group(f[where], str(f.attrs.get("package_version", "")))
         except ValueError as exc:
             raise ValueError(f"{path}: {exc}") from None

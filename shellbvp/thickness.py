@@ -30,8 +30,6 @@ shell's bending round the tip; ``RotationBending`` does better there).
 
 from __future__ import annotations
 
-from dataclasses import replace
-
 import numpy as np
 
 __all__ = ["SHEAR_FACTOR", "shear_delta", "force_at", "model_error", "MEASURED_MODEL_ERROR", "MAPPED_EPS",
@@ -155,7 +153,7 @@ def model_error_line(scene) -> str:
     if scene.transverse_shear:
         better = "with transverse shear"
     else:
-        sheared = model_error(replace(scene, transverse_shear=True)) if scene.contact == "smooth" else None
+        sheared = model_error(scene.replace(transverse_shear=True)) if scene.contact == "smooth" else None
         better = ("without transverse shear; --transverse-shear: up to "
                   f"{100 * sheared[0]:.2g} %" if sheared else "without transverse shear")
     return (f"model  = beside this interval, the shell model's own error against 3D elasticity: up to "
