@@ -544,7 +544,7 @@ def _cmd_fit(args):
             if not geometry.success:
                 print(f"fit with the geometry's uncertainty failed: {geometry.message}")
             g1, g2 = geometry.mu_H_ci95
-            print(f"         95% CI [{g1:.4g}, {g2:.4g}] N/m with the geometry's uncertainty "
+            print(f"geometry = mu*H 95% CI [{g1:.4g}, {g2:.4g}] N/m with the geometry's uncertainty "
                   f"(u = {geometry.u_geometry:.3g} N/m; {geometry.fits_computed} fits)")
             print(geometry.table())
     if args.output or args.report:
