@@ -45,8 +45,7 @@ def main():
             c = sb.curve(scene, deltas=DELTAS, tol=TOL, estimate_error=False, max_nodes=50000)
             for s in c.solutions:
                 err, scale = identity_error(s) if s.success else (np.nan, np.nan)
-                rows.append((preset, label, s.delta, s.force, s.get("contact_edge", ""), s.get("edge_jump_ls", np.nan),
-                             err, scale, s.get("valid", False)))
+                rows.append((preset, label, s.delta, s.force, s.contact_edge, s.edge_jump_ls, err, scale, s.valid))
             print(preset, label, c.summary(), flush=True)
     out = Path(__file__).parent / "results" / "bending_choice.md"
     lines = [f"Measured {time.strftime('%Y-%m-%d')} on {platform.machine()} ({platform.python_version()}), "

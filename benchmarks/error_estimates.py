@@ -61,7 +61,7 @@ def _write_atomic(path: Path, text: str):
 
 
 def _configuration(s):
-    return s.get("topology", "cap"), s.get("contact_edge", "")
+    return s.topology, s.contact_edge
 
 
 def _geometric(residual, key, anchors):
@@ -136,7 +136,7 @@ def run_preset(name, log, old=None):
     for s in auto.solutions if not F_ref else ():
         r = sb.solve(scene, delta=float(s.delta), tol=REF_TOL, guess=s, max_nodes=REF_MAX_NODES,
                      estimate_error=False)
-        ok = r.success and r.get("topology") == s.get("topology")
+        ok = r.success and r.topology == s.topology
         F_ref.append(r.force if ok else math.nan)
         ref_nodes.append(int(r.nodes))
     log(f"{name}: reference at tol {REF_TOL:g}: {np.isfinite(F_ref).sum()}/{len(auto)} converged, "

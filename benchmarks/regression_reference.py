@@ -32,7 +32,7 @@ def main(out):
                      estimate_error=False)
         rows.append(dict(preset=preset, contact=contact, control=control, value=value, topology=topology,
                          success=bool(s.success), result_topology=s.topology, force=s.force, delta=s.delta,
-                         lambda0=s.lambda0, Sc=s.Sc, S1=s.get("S1", s.Sc), energy=s.energy))
+                         lambda0=s.lambda0, Sc=s.Sc, S1=s.S1, energy=s.energy))
         print(rows[-1], flush=True)
     commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True).stdout.strip()
     Path(out).write_text(json.dumps({"commit": commit, "tol": 1e-8, "states": rows}, indent=1) + "\n")

@@ -766,7 +766,7 @@ def _validate(lambdas=(1.0, 1.05, 1.1), rtols=(1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-
                 rows.append(dict(contact=contact, solver="collocation", tol=tol, lambda0=l,
                                  success=bool(s.success), dF=abs(s.force - refs[l].force),
                                  ddelta=abs(s.delta - refs[l].delta), time=t,
-                                 nodes=int(s.get("nodes", 0)), niter=int(s.get("niter", 0))))
+                                 nodes=int(s.nodes), niter=int(s.niter)))
             log(f"{contact}: collocation tol {tol:g} done")
         for jac in jacobians:
             for rtol in rtols:

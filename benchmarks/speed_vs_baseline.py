@@ -230,7 +230,7 @@ def worker(spec):
     sols = getattr(c, "solutions", None) or []
     out = dict(wall=wall, cpu=cpu, points=len(c), stop=c.stop_reason, complete=bool(c.complete),
                delta=[float(v) for v in c.delta], force=[float(v) for v in c.force],
-               topology=[str(s.get("topology", "cap")) for s in sols] or ["cap"] * len(c),
+               topology=[str(getattr(s, "topology", "cap")) for s in sols] or ["cap"] * len(c),
                valid=[bool(v) for v in c.valid], nodes=[int(v) for v in c.points["nodes"]],
                shellbvp=str(Path(sb.__file__).parent), kernel_load_s=kernel_load,
                interpolate_import_s=interpolate_import, first_point_cpu=first_cpu, **counts)
@@ -304,7 +304,7 @@ def _tight(scene, state, tol):
     from shellbvp.pointload import solve_point_load
     from shellbvp.state import TOPOLOGIES
 
-    top = state.get("topology", "cap")
+    top = getattr(state, "topology", "cap")
     if top == "point":
         return solve_point_load(scene, float(state.delta), tol=tol, max_nodes=REF_MAX_NODES, guess=state)
     return sb.solve(scene, delta=float(state.delta), tol=tol, guess=state, max_nodes=REF_MAX_NODES,
@@ -328,9 +328,9 @@ def reference(preset, deltas, topology, log, quick=False):
         ref["delta"].append(float(s.delta))
         ref["force"].append(float(r.force) if ok else math.nan)
         ref["lambda0"].append(float(r.lambda0) if ok else math.nan)
-        ref["topology"].append(str(r.get("topology", "cap")) if ok else "failed")
+        ref["topology"].append(str(getattr(r, "topology", "cap")) if ok else "failed")
         ref["nodes"].append(int(r.nodes))
-        is_cap = ok and r.get("topology", "cap") == "cap" and r.y.shape[0] == 8
+        is_cap = ok and getattr(r, "topology", "cap") == "cap" and r.y.shape[0] == 8
         ref["start"].append(dict(Sc=float(r.Sc), u=float(r.y[6, 0])) if is_cap else None)
         if ok and not quick and i % CHECK_EVERY == 0:
             t = _tight(scene, r, CHECK_TOL)

@@ -194,9 +194,9 @@ def worker(spec_path, out_path):
         # (only single-cap states have the cap angle and Sc+ used here; point-load, line and
         # annulus states are skipped)
         sols = c.solutions
-        cap = lambda s: s.get("topology", "cap") == "cap"  # noqa: E731
-        row["point_load_points"] = int(sum(s.get("topology") == "point" for s in sols))
-        row["curve"]["topology"] = [s.get("topology", "cap") for s in sols]
+        cap = lambda s: s.topology == "cap"  # noqa: E731
+        row["point_load_points"] = int(sum(s.topology == "point" for s in sols))
+        row["curve"]["topology"] = [s.topology for s in sols]
         row["topologies"] = c.topology_summary() if hasattr(c, "topology_summary") else ""
         if "edge_legendre" in p:
             row["curve"]["edge_legendre"] = [float(v) for v in p["edge_legendre"]]

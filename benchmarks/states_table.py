@@ -33,10 +33,10 @@ def main(argv=None):
                 t0 = time.perf_counter()
                 s = sb.solve(scene, delta=d)
                 rows.append(dict(preset=name, contact=contact, delta=d, success=bool(s.success),
-                                 topology=s.get("topology", "cap"),
+                                 topology=s.topology,
                                  status=s.status, force=s.force, Sc=float(s.Sc), lambda0=s.lambda0,
-                                 ring_force=s.get("ring_force"), pressure_min=s.get("pressure_min"),
-                                 valid=bool(s.get("valid")), force_error=s.get("force_error"),
+                                 ring_force=s.ring_force, pressure_min=s.pressure_min,
+                                 valid=bool(s.valid), force_error=s.force_error,
                                  nodes=s.nodes, seconds=time.perf_counter() - t0))
     out = (Path(args.out_dir) if args.out_dir else Path(__file__).parent) / "results"
     out.mkdir(parents=True, exist_ok=True)

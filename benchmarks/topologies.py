@@ -46,11 +46,11 @@ def main(argv=None):
             cap = sb.solve(scene, delta=d, topology="cap", tol=1e-8)
             t0 = time.perf_counter()
             auto = sb.solve(scene, delta=d, tol=1e-8)
-            states.append(dict(preset=name, delta=d, topology=auto.get("topology"), valid=bool(auto.get("valid")),
-                               force=auto.force, force_error=auto.get("force_error"), S1=float(auto.get("S1", 0.0)),
-                               Sc=float(auto.Sc), cap_force=cap.force, cap_valid=bool(cap.get("valid")),
-                               cap_pressure_min=cap.get("pressure_min"), flags="; ".join(auto.get("flags", [])),
-                               energy_change=auto.get("energy", np.nan) - cap.get("energy", np.nan),
+            states.append(dict(preset=name, delta=d, topology=auto.topology, valid=bool(auto.valid),
+                               force=auto.force, force_error=auto.force_error, S1=float(auto.S1),
+                               Sc=float(auto.Sc), cap_force=cap.force, cap_valid=bool(cap.valid),
+                               cap_pressure_min=cap.pressure_min, flags="; ".join(auto.flags),
+                               energy_change=auto.energy - cap.energy,
                                seconds=time.perf_counter() - t0))
         t0 = time.perf_counter()
         c = sb.curve(scene, delta_max=0.15 if args.quick else 0.5)

@@ -775,9 +775,9 @@ def kind_scenes(n, rng, tmp):
             o, d = judge_exception(out)
         else:
             s = out["result"]
-            nums = {k: s.get(k) for k in ("force", "delta", "Sc", "lambda0")}
-            if not isinstance(s.get("status"), (int, np.integer)) or not s.get("message"):
-                o, d = "DEFECT", f"no integer status or no message: status {s.get('status')!r}"
+            nums = {k: getattr(s, k) for k in ("force", "delta", "Sc", "lambda0")}
+            if not isinstance(s.status, (int, np.integer)) or not s.message:
+                o, d = "DEFECT", f"no integer status or no message: status {s.status!r}"
             elif s.success:
                 finite = all(isinstance(nums[k], (float, int, np.floating)) and math.isfinite(nums[k])
                              for k in ("force", "delta", "Sc"))

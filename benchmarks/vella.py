@@ -62,7 +62,7 @@ def row(beta: float, tau: float, frac: float) -> dict:
     k = s.force / delta if s.success else math.nan
     tau_def = p * R**2 / (4 * math.sqrt(3 * beta))
     return {"beta": beta, "tau": tau, "p": p, "delta_over_h": frac, "success": bool(s.success),
-            "topology": s.get("topology"), "message": "" if s.success else s.message,
+            "topology": s.topology, "message": "" if s.success else s.message,
             "k": k, "k_formula": k_reissner * vella_factor(tau), "ratio": k / (k_reissner * vella_factor(tau)),
             "R_inflated": R, "ratio_inflated_R": k / (k_reissner / R * vella_factor(tau_def)),
             "seconds": time.perf_counter() - t0}

@@ -149,7 +149,7 @@ def reference(scene, deltas, log, every_1e10=8):
             nodes.append(int(r.nodes))
             if tol == REF_TOL:
                 # shooting's unknown u = rQ(Sc+) (free state 4 at t = 0; cap states only)
-                is_cap = r.success and r.get("topology", "cap") == "cap" and r.y.shape[0] == 8
+                is_cap = r.success and r.topology == "cap" and r.y.shape[0] == 8
                 dl.append(dict(Sc=float(r.Sc), u=float(r.y[6, 0])) if is_cap else None)
         runs[tol] = dict(F=np.array(F), lambda0=np.array(lam), ok=np.array(ok), nodes=np.array(nodes),
                          seconds=float(np.sum(secs)), start=dl if tol == REF_TOL else None)
@@ -246,7 +246,7 @@ def adaptive_series(scene, tols, repeat, log, ref_every=1):
             if i % ref_every and i != len(c) - 1:
                 Fref.append(math.nan)  # not compared (quick mode)
                 continue
-            if s.get("topology") == "point":
+            if s.topology == "point":
                 Fref.append(math.nan)
                 skipped += 1
                 continue

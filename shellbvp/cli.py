@@ -399,7 +399,7 @@ def _cmd_solve(args):
             "delta_error", "nodes", "niter", "max_residual", "wall_time")
     if scene.transverse_shear:  # the thick shell's pole is at delta + shear_delta
         keys = keys[:5] + ("shear_delta",) + keys[5:]
-    out = {k: sol.get(k, 0.0 if k in ("S1", "ring_force_inner") else None) for k in keys}
+    out = {k: getattr(sol, k) for k in keys}
     out = {k: (float(v) if isinstance(v, (np.floating,)) else v) for k, v in out.items()}
     if (args.radius is None) != (args.mu_h is None):
         raise ValueError("--radius and --muH go together (rim radius, e.g. 0.3mm, and mu*H, e.g. 52N/m)")

@@ -211,7 +211,7 @@ def _error_mode(estimate_error):
 
 
 def _configuration(sol):
-    return sol.get("topology", "cap"), sol.get("contact_edge", "")
+    return sol.topology, sol.contact_edge
 
 
 class _Builder:
@@ -260,7 +260,7 @@ class _Builder:
                     return end
                 if end is None:
                     shown = self._before_fold(sol, kw)
-        if shown.get("topology") == "cap" and edge_model(shown) != "pinned" and wall_contact_suspected(shown):
+        if shown.topology == "cap" and edge_model(shown) != "pinned" and wall_contact_suspected(shown):
             wall = None
             if self.last_wall is not None:
                 wall = best_wall_state(self.last_wall, control="delta", value=shown.delta, **kw)
@@ -285,7 +285,7 @@ class _Builder:
         lifted = lifted_state_at(cap.delta, on_way, fold, **kw)
         if lifted is None:
             return cap
-        lifted.cap_state = {k: cap[k] for k in ("delta", "force", "energy", "pressure_min", "Sc")}
+        lifted.cap_state = cap.summary()
         lifted.cap_solution = cap
         self.liftoff_before, self.last_liftoff = last, lifted
         return lifted
@@ -310,7 +310,7 @@ class _Builder:
         if self.branch_end and self.settings["mode"] != "adaptive":  # requested depths only
             self.out.complete = True
             raise _Stop(self.branch_end)
-        self.rows.append((key, point_record(sol), "; ".join(sol.get("flags", [])), sol))
+        self.rows.append((key, point_record(sol), "; ".join(sol.flags), sol))
         self.last_accepted = time.perf_counter()
         if self.callback is not None:
             self.callback(self.snapshot(), sol)
@@ -327,7 +327,7 @@ class _Builder:
         return self._tightened(sol) if self._above_tol(sol) else sol
 
     def _above_tol(self, sol):
-        return bool(_TIGHTEN and sol.get("force_error", 0.0) > self.tol * abs(sol.force))
+        return bool(_TIGHTEN and sol.force_error > self.tol * abs(sol.force))
 
     #: solve_bvp bounds collocation residuals, not the error of F: where F is small (the
     #: end of the small-delta leg) its relative error can exceed tol (fit preset, delta 0.005:
@@ -360,20 +360,19 @@ class _Builder:
         """``sol`` solved again at ``tol`` from itself, with its Richardson estimate; None where that
         does not converge to a state of the same configuration and validity."""
         st = self.settings
-        if sol.get("topology") == "point":
+        if sol.topology == "point":
             fine = solve_point_load(sol.scene, sol.delta, tol=tol, max_nodes=st["max_nodes"], guess=sol,
                                     bc_tol=st["bc_tol"])
         else:
             fine = solve_from(sol.system, (sol.x, sol.y, sol.p), tol=tol, max_nodes=st["max_nodes"],
                               bc_tol=st["bc_tol"])
-        if not (fine.success and fine.get("valid") == sol.get("valid")
+        if not (fine.success and fine.valid == sol.valid
                 and _configuration(fine) == _configuration(sol)):
             return None
         richardson_error(fine.system, fine, tol)
         fine.error_method = "richardson"
-        for k in ("cap_state", "cap_solution", "line_state"):  # what the lift-off and wall searches attached
-            if k in sol:
-                fine[k] = sol[k]
+        # what the lift-off and wall searches attached
+        fine.set(cap_state=sol.cap_state, cap_solution=sol.cap_solution, line_state=sol.line_state)
         return fine
 
     def _estimate_calibrated(self, final):
@@ -383,7 +382,7 @@ class _Builder:
         now: switches are located last) puts a calibrated point at an end of the curve or
         next to another configuration.
         """
-        rows = sorted((r for r in self.rows if r[3].get("error_method")), key=lambda r: r[0])
+        rows = sorted((r for r in self.rows if r[3].error_method), key=lambda r: r[0])
         configurations = [_configuration(r[3]) for r in rows]
         if final and not self.out.interrupted:
             for i, (_, _, _, sol) in enumerate(rows):
@@ -394,7 +393,7 @@ class _Builder:
         anchors = {}  # configuration -> [(key, force ratio, delta ratio)] of its Richardson points
         for (key, _, _, sol), conf in zip(rows, configurations):
             res = float(sol.max_residual)
-            errors = (sol.get("force_error", math.nan), sol.get("delta_error", math.nan))
+            errors = (sol.force_error, sol.delta_error)
             ratios = (errors[0] / res, errors[1] / res) if res > 0 else (math.nan, math.nan)
             if sol.error_method == "richardson" and all(map(math.isfinite, ratios)):
                 anchors.setdefault(conf, []).append((key,) + ratios)
@@ -410,15 +409,13 @@ class _Builder:
                 if fine is not row[3]:
                     self._replace(row, fine)
         for r in self.rows:
-            for k in ("force_error", "delta_error", "error_method"):
-                if k in r[3]:
-                    r[1][k] = r[3][k]
+            r[1].update(force_error=r[3].force_error, delta_error=r[3].delta_error, error_method=r[3].error_method)
 
     def _replace(self, row, sol):
         """``row`` with ``sol`` as its point (in ``self.rows`` too); the row itself if ``sol`` is its own."""
         if sol is row[3]:
             return row
-        new = (row[0], point_record(sol), "; ".join(sol.get("flags", [])), sol)
+        new = (row[0], point_record(sol), "; ".join(sol.flags), sol)
         self.rows = [new if r is row else r for r in self.rows]
         return new
 
@@ -441,9 +438,9 @@ class _Builder:
 
 def _cap_of(sol):
     """The single-cap state behind a recorded point (itself, or the cap it replaced)."""
-    if sol.get("topology") == "cap":
+    if sol.topology == "cap":
         return sol
-    return sol.get("cap_solution")
+    return sol.cap_solution
 
 
 def _secant_distance(d, f, last):
@@ -539,7 +536,7 @@ def _locate_switches(builder: _Builder, st):
     def wall_line_at(d, near):
         sol = wall_state(near, "cap+line(cylinder)", control="delta", value=d, tol=st["tol"],
                          max_nodes=st["max_nodes"], bc_tol=st["bc_tol"])
-        return (sol, -sol.curvature_excess) if sol.success and "curvature_excess" in sol else (None, None)
+        return (sol, -sol.curvature_excess) if sol.success and not math.isnan(sol.curvature_excess) else (None, None)
 
     for (k1, _, _, s1), (k2, _, _, s2) in zip(rows[:-1], rows[1:]):
         c1, c2 = _cap_of(s1), _cap_of(s2)
@@ -547,38 +544,38 @@ def _locate_switches(builder: _Builder, st):
                 and (edge_model(c1), edge_model(c2)) == ("smooth", "corner"):
             switches.append(locate_corner_switch(c1, c2, st))
             continue
-        if s1.get("valid") and s2.get("valid") and (edge_model(s1), edge_model(s2)) == ("paper", "pinned"):
+        if s1.valid and s2.valid and (edge_model(s1), edge_model(s2)) == ("paper", "pinned"):
             # the free cap's edge reaches the tip's end: from the caps either side of it
-            ends = [s1, s2.get("cap_solution")]
+            ends = [s1, s2.cap_solution]
             if ends[1] is not None and ends[1].status in (0, 4) and ends[0].tip_end_margin > 0 > ends[1].tip_end_margin:
                 best = _regula_falsi(ends[0].delta, ends[0].tip_end_margin, ends[0], ends[1].delta,
                                      ends[1].tip_end_margin, ends[1], cap_end_at)
                 _add_switch(builder, st, switches, best, "cap", "cap (pinned at the tip's end)", k1, k2,
                             "tip_end_margin")
             continue
-        frm, to = s1.get("topology"), s2.get("topology")
+        frm, to = s1.topology, s2.topology
         pair = {frm, to}
-        if not (s1.get("valid") and s2.get("valid")) or frm == to:
+        if not (s1.valid and s2.valid) or frm == to:
             continue
         if "cap" in pair and pair & {"line", "annulus", "cap+line(tip)"}:
             ends, criterion, sign, solve_at = [_cap_of(s1), _cap_of(s2)], "pressure_min", 1.0, cap_at
         elif pair == {"line", "cap+line(tip)"}:  # the lifted pole touches down: a cap grows there
-            ends = [_with_pole_clearance(s if s.get("topology") == "line" else _line_state_at(s, st))
+            ends = [_with_pole_clearance(s if s.topology == "line" else _line_state_at(s, st))
                     for s in (s1, s2)]
             criterion, sign, solve_at = "pole_clearance", 1.0, line_touch_at
         elif pair == {"line", "annulus"}:
-            ends = [s if s.get("topology") == "line" else _line_state_at(s, st) for s in (s1, s2)]
+            ends = [s if s.topology == "line" else _line_state_at(s, st) for s in (s1, s2)]
             criterion, sign, solve_at = "curvature_excess", -1.0, line_at
         elif "cap" in pair and pair & {"cap+line(cylinder)", "cap+band(cylinder)", "cap+cylinder"}:
             ends = [_cap_of(s1), _cap_of(s2)]
             if any(e is None for e in ends):
                 continue
-            if all(math.isfinite(e.get("wall_gap", math.inf)) for e in ends):  # the shell reaches the wall
+            if all(math.isfinite(e.wall_gap) for e in ends):  # the shell reaches the wall
                 criterion, sign, solve_at = "wall_gap", 1.0, cap_touch_at
             else:  # the contact reaches the tip's end
                 criterion, sign, solve_at = "tip_end_margin", 1.0, cap_end_at
         elif pair == {"cap+line(cylinder)", "cap+band(cylinder)"}:
-            ends = [s if s.get("topology") == "cap+line(cylinder)" else
+            ends = [s if s.topology == "cap+line(cylinder)" else
                     _wall_line_at(s, st) for s in (s1, s2)]
             criterion, sign, solve_at = "curvature_excess", -1.0, wall_line_at
         else:
@@ -595,7 +592,7 @@ def _locate_switches(builder: _Builder, st):
         if any(e is None for e in ends):
             continue
         e1, e2 = sorted(ends, key=lambda e: e.delta)
-        f1, f2 = (sign * (min(e[criterion], 1.0) if criterion == "wall_gap" else e[criterion]) for e in (e1, e2))
+        f1, f2 = (sign * (min(getattr(e, criterion), 1.0) if criterion == "wall_gap" else getattr(e, criterion)) for e in (e1, e2))
         if not f1 * f2 < 0:
             continue
         best = _regula_falsi(e1.delta, f1, e1, e2.delta, f2, e2, solve_at)
@@ -636,7 +633,7 @@ def locate_corner_switch(smooth, corner, st, h=0.003):
 
     def root(states, key):
         x = np.array([s.delta for s in states])
-        yv = np.array([s[key] for s in states])
+        yv = np.array([getattr(s, key) for s in states])
         c = np.polyfit(x, yv, min(2, len(x) - 1))
         r = np.roots(c)
         r = r[np.isreal(r)].real
@@ -644,7 +641,7 @@ def locate_corner_switch(smooth, corner, st, h=0.003):
 
     def value_at(states, key, d):
         x = np.array([s.delta for s in states])
-        return float(np.polyval(np.polyfit(x, [s[key] for s in states], min(2, len(x) - 1)), d))
+        return float(np.polyval(np.polyfit(x, [getattr(s, key) for s in states], min(2, len(x) - 1)), d))
 
     d_smooth = root(lo, "edge_legendre") if len(lo) >= 2 else math.nan
     d_corner = root(hi, "edge_jump_ls") if len(hi) >= 2 else math.nan
@@ -667,14 +664,14 @@ def locate_corner_switch(smooth, corner, st, h=0.003):
 def _wall_line_at(sol, st):
     """The cap+line(cylinder) state at a band point's delta (from the band), or None."""
     line = wall_state(sol, "cap+line(cylinder)", tol=st["tol"], max_nodes=st["max_nodes"], bc_tol=st["bc_tol"])
-    return line if line.success and "curvature_excess" in line else None
+    return line if line.success and not math.isnan(line.curvature_excess) else None
 
 
 def _touchdown_bracket(states, delta):
     """The two line states, not deeper than ``delta``, between which a line's lifted pole comes
     down onto the tip (its clearance crosses zero), or None."""
     lines = sorted((_with_pole_clearance(s) for s in states
-                    if s.get("topology") == "line" and s.get("success") and s.delta <= delta),
+                    if s.topology == "line" and s.success and s.delta <= delta),
                    key=lambda s: s.delta)
     for a, b in reversed(list(zip(lines[:-1], lines[1:]))):
         if a.pole_clearance > 0 > b.pole_clearance:
@@ -689,7 +686,7 @@ def _with_pole_clearance(line):
     touches tangentially, so near zero it is noise at the tabulated tip's accuracy."""
     from .liftoff import pole_clearance
 
-    if line is not None and "pole_clearance" not in line:
+    if line is not None and math.isnan(line.pole_clearance):
         line.pole_clearance = pole_clearance(line)
     return line
 
@@ -699,19 +696,19 @@ def _line_state_at(sol, st):
     cap), or None."""
     from .liftoff import liftoff_state
 
-    line = sol.get("line_state")
-    if line is not None and line.success and "curvature_excess" in line and line.delta == sol.delta:
+    line = sol.line_state
+    if line is not None and line.success and not math.isnan(line.curvature_excess) and line.delta == sol.delta:
         return line
     cap = _cap_of(sol)
     if cap is None:
         return None
     line = liftoff_state(cap, "line", tol=st["tol"], max_nodes=st["max_nodes"], bc_tol=st["bc_tol"])
-    return line if line.success and "curvature_excess" in line else None
+    return line if line.success and not math.isnan(line.curvature_excess) else None
 
 
 def _add_switch(builder, st, switches, best, frm, to, k1, k2, criterion):
     switches.append({"delta": float(best.delta), "force": float(best.force), "from": frm, "to": to,
-                     "criterion": criterion, "value": float(best[criterion])})
+                     "criterion": criterion, "value": float(getattr(best, criterion))})
     log.info("topology switch %s -> %s at delta = %.6g", frm, to, best.delta)
     already = any(abs(r[3].delta - best.delta) <= 1e-12 * (1 + best.delta) for r in builder.rows)
     if st["mode"] == "adaptive" and not already:  # a curve at requested depths keeps exactly those
@@ -772,12 +769,12 @@ SECANT_MAX_LN_SC = 1.0
 def _solve_at_delta(scene, delta, prev, prev2, settings, prev3=None):
     """Delta-controlled solve warm-started from prev: with the quadratic predictor through
     prev, prev2 and prev3 where it applies, else the secant through prev and prev2."""
-    if prev.get("topology") == "point":
+    if prev.topology == "point":
         return _step_from_point(scene, delta, prev, settings)
     sysm = system_like(prev, "delta", delta, settings["eps"])
     guess = None
     a = secant_ratio(delta, prev, prev2)
-    if a is not None and prev2.get("topology") != "point" and edge_model(prev2) == edge_model(prev) \
+    if a is not None and prev2.topology != "point" and edge_model(prev2) == edge_model(prev) \
             and abs(a * (prev.p[0] - prev2.p[0])) <= SECANT_MAX_LN_SC:
         guess = _quadratic(sysm, (prev, prev2, prev3), delta) or _secant(sysm, prev, prev2, a)
     if guess is None:
@@ -821,7 +818,7 @@ def _quadratic(sysm, states, at):
     ``SECANT_MAX_RATIO`` times the one before, or ln Sc moved by more than ``SECANT_MAX_LN_SC``
     (the secant's guards)."""
     s1, s2, s3 = states
-    if not QUADRATIC_PREDICTOR or s3 is None or s3.get("topology") == "point" \
+    if not QUADRATIC_PREDICTOR or s3 is None or s3.topology == "point" \
             or not _configuration(s3) == _configuration(s2) == _configuration(s1):
         return None
     u1, u2, u3 = s1.delta, s2.delta, s3.delta
@@ -882,7 +879,7 @@ def _natural(scene, deltas, builder: _Builder, settings, first=None, key0=0):
         rule = _stop_rule(prev, settings)
         if rule:
             raise _Stop(rule)
-        if prev.get("topology") == "cap" and prev.Sc * prev.y[0, -1] / scene.rho > scene.tip_omega_max:
+        if prev.topology == "cap" and prev.Sc * prev.y[0, -1] / scene.rho > scene.tip_omega_max:
             _wall_leg(scene, builder, settings, prev, i, deltas=[d for d in deltas if d > prev.delta],
                       reason="the contact reached the end of the tip (the indenter's cylinder)")
     builder.out.complete = True
@@ -917,9 +914,9 @@ def _wall_leg(scene, builder, st, last_cap, key, *, reason, deltas=None):
     if prev is None:
         outcomes = []
         prev, past_end = best_wall_state(last_cap, tried=tried, outcomes=outcomes, **kw), last_cap
-        if prev is None and last_cap.get("topology") == "cap" and _room_may_help(outcomes):
+        if prev is None and last_cap.topology == "cap" and _room_may_help(outcomes):
             prev, past_end = _wall_state_deeper(scene, last_cap, st, kw, tried)
-        if prev is None and scene.contact == "paper" and last_cap.get("topology") == "cap":
+        if prev is None and scene.contact == "paper" and last_cap.topology == "cap":
             prev = _pinned_state(scene, last_cap, last_cap.delta, st, tried)
         if prev is None:  # not a physical end: a configuration that is missing or not found
             raise _Stop(f"{reason}; no valid contact with the cylinder ({'; '.join(tried)})")
@@ -1073,7 +1070,7 @@ def _adaptive(scene, builder: _Builder, settings):
     factor = 0.6
     while d > st["delta_min"] and steps < st["max_steps"]:
         nd = max(st["delta_min"], d * factor)
-        if prev.get("topology") == "point":
+        if prev.topology == "point":
             sol = solve_point_load(scene, nd, tol=st["tol"], max_nodes=st["max_nodes"], guess=prev)
         else:
             sol = _solve_at_delta(scene, nd, prev, prev2, st)
@@ -1092,7 +1089,7 @@ def _adaptive(scene, builder: _Builder, settings):
                 log.info("small-delta leg stopped at delta = %.4g: %s", d, sol.message)
                 break
     # Leg 2: pseudo-arclength upwards from the first point.
-    if first.get("topology") == "point":
+    if first.topology == "point":
         # the cap is below double precision there: no (delta, lambda0, F) branch to follow
         # until it comes back; natural continuation in delta instead (point-load limit or cap)
         grid = np.linspace(first.delta, st["delta_max"], 11)
@@ -1100,7 +1097,7 @@ def _adaptive(scene, builder: _Builder, settings):
         raise _Stop(f"delta_max = {st['delta_max']:g} reached")
     scale = np.array([1.0, 1.0, 1.0])
     cur = first
-    if below is not None and below.get("topology") != first.get("topology"):
+    if below is not None and below.topology != first.topology:
         below = None  # the small-delta leg went on in the point-load limit: no secant from a cap to it
     if below is None:  # need a second point for the tangent
         below = _solve_at_delta(scene, first.delta * 0.9, first, None, st)
@@ -1191,7 +1188,7 @@ def _adaptive(scene, builder: _Builder, settings):
             ds /= 2
             if ds < ds_min:
                 reason = sol.message if not sol.success else "the branch turned back to delta <= 0"
-                leg = cur.get("edge_legendre", float("nan"))
+                leg = cur.edge_legendre
                 if leg < 0.05 and edge_model(cur) == "smooth":
                     reason = (f"the energy loses convexity at the contact edge (Legendre determinant at Sc+ "
                               f"down to {leg:.2g} of its mid-region value): the free region's equations "

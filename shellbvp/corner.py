@@ -34,7 +34,7 @@ LEGENDRE_WATCH = 0.1
 def edge_model(sol) -> str:
     """The contact-edge model of a cap state's system ("smooth", "corner", "paper", or "pinned":
     the paper's edge held at the tip's end)."""
-    sysm = sol.get("system")
+    sysm = sol.system
     if sysm is None:
         return sol.scene.contact
     models = {j.model for j in sysm.junctions if isinstance(j, Edge)}
@@ -46,7 +46,7 @@ def limit_estimate(a, b):
     ``a`` and ``b``; None if it is not decreasing towards it."""
     if a is None or b is None or edge_model(a) != "smooth" or edge_model(b) != "smooth":
         return None
-    la, lb = a.get("edge_legendre", math.nan), b.get("edge_legendre", math.nan)
+    la, lb = a.edge_legendre, b.edge_legendre
     if not (math.isfinite(la) and math.isfinite(lb)) or a.delta == b.delta:
         return None
     slope = (lb - la) / (b.delta - a.delta)
@@ -57,14 +57,14 @@ def limit_estimate(a, b):
 
 def is_corner(sol, tol) -> bool:
     """A converged cap whose edge jumps (beyond solver noise) with a convex free region."""
-    return bool(sol.success and edge_model(sol) == "corner" and abs(sol.get("edge_jump_ls", 0.0)) > 10 * tol
-                and sol.get("legendre_min", -1.0) > 0)
+    return bool(sol.success and edge_model(sol) == "corner" and abs(sol.edge_jump_ls) > 10 * tol
+                and sol.legendre_min > 0)
 
 
 def near_limit(sol) -> bool:
     """A smooth-edge cap state of the smooth model close to its convexity limit."""
-    return bool(sol.get("topology") == "cap" and sol.scene.contact == "smooth" and edge_model(sol) == "smooth"
-                and sol.get("edge_legendre", math.inf) < LEGENDRE_WATCH)
+    return bool(sol.topology == "cap" and sol.scene.contact == "smooth" and edge_model(sol) == "smooth"
+                and sol.edge_legendre < LEGENDRE_WATCH)
 
 
 def _edge_conditions(sol):

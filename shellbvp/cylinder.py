@@ -37,7 +37,7 @@ from .chain import (
     cylinder_chain,
 )
 from .diagnosis import diagnose
-from .solution import Solution, attach_tip_table, passed_tip_end, richardson_error, warm_mesh
+from .solution import Solution, attach_tip_table, failure, passed_tip_end, richardson_error, warm_mesh
 
 __all__ = ["WALL_TOPOLOGIES", "make_wall_system", "wall_contact_suspected", "solve_chain_from", "wall_state",
            "best_wall_state", "transfer_guess"]
@@ -75,11 +75,11 @@ def make_wall_system(scene, topology, control, value, eps):
 def wall_contact_suspected(cap: Solution) -> bool:
     """A converged cap that passed the tip's end, or whose free shell passes through the
     indenter with its contact edge near the tip's end."""
-    if cap.get("topology") != "cap" or cap.get("system") is None or cap.scene.model().OMEGA_MAX is None:
+    if cap.topology != "cap" or cap.system is None or cap.scene.model().OMEGA_MAX is None:
         return False
     passed = passed_tip_end(cap)
     omega_max = cap.scene.tip_omega_max
-    near = bool(cap.get("success") and cap.get("penetration", -1.0) > 0
+    near = bool(cap.success and cap.penetration > 0
                 and omega_max - cap.tip_end_margin > NEAR_TIP_END * omega_max)  # the edge's omega
     return passed or near
 
@@ -106,7 +106,7 @@ def _fields_at(sol, S):
         for key, v in prof.items():
             out[key][inside] = v
         if reg.kind != "free":
-            out["z"][inside] = out["z"][inside] + sol["z_tip"]
+            out["z"][inside] = out["z"][inside] + sol.z_tip
         out["set"] |= inside
     return out
 
@@ -142,7 +142,7 @@ def transfer_guess(sysm: ChainBVP, source: Solution, n: int = 101, **unknowns):
         omega = f["omega"]
         if reg.kind == "cylinder":
             omega = np.where(np.isfinite(omega) & (omega >= sysm.model.OMEGA_MAX), omega,
-                             _wall_omega(sysm, f["z"], source["z_tip"]))
+                             _wall_omega(sysm, f["z"], source.z_tip))
             omega = np.maximum.accumulate(omega)
         elif not np.all(np.isfinite(omega)):
             # where the source is free (a lifted pole coming down): the tip's point at its radius,
@@ -162,16 +162,16 @@ def _touch_point(cap):
     t = np.linspace(0.0, 1.0, 801)
     S = sysm.S(1, t, cap.p)
     f = sysm.model.free_profile(S, cap.sol(t)[sysm.rows(1)], sysm.par)
-    above = f["z"] > cap["z_tip"] + cap.scene.rho  # above the tip's end (sphere: B(omega_max) = 1)
+    above = f["z"] > cap.z_tip + cap.scene.rho  # above the tip's end (sphere: B(omega_max) = 1)
     gap = np.where(above, f["r"] - cap.scene.rho * sysm.tip_A[-1], np.inf)
     i = int(np.argmin(gap))
-    return float(S[i]), float(_wall_omega(sysm, f["z"][i:i + 1], cap["z_tip"])[0])
+    return float(S[i]), float(_wall_omega(sysm, f["z"][i:i + 1], cap.z_tip)[0])
 
 
 def _guesses(sysm, start):
     """Guesses for ``sysm`` from ``start`` (a cap, or a wall state of this or a neighbouring
     configuration), best first."""
-    topo, src = sysm.topology, start.get("topology")
+    topo, src = sysm.topology, start.topology
     if src == topo:
         x = warm_mesh(start)
         q = dict(zip(start.system.unknowns, start.p), lambda0=start.lambda0, delta=start.delta)
@@ -248,12 +248,8 @@ def wall_state(start: Solution, topology: str, *, control=None, value=None, tol=
         if res.success:
             break
     if res is None:
-        nan = float("nan")
-        res = Solution(status=5, success=False, valid=False, flags=[], topology=topology, delta=nan, force=nan,
-                       lambda0=nan, Sc=nan, energy=nan, scene=sysm.scene,
-                       pressure=nan if sysm.scene.sealed else sysm.scene.pressure,
-                       message=f"no guess for {topology} from a "
-                       f"{start.get('topology')} state")
+        res = failure(5, f"no guess for {topology} from a {start.topology} state", scene=sysm.scene,
+                      control=None, value=None, topology=topology)
     elif res.success and estimate_error:
         richardson_error(sysm, res, tol, bc_tol)
     res.wall_time = time.perf_counter() - t0
@@ -278,7 +274,7 @@ def best_wall_state(start: Solution, *, control=None, value=None, tol=1e-6, max_
     """
     tried = [] if tried is None else tried
     outcomes = [] if outcomes is None else outcomes
-    order = list(WALL_TOPOLOGIES) if start.get("topology") == "cap" else _neighbours(start.topology)
+    order = list(WALL_TOPOLOGIES) if start.topology == "cap" else _neighbours(start.topology)
     if start.scene.contact == "paper":
         order = [t for t in order if t == "cap+cylinder"]
     valid = []

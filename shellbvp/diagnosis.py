@@ -15,10 +15,10 @@ import math
 import numpy as np
 
 from .chain import FREE_STATES, ContactPole, Edge, FreePole, Line, PointPole, TipEnd
-from .solution import Solution, penetration, set_status, wall_gap
+from .solution import STATE_NUMBERS, Solution, penetration, set_status, wall_gap
 from .thickness import shear_delta
 
-__all__ = ["diagnose", "STATE_NUMBERS", "as_failure"]
+__all__ = ["diagnose", "as_failure"]
 
 _LS, _LT = FREE_STATES.index("ls"), FREE_STATES.index("lt")
 
@@ -120,8 +120,9 @@ def _edge_jumps(sysm, ends):
     return free["lambda_s"] - on["lambda_s"], free["kappa_s"] - on["kappa_s"]
 
 
-def diagnose(sysm, bvp, tol, converged_note: str = "") -> Solution:
-    """The Solution of a solve_bvp run of ``sysm`` (a ChainBVP) with the model's checks.
+def diagnose(sysm, bvp, tol, converged_note: str = "", result: type = Solution) -> Solution:
+    """The Solution of a solve_bvp run of ``sysm`` (a ChainBVP) with the model's checks
+    (``result``: Solution or a subclass with a configuration's own fields).
 
     Status 4 (inadmissible) for edges out of order, non-positive stretches, delta < 0, a
     tip contact past the tip's end or a cylinder contact below it; ``valid`` also needs
@@ -139,7 +140,7 @@ def diagnose(sysm, bvp, tol, converged_note: str = "") -> Solution:
                else ya[sysm.rows(0)][_LS] if isinstance(first, FreePole) else nan)
     edges = _edges(sysm)
     S_edges = [sysm.S_point(pt, p) for pt, _, _ in edges] or [0.0]
-    res = Solution(
+    res = result(
         topology=sysm.topology, status=int(bvp.status), message=bvp.message, x=bvp.x, y=bvp.y,
         p=p if p is not None else np.empty(0), sol=bvp.sol,
         rms_residuals=bvp.rms_residuals, tol=tol, niter=int(bvp.niter), nodes=int(bvp.x.size),
@@ -169,10 +170,10 @@ def diagnose(sysm, bvp, tol, converged_note: str = "") -> Solution:
             flags.append(f"collapsed state with delta = {delta:.3g} < 0")
     set_status(res, bvp, flags, converged_note)
     if not finite:
-        res.update(energy=nan, shear_delta=nan, pressure_min=nan, penetration=nan, force_defect=nan, edge_legendre=nan,
-                   legendre_min=nan, legendre_min_S=nan, edge_jump_ls=nan, edge_jump_ks=nan,
-                   contact_edge=_edge_model(sysm),
-                   ring_force=nan, ring_force_inner=nan, cap_force=nan, edge_forces=[], valid=False, flags=flags)
+        res.set(energy=nan, shear_delta=nan, pressure_min=nan, penetration=nan, force_defect=nan, edge_legendre=nan,
+                legendre_min=nan, legendre_min_S=nan, edge_jump_ls=nan, edge_jump_ks=nan,
+                contact_edge=_edge_model(sysm),
+                ring_force=nan, ring_force_inner=nan, cap_force=nan, edge_forces=[], valid=False, flags=flags)
         return _without_iterate_numbers(res)
 
     t = _nodes_and_midpoints(bvp.x)  # from 0 to 1: the regions' ends
@@ -267,30 +268,21 @@ def diagnose(sysm, bvp, tol, converged_note: str = "") -> Solution:
     return _without_iterate_numbers(res)
 
 
-#: The numbers of a state; a run that did not converge reports them as NaN, all but the
-#: prescribed one (its ``y``, ``x`` and ``p`` stay: the last iterate, for inspection).
-STATE_NUMBERS = ("delta", "force", "lambda0", "Sc", "S1", "S_end", "energy", "shear_delta", "ring_force", "ring_force_inner",
-                 "cap_force", "pressure_min", "penetration", "wall_gap", "force_defect", "edge_legendre",
-                 "curvature_excess", "tip_end_margin", "legendre_min", "legendre_min_S", "edge_jump_ls",
-                 "edge_jump_ks")
-
-
 def _without_iterate_numbers(res):
     if res.status in (0, 4):  # converged (admissible or not)
         return res
-    prescribed = res.get("control")  # the prescribed delta, lambda0 or force is known all the same
+    prescribed = res.control  # the prescribed delta, lambda0 or force is known all the same
     for key in STATE_NUMBERS:
-        if key in res and key != prescribed:
-            res[key] = float("nan")
-    if prescribed in STATE_NUMBERS and res.get("system") is not None:
-        res[prescribed] = float(res.system.value)  # as given (the iterate's force is not it)
-    for key in ("edge_forces", "edge_S"):  # per-edge lists: as many NaN as edges
-        if key in res:
-            res[key] = [float("nan")] * len(res[key])
-    if res.get("system") is not None and res.system.volume_control:  # the pressure was an unknown
+        if key != prescribed:
+            setattr(res, key, float("nan"))
+    if prescribed in STATE_NUMBERS and res.system is not None:
+        setattr(res, prescribed, float(res.system.value))  # as given (the iterate's force is not it)
+    res.edge_forces = [float("nan")] * len(res.edge_forces)  # per-edge lists: as many NaN as edges
+    res.edge_S = [float("nan")] * len(res.edge_S)
+    if res.system is not None and res.system.volume_control:  # the pressure was an unknown
         res.pressure = float("nan")
-    if "z_tip" in res:  # the tip's height follows from delta: known only where delta is prescribed
-        res.z_tip = res.z_tip if prescribed == "delta" else float("nan")
+    # the tip's height follows from delta: known only where delta is prescribed
+    res.z_tip = res.z_tip if prescribed == "delta" else float("nan")
     res.valid = False
     return res
 
@@ -302,6 +294,5 @@ def as_failure(res, status, message):
     if status in (0, 4):
         raise ValueError(f"status must be that of a failure (1, 2, 3 or 5); got {status}")
     res.status, res.message, res.success = status, message, False
-    for key in ("force_error", "delta_error"):
-        res[key] = float("nan")
+    res.force_error = res.delta_error = float("nan")
     return _without_iterate_numbers(res)

@@ -378,7 +378,7 @@ def _check_model_start(scene, delta, tol):
     from .state import solve
 
     sol = solve(scene, delta=delta, tol=tol, estimate_error=False, topology="cap")
-    if not (sol.success and sol.get("topology") == "cap"):
+    if not (sol.success and sol.topology == "cap"):
         why = (sol.message if not sol.success else "the contact there is the point-load limit (the contact cap "
                "is exponentially small), from which the model curve cannot start")
         raise ValueError(f"the model curve cannot start at its shallowest depth delta = {delta:.3g} "

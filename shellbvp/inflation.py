@@ -22,14 +22,15 @@ from __future__ import annotations
 
 import functools
 import math
+from dataclasses import dataclass
 
 import numpy as np
 
 from .chain import Chain, ChainBVP, FreePole, Point, Region, Rim
 from .diagnosis import diagnose
-from .solution import attach_tip_table
+from .solution import Solution, attach_tip_table
 
-__all__ = ["inflate", "inflated_chain", "inflated_pole_rise", "start_shape"]
+__all__ = ["inflate", "InflatedState", "inflated_chain", "inflated_pole_rise", "start_shape"]
 
 #: Pole start of the inflated state, ``zeta = EPS * L`` (the free pole's truncation error
 #: is O(zeta^2): 1e-8 relative, below the inflation's tolerance).
@@ -37,6 +38,17 @@ EPS = 1e-4
 #: Tolerance of the inflated state: it fixes the origin of delta for every point of a curve.
 TOL = 1e-8
 _MAX_NODES = 50000
+
+
+@dataclass(eq=False, repr=False, slots=True)
+class InflatedState(Solution):
+    """The shell under its pressure before the indenter touches it: a :class:`Solution`
+    of topology ``"inflated"`` with the numbers that fix where a curve starts."""
+
+    pole_rise: float = math.nan
+    pole_stretch: float = math.nan
+    volume_change: float = math.nan
+    rim_hoop_tension: float = math.nan
 
 
 def inflated_chain(L: float) -> Chain:
@@ -66,7 +78,7 @@ def _system(scene, pressure):
 def _solve(sysm, x, y, tol, max_nodes):
     with np.errstate(all="ignore"):
         bvp = sysm.solve(x, y, None, tol=tol, bc_tol=1e-10, max_nodes=max_nodes)
-        return diagnose(sysm, bvp, tol)
+        return diagnose(sysm, bvp, tol, result=InflatedState)
 
 
 @functools.lru_cache(maxsize=64)
@@ -85,7 +97,7 @@ def inflate(scene, tol: float = TOL, max_nodes: int = _MAX_NODES):
 
     Returns
     -------
-    Solution
+    InflatedState
         Topology ``"inflated"``; ``pole_rise`` (the pole's height above ``Z(0)``),
         ``pole_stretch``, ``volume_change`` (``V - V_ref``, V the volume between the shell
         and its rim's plane), ``rim_hoop_tension`` and the usual fields (``force`` is 0 to
@@ -130,7 +142,7 @@ def _finish(res, sysm, failed=False):
     res.topology = "inflated"
     nan = float("nan")
     if failed or not res.success:
-        res.update(pole_rise=nan, pole_stretch=nan, volume_change=nan, rim_hoop_tension=nan)
+        res.set(pole_rise=nan, pole_stretch=nan, volume_change=nan, rim_hoop_tension=nan)
         return res
     zeta = sysm.S_point(sysm.regions[0].start, None)
     lt, phiS, ls, ks, rQ, z = res.y[:, 0]

@@ -183,11 +183,11 @@ def energy_residual(delta, energy, force):
 
 
 def point_record(sol) -> dict:
-    """One point of a curve from a Solution: every POINT_FIELDS value (cap defaults where absent)."""
-    row = {k: sol.get(k, _MISSING_FIELD_DEFAULTS.get(k, np.nan)) for k in POINT_FIELDS}
+    """One point of a curve from a Solution: every POINT_FIELDS value."""
+    row = {k: getattr(sol, k) for k in POINT_FIELDS}
     if row["topology"] == "point":
         row["S1"] = 0.0
-    row["valid"] = bool(sol.get("valid", False))
+    row["valid"] = bool(sol.valid)
     return row
 
 
@@ -251,7 +251,7 @@ def write_curve_group(g, curve, *, profiles=False, units=None):
     if profiles:
         pg = g.create_group("profiles")
         for i, sol in enumerate(curve.solutions):
-            if sol is None or not sol.get("success", False):
+            if sol is None or not sol.success:
                 continue
             sg = pg.create_group(f"point_{i:05d}")
             for k, v in sol.profile().items():
@@ -269,7 +269,7 @@ def _write_inflated(ig, scene):
                               ("pole_stretch", "1", "stretch at the inflated pole"),
                               ("volume_change", "1 (R_L^3)", "V - V_ref, V between the shell and its rim's plane"),
                               ("rim_hoop_tension", "1 (mu H)", "tau_theta at the rim")):
-        d = ig.create_dataset(name, data=float(state[name]))
+        d = ig.create_dataset(name, data=float(getattr(state, name)))
         d.attrs["units"], d.attrs["long_name"] = units, what
 
 

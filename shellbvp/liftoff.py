@@ -68,7 +68,7 @@ def _cap_as_free(cap, S):
     csys = cap.system
     pc = csys.model.contact_profile(S, _cap_states_at(cap, S), csys.par)
     return np.vstack([pc["lambda_theta"], pc["phi"] / S, pc["lambda_s"], pc["kappa_s"],
-                      pc["r"] * pc["Q"], pc["z"] + cap["z_tip"]])
+                      pc["r"] * pc["Q"], pc["z"] + cap.z_tip])
 
 
 def _cap_free_at(cap, S):
@@ -162,8 +162,8 @@ def lift_off_suspected(cap: Solution) -> bool:
     """The cap state asks the indenter to pull: negative pressure or normal ring force (at a
     corner edge the axial ring force also carries the tangential force [tau_s] = -kappa [M_s],
     so its sign is not the test)."""
-    normal = cap.get("edge_forces") or [cap.ring_force]
-    return bool(cap.success and cap.get("topology") == "cap"
+    normal = cap.edge_forces or [cap.ring_force]
+    return bool(cap.success and cap.topology == "cap"
                 and (cap.pressure_min < 0 or min(normal) < 0))
 
 
@@ -178,7 +178,7 @@ _WARM_FIRST = True  # False: the cap's guesses first, as before issue 14 (benchm
 
 
 def _near(state, cap, topology):
-    return (state is not None and state.get("topology") == topology and state.get("success")
+    return (state is not None and state.topology == topology and state.success
             and abs(state.delta - cap.delta) <= WARM_REACH * max(state.delta, cap.delta))
 
 
@@ -219,7 +219,7 @@ def liftoff_state(cap: Solution, topology: str, *, tol=1e-6, max_nodes=10000, bc
         if tries[-1].success and not _closed_at_pole(tries[-1]):
             break
     else:
-        if previous is not None and previous.get("topology") == topology and not warm:
+        if previous is not None and previous.topology == topology and not warm:
             tries.append(attempt(sysm, liftoff_warm_guess(sysm, previous), **kw))
     good = [r for r in tries if r.success and not _closed_at_pole(r)]
     closed = [r for r in tries if _closed_at_pole(r)]
@@ -235,7 +235,7 @@ def _closed_at_pole(res):
     """The annulus's inner edge has run to the pole: S1/S2 below ANNULUS_CLOSED_AT_POLE, read
     from the unknowns (ln S1, ln S2) -- of the converged state, or of the last iterate of a run
     that did not converge (Newton walking ln S1 down is how such a run fails)."""
-    if res.get("topology") != "annulus" or res.get("p") is None or len(res.p) < 2:
+    if res.topology != "annulus" or res.p is None or len(res.p) < 2:
         return False
     ratio = math.exp(min(0.0, float(res.p[0]) - float(res.p[1])))
     return bool(math.isfinite(res.p[0]) and math.isfinite(res.p[1]) and ratio < ANNULUS_CLOSED_AT_POLE)
@@ -280,7 +280,7 @@ def valid_liftoff_state(cap: Solution, *, tol=1e-6, max_nodes=10000, bc_tol=1e-1
             return res, tried
         tried.append("point load: " + (res.message if not res.success else "; ".join(res.flags)))
     order = ("line", "annulus")
-    if previous is not None and previous.get("topology") in order:
+    if previous is not None and previous.topology in order:
         order = (previous.topology,) + tuple(t for t in order if t != previous.topology)
     line_too_curved = False
     line = None
@@ -309,7 +309,7 @@ def valid_liftoff_state(cap: Solution, *, tol=1e-6, max_nodes=10000, bc_tol=1e-1
                             before=before)
         if res.success and res.valid:
             return res, tried
-        line_too_curved |= topology == "line" and res.get("curvature_excess", -1.0) > 0
+        line_too_curved |= topology == "line" and res.curvature_excess > 0
         line = res if topology == "line" else line
         why = res.message if not res.success else "; ".join(res.flags)
         tried.append(f"{topology}: {why}")
@@ -330,7 +330,7 @@ _SPLIT_FIRST = True
 def _with_line(split, line):
     """``split`` with ``line_state``: the (invalid) line converged at its depth, where the switch
     line -> cap+line(tip) is located from (``continuation._line_state_at``), not solved again."""
-    if line is not None and line.get("success"):
+    if line is not None and line.success:
         split.line_state = line
     return split
 
@@ -341,7 +341,7 @@ def _pole_down(line, tol) -> bool:
     annulus lifts the pole as the line does, so it is probed after the split: base at delta
     0.1125 (the line also too curved) spent 34 ms of a 0.5 s curve on two annulus probes that
     ran onto the pole, before the split converged at once."""
-    return bool(line is not None and line.get("success") and pole_clearance(line) <= 10 * tol)
+    return bool(line is not None and line.success and pole_clearance(line) <= 10 * tol)
 
 
 def _split_possible(last, line, tol):
@@ -354,11 +354,11 @@ def _split_possible(last, line, tol):
     not converge.  Without this, base at delta 0.1125 (after the line at 0.1; the line too
     curved here, the cap still pulling at its edge) spent 1.7 s of a 4.7 s curve on split
     guesses that find no state.  Without ``last`` (a single solve) it is always probed."""
-    if last is None or not (last.get("valid") and last.get("topology") in ("line", "annulus")):
+    if last is None or not (last.valid and last.topology in ("line", "annulus")):
         return True
-    if line is None or not line.get("success"):
+    if line is None or not line.success:
         return True
-    return bool(not line.get("penetration", math.inf) <= 10 * tol or pole_clearance(line) <= 10 * tol)
+    return bool(not line.penetration <= 10 * tol or pole_clearance(line) <= 10 * tol)
 
 
 def pole_clearance(state) -> float:
@@ -367,7 +367,7 @@ def pole_clearance(state) -> float:
     contact splits into a cap and the line (base at delta 0.1125: -1e-8; Gent 0.03 at 0.119:
     -3e-8)."""
     prof = state.profile()
-    return float(state["z_tip"] - prof["z"][0])
+    return float(state.z_tip - prof["z"][0])
 
 
 #: (Sc'/S_p, S1/Sc) of second-zone guesses from a cap pressed at the pole and pulling further out
@@ -412,10 +412,10 @@ def second_zone_state(cap: Solution, *, tol=1e-6, max_nodes=10000, bc_tol=1e-10,
             res.wall_time = time.perf_counter() - t0
             return res
     guesses = []
-    if previous is not None and previous.get("topology") == sysm.topology:
+    if previous is not None and previous.topology == sysm.topology:
         q = dict(zip(previous.system.unknowns, previous.p))
         guesses.append(transfer_guess(sysm, previous, ln_Sc=q["ln_Sc"], ln_S1=q["ln_S1"], chi1=q["chi1"]))
-    if line is not None and line.get("success") and line.get("topology") == "line":
+    if line is not None and line.success and line.topology == "line":
         # a lifted pole coming down inside the line (base at delta 0.1125: the guesses from
         # the cap below leave the model's domain; from the line, 0.7 S1, it converges at once)
         q = dict(zip(line.system.unknowns, line.p))
@@ -454,7 +454,7 @@ def _continue_in_delta(sysm, previous, before, delta, *, tol, max_nodes, bc_tol)
     state at ``delta``, or None."""
     # a tighter tol than the state's needs (previous.tol / tol)^(1/3) times its nodes
     # (a split solved at 1e-6 with ~220 nodes asks ~2200 at 1e-9)
-    finer = max(1.0, previous.get("tol", tol) / tol) ** (1.0 / RESIDUAL_ORDER)
+    finer = max(1.0, (previous.tol if math.isfinite(previous.tol) else tol) / tol) ** (1.0 / RESIDUAL_ORDER)
     budget = int(min(max_nodes, max(_CONTINUATION_NODES, WARM_NODES * previous.nodes * finer)))
     step = delta - previous.delta
     for _ in range(_CONTINUATION_STEPS):
@@ -480,8 +480,8 @@ def split_state_from(guess: Solution, control: str, value: float, *, tol=1e-6, m
     at another ``control`` value: under delta by natural continuation from it
     (:func:`_continue_in_delta`: halved steps, valid states only; None where none is found),
     under force or lambda0 by one solve from it (diagnosed, valid or not)."""
-    if guess.get("topology") not in SPLIT_TOPOLOGIES:
-        raise ValueError(f"guess must be a {' or '.join(SPLIT_TOPOLOGIES)} state; got {guess.get('topology')!r}")
+    if guess.topology not in SPLIT_TOPOLOGIES:
+        raise ValueError(f"guess must be a {' or '.join(SPLIT_TOPOLOGIES)} state; got {guess.topology!r}")
     sysm = ChainBVP(guess.scene, guess.system.chain, control, value)
     attach_tip_table(sysm)
     if control == "delta":
@@ -518,7 +518,7 @@ def replace_invalid_cap(cap: Solution, *, tol=1e-6, max_nodes=10000, bc_tol=1e-1
     if alt is None:
         cap.flags = list(cap.flags) + ["no valid lift-off state found (" + "; ".join(tried) + ")"]
         return cap
-    alt.cap_state = {k: cap[k] for k in ("delta", "force", "energy", "pressure_min", "Sc")}
+    alt.cap_state = cap.summary()
     alt.cap_solution = cap
     return alt
 
@@ -540,8 +540,8 @@ def pole_legendre(state) -> float:
 
     The lifted cap is nearly uniform, so its own median falls with it: the outer region is
     the scale that stays (rho 0.05: about 0.04 there while the pole's falls to 0)."""
-    sysm = state.get("system")
-    if sysm is None or not state.get("success") or not isinstance(sysm.junctions[0], FreePole):
+    sysm = state.system
+    if sysm is None or not state.success or not isinstance(sysm.junctions[0], FreePole):
         return math.nan
     last = len(sysm.regions) - 1
     pole = sysm.model.free_legendre(sysm.S(0, np.array([0.0]), state.p), state.sol(np.array([0.0]))[sysm.rows(0)],
@@ -579,8 +579,8 @@ def lifted_pole_branch_end(previous: Solution, before: Solution, *, tol=1e-6, ma
     it by ``_END_MIN_GAIN``, ends the search (beta 0.2: it levels off near 0.01 at delta 0.33
     and rises again towards a fold of the branch, :func:`lifted_pole_fold`).
     """
-    if previous is None or before is None or previous.get("topology") != before.get("topology") \
-            or previous.get("topology") not in ("line", "annulus") or not previous.delta > before.delta:
+    if previous is None or before is None or previous.topology != before.topology \
+            or previous.topology not in ("line", "annulus") or not previous.delta > before.delta:
         return None
     g_prev, g = pole_legendre(before), pole_legendre(previous)
     if not (math.isfinite(g_prev) and math.isfinite(g) and 0 < g < g_prev):
@@ -716,9 +716,9 @@ def lifted_pole_fold(previous: Solution, before: Solution, *, delta_limit=math.i
     ends without a fold where a state is not valid, where delta passes ``delta_limit``, or after
     ``_FOLD_STEPS`` solves.
     """
-    if previous is None or before is None or previous.get("topology") != before.get("topology") \
-            or previous.get("topology") not in ("line", "annulus") or not previous.delta > before.delta \
-            or not (previous.get("valid") and before.get("valid")) \
+    if previous is None or before is None or previous.topology != before.topology \
+            or previous.topology not in ("line", "annulus") or not previous.delta > before.delta \
+            or not (previous.valid and before.valid) \
             or not (math.isfinite(previous.lambda0) and previous.lambda0 != before.lambda0):
         return None, []
     scene, topology = previous.scene, previous.topology

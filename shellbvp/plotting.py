@@ -80,7 +80,7 @@ def plot_profiles(scene, deltas, ax=None, solutions=None):
     sols = solutions or []
     if not sols:
         for d in sorted(deltas):
-            sol = solve(scene, delta=d, guess=sol if sol is not None and sol.get("topology") == "cap" else None,
+            sol = solve(scene, delta=d, guess=sol if sol is not None and sol.topology == "cap" else None,
                         estimate_error=False)
             sols.append(sol)
     om = np.linspace(0, scene.tip_omega_max, 100)

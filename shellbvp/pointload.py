@@ -32,7 +32,7 @@ POINT_S0 = 1e-12
 
 def _point_guess(sysm, prev):
     """Free states for the point-load problem from a cap or point solution."""
-    if prev.get("topology") == "point":
+    if prev.topology == "point":
         # every third node, not solution.warm_mesh: the march towards a larger depth fails
         # often (the state passes through the tip), and a failed step refines from the whole
         # mesh (base, a cap from a point-load guess: 28 s against 4.5 s)

@@ -9,12 +9,15 @@ solve_bvp call, error estimates and the checks against the indenter.
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
 from . import collocation
 
-__all__ = ["STATUS_MESSAGES", "Solution", "solve_bvp", "set_status", "thin_mesh", "warm_mesh", "secant_ratio",
+__all__ = ["STATUS_MESSAGES", "STATE_NUMBERS", "Solution", "failure", "solve_bvp", "set_status", "thin_mesh",
+           "warm_mesh", "secant_ratio",
            "richardson_error", "penetration", "wall_gap", "attach_tip_table", "default_eps"]
 
 
@@ -29,6 +32,9 @@ STATUS_MESSAGES = {
     4: "converged to an inadmissible state (see message): start from a neighbouring solution",
     5: "no initial guess converged (crude guesses and continuation from small delta)",
 }
+
+
+_NAN = float("nan")
 
 
 class _NonFinite(Exception):
@@ -130,8 +136,14 @@ def solve_bvp(fun, bc, x, y, p=None, *, fun_jac, bc_jac, max_jacobians=None, ker
 
 
 
-class Solution(dict):
-    """Result of :func:`solve` (a dict with attribute access, like OptimizeResult).
+@dataclass(eq=False, repr=False, slots=True)
+class Solution:
+    """Result of :func:`solve`: every state of every configuration, with fixed fields.
+
+    A field that a configuration does not have keeps its default (NaN for a number); a
+    name that is not a field cannot be set (``AttributeError``).  Built by the one
+    diagnosis of a solve_bvp run (:func:`shellbvp.diagnosis.diagnose`) or, for a search
+    that produced no state, by :func:`failure`.
 
     Attributes
     ----------
@@ -148,8 +160,15 @@ class Solution(dict):
         The contact configuration (``"cap"``, ``"point"``, ``"line"``, ``"annulus"``,
         ``"cap+line(tip)"``, ``"cap+line(cylinder)"``, ``"cap+band(cylinder)"``,
         ``"cap+cylinder"``; ``shellbvp.chain``).
+    control : str
+        What was prescribed: ``"delta"``, ``"force"`` or ``"lambda0"``.
+    scene, system
+        The :class:`~shellbvp.scene.Scene` and the solved ``ChainBVP`` (None for a failure
+        without a system).
     S1 : float
         Where the contact starts (0 when it reaches the pole; a lifted pole's first edge).
+    edge_S : list of float
+        Every contact edge's S, pole to rim.
     x, y, p, sol, rms_residuals, niter
         solve_bvp's mesh on t in [0, 1], stacked states (8, m) (layout in
         ``shellbvp.chain``), unknown parameters, interpolant, residuals, iterations.
@@ -158,35 +177,66 @@ class Solution(dict):
     nodes : int
     max_residual : float
         Largest relative collocation residual.
+    z_tip : float
+        The indenter tip's height.
     energy : float
         ``E = 2 pi Int U R Psi dS`` (F = dE/ddelta for the smooth model).
+    shear_delta : float
+        The transverse-shear depth correction (``shellbvp.thickness``).
     ring_force, cap_force : float
         Axial force of the ring at Sc (jump of Q) and of the pressure on the cap;
         ``force = ring_force + cap_force``.  For ``contact="paper"`` the ring force is ~0.
+    ring_force_inner : float
+        The ring force at the first edge of a configuration with two (else 0).
+    edge_forces : list of float
+        Normal ring force of every edge.
     pressure : float
         The pressure below the shell (``p R_L/(mu H)``): the scene's, or under volume control
         (``Scene.sealed``) the one that holds the enclosed volume.
     pressure_min : float
-        Minimum contact pressure over the cap (< 0: the shell would pull the indenter).
+        Minimum contact pressure over the contact regions (< 0: the shell would pull the indenter).
     edge_legendre : float
         det d(tau_s, M_s)/d(lambda_s, kappa_s) at Sc+ relative to mid-region; it goes to 0
         where the energy loses convexity at the contact edge and the branch ends.
+    legendre_min, legendre_min_S : float
+        The smallest such determinant over the free shell, and where.
+    contact_edge : str
+        The edge conditions in force at Sc (``shellbvp.corner``).
+    edge_jump_ls, edge_jump_ks : float
+        The jumps of lambda_s and kappa_s across the contact edge.
     penetration : float
         Largest height of the free shell above the indenter's surface (> 0: it passes
         through the indenter).
+    wall_gap : float
+        Smallest distance of the free shell above the tip's end from the indenter's
+        cylinder (< 0: through it).
+    tip_end_margin : float
+        How far the last contact on the tip is from the tip's end, in the tip's angle
+        (< 0: past it).
+    S_end : float
+        Where a contact that ends at the tip's end ends.
+    curvature_excess : float
+        A line contact's kappa_s beyond the indenter's (> 0: the shell would cut into it).
+    pole_clearance : float
+        A lifted pole's height above the tip (set by the touch-down search).
     valid : bool
         pressure_min >= 0, ring_force >= 0, no penetration, contact on the tip.
     flags : list of str
         Why the state is not valid (empty when valid).
     force_defect : float
-        ``max |F(S) - F|`` over the free region (F is a first integral there).
+        ``max abs(F(S) - F)`` over the free region (F is a first integral there).
     past_tip_end : bool
         Set on a state of status 4 whose contact has passed the end of the tip (onto the
         indenter's cylinder): :func:`passed_tip_end`.
     force_error, delta_error : float
-        Richardson error estimates (halved mesh; NaN if not estimated).
+        Error estimates (NaN if not estimated); ``error_method`` says how
+        (``"richardson"``: halved mesh, ``"calibrated"``, or ``""``).
     wall_time : float
         Seconds.
+    cap_solution, cap_state, line_state, candidates
+        What a search that replaced a state attached: the cap state it replaced and a
+        summary of it, the line state tried beside it, the energies of the wall
+        configurations that were compared (None where there was no such search).
 
     Notes
     -----
@@ -208,18 +258,82 @@ class Solution(dict):
     True
     """
 
-    def __getattr__(self, name):
-        try:
-            return self[name]
-        except KeyError:
-            raise AttributeError(name) from None
-
-    __setattr__ = dict.__setitem__
+    # how the run went
+    status: int = 5
+    message: str = ""
+    success: bool = False
+    topology: str = "cap"
+    control: str = "delta"
+    scene: Any = None
+    system: Any = None
+    # solve_bvp's run
+    x: np.ndarray = field(default_factory=lambda: np.empty(0))
+    y: np.ndarray = field(default_factory=lambda: np.empty((8, 0)))
+    p: np.ndarray = field(default_factory=lambda: np.empty(0))
+    sol: Any = None
+    rms_residuals: np.ndarray = field(default_factory=lambda: np.empty(0))
+    tol: float = _NAN
+    niter: int = 0
+    nodes: int = 0
+    max_residual: float = _NAN
+    wall_time: float = _NAN
+    # the state
+    delta: float = _NAN
+    force: float = _NAN
+    lambda0: float = _NAN
+    Sc: float = _NAN
+    S1: float = 0.0
+    edge_S: list = field(default_factory=list)
+    z_tip: float = _NAN
+    pressure: float = _NAN
+    energy: float = _NAN
+    shear_delta: float = 0.0
+    ring_force: float = _NAN
+    ring_force_inner: float = 0.0
+    cap_force: float = _NAN
+    edge_forces: list = field(default_factory=list)
+    # checks
+    pressure_min: float = _NAN
+    penetration: float = _NAN
+    wall_gap: float = _NAN
+    tip_end_margin: float = _NAN
+    S_end: float = _NAN
+    force_defect: float = _NAN
+    edge_legendre: float = _NAN
+    legendre_min: float = _NAN
+    legendre_min_S: float = _NAN
+    contact_edge: str = ""
+    edge_jump_ls: float = _NAN
+    edge_jump_ks: float = _NAN
+    curvature_excess: float = _NAN
+    pole_clearance: float = _NAN
+    valid: bool = False
+    flags: list = field(default_factory=list)
+    past_tip_end: bool = False
+    # error estimates
+    force_error: float = _NAN
+    delta_error: float = _NAN
+    error_method: str = ""
+    # what a search that replaced this state attached
+    cap_solution: Any = None
+    cap_state: Any = None
+    line_state: Any = None
+    candidates: Any = None
 
     def __repr__(self):
         keys = ("success", "status", "delta", "force", "lambda0", "Sc", "nodes", "valid")
-        inner = ", ".join(f"{k}={self.get(k)!r}" for k in keys)
-        return f"Solution({inner})"
+        inner = ", ".join(f"{k}={getattr(self, k)!r}" for k in keys)
+        return f"{type(self).__name__}({inner})"
+
+    def summary(self) -> dict:
+        """The numbers that a replaced state leaves behind (``cap_state``)."""
+        return {k: getattr(self, k) for k in ("delta", "force", "energy", "pressure_min", "Sc")}
+
+    def set(self, **fields):
+        """Set several fields at once (names are checked: only declared fields)."""
+        for name, value in fields.items():
+            setattr(self, name, value)
+        return self
 
     # -- fields over S ------------------------------------------------------------------
     def profile(self, points_per_interval: int = 1):
@@ -249,12 +363,12 @@ class Solution(dict):
         >>> bool(abs(prof["lambda_theta"][-1] - 1) < 1e-8)    # the rim is held: r(L) = R(L)
         True
         """
-        sysm = self["system"]
+        sysm = self.system
         t = self.x
         if points_per_interval > 1:
             t = np.unique(np.concatenate([np.linspace(a, b, points_per_interval + 1)
                                           for a, b in zip(t[:-1], t[1:])]))
-        return sysm.profile(t, self.sol(t), self.p, self["z_tip"])
+        return sysm.profile(t, self.sol(t), self.p, self.z_tip)
 
 
 
@@ -302,10 +416,10 @@ def warm_mesh(sol, tol=None):
     one (every third node, :func:`thin_mesh`, the fallback when ``sol`` has no residuals)
     is refined in a second pass: about 1.6x the Newton iterations of a curve.
     """
-    r = np.asarray(sol.get("rms_residuals", ()), float)
-    tol = sol.get("tol") if tol is None else tol
-    x = np.asarray(sol["x"], float)
-    if not _EQUIDISTRIBUTE or tol is None or r.size != x.size - 1 or r.size == 0 or not np.all(np.isfinite(r)):
+    r = np.asarray(sol.rms_residuals, float)
+    tol = sol.tol if tol is None else tol
+    x = np.asarray(sol.x, float)
+    if not _EQUIDISTRIBUTE or not math.isfinite(tol) or r.size != x.size - 1 or r.size == 0 or not np.all(np.isfinite(r)):
         return thin_mesh(x)
     h = np.diff(x)
     target = WARM_MESH_SAFETY * tol
@@ -316,11 +430,35 @@ def warm_mesh(sol, tol=None):
 
 
 
+#: The numbers of a state; a run that did not converge reports them as NaN, all but the
+#: prescribed one (its ``y``, ``x`` and ``p`` stay: the last iterate, for inspection).
+STATE_NUMBERS = ("delta", "force", "lambda0", "Sc", "S1", "S_end", "energy", "shear_delta", "ring_force", "ring_force_inner",
+                 "cap_force", "pressure_min", "penetration", "wall_gap", "force_defect", "edge_legendre",
+                 "curvature_excess", "tip_end_margin", "legendre_min", "legendre_min_S", "edge_jump_ls",
+                 "edge_jump_ks")
+
+
+def failure(status, message, *, scene, control, value, topology="cap", **fields) -> Solution:
+    """A result without any state (status 1, 2, 3 or 5): every number NaN but the
+    prescribed ``control`` = ``value`` and the scene's pressure, unless that is an unknown
+    (volume control).  ``fields``: what the run that failed can still tell (``nodes``,
+    ``wall_time``, ...)."""
+    if status in (0, 4):
+        raise ValueError(f"status must be that of a failure (1, 2, 3 or 5); got {status}")
+    res = Solution(status=status, message=message, success=False, valid=False, topology=topology, control=control,
+                   scene=scene, pressure=_NAN if scene.sealed else scene.pressure, **fields)
+    for key in STATE_NUMBERS:  # those whose default is a number (S1 = 0 ...)
+        setattr(res, key, _NAN)
+    if control is not None:
+        setattr(res, control, float(value))
+    return res
+
+
 def passed_tip_end(sol) -> bool:
     """Whether a state is inadmissible (status 4) because its contact has passed the end of the
     tip onto the indenter's cylinder (diagnosis sets ``past_tip_end``): where a curve goes on
     on the cylinder."""
-    return sol.get("status") == 4 and bool(sol.get("past_tip_end", False))
+    return sol.status == 4 and bool(sol.past_tip_end)
 
 
 def set_status(res, bvp, flags, converged_note=""):

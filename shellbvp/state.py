@@ -25,6 +25,7 @@ from .solution import (
     Solution,
     attach_tip_table,
     default_eps,
+    failure,
     passed_tip_end,
     richardson_error,
     warm_mesh,
@@ -90,7 +91,7 @@ def make_system(scene, control, value, eps, edge=None):
 def system_like(prev, control, value, eps):
     """The cap system of ``prev``'s scene with ``prev``'s contact edge (smooth or corner):
     ``prev``'s own system with the new value where it is that system, else a new one."""
-    edge, sysm = edge_model(prev), prev.get("system")
+    edge, sysm = edge_model(prev), prev.system
     if (isinstance(sysm, ChainBVP) and sysm.control == control and not sysm.volume_control
             and sysm.scene is prev.scene and hasattr(sysm, "tip_A")
             and sysm.chain == cap_chain(eps, prev.scene.shell_length, edge)):
@@ -116,7 +117,7 @@ def cross_convexity_limit(prev, prev2, delta, *, eps, tol, max_nodes, bc_tol, ex
     # state further from the limit is often the better start)
     ladder = sorted({max(delta, prev.delta + k * gap, prev.delta + 0.005) for k in (3, 6, 12)}
                     | {max(delta, prev.delta + 0.02), max(delta, prev.delta + 0.04)})
-    starts = [s for s in (prev, prev2) if s is not None and s.get("success") and edge_model(s) == "smooth"]
+    starts = [s for s in (prev, prev2) if s is not None and s.success and edge_model(s) == "smooth"]
     sol = None
     # seeds: the edge's other root scaled to d_far; else a jump of CORNER_SEED_JUMP in lambda_s
     # (either sign) along the null direction of the edge conditions (gamma = 0 with the numpy
@@ -149,7 +150,7 @@ def cross_convexity_limit(prev, prev2, delta, *, eps, tol, max_nodes, bc_tol, ex
             step /= 2
             if step < 1e-4 * (1 + delta):
                 return None
-    return sol if sol.success and sol.get("legendre_min", -1.0) > 0 else None
+    return sol if sol.success and sol.legendre_min > 0 else None
 
 
 #: Size of the jump of lambda_s put at the edge of a corner guess along the null direction of
@@ -366,7 +367,7 @@ def solve(scene, *, delta=None, lambda0=None, force=None, tol=1e-6, max_nodes=10
     if topology in ("line", "annulus") and scene.contact != "smooth":
         raise ValueError(f"topology={topology!r} needs contact='smooth' (the variational contact line); "
                          f"the paper's model has the single cap only")
-    if guess is not None and guess.get("topology") in ("line", "annulus"):
+    if guess is not None and guess.topology in ("line", "annulus"):
         from .liftoff import solve_liftoff
 
         res = solve_liftoff(scene, guess.topology, delta=delta, force=force, lambda0=lambda0, guess=guess,
@@ -375,7 +376,7 @@ def solve(scene, *, delta=None, lambda0=None, force=None, tol=1e-6, max_nodes=10
             return res
         guess = None  # back to the cap
 
-    if guess is not None and guess.get("topology") in SPLIT_TOPOLOGIES:  # a cap and a second zone on the tip
+    if guess is not None and guess.topology in SPLIT_TOPOLOGIES:  # a cap and a second zone on the tip
         from .liftoff import split_state_from
 
         t0 = time.perf_counter()
@@ -384,7 +385,7 @@ def solve(scene, *, delta=None, lambda0=None, force=None, tol=1e-6, max_nodes=10
             return _finished(res, t0, estimate_error, tol, bc_tol)
         guess = None  # back to the cap
 
-    if guess is not None and guess.get("topology") in _WALL:
+    if guess is not None and guess.topology in _WALL:
         from .cylinder import best_wall_state, wall_state
 
         t0 = time.perf_counter()
@@ -396,7 +397,7 @@ def solve(scene, *, delta=None, lambda0=None, force=None, tol=1e-6, max_nodes=10
         guess = None  # back to the cap
 
     near_point = None
-    if guess is not None and guess.get("topology") == "point":
+    if guess is not None and guess.topology == "point":
         # a point-load state has no cap to start from: cold start, with the point-load limit
         # (tried where the crude caps fail) warm-started from it
         near_point, guess = guess, None
@@ -413,9 +414,9 @@ def solve(scene, *, delta=None, lambda0=None, force=None, tol=1e-6, max_nodes=10
         res = _cold_delta(make_system(scene, control, value, eps), value, near_point=near_point, **kw)
     else:
         res = _cold_other(scene, make_system(scene, control, value, eps), control, value, eps, **kw)
-    if (topology == "auto" or topology in _WALL) and res.get("topology") == "cap":
+    if (topology == "auto" or topology in _WALL) and res.topology == "cap":
         res = _onto_wall(res, topology, kw)
-    if topology in ("auto", "line", "annulus") and scene.contact == "smooth" and res.get("topology") == "cap" \
+    if topology in ("auto", "line", "annulus") and scene.contact == "smooth" and res.topology == "cap" \
             and res.success:
         res = _other_topology(res, topology, kw)
     if res.success and estimate_error:
@@ -432,7 +433,7 @@ def _onto_wall(cap, topology, kw):
     (``shellbvp.cylinder``); else the cap, with what was tried in its flags."""
     from .cylinder import best_wall_state, wall_contact_suspected, wall_state
 
-    if cap.get("system") is None or cap.scene.model().OMEGA_MAX is None:
+    if cap.system is None or cap.scene.model().OMEGA_MAX is None:
         return cap
     if not (cap.success or passed_tip_end(cap)):
         return cap
@@ -497,7 +498,7 @@ def _cold_delta(sysm, delta, near_point=None, **kw):
             return res
     res = _continue_in_delta(sysm.scene, sysm.eps, delta, **_loose(kw))
     if res is not None and res.success:
-        if res.get("topology") == "point":
+        if res.topology == "point":
             return solve_point_load(sysm.scene, delta, tol=kw["tol"], max_nodes=kw["max_nodes"], guess=res)
         return _tighten(res.system, res, **kw)
     return as_failure(best, 5, STATUS_MESSAGES[5] + f" (first attempt: {best.message})")
@@ -591,7 +592,7 @@ def _continue_in_delta(scene, eps, target, starts=(0.1, 0.05), **kw):
     before = None
     while d != target:
         nd = min(target, d * (1 + frac)) if up else max(target, d * (1 - frac))
-        if res.get("topology") == "point":
+        if res.topology == "point":
             nxt = solve_point_load(scene, nd, tol=kw["tol"], max_nodes=kw["max_nodes"], guess=res)
         else:
             sysm = system_like(res, "delta", nd, eps)
@@ -614,15 +615,8 @@ def _continue_in_delta(scene, eps, target, starts=(0.1, 0.05), **kw):
 
 
 def _failure(status, message, control, value, scene):
-    """A result without any state: NaN but the prescribed ``control`` = ``value`` (and the
-    scene's pressure, unless it is an unknown: volume control)."""
-    nan = float("nan")
-    res = Solution(status=status, message=message, success=False, valid=False, flags=[],
-                   delta=nan, force=nan, lambda0=nan, Sc=nan, nodes=0, niter=0, wall_time=nan,
-                   pressure=nan if scene.sealed else scene.pressure, scene=scene,
-                   x=np.empty(0), y=np.empty((8, 0)), p=np.full(2, nan), topology="cap", control=control)
-    res[control] = float(value)
-    return res
+    """A result without any state (``solution.failure``) of a cap search."""
+    return failure(status, message, scene=scene, control=control, value=value, p=np.full(2, float("nan")))
 
 
 _MARCH_DELTA_MAX = 1.0  # pole displacement of a rim radius: beyond any indentation test
@@ -644,23 +638,23 @@ def _cold_other(scene, sysm, control, value, eps, **kw):
     prev = None
     attempts = 0
     def bracketed():  # a point-load state's lambda0 is NaN: it brackets nothing
-        return prev is not None and (prev[key] - value) * (cur[key] - value) <= 0
+        return prev is not None and (getattr(prev, key) - value) * (getattr(cur, key) - value) <= 0
 
     while not bracketed():
         attempts += 1
         if attempts > _MARCH_MAX_SOLVES:
             return fail(f"{control} = {value:g} was not bracketed within {_MARCH_MAX_SOLVES} "
-                        f"continuation steps (delta reached {d:.3g}, {key} there {cur[key]:.4g})")
+                        f"continuation steps (delta reached {d:.3g}, {key} there {getattr(cur, key):.4g})")
         nd = d + step
         if nd > _MARCH_DELTA_MAX:
             return fail(f"{control} = {value:g} was not reached on the branch for delta up to "
-                        f"{d:.3g} ({key} there: {cur[key]:.4g})")
+                        f"{d:.3g} ({key} there: {getattr(cur, key):.4g})")
         # a point-load state has no cap to warm-start from: a cold solve finds the cap or the limit again
-        if cur.get("topology") == "point":
+        if cur.topology == "point":
             nxt = _cold_delta(make_system(scene, "delta", nd, eps), nd, near_point=cur, **lk)
             if not nxt.success:  # a cold solve does not start from cur: smaller steps do not help it
                 return fail(f"{control} = {value:g} not reached: the states up to delta = {d:.3g} are point-load "
-                            f"limits ({key} there: {cur[key]:.4g}) and no state was found at delta = {nd:.3g} "
+                            f"limits ({key} there: {getattr(cur, key):.4g}) and no state was found at delta = {nd:.3g} "
                             f"({nxt.message})")
         else:
             dsys = system_like(cur, "delta", nd, eps)
@@ -678,6 +672,6 @@ def _cold_other(scene, sysm, control, value, eps, **kw):
             if step < 1e-3:
                 return fail(f"continuation in delta towards {control} = {value:g} stalled at "
                             f"delta = {d:.3g}")
-    start = min((prev, cur), key=lambda s: abs(s[key] - value))
+    start = min((prev, cur), key=lambda s: abs(getattr(s, key) - value))
     sysm = system_like(start, control, value, eps)
     return solve_from(sysm, warm_guess(sysm, start), **kw)

@@ -152,7 +152,7 @@ def test_states_equal_those_before_the_assembler(ref):
     if not ref["success"]:
         return  # e.g. an annulus closing onto the pole: a degenerate state, its numbers are not reproducible
     for key in ("force", "delta", "lambda0", "Sc", "energy"):
-        assert s[key] == pytest.approx(ref[key], rel=1e-10, abs=1e-14, nan_ok=True), key
+        assert getattr(s, key) == pytest.approx(ref[key], rel=1e-10, abs=1e-14, nan_ok=True), key
     if ref["result_topology"] in ("line", "annulus"):  # (the file holds Sc for a cap: it had no S1)
         assert s.S1 == pytest.approx(ref["S1"], rel=1e-10, abs=1e-14)
 
@@ -190,7 +190,7 @@ def test_a_run_that_does_not_converge_reports_nan_numbers_not_its_last_iterate()
     assert not bad.success and bad.status not in (0, 4) and bad.message
     assert bad.delta == 0.6  # prescribed: known
     for key in ("force", "lambda0", "Sc", "energy", "ring_force", "pressure_min"):
-        assert np.isnan(bad[key]), key
+        assert np.isnan(getattr(bad, key)), key
     assert not bad.valid and bad.y.shape[0] == sysm.n  # the last iterate stays for inspection
 
 
@@ -222,3 +222,22 @@ def test_diagnosis_median_is_numpys():
         a = np.abs(rng.standard_normal(n)) * 10.0 ** rng.uniform(-8, 8, n)
         assert _median(a) == float(np.median(a))
     assert math.isnan(_median(np.array([1.0, np.nan, 2.0]))) and math.isnan(_median(np.empty(0)))
+
+
+def test_a_solution_has_fixed_fields_and_one_way_to_fail():
+    """Every field is declared: a misspelt name is refused, not stored beside the real one;
+    a search without any state is built by ``failure`` with every state number NaN but the
+    prescribed one."""
+    from shellbvp.solution import STATE_NUMBERS, failure
+
+    sol = sb.solve(sb.Scene.preset("base"), delta=0.2, estimate_error=False)
+    with pytest.raises(AttributeError):
+        sol.forse = 1.0
+    assert math.isnan(sol.force_error) and sol.error_method == ""  # declared, not estimated
+    scene = sb.Scene.preset("base", sealed=True)
+    fail = failure(5, "no guess converged", scene=scene, control="force", value=0.3)
+    assert fail.force == 0.3 and not fail.success and not fail.valid and fail.message
+    assert all(math.isnan(getattr(fail, k)) for k in STATE_NUMBERS if k != "force")
+    assert math.isnan(fail.pressure)  # an unknown under volume control
+    with pytest.raises(ValueError, match="status must be that of a failure"):
+        failure(0, "", scene=scene, control="delta", value=0.1)

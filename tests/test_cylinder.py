@@ -6,6 +6,7 @@ cap passes through the indenter's side from delta ~1.14 and reaches the tip's en
 delta ~1.32 (issue 12).
 """
 
+import dataclasses
 import math
 
 import numpy as np
@@ -147,7 +148,7 @@ def test_force_is_the_derivative_of_the_energy_on_the_cylinder_branch(state):
 
 @pytest.mark.parametrize("control", ["force", "lambda0"])
 def test_other_controls_reach_the_same_cylinder_state(state, control):
-    value = state[control]
+    value = getattr(state, control)
     s = wall_state(state, "cap+cylinder", control=control, value=value, tol=1e-8)
     assert s.success and s.topology == "cap+cylinder"
     assert s.delta == pytest.approx(state.delta, abs=1e-7)
@@ -327,7 +328,7 @@ def test_the_paper_cap_held_at_the_tip_end_takes_over_where_the_free_edge_reache
     assert free[0.91].success and free[0.92].status == 4
     assert free[0.91].tip_end_margin > 0 > free[0.92].tip_end_margin
     assert passed_tip_end(free[0.92]) and not passed_tip_end(free[0.91])  # the diagnosis' flag
-    told = sb.Solution(dict(free[0.92], past_tip_end=False))
+    told = dataclasses.replace(free[0.92], past_tip_end=False)
     assert not passed_tip_end(told)  # the flag decides, not the message's words
     held = {}
     for d in (0.91, 0.92):

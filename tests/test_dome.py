@@ -10,6 +10,7 @@ delta 0.01 and 2e-13 at 0.05, and pulls), so its states are the point-load limit
 (docs/limits.md).
 """
 
+import dataclasses
 import math
 import numbers
 import re
@@ -150,7 +151,7 @@ _RUN = {"status", "niter", "nodes", "max_residual", "wall_time", "x", "y", "p", 
 def _numbers(sol):
     """{name: value} of every number a Solution carries (scalars; lists of numbers)."""
     out = {}
-    for key, v in sol.items():
+    for key, v in ((f.name, getattr(sol, f.name)) for f in dataclasses.fields(sol)):
         if isinstance(v, (bool, np.bool_)) or key in _RUN:
             continue
         if isinstance(v, (numbers.Number, np.number)):

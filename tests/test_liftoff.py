@@ -566,7 +566,7 @@ def test_the_free_pole_conditions_are_well_scaled_and_the_line_is_continued_with
 
     def counted(*args, **kw):
         r = orig(*args, **kw)
-        runs.append((r.status, r.get("delta")))
+        runs.append((r.status, r.delta))
         return r
 
     monkeypatch.setattr(shellbvp.liftoff, "solve_liftoff_from", counted)

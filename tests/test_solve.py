@@ -6,6 +6,7 @@ independent solver described in SPEC.md section 2b/3 where it gives them
 small delta for the paper model).
 """
 
+import dataclasses
 import math
 
 import numpy as np
@@ -120,7 +121,7 @@ def test_warm_mesh_holds_its_state_to_tol_in_one_pass(base):
     assert abs(sb.solve(base, delta=0.3, tol=1e-9, estimate_error=False).force - sol.force) < sol.tol
     ratio = (warm_mesh(sol, tol=sol.tol / 10).size - 1) / (x.size - 1)
     assert 1.9 < ratio < 2.5, ratio
-    bare = dict(sol, rms_residuals=np.full(sol.x.size - 1, np.nan))  # e.g. a failed run's
+    bare = dataclasses.replace(sol, rms_residuals=np.full(sol.x.size - 1, np.nan))  # e.g. a failed run's
     assert np.array_equal(warm_mesh(bare), thin_mesh(sol.x))
 
 

@@ -32,8 +32,8 @@ def test_without_transverse_shear_nothing_changes():
     scene = sb.Scene(rho=0.2, thickness=0.05)
     off = sb.solve(scene, delta=0.1)
     on = sb.solve(scene.replace(transverse_shear=True), delta=0.1)
-    assert off["shear_delta"] == 0.0 and on["shear_delta"] > 0
-    assert on["force"] == off["force"]       # the shell's state is the same; only its depth moves
+    assert off.shear_delta == 0.0 and on.shear_delta > 0
+    assert on.force == off.force       # the shell's state is the same; only its depth moves
 
 
 def test_shear_delta_of_a_flat_plate_is_the_closed_form():
@@ -43,9 +43,9 @@ def test_shear_delta_of_a_flat_plate_is_the_closed_form():
     sol = sb.solve(sb.Scene(gamma=0.0, rho=0.2, thickness=eps, transverse_shear=True), delta=0.002)
     assert sol.success
     p = sol.profile()
-    edge = 0.0 if sol["topology"] == "point" else float(np.interp(sol["Sc"], p["S"], p["r"]))
-    expected = sol["force"] * math.log(1.0 / (edge + eps / 2)) / (2 * math.pi * SHEAR_FACTOR)
-    assert sol["shear_delta"] == pytest.approx(expected, rel=0.01)
+    edge = 0.0 if sol.topology == "point" else float(np.interp(sol.Sc, p["S"], p["r"]))
+    expected = sol.force * math.log(1.0 / (edge + eps / 2)) / (2 * math.pi * SHEAR_FACTOR)
+    assert sol.shear_delta == pytest.approx(expected, rel=0.01)
 
 
 def test_force_at_interpolates_at_the_thick_shells_depth():

@@ -1,0 +1,142 @@
+"""A census of the package's structure, from its source (nothing of it is run).
+
+    python benchmarks/architecture.py [--markdown] [--root CHECKOUT]
+
+Counts what issue 43 names: comparisons with configuration names, modules and functions
+by length, ``.get`` on results, places that build a ``Solution``, function-level
+imports, module flags that tests patch.  The numbers are what the redesign is judged by;
+``--markdown`` prints them as the table of benchmarks/results/architecture.md.  A ``.get`` is
+counted where its key is a result's field name; ``--verbose`` shows its receiver, which may
+be a dict of another kind.
+"""
+
+from __future__ import annotations
+
+import argparse
+import ast
+import pathlib
+import re
+import sys
+
+ROOT = pathlib.Path(__file__).resolve().parents[1]
+
+MODULE_LINES = 600
+FUNCTION_LINES = 80
+#: Module-level names that a result carries (a ``.get`` of one of them reads a result)
+RESULT_KEYS = {
+    "success", "status", "message", "topology", "delta", "force", "lambda0", "Sc", "S1", "x", "y", "p", "sol",
+    "rms_residuals", "tol", "niter", "nodes", "max_residual", "energy", "ring_force", "ring_force_inner",
+    "cap_force", "edge_forces", "edge_S", "pressure", "pressure_min", "edge_legendre", "legendre_min",
+    "legendre_min_S", "penetration", "valid", "flags", "force_defect", "past_tip_end", "force_error",
+    "delta_error", "wall_time", "control", "scene", "system", "z_tip", "shear_delta", "S_end", "contact_edge",
+    "edge_jump_ls", "edge_jump_ks", "wall_gap", "lifted", "estimate",
+}
+
+
+def configuration_names(root):
+    text = (root / "shellbvp" / "chain.py").read_text()
+    match = re.search(r"CONFIGURATION_NAMES = \((.*?)\)\n", text, re.S)
+    return set(re.findall(r'"([^"]+)"', match.group(1)))
+
+
+def _strings(node):
+    if isinstance(node, ast.Constant) and isinstance(node.value, str):
+        return [node.value]
+    if isinstance(node, (ast.Tuple, ast.List, ast.Set)):
+        return [s for e in node.elts for s in _strings(e)]
+    return []
+
+
+def _module_level(tree):
+    """Statements outside every function (imports under ``if``/``try`` at the top included)."""
+    todo = list(tree.body)
+    while todo:
+        node = todo.pop()
+        if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.Lambda)):
+            continue
+        yield node
+        todo.extend(ast.iter_child_nodes(node))
+
+
+def census(root=ROOT):
+    names = configuration_names(root)
+    out = {"name_comparisons": {}, "long_modules": {}, "long_functions": [], "result_gets": {},
+           "solution_builds": {}, "function_imports": {}, "lines": 0}
+    for path in sorted((root / "shellbvp").glob("*.py")):
+        text = path.read_text()
+        tree = ast.parse(text)
+        nlines = text.count("\n")
+        out["lines"] += nlines
+        mod = path.stem
+        if nlines > MODULE_LINES:
+            out["long_modules"][mod] = nlines
+        for node in ast.walk(tree):
+            if isinstance(node, ast.Compare):
+                hits = [s for side in [node.left, *node.comparators] for s in _strings(side) if s in names]
+                if hits:
+                    out["name_comparisons"][mod] = out["name_comparisons"].get(mod, 0) + 1
+            elif isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
+                length = node.end_lineno - node.lineno + 1
+                if length > FUNCTION_LINES:
+                    out["long_functions"].append((f"{mod}.{node.name}", length))
+            elif isinstance(node, ast.Call):
+                f = node.func
+                if isinstance(f, ast.Attribute) and f.attr == "get" and node.args \
+                        and isinstance(node.args[0], ast.Constant) and node.args[0].value in RESULT_KEYS:
+                    receiver = ast.unparse(f.value)
+                    out["result_gets"][f"{mod}:{node.lineno} ({receiver})"] = 1
+                # the diagnosis builds a Solution or a subclass, passed as ``result``
+                if isinstance(f, ast.Name) and f.id in ("Solution", "result"):
+                    out["solution_builds"][mod] = out["solution_builds"].get(mod, 0) + 1
+        n_imports = sum(isinstance(n, (ast.Import, ast.ImportFrom)) for n in ast.walk(tree)) \
+            - sum(isinstance(n, (ast.Import, ast.ImportFrom)) for n in _module_level(tree))
+        if n_imports:
+            out["function_imports"][mod] = n_imports
+    patched = set()
+    for path in sorted((root / "tests").glob("*.py")) + sorted((root / "benchmarks").glob("*.py")):
+        for m in re.finditer(r"monkeypatch\.setattr\(\s*([\w.]+)\s*,\s*\"(_?[A-Z_]+)\"", path.read_text()):
+            patched.add(f"{m.group(1)}.{m.group(2)}")
+    out["patched_flags"] = sorted(patched)
+    return out
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--markdown", action="store_true")
+    ap.add_argument("--verbose", action="store_true", help="every .get with its line and receiver")
+    ap.add_argument("--root", type=pathlib.Path, default=ROOT, help="another checkout (default: this one)")
+    args = ap.parse_args(argv)
+    c = census(args.root)
+    total = lambda d: sum(d.values())  # noqa: E731
+    gets = {}
+    for where in c["result_gets"]:
+        mod = where.split(":")[0]
+        gets[mod] = gets.get(mod, 0) + 1
+    rows = [
+        ("comparisons with configuration names", total(c["name_comparisons"]), c["name_comparisons"]),
+        (f"modules over {MODULE_LINES} lines", len(c["long_modules"]), c["long_modules"]),
+        (f"functions over {FUNCTION_LINES} lines", len(c["long_functions"]),
+         dict(sorted(c["long_functions"], key=lambda t: -t[1]))),
+        ("`.get` of a result's field", total(c["result_gets"]), c["result_gets"] if args.verbose else gets),
+        ("places that build a Solution", total(c["solution_builds"]), c["solution_builds"]),
+        ("imports inside functions", total(c["function_imports"]), c["function_imports"]),
+        ("module flags patched by tests and benchmarks", len(c["patched_flags"]), c["patched_flags"]),
+        ("lines of shellbvp/*.py", c["lines"], ""),
+    ]
+    if args.markdown:
+        print("| measure | count | where |\n|---|---|---|")
+        for what, n, where in rows:
+            detail = ", ".join(f"{k} {v}" for k, v in where.items()) if isinstance(where, dict) else \
+                ", ".join(where) if isinstance(where, list) else where
+            print(f"| {what} | {n} | {detail} |")
+    else:
+        for what, n, where in rows:
+            print(f"{n:6d}  {what}")
+            if where:
+                print("        " + (", ".join(f"{k} {v}" for k, v in where.items()) if isinstance(where, dict)
+                                    else ", ".join(where)))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

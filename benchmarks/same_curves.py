@@ -1,0 +1,105 @@
+"""Whether a change of structure changed any number: every preset's curve (both contact
+models) computed by this checkout and by an older commit, point by point.
+
+    python benchmarks/same_curves.py --against a20bb93 [--only base] [--tol 1e-12]
+
+The older commit's package is extracted with ``git archive`` and imported in a process of
+its own (its derived code is generated there, in a cache of its own).  Every number of
+every point (``POINT_FIELDS`` but the wall time) is compared: identical, equal to ``--tol``
+relative (arithmetic in another order), or different.  Exit status 1 if any curve differs.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import subprocess
+import sys
+import tarfile
+import tempfile
+from pathlib import Path
+
+from checkout import ROOT
+
+#: Numbers of a point that are not the state's (time of the run)
+SKIPPED = {"wall_time"}
+
+CHILD = r"""
+import json, sys, math
+import numpy as np
+import shellbvp as sb
+from shellbvp.io import POINT_FIELDS
+out = {}
+for name in json.loads(sys.argv[1]):
+    for contact in ("smooth", "paper"):
+        c = sb.curve(sb.Scene.preset(name, contact=contact))
+        pts = {k: [v.item() if hasattr(v, "item") else v for v in np.asarray(c.points[k]).tolist()]
+               for k in POINT_FIELDS if k in c.points}
+        out[f"{name}/{contact}"] = dict(points=pts, stop=c.stop_reason, complete=bool(c.complete))
+json.dump(out, sys.stdout, allow_nan=True)
+"""
+
+
+def run_tree(tree: Path, presets, cache: Path) -> dict:
+    env = {"PYTHONPATH": str(tree), "SHELLBVP_CACHE_DIR": str(cache), "PATH": "/usr/bin:/bin",
+           "OMP_NUM_THREADS": "1"}
+    done = subprocess.run([sys.executable, "-c", CHILD, json.dumps(list(presets))], env=env, cwd=tree,
+                          capture_output=True, text=True, check=True)
+    return json.loads(done.stdout)
+
+
+def compare(a, b, tol):
+    """'identical', 'equal to tol' with the largest relative difference, or what differs."""
+    if a["stop"] != b["stop"] or set(a["points"]) != set(b["points"]):
+        return "different", math.inf, f"stop: {a['stop']!r} vs {b['stop']!r}"
+    worst, where = 0.0, ""
+    for k, va in a["points"].items():
+        if k in SKIPPED:
+            continue
+        vb = b["points"][k]
+        if len(va) != len(vb):
+            return "different", math.inf, f"{len(va)} vs {len(vb)} points"
+        for x, y in zip(va, vb):
+            if isinstance(x, str) or isinstance(y, str) or isinstance(x, bool):
+                if x != y:
+                    return "different", math.inf, f"{k}: {x!r} vs {y!r}"
+                continue
+            if (math.isnan(x) and math.isnan(y)) or x == y:
+                continue
+            rel = abs(x - y) / max(abs(x), abs(y), 1e-300)
+            if rel > worst:
+                worst, where = rel, k
+    if worst == 0.0:
+        return "identical", 0.0, ""
+    return ("equal to tol" if worst <= tol else "different"), worst, where
+
+
+def main(argv=None):
+    import shellbvp as sb
+
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--against", required=True, help="the older commit")
+    ap.add_argument("--only", nargs="*", default=None, help="presets (default: all)")
+    ap.add_argument("--tol", type=float, default=1e-12)
+    args = ap.parse_args(argv)
+    presets = args.only or list(sb.PRESETS)
+    with tempfile.TemporaryDirectory() as tmp:
+        old = Path(tmp) / "old"
+        old.mkdir()
+        archive = subprocess.run(["git", "-C", str(ROOT), "archive", args.against], capture_output=True, check=True)
+        with tarfile.open(fileobj=__import__("io").BytesIO(archive.stdout)) as tar:
+            tar.extractall(old, filter="data")
+        before = run_tree(old, presets, Path(tmp) / "cache-old")
+        after = run_tree(ROOT, presets, Path(tmp) / "cache-new")
+    bad = 0
+    for key in before:
+        verdict, worst, where = compare(before[key], after[key], args.tol)
+        bad += verdict == "different"
+        print(f"{key:28s} {verdict:14s} {worst:9.2g} {where}")
+    print(f"{len(before) - bad} of {len(before)} curves the same (identical or to {args.tol:g})")
+    return 1 if bad else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
