@@ -34,8 +34,12 @@ RESULT_KEYS = {
 
 
 def configuration_names(root):
-    text = (root / "shellbvp" / "chain.py").read_text()
-    match = re.search(r"CONFIGURATION_NAMES = \((.*?)\)\n", text, re.S)
+    """The registered names (``shellbvp/configurations.py``), or, in a checkout from before the
+    registry, the tuple ``chain.CONFIGURATION_NAMES``."""
+    registry = root / "shellbvp" / "configurations.py"
+    if registry.exists():
+        return set(re.findall(r'register\(Configuration\("([^"]+)"', registry.read_text()))
+    match = re.search(r"CONFIGURATION_NAMES = \((.*?)\)\n", (root / "shellbvp" / "chain.py").read_text(), re.S)
     return set(re.findall(r'"([^"]+)"', match.group(1)))
 
 

@@ -61,8 +61,7 @@ __all__ = ["Point", "Region", "ContactPole", "FreePole", "PointPole", "Edge", "T
            "cap_line_cylinder_chain", "cap_band_cylinder_chain", "cap_line_tip_chain", "cap_band_tip_chain",
            "line_kink_chain",
            "CONTROLS",
-           "SIZES", "FREE_STATES", "CONTACT_STATES", "CONTACT_KINDS", "REGION_CODES", "CONFIGURATION_NAMES",
-           "SPLIT_TOPOLOGIES"]
+           "SIZES", "FREE_STATES", "CONTACT_STATES", "CONTACT_KINDS", "REGION_CODES"]
 
 CONTROLS = ("delta", "lambda0", "force", "arclength")
 FREE_STATES = ("lt", "phiS", "ls", "ks", "rQ", "z")
@@ -208,13 +207,6 @@ class Chain:
 
 def _fields(j):
     return "(" + ", ".join(f"{k}={v!r}" for k, v in j.__dict__.items()) + ")"
-
-
-#: Every configuration's name (``Solution.topology``, a curve's per-point ``topology``).
-CONFIGURATION_NAMES = ("cap", "point", "line", "annulus", "cap+line(tip)", "cap+band(tip)", "cap+line(cylinder)",
-                       "cap+band(cylinder)", "cap+cylinder", "line+corner")
-#: A cap with a second contact zone on the tip beyond a lifted gap
-SPLIT_TOPOLOGIES = ("cap+line(tip)", "cap+band(tip)")
 
 
 def cap_chain(eps: float, L: float, model: str = "smooth") -> Chain:

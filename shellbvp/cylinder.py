@@ -29,23 +29,17 @@ import time
 
 import numpy as np
 
-from .chain import (
-    ChainBVP,
-    TipEnd,
-    cap_band_cylinder_chain,
-    cap_line_cylinder_chain,
-    cylinder_chain,
-)
+from .chain import ChainBVP, TipEnd
+from .configurations import configuration, names
 from .diagnosis import diagnose
-from .solution import Solution, attach_tip_table, failure, passed_tip_end, richardson_error, warm_mesh
+from .solution import Solution, failure, passed_tip_end, richardson_error, warm_mesh
 
 __all__ = ["WALL_TOPOLOGIES", "make_wall_system", "wall_contact_suspected", "solve_chain_from", "wall_state",
            "best_wall_state", "transfer_guess"]
 
-#: The configurations with contact on the cylinder, in the order they follow each other as
-#: the indenter goes deeper, and their chains.
-WALL_TOPOLOGIES = {"cap+line(cylinder)": cap_line_cylinder_chain, "cap+band(cylinder)": cap_band_cylinder_chain,
-                   "cap+cylinder": cylinder_chain}
+#: The configurations with contact on the cylinder (``shellbvp.configurations``, family
+#: "wall"), in the order they follow each other as the indenter goes deeper.
+WALL_TOPOLOGIES = names("wall")
 #: A cap whose contact edge has reached this fraction of the tip's end, and whose free shell
 #: passes through the indenter, is tried against the wall configurations.
 NEAR_TIP_END = 0.7
@@ -60,16 +54,10 @@ _CAP_SPLITS = ((0.97, 1.15), (0.9, 1.3), (0.99, 1.05))  # (S*/Sc, Sc'/Sc) of cap
 
 
 def make_wall_system(scene, topology, control, value, eps):
-    if scene.model().OMEGA_MAX is None:
-        raise ValueError("this tip has no end where it meets a cylinder (A' never vanishes): no wall contact")
+    """The system of a wall configuration (``WALL_TOPOLOGIES``)."""
     if topology not in WALL_TOPOLOGIES:
-        raise ValueError(f"topology must be one of {tuple(WALL_TOPOLOGIES)}; got {topology!r}")
-    if scene.contact == "paper" and topology != "cap+cylinder":
-        raise ValueError(f"topology={topology!r} needs contact='smooth': the paper's contact model has the single "
-                         "cap only, which may run onto the cylinder ('cap+cylinder')")
-    sysm = ChainBVP(scene, WALL_TOPOLOGIES[topology](eps, scene.shell_length, scene.contact), control, value)
-    attach_tip_table(sysm)
-    return sysm
+        raise ValueError(f"topology must be one of {WALL_TOPOLOGIES}; got {topology!r}")
+    return configuration(topology).system(scene, control, value, eps)
 
 
 def wall_contact_suspected(cap: Solution) -> bool:
@@ -257,11 +245,11 @@ def wall_state(start: Solution, topology: str, *, control=None, value=None, tol=
 
 
 def _neighbours(topology):
-    names = list(WALL_TOPOLOGIES)
-    if topology not in names:
-        return names
-    i = names.index(topology)
-    return [names[i]] + names[i + 1:i + 2] + names[max(i - 1, 0):i]
+    order = list(WALL_TOPOLOGIES)
+    if topology not in order:
+        return order
+    i = order.index(topology)
+    return [order[i]] + order[i + 1:i + 2] + order[max(i - 1, 0):i]
 
 
 def best_wall_state(start: Solution, *, control=None, value=None, tol=1e-6, max_nodes=10000, bc_tol=1e-10,

@@ -24,7 +24,7 @@ contact_edge and edge_jump_ls/ks, which read as NaN and "")::
     /curve/force            (n,) signal: indenter force / (mu H R_L)
     /curve/<field>          (n,) each of POINT_FIELDS, plus
                             energy_residual (dE/ddelta - F) and flags (strings);
-                            topology (strings: shellbvp.chain.CONFIGURATION_NAMES),
+                            topology (strings: shellbvp.configurations.CONFIGURATION_NAMES),
                             contact_edge (strings: smooth, corner, paper or pinned);
                             error_method (strings: how force_error/delta_error were
                             made: richardson, calibrated, or empty: not estimated);
@@ -46,7 +46,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .chain import CONFIGURATION_NAMES
+from .configurations import CONFIGURATION_NAMES
 from .nexus import new_file
 from .paths import open_hdf5
 from .schema import MAX_DATASET_BYTES

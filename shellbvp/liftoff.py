@@ -24,7 +24,8 @@ import time
 
 import numpy as np
 
-from .chain import SPLIT_TOPOLOGIES, ChainBVP, FreePole, annulus_chain, cap_line_tip_chain, line_chain
+from .chain import ChainBVP, FreePole
+from .configurations import configuration, family_of, names
 from .cylinder import solve_chain_from, transfer_guess
 from .pointload import solve_point_load
 from .solution import (
@@ -45,15 +46,15 @@ __all__ = ["solve_liftoff", "solve_liftoff_from", "make_liftoff_system", "liftof
            "lifted_state_at"]
 
 
+#: The lifted-pole configurations that this module solves
+LIFTED = ("line", "annulus")
+
+
 def make_liftoff_system(scene, topology, control, value, eps):
-    if topology not in ("annulus", "line"):
-        raise ValueError(f"topology must be 'annulus' or 'line'; got {topology!r}")
-    if control not in ("delta", "force", "lambda0"):
-        raise ValueError(f"control must be 'delta', 'force' or 'lambda0' for {topology} contact; got {control!r}")
-    chain = (annulus_chain if topology == "annulus" else line_chain)(eps, scene.shell_length)
-    sysm = ChainBVP(scene, chain, control, value)
-    attach_tip_table(sysm)
-    return sysm
+    """The system of a lifted-pole configuration (``shellbvp.configurations``, family "lifted")."""
+    if topology not in LIFTED:
+        raise ValueError(f"topology must be one of {LIFTED}; got {topology!r}")
+    return configuration(topology).system(scene, control, value, eps)
 
 
 # -- guesses --------------------------------------------------------------------------------
@@ -397,8 +398,7 @@ def second_zone_state(cap: Solution, *, tol=1e-6, max_nodes=10000, bc_tol=1e-10,
     control = cap.control if cap.control in ("force",) else "delta"
     value = cap.force if control == "force" else cap.delta
     scene, rho = cap.scene, cap.scene.rho
-    sysm = ChainBVP(scene, cap_line_tip_chain(cap.system.eps, scene.shell_length), control, value)
-    attach_tip_table(sysm)
+    sysm = configuration("cap+line(tip)").system(scene, control, value, cap.system.eps)
     kw = dict(tol=tol, max_nodes=int(min(max_nodes, max(2000, 4 * cap.nodes))), bc_tol=bc_tol)
     if _near(previous, cap, sysm.topology) and control == "delta":
         # near the closing of the gap (beta 0.1: S_c/S1 -> 1 at delta 0.394) the unknowns move
@@ -476,12 +476,12 @@ def _continue_in_delta(sysm, previous, before, delta, *, tol, max_nodes, bc_tol)
 
 
 def split_state_from(guess: Solution, control: str, value: float, *, tol=1e-6, max_nodes=10000, bc_tol=1e-10):
-    """The configuration of ``guess`` (a cap with a second zone on the tip, ``SPLIT_TOPOLOGIES``)
+    """The configuration of ``guess`` (a cap with a second zone on the tip: family "split")
     at another ``control`` value: under delta by natural continuation from it
     (:func:`_continue_in_delta`: halved steps, valid states only; None where none is found),
     under force or lambda0 by one solve from it (diagnosed, valid or not)."""
-    if guess.topology not in SPLIT_TOPOLOGIES:
-        raise ValueError(f"guess must be a {' or '.join(SPLIT_TOPOLOGIES)} state; got {guess.topology!r}")
+    if family_of(guess) != "split":
+        raise ValueError(f"guess must be a {' or '.join(names('split'))} state; got {guess.topology!r}")
     sysm = ChainBVP(guess.scene, guess.system.chain, control, value)
     attach_tip_table(sysm)
     if control == "delta":

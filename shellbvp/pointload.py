@@ -12,13 +12,10 @@ import time
 
 import numpy as np
 
-from .chain import ChainBVP, point_chain
+from .configurations import POINT_S0, configuration
 from .diagnosis import diagnose
 from .inflation import start_shape
-from .solution import (
-    attach_tip_table,
-    thin_mesh,
-)
+from .solution import thin_mesh
 
 __all__ = ["solve_point_load", "SC_POINT", "POINT_S0"]
 
@@ -26,8 +23,6 @@ __all__ = ["solve_point_load", "SC_POINT", "POINT_S0"]
 #: Caps smaller than this are replaced by the point-load limit (their own equations
 #: leave double precision near Sc ~ 1e-75; the difference is exponentially small).
 SC_POINT = 1e-30
-#: Start of the point-load state's free region (truncation error O(s0^2 ln^2 s0)).
-POINT_S0 = 1e-12
 
 
 def _point_guess(sysm, prev):
@@ -86,8 +81,7 @@ def solve_point_load(scene, delta, *, tol=1e-6, max_nodes=10000, guess=None, bc_
 
 def _point_run(scene, delta, guess, *, tol, max_nodes, bc_tol):
     """One solve_bvp run of the point-load problem from ``guess`` (a state) or the crude guess."""
-    sysm = ChainBVP(scene, point_chain(POINT_S0, scene.shell_length), "delta", delta)
-    attach_tip_table(sysm)
+    sysm = configuration("point").system(scene, "delta", delta, None)
     x, y = _point_guess(sysm, guess) if guess is not None else _crude_point_guess(sysm)
     with np.errstate(all="ignore"):
         bvp = sysm.solve(x, y, None, tol=tol, bc_tol=bc_tol, max_nodes=max_nodes)

@@ -15,7 +15,8 @@ import time
 
 import numpy as np
 
-from .chain import FREE_STATES, SPLIT_TOPOLOGIES, ChainBVP, cap_chain
+from .chain import FREE_STATES, ChainBVP, cap_chain
+from .configurations import ASKED, configuration, family_of, names
 from .corner import edge_model, edge_null_jump, is_corner, limit_estimate, near_limit, other_edge_root
 from .diagnosis import as_failure, diagnose
 from .inflation import start_shape
@@ -23,7 +24,6 @@ from .pointload import SC_POINT, solve_point_load
 from .solution import (
     STATUS_MESSAGES,
     Solution,
-    attach_tip_table,
     default_eps,
     failure,
     passed_tip_end,
@@ -83,9 +83,7 @@ def _run_bvp(sysm, guess, tol, max_nodes, bc_tol):
 def make_system(scene, control, value, eps, edge=None):
     """The single-cap system (``shellbvp.chain.cap_chain``) of a scene, control and value;
     ``edge`` ("smooth", "corner", "paper") defaults to the scene's contact model."""
-    sysm = ChainBVP(scene, cap_chain(eps, scene.shell_length, edge or scene.contact), control, value)
-    attach_tip_table(sysm)
-    return sysm
+    return configuration("cap").system(scene, control, value, eps, edge)
 
 
 def system_like(prev, control, value, eps):
@@ -205,8 +203,9 @@ def solve_from(sysm, guess, *, tol=1e-6, max_nodes=10000, bc_tol=None):
     return res
 
 
-TOPOLOGIES = ("auto", "cap", "line", "annulus", "cap+line(cylinder)", "cap+band(cylinder)", "cap+cylinder")
-_WALL = ("cap+line(cylinder)", "cap+band(cylinder)", "cap+cylinder")
+#: What ``solve(topology=...)`` accepts: "auto" and the configurations that may be asked for
+TOPOLOGIES = ASKED
+_WALL = names("wall")
 
 #: Mean meridional stretch taken as beyond reach (see :func:`delta_bounds`).
 MEAN_STRETCH_LIMIT = 2.5
@@ -364,10 +363,9 @@ def solve(scene, *, delta=None, lambda0=None, force=None, tol=1e-6, max_nodes=10
         raise ValueError(f"topology must be one of {TOPOLOGIES}; got {topology!r}")
     if control == "delta":
         check_delta("delta", value, scene, tol)
-    if topology in ("line", "annulus") and scene.contact != "smooth":
-        raise ValueError(f"topology={topology!r} needs contact='smooth' (the variational contact line); "
-                         f"the paper's model has the single cap only")
-    if guess is not None and guess.topology in ("line", "annulus"):
+    if topology != "auto":
+        configuration(topology).check_contact(scene)
+    if guess is not None and family_of(guess) == "lifted":
         from .liftoff import solve_liftoff
 
         res = solve_liftoff(scene, guess.topology, delta=delta, force=force, lambda0=lambda0, guess=guess,
@@ -376,7 +374,7 @@ def solve(scene, *, delta=None, lambda0=None, force=None, tol=1e-6, max_nodes=10
             return res
         guess = None  # back to the cap
 
-    if guess is not None and guess.topology in SPLIT_TOPOLOGIES:  # a cap and a second zone on the tip
+    if guess is not None and family_of(guess) == "split":  # a cap and a second zone on the tip
         from .liftoff import split_state_from
 
         t0 = time.perf_counter()
@@ -385,7 +383,7 @@ def solve(scene, *, delta=None, lambda0=None, force=None, tol=1e-6, max_nodes=10
             return _finished(res, t0, estimate_error, tol, bc_tol)
         guess = None  # back to the cap
 
-    if guess is not None and guess.topology in _WALL:
+    if guess is not None and family_of(guess) == "wall":
         from .cylinder import best_wall_state, wall_state
 
         t0 = time.perf_counter()
@@ -416,7 +414,7 @@ def solve(scene, *, delta=None, lambda0=None, force=None, tol=1e-6, max_nodes=10
         res = _cold_other(scene, make_system(scene, control, value, eps), control, value, eps, **kw)
     if (topology == "auto" or topology in _WALL) and res.topology == "cap":
         res = _onto_wall(res, topology, kw)
-    if topology in ("auto", "line", "annulus") and scene.contact == "smooth" and res.topology == "cap" \
+    if (topology == "auto" or topology in names("lifted")) and scene.contact == "smooth" and res.topology == "cap" \
             and res.success:
         res = _other_topology(res, topology, kw)
     if res.success and estimate_error:
@@ -456,7 +454,7 @@ def _other_topology(cap, topology, kw):
     """Replace an invalid cap by a valid lift-off state (auto) or by the asked topology."""
     from .liftoff import liftoff_state, replace_invalid_cap
 
-    if topology in ("line", "annulus"):
+    if topology in names("lifted"):
         return liftoff_state(cap, topology, **kw)
     return replace_invalid_cap(cap, **kw)
 

@@ -241,3 +241,27 @@ def test_a_solution_has_fixed_fields_and_one_way_to_fail():
     assert math.isnan(fail.pressure)  # an unknown under volume control
     with pytest.raises(ValueError, match="status must be that of a failure"):
         failure(0, "", scene=scene, control="delta", value=0.1)
+
+
+def test_every_configuration_is_registered_once_with_its_system():
+    """The registry names every configuration a state can have; each builds its own system
+    (the chain it declares, the tip tabulated) and refuses what it does not allow in one line."""
+    from shellbvp import configurations as cf
+
+    assert cf.CONFIGURATION_NAMES == tuple(cf.CONFIGURATIONS) and len(set(cf.CONFIGURATION_NAMES)) == 10
+    assert set(cf.names("wall")) == {"cap+line(cylinder)", "cap+band(cylinder)", "cap+cylinder"}
+    assert cf.ASKED[0] == "auto" and "cap+line(tip)" not in cf.ASKED
+    scene = sb.Scene.preset("base")
+    for name, conf in cf.CONFIGURATIONS.items():
+        sysm = conf.system(scene, "delta", 0.2, EPS)
+        assert sysm.topology == name and sysm.tip_A.size > 0
+    with pytest.raises(ValueError, match="topology must be one of"):
+        cf.configuration("cap+line(tipp)")
+    with pytest.raises(ValueError, match="registered already"):
+        cf.register(cf.Configuration("cap", "cap", ch.cap_chain))
+    with pytest.raises(ValueError, match="needs contact='smooth'"):
+        cf.configuration("line").system(sb.Scene.preset("base", contact="paper"), "delta", 0.2, EPS)
+    with pytest.raises(ValueError, match="control must be one of"):
+        cf.configuration("point").system(scene, "force", 0.2, EPS)
+    with pytest.raises(ValueError, match="needs contact='smooth'"):  # before any solve
+        sb.solve(sb.Scene.preset("base", contact="paper"), delta=0.9, topology="cap+band(cylinder)")

@@ -1,0 +1,145 @@
+"""The contact configurations, registered in one place.
+
+A :class:`Configuration` is what a state's ``topology`` names: its chain of regions
+(``shellbvp.chain``), the contact models and controls it exists for, its family (what
+kind of search finds it) and how its system is built.  Every other module asks the
+registry (:func:`configuration`, :func:`names`) instead of listing names itself.
+
+Families:
+
+``cap``
+    one contact region from the pole (the single cap);
+``point``
+    the point-load limit, no contact region;
+``lifted``
+    the pole lifted off the tip, contact further out (line, annulus, line+corner);
+``split``
+    a cap and, beyond a lifted gap, a second zone on the tip;
+``wall``
+    contact on the indenter's cylinder beyond the tip's end.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Callable
+
+from . import chain as ch
+from .solution import attach_tip_table
+
+__all__ = ["Configuration", "CONFIGURATIONS", "CONFIGURATION_NAMES", "FAMILIES", "configuration", "names",
+           "register", "family_of", "ASKED"]
+
+FAMILIES = ("cap", "point", "lifted", "split", "wall")
+#: Start of the point-load state's free region (its own eps; truncation error O(s0^2 ln^2 s0)).
+POINT_S0 = 1e-12
+
+
+@dataclass(frozen=True)
+class Configuration:
+    """One contact configuration.
+
+    Attributes
+    ----------
+    name : str
+        What ``Solution.topology`` and a curve's ``topology`` column hold.
+    family : str
+        One of :data:`FAMILIES`.
+    chain : callable
+        ``chain(eps, L, edge)`` -> :class:`shellbvp.chain.Chain` (``edge``: the contact
+        edge's model, "smooth", "corner", "paper" or "pinned").
+    contacts : tuple of str
+        The scene contact models it exists for.
+    controls : tuple of str
+        What may be prescribed.
+    askable : bool
+        Whether ``solve(topology=name)`` may ask for it.
+    needs_tip_end : bool
+        Whether it needs a tip that ends on a cylinder (``model.OMEGA_MAX``).
+    """
+
+    name: str
+    family: str
+    chain: Callable
+    contacts: tuple = ("smooth", "paper")
+    controls: tuple = ("delta", "force", "lambda0")
+    askable: bool = False
+    needs_tip_end: bool = False
+
+    def check(self, scene, control):
+        """A clear ValueError where ``scene`` or ``control`` does not allow this configuration."""
+        if self.needs_tip_end and scene.model().OMEGA_MAX is None:
+            raise ValueError("this tip has no end where it meets a cylinder (A' never vanishes): no wall contact")
+        self.check_contact(scene)
+        if control not in self.controls:
+            raise ValueError(f"control must be one of {self.controls} for {self.name} contact; got {control!r}")
+
+    def check_contact(self, scene):
+        """A clear ValueError where the scene's contact model does not have this configuration."""
+        if scene.contact not in self.contacts:
+            raise ValueError(f"topology={self.name!r} needs contact='smooth': the paper's contact model has the "
+                             f"single cap only" + (", which may run onto the cylinder ('cap+cylinder')"
+                                                   if self.family == "wall" else ""))
+
+    def system(self, scene, control, value, eps, edge=None):
+        """The ChainBVP of this configuration for ``scene`` with ``control`` = ``value``, its
+        tip tabulated for the admissibility checks."""
+        self.check(scene, control)
+        sysm = ch.ChainBVP(scene, self.chain(eps, scene.shell_length, edge or scene.contact), control, value)
+        attach_tip_table(sysm)
+        return sysm
+
+
+#: Every configuration, by name, in the order of :func:`register`
+CONFIGURATIONS: dict[str, Configuration] = {}
+
+
+def register(conf: Configuration) -> Configuration:
+    if conf.family not in FAMILIES:
+        raise ValueError(f"family must be one of {FAMILIES}; got {conf.family!r}")
+    if conf.name in CONFIGURATIONS:
+        raise ValueError(f"configuration {conf.name!r} is registered already")
+    CONFIGURATIONS[conf.name] = conf
+    return conf
+
+
+def configuration(name: str) -> Configuration:
+    """The registered configuration ``name`` (ValueError naming the known ones otherwise)."""
+    try:
+        return CONFIGURATIONS[name]
+    except KeyError:
+        raise ValueError(f"topology must be one of {tuple(CONFIGURATIONS)}; got {name!r}") from None
+
+
+def names(family: str | None = None) -> tuple:
+    """The names of every configuration, or of one family's, in registration order."""
+    return tuple(n for n, c in CONFIGURATIONS.items() if family is None or c.family == family)
+
+
+def family_of(state) -> str:
+    """The family of a state's configuration (``"inflated"`` for the inflated shell)."""
+    conf = CONFIGURATIONS.get(state.topology)
+    return state.topology if conf is None else conf.family
+
+
+def _lifted(chain):
+    return lambda eps, L, edge: chain(eps, L)
+
+
+register(Configuration("cap", "cap", ch.cap_chain, controls=("delta", "force", "lambda0", "arclength"), askable=True))
+register(Configuration("point", "point", lambda eps, L, edge: ch.point_chain(POINT_S0, L), controls=("delta",)))
+register(Configuration("line", "lifted", _lifted(ch.line_chain), contacts=("smooth",), askable=True))
+register(Configuration("annulus", "lifted", _lifted(ch.annulus_chain), contacts=("smooth",), askable=True))
+register(Configuration("cap+line(tip)", "split", _lifted(ch.cap_line_tip_chain), contacts=("smooth",)))
+register(Configuration("cap+band(tip)", "split", _lifted(ch.cap_band_tip_chain), contacts=("smooth",)))
+register(Configuration("cap+line(cylinder)", "wall", ch.cap_line_cylinder_chain, contacts=("smooth",), askable=True,
+                       needs_tip_end=True))
+register(Configuration("cap+band(cylinder)", "wall", ch.cap_band_cylinder_chain, contacts=("smooth",), askable=True,
+                       needs_tip_end=True))
+register(Configuration("cap+cylinder", "wall", ch.cylinder_chain, askable=True, needs_tip_end=True))
+register(Configuration("line+corner", "lifted", _lifted(ch.line_kink_chain), contacts=("smooth",)))
+
+#: Every configuration's name (``Solution.topology``, a curve's per-point ``topology``)
+CONFIGURATION_NAMES = names()
+#: What ``solve(topology=...)`` accepts
+ASKED = ("auto",) + tuple(n for n, c in CONFIGURATIONS.items() if c.askable)
