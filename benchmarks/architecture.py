@@ -62,9 +62,22 @@ def _module_level(tree):
         todo.extend(ast.iter_child_nodes(node))
 
 
+def _adapts_a_step(loop):
+    """A loop that grows a step after a success and halves it after a failure: natural
+    continuation written out (``x *= 1.5`` or ``x = 1.5 * x`` ..., and ``x /= 2``)."""
+    grows = halves = False
+    for n in ast.walk(loop):
+        if isinstance(n, ast.AugAssign) and isinstance(n.value, ast.Constant):
+            grows |= isinstance(n.op, ast.Mult) and n.value.value == 1.5
+            halves |= isinstance(n.op, ast.Div) and n.value.value == 2
+        elif isinstance(n, ast.BinOp) and isinstance(n.op, ast.Mult):
+            grows |= any(isinstance(x, ast.Constant) and x.value == 1.5 for x in (n.left, n.right))
+    return grows and halves
+
+
 def census(root=ROOT):
     names = configuration_names(root)
-    out = {"name_comparisons": {}, "long_modules": {}, "long_functions": [], "result_gets": {},
+    out = {"step_loops": [], "name_comparisons": {}, "long_modules": {}, "long_functions": [], "result_gets": {},
            "solution_builds": {}, "function_imports": {}, "lines": 0}
     for path in sorted((root / "shellbvp").glob("*.py")):
         text = path.read_text()
@@ -79,6 +92,8 @@ def census(root=ROOT):
                 hits = [s for side in [node.left, *node.comparators] for s in _strings(side) if s in names]
                 if hits:
                     out["name_comparisons"][mod] = out["name_comparisons"].get(mod, 0) + 1
+            elif isinstance(node, (ast.While, ast.For)) and _adapts_a_step(node):
+                out["step_loops"].append(f"{mod}:{node.lineno}")
             elif isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
                 length = node.end_lineno - node.lineno + 1
                 if length > FUNCTION_LINES:
@@ -117,6 +132,7 @@ def main(argv=None):
         mod = where.split(":")[0]
         gets[mod] = gets.get(mod, 0) + 1
     rows = [
+        ("loops of natural continuation (a step grown by 1.5, halved)", len(c["step_loops"]), c["step_loops"]),
         ("comparisons with configuration names", total(c["name_comparisons"]), c["name_comparisons"]),
         (f"modules over {MODULE_LINES} lines", len(c["long_modules"]), c["long_modules"]),
         (f"functions over {FUNCTION_LINES} lines", len(c["long_functions"]),

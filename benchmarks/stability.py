@@ -93,7 +93,7 @@ def free_det(sol):
     """
     import numpy as np
 
-    sysm = sol["system"]
+    sysm = sol.system
     mod, par = sysm.model, sysm.par
     S = sysm.S(1, sol.x, sol.p)
     y = sol.y[sysm.rows(1)]

@@ -39,6 +39,7 @@ from .pointload import SC_POINT, solve_point_load
 from .solution import (SECANT_MAX_RATIO, Solution, calibrated_error, default_eps, passed_tip_end, richardson_error,
                        secant_ratio, warm_mesh)
 from .corner import LEGENDRE_WATCH, edge_model, is_corner, limit_estimate, near_limit
+from .march import Steps, march
 from .state import check_delta, check_tol, cross_convexity_limit, make_system, solve, solve_from, system_like, \
     warm_guess
 from .version import __version__ as VERSION
@@ -851,31 +852,30 @@ def _secant(sysm, cur, prev, a):
 
 def _natural(scene, deltas, builder: _Builder, settings, first=None, key0=0):
     """Natural continuation through ``deltas`` (from ``first``, already recorded, if given)."""
-    prev2 = prev3 = None
     if first is None:
         prev = _first_point(scene, float(deltas[0]), settings)
         builder.add(prev, key0)
     else:
         prev = first
+    history = [prev]
+
+    def solve_at(nd, states):
+        prev, prev2, prev3 = (states[-k] if len(states) >= k else None for k in (1, 2, 3))
+        return _solve_at_delta(scene, nd, prev, prev2, settings, prev3)
+
     for i, target in enumerate(deltas[1:], key0 + 1):
-        d = prev.delta
-        step = target - d
-        while prev.delta < target:
-            nd = min(target, prev.delta + step)
-            sol = _solve_at_delta(scene, nd, prev, prev2, settings, prev3)
-            if sol.success:
-                prev3, prev2, prev = prev2, prev, sol
-                if nd == target:
-                    builder.add(sol, i)
-                step *= 1.5
-            elif passed_tip_end(sol):
-                _wall_leg(scene, builder, settings, sol, i, deltas=[d for d in deltas if d > prev.delta],
-                          reason=f"the contact reached the end of the tip (the indenter's cylinder) just after "
-                                 f"delta = {prev.delta:.6g}")
-            else:
-                step /= 2
-                if step < min(1e-6, 1e-3 * target):
-                    raise _Stop(f"no solution near delta = {nd:.6g}: {sol.message}{_fold_note(prev, prev2)}")
+        steps = Steps(target - prev.delta, too_small=lambda s, u, t=target: s < min(1e-6, 1e-3 * t))
+        m = march(prev.delta, target, solve_at, steps, history=history[-3:], position=lambda s: s.delta,
+                  arrived=lambda u, t=target: not u < t, stop=lambda sol, nd, states: "tip end" if passed_tip_end(sol) else None,
+                  on_accept=lambda sol, nd, i=i, t=target: builder.add(sol, i) if nd == t else None)
+        history = m.states
+        prev, prev2 = history[-1], (history[-2] if len(history) > 1 else None)
+        if m.reason == "tip end":
+            _wall_leg(scene, builder, settings, m.failed, i, deltas=[d for d in deltas if d > prev.delta],
+                      reason=f"the contact reached the end of the tip (the indenter's cylinder) just after "
+                             f"delta = {prev.delta:.6g}")
+        if m.reason == "step":
+            raise _Stop(f"no solution near delta = {m.tried:.6g}: {m.failed.message}{_fold_note(prev, prev2)}")
         rule = _stop_rule(prev, settings)
         if rule:
             raise _Stop(rule)
@@ -926,32 +926,34 @@ def _wall_leg(scene, builder, st, last_cap, key, *, reason, deltas=None):
             key += 1
             builder.add(prev, key)
     d_end = st["delta_max"] if targets is None else (targets[-1] if targets else prev.delta)
-    step = max(1e-3, (d_end - prev.delta) / 20)
-    while prev.delta < d_end * (1 - 1e-12):
-        rule = _stop_rule(prev, st)
-        if rule:
-            builder.out.complete = True
-            raise _Stop(rule)
-        nxt_target = min(d_end, prev.delta + step) if targets is None else min(
-            min(t for t in targets if t > prev.delta), prev.delta + step)
-        tried = []
+
+    def advance(u, step, t):
+        return min(t, u + step) if targets is None else min(min(d for d in targets if d > u), u + step)
+
+    def solve_at(nxt_target, states):  # the valid wall state of lowest energy, or None
+        prev = states[-1]
+        tried.clear()
         sol = None
         if edge_model(prev) == "pinned":  # held at the tip's end while its ring force pushes
             sol = _pinned_state(scene, prev, nxt_target, st, tried)
-        if sol is None:
-            sol = best_wall_state(prev, control="delta", value=nxt_target, tried=tried, **kw)
-        if sol is None:
-            step /= 2
-            if step < 1e-5 * (1 + prev.delta):
-                raise _Stop(f"no valid contact configuration beyond delta = {prev.delta:.6g} "
-                            f"({'; '.join(tried)})")
-            continue
+        return sol if sol is not None else best_wall_state(prev, control="delta", value=nxt_target, tried=tried, **kw)
+
+    def record(sol, _):
+        nonlocal key
         key += 1
-        builder.last_wall = prev = sol
+        builder.last_wall = sol
         if targets is None or any(abs(sol.delta - t) < 1e-12 for t in targets):
             builder.add(sol, key)
-        step *= 1.5
+
+    steps = Steps(max(1e-3, (d_end - prev.delta) / 20), advance=advance, too_small=lambda s, u: s < 1e-5 * (1 + u))
+    m = march(prev.delta, d_end, solve_at, steps, history=[prev], position=lambda s: s.delta,
+              arrived=lambda u: not u < d_end * (1 - 1e-12), accept=lambda s: s is not None, on_accept=record,
+              done=lambda states: _stop_rule(states[-1], st))
+    if m.reason == "step":
+        raise _Stop(f"no valid contact configuration beyond delta = {m.at:.6g} ({'; '.join(tried)})")
     builder.out.complete = True
+    if m.reason:  # a stop rule
+        raise _Stop(m.reason)
     raise _Stop(f"delta_max = {st['delta_max']:g} reached" if targets is None else "all requested deltas computed")
 
 

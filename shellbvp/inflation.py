@@ -28,6 +28,7 @@ import numpy as np
 
 from .chain import Chain, ChainBVP, FreePole, Point, Region, Rim
 from .diagnosis import diagnose
+from .march import Steps, march
 from .solution import Solution, attach_tip_table
 
 __all__ = ["inflate", "InflatedState", "inflated_chain", "inflated_pole_rise", "start_shape"]
@@ -118,24 +119,23 @@ def inflate(scene, tol: float = TOL, max_nodes: int = _MAX_NODES):
     if target == 0.0:
         res = _solve(sysm, x, y, tol, max_nodes)
         return _finish(res, sysm)
-    done, step, res = 0.0, target, None
-    while done != target:
-        p_next = target if abs(target - done) <= abs(step) else done + step
-        sysm = _system(scene, p_next)
-        nxt = _solve(sysm, x, y, tol, max_nodes)
-        if nxt.success:
-            res, done = nxt, p_next
-            x, y = nxt.x, nxt.y
-            step *= 1.5
-        else:
-            step /= 2
-            if abs(step) < 1e-6 * max(1.0, abs(target)):
-                out = nxt if res is None else res
-                out.success, out.status = False, 5
-                out.message = (f"the inflated state was not reached: continuation in the pressure stalled at "
-                               f"p = {done:.4g} of {target:.4g} ({nxt.message})")
-                return _finish(out, sysm, failed=True)
-    return _finish(res, sysm)
+    systems = {}
+
+    def solve_at(p_next, states):
+        sysm = systems[p_next] = _system(scene, p_next)
+        return _solve(sysm, *((states[-1].x, states[-1].y) if states else (x, y)), tol, max_nodes)
+
+    steps = Steps(target, advance=lambda u, s, t: t if abs(t - u) <= abs(s) else u + s,
+                  too_small=lambda s, u: abs(s) < 1e-6 * max(1.0, abs(target)))
+    m = march(0.0, target, solve_at, steps, arrived=lambda u: u == target)
+    sysm = systems[m.tried]
+    if not m.reached:
+        out = m.failed if m.last is None else m.last
+        out.success, out.status = False, 5
+        out.message = (f"the inflated state was not reached: continuation in the pressure stalled at "
+                       f"p = {m.at:.4g} of {target:.4g} ({m.failed.message})")
+        return _finish(out, sysm, failed=True)
+    return _finish(m.last, sysm)
 
 
 def _finish(res, sysm, failed=False):

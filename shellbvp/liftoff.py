@@ -26,6 +26,7 @@ import numpy as np
 
 from .chain import ChainBVP, FreePole
 from .configurations import configuration, family_of, names
+from .march import Steps, march
 from .cylinder import solve_chain_from, transfer_guess
 from .pointload import solve_point_load
 from .solution import (
@@ -456,23 +457,30 @@ def _continue_in_delta(sysm, previous, before, delta, *, tol, max_nodes, bc_tol)
     # (a split solved at 1e-6 with ~220 nodes asks ~2200 at 1e-9)
     finer = max(1.0, (previous.tol if math.isfinite(previous.tol) else tol) / tol) ** (1.0 / RESIDUAL_ORDER)
     budget = int(min(max_nodes, max(_CONTINUATION_NODES, WARM_NODES * previous.nodes * finer)))
-    step = delta - previous.delta
-    for _ in range(_CONTINUATION_STEPS):
-        last = abs(delta - previous.delta) <= abs(step) * (1 + 1e-9)  # (halved steps add up to delta
-        target = delta if last else previous.delta + step                 # only to rounding)
+
+    def solve_at(target, states):
+        previous, before = states[-1], (states[-2] if len(states) > 1 else None)
         stepper = ChainBVP(sysm.scene, sysm.chain, "delta", target, model=sysm.model, par=sysm.par)
         stepper.tip_A, stepper.tip_B = sysm.tip_A, sysm.tip_B
         secant = before if before is not None and abs(target - previous.delta) <= abs(previous.delta - before.delta) \
             else None
-        res = solve_chain_from(stepper, liftoff_warm_guess(stepper, previous, secant, target), tol=tol,
-                               max_nodes=budget, bc_tol=bc_tol)
-        if not (res.success and res.valid):
-            step /= 2
-            continue
-        if last:
-            return res
-        before, previous = previous, res  # the step is kept: a longer one fails there
-    return None
+        return solve_chain_from(stepper, liftoff_warm_guess(stepper, previous, secant, target), tol=tol,
+                                max_nodes=budget, bc_tol=bc_tol)
+
+    # the whole step first; a step that succeeds is kept (a longer one fails there): no growth.
+    # Halved steps add up to delta only to rounding: the last one lands on delta itself.
+    steps = Steps(delta - previous.delta, grow=lambda s: s,
+                  advance=lambda u, s, t: t if abs(t - u) <= abs(s) * (1 + 1e-9) else u + s)
+    landed = []  # the state solved at delta itself
+
+    def on_accept(state, target):
+        if target == delta:
+            landed.append(state)
+
+    marched = march(previous.delta, delta, solve_at, steps, history=[before, previous], position=lambda s: s.delta,
+                    accept=lambda s: s.success and s.valid, arrived=lambda u: False, on_accept=on_accept,
+                    done=lambda states: "" if landed else None, max_solves=_CONTINUATION_STEPS)
+    return landed[0] if marched.reached else None
 
 
 def split_state_from(guess: Solution, control: str, value: float, *, tol=1e-6, max_nodes=10000, bc_tol=1e-10):
@@ -730,40 +738,50 @@ def lifted_pole_fold(previous: Solution, before: Solution, *, delta_limit=math.i
         nonlocal solves
         solves += 1
         sysm = make_liftoff_system(scene, topology, control, value, previous.system.eps)
-        a = (value - prev[control]) / (prev[control] - before[control])
+        a = (value - getattr(prev, control)) / (getattr(prev, control) - getattr(before, control))
         return solve_liftoff_from(sysm, _moved_guess(sysm, prev, before, a), **kw)
 
     # 1. in delta while the steps go through (far from the fold delta is the better control)
-    step = first = previous.delta - before.delta
-    while step > first / 16 and solves < _FOLD_STEPS:
-        b, a = states[-1], states[-2]
-        res = at("delta", b.delta + step, b, a)
-        expected = (b.lambda0 - a.lambda0) * step / (b.delta - a.delta)
-        if res.success and res.valid and abs(res.lambda0 - b.lambda0) <= 2 * abs(expected) + 1e-3:
-            states.append(res)
-            if res.delta > delta_limit:
-                return None, states
-            step *= 1.5
-        else:  # failed, invalid, or leapt in lambda0 (onto the branch beyond the fold)
-            step /= 2
+    first, taken = previous.delta - before.delta, []
+
+    def advance(u, step, _):
+        taken.append(step)  # the step of the attempt, for its expected change of lambda0
+        return u + step
+
+    followed = []  # whether the last state is valid and has not leapt in lambda0 (onto the branch beyond the fold)
+
+    def in_delta(d, st):
+        b, a = st[-1], st[-2]
+        res = at("delta", d, b, a)
+        expected = (b.lambda0 - a.lambda0) * taken[-1] / (b.delta - a.delta)
+        followed.append(res.success and res.valid and abs(res.lambda0 - b.lambda0) <= 2 * abs(expected) + 1e-3)
+        return res
+
+    m = march(previous.delta, math.inf, in_delta, Steps(first, advance=advance, too_small=lambda s, u: not s > first / 16),
+              history=states, position=lambda s: s.delta, arrived=lambda u: False, max_solves=_FOLD_STEPS,
+              stop=lambda res, d, st: "limit" if followed[-1] and res.delta > delta_limit else None,
+              accept=lambda res: followed[-1])
+    states = m.states
+    if m.reason == "limit":
+        return None, states + [m.failed]
     # 2. in lambda0 until delta falls: the maximum is bracketed
-    step = math.copysign(min(_FOLD_MAX_STEP, abs(states[-1].lambda0 - states[-2].lambda0)),
-                         states[-1].lambda0 - states[-2].lambda0)
-    while solves < _FOLD_STEPS:
-        res = at("lambda0", states[-1].lambda0 + step, states[-1], states[-2])
+    grown = min(_FOLD_MAX_STEP, abs(states[-1].lambda0 - states[-2].lambda0))
+
+    def bracketed(res, lam, st):
         if not (res.success and res.valid):
-            step /= 2
-            if abs(step) < _FOLD_MIN_STEP:
-                return None, []
-            continue
-        if res.delta > delta_limit:
-            return None, states + [res]
-        if res.delta < states[-1].delta:
-            triple = [states[-2], states[-1], res]
-            break
-        states.append(res)
-        step = math.copysign(min(_FOLD_MAX_STEP, 1.5 * abs(step)), step)
-    else:
+            return None
+        return "limit" if res.delta > delta_limit else ("fold" if res.delta < st[-1].delta else None)
+
+    m = march(states[-1].lambda0, math.nan, lambda lam, st: at("lambda0", lam, st[-1], st[-2]),
+              Steps(math.copysign(grown, states[-1].lambda0 - states[-2].lambda0), advance=lambda u, s, _: u + s,
+                    grow=lambda s: math.copysign(min(_FOLD_MAX_STEP, 1.5 * abs(s)), s),
+                    too_small=lambda s, u: abs(s) < _FOLD_MIN_STEP),
+              history=states, position=lambda s: s.lambda0, arrived=lambda u: False,
+              accept=lambda res: res.success and res.valid, stop=bracketed, max_solves=_FOLD_STEPS - solves)
+    states, res = m.states, m.failed
+    if m.reason == "limit":
+        return None, states + [res]
+    if m.reason != "fold":
         return None, []
     # 3. the vertex of parabolas through the deepest state and its neighbours in lambda0
     pool, fold = states[-3:] + [res], None

@@ -15,6 +15,7 @@ import numpy as np
 from .configurations import POINT_S0, configuration
 from .diagnosis import diagnose
 from .inflation import start_shape
+from .march import Steps, march
 from .solution import thin_mesh
 
 __all__ = ["solve_point_load", "SC_POINT", "POINT_S0"]
@@ -124,17 +125,17 @@ def _from_smaller_depth(scene, delta, **kw):
             break
     if start is None or not start.success:
         return None
-    prev, ratio = start, _STEP_MAX / 2
-    while prev.delta < delta:
-        d = min(delta, prev.delta * ratio)
-        step_kw = dict(kw, max_nodes=int(min(kw["max_nodes"], max(2000, 4 * prev.nodes))))
-        nxt = _point_run(scene, d, prev, **step_kw)
-        if nxt.success and d < delta and not nxt.valid:
-            return None
-        if nxt.success:
-            prev, ratio = nxt, min(_STEP_MAX, 1.5 * ratio)
-        else:
-            ratio = math.sqrt(d / prev.delta)
-            if ratio < _STEP_MIN:
-                return None
-    return prev
+
+    def solve_at(d, states):
+        prev = states[-1]
+        return _point_run(scene, d, prev, **dict(kw, max_nodes=int(min(kw["max_nodes"], max(2000, 4 * prev.nodes)))))
+
+    def passes_the_tip(nxt, d, states):  # short of the depth asked: the contact is no longer a point
+        return "invalid" if nxt.success and d < delta and not nxt.valid else None
+
+    # steps are ratios of depths: d = delta_prev * ratio
+    steps = Steps(_STEP_MAX / 2, advance=lambda u, r, t: min(t, u * r), grow=lambda r: min(_STEP_MAX, 1.5 * r),
+                  shrink=lambda r, u, tried: math.sqrt(tried / u), too_small=lambda r, u: r < _STEP_MIN)
+    marched = march(start.delta, delta, solve_at, steps, history=[start], position=lambda s: s.delta,
+                    stop=passes_the_tip)
+    return marched.last if marched.reached else None

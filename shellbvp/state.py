@@ -20,6 +20,7 @@ from .configurations import ASKED, configuration, family_of, names
 from .corner import edge_model, edge_null_jump, is_corner, limit_estimate, near_limit, other_edge_root
 from .diagnosis import as_failure, diagnose
 from .inflation import start_shape
+from .march import Steps, march
 from .pointload import SC_POINT, solve_point_load
 from .solution import (
     STATUS_MESSAGES,
@@ -586,30 +587,27 @@ def _continue_in_delta(scene, eps, target, starts=(0.1, 0.05), **kw):
     if res is None or not res.success:
         return None
     up = target > d
-    frac = min(0.5, abs(target - d) / d) if up else 0.3
-    before = None
-    while d != target:
-        nd = min(target, d * (1 + frac)) if up else max(target, d * (1 - frac))
+
+    def solve_at(nd, states):
+        res, before = states[-1], (states[-2] if len(states) > 1 else None)
         if res.topology == "point":
-            nxt = solve_point_load(scene, nd, tol=kw["tol"], max_nodes=kw["max_nodes"], guess=res)
-        else:
-            sysm = system_like(res, "delta", nd, eps)
-            nxt = solve_from(sysm, warm_guess(sysm, res), **kw)
-            if up and not nxt.success and near_limit(res):
-                nxt = cross_convexity_limit(res, before, nd, eps=eps, **kw) or nxt
-            if not up and scene.contact == "smooth" and (not nxt.success or nxt.Sc < SC_POINT) \
-                    and res.Sc < 1e-8:
-                # the cap is leaving double precision: continue with its point-load limit
-                point = solve_point_load(scene, nd, tol=kw["tol"], max_nodes=kw["max_nodes"], guess=res)
-                nxt = point if point.success else nxt
-        if nxt.success:
-            before, res, d = res, nxt, nd
-            frac = min(1.5 * frac, 0.5)
-        else:
-            frac /= 2
-            if frac < 1e-3:
-                return None
-    return res
+            return solve_point_load(scene, nd, tol=kw["tol"], max_nodes=kw["max_nodes"], guess=res)
+        sysm = system_like(res, "delta", nd, eps)
+        nxt = solve_from(sysm, warm_guess(sysm, res), **kw)
+        if up and not nxt.success and near_limit(res):
+            nxt = cross_convexity_limit(res, before, nd, eps=eps, **kw) or nxt
+        if not up and scene.contact == "smooth" and (not nxt.success or nxt.Sc < SC_POINT) and res.Sc < 1e-8:
+            # the cap is leaving double precision: continue with its point-load limit
+            point = solve_point_load(scene, nd, tol=kw["tol"], max_nodes=kw["max_nodes"], guess=res)
+            nxt = point if point.success else nxt
+        return nxt
+
+    # relative steps, delta (1 +- frac): caps shrink fast as delta -> 0
+    steps = Steps(min(0.5, abs(target - d) / d) if up else 0.3,
+                  advance=lambda u, f, t: min(t, u * (1 + f)) if up else max(t, u * (1 - f)),
+                  grow=lambda f: min(1.5 * f, 0.5), too_small=lambda f, u: f < 1e-3)
+    marched = march(d, target, solve_at, steps, history=[res])
+    return marched.last if marched.reached else None
 
 
 def _failure(status, message, control, value, scene):
@@ -628,48 +626,54 @@ def _cold_other(scene, sysm, control, value, eps, **kw):
     def fail(message):
         return _failure(5, message, control, value, scene)
 
-    d, step = 0.02, 0.02
+    d = 0.02
     lk = _loose(kw)
     cur = _cold_delta(make_system(scene, "delta", d, eps), d, **lk)
     if not cur.success:
         return fail(STATUS_MESSAGES[5])
-    prev = None
-    attempts = 0
-    def bracketed():  # a point-load state's lambda0 is NaN: it brackets nothing
-        return prev is not None and (getattr(prev, key) - value) * (getattr(cur, key) - value) <= 0
 
-    while not bracketed():
-        attempts += 1
-        if attempts > _MARCH_MAX_SOLVES:
-            return fail(f"{control} = {value:g} was not bracketed within {_MARCH_MAX_SOLVES} "
-                        f"continuation steps (delta reached {d:.3g}, {key} there {getattr(cur, key):.4g})")
-        nd = d + step
-        if nd > _MARCH_DELTA_MAX:
-            return fail(f"{control} = {value:g} was not reached on the branch for delta up to "
-                        f"{d:.3g} ({key} there: {getattr(cur, key):.4g})")
+    def bracketed(states):  # a point-load state's lambda0 is NaN: it brackets nothing
+        if len(states) > 1 and (getattr(states[-2], key) - value) * (getattr(states[-1], key) - value) <= 0:
+            return ""
+        return None
+
+    def solve_at(nd, states):
+        cur, prev = states[-1], (states[-2] if len(states) > 1 else None)
         # a point-load state has no cap to warm-start from: a cold solve finds the cap or the limit again
         if cur.topology == "point":
-            nxt = _cold_delta(make_system(scene, "delta", nd, eps), nd, near_point=cur, **lk)
-            if not nxt.success:  # a cold solve does not start from cur: smaller steps do not help it
-                return fail(f"{control} = {value:g} not reached: the states up to delta = {d:.3g} are point-load "
-                            f"limits ({key} there: {getattr(cur, key):.4g}) and no state was found at delta = {nd:.3g} "
-                            f"({nxt.message})")
-        else:
-            dsys = system_like(cur, "delta", nd, eps)
-            nxt = solve_from(dsys, warm_guess(dsys, cur), **lk)
-            if not nxt.success and near_limit(cur):
-                nxt = cross_convexity_limit(cur, prev, nd, eps=eps, **lk) or nxt
+            return _cold_delta(make_system(scene, "delta", nd, eps), nd, near_point=cur, **lk)
+        dsys = system_like(cur, "delta", nd, eps)
+        nxt = solve_from(dsys, warm_guess(dsys, cur), **lk)
+        if not nxt.success and near_limit(cur):
+            nxt = cross_convexity_limit(cur, prev, nd, eps=eps, **lk) or nxt
+        return nxt
+
+    def stop(nxt, nd, states):
         if nxt.success:
-            prev, cur, d = cur, nxt, nd
-            step = min(1.5 * step, 0.05)
-        elif passed_tip_end(nxt):
-            return fail(f"{control} = {value:g} not reached before the contact reaches the end "
-                        f"of the tip (the indenter's cylinder) near delta = {nd:.3g}")
-        else:
-            step /= 2
-            if step < 1e-3:
-                return fail(f"continuation in delta towards {control} = {value:g} stalled at "
-                            f"delta = {d:.3g}")
+            return None
+        if states[-1].topology == "point":  # a cold solve does not start from cur: smaller steps do not help it
+            return "point"
+        return "tip end" if passed_tip_end(nxt) else None
+
+    steps = Steps(0.02, advance=lambda u, s, t: u + s if u + s <= _MARCH_DELTA_MAX else None,
+                  grow=lambda s: min(1.5 * s, 0.05), too_small=lambda s, u: s < 1e-3)
+    m = march(d, math.inf, solve_at, steps, history=[cur], done=bracketed, stop=stop, max_solves=_MARCH_MAX_SOLVES)
+    cur = m.last
+    there = f"{key} there: {getattr(cur, key):.4g}"
+    if m.reason == "solves":
+        return fail(f"{control} = {value:g} was not bracketed within {_MARCH_MAX_SOLVES} "
+                    f"continuation steps (delta reached {m.at:.3g}, {there})")
+    if m.reason == "range":
+        return fail(f"{control} = {value:g} was not reached on the branch for delta up to {m.at:.3g} ({there})")
+    if m.reason == "point":
+        return fail(f"{control} = {value:g} not reached: the states up to delta = {m.at:.3g} are point-load "
+                    f"limits ({there}) and no state was found at delta = {m.tried:.3g} ({m.failed.message})")
+    if m.reason == "tip end":
+        return fail(f"{control} = {value:g} not reached before the contact reaches the end "
+                    f"of the tip (the indenter's cylinder) near delta = {m.tried:.3g}")
+    if m.reason == "step":
+        return fail(f"continuation in delta towards {control} = {value:g} stalled at delta = {m.at:.3g}")
+    prev, cur = m.states[-2], m.states[-1]
     start = min((prev, cur), key=lambda s: abs(getattr(s, key) - value))
     sysm = system_like(start, control, value, eps)
     return solve_from(sysm, warm_guess(sysm, start), **kw)
