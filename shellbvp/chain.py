@@ -320,7 +320,8 @@ class ChainBVP:
     model : module, optional
         The scene's generated module (loaded if not given).
     par : array, optional
-        Its run-time parameters (default ``scene.parameters(model)``).
+        Its run-time parameters (default: ``shellbvp.inflation.system_parameters``, the
+        scene's with the inflated state's pole rise under pressure).
     volume_control : bool, optional
         The pressure as an unknown with the enclosed volume held at ``scene.enclosed_volume()``
         (default: ``scene.sealed``).
@@ -331,7 +332,11 @@ class ChainBVP:
             raise ValueError(f"control must be one of {CONTROLS}; got {control!r}")
         self.scene, self.chain, self.control = scene, chain, control
         self.model = mod = model if model is not None else scene.model()
-        self.par = scene.parameters(mod) if par is None else np.asarray(par, float)
+        if par is None:
+            from .inflation import system_parameters  # (inflation builds its own systems from this module)
+
+            par = system_parameters(scene, mod)
+        self.par = np.asarray(par, float)
         self.regions = chain.regions
         self._bind()
         self.sizes = [SIZES[r.kind] for r in chain.regions]

@@ -25,6 +25,7 @@ from dataclasses import dataclass
 from typing import Callable
 
 from . import chain as ch
+from .inflation import system_parameters
 from .solution import attach_tip_table
 
 __all__ = ["Configuration", "CONFIGURATIONS", "CONFIGURATION_NAMES", "FAMILIES", "configuration", "names",
@@ -85,7 +86,9 @@ class Configuration:
         """The ChainBVP of this configuration for ``scene`` with ``control`` = ``value``, its
         tip tabulated for the admissibility checks."""
         self.check(scene, control)
-        sysm = ch.ChainBVP(scene, self.chain(eps, scene.shell_length, edge or scene.contact), control, value)
+        model = scene.model()
+        sysm = ch.ChainBVP(scene, self.chain(eps, scene.shell_length, edge or scene.contact), control, value,
+                           model=model, par=system_parameters(scene, model))
         attach_tip_table(sysm)
         return sysm
 

@@ -31,7 +31,7 @@ from .diagnosis import diagnose
 from .march import Steps, march
 from .solution import Solution, attach_tip_table
 
-__all__ = ["inflate", "InflatedState", "inflated_chain", "inflated_pole_rise", "start_shape"]
+__all__ = ["inflate", "InflatedState", "inflated_chain", "inflated_pole_rise", "start_shape", "system_parameters"]
 
 #: Pole start of the inflated state, ``zeta = EPS * L`` (the free pole's truncation error
 #: is O(zeta^2): 1e-8 relative, below the inflation's tolerance).
@@ -154,6 +154,12 @@ def _finish(res, sysm, failed=False):
     rim = sysm.model.free_profile(np.array([sysm.L]), res.y[:, -1:], sysm.par)
     res.rim_hoop_tension = float(rim["tau_theta"][0])
     return res
+
+
+def system_parameters(scene, model=None):
+    """The run-time parameters of a system of ``scene``: with the inflated state's pole rise
+    (:func:`inflate`, solved once per scene) where the scene is under pressure."""
+    return scene.parameters(model, pole_rise=inflated_pole_rise(scene) if scene.pressure else 0.0)
 
 
 def inflated_pole_rise(scene) -> float:

@@ -490,7 +490,7 @@ def split_state_from(guess: Solution, control: str, value: float, *, tol=1e-6, m
     under force or lambda0 by one solve from it (diagnosed, valid or not)."""
     if family_of(guess) != "split":
         raise ValueError(f"guess must be a {' or '.join(names('split'))} state; got {guess.topology!r}")
-    sysm = ChainBVP(guess.scene, guess.system.chain, control, value)
+    sysm = ChainBVP(guess.scene, guess.system.chain, control, value, model=guess.system.model, par=guess.system.par)
     attach_tip_table(sysm)
     if control == "delta":
         return _continue_in_delta(sysm, guess, None, value, tol=tol, max_nodes=max_nodes, bc_tol=bc_tol)

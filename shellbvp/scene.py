@@ -382,20 +382,17 @@ class Scene:
         v.update(self.material.values())
         return v
 
-    def parameters(self, model=None, *, pole_rise=None) -> np.ndarray:
+    def parameters(self, model=None, *, pole_rise: float = 0.0) -> np.ndarray:
         """Run-time parameter vector in the order of the generated functions.
 
-        ``pole_rise`` (where the indenter finds the pole before indenting, above ``Z(0)``):
-        by default the inflated state's (:func:`shellbvp.inflate`, solved once per scene),
-        0 without pressure.
+        ``pole_rise``: where the indenter finds the pole before indenting, above ``Z(0)``.
+        Under pressure that is the inflated state's, which a system's parameters carry
+        (:func:`shellbvp.inflation.system_parameters` solves it once per scene); a scene
+        itself solves nothing.
         """
         model = model or self.model()
         v = self.values()
-        if pole_rise is None and self.pressure:
-            from .inflation import inflated_pole_rise
-
-            pole_rise = inflated_pole_rise(self)
-        v["pole_rise"] = float(pole_rise or 0.0)
+        v["pole_rise"] = float(pole_rise)
         return np.array([v[name] for name in model.PARAMS], dtype=float)
 
     def enclosed_volume(self) -> float:

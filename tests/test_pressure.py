@@ -314,3 +314,19 @@ def test_corner_edge_with_pressure_keeps_the_energy_identity(delta=0.7):
     assert all(s.success and s.contact_edge == "corner" and s.edge_jump_ls > 0.1 for s in sols)
     dE = (sols[2].energy - sols[0].energy) / (2 * h)
     assert sols[1].force == pytest.approx(dE, rel=1e-7)
+
+
+def test_a_scene_solves_nothing_its_systems_carry_the_inflated_pole_rise(monkeypatch):
+    """Scene.parameters is a value's method (the pole rise as given, 0 by default); building
+    a system of a scene under pressure is where the inflated state is solved (once, cached)."""
+    from shellbvp import inflation
+    from shellbvp.configurations import configuration
+
+    scene = sb.Scene.preset("dome", pressure=0.05)
+    mod = scene.model()
+    rise = inflation.inflate(scene).pole_rise
+    monkeypatch.setattr(inflation, "inflate", lambda *a, **k: pytest.fail("a scene solved its inflated state"))
+    assert scene.parameters(mod)[mod.PARAMS.index("pole_rise")] == 0.0
+    monkeypatch.undo()
+    sysm = configuration("cap").system(scene, "delta", 0.05, 1e-4)
+    assert sysm.par[mod.PARAMS.index("pole_rise")] == rise > 0
