@@ -29,7 +29,7 @@ from .inflation import system_parameters
 from .solution import attach_tip_table
 
 __all__ = ["Configuration", "CONFIGURATIONS", "CONFIGURATION_NAMES", "FAMILIES", "configuration", "names",
-           "register", "family_of", "ASKED"]
+           "register", "family_of", "ASKED", "Switch", "SWITCHES", "switch_between"]
 
 FAMILIES = ("cap", "point", "lifted", "split", "wall")
 #: Start of the point-load state's free region (its own eps; truncation error O(s0^2 ln^2 s0)).
@@ -141,6 +141,41 @@ register(Configuration("cap+band(cylinder)", "wall", ch.cap_band_cylinder_chain,
                        needs_tip_end=True))
 register(Configuration("cap+cylinder", "wall", ch.cylinder_chain, askable=True, needs_tip_end=True))
 register(Configuration("line+corner", "lifted", _lifted(ch.line_kink_chain), contacts=("smooth",)))
+
+@dataclass(frozen=True)
+class Switch:
+    """Where a curve passes from one configuration to a neighbour: the depth at which
+    ``criterion`` of the ``measured_on`` configuration's state crosses zero (``sign`` times it
+    is positive on the side of the first configuration's validity).  Of ``criteria`` the first
+    that both neighbouring points have finite is used (else the last)."""
+
+    between: frozenset
+    measured_on: str
+    criteria: tuple
+    sign: float = 1.0
+
+
+#: The switches a curve locates between neighbouring configurations
+SWITCHES = [
+    # the cap's contact pressure at its edge: where a lifted pole or a split contact takes over
+    *(Switch(frozenset({"cap", other}), "cap", ("pressure_min",)) for other in ("line", "annulus", "cap+line(tip)")),
+    # the lifted pole comes down onto the tip: a cap grows there
+    Switch(frozenset({"line", "cap+line(tip)"}), "line", ("pole_clearance",)),
+    # the line's curvature reaches the indenter's: the line opens into an annulus
+    Switch(frozenset({"line", "annulus"}), "line", ("curvature_excess",), -1.0),
+    # the free shell reaches the cylinder (or the contact the tip's end)
+    *(Switch(frozenset({"cap", wall}), "cap", ("wall_gap", "tip_end_margin"))
+      for wall in ("cap+line(cylinder)", "cap+band(cylinder)", "cap+cylinder")),
+    # the line on the cylinder opens into a band
+    Switch(frozenset({"cap+line(cylinder)", "cap+band(cylinder)"}), "cap+line(cylinder)", ("curvature_excess",), -1.0),
+]
+
+
+def switch_between(a: str, b: str):
+    """The :class:`Switch` between configurations ``a`` and ``b`` (None if there is none)."""
+    pair = frozenset({a, b})
+    return next((s for s in SWITCHES if s.between == pair), None)
+
 
 #: Every configuration's name (``Solution.topology``, a curve's per-point ``topology``)
 CONFIGURATION_NAMES = names()

@@ -23,6 +23,7 @@ import time
 
 import numpy as np
 
+from .configurations import switch_between
 from .cylinder import best_wall_state, wall_contact_suspected, wall_state
 from .io import POINT_FIELDS, Curve, point_record
 from .kernels import LONG_CURVE_POINTS, kernel_set
@@ -498,13 +499,15 @@ def _regula_falsi(a, fa, sa, b, fb, sb, solve_at):
 def _locate_switches(builder: _Builder, st):
     """Add the point where the recorded topology switches between neighbouring points.
 
-    cap <-> line, annulus or cap+line(tip): where the cap's minimum contact pressure crosses
-    zero (the cap state there, pressure >= 0 side; for cap+line(tip) that is where its gap
-    closes).  line <-> cap+line(tip): where the line's lifted cap comes down onto the tip
-    (its penetration crosses zero).  line <-> annulus: where the line's
-    curvature excess over the indenter crosses zero (the line state there).  Both by
-    regula falsi (Illinois); the point is added to an adaptive curve, and every switch
-    is listed in ``settings["topology_switches"]``.
+    Each switch is declared in ``shellbvp.configurations.SWITCHES``: the configuration whose
+    criterion crosses zero there (cap <-> line, annulus or cap+line(tip): the cap's minimum
+    contact pressure; line <-> cap+line(tip): the lifted pole's clearance above the tip;
+    line <-> annulus and the line <-> band on the cylinder: the line's curvature excess over
+    the indenter; cap <-> contact on the cylinder: the free shell's gap to the cylinder, or the
+    contact's margin to the tip's end).  The root is found by regula falsi (Illinois) on that
+    configuration's states; the point is added to an adaptive curve, and every switch is
+    listed in ``settings["topology_switches"]``.  The corner edge and the paper cap held at the
+    tip's end are located from the caps' edge models.
     """
     from .liftoff import solve_liftoff
 
@@ -513,31 +516,24 @@ def _locate_switches(builder: _Builder, st):
     rows = sorted(builder.rows, key=lambda r: r[0])
 
     def cap_at(d, near):
-        sol = _solve_at_delta(scene, d, near, None, st)
-        return (sol, sol.pressure_min) if sol.success else (None, None)
-
-    def line_at(d, near):
-        sol = solve_liftoff(scene, "line", delta=d, guess=near, tol=st["tol"], max_nodes=st["max_nodes"],
-                            bc_tol=st["bc_tol"])
-        return (sol, -sol.curvature_excess) if sol.success else (None, None)
-
-    def line_touch_at(d, near):  # the line whose lifted pole comes down onto the tip
-        sol = solve_liftoff(scene, "line", delta=d, guess=near, tol=st["tol"], max_nodes=st["max_nodes"],
-                            bc_tol=st["bc_tol"])
-        return (_with_pole_clearance(sol), sol.pole_clearance) if sol.success else (None, None)
-
-    def cap_touch_at(d, near):  # the cap whose free shell just touches the cylinder
-        sol = _solve_at_delta(scene, d, near, None, st)
-        return (sol, min(sol.wall_gap, 1.0)) if sol.success else (None, None)  # inf: nothing above the tip end
+        return _solve_at_delta(scene, d, near, None, st)
 
     def cap_end_at(d, near):  # the cap whose contact edge is at the tip's end
-        sol = _solve_at_delta(scene, d, near, None, st)
+        sol = cap_at(d, near)
         return (sol, sol.tip_end_margin) if sol.status in (0, 4) else (None, None)
 
+    def line_at(d, near):
+        return solve_liftoff(scene, "line", delta=d, guess=near, tol=st["tol"], max_nodes=st["max_nodes"],
+                             bc_tol=st["bc_tol"])
+
     def wall_line_at(d, near):
-        sol = wall_state(near, "cap+line(cylinder)", control="delta", value=d, tol=st["tol"],
-                         max_nodes=st["max_nodes"], bc_tol=st["bc_tol"])
-        return (sol, -sol.curvature_excess) if sol.success and not math.isnan(sol.curvature_excess) else (None, None)
+        return wall_state(near, "cap+line(cylinder)", control="delta", value=d, tol=st["tol"],
+                          max_nodes=st["max_nodes"], bc_tol=st["bc_tol"])
+
+    # a configuration's state at a recorded point's depth, and solved at another depth from a neighbour
+    state_of = {"cap": lambda s: _cap_of(s), "line": lambda s: _line_state_at(s, st),
+                "cap+line(cylinder)": lambda s: _wall_line_at(s, st)}
+    solve_on = {"cap": cap_at, "line": line_at, "cap+line(cylinder)": wall_line_at}
 
     for (k1, _, _, s1), (k2, _, _, s2) in zip(rows[:-1], rows[1:]):
         c1, c2 = _cap_of(s1), _cap_of(s2)
@@ -555,47 +551,39 @@ def _locate_switches(builder: _Builder, st):
                             "tip_end_margin")
             continue
         frm, to = s1.topology, s2.topology
-        pair = {frm, to}
-        if not (s1.valid and s2.valid) or frm == to:
+        switch = switch_between(frm, to)
+        if not (s1.valid and s2.valid) or switch is None:
             continue
-        if "cap" in pair and pair & {"line", "annulus", "cap+line(tip)"}:
-            ends, criterion, sign, solve_at = [_cap_of(s1), _cap_of(s2)], "pressure_min", 1.0, cap_at
-        elif pair == {"line", "cap+line(tip)"}:  # the lifted pole touches down: a cap grows there
-            ends = [_with_pole_clearance(s if s.topology == "line" else _line_state_at(s, st))
-                    for s in (s1, s2)]
-            criterion, sign, solve_at = "pole_clearance", 1.0, line_touch_at
-        elif pair == {"line", "annulus"}:
-            ends = [s if s.topology == "line" else _line_state_at(s, st) for s in (s1, s2)]
-            criterion, sign, solve_at = "curvature_excess", -1.0, line_at
-        elif "cap" in pair and pair & {"cap+line(cylinder)", "cap+band(cylinder)", "cap+cylinder"}:
-            ends = [_cap_of(s1), _cap_of(s2)]
-            if any(e is None for e in ends):
-                continue
-            if all(math.isfinite(e.wall_gap) for e in ends):  # the shell reaches the wall
-                criterion, sign, solve_at = "wall_gap", 1.0, cap_touch_at
-            else:  # the contact reaches the tip's end
-                criterion, sign, solve_at = "tip_end_margin", 1.0, cap_end_at
-        elif pair == {"cap+line(cylinder)", "cap+band(cylinder)"}:
-            ends = [s if s.topology == "cap+line(cylinder)" else
-                    _wall_line_at(s, st) for s in (s1, s2)]
-            criterion, sign, solve_at = "curvature_excess", -1.0, wall_line_at
-        else:
-            continue
-        if criterion == "pole_clearance" and (any(e is None for e in ends)
-                                              or not ends[0].pole_clearance * ends[1].pole_clearance < 0):
-            # a line recorded as valid may have its pole down on the tip already (to 10 tol), and the
-            # split state may have no line at its depth: the touch-down then lies between two of the
-            # line points before it
-            bracket = _touchdown_bracket([r[3] for r in rows], min(s1.delta, s2.delta))
-            if bracket is not None:  # the switch point goes between those two, in branch order
-                ends = list(bracket)
-                k1, k2 = (next(r[0] for r in rows if r[3] is e) for e in bracket)
+        on = switch.measured_on
+        ends = [s if s.topology == on else state_of[on](s) for s in (s1, s2)]
+        if switch.criteria == ("pole_clearance",):
+            ends = [_with_pole_clearance(e) for e in ends]
+            if any(e is None for e in ends) or not ends[0].pole_clearance * ends[1].pole_clearance < 0:
+                # a line recorded as valid may have its pole down on the tip already (to 10 tol), and the
+                # split state may have no line at its depth: the touch-down then lies between two of the
+                # line points before it
+                bracket = _touchdown_bracket([r[3] for r in rows], min(s1.delta, s2.delta))
+                if bracket is not None:  # the switch point goes between those two, in branch order
+                    ends = list(bracket)
+                    k1, k2 = (next(r[0] for r in rows if r[3] is e) for e in bracket)
         if any(e is None for e in ends):
             continue
+        criterion = next((c for c in switch.criteria if all(math.isfinite(getattr(e, c)) for e in ends)),
+                         switch.criteria[-1])
         e1, e2 = sorted(ends, key=lambda e: e.delta)
-        f1, f2 = (sign * (min(getattr(e, criterion), 1.0) if criterion == "wall_gap" else getattr(e, criterion)) for e in (e1, e2))
+        f1, f2 = (switch.sign * _criterion_value(e, criterion) for e in (e1, e2))
         if not f1 * f2 < 0:
             continue
+
+        def solve_at(d, near, solve=solve_on[on], criterion=criterion, sign=switch.sign):
+            sol = solve(d, near)
+            usable = sol.status in (0, 4) if criterion == "tip_end_margin" else sol.success
+            if usable and criterion == "pole_clearance":
+                _with_pole_clearance(sol)
+            if not usable or math.isnan(_criterion_value(sol, criterion)):
+                return None, None
+            return sol, sign * _criterion_value(sol, criterion)
+
         best = _regula_falsi(e1.delta, f1, e1, e2.delta, f2, e2, solve_at)
         _add_switch(builder, st, switches, best, frm, to, k1, k2, criterion)
 
@@ -705,6 +693,13 @@ def _line_state_at(sol, st):
         return None
     line = liftoff_state(cap, "line", tol=st["tol"], max_nodes=st["max_nodes"], bc_tol=st["bc_tol"])
     return line if line.success and not math.isnan(line.curvature_excess) else None
+
+
+def _criterion_value(state, criterion):
+    """A switch criterion of a state; ``wall_gap`` is inf where nothing is above the tip's end:
+    capped at 1."""
+    value = getattr(state, criterion)
+    return min(value, 1.0) if criterion == "wall_gap" else value
 
 
 def _add_switch(builder, st, switches, best, frm, to, k1, k2, criterion):

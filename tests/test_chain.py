@@ -265,3 +265,18 @@ def test_every_configuration_is_registered_once_with_its_system():
         cf.configuration("point").system(scene, "force", 0.2, EPS)
     with pytest.raises(ValueError, match="needs contact='smooth'"):  # before any solve
         sb.solve(sb.Scene.preset("base", contact="paper"), delta=0.9, topology="cap+band(cylinder)")
+
+
+def test_every_switch_joins_registered_configurations_on_a_field_of_their_states():
+    import dataclasses
+
+    from shellbvp import configurations as cf
+    from shellbvp.solution import Solution
+
+    fields = {f.name for f in dataclasses.fields(Solution)}
+    for sw in cf.SWITCHES:
+        a, b = sorted(sw.between)
+        assert {a, b} <= set(cf.CONFIGURATION_NAMES) and sw.measured_on in sw.between
+        assert set(sw.criteria) <= fields and sw.sign in (1.0, -1.0)
+        assert cf.switch_between(a, b) is sw is cf.switch_between(b, a)
+    assert cf.switch_between("cap", "cap") is None and cf.switch_between("point", "line") is None
