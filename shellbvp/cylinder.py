@@ -156,47 +156,73 @@ def _touch_point(cap):
     return float(S[i]), float(_wall_omega(sysm, f["z"][i:i + 1], cap.z_tip)[0])
 
 
+def _unknowns(state):
+    return dict(zip(state.system.unknowns, state.p))
+
+
+def _cap_to_cylinder(sysm, cap):
+    Sc = cap.Sc
+    return [transfer_guess(sysm, cap, ln_Send=math.log(a * Sc), ln_Sc=math.log(b * Sc)) for a, b in _CAP_SPLITS]
+
+
+def _cap_to_wall_line(sysm, cap):
+    S1, w1 = _touch_point(cap)
+    return [transfer_guess(sysm, cap, ln_Sc=math.log(cap.Sc), ln_S1=math.log(S1), chi1=cap.scene.rho * w1 / S1)]
+
+
+def _cap_to_band(sysm, cap):
+    S1, _ = _touch_point(cap)
+    return [transfer_guess(sysm, cap, ln_Sc=math.log(cap.Sc), ln_S1=math.log(S1 * (1 - _BAND_HALF_WIDTH)),
+                           ln_S2=math.log(S1 * (1 + _BAND_HALF_WIDTH)))]
+
+
+def _wall_line_to_band(sysm, line):
+    q = _unknowns(line)
+    S1 = math.exp(q["ln_S1"])
+    return [transfer_guess(sysm, line, ln_Sc=q["ln_Sc"], ln_S1=math.log(S1 * (1 - w)), ln_S2=math.log(S1 * (1 + w)))
+            for w in _BAND_FROM_LINE_HALF_WIDTHS]
+
+
+def _band_to_cylinder(sysm, band):
+    q = _unknowns(band)
+    Sc, S1, S2 = (math.exp(q[k]) for k in ("ln_Sc", "ln_S1", "ln_S2"))
+    return [transfer_guess(sysm, band, ln_Send=math.log(0.5 * (Sc + S1)), ln_Sc=math.log(S2))]
+
+
+def _band_to_wall_line(sysm, band):
+    q = _unknowns(band)
+    S1 = math.sqrt(math.exp(q["ln_S1"] + q["ln_S2"]))
+    w1 = float(_fields_at(band, np.array([S1]))["omega"][0])
+    return [transfer_guess(sysm, band, ln_Sc=q["ln_Sc"], ln_S1=math.log(S1), chi1=band.scene.rho * w1 / S1)]
+
+
+def _cylinder_to_band(sysm, state):
+    q = _unknowns(state)
+    Se, Sc = math.exp(q["ln_Send"]), math.exp(q["ln_Sc"])
+    return [transfer_guess(sysm, state, ln_Sc=math.log(0.98 * Se), ln_S1=math.log(1.02 * Se), ln_S2=math.log(Sc))]
+
+
+#: How a wall configuration is guessed from a state of another: {(from, to): guesses}
+_GUESSES = {
+    ("cap", "cap+cylinder"): _cap_to_cylinder,
+    ("cap", "cap+line(cylinder)"): _cap_to_wall_line,
+    ("cap", "cap+band(cylinder)"): _cap_to_band,
+    ("cap+line(cylinder)", "cap+band(cylinder)"): _wall_line_to_band,
+    ("cap+band(cylinder)", "cap+cylinder"): _band_to_cylinder,
+    ("cap+band(cylinder)", "cap+line(cylinder)"): _band_to_wall_line,
+    ("cap+cylinder", "cap+band(cylinder)"): _cylinder_to_band,
+}
+
+
 def _guesses(sysm, start):
     """Guesses for ``sysm`` from ``start`` (a cap, or a wall state of this or a neighbouring
-    configuration), best first."""
-    topo, src = sysm.topology, start.topology
-    if src == topo:
+    configuration), best first; none where no transition is known."""
+    if start.topology == sysm.topology:  # a warm start
         x = warm_mesh(start)
-        q = dict(zip(start.system.unknowns, start.p), lambda0=start.lambda0, delta=start.delta)
+        q = dict(_unknowns(start), lambda0=start.lambda0, delta=start.delta)
         return [(x, start.sol(x), sysm.pack(**q))]
-    out = []
-    if src == "cap":
-        Sc = start.Sc
-        if topo == "cap+cylinder":
-            return [transfer_guess(sysm, start, ln_Send=math.log(a * Sc), ln_Sc=math.log(b * Sc))
-                    for a, b in _CAP_SPLITS]
-        S1, w1 = _touch_point(start)
-        if topo == "cap+line(cylinder)":
-            out.append(transfer_guess(sysm, start, ln_Sc=math.log(Sc), ln_S1=math.log(S1),
-                                      chi1=start.scene.rho * w1 / S1))
-        else:  # band
-            out.append(transfer_guess(sysm, start, ln_Sc=math.log(Sc), ln_S1=math.log(S1 * (1 - _BAND_HALF_WIDTH)),
-                                      ln_S2=math.log(S1 * (1 + _BAND_HALF_WIDTH))))
-    elif src == "cap+line(cylinder)" and topo == "cap+band(cylinder)":
-        q = dict(zip(start.system.unknowns, start.p))
-        S1 = math.exp(q["ln_S1"])
-        out += [transfer_guess(sysm, start, ln_Sc=q["ln_Sc"], ln_S1=math.log(S1 * (1 - w)), ln_S2=math.log(S1 * (1 + w)))
-                for w in _BAND_FROM_LINE_HALF_WIDTHS]
-    elif src == "cap+band(cylinder)" and topo == "cap+cylinder":
-        q = dict(zip(start.system.unknowns, start.p))
-        Sc, S1, S2 = (math.exp(q[k]) for k in ("ln_Sc", "ln_S1", "ln_S2"))
-        out.append(transfer_guess(sysm, start, ln_Send=math.log(0.5 * (Sc + S1)), ln_Sc=math.log(S2)))
-    elif src == "cap+band(cylinder)" and topo == "cap+line(cylinder)":
-        q = dict(zip(start.system.unknowns, start.p))
-        S1 = math.sqrt(math.exp(q["ln_S1"] + q["ln_S2"]))
-        w1 = float(_fields_at(start, np.array([S1]))["omega"][0])
-        out.append(transfer_guess(sysm, start, ln_Sc=q["ln_Sc"], ln_S1=math.log(S1), chi1=start.scene.rho * w1 / S1))
-    elif src == "cap+cylinder" and topo == "cap+band(cylinder)":
-        q = dict(zip(start.system.unknowns, start.p))
-        Se, Sc = math.exp(q["ln_Send"]), math.exp(q["ln_Sc"])
-        out.append(transfer_guess(sysm, start, ln_Sc=math.log(0.98 * Se), ln_S1=math.log(1.02 * Se),
-                                  ln_S2=math.log(Sc)))
-    return out
+    guesses = _GUESSES.get((start.topology, sysm.topology))
+    return [] if guesses is None else guesses(sysm, start)
 
 
 # -- solving and choosing ---------------------------------------------------------------------------
