@@ -94,6 +94,7 @@ class Timers:
 
         import shellbvp.chain
         import shellbvp.continuation
+        import shellbvp.steps
         import shellbvp.state
         from shellbvp.kernels import kernel_set
 
@@ -104,7 +105,7 @@ class Timers:
             self.wrap(bvp, name, LINALG)
         self.wrap(shellbvp.state, "diagnose", DIAGNOSIS)
         self.wrap(shellbvp.continuation, "richardson_error", ESTIMATES)
-        self.wrap(shellbvp.continuation, "_quadratic", PREDICTOR)
+        self.wrap(shellbvp.steps, "quadratic_guess", PREDICTOR)
         active = kernel_set(scene.model(), scene.structure).active
         model = scene.model()
         for mod in {id(active): active, id(model): model}.values():

@@ -102,7 +102,7 @@ VARIANTS = {
     "this commit": ("new", {}, {}, NUMPY),
     "this commit, numba": ("new", {}, {}, NUMBA),
     "cold lift-off": ("new", {"shellbvp.liftoff": {"_WARM_FIRST": False}}, {}, NUMPY),
-    "no secant guard": ("new", {"shellbvp.continuation": {"SECANT_MAX_LN_SC": math.inf}}, {}, NUMPY),
+    "no secant guard": ("new", {"shellbvp.steps": {"SECANT_MAX_LN_SC": math.inf}}, {}, NUMPY),
     "full Richardson": ("new", {}, {"estimate_error": "full"}, NUMPY),
     "no split rule": ("new", {"shellbvp.liftoff": {"_SPLIT_RULE": False}}, {}, NUMPY),
     "annulus before split": ("new", {"shellbvp.liftoff": {"_SPLIT_FIRST": False}}, {}, NUMPY),

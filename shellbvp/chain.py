@@ -320,8 +320,9 @@ class ChainBVP:
     model : module, optional
         The scene's generated module (loaded if not given).
     par : array, optional
-        Its run-time parameters (default: ``shellbvp.inflation.system_parameters``, the
-        scene's with the inflated state's pole rise under pressure).
+        Its run-time parameters; default ``scene.parameters(model)``, without pressure only:
+        under pressure they carry the inflated state's pole rise
+        (``shellbvp.inflation.system_parameters``), which a configuration's system passes.
     volume_control : bool, optional
         The pressure as an unknown with the enclosed volume held at ``scene.enclosed_volume()``
         (default: ``scene.sealed``).
@@ -332,11 +333,11 @@ class ChainBVP:
             raise ValueError(f"control must be one of {CONTROLS}; got {control!r}")
         self.scene, self.chain, self.control = scene, chain, control
         self.model = mod = model if model is not None else scene.model()
-        if par is None:
-            from .inflation import system_parameters  # (inflation builds its own systems from this module)
-
-            par = system_parameters(scene, mod)
-        self.par = np.asarray(par, float)
+        if par is None and scene.pressure:
+            raise ValueError("par is needed for a scene under pressure: its run-time parameters with the inflated "
+                             "state's pole rise (shellbvp.inflation.system_parameters; a configuration's system "
+                             "passes them)")
+        self.par = scene.parameters(mod) if par is None else np.asarray(par, float)
         self.regions = chain.regions
         self._bind()
         self.sizes = [SIZES[r.kind] for r in chain.regions]

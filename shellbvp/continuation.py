@@ -23,8 +23,7 @@ import time
 
 import numpy as np
 
-from .configurations import switch_between
-from .cylinder import best_wall_state, wall_contact_suspected, wall_state
+from .cylinder import best_wall_state, wall_contact_suspected
 from .io import POINT_FIELDS, Curve, point_record
 from .kernels import LONG_CURVE_POINTS, kernel_set
 from .liftoff import (
@@ -37,12 +36,13 @@ from .liftoff import (
     replace_invalid_cap,
 )
 from .pointload import SC_POINT, solve_point_load
-from .solution import (SECANT_MAX_RATIO, Solution, calibrated_error, default_eps, passed_tip_end, richardson_error,
-                       secant_ratio, warm_mesh)
-from .corner import LEGENDRE_WATCH, edge_model, is_corner, limit_estimate, near_limit
+from .solution import Solution, calibrated_error, default_eps, passed_tip_end, richardson_error
+from .corner import LEGENDRE_WATCH, edge_model, limit_estimate, near_limit
 from .march import Steps, march
 from .state import check_delta, check_tol, cross_convexity_limit, make_system, solve, solve_from, system_like, \
     warm_guess
+from .steps import configuration_key, secant_guess, solve_at_delta, step_nodes
+from .switches import locate_switches
 from .version import __version__ as VERSION
 
 __all__ = ["curve"]
@@ -178,7 +178,7 @@ def curve(scene, delta_max: float = 0.5, *, deltas=None, force_max=None, lambda0
     settings["after_last_point_s"] = time.perf_counter() - (builder.last_accepted or t0)
     if topology == "auto" and not out.interrupted:
         try:
-            _locate_switches(builder, settings)
+            locate_switches(builder, settings)
         except KeyboardInterrupt:
             out.interrupted = True
     builder.finish()
@@ -210,10 +210,6 @@ def _error_mode(estimate_error):
     if isinstance(estimate_error, str) and estimate_error == "full":
         return "full"
     raise ValueError(f'estimate_error must be "auto" (or True), "full" or False; got {estimate_error!r}')
-
-
-def _configuration(sol):
-    return sol.topology, sol.contact_edge
 
 
 class _Builder:
@@ -296,7 +292,7 @@ class _Builder:
         """Accept a point; ``key`` orders points along the branch."""
         sol = self._shown(sol)
         if self.estimate_error and sol.success:
-            configuration = _configuration(sol)
+            configuration = configuration_key(sol)
             # point-load states too: their F error per unit residual scatters (flat preset at
             # 0.0065: a calibrated 5.4e-7 for a true 2.1e-6), and only a Richardson estimate
             # lets a point above tol be tightened
@@ -369,7 +365,7 @@ class _Builder:
             fine = solve_from(sol.system, (sol.x, sol.y, sol.p), tol=tol, max_nodes=st["max_nodes"],
                               bc_tol=st["bc_tol"])
         if not (fine.success and fine.valid == sol.valid
-                and _configuration(fine) == _configuration(sol)):
+                and configuration_key(fine) == configuration_key(sol)):
             return None
         richardson_error(fine.system, fine, tol)
         fine.error_method = "richardson"
@@ -385,7 +381,7 @@ class _Builder:
         next to another configuration.
         """
         rows = sorted((r for r in self.rows if r[3].error_method), key=lambda r: r[0])
-        configurations = [_configuration(r[3]) for r in rows]
+        configurations = [configuration_key(r[3]) for r in rows]
         if final and not self.out.interrupted:
             for i, (_, _, _, sol) in enumerate(rows):
                 at_edge = i in (0, len(rows) - 1) or configurations[i - 1] != configurations[i] \
@@ -438,279 +434,6 @@ class _Builder:
         self.out.solutions = [r[3] for r in rows]
 
 
-def _cap_of(sol):
-    """The single-cap state behind a recorded point (itself, or the cap it replaced)."""
-    if sol.topology == "cap":
-        return sol
-    return sol.cap_solution
-
-
-def _secant_distance(d, f, last):
-    """|d - root| by the secant through (d, f) and ``last`` = (d0, f0); inf without a slope."""
-    d0, f0 = last
-    return abs(f * (d - d0) / (f - f0)) if f != f0 and d != d0 else math.inf
-
-
-def _regula_falsi(a, fa, sa, b, fb, sb, solve_at):
-    """Root of f(delta) between a and b (Illinois); returns the last state with f >= 0: where
-    the bracket is below 1e-7 (1 + delta) wide, or where the secant puts that state within a
-    tenth of it from the root.
-
-    Where ``solve_at`` finds no state (e.g. the cap's contact has passed the tip's end, just
-    beyond a wall touch; beta 1e-3, paper model), that delta is taken as beyond the root: it
-    replaces the end where f < 0 (whose f stays as a proxy) and the next point bisects."""
-    best = sa if fa >= 0 else sb
-    side = 0
-    bisect, failures = False, 0
-    last = (a, fa) if abs(fa) < abs(fb) else (b, fb)  # the latest true value of f (Illinois halves the ends')
-    for _ in range(40):
-        d = 0.5 * (a + b) if bisect else (a * fb - b * fa) / (fb - fa)
-        sol, f = solve_at(d, sa if abs(d - a) < abs(d - b) else sb)
-        bisect = sol is None
-        if sol is None:
-            failures += 1
-            if fa < 0:
-                a = d
-            else:
-                b = d
-            side = 0
-        else:
-            if f >= 0:
-                best = sol
-                # the secant through the last two values puts the root within a tenth of the
-                # tolerance of this state: another solve would only confirm it (2 of 9 solves
-                # of base d40's two switch searches)
-                if _secant_distance(d, f, last) < 1e-8 * (1 + abs(d)):
-                    break
-            last = (d, f)
-            if f * fb > 0:
-                b, fb, sb = d, f, sol
-                fa = fa / 2 if side == -1 else fa
-                side = -1
-            else:
-                a, fa, sa = d, f, sol
-                fb = fb / 2 if side == 1 else fb
-                side = 1
-        if failures > 3 or abs(b - a) < 1e-7 * (1 + abs(d)) or f == 0:  # on delta: criteria's slopes differ
-            break
-    return best
-
-
-def _locate_switches(builder: _Builder, st):
-    """Add the point where the recorded topology switches between neighbouring points.
-
-    Each switch is declared in ``shellbvp.configurations.SWITCHES``: the configuration whose
-    criterion crosses zero there (cap <-> line, annulus or cap+line(tip): the cap's minimum
-    contact pressure; line <-> cap+line(tip): the lifted pole's clearance above the tip;
-    line <-> annulus and the line <-> band on the cylinder: the line's curvature excess over
-    the indenter; cap <-> contact on the cylinder: the free shell's gap to the cylinder, or the
-    contact's margin to the tip's end).  The root is found by regula falsi (Illinois) on that
-    configuration's states; the point is added to an adaptive curve, and every switch is
-    listed in ``settings["topology_switches"]``.  The corner edge and the paper cap held at the
-    tip's end are located from the caps' edge models.
-    """
-    from .liftoff import solve_liftoff
-
-    scene = builder.out.scene
-    switches = st.setdefault("topology_switches", [])
-    rows = sorted(builder.rows, key=lambda r: r[0])
-
-    def cap_at(d, near):
-        return _solve_at_delta(scene, d, near, None, st)
-
-    def cap_end_at(d, near):  # the cap whose contact edge is at the tip's end
-        sol = cap_at(d, near)
-        return (sol, sol.tip_end_margin) if sol.status in (0, 4) else (None, None)
-
-    def line_at(d, near):
-        return solve_liftoff(scene, "line", delta=d, guess=near, tol=st["tol"], max_nodes=st["max_nodes"],
-                             bc_tol=st["bc_tol"])
-
-    def wall_line_at(d, near):
-        return wall_state(near, "cap+line(cylinder)", control="delta", value=d, tol=st["tol"],
-                          max_nodes=st["max_nodes"], bc_tol=st["bc_tol"])
-
-    # a configuration's state at a recorded point's depth, and solved at another depth from a neighbour
-    state_of = {"cap": lambda s: _cap_of(s), "line": lambda s: _line_state_at(s, st),
-                "cap+line(cylinder)": lambda s: _wall_line_at(s, st)}
-    solve_on = {"cap": cap_at, "line": line_at, "cap+line(cylinder)": wall_line_at}
-
-    for (k1, _, _, s1), (k2, _, _, s2) in zip(rows[:-1], rows[1:]):
-        c1, c2 = _cap_of(s1), _cap_of(s2)
-        if c1 is not None and c2 is not None and c1.success and c2.success \
-                and (edge_model(c1), edge_model(c2)) == ("smooth", "corner"):
-            switches.append(locate_corner_switch(c1, c2, st))
-            continue
-        if s1.valid and s2.valid and (edge_model(s1), edge_model(s2)) == ("paper", "pinned"):
-            # the free cap's edge reaches the tip's end: from the caps either side of it
-            ends = [s1, s2.cap_solution]
-            if ends[1] is not None and ends[1].status in (0, 4) and ends[0].tip_end_margin > 0 > ends[1].tip_end_margin:
-                best = _regula_falsi(ends[0].delta, ends[0].tip_end_margin, ends[0], ends[1].delta,
-                                     ends[1].tip_end_margin, ends[1], cap_end_at)
-                _add_switch(builder, st, switches, best, "cap", "cap (pinned at the tip's end)", k1, k2,
-                            "tip_end_margin")
-            continue
-        frm, to = s1.topology, s2.topology
-        switch = switch_between(frm, to)
-        if not (s1.valid and s2.valid) or switch is None:
-            continue
-        on = switch.measured_on
-        ends = [s if s.topology == on else state_of[on](s) for s in (s1, s2)]
-        if switch.criteria == ("pole_clearance",):
-            ends = [_with_pole_clearance(e) for e in ends]
-            if any(e is None for e in ends) or not ends[0].pole_clearance * ends[1].pole_clearance < 0:
-                # a line recorded as valid may have its pole down on the tip already (to 10 tol), and the
-                # split state may have no line at its depth: the touch-down then lies between two of the
-                # line points before it
-                bracket = _touchdown_bracket([r[3] for r in rows], min(s1.delta, s2.delta))
-                if bracket is not None:  # the switch point goes between those two, in branch order
-                    ends = list(bracket)
-                    k1, k2 = (next(r[0] for r in rows if r[3] is e) for e in bracket)
-        if any(e is None for e in ends):
-            continue
-        criterion = next((c for c in switch.criteria if all(math.isfinite(getattr(e, c)) for e in ends)),
-                         switch.criteria[-1])
-        e1, e2 = sorted(ends, key=lambda e: e.delta)
-        f1, f2 = (switch.sign * _criterion_value(e, criterion) for e in (e1, e2))
-        if not f1 * f2 < 0:
-            continue
-
-        def solve_at(d, near, solve=solve_on[on], criterion=criterion, sign=switch.sign):
-            sol = solve(d, near)
-            usable = sol.status in (0, 4) if criterion == "tip_end_margin" else sol.success
-            if usable and criterion == "pole_clearance":
-                _with_pole_clearance(sol)
-            if not usable or math.isnan(_criterion_value(sol, criterion)):
-                return None, None
-            return sol, sign * _criterion_value(sol, criterion)
-
-        best = _regula_falsi(e1.delta, f1, e1, e2.delta, f2, e2, solve_at)
-        _add_switch(builder, st, switches, best, frm, to, k1, k2, criterion)
-
-
-def locate_corner_switch(smooth, corner, st, h=0.003):
-    """Where the corner takes over from the smooth cap, located from both sides.
-
-    From the smooth side: the depth where edge_legendre reaches 0 (quadratic through smooth
-    caps at delta* - h, - 2h, - 3h, delta* first estimated linearly); from the corner side:
-    where the jump of lambda_s at the edge reaches 0 (quadratic through three corner caps h
-    apart from the first found past the limit, stepping away from it: Newton does not
-    converge stepping from a corner towards the limit).  They agree when the corner grows
-    out of the smooth branch (a continuous switch); F and E extrapolated from each side give
-    their jumps at the switch.
-    """
-    kw = dict(tol=st["tol"], max_nodes=_step_nodes(smooth, st), bc_tol=st["bc_tol"])  # fail fast
-    sysm = system_like(smooth, "delta", 0.98 * smooth.delta, st["eps"])
-    d0 = limit_estimate(solve_from(sysm, warm_guess(sysm, smooth), **kw), smooth)
-    d0 = d0 if d0 is not None and smooth.delta < d0 < corner.delta else 0.5 * (smooth.delta + corner.delta)
-    lo = [smooth]
-    for d in sorted((d0 - k * h for k in (1, 2, 3)), key=lambda d: abs(d - smooth.delta)):
-        sysm = system_like(lo[-1], "delta", d, st["eps"])
-        s = solve_from(sysm, warm_guess(sysm, lo[-1]), **kw)
-        if s.success and edge_model(s) == "smooth":
-            lo.append(s)
-    lo = sorted(lo[1:], key=lambda s: s.delta)
-    first = cross_convexity_limit(lo[-1], lo[0] if len(lo) > 1 else None, d0 + h, eps=st["eps"], exact=False,
-                                  **kw) if lo else None
-    hi = [first] if first is not None and is_corner(first, st["tol"]) else []
-    for k in (1, 2):
-        if hi:
-            sysm = system_like(hi[-1], "delta", hi[0].delta + k * h, st["eps"])
-            s = solve_from(sysm, warm_guess(sysm, hi[-1]), **kw)
-            if is_corner(s, st["tol"]):
-                hi.append(s)
-
-    def root(states, key):
-        x = np.array([s.delta for s in states])
-        yv = np.array([getattr(s, key) for s in states])
-        c = np.polyfit(x, yv, min(2, len(x) - 1))
-        r = np.roots(c)
-        r = r[np.isreal(r)].real
-        return float(r[np.argmin(np.abs(r - d0))]) if r.size else math.nan
-
-    def value_at(states, key, d):
-        x = np.array([s.delta for s in states])
-        return float(np.polyval(np.polyfit(x, [getattr(s, key) for s in states], min(2, len(x) - 1)), d))
-
-    d_smooth = root(lo, "edge_legendre") if len(lo) >= 2 else math.nan
-    d_corner = root(hi, "edge_jump_ls") if len(hi) >= 2 else math.nan
-    d_star = d_smooth if math.isfinite(d_smooth) else d_corner
-    f_lo, f_hi, e_lo, e_hi = (value_at(states, key, d_star) if len(states) >= 2 else math.nan
-                              for key in ("force", "energy") for states in (lo, hi))
-    if not (math.isfinite(d_smooth) and math.isfinite(d_corner)):
-        kind = "not determined (the states either side of the limit did not converge)"
-    elif abs(d_smooth - d_corner) <= 1e-2 * d_star:
-        kind = "continuous: the corner grows from a zero jump at the convexity limit"
-    else:
-        kind = "first-order: the corner appears with a finite jump"
-    log.info("switch to the corner edge at delta = %.6g (%s)", d_star, kind)
-    return {"delta": d_star, "force": f_lo, "from": "cap", "to": "cap (corner edge)", "criterion": "edge_legendre",
-            "value": 0.0, "kind": kind, "delta_from_jump": d_corner, "force_jump": f_hi - f_lo,
-            "energy_jump": e_hi - e_lo,
-            "jump_ls_after": float(corner.edge_jump_ls)}
-
-
-def _wall_line_at(sol, st):
-    """The cap+line(cylinder) state at a band point's delta (from the band), or None."""
-    line = wall_state(sol, "cap+line(cylinder)", tol=st["tol"], max_nodes=st["max_nodes"], bc_tol=st["bc_tol"])
-    return line if line.success and not math.isnan(line.curvature_excess) else None
-
-
-def _touchdown_bracket(states, delta):
-    """The two line states, not deeper than ``delta``, between which a line's lifted pole comes
-    down onto the tip (its clearance crosses zero), or None."""
-    lines = sorted((_with_pole_clearance(s) for s in states
-                    if s.topology == "line" and s.success and s.delta <= delta),
-                   key=lambda s: s.delta)
-    for a, b in reversed(list(zip(lines[:-1], lines[1:]))):
-        if a.pole_clearance > 0 > b.pole_clearance:
-            return a, b
-    return None
-
-
-def _with_pole_clearance(line):
-    """``line`` with its ``pole_clearance`` set (None passes).  The touch-down of a lifted pole
-    is located on this gap, which closes transversally, not on the free shell's penetration:
-    that one is the largest over the shell and sits at the contact line, where the shell
-    touches tangentially, so near zero it is noise at the tabulated tip's accuracy."""
-    from .liftoff import pole_clearance
-
-    if line is not None and math.isnan(line.pole_clearance):
-        line.pole_clearance = pole_clearance(line)
-    return line
-
-
-def _line_state_at(sol, st):
-    """The line state at a lift-off point's delta (the one its search converged, else from its
-    cap), or None."""
-    from .liftoff import liftoff_state
-
-    line = sol.line_state
-    if line is not None and line.success and not math.isnan(line.curvature_excess) and line.delta == sol.delta:
-        return line
-    cap = _cap_of(sol)
-    if cap is None:
-        return None
-    line = liftoff_state(cap, "line", tol=st["tol"], max_nodes=st["max_nodes"], bc_tol=st["bc_tol"])
-    return line if line.success and not math.isnan(line.curvature_excess) else None
-
-
-def _criterion_value(state, criterion):
-    """A switch criterion of a state; ``wall_gap`` is inf where nothing is above the tip's end:
-    capped at 1."""
-    value = getattr(state, criterion)
-    return min(value, 1.0) if criterion == "wall_gap" else value
-
-
-def _add_switch(builder, st, switches, best, frm, to, k1, k2, criterion):
-    switches.append({"delta": float(best.delta), "force": float(best.force), "from": frm, "to": to,
-                     "criterion": criterion, "value": float(getattr(best, criterion))})
-    log.info("topology switch %s -> %s at delta = %.6g", frm, to, best.delta)
-    already = any(abs(r[3].delta - best.delta) <= 1e-12 * (1 + best.delta) for r in builder.rows)
-    if st["mode"] == "adaptive" and not already:  # a curve at requested depths keeps exactly those
-        builder.add(best, 0.5 * (k1 + k2))
-
-
 def _first_point(scene, delta, settings):
     sol = solve(scene, delta=delta, tol=settings["tol"], max_nodes=settings["max_nodes"],
                 estimate_error=False, topology="cap")  # the branch followed is the cap's
@@ -755,96 +478,6 @@ def _physical_end(sol):
     return None
 
 
-#: The secant predictor of a delta step is linear in ln Sc; it is used only while it moves
-#: ln Sc by at most this much.  Near the point-load limit the cap grows exponentially (base:
-#: Sc = 9e-12, 2e-6, 1e-4 at delta = 0.0125, 0.025, 0.0375), the secant overshoots by orders
-#: of magnitude and the step fails at the node budget; the plain warm start converges.
-SECANT_MAX_LN_SC = 1.0
-
-
-def _solve_at_delta(scene, delta, prev, prev2, settings, prev3=None):
-    """Delta-controlled solve warm-started from prev: with the quadratic predictor through
-    prev, prev2 and prev3 where it applies, else the secant through prev and prev2."""
-    if prev.topology == "point":
-        return _step_from_point(scene, delta, prev, settings)
-    sysm = system_like(prev, "delta", delta, settings["eps"])
-    guess = None
-    a = secant_ratio(delta, prev, prev2)
-    if a is not None and prev2.topology != "point" and edge_model(prev2) == edge_model(prev) \
-            and abs(a * (prev.p[0] - prev2.p[0])) <= SECANT_MAX_LN_SC:
-        guess = _quadratic(sysm, (prev, prev2, prev3), delta) or _secant(sysm, prev, prev2, a)
-    if guess is None:
-        guess = warm_guess(sysm, prev)
-    kw = dict(tol=settings["tol"], max_nodes=_step_nodes(prev, settings), bc_tol=settings["bc_tol"])
-    sol = solve_from(sysm, guess, **kw)
-    if not sol.success and delta > prev.delta and near_limit(prev):
-        sol = cross_convexity_limit(prev, prev2, delta, eps=settings["eps"], **kw) or sol
-    return sol
-
-
-def _step_from_point(scene, delta, prev, settings):
-    """A step from a point-load state (no cap to warm-start from).  Deeper, the cap may
-    come back within double precision: a cold solve finds the cap there, or the point-load
-    limit again; shallower, the point-load limit from ``prev``."""
-    if delta > prev.delta:  # (solve takes a point-load guess for its point-load limit only)
-        return solve(scene, delta=delta, guess=prev, tol=settings["tol"], max_nodes=settings["max_nodes"],
-                     bc_tol=settings["bc_tol"], estimate_error=False, topology="cap")
-    return solve_point_load(scene, delta, tol=settings["tol"], max_nodes=settings["max_nodes"], guess=prev)
-
-
-def _step_nodes(prev, settings):
-    """Node budget of one continuation step: a few times the previous mesh, so that a
-    step towards a singularity (e.g. a boundary layer forming) fails fast and is halved."""
-    return int(min(settings["max_nodes"], max(2000, 4 * prev.nodes)))
-
-
-#: The quadratic predictor of a step of natural continuation in delta: where three converged
-#: states of one configuration precede it, their quadratic in delta, extrapolated.  Its error is
-#: a step's cube, the secant's its square: on the cap curves through shooting's depths
-#: (benchmarks/speed_vs_baseline.py) solve_bvp's Newton takes 15-20 % fewer steps.  Not on the
-#: adaptive curve's arclength steps, whose steps grow: there the chord length as the parameter
-#: saved 2-6 % of the steps and cost a Jacobian more on 4 of 6 presets.
-QUADRATIC_PREDICTOR = True
-
-
-def _quadratic(sysm, states, at):
-    """Guess at delta = ``at`` from the quadratic in delta through ``states`` (three, newest
-    first), on the newest one's warm-start mesh; None where it does not apply: a missing state
-    or one of another configuration, depths not monotone towards ``at``, a step more than
-    ``SECANT_MAX_RATIO`` times the one before, or ln Sc moved by more than ``SECANT_MAX_LN_SC``
-    (the secant's guards)."""
-    s1, s2, s3 = states
-    if not QUADRATIC_PREDICTOR or s3 is None or s3.topology == "point" \
-            or not _configuration(s3) == _configuration(s2) == _configuration(s1):
-        return None
-    u1, u2, u3 = s1.delta, s2.delta, s3.delta
-    if not ((u3 < u2 < u1 < at) or (u3 > u2 > u1 > at)) \
-            or max(abs((at - u1) / (u1 - u2)), abs((u1 - u2) / (u2 - u3))) > SECANT_MAX_RATIO:
-        return None
-    w1 = (at - u2) * (at - u3) / ((u1 - u2) * (u1 - u3))  # Lagrange's weights (they sum to 1)
-    w2 = (at - u1) * (at - u3) / ((u2 - u1) * (u2 - u3))
-    w3 = (at - u1) * (at - u2) / ((u3 - u1) * (u3 - u2))
-    X = [np.array([s.p[0], s.lambda0, s.delta]) for s in states]
-    ln_Sc, lambda0, delta = w1 * X[0] + w2 * X[1] + w3 * X[2]
-    if not abs(ln_Sc - X[0][0]) <= SECANT_MAX_LN_SC:
-        return None
-    x = warm_mesh(s1)
-    y = w1 * s1.sol(x) + w2 * s2.sol(x) + w3 * s3.sol(x)
-    return x, y, sysm.pack(ln_Sc=ln_Sc, lambda0=lambda0, delta=delta)
-
-
-def _secant(sysm, cur, prev, a):
-    """Guess cur + a (cur - prev) on cur's warm-start mesh (states and parameters)."""
-    x = warm_mesh(cur)
-    y = cur.sol(x)
-    if a:
-        y = y + a * (y - prev.sol(x))
-    X = np.array([cur.p[0], cur.lambda0, cur.delta])
-    Xp = np.array([prev.p[0], prev.lambda0, prev.delta])
-    ln_Sc, lambda0, delta = X + a * (X - Xp)
-    return x, y, sysm.pack(ln_Sc=ln_Sc, lambda0=lambda0, delta=delta)
-
-
 def _natural(scene, deltas, builder: _Builder, settings, first=None, key0=0):
     """Natural continuation through ``deltas`` (from ``first``, already recorded, if given)."""
     if first is None:
@@ -856,7 +489,7 @@ def _natural(scene, deltas, builder: _Builder, settings, first=None, key0=0):
 
     def solve_at(nd, states):
         prev, prev2, prev3 = (states[-k] if len(states) >= k else None for k in (1, 2, 3))
-        return _solve_at_delta(scene, nd, prev, prev2, settings, prev3)
+        return solve_at_delta(scene, nd, prev, prev2, settings, prev3)
 
     for i, target in enumerate(deltas[1:], key0 + 1):
         steps = Steps(target - prev.delta, too_small=lambda s, u, t=target: s < min(1e-6, 1e-3 * t))
@@ -962,7 +595,7 @@ def _pinned_state(scene, start, delta, st, tried):
     delta 0.9295, where the free cap's edge reaches the end, to delta 1, where no cap+cylinder
     state exists (its band on the cylinder would have a negative length)."""
     sysm = make_system(scene, "delta", delta, st["eps"], edge="pinned")
-    sol = solve_from(sysm, warm_guess(sysm, start), tol=st["tol"], max_nodes=_step_nodes(start, st),
+    sol = solve_from(sysm, warm_guess(sysm, start), tol=st["tol"], max_nodes=step_nodes(start, st),
                      bc_tol=st["bc_tol"])
     if sol.success and sol.valid:
         return sol
@@ -972,7 +605,7 @@ def _pinned_state(scene, start, delta, st, tried):
 
 def _cross(cur, prev, delta, st):
     """The corner cap at ``delta`` past the smooth cap's convexity limit (or None)."""
-    sol = cross_convexity_limit(cur, prev, delta, eps=st["eps"], tol=st["tol"], max_nodes=_step_nodes(cur, st),
+    sol = cross_convexity_limit(cur, prev, delta, eps=st["eps"], tol=st["tol"], max_nodes=step_nodes(cur, st),
                                 bc_tol=st["bc_tol"], exact=False)
     if sol is not None:
         log.info("past the convexity limit near delta = %.6g: corner at the contact edge", cur.delta)
@@ -995,11 +628,11 @@ def _wall_state_deeper(scene, last_cap, st, kw, tried):
     contact runs back onto the tip; a few hundredths deeper it has room (paper's model, beta
     1e-3: from delta 0.94 where the end is reached at 0.915).  Deeper starts are tried while
     they may help (:func:`_room_may_help`).  The switch itself is located afterwards
-    (``_locate_switches``)."""
+    (``locate_switches``)."""
     for dd in (0.01, 0.02, 0.04, 0.08):
         if last_cap.delta + dd > st["delta_max"]:
             break
-        deeper = _solve_at_delta(scene, last_cap.delta + dd, last_cap, None, st)
+        deeper = solve_at_delta(scene, last_cap.delta + dd, last_cap, None, st)
         if deeper.status not in (0, 4):  # converged, possibly past the tip's end
             continue
         outcomes = []
@@ -1014,7 +647,7 @@ def _wall_state_deeper(scene, last_cap, st, kw, tried):
 
 def _land_on_delta_max(scene, cur, prev, builder, st, key):
     """Delta-controlled solve at delta_max from the current point; ends the curve on success."""
-    sol = _solve_at_delta(scene, st["delta_max"], cur, prev, st)
+    sol = solve_at_delta(scene, st["delta_max"], cur, prev, st)
     if sol.success:
         builder.add(sol, key)
         builder.out.complete = True
@@ -1070,7 +703,7 @@ def _adaptive(scene, builder: _Builder, settings):
         if prev.topology == "point":
             sol = solve_point_load(scene, nd, tol=st["tol"], max_nodes=st["max_nodes"], guess=prev)
         else:
-            sol = _solve_at_delta(scene, nd, prev, prev2, st)
+            sol = solve_at_delta(scene, nd, prev, prev2, st)
             if scene.contact == "smooth" and prev.Sc < 1e-8 and (not sol.success or sol.Sc < SC_POINT):
                 # the cap is leaving double precision: continue with its point-load limit
                 point = solve_point_load(scene, nd, tol=st["tol"], max_nodes=st["max_nodes"], guess=prev)
@@ -1097,7 +730,7 @@ def _adaptive(scene, builder: _Builder, settings):
     if below is not None and below.topology != first.topology:
         below = None  # the small-delta leg went on in the point-load limit: no secant from a cap to it
     if below is None:  # need a second point for the tangent
-        below = _solve_at_delta(scene, first.delta * 0.9, first, None, st)
+        below = solve_at_delta(scene, first.delta * 0.9, first, None, st)
         if not below.success:
             raise _Stop(f"no second point near delta = {first.delta:g}: {below.message}")
     prev = below
@@ -1142,9 +775,9 @@ def _adaptive(scene, builder: _Builder, settings):
             sysm = system_like(cur, "arclength", (Xhat, tangent, scale), st["eps"])
             # no secant across a change of configuration (e.g. the smooth edge to the corner:
             # the states' difference is the jump forming, not the branch's direction)
-            a = ds / max(norm, 1e-300) if _configuration(cur) == _configuration(prev) else 0.0
-            guess = _secant(sysm, cur, prev, a)
-            sol = solve_from(sysm, guess, tol=st["tol"], max_nodes=_step_nodes(cur, st), bc_tol=st["bc_tol"])
+            a = ds / max(norm, 1e-300) if configuration_key(cur) == configuration_key(prev) else 0.0
+            guess = secant_guess(sysm, cur, prev, a)
+            sol = solve_from(sysm, guess, tol=st["tol"], max_nodes=step_nodes(cur, st), bc_tol=st["bc_tol"])
             if not sol.success and crossing and crossed_from is not cur:
                 sol = _cross(cur, prev, Xhat[0], st) or sol
                 crossed_from = cur

@@ -331,7 +331,7 @@ _SPLIT_FIRST = True
 
 def _with_line(split, line):
     """``split`` with ``line_state``: the (invalid) line converged at its depth, where the switch
-    line -> cap+line(tip) is located from (``continuation._line_state_at``), not solved again."""
+    line -> cap+line(tip) is located from (``switches.line_state_at``), not solved again."""
     if line is not None and line.success:
         split.line_state = line
     return split

@@ -14,6 +14,7 @@ import pytest
 
 import shellbvp as sb
 from shellbvp import chain as ch
+from shellbvp.inflation import system_parameters
 
 EPS = 1e-3
 CHAINS = {"cap": lambda L, contact: ch.cap_chain(EPS, L, contact),
@@ -59,7 +60,9 @@ def system(kind, contact, control, sealed=False):
     scene = (sb.Scene.preset("balloon", sealed=True, contact=contact_model) if sealed
              else sb.Scene.preset("base", contact=contact_model))
     value = ARC if control == "arclength" else 0.3
-    return ch.ChainBVP(scene, CHAINS[kind](scene.shell_length, contact), control, value)
+    mod = scene.model()
+    return ch.ChainBVP(scene, CHAINS[kind](scene.shell_length, contact), control, value, model=mod,
+                       par=system_parameters(scene, mod))
 
 
 def state(sysm, rng):
@@ -100,7 +103,7 @@ def test_fun_kept_results_are_those_of_its_arguments(kind, sealed):
     changed in place is evaluated again), and fun_jac with them equals fun_jac without, bit for bit."""
     sysm = system(kind, "smooth", "delta", sealed)
     t, y, p = state(sysm, np.random.default_rng(3))
-    fresh = ch.ChainBVP(sysm.scene, sysm.chain, "delta", 0.3)
+    fresh = ch.ChainBVP(sysm.scene, sysm.chain, "delta", 0.3, par=sysm.par)
     f0 = sysm.fun(t, y, p)
     assert np.array_equal(sysm.fun(t, y.copy(), p.copy()), f0)  # equal values: kept
     f0[:] = 0.0  # a caller changing its result does not change what is kept

@@ -175,8 +175,8 @@ def test_without_a_corner_the_curve_stops_at_the_limit_at_once(monkeypatch):
     """If no corner state is found past the limit, the curve stops there with the reason after
     one failed step, instead of halving its step many times (the old 40-50 s stall)."""
     import shellbvp.continuation as cont
+    import shellbvp.steps as steps
 
-    monkeypatch.setattr(cont, "cross_convexity_limit", lambda *a, **k: None)
     failed = []
     solve = cont.solve_from
 
@@ -186,7 +186,9 @@ def test_without_a_corner_the_curve_stops_at_the_limit_at_once(monkeypatch):
             failed.append(sol.delta)
         return sol
 
-    monkeypatch.setattr(cont, "solve_from", counted)
+    for module in (cont, steps):  # the curve's arclength steps and its delta steps
+        monkeypatch.setattr(module, "cross_convexity_limit", lambda *a, **k: None)
+        monkeypatch.setattr(module, "solve_from", counted)
     c = sb.curve(BASE, delta_max=1.0, delta_start=0.55, estimate_error=False, topology="cap")
     assert "no corner state was found" in c.stop_reason and not c.complete
     assert 0.6 < c.points["delta"][-1] < 0.6146

@@ -77,7 +77,7 @@ def test_the_quadratic_predictor_is_nearer_the_next_state_than_the_secant():
     """Natural continuation guesses from the quadratic through the last three states: on base
     (steps 0.02, and unequal ones) its guess is 3-5 times nearer the converged next state than
     the secant's, in the states and in the unknowns."""
-    from shellbvp.continuation import _quadratic, _secant
+    from shellbvp.steps import quadratic_guess as _quadratic, secant_guess as _secant
     from shellbvp.solution import secant_ratio
     from shellbvp.state import system_like
 
@@ -95,9 +95,11 @@ def test_the_quadratic_predictor_is_nearer_the_next_state_than_the_secant():
 
 
 def test_the_quadratic_predictor_keeps_the_secants_guards():
-    from shellbvp import continuation
-    from shellbvp.continuation import _quadratic
+    import dataclasses
+
+    from shellbvp import steps
     from shellbvp.solution import SECANT_MAX_RATIO
+    from shellbvp.steps import quadratic_guess as _quadratic
 
     c = sb.curve(sb.Scene.preset("base"), deltas=[0.2, 0.22, 0.24], topology="cap", estimate_error=False)
     s3, s2, s1 = c.solutions
@@ -107,9 +109,9 @@ def test_the_quadratic_predictor_keeps_the_secants_guards():
     assert _quadratic(s1.system, (s1, s3, s2), 0.26) is None  # not monotone
     assert _quadratic(s1.system, states, 0.24 + 1.01 * SECANT_MAX_RATIO * 0.02) is None  # too far
     assert _quadratic(s1.system, (s1, s2, None), 0.26) is None
-    other = type(s3)(s3, contact_edge="corner")  # another configuration
+    other = dataclasses.replace(s3, contact_edge="corner")  # another configuration
     assert _quadratic(s1.system, (s1, s2, other), 0.26) is None
-    with mock.patch.object(continuation, "QUADRATIC_PREDICTOR", False):
+    with mock.patch.object(steps, "QUADRATIC_PREDICTOR", False):
         assert _quadratic(s1.system, states, 0.26) is None
 
 
@@ -256,7 +258,7 @@ def test_switch_search_stops_where_the_secant_puts_the_root_within_its_tolerance
     the state it returns already satisfies (f = (d - r) e^(d - r): Illinois's iterates)."""
     import math
 
-    from shellbvp.continuation import _regula_falsi
+    from shellbvp.switches import regula_falsi as _regula_falsi
 
     root = 0.1117
     calls = []
@@ -273,7 +275,7 @@ def test_switch_search_stops_where_the_secant_puts_the_root_within_its_tolerance
     assert calls[-1] == best["d"], calls  # it stopped at the state it returns
     stopped = len(calls)
     calls.clear()
-    with mock.patch("shellbvp.continuation._secant_distance", return_value=math.inf):  # the bracket alone
+    with mock.patch("shellbvp.switches._secant_distance", return_value=math.inf):  # the bracket alone
         assert _regula_falsi(0.1, f(0.1), {"d": 0.1}, 0.1125, f(0.1125), {"d": 0.1125}, solve_at) is not None
     assert len(calls) > stopped, (stopped, calls)
 

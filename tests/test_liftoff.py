@@ -299,7 +299,7 @@ def test_where_the_lines_pole_is_down_the_split_is_tried_before_the_annulus(monk
     # the line converged there is kept: the switch line -> cap+line(tip) is located from it
     line_here = split.line_state
     assert line_here.topology == "line" and line_here.delta == split.delta and not line_here.valid
-    from shellbvp.continuation import _line_state_at
+    from shellbvp.switches import line_state_at as _line_state_at
 
     assert _line_state_at(split, {}) is line_here  # (no settings needed: nothing is solved)
     monkeypatch.setattr(lo, "_SPLIT_FIRST", False)
