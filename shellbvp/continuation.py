@@ -26,15 +26,14 @@ import numpy as np
 from .cylinder import best_wall_state, wall_contact_suspected
 from .io import POINT_FIELDS, Curve, point_record
 from .kernels import LONG_CURVE_POINTS, kernel_set
-from .liftoff import (
-    lift_off_suspected,
+from .lifted_ends import (
     lifted_pole_branch_end,
     lifted_pole_end_reason,
     lifted_pole_fold,
     lifted_pole_fold_reason,
     lifted_state_at,
-    replace_invalid_cap,
 )
+from .liftoff import lift_off_suspected, replace_invalid_cap
 from .pointload import SC_POINT, solve_point_load
 from .solution import Solution, calibrated_error, default_eps, passed_tip_end, richardson_error
 from .corner import LEGENDRE_WATCH, edge_model, limit_estimate, near_limit

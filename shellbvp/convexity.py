@@ -110,7 +110,7 @@ def envelope_partner(sysm, S, y, *, lambda_min=0.1, kappa_rho_max=100.0, n=(161,
         ``gap``: (U - envelope)/U at the state (0 on the envelope: the Weierstrass condition holds
         in the box); ``partner``: (lambda_s, kappa_s) of the envelope's facet vertex farthest from
         the state (the other phase, where ``gap > 0``; compare two boxes: a partner that moves out
-        with the box is no state of the shell, see ``liftoff.pole_corner_partner``).
+        with the box is no state of the shell, see ``lifted_ends.pole_corner_partner``).
     """
     from scipy.spatial import ConvexHull
 

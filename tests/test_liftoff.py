@@ -13,7 +13,8 @@ import pytest
 from scipy.integrate import trapezoid
 
 import shellbvp as sb
-from shellbvp.liftoff import liftoff_state, pole_corner_partner
+from shellbvp.lifted_ends import pole_corner_partner
+from shellbvp.liftoff import liftoff_state
 from shellbvp.pointload import solve_point_load
 
 
@@ -383,7 +384,8 @@ def test_the_lifted_pole_branch_ends_where_the_pole_loses_convexity():
     being convex in (lambda_s, kappa_s) at the lifted cap's free pole, not at a regular fold:
     followed in the pole's stretch, delta grows to a maximum exactly where the pole's Legendre
     determinant reaches zero, with F(delta) smooth up to it (dE/ddelta = F there)."""
-    from shellbvp.liftoff import lifted_pole_branch_end, pole_legendre, replace_invalid_cap, solve_liftoff
+    from shellbvp.lifted_ends import lifted_pole_branch_end, pole_legendre
+    from shellbvp.liftoff import replace_invalid_cap, solve_liftoff
 
     scene = sb.Scene.preset("base", rho=0.05)
     a, b = (replace_invalid_cap(sb.solve(scene, delta=d, topology="cap", estimate_error=False))
@@ -460,7 +462,8 @@ def test_the_lifted_pole_branch_of_a_thick_shell_folds():
     lifted pole sagging away from the tip (not coming down onto it) and lambda0 falling fast.
     Located from two line states below it; F continuous through it along the branch; the
     energy identity holds on the branch close to it (Richardson differences)."""
-    from shellbvp.liftoff import lifted_pole_fold, pole_clearance, pole_legendre, replace_invalid_cap, solve_liftoff
+    from shellbvp.lifted_ends import lifted_pole_fold, pole_legendre
+    from shellbvp.liftoff import pole_clearance, replace_invalid_cap, solve_liftoff
 
     scene = sb.Scene.preset("base", beta=0.2)
     a = replace_invalid_cap(sb.solve(scene, delta=0.33, topology="cap", estimate_error=False))
