@@ -246,3 +246,14 @@ def test_point_budget_charges_each_category_its_exclusive_time():
     assert timers.calls[pb.KERNELS] == timers.calls[pb.CALLBACKS] == 1
     assert 0.02 <= timers.spent[pb.KERNELS] < 0.03
     assert 0.01 <= timers.spent[pb.CALLBACKS] < 0.02  # the inner call's time is not charged twice
+
+
+def test_the_structure_census_holds_what_the_redesign_reached():
+    """benchmarks/architecture.py on this checkout: no natural-continuation loop written out
+    beside shellbvp.march, results built in two places only (the diagnosis, failure()), and no
+    .get on a result (what is left are dicts of other kinds: scene, switch, settings, points)."""
+    census = _load("architecture").census()
+    assert census["step_loops"] == []
+    assert census["solution_builds"] == {"diagnosis": 1, "solution": 1}
+    receivers = {where.split("(")[1].rstrip(")") for where in census["result_gets"]}
+    assert receivers <= {"sc", "s", "settings", "p"}, receivers
