@@ -542,6 +542,24 @@ def _runs(state):
     return [(int(state[a]), int(a), int(b)) for a, b in zip(starts, stops)]
 
 
+def smoothed_slope(values, window: int):
+    """The slope per sample of ``values`` by a least-squares quadratic over ``window`` points (odd):
+    Savitzky–Golay, as ``scipy.signal.savgol_filter(values, window, 2, deriv=1)`` (mode "interp")
+    computes it, without importing scipy.signal (0.37 s, for it imports scipy.stats)."""
+    d = np.asarray(values, float)
+    m = window // 2
+    k = np.arange(-m, m + 1, dtype=float)
+    rate = np.empty_like(d)
+    # inside: the slope of a quadratic at the centre of a symmetric window is the straight line's
+    rate[m:d.size - m] = np.correlate(d, k / np.sum(k * k), mode="valid")
+    # the ends: the quadratic through the first (last) window, differentiated there
+    x = np.arange(window, dtype=float)
+    for rows, at in ((slice(0, window), np.arange(m)), (slice(d.size - window, d.size), np.arange(window - m, window))):
+        c = np.polyfit(x, d[rows], 2)
+        rate[rows][at] = np.polyval(np.polyder(c), x[at])
+    return rate
+
+
 def segment(displacement, time=None) -> np.ndarray:
     """Label each row of a record: approach/loading (pushing), hold, retraction, other.
 
@@ -582,9 +600,7 @@ def segment(displacement, time=None) -> np.ndarray:
         return labels.astype(str)
     w = int(min(51, max(5, 2 * (n // 100) + 1)))
     if n >= w + 2:
-        from scipy.signal import savgol_filter
-
-        rate = savgol_filter(d, w, 2, deriv=1)
+        rate = smoothed_slope(d, w)
     else:
         w = 3
         rate = np.gradient(d)

@@ -236,7 +236,7 @@ def fit_with_geometry(scene, displacement, force, *, R_L, uncertainty, executor=
     >>> bool(glo < lo < 52 < hi < ghi), bool((ghi - glo) > 5 * (hi - lo))   # much wider than the noise's
     (True, True)
     """
-    from scipy import stats
+    from scipy import special
 
     from .fitting import fit
     from .sweep import local_pool
@@ -276,7 +276,7 @@ def fit_with_geometry(scene, displacement, force, *, R_L, uncertainty, executor=
     half = math.sqrt(h_fit ** 2 + (Z95 * u_geom) ** 2)
     # the fit's own standard uncertainty (its interval is mu_H +- t u with Student's t)
     dof = max(nominal.n - len(nominal.fitted), 1)
-    u_fit = h_fit / stats.t.ppf(0.975, dof)
+    u_fit = h_fit / special.stdtrit(dof, 0.975)
     var = {c["parameter"]: (Z95 * c["u_mu_H"]) ** 2 for c in contributions}
     total = h_fit ** 2 + sum(var.values())
     for c in contributions:
