@@ -594,7 +594,7 @@ def kind_hdf5(n, rng, tmp):
 LEN_UNITS = {"mm": 1e-3, "um": 1e-6, "µm": 1e-6, "m": 1.0, "nm": 1e-9}
 FORCE_UNITS = {"mN": 1e-3, "µN": 1e-6, "μN": 1e-6, "uN": 1e-6, "N": 1.0, "kN": 1e3}
 HEADERS = ["Displacement (um)", "Force (µN)", "Force (μN)", "Force (kN)", "disp (mm)", "force [mN]",
-           "Displacement", "Force", "time (s)", "", "Depth (furlong)", "x (µm)"]
+           "Displacement", "Force", "time (s)", "", "Depth (blorp)", "x (µm)"]
 CELLS = ["5_0", "inf", "-inf", "1e999", "nan", "NaN", "", "abc", "N/A", "null", "1,5", "１２", "٣",
          "0x10", "1.2.3", "+1", "-0", " 3 ", "1e-400", '"1.5"', "\x00", "Force (kN)", "µN", "1e308", "-1e308",
          "1.5e", "e5", ".", "--1"]
@@ -857,7 +857,7 @@ def cli_inputs(tmp, n):
         (["fit", "--preset", "fit", "text.csv", "--radius", "0.3mm", "--json"], True),
         (["fit", "--preset", "fit", "nounits.csv", "--radius", "abc", "--json"], True),
         (["fit", "--preset", "fit", "nounits.csv", "--radius", "0", "--units", "mm,mN"], False),
-        (["fit", "--preset", "fit", "nounits.csv", "--radius", "0.3mm", "--units", "furlong,mN"], False),
+        (["fit", "--preset", "fit", "nounits.csv", "--radius", "0.3mm", "--units", "blorp,mN"], False),
         (["info", "/nonexistent/x.h5"], False), (["info", "."], False), (["info", "/dev/null"], False),
         (["info", "empty.csv"], False), (["plot", "/nonexistent/x.h5", "-o", "x.png"], False),
         (["presets"], False), (["nosuchcommand"], False), ([], False),

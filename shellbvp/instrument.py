@@ -104,14 +104,27 @@ def _number(s):
     return v if math.isfinite(v) else None
 
 
+def _unit_suffix(name):
+    """The unit after a column name's last underscore (``'displacement_mm'``), where the unit
+    tables know it (a name such as ``'vertical_deflection'`` has none), else None."""
+    m = re.search(r"_([^\W_]+(?:/[^\W_]+)?)\s*$", name)
+    return m.group(1) if m and unit_kind(m.group(1)) else None
+
+
 def _unit_of(name):
-    """The unit in a column name: ``'Force (uN)'``, ``'force [µN]'``, ``'Time / s'`` -> the unit or None."""
+    """The unit in a column name: ``'Force (uN)'``, ``'force [µN]'``, ``'Time / s'``,
+    ``'force_uN'`` -> the unit or None."""
     m = re.search(r"[\(\[]\s*([^\)\]]+?)\s*[\)\]]\s*$", name) or re.search(r"\s/\s*(\S+)\s*$", name)
-    return normalize_unit(m.group(1)) if m else None
+    if m:
+        return normalize_unit(m.group(1))
+    suffix = _unit_suffix(name)
+    return normalize_unit(suffix) if suffix else None
 
 
 def _bare_name(name):
-    return re.sub(r"\s*([\(\[][^\)\]]*[\)\]]|/\s*\S+)\s*$", "", name).strip().lower()
+    bare = re.sub(r"\s*([\(\[][^\)\]]*[\)\]]|/\s*\S+)\s*$", "", name).strip()
+    suffix = _unit_suffix(bare)
+    return (bare[:-len(suffix) - 1] if suffix else bare).strip().lower()
 
 
 @dataclass
@@ -245,7 +258,7 @@ def _find_column(table, role, path, taken):
     """Index of the column holding ``role`` (displacement, force, time), by unit and name; None if absent."""
     n = len(table.header)
     kind = _KIND[role]
-    by_unit = [i for i in range(n) if i not in taken and unit_kind(_column_unit(table, i) or "") == kind]
+    by_unit = [i for i in range(n) if i not in taken and unit_kind(_column_unit(table, i) or "", extended=True) == kind]
     tiers = _NAMES[role]
 
     def rank(i):

@@ -9,6 +9,7 @@ incompressible solid (``D = mu H^3/3``) with ``beta = (H/R_L)^2 / 3``
 
 from __future__ import annotations
 
+import functools
 import math
 import numbers
 import re
@@ -49,17 +50,60 @@ def normalize_unit(unit: str) -> str:
     return "micron" if u.lower() in ("micron", "microns", "micrometer", "micrometre") else u
 
 
-def unit_kind(unit: str):
-    """The kind ('length', 'force', 'time', 'mu_H') of a unit name, or None if it is none of them."""
+#: A unit expression that may be handed to pint: names joined by ``*`` or ``/``, each with a
+#: small integer power at most (no numbers, no nesting: pint parses it, and an exponent such as
+#: ``m**99999999`` would be arithmetic on a huge integer)
+_UNIT_EXPRESSION = re.compile(r"[A-Za-z\u00b5_]{1,24}(?:(?:\^|\*\*)-?[1-4])?"
+                              r"(?:[*/][A-Za-z\u00b5_]{1,24}(?:(?:\^|\*\*)-?[1-4])?){0,3}")
+PINT_HINT = "more units (gf, lbf, sec, millimeter, pN/nm, ...) with pint: pip install 'shellbvp[units]'"
+
+
+@functools.lru_cache(maxsize=None)
+def _pint_registry():
+    import pint
+
+    return pint.UnitRegistry()
+
+
+@functools.lru_cache(maxsize=256)
+def pint_unit(unit: str):
+    """``(kind, SI factor)`` of a unit that the tables do not have but pint knows (``'gf'``,
+    ``'lbf'``, ``'sec'``, ``'millimeter'``, ``'pN/nm'``), or None: pint not installed (the
+    ``units`` extra), not a plain unit expression, unknown, or of no kind the package uses.
+    pint is imported only here, for such a unit (0.4 s with its registry)."""
+    u = normalize_unit(unit)
+    if not _UNIT_EXPRESSION.fullmatch(u):
+        return None
+    try:
+        ureg = _pint_registry()
+    except ImportError:
+        return None
+    try:
+        q = ureg.Quantity(1.0, u.replace("\u00b5", "u"))
+        for kind, si in SI_UNITS.items():
+            if q.dimensionality == ureg.Quantity(1.0, si).dimensionality:
+                factor = float(q.to(si).magnitude)
+                return (kind, factor) if math.isfinite(factor) and factor > 0 else None
+    except Exception:  # pint's own errors: an undefined name, a syntax it refuses
+        return None
+    return None
+
+
+def unit_kind(unit: str, *, extended: bool = False):
+    """The kind ('length', 'force', 'time', 'mu_H', 'pressure') of a unit name, or None if it is
+    none of them.  ``extended``: a name the tables lack is asked of pint (:func:`pint_unit`);
+    for strings known to be units, not for every header cell (pint costs 0.4 s to load)."""
     u = normalize_unit(unit)
     for kind, table in UNIT_TABLES.items():
         if u in table:
             return kind
-    return None
+    found = pint_unit(u) if extended and u else None
+    return found[0] if found else None
 
 
 def unit_factor(unit: str, kind: str) -> float:
-    """SI factor of a unit name of one kind ('length', 'force', 'time' or 'mu_H').
+    """SI factor of a unit name of one kind ('length', 'force', 'time', 'mu_H' or 'pressure'):
+    from the tables, else from pint (:func:`pint_unit`) where it is installed.
 
     Raises
     ------
@@ -68,9 +112,12 @@ def unit_factor(unit: str, kind: str) -> float:
     """
     table = UNIT_TABLES[kind]
     u = normalize_unit(unit)
-    if u not in table:
-        raise ValueError(f"unknown {kind} unit {unit!r}; use one of {', '.join(table)}")
-    return table[u]
+    if u in table:
+        return table[u]
+    found = pint_unit(u)
+    if found is not None and found[0] == kind:
+        return found[1]
+    raise ValueError(f"unknown {kind} unit {unit!r}; use one of {', '.join(table)} ({PINT_HINT})")
 
 
 def format_in(value: float, unit: str, kind: str, digits: int = 4) -> str:
@@ -102,8 +149,9 @@ def split_quantity(text, kind: str = "length", name: str | None = None):
     if not m or not math.isfinite(float(m.group(1))):
         raise ValueError(f"cannot read {text!r} as {label}: a plain finite number and a unit, e.g. {_EXAMPLE[kind]}")
     unit = m.group(2) or ""
-    if unit and unit_kind(unit) != kind:
-        raise ValueError(f"{label}: unknown {kind} unit {unit!r}; use one of {', '.join(UNIT_TABLES[kind])}")
+    if unit and unit_kind(unit, extended=True) != kind:
+        raise ValueError(f"{label}: unknown {kind} unit {unit!r}; use one of {', '.join(UNIT_TABLES[kind])} "
+                         f"({PINT_HINT})")
     return float(m.group(1)), normalize_unit(unit) if unit else ""
 
 

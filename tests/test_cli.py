@@ -83,7 +83,7 @@ def test_presets_lists_all():
     (["curve", "--radius", "0.3", "--muH", "52N/m", "-o", "x.h5"], ["--radius", "needs a unit", "0.3mm"]),
     (["curve", "--radius", "0.3mm", "--muH", "52", "-o", "x.h5"], ["--muH", "needs a unit", "52N/m"]),
     (["fit", "--example", "--radius", "0.3"], ["--radius", "needs a unit", "0.3mm"]),
-    (["fit", "--example", "--radius", "0.3 furlong"], ["--radius", "unknown length unit", "mm"]),
+    (["fit", "--example", "--radius", "0.3 blorp"], ["--radius", "unknown length unit", "mm"]),
     (["fit", "--example", "--radius", "0mm"], ["--radius", "> 0"]),
     (["curve", "--radius", "0.3mm", "--muH", "52N", "-o", "x.h5"], ["--muH", "unknown mu_H unit", "N/m"]),
 ])

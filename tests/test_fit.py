@@ -185,7 +185,7 @@ def test_dimensional_round_trip_and_units():
     assert sb.parse_quantity(5, "length", default_unit="um") == pytest.approx(5e-6)
     assert sb.beta_from_thickness(50e-6, 0.3e-3) == pytest.approx((50 / 300) ** 2 / 3)
     with pytest.raises(ValueError, match="unit"):
-        sb.parse_quantity("3 furlongs")
+        sb.parse_quantity("3 blorps")
     with pytest.raises(ValueError, match="R_L"):
         sb.Dimensions(R_L=-1.0)
 
@@ -217,7 +217,7 @@ def test_csv_formats(tmp_path):
     ("d (mm),F (mN)\n1,2\n3\n4,5\n", {}, "line 3"),
     ("d (mm),F (mN)\n1,2\n", {}, "fewer than 3"),
     ("d (mm),F (mN)\n1,2\n2,3\n3,4\n", dict(columns=["depth", "F"]), "no column named"),
-    ("d (furlong),F (mN)\n1,2\n2,3\n3,4\n", {}, "unknown length unit"),
+    ("d (blorp),F (mN)\n1,2\n2,3\n3,4\n", {}, "unknown length unit"),
 ])
 def test_malformed_csv_messages(tmp_path, text, kwargs, match):
     p = _write(tmp_path, "bad.csv", text)

@@ -236,3 +236,43 @@ def test_the_smoothed_slope_is_savitzky_golays():
         d = np.cumsum(rng.standard_normal(n))
         want = savgol_filter(d, w, 2, deriv=1)
         assert np.max(np.abs(smoothed_slope(d, w) - want)) <= 1e-12 * np.max(np.abs(want))
+
+
+def test_a_unit_after_the_columns_last_underscore_is_read(tmp_path):
+    """``displacement_mm,force_mN`` (a common export header) names its units; a name such as
+    ``vertical_deflection`` does not."""
+    from shellbvp.instrument import _bare_name, _unit_of
+
+    path = tmp_path / "nu.csv"
+    path.write_text("displacement_mm,force_mN\n" + "".join(f"{0.01 * i},{0.1 * i * i}\n" for i in range(8)))
+    rec = sb.read_instrument(path)
+    assert rec.units == {"displacement": "mm", "force": "mN"}
+    assert rec.displacement[1] == pytest.approx(1e-5) and rec.force[2] == pytest.approx(4e-4)
+    assert _unit_of("vertical_deflection") is None and _bare_name("force_mN") == "force"
+
+
+def test_units_beyond_the_tables_come_from_pint_and_only_for_such_a_unit(tmp_path):
+    pytest.importorskip("pint")
+    import subprocess
+    import sys
+
+    from shellbvp.units import parse_quantity, pint_unit, unit_factor
+
+    assert unit_factor("gf", "force") == pytest.approx(9.80665e-3, rel=1e-12)
+    assert unit_factor("lbf", "force") == pytest.approx(4.4482216152605, rel=1e-12)
+    assert unit_factor("sec", "time") == 1.0 and unit_factor("millimeter", "length") == pytest.approx(1e-3)
+    assert unit_factor("pN/nm", "mu_H") == pytest.approx(1e-3) and parse_quantity("2 psi", "pressure") > 13e3
+    with pytest.raises(ValueError, match="unknown force unit 'mm'"):
+        unit_factor("mm", "force")  # a length, not a force
+    for hostile in ("m**99999999", "10**10**10", "__import__('os')", "N" * 40, "m/m/m/m/m/m"):
+        assert pint_unit(hostile) is None  # not a plain unit expression: pint is not asked
+    path = tmp_path / "pu.csv"
+    path.write_text("Height (millimeter),Force (gf)\n" + "".join(f"{0.01 * i},{0.1 * i * i}\n" for i in range(8)))
+    rec = sb.read_instrument(path)
+    assert rec.force[2] == pytest.approx(0.4 * 9.80665e-3) and rec.displacement[1] == pytest.approx(1e-5)
+    # a file in the tables' units does not load pint (0.4 s)
+    code = ("import sys, shellbvp as sb; from shellbvp.fitting import example_data_path; "
+            "sb.read_instrument(example_data_path()); "
+            "print('pint' in sys.modules)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "False"
