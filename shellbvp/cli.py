@@ -107,16 +107,42 @@ def _say(line=""):
     print(printable(line))
 
 
-def _thickness(text):
-    """argparse type: eps = H / R_L as a plain number, or the thickness with its unit (``50um``)."""
+def number_or(kind):
+    """argparse type: a plain number (nondimensional) or a quantity with its unit (``50um``,
+    ``10mN``), which :func:`_nondimensional` turns into the model's units."""
     from .units import Quantity, plain_number, split_quantity
 
-    try:
-        if split_quantity(text, "length", "the value")[1]:
-            return Quantity.parse(text, "length", "the value")
-        return plain_number(text, "the value")
-    except ValueError as exc:
-        raise argparse.ArgumentTypeError(str(exc)) from None
+    def parse(text):
+        try:
+            if split_quantity(text, kind, "the value")[1]:
+                return Quantity.parse(text, kind, "the value")
+            return plain_number(text, "the value")
+        except ValueError as exc:
+            raise argparse.ArgumentTypeError(str(exc)) from None
+
+    parse.__name__ = f"number or {kind}"
+    return parse
+
+
+_thickness = number_or("length")  # eps = H / R_L, or the thickness with its unit
+
+
+def _nondimensional(args, value, option):
+    """``value`` of ``option`` in the model's units: a plain number as it is; a length over the rim
+    radius (``--radius``), a force over mu*H times it (``--muH`` too)."""
+    from .units import Quantity
+
+    if not isinstance(value, Quantity):
+        return value
+    if value.kind == "length":
+        if args.radius is None:
+            raise ValueError(f"{option} {value} needs --radius (the rim radius, e.g. 0.3mm), or give it in "
+                             f"rim radii (a plain number)")
+        return value.si / args.radius.si
+    if args.radius is None or args.mu_h is None:
+        raise ValueError(f"{option} {value} needs --radius and --muH (e.g. 0.3mm and 52N/m), or give it in "
+                         f"mu*H R_L (a plain number)")
+    return value.si / (args.mu_h.si * args.radius.si)
 
 
 def _scene_options(p, uncertain=False, preset_required=False):
@@ -311,6 +337,8 @@ def _cmd_curve(args):
         raise ValueError("--radius and --muH go together (rim radius, e.g. 0.3mm, and mu*H, e.g. 52N/m)")
     if args.radius is not None:
         units = {"R_L": args.radius.si, "mu_H": args.mu_h.si}
+    args.delta_max = _nondimensional(args, args.delta_max, "--delta-max")
+    args.force_max = _nondimensional(args, args.force_max, "--force-max")
     deltas = None
     if args.points is not None:
         if not 2 <= args.points <= MAX_POINTS:
@@ -388,8 +416,8 @@ def _cmd_solve(args):
     import shellbvp as sb
 
     scene = _scene(args)
-    given = {k: v for k, v in (("delta", args.delta), ("lambda0", args.lambda0), ("force", args.load))
-             if v is not None}
+    given = {k: _nondimensional(args, v, f"--{k}") for k, v in (("delta", args.delta), ("lambda0", args.lambda0),
+                                                                ("force", args.load)) if v is not None}
     if not given:
         given = {"delta": 0.2}
     sol = sb.solve(scene, tol=args.tol, max_nodes=args.max_nodes, topology=args.topology, **given)
@@ -1057,9 +1085,11 @@ def build_parser():
     sub = p.add_subparsers(dest="command", parser_class=_Parser)
     c = sub.add_parser("curve", help="compute a force-displacement curve into an HDF5 file")
     _scene_options(c)
-    c.add_argument("--delta-max", type=_number, default=0.5, dest="delta_max", help="largest pole displacement (default 0.5)")
+    c.add_argument("--delta-max", type=number_or("length"), default=0.5, dest="delta_max",
+                   help="largest pole displacement (default 0.5); with a unit (100um) it needs --radius")
     c.add_argument("--points", type=int, help="N equally spaced depths up to delta-max (default: adaptive)")
-    c.add_argument("--force-max", type=_number, dest="force_max", help="stop at this force")
+    c.add_argument("--force-max", type=number_or("force"), dest="force_max",
+                   help="stop at this force; with a unit (10mN) it needs --radius and --muH")
     c.add_argument("--lambda0-max", type=_number, dest="lambda0_max", help="stop at this pole stretch")
     c.add_argument("--max-steps", type=int, default=400, dest="max_steps", help="most continuation steps of a curve (default 400)")
     c.add_argument("--profiles", action="store_true", help="store each point's profiles")
@@ -1077,10 +1107,11 @@ def build_parser():
     s = sub.add_parser("solve", help="solve one state and print it")
     _scene_options(s)
     g = s.add_mutually_exclusive_group()
-    g.add_argument("--delta", type=_number, help="pole displacement (default 0.2)")
+    g.add_argument("--delta", type=number_or("length"),
+                   help="pole displacement (default 0.2); with a unit (50um) it needs --radius")
     g.add_argument("--lambda0", type=_number, help="pole stretch")
-    g.add_argument("--force", "--load", type=_number, dest="load",
-                   help="indenter force F / (mu H R_L) (force control)")
+    g.add_argument("--force", "--load", type=number_or("force"), dest="load",
+                   help="indenter force F / (mu H R_L) (force control); with a unit (5mN) it needs --radius and --muH")
     s.add_argument("--radius", "--rim-radius", type=quantity("length"), help="rim radius with its unit, e.g. 0.3mm (with --muH: "
                    "the state also in these units)")
     s.add_argument("--muH", type=quantity("mu_H"), dest="mu_h", help="mu*H with its unit, e.g. 52N/m")

@@ -174,3 +174,22 @@ def test_every_option_has_help():
     bare = [(name, a.option_strings) for name, sp in p._subparsers._group_actions[0].choices.items()
             for a in sp._actions if a.option_strings and a.help is None]
     assert bare == []
+
+
+def test_depths_and_forces_in_lab_units_are_made_nondimensional_by_the_scales(tmp_path):
+    """``solve --delta 60um``, ``--force 5.7mN`` and ``curve --delta-max 60um`` with --radius
+    (and --muH for a force) are the model's delta = 60 um / R_L and F = F / (mu H R_L); without
+    the scales, a one-line error names what is missing."""
+    r = run("solve", "--preset", "base", "--delta", "60um", "--radius", "0.3mm", "--muH", "52N/m", "--json")
+    assert r.returncode == 0, r.stderr
+    assert json.loads(r.stdout)["delta"] == pytest.approx(0.2, rel=1e-12)
+    r = run("solve", "--preset", "base", "--force", "5.7mN", "--radius", "0.3mm", "--muH", "52N/m", "--json")
+    assert json.loads(r.stdout)["force"] == pytest.approx(5.7e-3 / (52 * 0.3e-3), rel=1e-9)
+    r = run("solve", "--preset", "base", "--delta", "60um")
+    assert r.returncode == 2 and "--delta 60 um needs --radius" in r.stderr and len(r.stderr.strip().splitlines()) == 1
+    r = run("solve", "--preset", "base", "--force", "5mN", "--radius", "0.3mm")
+    assert r.returncode == 2 and "needs --radius and --muH" in r.stderr
+    out = tmp_path / "c.h5"
+    r = run("curve", "--delta-max", "60um", "--points", "2", "--radius", "0.3mm", "--muH", "52N/m", "-o", str(out), "-q")
+    assert r.returncode == 0, r.stderr
+    assert sb.read_curve(out).delta[-1] == pytest.approx(0.2, rel=1e-9)
