@@ -117,33 +117,30 @@ def inflate(scene, tol: float = TOL, max_nodes: int = _MAX_NODES):
     x = np.linspace(0.0, 1.0, 81)
     y = _reference_states(sysm, sysm.S(0, x, None))
     if target == 0.0:
-        res = _solve(sysm, x, y, tol, max_nodes)
-        return _finish(res, sysm)
-    systems = {}
-
+        return _finish(_solve(sysm, x, y, tol, max_nodes))
     def solve_at(p_next, states):
-        sysm = systems[p_next] = _system(scene, p_next)
-        return _solve(sysm, *((states[-1].x, states[-1].y) if states else (x, y)), tol, max_nodes)
+        return _solve(_system(scene, p_next), *((states[-1].x, states[-1].y) if states else (x, y)), tol, max_nodes)
 
     steps = Steps(target, advance=lambda u, s, t: t if abs(t - u) <= abs(s) else u + s,
                   too_small=lambda s, u: abs(s) < 1e-6 * max(1.0, abs(target)))
     m = march(0.0, target, solve_at, steps, arrived=lambda u: u == target)
-    sysm = systems[m.tried]
     if not m.reached:
         out = m.failed if m.last is None else m.last
         out.success, out.status = False, 5
         out.message = (f"the inflated state was not reached: continuation in the pressure stalled at "
                        f"p = {m.at:.4g} of {target:.4g} ({m.failed.message})")
-        return _finish(out, sysm, failed=True)
-    return _finish(m.last, sysm)
+        return _finish(out, failed=True)
+    return _finish(m.last)
 
 
-def _finish(res, sysm, failed=False):
+def _finish(res, failed=False):
+    """The inflated state's own numbers (from its system, ``res.system``), NaN where it failed."""
     res.topology = "inflated"
     nan = float("nan")
     if failed or not res.success:
         res.set(pole_rise=nan, pole_stretch=nan, volume_change=nan, rim_hoop_tension=nan)
         return res
+    sysm = res.system
     zeta = sysm.S_point(sysm.regions[0].start, None)
     lt, phiS, ls, ks, rQ, z = res.y[:, 0]
     Z0 = float(sysm.model.reference_shell(0.0, sysm.par)["Z"])

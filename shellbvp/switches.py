@@ -113,7 +113,7 @@ def locate_switches(builder, st):
                           max_nodes=st["max_nodes"], bc_tol=st["bc_tol"])
 
     # a configuration's state at a recorded point's depth, and solved at another depth from a neighbour
-    state_of = {"cap": lambda s: cap_of(s), "line": lambda s: line_state_at(s, st),
+    state_of = {"cap": cap_of, "line": lambda s: line_state_at(s, st),
                 "cap+line(cylinder)": lambda s: _wall_line_at(s, st)}
     solve_on = {"cap": cap_at, "line": line_at, "cap+line(cylinder)": wall_line_at}
 
