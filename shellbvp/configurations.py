@@ -21,6 +21,7 @@ Families:
 
 from __future__ import annotations
 
+import importlib
 from dataclasses import dataclass
 from typing import Callable
 
@@ -29,7 +30,8 @@ from .inflation import system_parameters
 from .solution import attach_tip_table
 
 __all__ = ["Configuration", "CONFIGURATIONS", "CONFIGURATION_NAMES", "FAMILIES", "configuration", "names",
-           "register", "family_of", "ASKED", "Switch", "SWITCHES", "switch_between"]
+           "register", "family_of", "of", "is_single_cap", "is_point_load", "resolve", "CAP_REPLACEMENTS", "ASKED",
+           "Switch", "SWITCHES", "switch_between"]
 
 FAMILIES = ("cap", "point", "lifted", "split", "wall")
 #: Start of the point-load state's free region (its own eps; truncation error O(s0^2 ln^2 s0)).
@@ -57,6 +59,20 @@ class Configuration:
         Whether ``solve(topology=name)`` may ask for it.
     needs_tip_end : bool
         Whether it needs a tip that ends on a cylinder (``model.OMEGA_MAX``).
+    again : str or None
+        ``"module:function"`` that solves this configuration again from one of its states
+        (``solve(guess=...)``): ``again(guess, control, value, *, topology, tol, max_nodes,
+        eps, bc_tol, estimate_error)`` returns the finished state, or None to fall back to
+        the single cap.  None: the cap's own warm start serves.
+    inner_edge : bool
+        Its contact zone has an inner edge ``S1`` besides ``Sc`` (the annulus): guessed with
+        the edge near the cap's middle, refused once the edge runs to the pole.
+    line_contact : bool
+        Its outer contact on the tip is one circle carrying a ring force (zero width), whose
+        ``curvature_excess`` says when it opens into a band.
+    pole_branch_end : bool
+        A smooth lifted pole whose branch may end where its Legendre determinant vanishes
+        (:mod:`shellbvp.lifted_ends`).
     """
 
     name: str
@@ -66,6 +82,20 @@ class Configuration:
     controls: tuple = ("delta", "force", "lambda0")
     askable: bool = False
     needs_tip_end: bool = False
+    again: str | None = None
+    inner_edge: bool = False
+    line_contact: bool = False
+    pole_branch_end: bool = False
+
+    @property
+    def single_cap(self) -> bool:
+        """One contact region from the pole: the state every other configuration is searched from."""
+        return self.family == "cap"
+
+    @property
+    def point_load(self) -> bool:
+        """No contact region (the point-load limit, solved by ``shellbvp.pointload``)."""
+        return self.family == "point"
 
     def check(self, scene, control):
         """A clear ValueError where ``scene`` or ``control`` does not allow this configuration."""
@@ -114,9 +144,11 @@ def configuration(name: str) -> Configuration:
         raise ValueError(f"topology must be one of {tuple(CONFIGURATIONS)}; got {name!r}") from None
 
 
-def names(family: str | None = None) -> tuple:
-    """The names of every configuration, or of one family's, in registration order."""
-    return tuple(n for n, c in CONFIGURATIONS.items() if family is None or c.family == family)
+def names(family: str | None = None, *, having: str | None = None) -> tuple:
+    """The names of every configuration, or of one family's, in registration order; ``having``:
+    only those with that trait (an attribute, e.g. ``"pole_branch_end"``)."""
+    return tuple(n for n, c in CONFIGURATIONS.items()
+                 if (family is None or c.family == family) and (having is None or getattr(c, having)))
 
 
 def family_of(state) -> str:
@@ -125,22 +157,58 @@ def family_of(state) -> str:
     return state.topology if conf is None else conf.family
 
 
+def of(state) -> Configuration | None:
+    """The registered configuration of a state (None for the inflated shell)."""
+    return CONFIGURATIONS.get(state.topology)
+
+
+def is_single_cap(state) -> bool:
+    conf = CONFIGURATIONS.get(state.topology)
+    return conf is not None and conf.single_cap
+
+
+def is_point_load(state) -> bool:
+    conf = CONFIGURATIONS.get(state.topology)
+    return conf is not None and conf.point_load
+
+
+def resolve(path: str) -> Callable:
+    """The function a ``"module:function"`` path names (imported when first asked for: a
+    configuration's numerics live in its family's module, which imports this registry)."""
+    module, _, name = path.partition(":")
+    return getattr(importlib.import_module(module), name)
+
+
+#: How a single cap is replaced where a state of another family is suspected, in the order tried:
+#: ``replace(cap, topology, kw)`` returns the replacement or the cap (with what was tried in its flags)
+CAP_REPLACEMENTS = (("wall", "shellbvp.cylinder:cap_onto_wall"), ("lifted", "shellbvp.liftoff:cap_lifted_off"))
+
+
 def _lifted(chain):
     return lambda eps, L, edge: chain(eps, L)
 
 
+_LIFTED_AGAIN = "shellbvp.liftoff:lifted_again"
+_SPLIT_AGAIN = "shellbvp.liftoff:split_again"
+_WALL_AGAIN = "shellbvp.cylinder:wall_again"
 register(Configuration("cap", "cap", ch.cap_chain, controls=("delta", "force", "lambda0", "arclength"), askable=True))
 register(Configuration("point", "point", lambda eps, L, edge: ch.point_chain(POINT_S0, L), controls=("delta",)))
-register(Configuration("line", "lifted", _lifted(ch.line_chain), contacts=("smooth",), askable=True))
-register(Configuration("annulus", "lifted", _lifted(ch.annulus_chain), contacts=("smooth",), askable=True))
-register(Configuration("cap+line(tip)", "split", _lifted(ch.cap_line_tip_chain), contacts=("smooth",)))
-register(Configuration("cap+band(tip)", "split", _lifted(ch.cap_band_tip_chain), contacts=("smooth",)))
+register(Configuration("line", "lifted", _lifted(ch.line_chain), contacts=("smooth",), askable=True,
+                       again=_LIFTED_AGAIN, line_contact=True, pole_branch_end=True))
+register(Configuration("annulus", "lifted", _lifted(ch.annulus_chain), contacts=("smooth",), askable=True,
+                       again=_LIFTED_AGAIN, inner_edge=True, pole_branch_end=True))
+register(Configuration("cap+line(tip)", "split", _lifted(ch.cap_line_tip_chain), contacts=("smooth",),
+                       again=_SPLIT_AGAIN))
+register(Configuration("cap+band(tip)", "split", _lifted(ch.cap_band_tip_chain), contacts=("smooth",),
+                       again=_SPLIT_AGAIN))
 register(Configuration("cap+line(cylinder)", "wall", ch.cap_line_cylinder_chain, contacts=("smooth",), askable=True,
-                       needs_tip_end=True))
+                       needs_tip_end=True, again=_WALL_AGAIN))
 register(Configuration("cap+band(cylinder)", "wall", ch.cap_band_cylinder_chain, contacts=("smooth",), askable=True,
-                       needs_tip_end=True))
-register(Configuration("cap+cylinder", "wall", ch.cylinder_chain, askable=True, needs_tip_end=True))
-register(Configuration("line+corner", "lifted", _lifted(ch.line_kink_chain), contacts=("smooth",)))
+                       needs_tip_end=True, again=_WALL_AGAIN))
+register(Configuration("cap+cylinder", "wall", ch.cylinder_chain, askable=True, needs_tip_end=True,
+                       again=_WALL_AGAIN))
+register(Configuration("line+corner", "lifted", _lifted(ch.line_kink_chain), contacts=("smooth",),
+                       again=_LIFTED_AGAIN))
 
 @dataclass(frozen=True)
 class Switch:

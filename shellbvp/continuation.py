@@ -43,6 +43,7 @@ from .state import check_delta, check_tol, cross_convexity_limit, make_system, s
 from .steps import configuration_key, secant_guess, solve_at_delta, step_nodes
 from .switches import locate_switches
 from .version import __version__ as VERSION
+from .configurations import is_point_load, is_single_cap, names
 
 __all__ = ["curve"]
 
@@ -147,7 +148,7 @@ def curve(scene, delta_max: float = 0.5, *, deltas=None, force_max=None, lambda0
     check_delta("delta_min", delta_min, scene, tol)
     ds_max = delta_max / 10 if ds_max is None else float(ds_max)
     _check_positive("ds_max", ds_max)
-    if topology not in ("auto", "cap"):
+    if topology not in ("auto",) + names("cap"):
         raise ValueError(f"topology must be 'auto' or 'cap' for a curve; got {topology!r}")
     estimate_error = _error_mode(estimate_error)
 
@@ -257,7 +258,7 @@ class _Builder:
                     return end
                 if end is None:
                     shown = self._before_fold(sol, kw)
-        if shown.topology == "cap" and edge_model(shown) != "pinned" and wall_contact_suspected(shown):
+        if is_single_cap(shown) and edge_model(shown) != "pinned" and wall_contact_suspected(shown):
             wall = None
             if self.last_wall is not None:
                 wall = best_wall_state(self.last_wall, control="delta", value=shown.delta, **kw)
@@ -297,7 +298,7 @@ class _Builder:
             # lets a point above tol be tightened
             if self.estimate_error == "full" or self.since_richardson is None \
                     or self.since_richardson >= RICHARDSON_EVERY - 1 or configuration != self.last_configuration \
-                    or configuration[0] == "point":
+                    or is_point_load(sol):
                 sol = self._richardson(sol)
                 self.since_richardson = 0
             else:
@@ -357,7 +358,7 @@ class _Builder:
         """``sol`` solved again at ``tol`` from itself, with its Richardson estimate; None where that
         does not converge to a state of the same configuration and validity."""
         st = self.settings
-        if sol.topology == "point":
+        if is_point_load(sol):
             fine = solve_point_load(sol.scene, sol.delta, tol=tol, max_nodes=st["max_nodes"], guess=sol,
                                     bc_tol=st["bc_tol"])
         else:
@@ -506,7 +507,7 @@ def _natural(scene, deltas, builder: _Builder, settings, first=None, key0=0):
         rule = _stop_rule(prev, settings)
         if rule:
             raise _Stop(rule)
-        if prev.topology == "cap" and prev.Sc * prev.y[0, -1] / scene.rho > scene.tip_omega_max:
+        if is_single_cap(prev) and prev.Sc * prev.y[0, -1] / scene.rho > scene.tip_omega_max:
             _wall_leg(scene, builder, settings, prev, i, deltas=[d for d in deltas if d > prev.delta],
                       reason="the contact reached the end of the tip (the indenter's cylinder)")
     builder.out.complete = True
@@ -541,9 +542,9 @@ def _wall_leg(scene, builder, st, last_cap, key, *, reason, deltas=None):
     if prev is None:
         outcomes = []
         prev, past_end = best_wall_state(last_cap, tried=tried, outcomes=outcomes, **kw), last_cap
-        if prev is None and last_cap.topology == "cap" and _room_may_help(outcomes):
+        if prev is None and is_single_cap(last_cap) and _room_may_help(outcomes):
             prev, past_end = _wall_state_deeper(scene, last_cap, st, kw, tried)
-        if prev is None and scene.contact == "paper" and last_cap.topology == "cap":
+        if prev is None and scene.contact == "paper" and is_single_cap(last_cap):
             prev = _pinned_state(scene, last_cap, last_cap.delta, st, tried)
         if prev is None:  # not a physical end: a configuration that is missing or not found
             raise _Stop(f"{reason}; no valid contact with the cylinder ({'; '.join(tried)})")
@@ -699,7 +700,7 @@ def _adaptive(scene, builder: _Builder, settings):
     factor = 0.6
     while d > st["delta_min"] and steps < st["max_steps"]:
         nd = max(st["delta_min"], d * factor)
-        if prev.topology == "point":
+        if is_point_load(prev):
             sol = solve_point_load(scene, nd, tol=st["tol"], max_nodes=st["max_nodes"], guess=prev)
         else:
             sol = solve_at_delta(scene, nd, prev, prev2, st)
@@ -718,7 +719,7 @@ def _adaptive(scene, builder: _Builder, settings):
                 log.info("small-delta leg stopped at delta = %.4g: %s", d, sol.message)
                 break
     # Leg 2: pseudo-arclength upwards from the first point.
-    if first.topology == "point":
+    if is_point_load(first):
         # the cap is below double precision there: no (delta, lambda0, F) branch to follow
         # until it comes back; natural continuation in delta instead (point-load limit or cap)
         grid = np.linspace(first.delta, st["delta_max"], 11)

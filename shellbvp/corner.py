@@ -22,6 +22,7 @@ import math
 import numpy as np
 
 from .chain import Edge
+from .configurations import is_single_cap
 
 __all__ = ["LEGENDRE_WATCH", "edge_model", "edge_null_jump", "limit_estimate", "is_corner", "near_limit",
            "other_edge_root"]
@@ -63,7 +64,7 @@ def is_corner(sol, tol) -> bool:
 
 def near_limit(sol) -> bool:
     """A smooth-edge cap state of the smooth model close to its convexity limit."""
-    return bool(sol.topology == "cap" and sol.scene.contact == "smooth" and edge_model(sol) == "smooth"
+    return bool(is_single_cap(sol) and sol.scene.contact == "smooth" and edge_model(sol) == "smooth"
                 and sol.edge_legendre < LEGENDRE_WATCH)
 
 

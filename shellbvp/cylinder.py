@@ -30,11 +30,11 @@ import time
 import numpy as np
 
 from .chain import ChainBVP, TipEnd
-from .configurations import configuration, names
+from .configurations import configuration, is_single_cap, names
 from .diagnosis import diagnose
-from .solution import Solution, failure, passed_tip_end, richardson_error, warm_mesh
+from .solution import Solution, failure, finished, passed_tip_end, richardson_error, warm_mesh
 
-__all__ = ["WALL_TOPOLOGIES", "make_wall_system", "wall_contact_suspected", "solve_chain_from", "wall_state",
+__all__ = ["WALL_TOPOLOGIES", "wall_again", "cap_onto_wall", "make_wall_system", "wall_contact_suspected", "solve_chain_from", "wall_state",
            "best_wall_state", "transfer_guess"]
 
 #: The configurations with contact on the cylinder (``shellbvp.configurations``, family
@@ -63,7 +63,7 @@ def make_wall_system(scene, topology, control, value, eps):
 def wall_contact_suspected(cap: Solution) -> bool:
     """A converged cap that passed the tip's end, or whose free shell passes through the
     indenter with its contact edge near the tip's end."""
-    if cap.topology != "cap" or cap.system is None or cap.scene.model().OMEGA_MAX is None:
+    if not is_single_cap(cap) or cap.system is None or cap.scene.model().OMEGA_MAX is None:
         return False
     passed = passed_tip_end(cap)
     omega_max = cap.scene.tip_omega_max
@@ -288,9 +288,9 @@ def best_wall_state(start: Solution, *, control=None, value=None, tol=1e-6, max_
     """
     tried = [] if tried is None else tried
     outcomes = [] if outcomes is None else outcomes
-    order = list(WALL_TOPOLOGIES) if start.topology == "cap" else _neighbours(start.topology)
+    order = list(WALL_TOPOLOGIES) if is_single_cap(start) else _neighbours(start.topology)
     if start.scene.contact == "paper":
-        order = [t for t in order if t == "cap+cylinder"]
+        order = [t for t in order if "paper" in configuration(t).contacts]
     valid = []
     for topology in order:
         res = wall_state(start, topology, control=control, value=value, tol=tol, max_nodes=max_nodes,
@@ -306,3 +306,37 @@ def best_wall_state(start: Solution, *, control=None, value=None, tol=1e-6, max_
     best.candidates = {r.topology: r.energy for r in valid}
     return best
 
+
+def wall_again(guess, control, value, *, topology, tol, max_nodes, eps, bc_tol, estimate_error):
+    """``solve(guess=...)`` from a wall state: the valid wall configuration of lowest energy
+    (auto) or the asked one; None (back to the single cap) where that does not converge."""
+    t0 = time.perf_counter()
+    kw = dict(control=control, value=value, tol=tol, max_nodes=max_nodes, bc_tol=bc_tol)
+    res = best_wall_state(guess, **kw) if topology == "auto" else (
+        wall_state(guess, topology, **kw) if topology in WALL_TOPOLOGIES else None)
+    if res is not None and res.success:
+        return finished(res, t0, estimate_error, tol, bc_tol)
+    return None
+
+
+def cap_onto_wall(cap, topology, kw):
+    """The asked wall configuration, or (auto) the valid one of lowest energy where the cap
+    passes the tip's end or its free shell passes through the indenter near it; else the
+    cap, with what was tried in its flags."""
+    if cap.system is None or cap.scene.model().OMEGA_MAX is None:
+        return cap
+    if not (cap.success or passed_tip_end(cap)):
+        return cap
+    if topology in WALL_TOPOLOGIES:
+        alt = wall_state(cap, topology, **kw)
+        alt.cap_solution = cap
+        return alt
+    if not wall_contact_suspected(cap):
+        return cap
+    tried = []
+    alt = best_wall_state(cap, tried=tried, **kw)
+    if alt is None:
+        cap.flags = list(cap.flags) + ["no valid contact with the indenter's cylinder (" + "; ".join(tried) + ")"]
+        return cap
+    alt.cap_solution = cap
+    return alt

@@ -375,10 +375,11 @@ def _check_model_start(scene, delta, tol):
     the scene's contact is the point-load limit (far shallower than the shell's
     size) it cannot start, so data that shallow are reported before the curve.
     """
+    from .configurations import is_single_cap
     from .state import solve
 
     sol = solve(scene, delta=delta, tol=tol, estimate_error=False, topology="cap")
-    if not (sol.success and sol.topology == "cap"):
+    if not (sol.success and is_single_cap(sol)):
         why = (sol.message if not sol.success else "the contact there is the point-load limit (the contact cap "
                "is exponentially small), from which the model curve cannot start")
         raise ValueError(f"the model curve cannot start at its shallowest depth delta = {delta:.3g} "

@@ -46,7 +46,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .configurations import CONFIGURATION_NAMES
+from .configurations import CONFIGURATION_NAMES, is_point_load
 from .nexus import new_file
 from .paths import open_hdf5
 from .schema import MAX_DATASET_BYTES
@@ -185,7 +185,7 @@ def energy_residual(delta, energy, force):
 def point_record(sol) -> dict:
     """One point of a curve from a Solution: every POINT_FIELDS value."""
     row = {k: getattr(sol, k) for k in POINT_FIELDS}
-    if row["topology"] == "point":
+    if is_point_load(sol):
         row["S1"] = 0.0
     row["valid"] = bool(sol.valid)
     return row

@@ -10,6 +10,7 @@ import math
 import numpy as np
 
 from .chain import FreePole
+from .configurations import names
 from .liftoff import WARM_NODES, make_liftoff_system, moved_guess, pole_clearance, solve_liftoff, solve_liftoff_from
 from .march import Steps, march
 from .solution import Solution
@@ -69,7 +70,7 @@ def lifted_pole_branch_end(previous: Solution, before: Solution, *, tol=1e-6, ma
     and rises again towards a fold of the branch, :func:`lifted_pole_fold`).
     """
     if previous is None or before is None or previous.topology != before.topology \
-            or previous.topology not in ("line", "annulus") or not previous.delta > before.delta:
+            or previous.topology not in names(having="pole_branch_end") or not previous.delta > before.delta:
         return None
     g_prev, g = pole_legendre(before), pole_legendre(previous)
     if not (math.isfinite(g_prev) and math.isfinite(g) and 0 < g < g_prev):
@@ -206,7 +207,7 @@ def lifted_pole_fold(previous: Solution, before: Solution, *, delta_limit=math.i
     ``_FOLD_STEPS`` solves.
     """
     if previous is None or before is None or previous.topology != before.topology \
-            or previous.topology not in ("line", "annulus") or not previous.delta > before.delta \
+            or previous.topology not in names(having="pole_branch_end") or not previous.delta > before.delta \
             or not (previous.valid and before.valid) \
             or not (math.isfinite(previous.lambda0) and previous.lambda0 != before.lambda0):
         return None, []

@@ -25,7 +25,7 @@ import time
 import numpy as np
 
 from .chain import ChainBVP
-from .configurations import configuration, family_of, names
+from .configurations import configuration, is_single_cap, names
 from .march import Steps, march
 from .cylinder import solve_chain_from, transfer_guess
 from .pointload import solve_point_load
@@ -35,6 +35,7 @@ from .solution import (
     Solution,
     attach_tip_table,
     default_eps,
+    finished,
     richardson_error,
     secant_ratio,
     warm_mesh,
@@ -42,7 +43,8 @@ from .solution import (
 
 __all__ = ["solve_liftoff", "solve_liftoff_from", "make_liftoff_system", "liftoff_guess_from_cap",
            "liftoff_warm_guess", "liftoff_state", "valid_liftoff_state", "lift_off_suspected",
-           "replace_invalid_cap", "pole_clearance", "split_state_from", "moved_guess"]
+           "replace_invalid_cap", "pole_clearance", "split_state_from", "moved_guess", "lifted_again",
+           "split_again", "cap_lifted_off"]
 
 
 #: The lifted-pole configurations that this module solves
@@ -85,7 +87,7 @@ def liftoff_guess_from_cap(sysm: ChainBVP, cap: Solution, S1_fraction: float, n:
     S1 = S1_fraction * Sc
     t = np.linspace(0.0, 1.0, n)
     delta = cap.delta
-    if sysm.topology == "annulus":
+    if configuration(sysm.topology).inner_edge:
         p = sysm.pack(ln_S1=math.log(S1), ln_S2=math.log(Sc), delta=delta)
         Sin, Scont, Sout = sysm.S(0, t, p), sysm.S(1, t, p), sysm.S(2, t, p)
         y = np.vstack([_cap_as_free(cap, Sin), _cap_states_at(cap, Scont), _cap_free_at(cap, Sout)])
@@ -163,7 +165,7 @@ def lift_off_suspected(cap: Solution) -> bool:
     corner edge the axial ring force also carries the tangential force [tau_s] = -kappa [M_s],
     so its sign is not the test)."""
     normal = cap.edge_forces or [cap.ring_force]
-    return bool(cap.success and cap.topology == "cap"
+    return bool(cap.success and is_single_cap(cap)
                 and (cap.pressure_min < 0 or min(normal) < 0))
 
 
@@ -202,7 +204,7 @@ def liftoff_state(cap: Solution, topology: str, *, tol=1e-6, max_nodes=10000, bc
     # near the switch and its contact edge is where the cap's is).  A node budget of a few
     # times the cap's makes hopeless starts fail fast.
     kw = dict(tol=tol, max_nodes=int(min(max_nodes, max(2000, 4 * cap.nodes))), bc_tol=bc_tol)
-    attempt = _solve_annulus if topology == "annulus" else solve_liftoff_from
+    attempt = _solve_annulus if configuration(topology).inner_edge else solve_liftoff_from
     tries = []
     warm = _WARM_FIRST and _near(previous, cap, topology)
     if warm:
@@ -214,7 +216,7 @@ def liftoff_state(cap: Solution, topology: str, *, tol=1e-6, max_nodes=10000, bc
             return tries[-1]
     # The annulus equations also hold, degenerately, for the cap (S1 -> 0): Newton may run
     # there from one guess and find a true annulus from another, so every guess is tried.
-    for frac in ((0.9, 0.5) if topology == "line" else (0.5, 0.9)):
+    for frac in ((0.5, 0.9) if configuration(topology).inner_edge else (0.9, 0.5)):
         tries.append(attempt(sysm, liftoff_guess_from_cap(sysm, cap, frac), **kw))
         if tries[-1].success and not _closed_at_pole(tries[-1]):
             break
@@ -235,7 +237,7 @@ def _closed_at_pole(res):
     """The annulus's inner edge has run to the pole: S1/S2 below ANNULUS_CLOSED_AT_POLE, read
     from the unknowns (ln S1, ln S2) -- of the converged state, or of the last iterate of a run
     that did not converge (Newton walking ln S1 down is how such a run fails)."""
-    if res.topology != "annulus" or res.p is None or len(res.p) < 2:
+    if not configuration(res.topology).inner_edge or res.p is None or len(res.p) < 2:
         return False
     ratio = math.exp(min(0.0, float(res.p[0]) - float(res.p[1])))
     return bool(math.isfinite(res.p[0]) and math.isfinite(res.p[1]) and ratio < ANNULUS_CLOSED_AT_POLE)
@@ -279,7 +281,7 @@ def valid_liftoff_state(cap: Solution, *, tol=1e-6, max_nodes=10000, bc_tol=1e-1
         if res.success and res.valid:
             return res, tried
         tried.append("point load: " + (res.message if not res.success else "; ".join(res.flags)))
-    order = ("line", "annulus")
+    order = LIFTED
     if previous is not None and previous.topology in order:
         order = (previous.topology,) + tuple(t for t in order if t != previous.topology)
     line_too_curved = False
@@ -295,12 +297,12 @@ def valid_liftoff_state(cap: Solution, *, tol=1e-6, max_nodes=10000, bc_tol=1e-1
         return None
 
     for topology in order:
-        if topology == "annulus" and not (line_too_curved or _pressed_somewhere(cap)):
+        if configuration(topology).inner_edge and not (line_too_curved or _pressed_somewhere(cap)):
             # an annulus needs a pressed band: where the whole cap pulls and the line is not
             # bent through the tip, Newton only walks its inner edge to the pole (seconds)
             tried.append("annulus: not tried (the cap pulls everywhere)")
             continue
-        if topology == "annulus" and _SPLIT_FIRST and _pole_down(line, tol) and _pressed_at_the_pole(cap):
+        if configuration(topology).inner_edge and _SPLIT_FIRST and _pole_down(line, tol) and _pressed_at_the_pole(cap):
             split_tried = True
             split = split_here()
             if split is not None:
@@ -309,8 +311,8 @@ def valid_liftoff_state(cap: Solution, *, tol=1e-6, max_nodes=10000, bc_tol=1e-1
                             before=before)
         if res.success and res.valid:
             return res, tried
-        line_too_curved |= topology == "line" and res.curvature_excess > 0
-        line = res if topology == "line" else line
+        line_too_curved |= configuration(topology).line_contact and res.curvature_excess > 0
+        line = res if configuration(topology).line_contact else line
         why = res.message if not res.success else "; ".join(res.flags)
         tried.append(f"{topology}: {why}")
     if split_tried or not _pressed_at_the_pole(cap):
@@ -354,7 +356,7 @@ def _split_possible(last, line, tol):
     not converge.  Without this, base at delta 0.1125 (after the line at 0.1; the line too
     curved here, the cap still pulling at its edge) spent 1.7 s of a 4.7 s curve on split
     guesses that find no state.  Without ``last`` (a single solve) it is always probed."""
-    if last is None or not (last.valid and last.topology in ("line", "annulus")):
+    if last is None or not (last.valid and last.topology in LIFTED):
         return True
     if line is None or not line.success:
         return True
@@ -414,7 +416,7 @@ def second_zone_state(cap: Solution, *, tol=1e-6, max_nodes=10000, bc_tol=1e-10,
     if previous is not None and previous.topology == sysm.topology:
         q = dict(zip(previous.system.unknowns, previous.p))
         guesses.append(transfer_guess(sysm, previous, ln_Sc=q["ln_Sc"], ln_S1=q["ln_S1"], chi1=q["chi1"]))
-    if line is not None and line.success and line.topology == "line":
+    if line is not None and line.success and line.topology in names("lifted", having="line_contact"):
         # a lifted pole coming down inside the line (base at delta 0.1125: the guesses from
         # the cap below leave the model's domain; from the line, 0.7 S1, it converges at once)
         q = dict(zip(line.system.unknowns, line.p))
@@ -486,7 +488,7 @@ def split_state_from(guess: Solution, control: str, value: float, *, tol=1e-6, m
     at another ``control`` value: under delta by natural continuation from it
     (:func:`_continue_in_delta`: halved steps, valid states only; None where none is found),
     under force or lambda0 by one solve from it (diagnosed, valid or not)."""
-    if family_of(guess) != "split":
+    if guess.topology not in names("split"):
         raise ValueError(f"guess must be a {' or '.join(names('split'))} state; got {guess.topology!r}")
     sysm = ChainBVP(guess.scene, guess.system.chain, control, value, model=guess.system.model, par=guess.system.par)
     attach_tip_table(sysm)
@@ -535,3 +537,31 @@ def _pressed_somewhere(cap):
 
 
 # -- the end of a lifted-pole branch: loss of convexity at the free pole -----------------------------
+
+
+def lifted_again(guess, control, value, *, topology, tol, max_nodes, eps, bc_tol, estimate_error):
+    """``solve(guess=...)`` from a lifted-pole state: its configuration solved again; None
+    (back to the single cap) where it fails or another configuration was asked for."""
+    res = solve_liftoff(guess.scene, guess.topology, **{control: value}, guess=guess, tol=tol,
+                        max_nodes=max_nodes, eps=eps, bc_tol=bc_tol, estimate_error=estimate_error)
+    return res if topology in ("auto", guess.topology) and res.success else None
+
+
+def split_again(guess, control, value, *, topology, tol, max_nodes, eps, bc_tol, estimate_error):
+    """``solve(guess=...)`` from a split state (auto only): continued to ``value``
+    (:func:`split_state_from`); None (back to the single cap) where that fails."""
+    t0 = time.perf_counter()
+    res = split_state_from(guess, control, value, tol=tol, max_nodes=max_nodes, bc_tol=bc_tol)
+    if res is not None and res.success and topology == "auto":
+        return finished(res, t0, estimate_error, tol, bc_tol)
+    return None
+
+
+def cap_lifted_off(cap, topology, kw):
+    """The asked lifted configuration from the cap, or (auto, smooth model) a valid lifted or
+    split state replacing an invalid cap (:func:`replace_invalid_cap`)."""
+    if cap.scene.contact != "smooth" or not cap.success:
+        return cap
+    if topology in names("lifted"):
+        return liftoff_state(cap, topology, **kw)
+    return replace_invalid_cap(cap, **kw)

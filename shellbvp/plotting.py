@@ -66,6 +66,7 @@ def plot_curves(curves, ax=None, labels=None, mark_invalid=True):
 def plot_profiles(scene, deltas, ax=None, solutions=None):
     """Deformed meridians at the given depths, the indenter and the undeformed shell."""
     plt = require_matplotlib()
+    from .configurations import is_single_cap
     from .state import solve
 
     if ax is None:
@@ -80,7 +81,7 @@ def plot_profiles(scene, deltas, ax=None, solutions=None):
     sols = solutions or []
     if not sols:
         for d in sorted(deltas):
-            sol = solve(scene, delta=d, guess=sol if sol is not None and sol.topology == "cap" else None,
+            sol = solve(scene, delta=d, guess=sol if sol is not None and is_single_cap(sol) else None,
                         estimate_error=False)
             sols.append(sol)
     om = np.linspace(0, scene.tip_omega_max, 100)

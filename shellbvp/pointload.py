@@ -12,7 +12,7 @@ import time
 
 import numpy as np
 
-from .configurations import POINT_S0, configuration
+from .configurations import POINT_S0, configuration, is_point_load
 from .diagnosis import diagnose
 from .inflation import start_shape
 from .march import Steps, march
@@ -28,7 +28,7 @@ SC_POINT = 1e-30
 
 def _point_guess(sysm, prev):
     """Free states for the point-load problem from a cap or point solution."""
-    if prev.topology == "point":
+    if is_point_load(prev):
         # every third node, not solution.warm_mesh: the march towards a larger depth fails
         # often (the state passes through the tip), and a failed step refines from the whole
         # mesh (base, a cap from a point-load guess: 28 s against 4.5 s)

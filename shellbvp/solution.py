@@ -9,6 +9,7 @@ solve_bvp call, error estimates and the checks against the indenter.
 from __future__ import annotations
 
 import math
+import time
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -18,7 +19,7 @@ from . import collocation
 
 __all__ = ["STATUS_MESSAGES", "STATE_NUMBERS", "Solution", "failure", "solve_bvp", "set_status", "thin_mesh",
            "warm_mesh", "secant_ratio",
-           "richardson_error", "penetration", "wall_gap", "attach_tip_table", "default_eps"]
+           "richardson_error", "finished", "penetration", "wall_gap", "attach_tip_table", "default_eps"]
 
 
 #: What each ``Solution.status`` means and what to try: ``{status: message}``.
@@ -546,6 +547,14 @@ def richardson_error(sysm, res, tol, bc_tol=1e-10):
     res.delta_error = abs(delta - res.delta) * 16 / 15
 
 
+
+
+def finished(res, t0, estimate_error, tol, bc_tol):
+    """``res`` with its error estimate (if asked for) and its wall time since ``t0``."""
+    if estimate_error:
+        richardson_error(res.system, res, tol, bc_tol)
+    res.wall_time = time.perf_counter() - t0
+    return res
 
 def calibrated_error(residual, key, anchors):
     """An error estimate without a solve, calibrated against Richardson estimates.

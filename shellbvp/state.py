@@ -16,7 +16,7 @@ import time
 import numpy as np
 
 from .chain import FREE_STATES, ChainBVP, cap_chain
-from .configurations import ASKED, configuration, family_of, names
+from .configurations import ASKED, CAP_REPLACEMENTS, configuration, is_point_load, is_single_cap, of, resolve
 from .corner import edge_model, edge_null_jump, is_corner, limit_estimate, near_limit, other_edge_root
 from .diagnosis import as_failure, diagnose
 from .inflation import start_shape
@@ -186,14 +186,6 @@ def _seed_corner(sysm, guess, start, d_star, d_far):
     return _with_edge_jump(sysm, guess, -jump * (d_far - d_star) / (d_star - start.delta))
 
 
-def _finished(res, t0, estimate_error, tol, bc_tol):
-    """``res`` with its error estimate (if asked for) and its wall time since ``t0``."""
-    if estimate_error:
-        richardson_error(res.system, res, tol, bc_tol)
-    res.wall_time = time.perf_counter() - t0
-    return res
-
-
 def solve_from(sysm, guess, *, tol=1e-6, max_nodes=10000, bc_tol=None):
     """One solve_bvp run from a given (x, y, p) guess, diagnosed."""
     t0 = time.perf_counter()
@@ -206,7 +198,6 @@ def solve_from(sysm, guess, *, tol=1e-6, max_nodes=10000, bc_tol=None):
 
 #: What ``solve(topology=...)`` accepts: "auto" and the configurations that may be asked for
 TOPOLOGIES = ASKED
-_WALL = names("wall")
 
 #: Mean meridional stretch taken as beyond reach (see :func:`delta_bounds`).
 MEAN_STRETCH_LIMIT = 2.5
@@ -366,37 +357,16 @@ def solve(scene, *, delta=None, lambda0=None, force=None, tol=1e-6, max_nodes=10
         check_delta("delta", value, scene, tol)
     if topology != "auto":
         configuration(topology).check_contact(scene)
-    if guess is not None and family_of(guess) == "lifted":
-        from .liftoff import solve_liftoff
-
-        res = solve_liftoff(scene, guess.topology, delta=delta, force=force, lambda0=lambda0, guess=guess,
-                            tol=tol, max_nodes=max_nodes, eps=eps, bc_tol=bc_tol, estimate_error=estimate_error)
-        if topology in ("auto", guess.topology) and res.success:
+    again = of(guess).again if guess is not None and of(guess) is not None else None
+    if again is not None:  # a lifted, split or wall state: its configuration solved again from it
+        res = resolve(again)(guess, control, value, topology=topology, tol=tol, max_nodes=max_nodes, eps=eps,
+                             bc_tol=bc_tol, estimate_error=estimate_error)
+        if res is not None:
             return res
         guess = None  # back to the cap
 
-    if guess is not None and family_of(guess) == "split":  # a cap and a second zone on the tip
-        from .liftoff import split_state_from
-
-        t0 = time.perf_counter()
-        res = split_state_from(guess, control, value, tol=tol, max_nodes=max_nodes, bc_tol=bc_tol)
-        if res is not None and res.success and topology == "auto":
-            return _finished(res, t0, estimate_error, tol, bc_tol)
-        guess = None  # back to the cap
-
-    if guess is not None and family_of(guess) == "wall":
-        from .cylinder import best_wall_state, wall_state
-
-        t0 = time.perf_counter()
-        kw = dict(control=control, value=value, tol=tol, max_nodes=max_nodes, bc_tol=bc_tol)
-        res = best_wall_state(guess, **kw) if topology == "auto" else (
-            wall_state(guess, topology, **kw) if topology in _WALL else None)
-        if res is not None and res.success:
-            return _finished(res, t0, estimate_error, tol, bc_tol)
-        guess = None  # back to the cap
-
     near_point = None
-    if guess is not None and guess.topology == "point":
+    if guess is not None and is_point_load(guess):
         # a point-load state has no cap to start from: cold start, with the point-load limit
         # (tried where the crude caps fail) warm-started from it
         near_point, guess = guess, None
@@ -413,51 +383,15 @@ def solve(scene, *, delta=None, lambda0=None, force=None, tol=1e-6, max_nodes=10
         res = _cold_delta(make_system(scene, control, value, eps), value, near_point=near_point, **kw)
     else:
         res = _cold_other(scene, make_system(scene, control, value, eps), control, value, eps, **kw)
-    if (topology == "auto" or topology in _WALL) and res.topology == "cap":
-        res = _onto_wall(res, topology, kw)
-    if (topology == "auto" or topology in names("lifted")) and scene.contact == "smooth" and res.topology == "cap" \
-            and res.success:
-        res = _other_topology(res, topology, kw)
+    for family, replace in CAP_REPLACEMENTS:
+        if is_single_cap(res) and (topology == "auto" or configuration(topology).family == family):
+            res = resolve(replace)(res, topology, kw)
     if res.success and estimate_error:
         richardson_error(res.system, res, tol, bc_tol)
     else:
         res.force_error = res.delta_error = float("nan")
     res.wall_time = time.perf_counter() - t0
     return res
-
-
-def _onto_wall(cap, topology, kw):
-    """The asked wall configuration, or (auto) the valid one of lowest energy where the cap
-    passes the tip's end or its free shell passes through the indenter near it
-    (``shellbvp.cylinder``); else the cap, with what was tried in its flags."""
-    from .cylinder import best_wall_state, wall_contact_suspected, wall_state
-
-    if cap.system is None or cap.scene.model().OMEGA_MAX is None:
-        return cap
-    if not (cap.success or passed_tip_end(cap)):
-        return cap
-    if topology in _WALL:
-        alt = wall_state(cap, topology, **kw)
-        alt.cap_solution = cap
-        return alt
-    if not wall_contact_suspected(cap):
-        return cap
-    tried = []
-    alt = best_wall_state(cap, tried=tried, **kw)
-    if alt is None:
-        cap.flags = list(cap.flags) + ["no valid contact with the indenter's cylinder (" + "; ".join(tried) + ")"]
-        return cap
-    alt.cap_solution = cap
-    return alt
-
-
-def _other_topology(cap, topology, kw):
-    """Replace an invalid cap by a valid lift-off state (auto) or by the asked topology."""
-    from .liftoff import liftoff_state, replace_invalid_cap
-
-    if topology in names("lifted"):
-        return liftoff_state(cap, topology, **kw)
-    return replace_invalid_cap(cap, **kw)
 
 
 _SC_GUESSES = (0.05, 0.2, 0.01, 0.002)
@@ -497,7 +431,7 @@ def _cold_delta(sysm, delta, near_point=None, **kw):
             return res
     res = _continue_in_delta(sysm.scene, sysm.eps, delta, **_loose(kw))
     if res is not None and res.success:
-        if res.topology == "point":
+        if is_point_load(res):
             return solve_point_load(sysm.scene, delta, tol=kw["tol"], max_nodes=kw["max_nodes"], guess=res)
         return _tighten(res.system, res, **kw)
     return as_failure(best, 5, STATUS_MESSAGES[5] + f" (first attempt: {best.message})")
@@ -590,7 +524,7 @@ def _continue_in_delta(scene, eps, target, starts=(0.1, 0.05), **kw):
 
     def solve_at(nd, states):
         res, before = states[-1], (states[-2] if len(states) > 1 else None)
-        if res.topology == "point":
+        if is_point_load(res):
             return solve_point_load(scene, nd, tol=kw["tol"], max_nodes=kw["max_nodes"], guess=res)
         sysm = system_like(res, "delta", nd, eps)
         nxt = solve_from(sysm, warm_guess(sysm, res), **kw)
@@ -640,7 +574,7 @@ def _cold_other(scene, sysm, control, value, eps, **kw):
     def solve_at(nd, states):
         cur, prev = states[-1], (states[-2] if len(states) > 1 else None)
         # a point-load state has no cap to warm-start from: a cold solve finds the cap or the limit again
-        if cur.topology == "point":
+        if is_point_load(cur):
             return _cold_delta(make_system(scene, "delta", nd, eps), nd, near_point=cur, **lk)
         dsys = system_like(cur, "delta", nd, eps)
         nxt = solve_from(dsys, warm_guess(dsys, cur), **lk)
@@ -651,7 +585,7 @@ def _cold_other(scene, sysm, control, value, eps, **kw):
     def stop(nxt, nd, states):
         if nxt.success:
             return None
-        if states[-1].topology == "point":  # a cold solve does not start from cur: smaller steps do not help it
+        if is_point_load(states[-1]):  # a cold solve does not start from cur: smaller steps do not help it
             return "point"
         return "tip end" if passed_tip_end(nxt) else None
 

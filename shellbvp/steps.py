@@ -11,6 +11,7 @@ from .corner import edge_model, near_limit
 from .pointload import solve_point_load
 from .solution import SECANT_MAX_RATIO, secant_ratio, warm_mesh
 from .state import cross_convexity_limit, solve, solve_from, system_like, warm_guess
+from .configurations import is_point_load
 
 __all__ = ["solve_at_delta", "step_from_point", "step_nodes", "quadratic_guess", "secant_guess", "configuration_key"]
 
@@ -29,12 +30,12 @@ SECANT_MAX_LN_SC = 1.0
 def solve_at_delta(scene, delta, prev, prev2, settings, prev3=None):
     """Delta-controlled solve warm-started from prev: with the quadratic predictor through
     prev, prev2 and prev3 where it applies, else the secant through prev and prev2."""
-    if prev.topology == "point":
+    if is_point_load(prev):
         return step_from_point(scene, delta, prev, settings)
     sysm = system_like(prev, "delta", delta, settings["eps"])
     guess = None
     a = secant_ratio(delta, prev, prev2)
-    if a is not None and prev2.topology != "point" and edge_model(prev2) == edge_model(prev) \
+    if a is not None and not is_point_load(prev2) and edge_model(prev2) == edge_model(prev) \
             and abs(a * (prev.p[0] - prev2.p[0])) <= SECANT_MAX_LN_SC:
         guess = quadratic_guess(sysm, (prev, prev2, prev3), delta) or secant_guess(sysm, prev, prev2, a)
     if guess is None:
@@ -78,7 +79,7 @@ def quadratic_guess(sysm, states, at):
     ``SECANT_MAX_RATIO`` times the one before, or ln Sc moved by more than ``SECANT_MAX_LN_SC``
     (the secant's guards)."""
     s1, s2, s3 = states
-    if not QUADRATIC_PREDICTOR or s3 is None or s3.topology == "point" \
+    if not QUADRATIC_PREDICTOR or s3 is None or is_point_load(s3) \
             or not configuration_key(s3) == configuration_key(s2) == configuration_key(s1):
         return None
     u1, u2, u3 = s1.delta, s2.delta, s3.delta

@@ -10,7 +10,7 @@ import math
 
 import numpy as np
 
-from .configurations import switch_between
+from .configurations import is_single_cap, names, switch_between
 from .corner import edge_model, is_corner, limit_estimate
 from .cylinder import wall_state
 from .liftoff import liftoff_state, pole_clearance, solve_liftoff
@@ -24,7 +24,7 @@ log = logging.getLogger(__name__)
 
 def cap_of(sol):
     """The single-cap state behind a recorded point (itself, or the cap it replaced)."""
-    if sol.topology == "cap":
+    if is_single_cap(sol):
         return sol
     return sol.cap_solution
 
@@ -242,7 +242,7 @@ def _touchdown_bracket(states, delta):
     """The two line states, not deeper than ``delta``, between which a line's lifted pole comes
     down onto the tip (its clearance crosses zero), or None."""
     lines = sorted((_with_pole_clearance(s) for s in states
-                    if s.topology == "line" and s.success and s.delta <= delta),
+                    if s.topology in names("lifted", having="line_contact") and s.success and s.delta <= delta),
                    key=lambda s: s.delta)
     for a, b in reversed(list(zip(lines[:-1], lines[1:]))):
         if a.pole_clearance > 0 > b.pole_clearance:
