@@ -615,7 +615,7 @@ def markdown(data):
         if data.get("shooting_from"):
             sf = data["shooting_from"]
             lines[-2:-2] = [f"Shooting's rows of {', '.join(sf.get('presets') or ['every preset'])} are from the "
-                            f"run of {sf['date']} (at {sf['commit']}; `benchmarks/shooting.py` unchanged since), "
+                            f"run at {sf['commit']} (measured {sf['date']}; `benchmarks/shooting.py` unchanged since), "
                             f"not measured again in this run; the collocation side is this run's.", ""]
 
         def cell(r, case, key, per="ms_per_point"):

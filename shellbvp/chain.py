@@ -40,7 +40,8 @@ about the cube of the states per node.  Guesses need only the regions' states an
 the unknowns before the pressure: :meth:`ChainBVP.solve` completes them.
 
 :func:`cap_chain`, :func:`point_chain`, :func:`annulus_chain` and
-:func:`line_chain` declare today's configurations; :class:`ChainBVP`
+:func:`line_chain` declare the basic chains (every configuration is registered in
+:mod:`shellbvp.configurations`); :class:`ChainBVP`
 assembles any chain into ``fun``, ``fun_jac``, ``bc``, ``bc_jac`` (analytic,
 from the generated Jacobians), end values, energy and profile.
 """
