@@ -116,7 +116,7 @@ def _ratios(est, true):
 
 def run_preset(name, log, old=None):
     import shellbvp as sb
-    from shellbvp.continuation import RICHARDSON_EVERY
+    from shellbvp.recorder import RICHARDSON_EVERY
 
     scene = sb.Scene.preset(name)
     sb.curve(scene, deltas=DELTAS[:2], tol=TOL, estimate_error=False)  # load the generated code

@@ -106,7 +106,7 @@ VARIANTS = {
     "full Richardson": ("new", {}, {"estimate_error": "full"}, NUMPY),
     "no split rule": ("new", {"shellbvp.liftoff": {"_SPLIT_RULE": False}}, {}, NUMPY),
     "annulus before split": ("new", {"shellbvp.liftoff": {"_SPLIT_FIRST": False}}, {}, NUMPY),
-    "no tightening": ("new", {"shellbvp.continuation": {"_TIGHTEN": False}}, {}, NUMPY),
+    "no tightening": ("new", {"shellbvp.recorder": {"_TIGHTEN": False}}, {}, NUMPY),
     "thinned warm meshes": ("new", {"shellbvp.solution": {"_EQUIDISTRIBUTE": False}}, {}, NUMPY),
     "explicit zeros kept": ("new", {"shellbvp.collocation": {"ENABLED": False}}, {}, NUMPY),
     "explicit zeros kept, numba": ("new", {"shellbvp.collocation": {"ENABLED": False}}, {}, NUMBA),

@@ -23,8 +23,10 @@ import time
 
 import numpy as np
 
+from dataclasses import dataclass
+
 from .cylinder import best_wall_state, wall_contact_suspected
-from .io import POINT_FIELDS, Curve, point_record
+from .io import POINT_FIELDS, Curve
 from .kernels import LONG_CURVE_POINTS, kernel_set
 from .lifted_ends import (
     lifted_pole_branch_end,
@@ -35,9 +37,10 @@ from .lifted_ends import (
 )
 from .liftoff import lift_off_suspected, replace_invalid_cap
 from .pointload import SC_POINT, solve_point_load
-from .solution import Solution, calibrated_error, default_eps, passed_tip_end, richardson_error
+from .solution import Solution, default_eps, passed_tip_end
 from .corner import LEGENDRE_WATCH, edge_model, limit_estimate, near_limit
-from .march import Steps, march
+from .march import Steps, iter_march
+from .recorder import Recorder
 from .state import check_delta, check_tol, cross_convexity_limit, make_system, solve, solve_from, system_like, \
     warm_guess
 from .steps import configuration_key, secant_guess, solve_at_delta, step_nodes
@@ -45,12 +48,16 @@ from .switches import locate_switches
 from .version import __version__ as VERSION
 from .configurations import is_point_load, is_single_cap, names
 
-__all__ = ["curve"]
+__all__ = ["curve", "iter_curve", "CurveRun", "Stop"]
 
 log = logging.getLogger(__name__)
 
-class _Stop(Exception):
-    pass
+@dataclass(frozen=True)
+class Stop:
+    """Why a curve (or one leg of it) ended, and whether that is the end asked for."""
+
+    reason: str
+    complete: bool = False
 
 
 def _X(sol):
@@ -101,7 +108,8 @@ def curve(scene, delta_max: float = 0.5, *, deltas=None, force_max=None, lambda0
         estimated by Richardson (``_Builder._tightened``).
     callback : callable, optional
         ``callback(curve_so_far, solution)`` after each accepted point (progress,
-        checkpoints).  It may raise ``KeyboardInterrupt`` to stop the curve.
+        checkpoints).  It may raise ``KeyboardInterrupt`` to stop the curve.  (To act on the
+        states as they come, iterate :func:`iter_curve` instead.)
     topology : {"auto", "cap"}
         ``"auto"`` (smooth model): where the single cap would pull the shell, record
         the valid line or annular contact at that delta (``shellbvp.liftoff``);
@@ -124,6 +132,50 @@ def curve(scene, delta_max: float = 0.5, *, deltas=None, force_max=None, lambda0
     0.1505, 0.3639
     >>> c.topology_summary()
     'line x1, cap x1 (switch line -> cap at delta = 0.113089)'
+    """
+    run = iter_curve(scene, delta_max, deltas=deltas, force_max=force_max, lambda0_max=lambda0_max,
+                     max_steps=max_steps, delta_start=delta_start, delta_min=delta_min, tol=tol,
+                     max_nodes=max_nodes, ds_max=ds_max, estimate_error=estimate_error, topology=topology)
+    try:
+        for sol in run:
+            if callback is not None:
+                callback(run.recorder.snapshot(), sol)
+    except KeyboardInterrupt:
+        run.interrupt()
+    return run.result()
+
+
+def iter_curve(scene, delta_max: float = 0.5, *, deltas=None, force_max=None, lambda0_max=None,
+               max_steps: int = 400, delta_start=None, delta_min=None, tol: float = 1e-6,
+               max_nodes: int = 10000, ds_max=None, estimate_error: bool | str = "auto",
+               topology: str = "auto") -> CurveRun:
+    """The curve of :func:`curve` as its states come.
+
+    The arguments are checked here, before any solve; iterating the returned run computes
+    the curve.
+
+    Parameters
+    ----------
+    scene : Scene
+    delta_max, deltas, force_max, lambda0_max, max_steps, delta_start, delta_min, tol, max_nodes, ds_max, \
+estimate_error, topology
+        As for :func:`curve`.
+
+    Returns
+    -------
+    CurveRun
+        Yields each recorded state (a :class:`~shellbvp.solution.Solution`) as it is accepted;
+        ``result()`` is the :class:`~shellbvp.io.Curve`.
+
+    Examples
+    --------
+    >>> import shellbvp as sb
+    >>> run = sb.iter_curve(sb.Scene.preset("base"), deltas=[0.1, 0.2], estimate_error=False)
+    >>> [f"{s.topology} {s.force:.4f}" for s in run]
+    ['line 0.1505', 'cap 0.3639']
+    >>> c = run.result()
+    >>> c.complete, c.stop_reason
+    (True, 'all requested deltas computed')
     """
     _check_positive("delta_max", delta_max)
     check_tol(tol)
@@ -158,47 +210,129 @@ def curve(scene, delta_max: float = 0.5, *, deltas=None, force_max=None, lambda0
                     mode="deltas" if deltas is not None else "adaptive", eps=default_eps(tol),
                     bc_tol=1e-10, topology=topology)
 
-    out = Curve(scene=scene, points={k: [] for k in POINT_FIELDS}, flags=[], stop_reason="",
-                complete=False, interrupted=False, settings=settings, version=VERSION)
-    builder = _Builder(out, callback, estimate_error, settings)
-    if deltas is None or deltas.size >= LONG_CURVE_POINTS:  # long enough to repay compiled kernels
-        kernel_set(scene.model(), scene.structure).start_now()
-    t0 = time.perf_counter()
-    try:
-        if deltas is not None:
-            _natural(scene, deltas, builder, settings)
-        else:
-            _adaptive(scene, builder, settings)
-    except KeyboardInterrupt:
-        out.interrupted = True
-        out.stop_reason = "interrupted"
-    except _Stop as stop:
-        out.stop_reason = str(stop)
-    # what the stop cost: failed attempts after the last accepted point (issue 14: <= 2 s)
-    settings["after_last_point_s"] = time.perf_counter() - (builder.last_accepted or t0)
-    if topology == "auto" and not out.interrupted:
-        try:
-            locate_switches(builder, settings)
-        except KeyboardInterrupt:
-            out.interrupted = True
-    builder.finish()
-    settings["wall_time"] = time.perf_counter() - t0
-    log.info("curve: %s in %.2f s", out.summary(), settings["wall_time"])
-    return out
+    settings = dict(tol=tol, max_nodes=max_nodes, delta_max=delta_max, force_max=force_max,
+                    lambda0_max=lambda0_max, max_steps=max_steps, delta_start=delta_start,
+                    delta_min=delta_min, ds_max=ds_max, estimate_error=estimate_error,
+                    mode="deltas" if deltas is not None else "adaptive", eps=default_eps(tol),
+                    bc_tol=1e-10, topology=topology)
+    return CurveRun(scene, settings, deltas)
+
+
+class CurveRun:
+    """A curve as it is computed (made by :func:`iter_curve`).
+
+    Iterating it runs the continuation and yields each recorded state; the located switches
+    between configurations come last.  :meth:`result` gives the :class:`~shellbvp.io.Curve`
+    (the points so far, if the iteration was left early); ``stop`` says why it ended.
+
+    Examples
+    --------
+    >>> import shellbvp as sb
+    >>> run = sb.iter_curve(sb.Scene.preset("base"), delta_max=0.3, estimate_error=False)
+    >>> for state in run:
+    ...     if state.force > 0.2:
+    ...         break
+    >>> c = run.result()
+    >>> c.interrupted, c.stop_reason, bool(c.force.max() > 0.2)
+    (True, 'interrupted', True)
+    """
+
+    def __init__(self, scene, settings, deltas=None):
+        self.scene, self.settings, self.deltas = scene, settings, deltas
+        self.out = Curve(scene=scene, points={k: [] for k in POINT_FIELDS}, flags=[], stop_reason="",
+                         complete=False, interrupted=False, settings=settings, version=VERSION)
+        self.recorder = Recorder(self.out, settings["estimate_error"], settings)
+        self.branch = _Branch(settings)
+        self.stop = None  # the Stop of the continuation, once it has ended
+        self._states = None
+        self._finished = False
+        self._pending = []  # states recorded by the switch search, not yet yielded
+
+    def __iter__(self):
+        if self._states is None:
+            self._states = self._run()
+        return self._states
+
+    @property
+    def rows(self):
+        return self.recorder.rows
+
+    def add(self, sol: Solution, key: float):
+        """Record a state found outside the legs (a located switch), as a leg's point is."""
+        _, shown = self._accept(sol, key)
+        if shown is not None:
+            self._pending.append(shown)
+
+    def _accept(self, sol, key):
+        """(Stop or None, the recorded state or None) for a leg's state ``sol``."""
+        shown = self.recorder.estimated(self.branch.shown(sol))
+        end = self.branch.end
+        if end and self.settings["mode"] != "adaptive":  # requested depths only
+            return Stop(end, complete=True), None
+        self.recorder.record(shown, key)
+        self.branch.last_shown = shown
+        return (Stop(end, complete=True) if end else None), shown
+
+    def _run(self):
+        st, scene = self.settings, self.scene
+        if self.deltas is None or self.deltas.size >= LONG_CURVE_POINTS:  # long enough to repay compiled kernels
+            kernel_set(scene.model(), scene.structure).start_now()
+        self.t0 = time.perf_counter()
+        legs = _natural(scene, self.deltas, self.branch, st) if self.deltas is not None else \
+            _adaptive(scene, self.branch, st)
+        while True:
+            try:
+                sol, key = next(legs)
+            except StopIteration as end:
+                self.stop = end.value or Stop("all requested deltas computed", complete=True)
+                break
+            stop, shown = self._accept(sol, key)
+            if shown is not None:
+                yield shown
+            if stop is not None:
+                legs.close()
+                self.stop = stop
+                break
+        self.out.stop_reason, self.out.complete = self.stop.reason, self.stop.complete
+        # what the stop cost: failed attempts after the last accepted point (issue 14: <= 2 s)
+        st["after_last_point_s"] = time.perf_counter() - (self.recorder.last_accepted or self.t0)
+        if st["topology"] == "auto":
+            locate_switches(self, st)
+            yield from self._pending
+            self._pending = []
+        self._finish()
+
+    def interrupt(self):
+        """Stop here (Ctrl-C, or the caller left the iteration): the points so far are the curve."""
+        if self._states is not None:
+            self._states.close()
+        self.out.interrupted = True
+        if self.stop is None:
+            self.out.stop_reason = "interrupted"
+            self.settings["after_last_point_s"] = time.perf_counter() - (
+                self.recorder.last_accepted or getattr(self, "t0", time.perf_counter()))
+        self._finish()
+
+    def result(self) -> Curve:
+        """The curve: complete if the iteration ran to its end, else the points so far
+        (``interrupted``)."""
+        if not self._finished:
+            self.interrupt()
+        return self.out
+
+    def _finish(self):
+        if self._finished:
+            return
+        self._finished = True
+        self.recorder.finish()
+        self.settings["wall_time"] = time.perf_counter() - getattr(self, "t0", time.perf_counter())
+        log.info("curve: %s in %.2f s", self.out.summary(), self.settings["wall_time"])
 
 
 def _check_positive(name, v):
     if isinstance(v, bool) or not isinstance(v, (int, float, np.floating, np.integer)) \
             or not math.isfinite(v) or v <= 0:
         raise ValueError(f"{name} must be a finite number > 0; got {v!r}")
-
-
-#: With ``estimate_error="auto"``, a Richardson estimate at least every this many points
-#: (measured: benchmarks/error_estimates.py).
-RICHARDSON_EVERY = 5
-
-
-_TIGHTEN = True  # False: no point solved again where its estimate exceeds tol (benchmarks measure the cost)
 
 
 def _error_mode(estimate_error):
@@ -212,37 +346,37 @@ def _error_mode(estimate_error):
     raise ValueError(f'estimate_error must be "auto" (or True), "full" or False; got {estimate_error!r}')
 
 
-class _Builder:
-    """Collects accepted points (sorted into branch order at the end).
+class _Branch:
+    """What the continuation remembers of the configurations it meets, and which state it
+    records at a depth.
 
     The continuation follows the single-cap branch; with ``topology="auto"`` a cap
     point that would pull the shell is recorded as the valid line or annular state
-    at the same delta instead (found from the cap, or from the last lift-off state).
+    at the same delta instead (found from the cap, or from the last lift-off state), and a cap
+    whose shell reaches the indenter's cylinder as the valid wall state of lowest energy.
     At the switch the two coincide (the cap's pressure and the line's excess
-    curvature vanish together), so F(delta) has no jump.
+    curvature vanish together), so F(delta) has no jump.  ``end`` is the reason where the
+    followed branch ends physically (its last state recorded).
     """
 
-    def __init__(self, out: Curve, callback, estimate_error, settings):
-        self.out, self.callback, self.estimate_error = out, callback, estimate_error
+    def __init__(self, settings):
         self.settings = settings
-        self.tol = settings["tol"]
-        self.rows = []  # (order key, row, flags, solution)
         self.last_liftoff = self.liftoff_before = None  # the last two lift-off states (warm starts)
         self.last_wall = None  # the last state with contact on the indenter's cylinder
-        self.since_richardson = None  # points added since the last Richardson estimate
-        self.last_configuration = None
-        self.last_accepted = None  # perf_counter() when the last point was accepted
-        self.branch_end = None  # the stop reason where the followed branch ends physically
+        self.last_shown = None  # the state recorded last
+        self.end = None  # the stop reason where the followed branch ends physically
         self.end_searched_from = None  # the lifted state from which that end was last searched
 
-    def _shown(self, sol: Solution) -> Solution:
+    def shown(self, sol: Solution) -> Solution:
+        """The state the curve records at ``sol``'s depth: ``sol``, or the configuration that
+        replaces it there."""
         st = self.settings
         if st["topology"] != "auto":
             return sol
         kw = dict(tol=st["tol"], max_nodes=st["max_nodes"], bc_tol=st["bc_tol"])
         shown = sol
         if sol.scene.contact == "smooth":
-            last = self.rows[-1][3] if self.rows else None  # the point computed before this one
+            last = self.last_shown  # the point computed before this one
             shown = replace_invalid_cap(sol, previous=self.last_liftoff, before=self.liftoff_before, last=last,
                                         **kw)
             if shown is not sol:
@@ -254,7 +388,7 @@ class _Builder:
                 self.end_searched_from = self.last_liftoff
                 end = lifted_pole_branch_end(self.last_liftoff, self.liftoff_before, **kw)
                 if end is not None and end.delta < sol.delta:
-                    self.branch_end = lifted_pole_end_reason(end)
+                    self.end = lifted_pole_end_reason(end)
                     return end
                 if end is None:
                     shown = self._before_fold(sol, kw)
@@ -278,7 +412,7 @@ class _Builder:
         # followed one curve step past this depth at most
         fold, on_way = lifted_pole_fold(last, before, delta_limit=2 * cap.delta - last.delta, **kw)
         if fold is not None and fold.delta < cap.delta:
-            self.branch_end = lifted_pole_fold_reason(fold)
+            self.end = lifted_pole_fold_reason(fold)
             return fold
         lifted = lifted_state_at(cap.delta, on_way, fold, **kw)
         if lifted is None:
@@ -288,158 +422,27 @@ class _Builder:
         self.liftoff_before, self.last_liftoff = last, lifted
         return lifted
 
-    def add(self, sol: Solution, key: float):
-        """Accept a point; ``key`` orders points along the branch."""
-        sol = self._shown(sol)
-        if self.estimate_error and sol.success:
-            configuration = configuration_key(sol)
-            # point-load states too: their F error per unit residual scatters (flat preset at
-            # 0.0065: a calibrated 5.4e-7 for a true 2.1e-6), and only a Richardson estimate
-            # lets a point above tol be tightened
-            if self.estimate_error == "full" or self.since_richardson is None \
-                    or self.since_richardson >= RICHARDSON_EVERY - 1 or configuration != self.last_configuration \
-                    or is_point_load(sol):
-                sol = self._richardson(sol)
-                self.since_richardson = 0
-            else:
-                sol.error_method = "calibrated"  # values set by finish(), from the Richardson points
-                self.since_richardson += 1
-            self.last_configuration = configuration
-        if self.branch_end and self.settings["mode"] != "adaptive":  # requested depths only
-            self.out.complete = True
-            raise _Stop(self.branch_end)
-        self.rows.append((key, point_record(sol), "; ".join(sol.flags), sol))
-        self.last_accepted = time.perf_counter()
-        if self.callback is not None:
-            self.callback(self.snapshot(), sol)
-        if self.branch_end:  # a physical end of the curve, recorded as its last point
-            self.out.complete = True
-            raise _Stop(self.branch_end)
-
-    def _richardson(self, sol):
-        """Richardson estimate of ``sol``; returns the point to record: ``sol``, or, where the
-        estimate puts its relative F error above tol, the same state solved again at a tighter
-        tolerance (:meth:`_tightened`)."""
-        richardson_error(sol.system, sol, self.tol)
-        sol.error_method = "richardson"
-        return self._tightened(sol) if self._above_tol(sol) else sol
-
-    def _above_tol(self, sol):
-        return bool(_TIGHTEN and sol.force_error > self.tol * abs(sol.force))
-
-    #: solve_bvp bounds collocation residuals, not the error of F: where F is small (the
-    #: end of the small-delta leg) its relative error can exceed tol (fit preset, delta 0.005:
-    #: 1.4e-6 at tol 1e-6; flat, point-load limit at 0.005: 2.0e-6; the estimates saying so).
-    #: Such a point is solved again, from itself, on the same system (same depth, or the same
-    #: point of the arclength step), at a tolerance at least TIGHTEN times tighter, and tighter
-    #: still by twice the factor its estimate exceeds tol by (the error falls about as fast as
-    #: the tolerance: flat's point-load state at delta 2e-4 errs by 9.6e-5, 5.3e-6, 3.8e-7 and
-    #: 4.5e-8 at tol 1e-6 to 1e-9); up to MAX_TIGHTENINGS times, never below MIN_TOL.
-    TIGHTEN = 10.0
-    MAX_TIGHTENINGS = 3
-    MIN_TOL = 1e-12
-
-    def _tightened(self, sol):
-        tol, fine = self.tol, sol
-        for _ in range(self.MAX_TIGHTENINGS):
-            excess = fine.force_error / (self.tol * abs(fine.force))
-            tol = max(self.MIN_TOL, tol / min(1000.0, max(self.TIGHTEN, 2.0 * excess)))
-            finer = self._solved_again(fine, tol)
-            if finer is None:
-                break  # keep the last state that converged, with its estimate
-            log.info("delta = %.6g: F error estimate %.2g relative > tol: solved again at tol %.2g (%.2g)",
-                     fine.delta, fine.force_error / abs(fine.force), tol, finer.force_error / abs(finer.force))
-            fine = finer
-            if not self._above_tol(fine) or tol <= self.MIN_TOL:
-                break
-        return fine
-
-    def _solved_again(self, sol, tol):
-        """``sol`` solved again at ``tol`` from itself, with its Richardson estimate; None where that
-        does not converge to a state of the same configuration and validity."""
-        st = self.settings
-        if is_point_load(sol):
-            fine = solve_point_load(sol.scene, sol.delta, tol=tol, max_nodes=st["max_nodes"], guess=sol,
-                                    bc_tol=st["bc_tol"])
-        else:
-            fine = solve_from(sol.system, (sol.x, sol.y, sol.p), tol=tol, max_nodes=st["max_nodes"],
-                              bc_tol=st["bc_tol"])
-        if not (fine.success and fine.valid == sol.valid
-                and configuration_key(fine) == configuration_key(sol)):
-            return None
-        richardson_error(fine.system, fine, tol)
-        fine.error_method = "richardson"
-        # what the lift-off and wall searches attached
-        fine.set(cap_state=sol.cap_state, cap_solution=sol.cap_solution, line_state=sol.line_state)
-        return fine
-
-    def _estimate_calibrated(self, final):
-        """Fill the calibrated points' estimates (in branch order, per configuration run).
-
-        With ``final``, first add Richardson estimates where the branch order (known only
-        now: switches are located last) puts a calibrated point at an end of the curve or
-        next to another configuration.
-        """
-        rows = sorted((r for r in self.rows if r[3].error_method), key=lambda r: r[0])
-        configurations = [configuration_key(r[3]) for r in rows]
-        if final and not self.out.interrupted:
-            for i, (_, _, _, sol) in enumerate(rows):
-                at_edge = i in (0, len(rows) - 1) or configurations[i - 1] != configurations[i] \
-                    or configurations[i + 1] != configurations[i]
-                if sol.error_method == "calibrated" and at_edge:
-                    rows[i] = self._replace(rows[i], self._richardson(sol))
-        anchors = {}  # configuration -> [(key, force ratio, delta ratio)] of its Richardson points
-        for (key, _, _, sol), conf in zip(rows, configurations):
-            res = float(sol.max_residual)
-            errors = (sol.force_error, sol.delta_error)
-            ratios = (errors[0] / res, errors[1] / res) if res > 0 else (math.nan, math.nan)
-            if sol.error_method == "richardson" and all(map(math.isfinite, ratios)):
-                anchors.setdefault(conf, []).append((key,) + ratios)
-        everywhere = [a for run in anchors.values() for a in run]
-        for (key, _, _, sol), conf in zip(rows, configurations):
-            if sol.error_method == "calibrated":
-                near = anchors.get(conf) or everywhere  # another configuration only while incomplete
-                sol.force_error = calibrated_error(sol.max_residual, key, [(a[0], a[1]) for a in near])
-                sol.delta_error = calibrated_error(sol.max_residual, key, [(a[0], a[2]) for a in near])
-        if final and not self.out.interrupted:  # calibrated points whose estimate is above tol, as above
-            for row in [r for r in rows if r[3].error_method == "calibrated" and self._above_tol(r[3])]:
-                fine = self._tightened(row[3])
-                if fine is not row[3]:
-                    self._replace(row, fine)
-        for r in self.rows:
-            r[1].update(force_error=r[3].force_error, delta_error=r[3].delta_error, error_method=r[3].error_method)
-
-    def _replace(self, row, sol):
-        """``row`` with ``sol`` as its point (in ``self.rows`` too); the row itself if ``sol`` is its own."""
-        if sol is row[3]:
-            return row
-        new = (row[0], point_record(sol), "; ".join(sol.flags), sol)
-        self.rows = [new if r is row else r for r in self.rows]
-        return new
-
-    def snapshot(self) -> Curve:
-        self.finish(final=False)
-        return self.out
-
-    def finish(self, final: bool = True):
-        if self.estimate_error == "auto":
-            self._estimate_calibrated(final)
-        rows = sorted(self.rows, key=lambda r: r[0])
-        pts = {k: np.array([r[1][k] for r in rows]) for k in POINT_FIELDS}
-        pts["valid"] = pts["valid"].astype(bool)
-        for k in ("status", "nodes", "niter"):
-            pts[k] = pts[k].astype(int) if len(rows) else pts[k]
-        self.out.points = pts
-        self.out.flags = [r[2] for r in rows]
-        self.out.solutions = [r[3] for r in rows]
-
 
 def _first_point(scene, delta, settings):
+    """The curve's first state (the single cap: the branch followed is the cap's), or a Stop."""
     sol = solve(scene, delta=delta, tol=settings["tol"], max_nodes=settings["max_nodes"],
-                estimate_error=False, topology="cap")  # the branch followed is the cap's
+                estimate_error=False, topology="cap")
     if not sol.success:
-        raise _Stop(f"no solution at the first point delta = {delta:g}: {sol.message}")
+        return Stop(f"no solution at the first point delta = {delta:g}: {sol.message}")
     return sol
+
+
+def _points(marching, point):
+    """Run an :func:`~shellbvp.march.iter_march`, yielding ``point(state, u)`` for each accepted
+    state where that is not None; returns the march's :class:`~shellbvp.march.Marched`."""
+    while True:
+        try:
+            sol, u = next(marching)
+        except StopIteration as end:
+            return end.value
+        p = point(sol, u)
+        if p is not None:
+            yield p
 
 
 #: A Gent material's strain energy ``-Jm/2 ln(1 - (I1 - 3)/Jm)`` diverges as ``(I1 - 3)/Jm``
@@ -478,11 +481,14 @@ def _physical_end(sol):
     return None
 
 
-def _natural(scene, deltas, builder: _Builder, settings, first=None, key0=0):
-    """Natural continuation through ``deltas`` (from ``first``, already recorded, if given)."""
+def _natural(scene, deltas, branch, settings, first=None, key0=0):
+    """Natural continuation through ``deltas`` (from ``first``, already recorded, if given):
+    yields ``(state, order key)``; returns the Stop, or None where every depth was computed."""
     if first is None:
         prev = _first_point(scene, float(deltas[0]), settings)
-        builder.add(prev, key0)
+        if isinstance(prev, Stop):
+            return prev
+        yield prev, key0
     else:
         prev = first
     history = [prev]
@@ -493,25 +499,27 @@ def _natural(scene, deltas, builder: _Builder, settings, first=None, key0=0):
 
     for i, target in enumerate(deltas[1:], key0 + 1):
         steps = Steps(target - prev.delta, too_small=lambda s, u, t=target: s < min(1e-6, 1e-3 * t))
-        m = march(prev.delta, target, solve_at, steps, history=history[-3:], position=lambda s: s.delta,
-                  arrived=lambda u, t=target: not u < t, stop=lambda sol, nd, states: "tip end" if passed_tip_end(sol) else None,
-                  on_accept=lambda sol, nd, i=i, t=target: builder.add(sol, i) if nd == t else None)
+        m = yield from _points(
+            iter_march(prev.delta, target, solve_at, steps, history=history[-3:], position=lambda s: s.delta,
+                       arrived=lambda u, t=target: not u < t,
+                       stop=lambda sol, nd, states: "tip end" if passed_tip_end(sol) else None),
+            lambda sol, nd, i=i, t=target: (sol, i) if nd == t else None)
         history = m.states
         prev, prev2 = history[-1], (history[-2] if len(history) > 1 else None)
         if m.reason == "tip end":
-            _wall_leg(scene, builder, settings, m.failed, i, deltas=[d for d in deltas if d > prev.delta],
-                      reason=f"the contact reached the end of the tip (the indenter's cylinder) just after "
-                             f"delta = {prev.delta:.6g}")
+            return (yield from _wall_leg(scene, branch, settings, m.failed, i,
+                                         deltas=[d for d in deltas if d > prev.delta],
+                                         reason=f"the contact reached the end of the tip (the indenter's "
+                                                f"cylinder) just after delta = {prev.delta:.6g}"))
         if m.reason == "step":
-            raise _Stop(f"no solution near delta = {m.tried:.6g}: {m.failed.message}{_fold_note(prev, prev2)}")
+            return Stop(f"no solution near delta = {m.tried:.6g}: {m.failed.message}{_fold_note(prev, prev2)}")
         rule = _stop_rule(prev, settings)
         if rule:
-            raise _Stop(rule)
+            return Stop(rule)
         if is_single_cap(prev) and prev.Sc * prev.y[0, -1] / scene.rho > scene.tip_omega_max:
-            _wall_leg(scene, builder, settings, prev, i, deltas=[d for d in deltas if d > prev.delta],
-                      reason="the contact reached the end of the tip (the indenter's cylinder)")
-    builder.out.complete = True
-    builder.out.stop_reason = "all requested deltas computed"
+            return (yield from _wall_leg(scene, branch, settings, prev, i, deltas=[d for d in deltas if d > prev.delta],
+                                         reason="the contact reached the end of the tip (the indenter's cylinder)"))
+    return None  # every requested depth computed
 
 
 def _fold_note(prev, prev2):
@@ -527,18 +535,18 @@ def _fold_note(prev, prev2):
             f"and {prev.delta:.6g}: likely a turning point in delta, a fold past which the shell snaps)")
 
 
-def _wall_leg(scene, builder, st, last_cap, key, *, reason, deltas=None):
+def _wall_leg(scene, branch, st, last_cap, key, *, reason, deltas=None):
     """Past the cap's branch (its contact at the tip's end): follow the configurations with
     contact on the indenter's cylinder by natural continuation in delta (the valid one of
     lowest energy at each depth, from the last such state), to delta_max or through the
-    remaining ``deltas``.  Raises _Stop at the end, with ``reason`` if no wall state is found."""
+    remaining ``deltas``.  Yields ``(state, order key)``; returns the Stop, with ``reason`` if no
+    wall state is found."""
     kw = dict(tol=st["tol"], max_nodes=st["max_nodes"], bc_tol=st["bc_tol"])
     if st["topology"] != "auto" or scene.model().OMEGA_MAX is None:
-        builder.out.complete = True  # the cap's branch ends at the tip's end: the end asked for
-        raise _Stop(reason)
+        return Stop(reason, complete=True)  # the cap's branch ends at the tip's end: the end asked for
     tried = []
     targets = list(deltas) if deltas is not None else None
-    prev = builder.last_wall
+    prev = branch.last_wall
     if prev is None:
         outcomes = []
         prev, past_end = best_wall_state(last_cap, tried=tried, outcomes=outcomes, **kw), last_cap
@@ -547,12 +555,12 @@ def _wall_leg(scene, builder, st, last_cap, key, *, reason, deltas=None):
         if prev is None and scene.contact == "paper" and is_single_cap(last_cap):
             prev = _pinned_state(scene, last_cap, last_cap.delta, st, tried)
         if prev is None:  # not a physical end: a configuration that is missing or not found
-            raise _Stop(f"{reason}; no valid contact with the cylinder ({'; '.join(tried)})")
+            return Stop(f"{reason}; no valid contact with the cylinder ({'; '.join(tried)})")
         prev.cap_solution = past_end  # the cap past the tip's end: where the switch is located from
-        builder.last_wall = prev
+        branch.last_wall = prev
         if targets is None or any(abs(prev.delta - t) < 1e-12 for t in targets):  # (a requested depth)
             key += 1
-            builder.add(prev, key)
+            yield prev, key
     d_end = st["delta_max"] if targets is None else (targets[-1] if targets else prev.delta)
 
     def advance(u, step, t):
@@ -569,20 +577,23 @@ def _wall_leg(scene, builder, st, last_cap, key, *, reason, deltas=None):
     def record(sol, _):
         nonlocal key
         key += 1
-        builder.last_wall = sol
+        branch.last_wall = sol
         if targets is None or any(abs(sol.delta - t) < 1e-12 for t in targets):
-            builder.add(sol, key)
+            return sol, key
+        return None
 
     steps = Steps(max(1e-3, (d_end - prev.delta) / 20), advance=advance, too_small=lambda s, u: s < 1e-5 * (1 + u))
-    m = march(prev.delta, d_end, solve_at, steps, history=[prev], position=lambda s: s.delta,
-              arrived=lambda u: not u < d_end * (1 - 1e-12), accept=lambda s: s is not None, on_accept=record,
-              done=lambda states: _stop_rule(states[-1], st))
+    m = yield from _points(
+        iter_march(prev.delta, d_end, solve_at, steps, history=[prev], position=lambda s: s.delta,
+                   arrived=lambda u: not u < d_end * (1 - 1e-12), accept=lambda s: s is not None,
+                   done=lambda states: _stop_rule(states[-1], st)),
+        record)
     if m.reason == "step":
-        raise _Stop(f"no valid contact configuration beyond delta = {m.at:.6g} ({'; '.join(tried)})")
-    builder.out.complete = True
+        return Stop(f"no valid contact configuration beyond delta = {m.at:.6g} ({'; '.join(tried)})")
     if m.reason:  # a stop rule
-        raise _Stop(m.reason)
-    raise _Stop(f"delta_max = {st['delta_max']:g} reached" if targets is None else "all requested deltas computed")
+        return Stop(m.reason, complete=True)
+    return Stop(f"delta_max = {st['delta_max']:g} reached" if targets is None else "all requested deltas computed",
+                complete=True)
 
 
 def _pinned_state(scene, start, delta, st, tried):
@@ -645,14 +656,14 @@ def _wall_state_deeper(scene, last_cap, st, kw, tried):
     return None, last_cap
 
 
-def _land_on_delta_max(scene, cur, prev, builder, st, key):
-    """Delta-controlled solve at delta_max from the current point; ends the curve on success."""
+def _land_on_delta_max(scene, cur, prev, st, key):
+    """Delta-controlled solve at delta_max from the current point: yields it where it converges;
+    returns (the state, the Stop that ends the curve there or None)."""
     sol = solve_at_delta(scene, st["delta_max"], cur, prev, st)
     if sol.success:
-        builder.add(sol, key)
-        builder.out.complete = True
-        raise _Stop(f"delta_max = {st['delta_max']:g} reached")
-    return sol
+        yield sol, key
+        return sol, Stop(f"delta_max = {st['delta_max']:g} reached", complete=True)
+    return sol, None
 
 
 #: The adaptive curve's first arclength step, in units of the chord from the point below the
@@ -689,10 +700,13 @@ def _angle(cosine):
     return math.acos(min(1.0, max(-1.0, float(cosine))))
 
 
-def _adaptive(scene, builder: _Builder, settings):
+def _adaptive(scene, branch, settings):
+    """The adaptive curve: yields ``(state, order key)``, returns the Stop."""
     st = settings
     first = _first_point(scene, st["delta_start"], st)
-    builder.add(first, 0)
+    if isinstance(first, Stop):
+        return first
+    yield first, 0
     steps = 1
     # Leg 1: down to delta_min (geometric), resolving the small-delta region.
     prev, prev2, below = first, None, None
@@ -710,7 +724,7 @@ def _adaptive(scene, builder: _Builder, settings):
                 sol = point if point.success else sol
         steps += 1
         if sol.success:
-            builder.add(sol, -steps)
+            yield sol, -steps
             below = below or sol
             prev2, prev, d = prev, sol, nd
         else:
@@ -723,8 +737,8 @@ def _adaptive(scene, builder: _Builder, settings):
         # the cap is below double precision there: no (delta, lambda0, F) branch to follow
         # until it comes back; natural continuation in delta instead (point-load limit or cap)
         grid = np.linspace(first.delta, st["delta_max"], 11)
-        _natural(scene, grid, builder, st, first=first, key0=steps)  # complete, or raises _Stop
-        raise _Stop(f"delta_max = {st['delta_max']:g} reached")
+        stop = yield from _natural(scene, grid, branch, st, first=first, key0=steps)
+        return Stop(f"delta_max = {st['delta_max']:g} reached", complete=True) if stop is None else stop
     scale = np.array([1.0, 1.0, 1.0])
     cur = first
     if below is not None and below.topology != first.topology:
@@ -732,7 +746,7 @@ def _adaptive(scene, builder: _Builder, settings):
     if below is None:  # need a second point for the tangent
         below = solve_at_delta(scene, first.delta * 0.9, first, None, st)
         if not below.success:
-            raise _Stop(f"no second point near delta = {first.delta:g}: {below.message}")
+            return Stop(f"no second point near delta = {first.delta:g}: {below.message}")
     prev = below
     ds = min(st["ds_max"], FIRST_STEP * np.linalg.norm((_X(cur) - _X(prev)) / scale))
     ds_min = 1e-4  # in (delta, lambda0, F): below this the branch is taken to end here
@@ -741,14 +755,13 @@ def _adaptive(scene, builder: _Builder, settings):
     crossed_from = None  # the smooth cap from which the corner was last tried
     while True:
         if steps >= st["max_steps"]:
-            raise _Stop(f"max_steps = {st['max_steps']} reached")
+            return Stop(f"max_steps = {st['max_steps']} reached")
         rule = _stop_rule(cur, st)
         if rule:
-            builder.out.complete = True
-            raise _Stop(rule)
+            return Stop(rule, complete=True)
         end = _physical_end(cur)
         if end:
-            raise _Stop(end)
+            return Stop(end)
         chord = (_X(cur) - _X(prev)) / scale
         norm = np.linalg.norm(chord)
         new_tangent = chord / norm
@@ -759,10 +772,12 @@ def _adaptive(scene, builder: _Builder, settings):
         Xhat = _X(cur) + ds * tangent * scale
         if Xhat[0] >= st["delta_max"]:
             steps += 1
-            sol = _land_on_delta_max(scene, cur, prev, builder, st, steps)
+            sol, stop = yield from _land_on_delta_max(scene, cur, prev, st, steps)
+            if stop:
+                return stop
             ds /= 2
             if ds < ds_min:
-                raise _Stop(f"no solution at delta_max = {st['delta_max']:g}: {sol.message}")
+                return Stop(f"no solution at delta_max = {st['delta_max']:g}: {sol.message}")
             continue
         sol = None
         crossing = near_limit(cur) and crossed_from is not cur  # the corner is tried once from each state
@@ -783,30 +798,32 @@ def _adaptive(scene, builder: _Builder, settings):
                 crossed_from = cur
             if not sol.success and crossed_from is cur and cur.edge_legendre < LEGENDRE_WATCH / 5:
                 # at the limit, no smooth step and no corner: halving the step only stalls
-                raise _Stop(f"continuation failed near delta = {cur.delta:.6g}: the energy loses convexity at "
+                return Stop(f"continuation failed near delta = {cur.delta:.6g}: the energy loses convexity at "
                             f"the contact edge (Legendre determinant at Sc+ down to {cur.edge_legendre:.2g} of "
                             f"its mid-region value) and no corner state was found past it ({sol.message})")
         steps += 1
         if sol.success and sol.delta > st["delta_max"]:  # overshot: land from the current point
             steps += 1
-            _land_on_delta_max(scene, cur, prev, builder, st, steps)
+            _, stop = yield from _land_on_delta_max(scene, cur, prev, st, steps)
+            if stop:
+                return stop
             ds /= 2
             continue
         if not sol.success and passed_tip_end(sol):
-            _wall_leg(scene, builder, st, sol, steps,
-                      reason=f"the contact reached the end of the tip (the indenter's cylinder) just after "
-                             f"delta = {cur.delta:.6g}")
+            return (yield from _wall_leg(scene, branch, st, sol, steps,
+                                         reason=f"the contact reached the end of the tip (the indenter's "
+                                                f"cylinder) just after delta = {cur.delta:.6g}"))
         if sol.success and sol.delta > 0:
             if ds > PLOT_TURN_MIN_DS * st["ds_max"] \
                     and _plot_turn(prev, cur, sol, st["delta_max"], force_scale) > MAX_PLOT_TURN:
                 ds /= 2  # the force-displacement curve would bend too much in one step: a shorter one
                 continue
-            builder.add(sol, steps)
+            yield sol, steps
             force_scale = max(force_scale, abs(sol.force))
             prev, cur = cur, sol
             if sol.y[0, -1] * sol.Sc / scene.rho > scene.tip_omega_max:
-                _wall_leg(scene, builder, st, sol, steps,
-                          reason="the contact reached the end of the tip (the indenter's cylinder)")
+                return (yield from _wall_leg(scene, branch, st, sol, steps,
+                                             reason="the contact reached the end of the tip (the indenter's cylinder)"))
             # adapt: Newton effort and turning of the branch
             grow = 1.5 if sol.niter <= 3 else (1.0 if sol.niter <= 6 else 0.6)
             if turn > 0.3:
@@ -824,4 +841,4 @@ def _adaptive(scene, builder: _Builder, settings):
                               f"down to {leg:.2g} of its mid-region value): the free region's equations "
                               f"become singular there, the smooth single-cap branch ends and no corner "
                               f"state was found ({reason})")
-                raise _Stop(f"continuation failed near delta = {cur.delta:.6g}: {reason}")
+                return Stop(f"continuation failed near delta = {cur.delta:.6g}: {reason}")

@@ -16,7 +16,7 @@ import math
 from dataclasses import dataclass, field
 from typing import Any, Callable
 
-__all__ = ["Steps", "Marched", "march"]
+__all__ = ["Steps", "Marched", "march", "iter_march"]
 
 
 @dataclass(frozen=True)
@@ -94,9 +94,11 @@ class Marched:
         return self.states[-1] if self.states else None
 
 
-def march(u0, target, solve_at, steps: Steps, *, history=(), position=None, accept=None, stop=None, done=None,
-          arrived=None, max_solves=None, on_accept=None) -> Marched:
-    """Natural continuation of a parameter u from ``u0`` to ``target``.
+def iter_march(u0, target, solve_at, steps: Steps, *, history=(), position=None, accept=None, stop=None,
+               done=None, arrived=None, max_solves=None):
+    """Natural continuation of a parameter u from ``u0`` to ``target``, as a generator: it yields
+    ``(state, u)`` for every accepted state, as it is accepted, and returns the :class:`Marched`
+    (``StopIteration.value``; :func:`march` collects it).
 
     Parameters
     ----------
@@ -124,8 +126,6 @@ def march(u0, target, solve_at, steps: Steps, *, history=(), position=None, acce
         direction of the march.
     max_solves : int, optional
         The march stops (reason ``"solves"``) before a solve beyond this many.
-    on_accept : callable, optional
-        ``on_accept(state, u)`` for every accepted state, as it is accepted.
     """
     states = [s for s in history if s is not None]
     accept = accept or (lambda s: s.success)
@@ -159,8 +159,7 @@ def march(u0, target, solve_at, steps: Steps, *, history=(), position=None, acce
             states.append(sol)
             u = out.at = nu if position is None else position(sol)
             s = steps.after_success(s)
-            if on_accept is not None:
-                on_accept(sol, nu)
+            yield sol, nu
         else:
             out.failed = sol
             s = steps.after_failure(s, u, nu)
@@ -169,3 +168,16 @@ def march(u0, target, solve_at, steps: Steps, *, history=(), position=None, acce
                 return out
     out.reached = True
     return out
+
+
+def march(u0, target, solve_at, steps: Steps, *, on_accept=None, **options) -> Marched:
+    """:func:`iter_march` run to its end (same parameters); ``on_accept(state, u)`` is called for
+    every accepted state, as it is accepted."""
+    marching = iter_march(u0, target, solve_at, steps, **options)
+    while True:
+        try:
+            sol, u = next(marching)
+        except StopIteration as end:
+            return end.value
+        if on_accept is not None:
+            on_accept(sol, u)

@@ -225,6 +225,42 @@ def test_interrupted_curve_keeps_finished_points(tmp_path):
     assert back.interrupted and len(back) == 3 and sorted(back.delta) == sorted(seen)
 
 
+def test_iter_curve_yields_the_states_that_curve_records(base_curve):
+    """The curve is a generator of states: iterating it gives what ``curve`` records (the
+    located switch last), and its result is the same curve, number for number."""
+    run = sb.iter_curve(sb.Scene.preset("base"), delta_max=0.5)
+    states = list(run)
+    c = run.result()
+    assert len(states) == len(c) == len(base_curve)
+    assert sorted(s.delta for s in states) == list(c.delta)
+    np.testing.assert_array_equal(c.force, base_curve.force)
+    np.testing.assert_array_equal(c.force_error, base_curve.force_error)
+    assert c.stop_reason == base_curve.stop_reason and c.complete
+    # the switch cap -> line is located after the legs, and yielded last
+    (switch,) = c.settings["topology_switches"]
+    assert states[-1].delta == pytest.approx(switch["delta"], abs=1e-12)
+
+
+def test_iter_curve_checks_its_arguments_before_any_solve():
+    with mock.patch("shellbvp.state.solve_from") as solve_from:
+        with pytest.raises(ValueError, match="delta_max"):
+            sb.iter_curve(sb.Scene.preset("base"), delta_max=-1)
+    solve_from.assert_not_called()
+
+
+def test_leaving_iter_curve_early_keeps_the_states_seen():
+    run = sb.iter_curve(sb.Scene.preset("base"), delta_max=0.5, estimate_error=False)
+    seen = []
+    for sol in run:
+        seen.append(sol.delta)
+        if len(seen) == 4:
+            break
+    c = run.result()
+    assert c.interrupted and not c.complete and c.stop_reason == "interrupted"
+    assert sorted(c.delta) == sorted(seen)
+    assert run.result() is c  # finished once
+
+
 @pytest.mark.parametrize("bad", ["missing.h5", "foreign.h5", "corrupt.h5"])
 def test_read_curve_rejects_bad_files(tmp_path, bad):
     path = tmp_path / bad

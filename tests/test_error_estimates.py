@@ -85,14 +85,14 @@ def test_a_point_whose_estimate_exceeds_tol_is_solved_again_tighter(monkeypatch)
     """solve_bvp bounds residuals, not F's error: where F is small it can exceed tol
     (flat preset, point-load limit at delta 0.005: 2e-6 relative at tol 1e-6, the Richardson
     estimate saying so).  Such points are solved again at tol/10 from themselves."""
-    from shellbvp.continuation import _Builder
+    from shellbvp.recorder import Recorder
     from shellbvp.pointload import solve_point_load
 
     scene = sb.Scene.preset("flat")
     kw = dict(delta_max=0.1, delta_start=0.05, delta_min=0.005, tol=1e-6)  # the default curve's small-delta leg
     c = sb.curve(scene, **kw)
     with monkeypatch.context() as m:
-        m.setattr(_Builder, "_above_tol", lambda self, sol: False)
+        m.setattr(Recorder, "_above_tol", lambda self, sol: False)
         loose = sb.curve(scene, **kw)
     np.testing.assert_array_equal(c.delta, loose.delta)
     i = int(np.argmin(c.delta))
