@@ -353,21 +353,24 @@ def _cmd_curve(args):
     bar, show = curve_progress(args.delta_max, f"curve {args.preset or 'base'}", enabled=wanted(args.quiet))
     last = [time.perf_counter()]
 
-    def callback(curve, sol):
-        show(curve, sol)
-        if time.perf_counter() - last[0] >= every:
-            # checkpoint: no finished work is lost, and the old output stays intact until the end
-            running = dataclasses.replace(curve, stop_reason="running", complete=False, interrupted=False)
-            write_curve(running, partial, overwrite=True, units=units)
-            last[0] = time.perf_counter()
-
     t0 = time.perf_counter()
+    run = sb.iter_curve(scene, args.delta_max, deltas=deltas, force_max=args.force_max,
+                        lambda0_max=args.lambda0_max, max_steps=args.max_steps, tol=args.tol,
+                        max_nodes=args.max_nodes, topology=args.topology)
     try:
-        c = sb.curve(scene, args.delta_max, deltas=deltas, force_max=args.force_max,
-                     lambda0_max=args.lambda0_max, max_steps=args.max_steps, tol=args.tol,
-                     max_nodes=args.max_nodes, callback=callback, topology=args.topology)
+        for sol in run:
+            so_far = run.snapshot()
+            show(so_far, sol)
+            if time.perf_counter() - last[0] >= every:
+                # checkpoint: no finished work is lost, and the old output stays intact until the end
+                running = dataclasses.replace(so_far, stop_reason="running", complete=False, interrupted=False)
+                write_curve(running, partial, overwrite=True, units=units)
+                last[0] = time.perf_counter()
+    except KeyboardInterrupt:
+        run.interrupt()
     finally:
         bar.close()
+    c = run.result()
     if c.interrupted and out.exists():
         # Ctrl-C is as safe as kill -9: an earlier file stays; the finished points go to the checkpoint
         write_curve(c, partial, profiles=args.profiles, overwrite=True, units=units)

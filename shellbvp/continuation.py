@@ -139,7 +139,7 @@ def curve(scene, delta_max: float = 0.5, *, deltas=None, force_max=None, lambda0
     try:
         for sol in run:
             if callback is not None:
-                callback(run.recorder.snapshot(), sol)
+                callback(run.snapshot(), sol)
     except KeyboardInterrupt:
         run.interrupt()
     return run.result()
@@ -301,6 +301,11 @@ class CurveRun:
             yield from self._pending
             self._pending = []
         self._finish()
+
+    def snapshot(self) -> Curve:
+        """The curve of the points so far (error estimates calibrated for now; for progress
+        and checkpoints)."""
+        return self.recorder.snapshot()
 
     def interrupt(self):
         """Stop here (Ctrl-C, or the caller left the iteration): the points so far are the curve."""
