@@ -92,7 +92,8 @@ CASES = [("base default", "base", "default"), ("base 40 depths", "base", "deltas
          ("base 40 depths, cap only", "base", "deltas40-cap")] + [
     (f"{p} default", p, "default") for p in ("base-xi0", "prolate2", "fit", "flat", "gent1", "dome")]
 
-#: variant -> (side, patches {module: {attribute: value}}, curve keyword arguments, environment).
+#: variant -> (side, patches {module: {attribute: value}} (for "shellbvp.config": the options),
+#: curve keyword arguments, environment).
 #: This commit runs with the numpy functions (SHELLBVP_KERNELS=numpy: the reference, and what
 #: the ablations switch changes off from) and with numba's compiled kernels (compiled while
 #: warming, not timed); the baseline has no compiled kernels.
@@ -101,16 +102,16 @@ VARIANTS = {
     "baseline": ("old", {}, {}, {}),
     "this commit": ("new", {}, {}, NUMPY),
     "this commit, numba": ("new", {}, {}, NUMBA),
-    "cold lift-off": ("new", {"shellbvp.liftoff": {"_WARM_FIRST": False}}, {}, NUMPY),
-    "no secant guard": ("new", {"shellbvp.steps": {"SECANT_MAX_LN_SC": math.inf}}, {}, NUMPY),
+    "cold lift-off": ("new", {"shellbvp.config": {"warm_first": False}}, {}, NUMPY),
+    "no secant guard": ("new", {"shellbvp.config": {"secant_max_ln_sc": math.inf}}, {}, NUMPY),
     "full Richardson": ("new", {}, {"estimate_error": "full"}, NUMPY),
-    "no split rule": ("new", {"shellbvp.liftoff": {"_SPLIT_RULE": False}}, {}, NUMPY),
-    "annulus before split": ("new", {"shellbvp.liftoff": {"_SPLIT_FIRST": False}}, {}, NUMPY),
-    "no tightening": ("new", {"shellbvp.recorder": {"_TIGHTEN": False}}, {}, NUMPY),
-    "thinned warm meshes": ("new", {"shellbvp.solution": {"_EQUIDISTRIBUTE": False}}, {}, NUMPY),
-    "explicit zeros kept": ("new", {"shellbvp.collocation": {"ENABLED": False}}, {}, NUMPY),
-    "explicit zeros kept, numba": ("new", {"shellbvp.collocation": {"ENABLED": False}}, {}, NUMBA),
-    "SuperLU, numba": ("new", {"shellbvp.collocation": {"COMPILED_ELIMINATION": False}}, {}, NUMBA),
+    "no split rule": ("new", {"shellbvp.config": {"split_rule": False}}, {}, NUMPY),
+    "annulus before split": ("new", {"shellbvp.config": {"split_first": False}}, {}, NUMPY),
+    "no tightening": ("new", {"shellbvp.config": {"tighten": False}}, {}, NUMPY),
+    "thinned warm meshes": ("new", {"shellbvp.config": {"equidistribute": False}}, {}, NUMPY),
+    "explicit zeros kept": ("new", {"shellbvp.config": {"collocation": False}}, {}, NUMPY),
+    "explicit zeros kept, numba": ("new", {"shellbvp.config": {"collocation": False}}, {}, NUMBA),
+    "SuperLU, numba": ("new", {"shellbvp.config": {"compiled_elimination": False}}, {}, NUMBA),
 }
 
 #: variant -> the curves it runs on (each change switched off where it acts; the others run everywhere)
@@ -209,6 +210,7 @@ def worker(spec):
         kernel_load = time.perf_counter() - t0
     for module, attrs in spec["patches"].items():
         m = importlib.import_module(module)
+        m = m.OPTIONS if module == "shellbvp.config" else m  # the package's options object
         for name, value in attrs.items():
             if not hasattr(m, name):
                 raise SystemExit(f"{module} has no {name}: this variant does not apply to this tree")

@@ -18,13 +18,13 @@ as nonzeros.  On the first solve this module replaces three private functions of
   case the kernels' ``collocation_factor`` and ``collocation_solve``
   (:mod:`symbolic.collocation_kernel`: Gaussian elimination with partial
   pivoting, node by node, skipping the zero blocks; 2-3x faster than SuperLU
-  there).  Factors whose entries grow beyond ``MAX_GROWTH`` times the matrix's
+  there).  Factors whose entries grow beyond ``OPTIONS.collocation_max_growth`` times the matrix's
   are not trusted: SuperLU factorises that matrix instead;
 * ``compute_jac_indices``, whose COO index arrays nothing needs any more.
 
 A scipy whose ``_bvp`` lacks them or calls them differently keeps its own
-functions: only slower.  ``ENABLED = False`` restores scipy's path at run time
-(the benchmarks' ablation).
+functions: only slower.  ``shellbvp.options(collocation=False)`` restores scipy's path at run
+time (the benchmarks' ablation).
 
 :func:`newton_on_mesh` solves the same collocation system on a mesh that stays fixed,
 by Newton's method without solve_bvp's line search: Richardson estimates need no
@@ -40,15 +40,13 @@ import threading
 
 import numpy as np
 
-__all__ = ["ENABLED", "COMPILED_ELIMINATION", "MAX_GROWTH", "CollocationBlocks", "CollocationLU", "assemble_csc",
+from .config import OPTIONS
+
+__all__ = ["CollocationBlocks", "CollocationLU", "assemble_csc",
            "collocation_jacobian", "factorise", "install", "newton_on_mesh", "solving_with"]
 
 log = logging.getLogger(__name__)
 
-#: Assemble without the zeros (False: scipy's own assembly and SuperLU; benchmarks measure the gain)
-ENABLED = True
-#: With compiled kernels, factorise by their elimination (False: assembly and SuperLU, as with numpy)
-COMPILED_ELIMINATION = True
 
 _SIGNATURES = {
     "splu": None,  # SuperLU's: any parameters
@@ -87,11 +85,11 @@ def collocation_jacobian(n, m, k, i_jac, j_jac, h, df_dy, df_dy_middle, df_dp, d
     """``scipy.integrate._bvp.construct_global_jac`` (the same arguments; ``i_jac``, ``j_jac``
     are not used): :func:`assemble_csc`, or, with compiled kernels (:func:`solving_with`), a
     :class:`CollocationBlocks` for :func:`factorise`."""
-    if not ENABLED:
+    if not OPTIONS.collocation:
         return _ORIGINAL["construct_global_jac"](n, m, k, i_jac, j_jac, h, df_dy, df_dy_middle, df_dp,
                                                  df_dp_middle, dbc_dya, dbc_dyb, dbc_dp)
     kernels = getattr(_CURRENT, "kernels", None)
-    if kernels is not None and COMPILED_ELIMINATION:
+    if kernels is not None and OPTIONS.compiled_elimination:
         return CollocationBlocks(kernels, n, m, k, h, df_dy, df_dy_middle, df_dp, df_dp_middle, dbc_dya, dbc_dyb,
                                  dbc_dp)
     return assemble_csc(n, m, k, h, df_dy, df_dy_middle, df_dp, df_dp_middle, dbc_dya, dbc_dyb, dbc_dp)
@@ -134,10 +132,6 @@ def assemble_csc(n, m, k, h, df_dy, df_dy_middle, df_dp, df_dp_middle, dbc_dya, 
     return csc_matrix((values[stored], rows[stored], kept), shape=(size, size))
 
 
-#: Partial pivoting's growth (the factors' largest entry over the matrix's) above which the
-#: compiled factors are not trusted and SuperLU factorises the matrix (on the stability grid
-#: and the presets the growth stayed below 50)
-MAX_GROWTH = 1e6
 
 
 class CollocationBlocks:
@@ -154,14 +148,14 @@ class CollocationBlocks:
 
     def factorise(self, max_growth=None):
         """:class:`CollocationLU`; RuntimeError for an exactly singular matrix (as SuperLU);
-        None when the factors grew beyond ``max_growth`` (default ``MAX_GROWTH``)."""
+        None when the factors grew beyond ``max_growth`` (default ``OPTIONS.collocation_max_growth``)."""
         h, df_dy, df_dy_middle, df_dp, df_dp_middle, dbc_dya, dbc_dyb, dbc_dp = self.blocks
         if self.k == 0:  # the kernels take arrays with no columns
             df_dp = df_dp_middle = np.empty((self.n, 0, self.m))
             dbc_dp = np.empty((self.n, 0))
         *factors, growth, status = self.kernels.collocation_factor(
             h, df_dy, df_dy_middle, df_dp, df_dp_middle, dbc_dya, dbc_dyb, dbc_dp,
-            MAX_GROWTH if max_growth is None else float(max_growth))
+            OPTIONS.collocation_max_growth if max_growth is None else float(max_growth))
         if status == 1:
             raise RuntimeError("Factor is exactly singular")
         if status == 2:
@@ -186,7 +180,7 @@ def factorise(J, *args, **kwargs):
         lu = J.factorise()
         if lu is not None:
             return lu
-        log.debug("collocation factors grew beyond %g times the matrix: SuperLU instead", MAX_GROWTH)
+        log.debug("collocation factors grew beyond %g times the matrix: SuperLU instead", OPTIONS.collocation_max_growth)
         J = J.tocsc()
     return _ORIGINAL["splu"](J, *args, **kwargs)
 
@@ -283,7 +277,7 @@ def newton_on_mesh(fun, bc, fun_jac, bc_jac, x, y, p, *, tol, bc_tol, kernels=No
                 blocks = (df_dy, df_dy_middle, df_dp, df_dp_middle, dbc_dya, dbc_dyb, dbc_dp)
                 if not all(b is None or np.all(np.isfinite(b)) for b in blocks):
                     return None
-                i_jac, j_jac = (None, None) if ENABLED else _ORIGINAL["compute_jac_indices"](n, m, k)
+                i_jac, j_jac = (None, None) if OPTIONS.collocation else _ORIGINAL["compute_jac_indices"](n, m, k)
                 try:
                     lu = factorise(collocation_jacobian(n, m, k, i_jac, j_jac, h, *blocks))
                 except RuntimeError:  # exactly singular
@@ -308,7 +302,7 @@ def newton_on_mesh(fun, bc, fun_jac, bc_jac, x, y, p, *, tol, bc_tol, kernels=No
 
 def _jac_indices(n, m, k):
     """Placeholder of ``compute_jac_indices``: :func:`collocation_jacobian` needs no COO indices."""
-    if not ENABLED:
+    if not OPTIONS.collocation:
         return _ORIGINAL["compute_jac_indices"](n, m, k)
     return None, None
 

@@ -40,6 +40,7 @@ from .pointload import SC_POINT, solve_point_load
 from .solution import Solution, default_eps, passed_tip_end
 from .corner import LEGENDRE_WATCH, edge_model, limit_estimate, near_limit
 from .march import Steps, iter_march
+from .config import OPTIONS
 from .recorder import Recorder
 from .state import check_delta, check_tol, cross_convexity_limit, make_system, solve, solve_from, system_like, \
     warm_guess
@@ -671,14 +672,6 @@ def _land_on_delta_max(scene, cur, prev, st, key):
     return sol, None
 
 
-#: The adaptive curve's first arclength step, in units of the chord from the point below the
-#: first.  Twice the chord fails on base, flat and dome (one solve_bvp run refined to its node
-#: budget, ~20 ms, then the step is halved); once the chord (tried at 5e2d0fb) avoids that
-#: but, the steps growing from a smaller start, the stability grid's curves took 1-3 points
-#: more each (2659 against 2608, 80 s against 68 s): 2 is kept.
-FIRST_STEP = 2.0
-
-
 #: The adaptive curve's steps also follow the force-displacement curve as it is plotted, on axes
 #: (``delta / delta_max``, ``F / max |F|`` so far): a step whose chord turns by more than
 #: MAX_PLOT_TURN (radians) from the previous chord is refused and halved, down to PLOT_TURN_MIN_DS
@@ -753,7 +746,7 @@ def _adaptive(scene, branch, settings):
         if not below.success:
             return Stop(f"no second point near delta = {first.delta:g}: {below.message}")
     prev = below
-    ds = min(st["ds_max"], FIRST_STEP * np.linalg.norm((_X(cur) - _X(prev)) / scale))
+    ds = min(st["ds_max"], OPTIONS.first_step * np.linalg.norm((_X(cur) - _X(prev)) / scale))
     ds_min = 1e-4  # in (delta, lambda0, F): below this the branch is taken to end here
     force_scale = max(abs(cur.force), abs(prev.force))
     tangent = None

@@ -27,6 +27,7 @@ import numpy as np
 from .chain import ChainBVP
 from .configurations import configuration, is_single_cap, names
 from .march import Steps, march
+from .config import OPTIONS
 from .cylinder import solve_chain_from, transfer_guess
 from .pointload import solve_point_load
 from .solution import (
@@ -176,7 +177,6 @@ WARM_REACH = 0.5
 #: Node budget of that warm start, in multiples of the previous state's mesh: a neighbour
 #: needs about its own mesh, and a start that does not converge must fail fast.
 WARM_NODES = 3
-_WARM_FIRST = True  # False: the cap's guesses first, as before issue 14 (benchmarks measure the gain)
 
 
 def _near(state, cap, topology):
@@ -206,7 +206,7 @@ def liftoff_state(cap: Solution, topology: str, *, tol=1e-6, max_nodes=10000, bc
     kw = dict(tol=tol, max_nodes=int(min(max_nodes, max(2000, 4 * cap.nodes))), bc_tol=bc_tol)
     attempt = _solve_annulus if configuration(topology).inner_edge else solve_liftoff_from
     tries = []
-    warm = _WARM_FIRST and _near(previous, cap, topology)
+    warm = OPTIONS.warm_first and _near(previous, cap, topology)
     if warm:
         secant = before if control == "delta" and _near(before, cap, topology) else None
         guess = liftoff_warm_guess(sysm, previous, secant, cap.delta if secant is not None else None)
@@ -302,7 +302,7 @@ def valid_liftoff_state(cap: Solution, *, tol=1e-6, max_nodes=10000, bc_tol=1e-1
             # bent through the tip, Newton only walks its inner edge to the pole (seconds)
             tried.append("annulus: not tried (the cap pulls everywhere)")
             continue
-        if configuration(topology).inner_edge and _SPLIT_FIRST and _pole_down(line, tol) and _pressed_at_the_pole(cap):
+        if configuration(topology).inner_edge and OPTIONS.split_first and _pole_down(line, tol) and _pressed_at_the_pole(cap):
             split_tried = True
             split = split_here()
             if split is not None:
@@ -317,16 +317,13 @@ def valid_liftoff_state(cap: Solution, *, tol=1e-6, max_nodes=10000, bc_tol=1e-1
         tried.append(f"{topology}: {why}")
     if split_tried or not _pressed_at_the_pole(cap):
         return None, tried
-    if _SPLIT_RULE and not _split_possible(last, line, tol):
+    if OPTIONS.split_rule and not _split_possible(last, line, tol):
         tried.append("cap+line(tip): not tried (the pole was lifted at the previous point and the line here "
                      "keeps it above the tip)")
         return None, tried
     return split_here(), tried
 
 
-_SPLIT_RULE = True  # False: the split probed wherever the cap is pressed at the pole (benchmarks measure the gain)
-#: False: the annulus before the split, as before issue 14 (benchmarks measure the gain)
-_SPLIT_FIRST = True
 
 
 def _with_line(split, line):

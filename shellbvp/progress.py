@@ -2,16 +2,17 @@
 
 Bars are drawn on stderr when it is a terminal and the caller did not ask for quiet
 (``-q``).  When stderr is a file or a pipe (a batch job, a log) a line is written there
-instead every :data:`LINE_SECONDS` (``SHELLBVP_PROGRESS_SECONDS``), none for a task shorter
+instead every ``OPTIONS.progress_seconds`` (``SHELLBVP_PROGRESS_SECONDS``), none for a task shorter
 than that.  Without tqdm, or when quiet, a silent stand-in with the same methods takes the
 bar's place, so callers never test for it.
 """
 
 from __future__ import annotations
 
-import os
 import sys
 import time
+
+from .config import OPTIONS
 
 __all__ = ["progress_bar", "curve_progress", "wanted"]
 
@@ -42,19 +43,10 @@ class _Silent:
         return False
 
 
-def _line_seconds() -> float:
-    try:
-        return max(float(os.environ.get("SHELLBVP_PROGRESS_SECONDS", "10")), 0.0)
-    except ValueError:
-        return 10.0
-
-
-#: Seconds between progress lines when stderr is not a terminal.
-LINE_SECONDS = _line_seconds()
 
 
 class _Lines(_Silent):
-    """Progress as a line on stderr every :data:`LINE_SECONDS` (for logs: no bar to redraw)."""
+    """Progress as a line on stderr every ``OPTIONS.progress_seconds`` (for logs: no bar to redraw)."""
 
     def __init__(self, total=None, desc="", unit=""):
         super().__init__(total)
@@ -73,7 +65,7 @@ class _Lines(_Silent):
     def update(self, n=1):
         self.n += n
         now = time.monotonic()
-        if now - self.last >= LINE_SECONDS:
+        if now - self.last >= OPTIONS.progress_seconds:
             self.last = now
             self._write()
 
@@ -105,7 +97,7 @@ def progress_bar(total=None, *, desc="", unit="it", enabled=True, leave=True, **
     desc, unit : str
     enabled : bool or str
         Draw it (see :func:`wanted`): True or ``"bar"`` a tqdm bar, ``"lines"`` a line on stderr
-        every :data:`LINE_SECONDS`, False nothing.
+        every ``OPTIONS.progress_seconds``, False nothing.
     leave : bool
         Keep the finished bar on screen.
     **kwargs

@@ -17,6 +17,7 @@ import numpy as np
 
 from .configurations import is_point_load
 from .io import POINT_FIELDS, Curve, point_record
+from .config import OPTIONS
 from .pointload import solve_point_load
 from .solution import Solution, calibrated_error, richardson_error
 from .state import solve_from
@@ -29,9 +30,6 @@ log = logging.getLogger(__name__)
 #: With ``estimate_error="auto"``, a Richardson estimate at least every this many points
 #: (measured: benchmarks/error_estimates.py).
 RICHARDSON_EVERY = 5
-
-
-_TIGHTEN = True  # False: no point solved again where its estimate exceeds tol (benchmarks measure the cost)
 
 
 class Recorder:
@@ -79,7 +77,7 @@ class Recorder:
         return self._tightened(sol) if self._above_tol(sol) else sol
 
     def _above_tol(self, sol):
-        return bool(_TIGHTEN and sol.force_error > self.tol * abs(sol.force))
+        return bool(OPTIONS.tighten and sol.force_error > self.tol * abs(sol.force))
 
     #: solve_bvp bounds collocation residuals, not the error of F: where F is small (the
     #: end of the small-delta leg) its relative error can exceed tol (fit preset, delta 0.005:

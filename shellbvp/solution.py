@@ -16,6 +16,7 @@ from typing import Any
 import numpy as np
 
 from . import collocation
+from .config import OPTIONS
 
 __all__ = ["STATUS_MESSAGES", "STATE_NUMBERS", "Solution", "failure", "solve_bvp", "set_status", "thin_mesh",
            "warm_mesh", "secant_ratio",
@@ -384,7 +385,6 @@ WARM_MESH_SAFETY = 0.5
 #: solve_bvp's relative residual goes as h^3 (halving a converged mesh: 2^2.98-2^3.00 per interval)
 RESIDUAL_ORDER = 3
 _WARM_MESH_MIN_INTERVALS = 10
-_EQUIDISTRIBUTE = True  # False: every third node, as before (benchmarks/speed_vs_baseline.py's ablation)
 
 
 #: A secant predictor ``cur + a (cur - prev)`` is made only while the step is at most this many
@@ -420,7 +420,7 @@ def warm_mesh(sol, tol=None):
     r = np.asarray(sol.rms_residuals, float)
     tol = sol.tol if tol is None else tol
     x = np.asarray(sol.x, float)
-    if not _EQUIDISTRIBUTE or not math.isfinite(tol) or r.size != x.size - 1 or r.size == 0 or not np.all(np.isfinite(r)):
+    if not OPTIONS.equidistribute or not math.isfinite(tol) or r.size != x.size - 1 or r.size == 0 or not np.all(np.isfinite(r)):
         return thin_mesh(x)
     h = np.diff(x)
     target = WARM_MESH_SAFETY * tol

@@ -8,6 +8,7 @@ from __future__ import annotations
 import numpy as np
 
 from .corner import edge_model, near_limit
+from .config import OPTIONS
 from .pointload import solve_point_load
 from .solution import SECANT_MAX_RATIO, secant_ratio, warm_mesh
 from .state import cross_convexity_limit, solve, solve_from, system_like, warm_guess
@@ -20,11 +21,6 @@ def configuration_key(sol):
     return sol.topology, sol.contact_edge
 
 
-#: The secant predictor of a delta step is linear in ln Sc; it is used only while it moves
-#: ln Sc by at most this much.  Near the point-load limit the cap grows exponentially (base:
-#: Sc = 9e-12, 2e-6, 1e-4 at delta = 0.0125, 0.025, 0.0375), the secant overshoots by orders
-#: of magnitude and the step fails at the node budget; the plain warm start converges.
-SECANT_MAX_LN_SC = 1.0
 
 
 def solve_at_delta(scene, delta, prev, prev2, settings, prev3=None):
@@ -36,7 +32,7 @@ def solve_at_delta(scene, delta, prev, prev2, settings, prev3=None):
     guess = None
     a = secant_ratio(delta, prev, prev2)
     if a is not None and not is_point_load(prev2) and edge_model(prev2) == edge_model(prev) \
-            and abs(a * (prev.p[0] - prev2.p[0])) <= SECANT_MAX_LN_SC:
+            and abs(a * (prev.p[0] - prev2.p[0])) <= OPTIONS.secant_max_ln_sc:
         guess = quadratic_guess(sysm, (prev, prev2, prev3), delta) or secant_guess(sysm, prev, prev2, a)
     if guess is None:
         guess = warm_guess(sysm, prev)
@@ -63,23 +59,14 @@ def step_nodes(prev, settings):
     return int(min(settings["max_nodes"], max(2000, 4 * prev.nodes)))
 
 
-#: The quadratic predictor of a step of natural continuation in delta: where three converged
-#: states of one configuration precede it, their quadratic in delta, extrapolated.  Its error is
-#: a step's cube, the secant's its square: on the cap curves through shooting's depths
-#: (benchmarks/speed_vs_baseline.py) solve_bvp's Newton takes 15-20 % fewer steps.  Not on the
-#: adaptive curve's arclength steps, whose steps grow: there the chord length as the parameter
-#: saved 2-6 % of the steps and cost a Jacobian more on 4 of 6 presets.
-QUADRATIC_PREDICTOR = True
-
-
 def quadratic_guess(sysm, states, at):
     """Guess at delta = ``at`` from the quadratic in delta through ``states`` (three, newest
     first), on the newest one's warm-start mesh; None where it does not apply: a missing state
     or one of another configuration, depths not monotone towards ``at``, a step more than
-    ``SECANT_MAX_RATIO`` times the one before, or ln Sc moved by more than ``SECANT_MAX_LN_SC``
+    ``SECANT_MAX_RATIO`` times the one before, or ln Sc moved by more than ``OPTIONS.secant_max_ln_sc``
     (the secant's guards)."""
     s1, s2, s3 = states
-    if not QUADRATIC_PREDICTOR or s3 is None or is_point_load(s3) \
+    if not OPTIONS.quadratic_predictor or s3 is None or is_point_load(s3) \
             or not configuration_key(s3) == configuration_key(s2) == configuration_key(s1):
         return None
     u1, u2, u3 = s1.delta, s2.delta, s3.delta
@@ -91,7 +78,7 @@ def quadratic_guess(sysm, states, at):
     w3 = (at - u1) * (at - u2) / ((u3 - u1) * (u3 - u2))
     X = [np.array([s.p[0], s.lambda0, s.delta]) for s in states]
     ln_Sc, lambda0, delta = w1 * X[0] + w2 * X[1] + w3 * X[2]
-    if not abs(ln_Sc - X[0][0]) <= SECANT_MAX_LN_SC:
+    if not abs(ln_Sc - X[0][0]) <= OPTIONS.secant_max_ln_sc:
         return None
     x = warm_mesh(s1)
     y = w1 * s1.sol(x) + w2 * s2.sol(x) + w3 * s3.sol(x)

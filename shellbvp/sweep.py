@@ -57,6 +57,7 @@ import numpy as np
 from .continuation import curve
 from .io import Curve, read_curve_group, write_curve_group
 from .materials import Gent, MooneyRivlin
+from .config import OPTIONS
 from .paths import atomic_file, open_hdf5
 from .version import __version__
 
@@ -739,8 +740,6 @@ class _Writer:
         _rewrite(self.path, edit)
 
 
-#: Seconds a sweep waits for a finished curve before it asks whether a Dask cluster is still there.
-HEALTH_SECONDS = 10.0
 
 
 def _executor_gone(executor) -> bool:
@@ -754,7 +753,7 @@ def _compute(todo, args_of, executor, on_records):
     in this process), passing finished records on in batches (whatever finished meanwhile).
 
     Returns (computed, lost): tasks the executor could not run (a worker died, or a Dask client
-    closed: checked whenever :data:`HEALTH_SECONDS` pass without a finished curve) are lost,
+    closed: checked whenever ``OPTIONS.health_seconds`` pass without a finished curve) are lost,
     logged and left pending.  On an interruption, tasks not yet started are cancelled.
     """
     if executor is None:
@@ -767,7 +766,7 @@ def _compute(todo, args_of, executor, on_records):
         futures = {executor.submit(run_curve, *args_of(i)): i for i in todo}
         pending = set(futures)
         while pending:
-            done, pending = wait(pending, timeout=HEALTH_SECONDS, return_when=FIRST_COMPLETED)
+            done, pending = wait(pending, timeout=OPTIONS.health_seconds, return_when=FIRST_COMPLETED)
             if not done and _executor_gone(executor):  # a cluster that went away never finishes them
                 lost += len(pending)
                 log.warning("the Dask client is %s: %d curves were not computed; they stay pending",

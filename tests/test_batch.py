@@ -17,6 +17,7 @@ import pytest
 from scipy.interpolate import PchipInterpolator
 
 import shellbvp as sb
+from shellbvp.config import OPTIONS
 from shellbvp.batch import TABLE_COLUMNS, expand_inputs, fit_files
 
 R_L = 0.3e-3
@@ -121,14 +122,14 @@ def test_progress_bar_is_silent_without_tqdm_or_when_not_wanted(monkeypatch, cap
 
 
 def test_progress_lines_go_to_a_log_now_and_then(monkeypatch, capsys):
-    """Not a terminal: a line every LINE_SECONDS and one at the end, none for a short task."""
+    """Not a terminal: a line every options.progress_seconds and one at the end, none for a short task."""
     from shellbvp import progress
 
     bar = progress.progress_bar(3, desc="fit", unit="file", enabled="lines")
     bar.update(1)
     bar.close()
-    assert capsys.readouterr().err == ""          # shorter than LINE_SECONDS: nothing
-    monkeypatch.setattr(progress, "LINE_SECONDS", 0.0)
+    assert capsys.readouterr().err == ""          # shorter than progress_seconds: nothing
+    monkeypatch.setattr(OPTIONS, "progress_seconds", 0.0)
     bar = progress.progress_bar(3, desc="fit", unit="file", enabled="lines")
     bar.set_postfix_str("a.csv: ok")
     bar.update(2)

@@ -23,7 +23,7 @@ def test_curve_without_arguments_writes_base_h5(tmp_path):
     assert "wrote base.h5" in r.stdout and " s" in r.stdout
     c = sb.read_curve(tmp_path / "base.h5")
     assert c.complete and c.delta[-1] == pytest.approx(0.5) and c.scene == sb.Scene.preset("base")
-    # no progress bar when not on a terminal: at most a plain line every progress.LINE_SECONDS
+    # no progress bar when not on a terminal: at most a plain line every options.progress_seconds
     # (a loaded machine takes that long)
     assert "\r" not in r.stderr and all(line.startswith("curve base: delta") for line in r.stderr.splitlines())
     first = (tmp_path / "base.h5").read_bytes()

@@ -97,7 +97,6 @@ def test_the_quadratic_predictor_is_nearer_the_next_state_than_the_secant():
 def test_the_quadratic_predictor_keeps_the_secants_guards():
     import dataclasses
 
-    from shellbvp import steps
     from shellbvp.solution import SECANT_MAX_RATIO
     from shellbvp.steps import quadratic_guess as _quadratic
 
@@ -111,7 +110,7 @@ def test_the_quadratic_predictor_keeps_the_secants_guards():
     assert _quadratic(s1.system, (s1, s2, None), 0.26) is None
     other = dataclasses.replace(s3, contact_edge="corner")  # another configuration
     assert _quadratic(s1.system, (s1, s2, other), 0.26) is None
-    with mock.patch.object(steps, "QUADRATIC_PREDICTOR", False):
+    with sb.options(quadratic_predictor=False):
         assert _quadratic(s1.system, states, 0.26) is None
 
 

@@ -13,6 +13,7 @@ import pytest
 from scipy.integrate import trapezoid
 
 import shellbvp as sb
+from shellbvp.config import OPTIONS
 from shellbvp.lifted_ends import pole_corner_partner
 from shellbvp.liftoff import liftoff_state
 from shellbvp.pointload import solve_point_load
@@ -303,7 +304,7 @@ def test_where_the_lines_pole_is_down_the_split_is_tried_before_the_annulus(monk
     from shellbvp.switches import line_state_at as _line_state_at
 
     assert _line_state_at(split, {}) is line_here  # (no settings needed: nothing is solved)
-    monkeypatch.setattr(lo, "_SPLIT_FIRST", False)
+    monkeypatch.setattr(OPTIONS, "split_first", False)
     again, tried_old = lo.valid_liftoff_state(cap, previous=line, last=line)
     assert [t.split(":")[0] for t in tried_old] == ["line", "annulus"], tried_old
     assert again.topology == "cap+line(tip)" and abs(again.force - split.force) < 1e-9
@@ -335,13 +336,11 @@ def test_warm_lift_off_gives_the_same_curve_with_fewer_newton_iterations(monkeyp
     the line fewer mesh passes (13 against 22).  On the annulus, since warm starts take meshes
     equidistributing the residual (solution.warm_mesh), a start from the cap converges in as
     many passes (40 each; 86 and 84 Jacobians)."""
-    import shellbvp.liftoff
-
     scene = sb.Scene.preset("base", **scene_kw)
     curves, counts = {}, {}
     for warm in (False, True):
         with monkeypatch.context() as m:
-            m.setattr(shellbvp.liftoff, "_WARM_FIRST", warm)
+            m.setattr(OPTIONS, "warm_first", warm)
             counts[warm] = _Count(m)
             curves[warm] = sb.curve(scene, deltas=deltas, estimate_error="full")
     cold, warm = curves[False], curves[True]
@@ -533,9 +532,7 @@ def test_the_touchdown_is_located_where_the_split_state_has_no_line_at_its_depth
     two points either side of the change give no bracket.  The touch-down is bracketed among the
     line points and the switch point recorded between them in branch order (before: no switch
     listed; and a switch point from that bracket went after the line point deeper than it)."""
-    from shellbvp import continuation
-
-    monkeypatch.setattr(continuation, "FIRST_STEP", 1.0)
+    monkeypatch.setattr(OPTIONS, "first_step", 1.0)
     c = sb.curve(sb.Scene.preset("base", beta=0.1), delta_max=1.0, delta_min=1e-4)
     sw = [s for s in c.settings["topology_switches"] if (s["from"], s["to"]) == ("line", "cap+line(tip)")]
     assert len(sw) == 1 and 0.3249 < sw[0]["delta"] < 0.3250 and sw[0]["criterion"] == "pole_clearance"

@@ -14,6 +14,7 @@ import pytest
 from scipy.integrate import trapezoid
 
 import shellbvp as sb
+from shellbvp.config import OPTIONS
 from shellbvp.chain import CONTROLS
 from shellbvp.state import make_system
 
@@ -403,7 +404,7 @@ def test_collocation_jacobian_is_scipys_without_its_stored_zeros(base, monkeypat
     assert all(nnz < 0.75 * blocks for _, nnz, blocks in compared)  # the zeros were many
     monkeypatch.setattr(bvp, "construct_global_jac", collocation.collocation_jacobian)
     ours = sb.solve(base, delta=0.1, tol=1e-8, estimate_error=False)
-    monkeypatch.setattr(collocation, "ENABLED", False)
+    monkeypatch.setattr(OPTIONS, "collocation", False)
     theirs = sb.solve(base, delta=0.1, tol=1e-8, estimate_error=False)
     assert ours.success and theirs.success and ours.nodes == theirs.nodes
     assert abs(ours.force - theirs.force) <= 1e-12 * abs(theirs.force)
@@ -449,7 +450,7 @@ def test_the_collocation_elimination_solves_as_superlu(base, monkeypatch):
     grown = collocation.CollocationBlocks(PLAIN, n, m, k, h, *blocks)
     growth = grown.factorise().growth
     assert grown.factorise(max_growth=growth / 2) is None
-    monkeypatch.setattr(collocation, "MAX_GROWTH", growth / 2)
+    monkeypatch.setattr(OPTIONS, "collocation_max_growth", growth / 2)
     assert type(collocation.factorise(grown)).__name__ == "SuperLU"
 
 

@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 import shellbvp as sb
+from shellbvp.config import OPTIONS
 
 
 def test_scene_round_trips_through_pickle_user_formulas_included():
@@ -237,7 +238,7 @@ def test_a_dask_cluster_that_goes_away_mid_run_leaves_its_curves_pending(tmp_pat
         def submit(self, fn, *args):
             return Future()  # never finishes
 
-    monkeypatch.setattr(sw, "HEALTH_SECONDS", 0.05)
+    monkeypatch.setattr(OPTIONS, "health_seconds", 0.05)
     res = sw.sweep(BASE, {"beta": [0.005, 0.01]}, delta_max=0.1, executor=GoneExecutor(), out=tmp_path / "g.h5",
                    deltas=[0.1], estimate_error=False)
     assert res.computed == 0 and res.lost == 2 and sw.read_sweep(tmp_path / "g.h5").counts() == {"pending": 2}
