@@ -37,3 +37,15 @@ for _cls in (*MATERIALS.values(), *BENDINGS.values()):
     if _cls.__name__ not in __all__:
         globals()[_cls.__name__] = _cls
         __all__.append(_cls.__name__)
+
+
+def _summary(cls) -> str:
+    """The first paragraph of a class's docstring, on one line."""
+    return " ".join((cls.__doc__ or "").strip().split("\n\n")[0].split())
+
+
+if __doc__:  # the list of families in the docs and help() comes from the registry
+    __doc__ += ("\n\nMaterials (``Scene(material=...)``; ``--material FAMILY``):\n\n"
+                + "\n".join(f"* ``{c.family}``: ``{c.__name__}``, {_summary(c)}" for c in MATERIALS.values())
+                + "\n\nBending energies (``Scene(bending=...)``; ``--bending FAMILY``, a user formula ``--bending-formula``):\n\n"
+                + "\n".join(f"* ``{c.family}``: ``{c.__name__}``, {_summary(c)}" for c in BENDINGS.values()) + "\n")
