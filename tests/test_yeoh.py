@@ -108,13 +108,16 @@ def neo_hookean_curve():
 
 
 # The Yeoh structure's code is derived once for this file (4.7 s here; the curves ~5 s more).
-def test_with_c2_c3_zero_the_curve_is_the_neo_hookean_one_and_c2_stiffens(neo_hookean_curve):
-    """Same physics, other generated code: F equal to 1e-10; c2 > 0 stiffens (larger F)."""
+def test_with_c2_c3_zero_the_curve_is_the_neo_hookean_one_and_c2_stiffens(neo_hookean_curve, tmp_path):
+    """Same physics, other generated code: F equal to 1e-10; c2 > 0 stiffens (larger F); the
+    curve's file gives its scene back."""
     yeoh0 = sb.curve(sb.Scene.preset("base", material=sb.Yeoh()), deltas=DELTAS, estimate_error=False)
     assert np.array_equal(yeoh0.delta, neo_hookean_curve.delta)
     assert np.allclose(yeoh0.force, neo_hookean_curve.force, rtol=1e-10, atol=0)
     stiff = sb.curve(sb.Scene.preset("base", material=sb.Yeoh(c2=0.5)), deltas=DELTAS, estimate_error=False)
     assert np.all(stiff.force > neo_hookean_curve.force * (1 + 1e-4))
+    stiff.to_hdf5(tmp_path / "yeoh.h5")
+    assert sb.read_curve(tmp_path / "yeoh.h5").scene == stiff.scene
 
 
 def test_the_command_line_solves_a_yeoh_scene(capsys):
