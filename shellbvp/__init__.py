@@ -30,12 +30,18 @@ _LAZY = {"curve": "continuation", "iter_curve": "continuation", "CurveRun": "con
 
 
 def __getattr__(name):
-    if name in _LAZY:
-        import importlib
+    import importlib
 
+    if name in _LAZY:
         value = getattr(importlib.import_module(f".{_LAZY[name]}", __name__), name)
         globals()[name] = value
         return value
+    # any registered material or bending energy (a module of shellbvp.materials: sb.Yeoh)
+    materials = importlib.import_module(".materials", __name__)
+    for value in (*materials.MATERIALS.values(), *materials.BENDINGS.values()):
+        if value.__name__ == name:
+            globals()[name] = value
+            return value
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 __all__ = [

@@ -145,6 +145,48 @@ def _nondimensional(args, value, option):
     return value.si / (args.mu_h.si * args.radius.si)
 
 
+def _material(text):
+    """argparse type: ``FAMILY[:NAME=VALUE,...]`` (``--material yeoh:c2=0.1,c3=0.01``), a registered
+    material's family and its parameters by the names files use; read as data, never run."""
+    from .materials import MATERIALS
+    from .units import plain_number
+
+    try:
+        family, _, options = (t.strip() for t in text.partition(":"))
+        known = {f: c for f, c in MATERIALS.items() if c.cli}
+        if family not in known:
+            raise ValueError(f"unknown material {family!r}; one of {', '.join(known)}")
+        names = [p.name for p in known[family].parameters]
+        values = {}
+        for item in (t.strip() for t in options.split(",") if options):
+            name, equals, value = (t.strip() for t in item.partition("="))
+            if not equals or name not in names or name in values:
+                wanted = f"give NAME=VALUE once each, NAME one of {', '.join(names)}" if names else "takes no parameters"
+                raise ValueError(f"{family}: {wanted}; got {item!r}")
+            values[name] = plain_number(value, f"{family}: {name}")
+        material = known[family](**values)
+        material.validate()
+        return material
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+
+
+def _material_help() -> str:
+    """What --material takes, from the registry of materials."""
+    from .materials import MATERIALS
+
+    kinds = [c.family + "".join(f", {p.name} {p.range_text()}" for p in c.parameters)
+             for c in MATERIALS.values() if c.cli]
+    return ("a material as FAMILY[:NAME=VALUE,...], e.g. gent:Jm=1 (parameters not given keep their "
+            f"defaults): {'; '.join(kinds)}")
+
+
+def _bending_families() -> tuple:
+    from .materials import BENDINGS
+
+    return tuple(f for f, c in BENDINGS.items() if c.cli)
+
+
 def _scene_options(p, uncertain=False, preset_required=False):
     g = p.add_argument_group("scene (overrides of the preset)")
     g.add_argument("--preset", default=None,
@@ -172,6 +214,8 @@ def _scene_options(p, uncertain=False, preset_required=False):
     m.add_argument("--alpha", type=kind, help=f"Mooney-Rivlin alpha in [0, 1]{note}")
     m.add_argument("--gent-jm", type=_number, dest="gent_jm", help="Gent model with this Jm (> 0)")
     m.add_argument("--neo-hookean", action="store_true", help="neo-Hookean material")
+    m.add_argument("--material", type=_material, metavar="FAMILY[:NAME=VALUE,...]",
+                   help=_material_help())
     g.add_argument("--xi", type=int, choices=(0, 1), help="1: full generalised tensions; 0: first approximation")
     g.add_argument("--pressure", type=_pressure,
                    help="pressure below the shell (from the side away from the indenter; > 0 inflates a dome or "
@@ -181,7 +225,7 @@ def _scene_options(p, uncertain=False, preset_required=False):
                         "sealed capsule); the pressure becomes an unknown of every state")
     g.add_argument("--contact", choices=("smooth", "paper"), help="contact-line model (default smooth)")
     b = g.add_mutually_exclusive_group()
-    b.add_argument("--bending", choices=("trace", "rotation"),
+    b.add_argument("--bending", choices=_bending_families(),
                    help="bending energy B in U = W + beta B: trace (the paper's, default) or rotation (convex)")
     b.add_argument("--bending-formula", dest="bending_formula",
                    help="a user bending energy B per beta in lambda_s, lambda_theta, kappa_s, kappa_theta, "
@@ -202,8 +246,12 @@ def _scene(args):
         over["material"] = sb.Gent(args.gent_jm)
     elif args.neo_hookean:
         over["material"] = sb.NeoHookean()
+    elif args.material is not None:
+        over["material"] = args.material
     if getattr(args, "bending", None):
-        over["bending"] = sb.TraceBending() if args.bending == "trace" else sb.RotationBending()
+        from .materials import bending_class
+
+        over["bending"] = bending_class(args.bending)()
     elif getattr(args, "bending_formula", None):
         over["bending"] = sb.BendingEnergy(args.bending_formula)
     if getattr(args, "pressure", None) is not None:
@@ -915,6 +963,8 @@ def _cmd_sweep(args):
         over["material"] = sb.Gent(grid["Jm"][0])
     elif args.neo_hookean:
         over["material"] = sb.NeoHookean()
+    elif args.material is not None:
+        over["material"] = args.material
     base = sb.Scene.preset(args.preset, **over)
     check_grid(base, grid, args.max_cells)  # before a scheduler is asked for anything
     settings = {"tol": args.tol, "max_nodes": args.max_nodes, "max_steps": args.max_steps, "topology": args.topology}
@@ -1194,6 +1244,8 @@ def build_parser():
     m.add_argument("--alpha", help="Mooney-Rivlin alpha: values to sweep")
     m.add_argument("--gent-jm", dest="gent_jm", help="Gent material, Jm values to sweep")
     m.add_argument("--neo-hookean", action="store_true", help="neo-Hookean material")
+    m.add_argument("--material", type=_material, metavar="FAMILY[:NAME=VALUE,...]",
+                   help=_material_help() + " (the base scene's; not swept)")
     g.add_argument("--pressure", help="pressure below the shell, nondimensional p R_L/(mu H): values to sweep")
     g.add_argument("--xi", type=int, choices=(0, 1), help="1: full generalised tensions; 0: first approximation")
     g.add_argument("--contact", choices=("smooth", "paper"), help="contact-line model (default smooth)")

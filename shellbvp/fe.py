@@ -7,8 +7,9 @@ the solid itself, so that a user sees the model's error for his own scene:
   on either side of it by eps/2 along the normal; 9-node quadratic elements (FElupe's
   ``RegionBiQuadraticQuad``) with the mixed u/p/J (Hu-Washizu) formulation of
   ``ThreeFieldVariation``, bulk modulus ``bulk`` (5000 mu by default: a Poisson ratio of
-  0.4999); the scene's Mooney-Rivlin, neo-Hookean or Gent energy on the isochoric
-  invariants (user energies ``W(lambda_s, lambda_theta)`` have no unique 3D form: refused);
+  0.4999); the scene's energy on the isochoric invariants, from its material's module
+  (``felupe_model``: Mooney-Rivlin, neo-Hookean, Gent, ...; user energies
+  ``W(lambda_s, lambda_theta)`` have no unique 3D form: refused);
 * the rim: pinned at its mid-thickness point (the shell model's simple support);
 * the indenter: rigid and frictionless, the scene's tip on its cylinder, pressed on the
   surface that faces it (the shell model presses the mid-surface); a penalty on the
@@ -27,6 +28,8 @@ import time
 from dataclasses import dataclass, field
 
 import numpy as np
+
+from .materials import MATERIALS
 
 __all__ = ["fe_curve", "FECurve", "TipSurface", "FE_DEFAULTS"]
 
@@ -230,31 +233,16 @@ def _build(scene, eps, *, through_thickness, element_length, pole_refinement, bu
 
 
 def _check_material(scene):
-    if scene.material.description()["family"] not in ("neo-hookean", "mooney-rivlin", "gent"):
-        raise ValueError(f"material: the 3D reference knows Mooney-Rivlin, neo-Hookean and Gent; a user energy "
-                         f"W(lambda_s, lambda_theta) of a sheet has no unique 3D form ({scene.material!r})")
+    if scene.material.felupe_model is None:
+        known = [c.label for c in MATERIALS.values() if c.felupe_model is not None]
+        raise ValueError(f"material: the 3D reference knows {', '.join(known[:-1])} and {known[-1]}; "
+                         f"{scene.material.no_3d_form} ({scene.material!r})")
 
 
 def _material(scene, fem):
+    """The scene's material on the isochoric invariants (its module's ``felupe_model``)."""
     _check_material(scene)
-    family = scene.material.description()["family"]
-    if family == "neo-hookean":
-        return fem.NeoHooke(mu=1.0)
-    import felupe.constitution.tensortrax as mat
-
-    if family == "mooney-rivlin":
-        alpha = scene.material.values()["alpha"]
-        return mat.Hyperelastic(mat.models.hyperelastic.mooney_rivlin, C10=(1 - alpha) / 2, C01=alpha / 2)
-    return mat.Hyperelastic(_gent, Jm=scene.material.values()["Jm"])
-
-
-def _gent(C, Jm):
-    """Gent's energy on the isochoric first invariant, as the shell model's (shear modulus 1)."""
-    from tensortrax.math import log, trace
-    from tensortrax.math.linalg import det
-
-    I1 = det(C) ** (-1 / 3) * trace(C)
-    return -Jm / 2 * log(1 - (I1 - 3) / Jm)
+    return scene.material.felupe_model(fem)
 
 
 class _PenaltyContact:
@@ -519,7 +507,7 @@ def fe_curve(scene, thickness, deltas, *, mesh_check=False, progress=None, **set
     Parameters
     ----------
     scene : Scene
-        Shell, indenter and material (Mooney-Rivlin, neo-Hookean or Gent); beta, xi, the
+        Shell, indenter and material (one with a ``felupe_model``); beta, xi, the
         bending energy and the contact model are the shell model's and play no part here.
         Pressurised scenes are refused.
     thickness : float

@@ -63,8 +63,9 @@ def _code_inputs() -> tuple[str, str]:
     """(fingerprint of the derivation's source, SymPy version), read once per process: hashing
     the files and reading package metadata cost ~2 ms, and every solve asks (``Scene.model()``,
     ~80 times on the default base curve: 6 % of its time).  The derivation imported in this
-    process is the one that generates, so its files are read once, like an import."""
-    return source_fingerprint(), importlib.metadata.version("sympy")
+    process is the one that generates, so its files are read once, like an import.  The
+    materials' modules hold their formulas: they are part of the derivation's source."""
+    return source_fingerprint(Path(__file__).parent / "materials"), importlib.metadata.version("sympy")
 
 
 def structure_description(material, xi: int, shell, tip, bending=None, pressurised=False) -> dict:

@@ -31,10 +31,7 @@ def require_matplotlib():
 
 
 def scene_label(scene) -> str:
-    m = scene.material
-    mat = {"mooney-rivlin": lambda: f"MR {m.alpha:g}", "neo-hookean": lambda: "NH",
-           "gent": lambda: f"Gent {m.Jm:g}", "user": lambda: "user W"}[m.family]()
-    return (f"gamma={scene.gamma:g} rho={scene.rho:.3g} beta={scene.beta:g} {mat} xi={scene.xi} "
+    return (f"gamma={scene.gamma:g} rho={scene.rho:.3g} beta={scene.beta:g} {scene.material.legend()} xi={scene.xi} "
             f"{scene.contact}" + (f" p={scene.pressure:g}" if scene.pressure else ""))
 
 

@@ -14,7 +14,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from .geometry import SphereTip, Spheroid, UserShell, UserTip
-from .materials import Bending, Gent, Material, MooneyRivlin, TraceBending
+from .materials import MATERIALS, Bending, Gent, Material, MooneyRivlin, TraceBending
 from .model import load_module, structure_description
 
 __all__ = ["Scene", "PRESETS", "CONTACT_MODELS"]
@@ -45,7 +45,8 @@ class Scene:
     beta : float
         Bending stiffness ``B/(mu R_L^2)``, > 0 (default 0.01, or from ``thickness``).
     material : Material
-        ``MooneyRivlin(alpha)``, ``NeoHookean()``, ``Gent(Jm)`` or ``StrainEnergy(W)``.
+        ``MooneyRivlin(alpha)``, ``NeoHookean()``, ``Gent(Jm)``, ``StrainEnergy(W)`` or any other
+        material of :mod:`shellbvp.materials` (one module each, found by family name).
     xi : {0, 1}
         1: generalised tensions ``T + M kappa`` (the full theory, default);
         0: the "first approximation" ``tau = T``.
@@ -150,7 +151,8 @@ class Scene:
         if self.contact not in CONTACT_MODELS:
             raise ValueError(f"contact must be one of {CONTACT_MODELS}; got {self.contact!r}")
         if not isinstance(self.material, Material):
-            raise ValueError(f"material must be MooneyRivlin, NeoHookean, Gent or StrainEnergy; got {self.material!r}")
+            raise ValueError(f"material must be one of {', '.join(c.__name__ for c in MATERIALS.values())}; "
+                             f"got {self.material!r}")
         self.material.validate()
         if not isinstance(self.shell, (Spheroid, UserShell)):
             raise ValueError(f"shell must be Spheroid() or UserShell(...); got {self.shell!r}")
@@ -250,7 +252,7 @@ class Scene:
         the field.
         """
         from .geometry import UserShell, UserTip
-        from .materials import BendingEnergy, NeoHookean, RotationBending, StrainEnergy
+        from .materials import bending_class, material_class
 
         def field(data, key, kind, where):
             if not isinstance(data, dict) or key not in data:
@@ -264,16 +266,11 @@ class Scene:
         what = {number: "a number", text: "text", (dict,): "a mapping", (int,): "an integer", (bool,): "true or false"}
         m = field(d, "material", (dict,), "")
         family = field(m, "family", text, "material.")
-        if family == "mooney-rivlin":
-            material = MooneyRivlin(field(m, "alpha", number, "material."))
-        elif family == "neo-hookean":
-            material = NeoHookean()
-        elif family == "gent":
-            material = Gent(field(m, "Jm", number, "material."))
-        elif family == "user":
-            material = StrainEnergy(field(m, "W", text, "material."), legacy_srepr=True)
-        else:
-            raise ValueError(f"scene data: unknown material family {family!r}")
+        try:
+            material_type = material_class(family)
+        except ValueError as exc:
+            raise ValueError(f"scene data: {exc}") from None
+        material = material_type.from_data(lambda key, kind: field(m, key, kind, "material."))
         sh, tp = field(d, "shell", (dict,), ""), field(d, "tip", (dict,), "")
         kind = field(sh, "kind", text, "shell.")
         if kind == "spheroid":
@@ -290,15 +287,12 @@ class Scene:
         else:
             raise ValueError(f"scene data: unknown tip kind {kind!r}")
         bd = d.get("bending", {"family": "trace"})  # files from before the choice: the paper's
-        kind = field(bd, "family", text, "bending.")
-        if kind == "trace":
-            bend = TraceBending()
-        elif kind == "rotation":
-            bend = RotationBending()
-        elif kind == "user":
-            bend = BendingEnergy(field(bd, "B", text, "bending."))
-        else:
-            raise ValueError(f"scene data: unknown bending family {kind!r}")
+        family = field(bd, "family", text, "bending.")
+        try:
+            bending_type = bending_class(family)
+        except ValueError as exc:
+            raise ValueError(f"scene data: {exc}") from None
+        bend = bending_type.from_data(lambda key, kind: field(bd, key, kind, "bending."))
         return cls(gamma=field(d, "gamma", number, ""), rho=field(d, "rho", number, ""),
                    beta=field(d, "beta", number, ""), material=material, xi=field(d, "xi", (int,), ""),
                    contact=field(d, "contact", text, ""), shell=shell, tip=tip, bending=bend,
@@ -344,9 +338,7 @@ class Scene:
                          + ("; with transverse shear" if self.transverse_shear else ""))
         else:
             parts.append(f"beta {self.beta:.4g} (no thickness given)")
-        m = self.material
-        parts.append({"mooney-rivlin": lambda: f"Mooney-Rivlin alpha {m.alpha:g}", "neo-hookean": lambda: "neo-Hookean",
-                      "gent": lambda: f"Gent Jm {m.Jm:g}", "user": lambda: "user strain energy"}[m.family]())
+        parts.append(self.material.describe())
         if not isinstance(self.bending, TraceBending):
             parts.append(f"{type(self.bending).__name__}()")
         parts.append(f"{self.contact} contact" + ("" if self.xi == 1 else ", first approximation xi 0"))

@@ -130,8 +130,7 @@ def model_error(scene):
     eps = getattr(scene, "thickness", None)
     if eps is None or scene.pressure or scene.sealed:
         return None
-    bending = {"TraceBending": "trace", "RotationBending": "rotation"}.get(type(scene.bending).__name__)
-    row = MEASURED_MODEL_ERROR.get((scene.contact, bending, bool(scene.transverse_shear)))
+    row = MEASURED_MODEL_ERROR.get((scene.contact, scene.bending.family, bool(scene.transverse_shear)))
     if row is None:
         return None
     x, y = np.log(MAPPED_EPS), np.log(row)

@@ -29,8 +29,8 @@ import sympy as sp
 
 from .materials import FLOAT_ZERO, LS, LT
 
-__all__ = ["KS", "KT", "KS0", "KT0", "BENDING_SYMBOLS", "trace_bending", "rotation_bending", "bending_energy",
-           "check_bending", "legendre_determinant", "plate_limit", "plate_3d"]
+__all__ = ["KS", "KT", "KS0", "KT0", "BENDING_SYMBOLS", "trace_bending", "rotation_bending", "check_bending",
+           "legendre_determinant", "plate_limit", "plate_3d"]
 
 KS, KT = sp.symbols("kappa_s kappa_theta", real=True)
 KS0, KT0 = sp.symbols("kappa_s0 kappa_theta0", real=True)
@@ -45,17 +45,6 @@ def trace_bending():
 
 def rotation_bending():
     return (LS * KS + LT * KT - KS0 - KT0) ** 2 / 2
-
-
-def bending_energy(family: str, formula=None):
-    """B of a bending family ("trace", "rotation", or "user" with its parsed formula)."""
-    if family == "trace":
-        return trace_bending()
-    if family == "rotation":
-        return rotation_bending()
-    if family == "user":
-        return formula
-    raise ValueError(f"unknown bending family {family!r}")
 
 
 def _zero(e) -> bool:

@@ -5,22 +5,18 @@ say everything the generated code depends on, and nothing else (continuous
 parameters are run-time arguments).  User formulas travel as plain text
 (``formula.formula_text``), read back by the whitelist parser
 ``formula.parse_formula``; descriptions of older versions held ``srepr`` text,
-which the parser's legacy mode reads.
+which the parser's legacy mode reads.  Strain and bending energies come from
+the families registered in ``symbolic.energies``.
 """
 
 from __future__ import annotations
 
-import sympy as sp
-
-from . import bending, codegen, codegen_numba, geometry, materials
+from . import codegen, codegen_numba, energies, geometry
 from .equations import Structure, derive
 from .formula import parse_formula
 from .version import canonical_json
 
 __all__ = ["structure_from_description", "generate_source", "generate_sources"]
-
-ALPHA = sp.Symbol("alpha", positive=True)
-JM = sp.Symbol("Jm", positive=True)
 
 
 def _expr(text: str, name: str, *syms):
@@ -29,18 +25,7 @@ def _expr(text: str, name: str, *syms):
 
 
 def structure_from_description(desc: dict) -> Structure:
-    mat = desc["material"]
-    family = mat["family"]
-    if family == "mooney-rivlin":
-        W, mpar = materials.mooney_rivlin(ALPHA), (ALPHA,)
-    elif family == "neo-hookean":
-        W, mpar = materials.neo_hookean(), ()
-    elif family == "gent":
-        W, mpar = materials.gent(JM), (JM,)
-    elif family == "user":
-        W, mpar = _expr(mat["W"], "W", materials.LS, materials.LT), ()
-    else:
-        raise ValueError(f"unknown material family {family!r}")
+    W, mpar = energies.strain_energy(desc["material"])
     sh = desc["shell"]
     if sh["kind"] == "spheroid":
         shell = geometry.spheroid()
@@ -52,9 +37,7 @@ def structure_from_description(desc: dict) -> Structure:
         tip = geometry.sphere_tip()
     else:
         tip = geometry.user_tip(_expr(tp["A"], "A(omega)", geometry.OMEGA), _expr(tp["B"], "B(omega)", geometry.OMEGA))
-    bend = desc.get("bending", {"family": "trace"})
-    B = None if bend["family"] == "trace" else bending.bending_energy(
-        bend["family"], _expr(bend["B"], "B", *bending.BENDING_SYMBOLS.values()) if bend["family"] == "user" else None)
+    B = energies.bending_energy(desc.get("bending", {"family": "trace"}))
     return Structure(W=W, material_params=mpar, shell=shell, tip=tip, xi=int(desc["xi"]), B=B,
                      pressurised=bool(desc.get("pressurised", False)))
 

@@ -9,19 +9,21 @@ so that reading it does not import SymPy.
 CODEGEN_VERSION = "12"
 
 
-def source_fingerprint() -> str:
-    """SHA-256 of this package's source files (part of the cache key).
+def source_fingerprint(*formula_dirs) -> str:
+    """SHA-256 of this package's source files and of those in ``formula_dirs`` (the modules
+    that register energies with ``symbolic.energies``): part of the cache key.
 
-    Any edit of the derivation or the printer changes it, so a stale cached
+    Any edit of the derivation, the printer or a formula changes it, so a stale cached
     module is never loaded even if CODEGEN_VERSION was not bumped.
     """
     import hashlib
     from pathlib import Path
 
     h = hashlib.sha256()
-    for path in sorted(Path(__file__).parent.glob("*.py")):
-        h.update(path.name.encode())
-        h.update(path.read_bytes())
+    for folder in (Path(__file__).parent, *map(Path, formula_dirs)):
+        for path in sorted(folder.glob("*.py")):
+            h.update(path.name.encode())
+            h.update(path.read_bytes())
     return h.hexdigest()[:16]
 
 

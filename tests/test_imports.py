@@ -8,28 +8,51 @@ from pathlib import Path
 PKG = Path(__file__).resolve().parents[1] / "shellbvp"
 
 
+def module_name(path):
+    """A file's module below the package: ``scene``, ``materials`` (a subpackage's __init__),
+    ``materials.gent``; ``__init__`` for the package's own."""
+    parts = list(path.relative_to(PKG).with_suffix("").parts)
+    if parts[-1] == "__init__" and len(parts) > 1:
+        parts.pop()
+    return ".".join(parts)
+
+
+def _resolve(base, name):
+    """The module ``name`` inside the package ``base`` (a list of parts), or the package's
+    __init__ when ``name`` is one of its names rather than a module."""
+    target = base + [name]
+    folder = PKG.joinpath(*target)
+    if folder.with_suffix(".py").exists() or (folder / "__init__.py").exists():
+        return ".".join(target)
+    return ".".join(base) or "__init__"
+
+
 def imports_of(path):
-    """(module imported, names) for every ``from .x import ...`` / ``from . import x`` in a file."""
+    """(module imported, names) for every relative import and ``shellbvp`` import in a file,
+    modules named as :func:`module_name` names them."""
     tree = ast.parse(path.read_text())
+    here = list(path.relative_to(PKG).parent.parts)  # the package the file sits in
     for node in ast.walk(tree):
-        if isinstance(node, ast.ImportFrom) and node.level == 1:
+        if isinstance(node, ast.ImportFrom) and node.level >= 1:
+            base = here[:len(here) - (node.level - 1)]
             if node.module:
-                yield node.module.split(".")[0], [a.name for a in node.names]
-            else:  # from . import x: x is a module or a name of __init__
+                yield _resolve(base, node.module.split(".")[0]) if not base else \
+                    ".".join(base + node.module.split(".")[:1]), [a.name for a in node.names]
+            else:  # from . import x: x is a module or a name of the package's __init__
                 for a in node.names:
-                    yield (a.name if (PKG / f"{a.name}.py").exists() else "__init__"), [a.name]
+                    yield _resolve(base, a.name), [a.name]
         elif isinstance(node, ast.ImportFrom) and node.module and node.module.startswith("shellbvp"):
-            parts = node.module.split(".")
-            yield (parts[1] if len(parts) > 1 else "__init__"), [a.name for a in node.names]
+            parts = node.module.split(".")[1:]
+            yield (".".join(parts) if parts else "__init__"), [a.name for a in node.names]
         elif isinstance(node, ast.Import):
             for a in node.names:
                 if a.name.startswith("shellbvp"):
-                    parts = a.name.split(".")
-                    yield (parts[1] if len(parts) > 1 else "__init__"), []
+                    parts = a.name.split(".")[1:]
+                    yield (".".join(parts) if parts else "__init__"), []
 
 
 def graph():
-    return {p.stem: {m for m, _ in imports_of(p)} - {p.stem} for p in PKG.glob("*.py")}
+    return {module_name(p): {m for m, _ in imports_of(p)} - {module_name(p)} for p in PKG.rglob("*.py")}
 
 
 def test_no_import_cycle_inside_the_package():
@@ -60,7 +83,7 @@ def test_no_import_cycle_inside_the_package():
 
 
 def test_no_private_name_is_imported_from_another_module():
-    bad = [(p.name, m, n) for p in PKG.glob("*.py") for m, names in imports_of(p) for n in names
+    bad = [(module_name(p), m, n) for p in PKG.rglob("*.py") for m, names in imports_of(p) for n in names
            if n.startswith("_") and not n.startswith("__")]
     assert not bad, bad
 
