@@ -78,6 +78,7 @@ import sympy as sp
 from sympy.polys.polyfuncs import symmetrize
 
 from . import bending
+from .equations import BETA, PRESSURE
 from .materials import LS, LT
 
 __all__ = ["TRC", "DETC", "BASE", "FIELDS", "N_MODE", "invariant_form", "membrane_energy",
@@ -92,8 +93,6 @@ N_MODE = sp.Symbol("n", integer=True, nonnegative=True)
 R_, LS_, RR, PSI_R = sp.symbols("r ls R Psi", positive=True)
 PHI, KS_, DLS, DKS = sp.symbols("phi ks dls dks", real=True)
 DPSI_R, KS0, KT0 = sp.symbols("dPsi kappa_s0 kappa_theta0", real=True)
-BETA = sp.Symbol("beta", positive=True)
-PRESSURE = sp.Symbol("pressure", real=True)
 #: The base-state symbols the coefficients are written in (besides beta, pressure, material params, n).
 BASE = (R_, PHI, LS_, KS_, DLS, DKS, RR, PSI_R, DPSI_R, KS0, KT0)
 #: The nine amplitudes (u, u', u'', v, v', v'', w, w', w'').
@@ -120,8 +119,8 @@ def invariant_form(W, ls=LS, lt=LT, name="W"):
     a few stretches.
     """
     W = sp.sympify(W, strict=True)
-    x, y = sp.symbols("x_ y_", positive=True)
-    e = sp.powsimp(W.xreplace({ls: sp.sqrt(x), lt: sp.sqrt(y)}), combine="base", force=True)
+    x, y = sp.symbols("x_ y_")  # no sign assumed: sqrt(x) sqrt(y) stays sqrt(x y) once combined
+    e = sp.powsimp(W.xreplace({ls: sp.sqrt(x), lt: sp.sqrt(y)}), combine="base", force=True, deep=True)
 
     def refuse(part):
         raise InvariantFormError(
@@ -164,7 +163,7 @@ def invariant_form(W, ls=LS, lt=LT, name="W"):
     try:
         out = rewrite(e)
     except InvariantFormError:  # log(x) + log(y) is log(x y): one more chance with the logs combined
-        out = rewrite(sp.logcombine(e, force=True))
+        out = rewrite(sp.powsimp(sp.logcombine(e, force=True), combine="base", force=True, deep=True))
     # check: at a few stretches the rewrite is W
     others = {q: sp.Float(7.3 + i, 30) for i, q in enumerate(sorted(W.free_symbols - {ls, lt}, key=str))}
     for a, b in ((1.3, 0.8), (0.7, 1.6), (1.1, 1.1), (2.1, 0.9)):
