@@ -57,7 +57,7 @@ def args_of(res):
 @functools.lru_cache(maxsize=None)
 def matrix_function(material, family, module="mpmath"):
     res = variation(material, family)
-    return sp.lambdify(args_of(res), res.matrix, module)
+    return sp.lambdify(args_of(res), res.matrix, module, cse=True)
 
 
 # ---------------------------------------------------------------- total derivative on base symbols
@@ -216,7 +216,7 @@ def test_first_variation_gives_the_equilibrium_equations(material, family):
     eqsyms = (S, r_, phi_, ls_, ks_, *d.params)
     parts = {k: sp.lambdify(eqsyms, A.expand(o[k]), "mpmath") for k in ("tau_s", "tau_t", "M_s", "M_t")}
     idx = {f.name: i for i, f in enumerate(sv.FIELDS)}
-    first = sp.lambdify(args_of(res), list(res.first), "mpmath")
+    first = sp.lambdify(args_of(res), list(res.first), "mpmath", cse=True)
     rng = random.Random(7 if material == "gent" else 3)
     checked = 0
     with mp.workdps(40):
@@ -389,3 +389,106 @@ def test_harmonic_deflection_of_a_flat_plate_costs_nothing():
             fields = [0, 0, 0, 0, 0, 0, w, sp.diff(w, s), sp.diff(w, s, 2)]
             q = res.quadratic_form().xreplace(at).xreplace(dict(zip(sv.FIELDS, fields))).subs(sv.N_MODE, n)
             assert sp.simplify(q).subs(s, sp.Rational(1, 2)) > 0
+
+
+def test_modes_decouple_at_n0():
+    """At n = 0 the torsion v does not couple to (u, w) (their coupling terms carry a factor n),
+    while at n = 1 it does: at a random stressed point with pressure."""
+    res = variation("mooney_rivlin", "trace")
+    rng = random.Random(2)
+    with mp.workdps(30):
+        for n in (0, 1):
+            vals = random_point(rng, res, n)
+            M = mp.matrix(matrix_function("mooney_rivlin", "trace")(*[vals[s] for s in args_of(res)]))
+            coupling = max(abs(M[i, j]) for i in (3, 4, 5) for j in (0, 1, 2, 6, 7, 8))
+            size = max(abs(M[i, j]) for i in range(9) for j in range(9))
+            assert (coupling < 1e-28 * size) if n == 0 else (coupling > 1e-3 * size), (n, coupling, size)
+
+
+def test_pressure_part_on_a_closed_sphere():
+    """The pressure's part of the form (d/dp of the matrix) on the unit sphere (R = sin S,
+    Z = -cos S, 0 < S < pi, N inward), for a normal field w cos(n theta): the second variation
+    of the volume for a normal displacement is ``Int H w^2 dA`` (H the mean curvature; the swept
+    volume of the normal segments, exact to second order), so with the package's V (negative for
+    this orientation) the eta^2 term of -p V is ``p Int w^2 cos^2(n theta) dA``, i.e.
+    ``Int_0^pi zeta^T dM/dp zeta dS = 1/2 Int_0^pi w^2 sin S dS`` for n >= 1.  w = sin(S)^2, n = 2
+    and 3, Gauss-Legendre with 40 nodes (the integrand is a trigonometric polynomial)."""
+    res = variation("mooney_rivlin", "trace")
+    dM = sp.lambdify(args_of(res), sp.diff(res.matrix, PRESSURE), "numpy", cse=True)
+    x, wts = np.polynomial.legendre.leggauss(40)
+    x, wts = (x + 1) * np.pi / 2, wts * np.pi / 2
+    w = sp.sin(S) ** 2
+    fw = [sp.lambdify(S, sp.diff(w, S, k), "numpy") for k in range(3)]
+    for n in (2, 3):
+        total = 0.0
+        for s, wt in zip(x, wts):
+            base = {sv.R_: np.sin(s), sv.PHI: s, sv.LS_: 1.0, sv.KS_: 1.0, sv.DLS: 0.0, sv.DKS: 0.0,
+                    sv.RR: np.sin(s), sv.PSI_R: 1.0, sv.DPSI_R: 0.0, sv.KS0: 1.0, sv.KT0: 1.0,
+                    BETA: 0.1, PRESSURE: 0.0, ALPHA: 0.2, sv.N_MODE: n}
+            M = np.array(dM(*[base[k] for k in args_of(res)]), dtype=float)
+            z = np.zeros(9)
+            z[6:] = [f(s) for f in fw]
+            total += wt * z @ M @ z
+        want = 0.5 * float(sp.integrate(w**2 * sp.sin(S), (S, 0, sp.pi)))
+        assert abs(total - want) < 1e-12 * want, (n, total, want)
+
+
+def _brute_force_second_order(material, family, n, S0, fields, meridian, gamma, params, swap=False):
+    """(``swap``: u, w along sin(n theta) and v along cos(n theta).)  The theta-average of the eta^2 coefficient of L at S0 for x = x0 + eta dx written out in
+    Cartesian coordinates (no series, no rotation to theta = 0, no parity trick): L through
+    ``surface_energy_density`` on plain expressions, the eta^2 coefficient by mpmath's
+    differentiation, the average by the trapezoidal rule (exact for the degree-2 trigonometric
+    polynomial in n theta)."""
+    W, _ = MATERIALS[material]
+    th, eta = sp.symbols("theta_ eta_", real=True)
+    r, z = meridian
+    sh = geometry.spheroid()
+    ksR, ktR = (k.subs(GAMMA, gamma) for k in sh.curvatures())
+    rp, zp = sp.diff(r, S), sp.diff(z, S)
+    psi = sp.sqrt(rp**2 + zp**2)
+    t = sp.Matrix([rp / psi * sp.cos(th), rp / psi * sp.sin(th), zp / psi])
+    N = sp.Matrix([-zp / psi * sp.cos(th), -zp / psi * sp.sin(th), rp / psi])
+    eth = sp.Matrix([-sp.sin(th), sp.cos(th), 0])
+    u, v, w = fields
+    even, odd = (sp.sin(n * th), sp.cos(n * th)) if swap else (sp.cos(n * th), sp.sin(n * th))
+    x = (sp.Matrix([r * sp.cos(th), r * sp.sin(th), z])
+         + eta * (u * even * t + v * odd * eth + w * even * N))
+    jets = {"x": list(x), "xS": list(x.diff(S)), "xT": list(x.diff(th)), "xSS": list(x.diff(S, 2)),
+            "xST": list(x.diff(S, th)), "xTT": list(x.diff(th, 2))}
+    ref = {"R": sh.R.subs(GAMMA, gamma), "Psi": sh.Psi.subs(GAMMA, gamma), "kappa_s0": ksR, "kappa_theta0": ktR}
+    L = sv.surface_energy_density(jets, ref, sv.membrane_energy(W), family)
+    f = sp.lambdify((S, th, eta, *params), L, "mpmath", cse=True)
+    pv = list(params.values())
+    m = 4 * n + 3
+    return mp.fsum(mp.diff(lambda e: f(S0, 2 * mp.pi * k / m, e, *pv), 0, 2) / 2 for k in range(m)) / m
+
+
+@pytest.mark.parametrize("material,family", [("mooney_rivlin", "trace"),
+                                             pytest.param("gent", "rotation", marks=pytest.mark.slow)])
+def test_form_against_a_brute_force_expansion(material, family):
+    """The 9x9 form at a point of a stressed meridian (not a solution; pressure on) against the
+    brute-force theta-average of the eta^2 coefficient (``_brute_force_second_order``), for n = 0,
+    2, 3 and fields with all three components: to 1e-25 relative (30 digits; they agree to ~30)."""
+    res = variation(material, family)
+    rng = random.Random(13)
+    g, r, z = _meridian(rng)
+    base = _base_along(g, r, z)
+    fields = (sp.sin(S) * (1 + S), S**2 - S**3 / 3, sp.cos(2 * S) + S)
+    params = {BETA: mp.mpf("0.2"), PRESSURE: mp.mpf("0.4"), **{k: mp.mpf(v) for k, v in MATERIAL_VALUES.items()
+                                                             if k in res.params}}
+    with mp.workdps(30):
+        for n in (0, 2, 3):
+            S0 = mp.mpf("0.83")
+            bv = {k: f(S0) for k, f in base.items()}
+            M = mp.matrix(matrix_function(material, family)(*[bv[k] for k in sv.BASE],
+                                                            *[params[p] for p in res.params], n))
+            zeta = [sp.lambdify(S, sp.diff(f, S, k), "mpmath")(S0) for f in fields for k in range(3)]
+            q = mp.fsum(M[i, j] * zeta[i] * zeta[j] for i in range(9) for j in range(9))
+            if n == 0:  # the polynomial at n = 0 is half the energy of theta-independent (u, w) and v
+                want = (_brute_force_second_order(material, family, 0, S0, (fields[0], 0, fields[2]), (r, z), g,
+                                                  params)
+                                + _brute_force_second_order(material, family, 0, S0, (0, fields[1], 0), (r, z), g,
+                                                    params, swap=True)) / 2
+            else:
+                want = _brute_force_second_order(material, family, n, S0, fields, (r, z), g, params)
+            assert abs(q - want) < 1e-25 * abs(want), (n, q, want)
