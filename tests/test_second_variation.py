@@ -492,3 +492,36 @@ def test_form_against_a_brute_force_expansion(material, family):
             else:
                 want = _brute_force_second_order(material, family, n, S0, fields, (r, z), g, params)
             assert abs(q - want) < 1e-25 * abs(want), (n, q, want)
+
+
+@pytest.mark.parametrize("material", ["mooney_rivlin", "gent"])
+def test_flat_disk_in_plane_block_is_plane_stress_elasticity(material):
+    """Unstressed flat disk: the (u, v) block is the linear plane-stress energy of an
+    incompressible sheet (nu = 1/2, E = 3 mu, mu = 1), ``2 (e_rr^2 + e_tt^2 + e_rr e_tt) + 2 e_rt^2``
+    (Timoshenko & Goodier, *Theory of Elasticity*, 3rd ed. 1970, plane stress strain energy
+    ``E/(2(1 - nu^2)) (e_rr^2 + e_tt^2 + 2 nu e_rr e_tt) + 2 mu e_rt^2``), with
+    ``e_rr = u'``, ``e_tt = (u + n v)/S``, ``e_rt = (v' - v/S - n u/S)/2`` (amplitudes of cos, cos,
+    sin), theta-averaged (1/2) and times the area element S; and u, v do not couple to w."""
+    res = variation(material, "trace")
+    s = sp.Symbol("S_", positive=True)
+    at = {sv.R_: s, sv.PHI: 0, sv.LS_: 1, sv.KS_: 0, sv.DLS: 0, sv.DKS: 0, sv.RR: s, sv.PSI_R: 1,
+          sv.DPSI_R: 0, sv.KS0: 0, sv.KT0: 0, PRESSURE: 0, ALPHA: sp.Rational(23, 100), JM: 6}
+    M = res.matrix.xreplace(at)
+    u, du, ddu, v, dv, ddv = sv.FIELDS[:6]
+    n = sv.N_MODE
+    err, ett, ert = du, (u + n * v) / s, (dv - v / s - n * u / s) / 2
+    want = s / 2 * (2 * (err**2 + ett**2 + err * ett) + 2 * ert**2)
+    z = sp.Matrix(sv.FIELDS[:6])
+    assert sp.simplify((z.T * M[:6, :6] * z)[0, 0] - want) == 0
+    assert all(sp.simplify(M[i, j]) == 0 for i in range(6) for j in (6, 7, 8))
+
+
+def test_structures_and_xi():
+    """A structure's form is that of its W, B and pressure; xi = 0 is refused."""
+    W, par = MATERIALS["mooney_rivlin"]
+    st = Structure(W=W, material_params=par, shell=geometry.spheroid(), tip=geometry.sphere_tip(), xi=1,
+                   pressurised=True)
+    assert sv.second_variation_of(st) is variation("mooney_rivlin", "trace")
+    with pytest.raises(ValueError, match="xi = 0"):
+        sv.second_variation_of(Structure(W=W, material_params=par, shell=geometry.spheroid(),
+                                         tip=geometry.sphere_tip(), xi=0))
