@@ -26,7 +26,10 @@ mid-surface ``x(S, theta)`` that need not be axisymmetric, per ``dS dtheta``:
   counts, is ``-N``).  Bending energies (``symbolic.bending``):
 
   - ``trace``: ``B = (tr K - kappa_s0 - kappa_theta0)^2/2``; a function of ``K`` alone, so its
-    isotropic extension from the axisymmetric states is unique;
+    isotropic extension from the axisymmetric states is unique.  Like the axisymmetric model
+    (``bending.plate_limit``) it has bending Poisson ratio 1: on a flat unstressed region
+    ``B = (Laplacian w)^2/2``, and a harmonic deflection (``w = S^n cos(n theta)``) costs no
+    bending energy (a test shows it); only tension or curvature resists such modes;
   - ``rotation``: ``B = (tr(C^{-1/2} K) - kappa_s0 - kappa_theta0)^2/2`` (``C^{1/2}`` the stretch
     tensor, by Cayley-Hamilton ``(C + sqrt(det C) I)/sqrt(tr C + 2 sqrt(det C))``).  It depends on
     ``C`` and ``K`` together, and the axisymmetric states (``C`` and ``K`` coaxial) do not fix
@@ -60,7 +63,8 @@ expand at ``theta = 0``; the theta-average of ``cos^2`` and ``sin^2`` is 1/2 and
 So the ``eta^2`` term of the energy is ``2 pi Int zeta^T matrix zeta dS`` for n >= 1.  The
 form has no ``u''^2`` or ``v''^2`` term: ``u''`` and ``v''`` enter only multiplied by lower
 derivatives (through the normal's change in ``b_SS``, ``b_S theta``), so an integration by
-parts leaves a system of order 2 in u, v and 4 in w.
+parts leaves a form in ``(u, u', v, v', w, w', w'')``: Euler-Lagrange equations of order 2 in
+u, v and 4 in w.
 
 Coefficients are SymPy expressions in the base state's variables as the free region stores them,
 ``r, phi, lambda_s, kappa_s`` and their S-derivatives ``dls = lambda_s'``, ``dks = kappa_s'`` (the
@@ -135,8 +139,10 @@ def invariant_form(W, ls=LS, lt=LT, name="W"):
     def refuse(part):
         raise InvariantFormError(
             f"{name} cannot be written through the invariants tr C = lambda_s^2 + lambda_theta^2 and "
-            f"det C = lambda_s^2 lambda_theta^2 of the surface metric: its part {part} (in x = lambda_s^2, "
-            f"y = lambda_theta^2) is not a symmetric function of them.  The second variation needs W "
+            f"det C = lambda_s^2 lambda_theta^2 of the surface metric: its part "
+            f"{part.xreplace({x: ls**2, y: lt**2})} is not a symmetric rational function of lambda_s^2 and "
+            f"lambda_theta^2 (each rational part of W, and each argument of a function or a non-integer "
+            f"power in it, is rewritten on its own).  The second variation needs W "
             f"as a smooth function of the metric; write W through I1, I2 or the invariants.")
 
     def rational(part):
@@ -162,18 +168,22 @@ def invariant_form(W, ls=LS, lt=LT, name="W"):
             rest = [rewrite(a) for a in part.args if not a.is_rational_function(x, y)]
             head = rational(part.func(*rat)) if rat else part.func.identity
             return part.func(head, *rest)
-        if part.is_Pow:
-            if part.exp.has(x, y):
-                refuse(part)
-            return rewrite(part.base) ** part.exp
-        if isinstance(part, sp.Function):
-            return part.func(*[rewrite(a) for a in part.args])
-        refuse(part)
+        try:
+            if part.is_Pow and not part.exp.has(x, y):
+                return rewrite(part.base) ** part.exp
+            if isinstance(part, sp.Function):
+                return part.func(*[rewrite(a) for a in part.args])
+        except InvariantFormError:
+            pass
+        refuse(part)  # the whole power or function: the message names what the user wrote
 
     try:
         out = rewrite(e)
-    except InvariantFormError:  # log(x) + log(y) is log(x y): one more chance with the logs combined
-        out = rewrite(sp.powsimp(sp.logcombine(e, force=True), combine="base", force=True, deep=True))
+    except InvariantFormError as first:  # log(x) + log(y) is log(x y): one more chance, logs combined
+        try:
+            out = rewrite(sp.powsimp(sp.logcombine(e, force=True), combine="base", force=True, deep=True))
+        except InvariantFormError:
+            raise first from None
     # check: at a few stretches the rewrite is W
     others = {q: sp.Float(7.3 + i, 30) for i, q in enumerate(sorted(W.free_symbols - {ls, lt}, key=str))}
     for a, b in ((1.3, 0.8), (0.7, 1.6), (1.1, 1.1), (2.1, 0.9)):
