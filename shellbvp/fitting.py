@@ -1245,14 +1245,19 @@ def _fit_result(fitted, mdl, sp, k, notes, keep, weights, baseline, curves_compu
 
 def _linearised(dq, x, dx_dtheta, mu_H, R_L, cov, t):
     """The derived quantity ``dq`` (:class:`shellbvp.shape_parameters.Derived`) and its interval
-    from the covariance of (mu_H, ..., theta) (theta, the shape parameter's search variable, last)."""
+    from the covariance of (mu_H, ..., theta) (theta, the shape parameter's search variable, last):
+    ``value +- t sd`` or, with ``dq.log_interval``, ``value exp(-+ t sd(ln value))``."""
     value = dq.value(x, mu_H, R_L)
     if cov is None or not np.all(np.isfinite(cov)):
         return float(value), (math.nan, math.nan)
     d_mu_H, d_x = dq.gradient(x, mu_H, R_L)
     g = np.zeros(cov.shape[0])
     g[0], g[-1] = d_mu_H, d_x * dx_dtheta
+    if dq.log_interval:
+        g = g / value
     half = t * math.sqrt(max(float(g @ cov @ g), 0.0))
+    if dq.log_interval:
+        return float(value), (float(value * math.exp(-half)), float(value * math.exp(half)))
     return float(value), (float(value - half), float(value + half))
 
 

@@ -28,7 +28,9 @@ class Derived:
     """A lab quantity of a fitted shape parameter that depends on mu*H too.
 
     Its 95 % interval is linearised: the gradient in (mu_H, theta) against the fit's
-    covariance of (mu_H, ..., theta), Student's t (as the Wald intervals of mu*H).
+    covariance of (mu_H, ..., theta), Student's t (as the Wald intervals of mu*H); with
+    ``log_interval`` the gradient of its logarithm, and the interval ``value * exp(-+ half)``
+    (positive, for a quantity that cannot change sign, such as a ratio).
 
     Attributes
     ----------
@@ -42,6 +44,8 @@ class Derived:
         ``value(x, mu_H, R_L)``: x the parameter's nondimensional value.
     gradient : callable
         ``gradient(x, mu_H, R_L) -> (d value / d mu_H, d value / d x)``.
+    log_interval : bool
+        Linearise its logarithm (a positive interval).
     """
 
     name: str
@@ -51,6 +55,7 @@ class Derived:
     note: str
     value: Callable
     gradient: Callable
+    log_interval: bool = False
 
 
 @dataclass(frozen=True)
