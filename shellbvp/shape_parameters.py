@@ -1,9 +1,9 @@
 """What a fit may fit besides mu*H: the shape parameters, each declared once.
 
 mu*H only scales the nondimensional curve F(delta); a shape parameter changes its shape
-(the bending stiffness beta, the Mooney-Rivlin alpha, the pressure below the shell).  A fit
-estimates one of them by its profile likelihood on a few model curves at trial values
-(:func:`shellbvp.fitting.fit`, ``free=(name,)``).  Everything that handles a shape
+(the bending stiffness beta, the Mooney-Rivlin alpha, the pressure below the shell, the
+thickness).  A fit estimates one of them by its profile likelihood on a few model curves at
+trial values (:func:`shellbvp.fitting.fit`, ``free=(name,)``).  Everything that handles a shape
 parameter -- the fit's search, ``FitResult`` and its JSON, the CLI's ``--fit-NAME`` and
 ``--NAME-range``, the batch table, the fit file and its report, the uncertainty of the
 geometry -- iterates over :data:`SHAPE_PARAMETERS`.
@@ -194,8 +194,48 @@ PRESSURE = ShapeParameter(
                "the start and 40 sqrt(3 beta))",
     sets=("pressure",), derived=(_pressure_Pa(),))
 
+
+def _eps_of_beta(beta, bending):
+    """eps = H/R_L of a bending stiffness, by the package's map (beta is eps^2 times its value at eps = 1)."""
+    from .units import beta_from_thickness
+
+    return math.sqrt(beta / beta_from_thickness(1.0, 1.0, bending))
+
+
+def _modulus(name, factor, note):
+    """``factor * mu*H / H`` (Pa) of a fitted thickness: mu (factor 1) or E = 3 mu (incompressible)."""
+    return Derived(name, "Pa", name, "MPa", note,
+                   value=lambda eps, mu_H, R_L: factor * mu_H / (eps * R_L),
+                   gradient=lambda eps, mu_H, R_L: (factor / (eps * R_L), -factor * mu_H / (eps ** 2 * R_L)),
+                   log_interval=True)
+
+
+# Fitting the thickness is fitting beta through the trace-bending map beta(eps) of
+# shellbvp.units.beta_from_thickness (the scene applies it): the same curves at the same trial
+# values (beta ~ eps^2, so a factor sqrt(2) in eps is beta's factor 2), reported as H = eps R_L,
+# and mu*H splits into the modulus, mu = mu*H / H, E = 3 mu.
+THICKNESS = ShapeParameter(
+    "thickness", "shell thickness H (beta = (H/R_L)^2/3)",
+    get=lambda scene: scene.thickness,
+    set=lambda scene, eps: scene.replace(thickness=eps),
+    unavailable=lambda scene: None if scene.thickness is not None else (
+        "fit_thickness starts from the scene's thickness: give one (Scene(thickness=H/R_L); the CLI's --thickness)"),
+    default_bounds=lambda scene: (_eps_of_beta(BETA.default_bounds(scene)[0], scene.bending), 0.5),
+    low_ok=lambda v: v > 0, high_ok=lambda v: v <= 0.5, log_scale=True,
+    step=lambda scene: 0.5 * math.log(2.0),
+    unit="m", report_scale=lambda R_L: R_L, display_unit="um", unit_kind="length",
+    note="; beta = (H/R_L)^2/3",
+    fit_help="also fit the shell's thickness H (beta = (H/R_L)^2/3, a 3D plate's bending), which gives the "
+             "modulus mu = mu*H / H and E = 3 mu; --thickness is the start",
+    range_help="search range of --fit-thickness, LOW,HIGH as H/R_L or lengths with --radius (e.g. 10um,100um; "
+               "default from beta = 1e-4 to H/R_L = 0.5)",
+    sets=("thickness", "beta"),
+    derived=(_modulus("mu", 1.0, "mu*H / H; linearised in ln mu, with H's uncertainty"),
+             _modulus("E", 3.0, "E = 3 mu, incompressible; linearised in ln E")))
+
+
 #: The shape parameters by name, in the order of the batch table's and the file's columns.
-SHAPE_PARAMETERS = {p.name: p for p in (BETA, ALPHA, PRESSURE)}
+SHAPE_PARAMETERS = {p.name: p for p in (BETA, ALPHA, PRESSURE, THICKNESS)}
 #: The derived quantities of all of them by name.
 DERIVED = {d.name: d for p in SHAPE_PARAMETERS.values() for d in p.derived}
 
