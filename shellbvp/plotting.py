@@ -215,11 +215,12 @@ def fit_summary_lines(record):
     lines.append(f"rms residual = {p['residual_rms']:.4g} N; R_L = {p['R_L']:.4g} m")
     lines += diagnostics_lines(record.quality, record.fitted, record.correlation, p)
     s = record.scene
-    if s.thickness is not None and "beta" not in record.fitted and "mu" not in iv:  # mu of a given thickness
-        H = s.thickness * p["R_L"]
-        lo, hi = iv["mu_H"]
-        lines.append(f"mu = {p['mu_H'] / H / 1e6:.5g} MPa   95% CI [{lo / H / 1e6:.5g}, {hi / H / 1e6:.5g}] "
-                     f"(thickness H = {H * 1e6:.4g} um, eps = {s.thickness:.3g})")
+    if s.thickness is not None and "beta" not in record.fitted:
+        if "mu" not in iv:  # mu of a given thickness (a fitted one's is a line above)
+            H = s.thickness * p["R_L"]
+            lo, hi = iv["mu_H"]
+            lines.append(f"mu = {p['mu_H'] / H / 1e6:.5g} MPa   95% CI [{lo / H / 1e6:.5g}, {hi / H / 1e6:.5g}] "
+                         f"(thickness H = {H * 1e6:.4g} um, eps = {s.thickness:.3g})")
         lines.append(model_error_line(s))
     lines.append(f"scene: {s.describe(p['R_L'])}")
     lines += [f"warning: {w}" for w in record.warnings] or ["warnings: none"]

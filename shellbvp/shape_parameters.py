@@ -101,6 +101,16 @@ class ShapeParameter:
         The scene quantities that fitting it determines (a fitted quantity cannot also be
         given an uncertainty).
     derived : tuple of Derived
+
+    Examples
+    --------
+    >>> import shellbvp as sb
+    >>> from shellbvp.shape_parameters import SHAPE_PARAMETERS
+    >>> beta = SHAPE_PARAMETERS["beta"]
+    >>> beta.get(sb.Scene.preset("fit")), beta.log_scale, beta.default_bounds(None)
+    (0.01, True, (0.0001, 1.0))
+    >>> beta.set(sb.Scene.preset("fit"), 0.02).beta
+    0.02
     """
 
     name: str

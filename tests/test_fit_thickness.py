@@ -121,7 +121,8 @@ def test_cli_fit_thickness_prints_h_and_mu_and_writes_them(closed_form, tmp_path
     lo, hi = rec.intervals["thickness"]
     assert lo < H_TRUE < hi and rec.intervals["mu"][0] < MU_H / H_TRUE < rec.intervals["mu"][1]
     assert rec.parameters["E"] == pytest.approx(3 * rec.parameters["mu"])
-    assert any(ln.startswith("E = ") for ln in fit_summary_lines(rec))
+    report = fit_summary_lines(rec)
+    assert any(ln.startswith("E = ") for ln in report) and any("3D elasticity" in ln for ln in report)
     assert main(argv[:-3] + ["--thickness-range", "10um", "-q"]) == 2
     assert "--thickness-range must be two numbers" in capsys.readouterr().err
     # batch table: one column each for H, mu and E and their intervals

@@ -78,3 +78,12 @@ def test_a_derived_interval_on_the_log_scale_stays_positive():
     value, (lo, hi) = shellbvp.fitting._linearised(logged, 1.0, 1.0, 2.0, 1.0, cov, 2.0)
     half = 2 * math.sqrt(0.25 + 0.36)  # sd of ln(mu_H / x): (1/mu_H, -1) against the covariance
     assert (lo, hi) == pytest.approx((2 * math.exp(-half), 2 * math.exp(half))) and lo > 0
+
+
+def test_the_declarations_examples_run():
+    import doctest
+
+    import shellbvp.shape_parameters
+
+    result = doctest.testmod(shellbvp.shape_parameters, optionflags=doctest.ELLIPSIS)
+    assert result.attempted > 0 and result.failed == 0
