@@ -1,4 +1,4 @@
-"""Fit mu*H (a displacement origin, and optionally beta or alpha) to a measured curve.
+"""Fit mu*H (a displacement origin, and optionally a shape parameter) to a measured curve.
 
 The model force scales linearly in mu*H (``F_SI = mu_H R_L F(delta)``), so
 one model curve serves a fit of mu*H and the contact point: it is computed
@@ -10,11 +10,11 @@ instrument reads before contact, as nanite fits it with the contact point):
 ``d_i <= d0`` (b0, b1 fitted or 0).  :func:`fit_record` fits a segment of an
 instrument record (:mod:`shellbvp.instrument`), the loading by default.
 
-beta (bending stiffness) and the Mooney–Rivlin alpha change the *shape* of
-the curve.  Fitting one of them uses a few model curves at trial values
-(nodes; log-spaced for beta, by 0.2 for alpha) on a common delta grid and
-interpolates F across them (cubic spline in ``ln beta`` or ``alpha`` at every
-grid depth).  The parameter is estimated by minimising the profiled residual
+A shape parameter (:mod:`shellbvp.shape_parameters`: beta, the Mooney–Rivlin alpha, ...)
+changes the *shape* of the curve.  Fitting one of them uses a few model curves at trial
+values theta (nodes, spaced as its declaration says: e.g. a factor 2 in beta, 0.2 in alpha)
+on a common delta grid and interpolates F across them (cubic spline in ``theta = ln x`` or
+``x`` at every grid depth).  The parameter is estimated by minimising the profiled residual
 (mu*H and d0 refitted at each trial value); nodes are added where the
 minimum or the interval reaches the edge of the nodes, and a last curve is
 computed at the estimate (the interpolation error there is reported).  Its
@@ -28,9 +28,10 @@ the force: residuals divided by ``max(|F_i|, floor * max|F_data|)``) and
 ``"mixed"`` (the default: ``sigma_i^2 = a^2 + b^2 F_i^2``, an additive floor
 plus a proportional part, both estimated from the squared residuals by
 non-negative least squares -- it covers either kind of noise and anything
-between).  Intervals of mu*H and d0 come from the
-linearised covariance (with beta or alpha as a third column when fitted) and
-Student's t.  ``benchmarks/fit_coverage.py`` measures their coverage.
+between).  Intervals of mu*H and d0 come from the linearised covariance (with the
+shape parameter's theta as a third column when fitted) and Student's t; the fitted shape
+parameter's quantities in lab units that depend on mu*H too (the pressure in Pa) from the
+same covariance.  ``benchmarks/fit_coverage.py`` measures their coverage.
 """
 
 from __future__ import annotations
@@ -834,11 +835,13 @@ def fit(scene, displacement, force, *, R_L, fit_offset=True, free=(), bounds=Non
         (e.g. ``lambda d, m: shellbvp.progress.curve_progress(m, d)``); None: silent.
     free : sequence of str
         Also fit a shape parameter, a name of :data:`shellbvp.shape_parameters.SHAPE_PARAMETERS`
-        (one at most): ``"beta"``, the Mooney–Rivlin ``"alpha"`` (subset of [0, 1]) or the
+        (one at most), e.g. ``"beta"``, the Mooney–Rivlin ``"alpha"`` (subset of [0, 1]), the
         ``"pressure"`` below the shell (nondimensional ``p R_L/(mu H)``; default range from 0 to
         the larger of 4 times the scene's and ``40 sqrt(3 beta)``, i.e. Vella's ``tau = p R^2/(4
-        sqrt(B Y))`` up to 10 for a pole of unit curvature).  With the pressure fitted, one
-        curve gives mu*H and the pressure in Pa (Vella et al. 2012's assay, with the full model).
+        sqrt(B Y))`` up to 10 for a pole of unit curvature) or the shell's ``"thickness"``
+        (``H/R_L``, from the scene's; beta follows it).  With the pressure fitted, one curve gives
+        mu*H and the pressure in Pa (Vella et al. 2012's assay, with the full model); with the
+        thickness, H and the modulus mu = mu*H / H.
     bounds : dict, optional
         ``{name: (low, high)}``: the search range of the free parameter (nondimensional, as in
         the scene); default the parameter's own.
