@@ -20,6 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .shape_parameters import DERIVED, SHAPE_PARAMETERS
 from .textdata import table_cell
 
 log = logging.getLogger(__name__)
@@ -29,12 +30,24 @@ __all__ = ["BatchRow", "fit_files", "fit_records", "fit_map", "read_record", "ex
 
 #: File names a directory given as input contributes (instrument exports are text tables).
 DATA_SUFFIXES = (".csv", ".tsv", ".txt", ".dat", ".jpk-force", ".ibw")  # AFM single curves: shellbvp.afm
-#: Columns of the results table, with their units.
+
+
+def _with_unit(name, unit):
+    return name if unit == "1" else f"{name} ({unit})"
+
+
+def _estimate_columns(name, unit):
+    return tuple(_with_unit(f"{name}{part}", unit) for part in ("", " 95% low", " 95% high"))
+
+
+#: Columns of the results table, with their units: a shape parameter's and its derived
+#: quantities' (:mod:`shellbvp.shape_parameters`) are filled where it was fitted.
 TABLE_COLUMNS = ("file", "status", "quality", "mu_H (N/m)", "mu_H 95% low (N/m)", "mu_H 95% high (N/m)", "offset (m)",
                  "offset 95% low (m)", "offset 95% high (m)", "baseline (N)", "baseline 95% low (N)",
-                 "baseline 95% high (N)", "baseline slope (N/m)", "baseline model", "beta", "beta 95% low",
-                 "beta 95% high", "alpha", "alpha 95% low", "alpha 95% high", "residual rms (N)", "points",
-                 "segment", "warnings", "message", "sha256")
+                 "baseline 95% high (N)", "baseline slope (N/m)", "baseline model",
+                 *(c for p in SHAPE_PARAMETERS.values() for c in _estimate_columns(p.name, p.unit)),
+                 *(c for d in DERIVED.values() for c in _estimate_columns(d.name, d.unit)),
+                 "residual rms (N)", "points", "segment", "warnings", "message", "sha256")
 
 
 @dataclass
@@ -74,11 +87,11 @@ class BatchRow:
         if r is None:
             return row
 
-        def put(key, value, ci=None, unit=""):
-            suffix = f" ({unit})" if unit else ""
-            row[f"{key}{suffix}"] = _num(value)
+        def put(key, value, ci=None, unit="1"):
+            columns = _estimate_columns(key, unit)
+            row[columns[0]] = _num(value)
             if ci is not None:
-                row[f"{key} 95% low{suffix}"], row[f"{key} 95% high{suffix}"] = _num(ci[0]), _num(ci[1])
+                row[columns[1]], row[columns[2]] = _num(ci[0]), _num(ci[1])
 
         put("mu_H", r.mu_H, r.mu_H_ci95, "N/m")
         if "offset" in r.fitted:
@@ -87,9 +100,11 @@ class BatchRow:
             put("baseline", r.baseline, r.baseline_ci95, "N")
         if r.baseline_model == "linear":
             put("baseline slope", r.baseline_slope, None, "N/m")
-        for name in ("beta", "alpha"):
+        for name, p in SHAPE_PARAMETERS.items():
             if name in r.fitted:
-                put(name, getattr(r, name), getattr(r, name + "_ci95"))
+                put(name, r.shape_values[name], r.shape_ci95[name], p.unit)
+                for d in p.derived:
+                    put(d.name, r.derived[d.name].value, r.derived[d.name].ci95, d.unit)
         row["quality"] = r.quality
         row["baseline model"] = r.baseline_model
         row["residual rms (N)"] = _num(r.residual_rms)
@@ -156,7 +171,7 @@ def fit_files(scene, paths, *, R_L, segment="loading", baseline="auto", columns=
     on_file : callable, optional
         Called as ``on_file(row)`` after each file (a progress bar over files).
     **options
-        Passed to :func:`shellbvp.fitting.fit` (``fit_offset``, ``fit_beta``, ``weights``, ``tol``,
+        Passed to :func:`shellbvp.fitting.fit` (``fit_offset``, ``free``, ``weights``, ``tol``,
         ``progress`` of the model curves...).
 
     Returns

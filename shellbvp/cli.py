@@ -27,6 +27,8 @@ import sys
 import time
 from pathlib import Path
 
+from .shape_parameters import SHAPE_PARAMETERS
+
 __all__ = ["main"]
 
 
@@ -541,20 +543,39 @@ def _fit_inputs(args):
     if columns is not None and len(columns) not in (2, 3):
         raise ValueError(f"--columns must name two columns (displacement, force) or three (and time); "
                          f"got {args.columns!r}")
-    options = {"fit_offset": not args.no_offset, "fit_beta": args.fit_beta, "fit_alpha": args.fit_alpha,
-               "fit_pressure": args.fit_pressure, "weights": args.weights, "tol": args.tol}
-    for name, text in (("beta", args.beta_range), ("alpha", args.alpha_range), ("pressure", args.pressure_range)):
+    free = tuple(name for name in SHAPE_PARAMETERS if getattr(args, f"fit_{name}"))
+    bounds = {}
+    for name, param in SHAPE_PARAMETERS.items():
+        text = getattr(args, f"{name}_range")
         if text is not None:
-            parts = text.split(",")
-            try:
-                options[f"{name}_bounds"] = tuple(_numbers(text, f"--{name}-range"))
-            except ValueError:
-                raise ValueError(f"--{name}-range must be two numbers LOW,HIGH; got {text!r}") from None
-            if len(parts) != 2:
-                raise ValueError(f"--{name}-range must be two numbers LOW,HIGH; got {text!r}")
-            if not getattr(args, f"fit_{name}"):
+            bounds[name] = _search_range(param, text, args.radius.si)
+            if name not in free:
                 raise ValueError(f"--{name}-range needs --fit-{name}")
+    options = {"fit_offset": not args.no_offset, "free": free, "bounds": bounds, "weights": args.weights,
+               "tol": args.tol}
     return scene, args.radius.si, {"columns": columns, "units": units, "invert": tuple(args.invert or ())}, options
+
+
+def _search_range(param, text, R_L):
+    """``--NAME-range LOW,HIGH`` as the nondimensional bounds of the shape parameter ``param``:
+    plain numbers as they are; with a unit (a parameter with a lab unit, e.g. 20um) through R_L."""
+    from .units import Quantity, plain_number, split_quantity
+
+    parts = text.split(",")
+    try:
+        if len(parts) != 2:
+            raise ValueError
+        values = []
+        for part in parts:
+            if param.unit_kind and split_quantity(part, param.unit_kind, f"--{param.name}-range")[1]:
+                values.append(Quantity.parse(part, param.unit_kind, f"--{param.name}-range").si
+                              / param.report_scale(R_L))
+            else:
+                values.append(plain_number(part, f"--{param.name}-range"))
+    except ValueError:
+        unit = f" (plain, or with a {param.unit_kind} unit)" if param.unit_kind else ""
+        raise ValueError(f"--{param.name}-range must be two numbers LOW,HIGH{unit}; got {text!r}") from None
+    return tuple(values)
 
 
 def _cmd_fit(args):
@@ -795,11 +816,10 @@ def _print_fit(res, record, used, args):
     _say(f"scene  = {res.scene.describe(res.R_L)}")
     lo, hi = res.mu_H_ci95
     _say(f"mu*H   = {res.mu_H:.4g} N/m (um*MPa)   95% CI [{lo:.4g}, {hi:.4g}]")
-    if res.mu is not None:
-        eps = res.scene.thickness
-        m1, m2 = res.mu_ci95
-        _say(f"mu     = {res.mu / 1e6:.4g} MPa   95% CI [{m1 / 1e6:.4g}, {m2 / 1e6:.4g}] (H = "
-             f"{format_in(res.thickness, 'um', 'length')}, eps = H/R_L = {eps:.3g}, beta = eps^2/3)")
+    for e in res.derived.values():
+        if e.of is None:  # from a given scene value (mu of a given thickness)
+            _say(_estimate_line(e))
+    if res.thickness is not None:
         from .thickness import model_error_line
 
         _say(model_error_line(res.scene))
@@ -815,16 +835,20 @@ def _print_fit(res, record, used, args):
     if res.baseline_model == "linear":
         s1, s2 = res.baseline_slope_ci95
         _say(f"baseline slope = {res.baseline_slope:.4g} N/m   95% CI [{s1:.4g}, {s2:.4g}]")
-    for name in ("beta", "alpha", "pressure"):
+    for name, param in SHAPE_PARAMETERS.items():
         if name in res.fitted:
-            v, (c1, c2) = getattr(res, name), getattr(res, name + "_ci95")
-            _say(f"{name:<6s} = {v:.4g}   95% CI [{c1:.4g}, {c2:.4g}] (profile likelihood; "
-                  f"{res.curves_computed} model curves)" + ("; nondimensional p R_L/(mu H)" if name == "pressure"
-                                                            else ""))
-    if "pressure" in res.fitted:
-        (c1, c2) = res.pressure_Pa_ci95
-        _say(f"p      = {res.pressure_Pa / 1e3:.4g} kPa   95% CI [{c1 / 1e3:.4g}, {c2 / 1e3:.4g}] "
-              f"(p mu_H/R_L; linearised)")
+            v, (c1, c2) = res.shape_values[name], res.shape_ci95[name]
+            if param.display_unit:
+                unit = param.display_unit
+                value = format_in(v, unit, param.unit_kind)
+                interval = f"[{show(c1, unit, param.unit_kind)}, {show(c2, unit, param.unit_kind)}] {unit}"
+            else:
+                value, interval = f"{v:.4g}", f"[{c1:.4g}, {c2:.4g}]"
+            _say(f"{name:<6s} = {value}   95% CI {interval} (profile likelihood; {res.curves_computed} model "
+                 f"curves){param.note}")
+            for e in res.derived.values():
+                if e.of == name:
+                    _say(_estimate_line(e))
     _say(f"rms residual = {format_in(res.residual_rms, fu, 'force')} over {res.n} points; R_L = "
           f"{args.radius}; {res.weights} weights")
     from .fitting import diagnostics_lines
@@ -836,6 +860,15 @@ def _print_fit(res, record, used, args):
         _say(line)
     for text in res.warnings:
         _say(f"warning: {text}")
+
+
+def _estimate_line(e):
+    """A line of a quantity a fit reports in lab units (``FitResult.derived``)."""
+    from .units import unit_factor, unit_kind
+
+    f = unit_factor(e.display_unit, unit_kind(e.display_unit))
+    c1, c2 = e.ci95
+    return f"{e.label:<6s} = {e.value / f:.4g} {e.display_unit}   95% CI [{c1 / f:.4g}, {c2 / f:.4g}] ({e.note})"
 
 
 def _check_report_path(path, overwrite):
@@ -1204,18 +1237,9 @@ def build_parser():
                    help="force baseline fitted with the contact point: auto (default: constant when the data "
                         "have an approach before contact, else none), none, constant, linear")
     f.add_argument("--no-offset", action="store_true", dest="no_offset", help="do not fit the contact point")
-    f.add_argument("--fit-beta", action="store_true", dest="fit_beta",
-                   help="also fit beta (starting from the scene's; a few more model curves)")
-    f.add_argument("--fit-alpha", action="store_true", dest="fit_alpha",
-                   help="also fit the Mooney-Rivlin alpha (starting from the scene's)")
-    f.add_argument("--beta-range", dest="beta_range", help="search range of --fit-beta, LOW,HIGH (default 1e-4,1)")
-    f.add_argument("--alpha-range", dest="alpha_range", help="search range of --fit-alpha, LOW,HIGH (default 0,1)")
-    f.add_argument("--fit-pressure", action="store_true", dest="fit_pressure",
-                   help="also fit the pressure below the shell (turgor, inflation): mu*H and the pressure in Pa "
-                        "from one curve; --pressure (nondimensional p R_L/(mu H)) is the start")
-    f.add_argument("--pressure-range", dest="pressure_range",
-                   help="search range of --fit-pressure, nondimensional LOW,HIGH (default 0 to the larger of 4x "
-                        "the start and 40 sqrt(3 beta))")
+    for name, param in SHAPE_PARAMETERS.items():  # one of them at most
+        f.add_argument(f"--fit-{name}", action="store_true", dest=f"fit_{name}", help=param.fit_help)
+        f.add_argument(f"--{name}-range", dest=f"{name}_range", help=param.range_help)
     f.add_argument("--weights", choices=("uniform", "relative", "mixed"),
                    help="noise model: uniform (same force noise everywhere), relative (noise proportional "
                         "to the force) or mixed (both, estimated; the default)")

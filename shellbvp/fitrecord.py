@@ -21,10 +21,12 @@ SI units, ``"1"`` nondimensional, ``""`` text)::
       displacement, force      (m,) m, N: offset + R_L delta, baseline + mu_H R_L F
       delta, F                 (m,) 1: the nondimensional curve
     /fit/parameters            NXparameters: mu_H (N/m), offset (m), baseline (N),
-                               baseline_slope (N/m), beta (1), alpha (1, NaN for other materials),
-                               R_L (m), residual_rms (N), n_points (1), pressure, pressure_Pa,
-                               noise_sigma (N), aic, bic, runs_p, residual_autocorrelation -- scalars;
-                               correlation (k, k); <name>_ci95 (2,) for each parameter fitted; attrs: fitted,
+                               baseline_slope (N/m), R_L (m), residual_rms (N), n_points (1),
+                               noise_sigma (N), aic, bic, runs_p, residual_autocorrelation, and every
+                               shape parameter and derived quantity of shellbvp.shape_parameters
+                               (beta (1), alpha (1, NaN for other materials), pressure (1), pressure_Pa
+                               (Pa, NaN unless fitted), ...) -- scalars; correlation (k, k); <name>_ci95
+                               (2,) for each parameter fitted and its derived quantities; attrs: fitted,
                                baseline_model, weights, segment
     /fit/warnings              (k,) the fit's warnings (text); attr codes
     /fit/sample                NXsample; attrs: scene (JSON, rebuilds the Scene), scene_<key>
@@ -47,6 +49,7 @@ import numpy as np
 
 from .nexus import DIMENSIONLESS, number_dataset, string_dataset
 from .paths import atomic_file, check_output_path, open_hdf5
+from .shape_parameters import DERIVED, SHAPE_PARAMETERS
 from .version import __version__
 
 __all__ = ["FitRecord", "write_fit", "read_fit", "is_fit_file", "FIT_FORMAT", "FIT_FORMAT_VERSION",
@@ -54,13 +57,17 @@ __all__ = ["FitRecord", "write_fit", "read_fit", "is_fit_file", "FIT_FORMAT", "F
 
 FIT_FORMAT = "shellbvp-fit"
 FIT_FORMAT_VERSION = 1
-#: Units of the scalar parameters in ``/fit/parameters``.
-PARAMETER_UNITS = {"mu_H": "N/m", "offset": "m", "baseline": "N", "baseline_slope": "N/m", "beta": DIMENSIONLESS,
-                   "alpha": DIMENSIONLESS, "R_L": "m", "residual_rms": "N", "n_points": DIMENSIONLESS,
-                   "pressure": DIMENSIONLESS, "pressure_Pa": "Pa", "noise_sigma": "N", "aic": DIMENSIONLESS,
-                   "bic": DIMENSIONLESS, "runs_p": DIMENSIONLESS, "residual_autocorrelation": DIMENSIONLESS}
-#: Parameters that files written before they existed lack (read as NaN).
-_NEWER_PARAMETERS = ("pressure", "pressure_Pa", "noise_sigma", "aic", "bic", "runs_p", "residual_autocorrelation")
+#: The fit's own scalar parameters in ``/fit/parameters`` with their units.
+_FIT_UNITS = {"mu_H": "N/m", "offset": "m", "baseline": "N", "baseline_slope": "N/m", "R_L": "m", "residual_rms": "N",
+              "n_points": DIMENSIONLESS, "noise_sigma": "N", "aic": DIMENSIONLESS, "bic": DIMENSIONLESS,
+              "runs_p": DIMENSIONLESS, "residual_autocorrelation": DIMENSIONLESS}
+#: Units of the scalar parameters in ``/fit/parameters``: the fit's own, every shape parameter's and
+#: every derived quantity's (:mod:`shellbvp.shape_parameters`).
+PARAMETER_UNITS = {**_FIT_UNITS, **{p.name: p.unit for p in SHAPE_PARAMETERS.values()},
+                   **{d.name: d.unit for d in DERIVED.values()}}
+#: Parameters every file of format version 1 holds; the others (later additions) read as NaN when absent.
+_REQUIRED_PARAMETERS = ("mu_H", "offset", "baseline", "baseline_slope", "beta", "alpha", "R_L", "residual_rms",
+                        "n_points")
 
 
 @dataclass
@@ -75,10 +82,12 @@ class FitRecord:
     model : dict of ndarray
         The model curve: ``displacement`` (m), ``force`` (N), ``delta``, ``F`` (nondimensional).
     parameters : dict of float
-        ``mu_H``, ``offset``, ``baseline``, ``baseline_slope``, ``beta``, ``alpha``, ``R_L``,
-        ``residual_rms``, ``n_points``.
+        ``mu_H``, ``offset``, ``baseline``, ``baseline_slope``, ``R_L``, ``residual_rms``,
+        ``n_points``, the diagnostics, and every shape parameter and derived quantity
+        (``beta``, ``alpha``, ``pressure``, ``pressure_Pa``, ...; :data:`PARAMETER_UNITS`).
     intervals : dict of (float, float)
-        The 95 % interval of each fitted parameter.
+        The 95 % interval of each fitted parameter and of the fitted shape parameter's
+        derived quantities.
     fitted : list of str
     settings : dict
         ``baseline_model``, ``weights``, ``segment``.
@@ -189,21 +198,20 @@ def write_fit(path, result, record, used, *, segment="loading", overwrite=False)
                             "weights": result.weights, "segment": segment,
                             "fitted": np.array(list(result.fitted), dtype=h5py.string_dtype())})
             values = {"mu_H": result.mu_H, "offset": result.offset, "baseline": result.baseline,
-                      "baseline_slope": result.baseline_slope, "beta": result.beta,
-                      "alpha": np.nan if result.alpha is None else result.alpha, "R_L": result.R_L,
+                      "baseline_slope": result.baseline_slope, "R_L": result.R_L,
                       "residual_rms": result.residual_rms, "n_points": result.n,
-                      "pressure": result.pressure if result.pressure is not None else np.nan,
-                      "pressure_Pa": np.nan if result.pressure_Pa is None else result.pressure_Pa,
                       **{k: getattr(result, k) for k in ("noise_sigma", "aic", "bic", "runs_p",
-                                                          "residual_autocorrelation")}}
+                                                          "residual_autocorrelation")},
+                      **{k: np.nan if getattr(result, k) is None else getattr(result, k)
+                         for k in (*SHAPE_PARAMETERS, *DERIVED)}}
             for name, v in values.items():
                 number_dataset(p, name, float(v), PARAMETER_UNITS[name])
             if result.correlation is not None:
                 number_dataset(p, "correlation", np.asarray(result.correlation, float), DIMENSIONLESS,
                                "correlation of the fitted parameters (rows and columns in the order of fitted)")
-            for name in result.fitted:
-                number_dataset(p, f"{name}_ci95", np.asarray(_interval(result, name), float), PARAMETER_UNITS[name],
-                               f"95 % interval of {name}")
+            for name in _with_intervals(result):
+                number_dataset(p, f"{name}_ci95", np.asarray(getattr(result, f"{name}_ci95"), float),
+                               PARAMETER_UNITS[name], f"95 % interval of {name}")
             w = string_dataset(e, "warnings", list(result.warnings), "warnings of the fit")
             w.attrs["codes"] = np.array(list(result.warning_codes), dtype=h5py.string_dtype())
             s = e.create_group("sample")
@@ -234,10 +242,11 @@ def _inverted(src):
     return inv
 
 
-def _interval(result, name):
-    return {"mu_H": result.mu_H_ci95, "offset": result.offset_ci95, "baseline": result.baseline_ci95,
-            "baseline_slope": result.baseline_slope_ci95, "beta": result.beta_ci95,
-            "alpha": result.alpha_ci95, "pressure": result.pressure_ci95}[name]
+def _with_intervals(result):
+    """The names whose 95 % intervals the file holds: the fitted parameters and the derived
+    quantities of a fitted shape parameter."""
+    derived = [d.name for name in result.fitted if name in SHAPE_PARAMETERS for d in SHAPE_PARAMETERS[name].derived]
+    return [*result.fitted, *derived]
 
 
 def is_fit_file(path) -> bool:
@@ -319,7 +328,7 @@ def read_fit(path) -> FitRecord:
             m = sc.dataset(gm, "delta").shape[0]
             model = {k: sc.dataset(gm, k, length=m) for k in ("displacement", "force", "delta", "F")}
             p = e["parameters"]
-            params = {k: sc.scalar(p, k, finite=False, required=k not in _NEWER_PARAMETERS)
+            params = {k: sc.scalar(p, k, finite=False, required=k in _REQUIRED_PARAMETERS)
                       for k in PARAMETER_UNITS}
             if not (params["R_L"] > 0 and math.isfinite(params["R_L"])):
                 raise ValueError(f"parameters/R_L must be a length > 0; got {params['R_L']!r}")
@@ -328,6 +337,7 @@ def read_fit(path) -> FitRecord:
             if unknown or "mu_H" not in fitted:
                 raise ValueError(f"parameters.fitted must name mu_H and known parameters; got {fitted}")
             intervals = {k: tuple(sc.dataset(p, f"{k}_ci95", length=2)) for k in fitted}
+            intervals.update({k: tuple(sc.dataset(p, f"{k}_ci95", length=2)) for k in DERIVED if f"{k}_ci95" in p})
             correlation = None
             if "correlation" in p:  # files before the diagnostics have none
                 correlation = np.asarray(sc.dataset(p, "correlation", ndim=2, length=len(fitted)), float)

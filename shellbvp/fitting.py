@@ -1,4 +1,4 @@
-"""Fit mu*H (a displacement origin, and optionally beta or alpha) to a measured curve.
+"""Fit mu*H (a displacement origin, and optionally a shape parameter) to a measured curve.
 
 The model force scales linearly in mu*H (``F_SI = mu_H R_L F(delta)``), so
 one model curve serves a fit of mu*H and the contact point: it is computed
@@ -10,11 +10,11 @@ instrument reads before contact, as nanite fits it with the contact point):
 ``d_i <= d0`` (b0, b1 fitted or 0).  :func:`fit_record` fits a segment of an
 instrument record (:mod:`shellbvp.instrument`), the loading by default.
 
-beta (bending stiffness) and the Mooney–Rivlin alpha change the *shape* of
-the curve.  Fitting one of them uses a few model curves at trial values
-(nodes; log-spaced for beta, by 0.2 for alpha) on a common delta grid and
-interpolates F across them (cubic spline in ``ln beta`` or ``alpha`` at every
-grid depth).  The parameter is estimated by minimising the profiled residual
+A shape parameter (:mod:`shellbvp.shape_parameters`: beta, the Mooney–Rivlin alpha, ...)
+changes the *shape* of the curve.  Fitting one of them uses a few model curves at trial
+values theta (nodes, spaced as its declaration says: e.g. a factor 2 in beta, 0.2 in alpha)
+on a common delta grid and interpolates F across them (cubic spline in ``theta = ln x`` or
+``x`` at every grid depth).  The parameter is estimated by minimising the profiled residual
 (mu*H and d0 refitted at each trial value); nodes are added where the
 minimum or the interval reaches the edge of the nodes, and a last curve is
 computed at the estimate (the interpolation error there is reported).  Its
@@ -28,9 +28,10 @@ the force: residuals divided by ``max(|F_i|, floor * max|F_data|)``) and
 ``"mixed"`` (the default: ``sigma_i^2 = a^2 + b^2 F_i^2``, an additive floor
 plus a proportional part, both estimated from the squared residuals by
 non-negative least squares -- it covers either kind of noise and anything
-between).  Intervals of mu*H and d0 come from the
-linearised covariance (with beta or alpha as a third column when fitted) and
-Student's t.  ``benchmarks/fit_coverage.py`` measures their coverage.
+between).  Intervals of mu*H and d0 come from the linearised covariance (with the
+shape parameter's theta as a third column when fitted) and Student's t; the fitted shape
+parameter's quantities in lab units that depend on mu*H too (the pressure in Pa) from the
+same covariance.  ``benchmarks/fit_coverage.py`` measures their coverage.
 """
 
 from __future__ import annotations
@@ -45,11 +46,13 @@ from scipy import optimize, special  # (scipy.stats: 0.4 s more to import, for f
 from scipy.interpolate import CubicSpline, PchipInterpolator
 
 from .instrument import read_force_csv
+from .shape_parameters import DERIVED, SHAPE_PARAMETERS, ShapeParameter, shape_parameter
 
 log = logging.getLogger(__name__)
 
 __all__ = ["FitResult", "fit", "fit_quality", "diagnostics_lines", "QUALITY_RULES", "read_force_csv", "example_data_path", "WEIGHTS",
-           "DEFAULT_WEIGHTS", "FIT_STATUS", "FIT_WARNINGS", "PLAUSIBLE_MU_H", "runs_test", "BASELINES", "MODEL_PARAMETERS", "fit_record"]
+           "DEFAULT_WEIGHTS", "FIT_STATUS", "FIT_WARNINGS", "PLAUSIBLE_MU_H", "runs_test", "BASELINES", "MODEL_PARAMETERS", "fit_record",
+           "Estimate", "free_parameters"]
 
 #: Force baselines of :func:`fit` (none; a constant b0; b0 + b1 (d - d0)).
 BASELINES = ("none", "constant", "linear")
@@ -61,9 +64,6 @@ WEIGHTS = ("uniform", "relative", "mixed")
 DEFAULT_WEIGHTS = "mixed"
 #: Depths of every model curve (equally spaced up to delta_max).
 N_DEPTHS = 40
-#: Default search ranges of the shape parameters.
-BETA_BOUNDS = (1e-4, 1.0)
-ALPHA_BOUNDS = (0.0, 1.0)
 _MAX_CURVES = 14
 
 #: Outcomes of a fit that ran (``FitResult.status``); ``success`` is ``status == 0``.
@@ -103,6 +103,20 @@ def example_data_path():
     return Path(__file__).parent / "data" / "lepidium_synthetic.csv"
 
 
+@dataclass(frozen=True)
+class Estimate:
+    """A quantity a fit reports in lab units beside mu*H (``FitResult.derived``): its value,
+    95 % interval and how the CLI shows it (``label = value display_unit   95% CI [..] (note)``);
+    ``of`` names the fitted shape parameter it comes from (None: from a given scene value)."""
+    value: float
+    ci95: tuple
+    unit: str
+    label: str
+    display_unit: str
+    note: str
+    of: str | None = None
+
+
 @dataclass
 class FitResult:
     """Result of :func:`fit` (SI units).
@@ -114,21 +128,23 @@ class FitResult:
     mu_H_ci95 : (float, float)
     offset, offset_ci95 : float, (float, float)
         Displacement origin d0 in m (0 and (0, 0) when not fitted).
-    beta, alpha : float
-        Bending stiffness and Mooney–Rivlin alpha of the fitted model (the
-        scene's values unless fitted; alpha is None for other materials).
-    beta_ci95, alpha_ci95 : (float, float) or None
-        Profile-likelihood 95 % intervals (None when not fitted).  A side that
-        reached the search bound is the bound (see ``message``).
-    pressure, pressure_ci95 : float, (float, float) or None
-        The pressure below the shell, nondimensional ``p R_L/(mu H)`` (the scene's unless
-        fitted) and, when fitted, its profile-likelihood 95 % interval.
-    pressure_Pa, pressure_Pa_ci95 : float, (float, float) or None
-        The same in pascals, ``p mu_H/R_L`` with the fitted mu*H, and its 95 % interval
-        (linearised: the covariance of mu*H and p, Student's t); None unless the pressure
-        was fitted.
+    shape_values : dict
+        Every shape parameter of :data:`shellbvp.shape_parameters.SHAPE_PARAMETERS` by name:
+        its value in the fitted model (the scene's unless fitted; None where the scene has
+        none), in the parameter's reported unit.  Also ``res.<name>``: ``res.beta``,
+        ``res.alpha`` (Mooney–Rivlin alpha; None for other materials), ``res.pressure``
+        (nondimensional ``p R_L/(mu H)``).
+    shape_ci95 : dict
+        The fitted shape parameter's profile-likelihood 95 % interval (``res.<name>_ci95``;
+        None for the others).  A side that reached the search bound is the bound (see
+        ``message``).
+    derived : dict
+        Quantities in lab units that depend on mu*H too, by name (:class:`Estimate`): of the
+        fitted shape parameter, with a linearised 95 % interval (the covariance of mu*H and the
+        parameter, Student's t), e.g. ``res.pressure_Pa``, ``res.pressure_Pa_ci95`` (``p
+        mu_H/R_L``; None unless the pressure was fitted); and mu of a given thickness (``mu``).
     fitted : tuple of str
-        The fitted parameters ("mu_H", "offset", "beta" | "alpha" | "pressure").
+        The fitted parameters ("mu_H", "offset", and a shape parameter's name).
     weights : str
         The noise model, "uniform", "relative" or "mixed".
     residual_rms : float
@@ -211,14 +227,9 @@ class FitResult:
     R_L: float
     curve: object = field(repr=False, default=None)
     _model: object = field(repr=False, default=None)
-    beta: float = None
-    beta_ci95: tuple = None
-    alpha: float = None
-    alpha_ci95: tuple = None
-    pressure: float = 0.0
-    pressure_ci95: tuple = None
-    pressure_Pa: float = None
-    pressure_Pa_ci95: tuple = None
+    shape_values: dict = field(default_factory=dict)
+    shape_ci95: dict = field(default_factory=dict)
+    derived: dict = field(default_factory=dict)
     fitted: tuple = ("mu_H", "offset")
     weights: str = DEFAULT_WEIGHTS
     scene: object = field(repr=False, default=None)
@@ -244,24 +255,38 @@ class FitResult:
         """True when the fit converged and passed its checks (``status == 0``)."""
         return self.status == 0
 
+    def __getattr__(self, name):
+        """``res.<p>`` and ``res.<p>_ci95`` of every shape parameter and derived quantity (None
+        where there is none)."""
+        base, ci = (name[:-5], True) if name.endswith("_ci95") else (name, False)
+        if base in SHAPE_PARAMETERS:
+            return self.__dict__.get("shape_ci95" if ci else "shape_values", {}).get(base)
+        if base in DERIVED:
+            e = self.__dict__.get("derived", {}).get(base)
+            return None if e is None else (e.ci95 if ci else e.value)
+        raise AttributeError(f"{type(self).__name__!r} object has no attribute {name!r}")
+
     @property
     def thickness(self):
         """The shell's thickness H (m) when the scene was given one (``Scene(thickness=H/R_L)``,
-        ``--thickness``): then beta is the 3D plate's and mu follows from mu*H; None otherwise."""
+        ``--thickness``) or a fit estimated it: then beta is the 3D plate's and mu follows from
+        mu*H; None otherwise."""
+        if self.shape_values.get("thickness") is not None:
+            return self.shape_values["thickness"]
         eps = getattr(self.scene, "thickness", None)
         return None if eps is None else eps * self.R_L
 
     @property
     def mu(self):
-        """The shear modulus mu = mu*H / H (Pa), with the thickness known (else None)."""
-        H = self.thickness
-        return None if H is None else self.mu_H / H
+        """The shear modulus mu = mu*H / H (Pa), with the thickness known or fitted (else None)."""
+        e = self.derived.get("mu")
+        return None if e is None else e.value
 
     @property
     def mu_ci95(self):
-        """mu's 95 % interval (Pa): mu*H's over H (the thickness taken as exact)."""
-        H = self.thickness
-        return None if H is None else (self.mu_H_ci95[0] / H, self.mu_H_ci95[1] / H)
+        """mu's 95 % interval (Pa): with a given thickness mu*H's over H (H taken as exact)."""
+        e = self.derived.get("mu")
+        return None if e is None else e.ci95
 
     @property
     def quality(self) -> str:
@@ -289,11 +314,11 @@ class FitResult:
             return None if v is None or not math.isfinite(v) else float(v)
 
         ci = (lambda v: None if v is None else [num(x) for x in v])
+        shape = {}
+        for name in (*SHAPE_PARAMETERS, *DERIVED):
+            shape[name], shape[f"{name}_ci95"] = num(getattr(self, name)), ci(getattr(self, f"{name}_ci95"))
         return {"mu_H": num(self.mu_H), "mu_H_ci95": ci(self.mu_H_ci95), "offset": num(self.offset),
-                "offset_ci95": ci(self.offset_ci95), "beta": num(self.beta), "beta_ci95": ci(self.beta_ci95),
-                "alpha": num(self.alpha), "alpha_ci95": ci(self.alpha_ci95), "pressure": num(self.pressure),
-                "pressure_ci95": ci(self.pressure_ci95), "pressure_Pa": num(self.pressure_Pa),
-                "pressure_Pa_ci95": ci(self.pressure_Pa_ci95), "fitted": list(self.fitted),
+                "offset_ci95": ci(self.offset_ci95), **shape, "fitted": list(self.fitted),
                 "weights": self.weights, "residual": num(self.residual_rms), "residual_rms": num(self.residual_rms),
                 "n": self.n, "success": self.success, "status": self.status, "message": self.message,
                 "warnings": list(self.warnings), "warning_codes": list(self.warning_codes), "R_L": self.R_L,
@@ -311,8 +336,9 @@ class FitResult:
                 "model_error": None if self.model_error is None else num(self.model_error[0]),
                 "model_error_extrapolated": None if self.model_error is None else self.model_error[1],
                 "units": {"mu_H": "N/m (= um*MPa)", "offset": "m", "residual": "N (rms)",
-                          "residual_rms": "N", "R_L": "m", "beta": "1 (B/(mu R_L^2))", "alpha": "1",
-                          "pressure": "1 (p R_L/(mu H))", "pressure_Pa": "Pa",
+                          "residual_rms": "N", "R_L": "m",
+                          **{p.name: p.unit_text or p.unit for p in SHAPE_PARAMETERS.values()},
+                          **{d.name: d.unit for d in DERIVED.values()},
                           "baseline": "N", "baseline_slope": "N/m", "thickness": "m", "mu": "Pa",
                           "model_error": "1 (fraction of F)", "noise_sigma": "N (of the most weighted point)",
                           "aic": "1", "bic": "1", "runs_p": "1", "residual_autocorrelation": "1",
@@ -780,17 +806,15 @@ def _check_bounds(name, bounds, lo_ok, hi_ok, value):
     return lo, hi
 
 
-def fit(scene, displacement, force, *, R_L, fit_offset=True, fit_beta=False, fit_alpha=False,
-        weights=None, floor=0.05, beta_bounds=BETA_BOUNDS, alpha_bounds=ALPHA_BOUNDS, delta_max=None,
-        tol=1e-6, loss="linear", baseline="none", contact_guess=None, progress=None, fit_pressure=False,
-        pressure_bounds=None):
-    """Least-squares fit of mu*H (the displacement origin, and beta or alpha) to measured data.
+def fit(scene, displacement, force, *, R_L, fit_offset=True, free=(), bounds=None, weights=None, floor=0.05,
+        delta_max=None, tol=1e-6, loss="linear", baseline="none", contact_guess=None, progress=None, **aliases):
+    """Least-squares fit of mu*H (the displacement origin, and a shape parameter) to measured data.
 
     Parameters
     ----------
     scene : Scene
-        Shape, indenter, material and beta (nondimensional); with ``fit_beta``
-        or ``fit_alpha`` its value is the start of the search.
+        Shape, indenter, material and beta (nondimensional); a free shape parameter's value
+        in it is the start of the search.
     displacement, force : array_like
         Measured indenter displacement (m, > 0 into the shell) and force (N).
     R_L : float
@@ -810,13 +834,21 @@ def fit(scene, displacement, force, *, R_L, fit_offset=True, fit_beta=False, fit
     progress : callable, optional
         ``progress(description, delta_max) -> (bar, callback)`` for each model curve computed
         (e.g. ``lambda d, m: shellbvp.progress.curve_progress(m, d)``); None: silent.
-    fit_beta, fit_alpha, fit_pressure : bool
-        Also fit beta (within ``beta_bounds``), the Mooney–Rivlin alpha (within
-        ``alpha_bounds``, subset of [0, 1]) or the pressure below the shell (nondimensional
-        ``p R_L/(mu H)``, within ``pressure_bounds``, default from 0 to the larger of 4 times
-        the scene's and ``40 sqrt(3 beta)``, i.e. Vella's ``tau = p R^2/(4 sqrt(B Y))`` up to 10
-        for a pole of unit curvature); one of them at most.  With the pressure fitted, one
-        curve gives mu*H and the pressure in Pa (Vella et al. 2012's assay, with the full model).
+    free : sequence of str
+        Also fit a shape parameter, a name of :data:`shellbvp.shape_parameters.SHAPE_PARAMETERS`
+        (one at most), e.g. ``"beta"``, the Mooney–Rivlin ``"alpha"`` (subset of [0, 1]), the
+        ``"pressure"`` below the shell (nondimensional ``p R_L/(mu H)``; default range from 0 to
+        the larger of 4 times the scene's and ``40 sqrt(3 beta)``, i.e. Vella's ``tau = p R^2/(4
+        sqrt(B Y))`` up to 10 for a pole of unit curvature) or the shell's ``"thickness"``
+        (``H/R_L``, from the scene's; beta follows it).  With the pressure fitted, one curve gives
+        mu*H and the pressure in Pa (Vella et al. 2012's assay, with the full model); with the
+        thickness, H and the modulus mu = mu*H / H.
+    bounds : dict, optional
+        ``{name: (low, high)}``: the search range of the free parameter (nondimensional, as in
+        the scene); default the parameter's own.
+    **aliases
+        ``fit_<name>=True`` and ``<name>_bounds=(low, high)`` for each shape parameter (e.g.
+        ``fit_beta=True, beta_bounds=(1e-3, 0.1)``): the same as ``free`` and ``bounds``.
     weights : {"uniform", "relative", "mixed"}, optional
         Noise model: the same force noise at every point, noise proportional
         to the force, or both (``sigma^2 = a^2 + b^2 F^2``, a and b estimated);
@@ -876,9 +908,7 @@ def fit(scene, displacement, force, *, R_L, fit_offset=True, fit_beta=False, fit
         raise ValueError(f"weights must be one of {WEIGHTS}; got {weights!r}")
     if not (isinstance(floor, (int, float)) and 0 < floor <= 1):
         raise ValueError(f"floor (of relative weights, fraction of max |force|) must be in (0, 1]; got {floor!r}")
-    if int(bool(fit_beta)) + int(bool(fit_alpha)) + int(bool(fit_pressure)) > 1:
-        raise ValueError("fit_beta, fit_alpha and fit_pressure: fit one of beta, alpha, pressure at a time (each "
-                         "changes the curve's shape only weakly; two with mu*H are not identifiable from one curve)")
+    free, bounds = free_parameters(free, bounds, aliases)
     if baseline not in BASELINES:
         raise ValueError(f"baseline must be one of {BASELINES}; got {baseline!r}")
     origin = 0.0 if contact_guess is None else contact_guess
@@ -887,12 +917,11 @@ def fit(scene, displacement, force, *, R_L, fit_offset=True, fit_beta=False, fit
     d = np.asarray(displacement, float).ravel()
     f = np.asarray(force, float).ravel()
     keep = np.isfinite(d) & np.isfinite(f) if d.shape == f.shape else None
-    k = 1 + bool(fit_offset) + bool(fit_beta or fit_alpha or fit_pressure) + (baseline != "none") \
-        + (baseline == "linear")
+    k = 1 + bool(fit_offset) + len(free) + (baseline != "none") + (baseline == "linear")
     d, f = _check_data(d, f, k, float(origin))
     if not (isinstance(R_L, (int, float)) and math.isfinite(R_L) and R_L > 0):
         raise ValueError(f"R_L (rim radius, m) must be a finite number > 0; got {R_L!r}")
-    sp = _shape_parameter(scene, fit_beta, fit_alpha, fit_pressure, beta_bounds, alpha_bounds, pressure_bounds)
+    sp = _search_of(scene, free[0], bounds.get(free[0])) if free else None
     depth = (np.max(d) - origin) / R_L  # the deepest datum's delta, if the contact is at the guess
     dm = 1.2 * depth if delta_max is None else float(delta_max)
     if not (math.isfinite(dm) and dm > 0):
@@ -915,41 +944,55 @@ def fit(scene, displacement, force, *, R_L, fit_offset=True, fit_beta=False, fit
     return _fit_result(fitted, mdl, sp, k, notes, keep, weights, baseline, counter[0])
 
 
+def free_parameters(free=(), bounds=None, aliases=None):
+    """``(free, bounds)`` of :func:`fit` checked, its ``fit_<name>`` and ``<name>_bounds``
+    aliases folded in: a tuple of shape parameter names (one at most) and ``{name: bounds}``."""
+    free = (free,) if isinstance(free, str) else tuple(free)
+    bounds = dict(bounds or {})
+    for key, value in (aliases or {}).items():
+        if key.startswith("fit_") and key[4:] in SHAPE_PARAMETERS:
+            free += (key[4:],) if value else ()
+        elif key.endswith("_bounds") and key[:-7] in SHAPE_PARAMETERS:
+            if value is not None:
+                bounds[key[:-7]] = value
+        else:
+            raise TypeError(f"fit() got an unexpected keyword argument {key!r}")
+    for name in free + tuple(bounds):
+        shape_parameter(name)
+    free = tuple(dict.fromkeys(free))
+    if len(free) > 1:
+        raise ValueError(f"{', '.join(f'fit_{n}' for n in SHAPE_PARAMETERS)}: fit one of "
+                         f"{', '.join(SHAPE_PARAMETERS)} at a time (each changes the curve's shape only weakly; two "
+                         f"with mu*H are not identifiable from one curve); got {', '.join(free)}")
+    return free, bounds
+
+
 @dataclass
 class _ShapeParameter:
-    """The shape parameter fitted with mu*H: its name, its search range, step and start in
-    theta (ln beta, alpha or the pressure) and the scene at a theta."""
-    name: str
+    """The shape parameter fitted with mu*H: its declaration, its search range, step and start
+    in theta (``ln x`` or ``x``) and the scene at a theta."""
+    param: ShapeParameter
     bounds: tuple
     step: float
     theta0: float
     scene_at: object
 
+    @property
+    def name(self):
+        return self.param.name
 
-def _shape_parameter(scene, fit_beta, fit_alpha, fit_pressure, beta_bounds, alpha_bounds, pressure_bounds):
-    """The :class:`_ShapeParameter` asked for (its bounds checked), or None."""
-    from .materials import MooneyRivlin
 
-    if fit_beta:
-        lo, hi = _check_bounds("beta", beta_bounds, lambda v: v > 0, lambda v: True, scene.beta)
-        return _ShapeParameter("beta", (math.log(lo), math.log(hi)), math.log(2.0), math.log(scene.beta),
-                               lambda th: scene.replace(beta=math.exp(th)))
-    if fit_alpha:
-        if not isinstance(scene.material, MooneyRivlin):
-            raise ValueError(f"fit_alpha needs a Mooney-Rivlin material (alpha); the scene's material is "
-                             f"{scene.material.family}")
-        bounds = _check_bounds("alpha", alpha_bounds, lambda v: v >= 0, lambda v: v <= 1, scene.material.alpha)
-        return _ShapeParameter("alpha", bounds, 0.2, float(scene.material.alpha),
-                               lambda th: scene.replace(material=MooneyRivlin(float(min(max(th, 0.0), 1.0)))))
-    if fit_pressure:
-        scale = 4 * math.sqrt(3 * scene.beta)  # tau = 1 at a pole of unit curvature
-        p0 = float(scene.pressure)
-        default = (0.0, max(4 * abs(p0), 10 * scale))
-        bounds = _check_bounds("pressure", default if pressure_bounds is None else pressure_bounds,
-                               lambda v: True, lambda v: True, p0)
-        return _ShapeParameter("pressure", bounds, max(0.25 * abs(p0), 0.5 * scale), p0,
-                               lambda th: scene.replace(pressure=float(th)))
-    return None
+def _search_of(scene, name, bounds):
+    """The :class:`_ShapeParameter` of the free parameter ``name`` (its bounds checked)."""
+    param = shape_parameter(name)
+    why = param.unavailable(scene)
+    if why:
+        raise ValueError(why)
+    x0 = param.get(scene)
+    lo, hi = _check_bounds(name, param.default_bounds(scene) if bounds is None else bounds, param.low_ok,
+                           param.high_ok, x0)
+    return _ShapeParameter(param, (param.to_theta(lo), param.to_theta(hi)), param.step(scene), param.to_theta(x0),
+                           lambda th: param.set(scene, param.from_theta(th)))
 
 
 @dataclass
@@ -1030,8 +1073,8 @@ class _ProfileSearch:
             return True
         # this curve ends before the data: the range ends between edge and new
         lim[0 if side < 0 else 1] = edge
-        self.notes.append(("search_range", f"model curves at {name} = {_show(name, new)} end before the deepest "
-                           f"data point; searched {name} up to {_show(name, edge)}"))
+        self.notes.append(("search_range", f"model curves at {name} = {_show(self.sp.param, new)} end before the "
+                           f"deepest data point; searched {name} up to {_show(self.sp.param, edge)}"))
         return False
 
     def profile(self, theta):
@@ -1123,7 +1166,7 @@ class _ProfileSearch:
         if open_lo or open_hi:
             name, lim = sp.name, self.lim
             self.notes.append(("search_range", f"the 95% interval of {name} reaches the end of the searched range "
-                               f"({_show(name, lim[0])}, {_show(name, lim[1])}); {name} is not determined "
+                               f"({_show(sp.param, lim[0])}, {_show(sp.param, lim[1])}); {name} is not determined "
                                f"by the data on that side"))
         P, dP, top = shape.at(theta_hat)
         res, rss, J = mdl.fit(P, dP, top, self.w, start=res.x)
@@ -1141,8 +1184,6 @@ class _ProfileSearch:
 def _fit_result(fitted, mdl, sp, k, notes, keep, weights, baseline, curves_computed):
     """The :class:`FitResult` of what a fit found: Wald (t) intervals of the free parameters
     from the weighted Jacobian, the shape parameter's profile interval, status and warnings."""
-    from .materials import MooneyRivlin
-
     res, rss, J, w, P, top, R_L = fitted.res, fitted.rss, fitted.J, fitted.w, fitted.P, fitted.top, mdl.R_L
     d, f = mdl.d, mdl.f
     n = d.size
@@ -1168,21 +1209,22 @@ def _fit_result(fitted, mdl, sp, k, notes, keep, weights, baseline, curves_compu
     name = sp.name if sp is not None else None
     fitted_names = tuple(nm for nm, free in zip(MODEL_PARAMETERS, mdl.free) if free) + ((name,) if name else ())
     fit_scene, theta_hat, theta_ci = fitted.scene, fitted.theta, fitted.theta_ci
-    mat = fit_scene.material
-    alpha = float(mat.alpha) if isinstance(mat, MooneyRivlin) else None
-    beta = float(fit_scene.beta)
-    beta_ci = alpha_ci = None
-    if name == "beta":
-        beta = float(math.exp(theta_hat))
-        beta_ci = tuple(float(math.exp(v)) for v in theta_ci)
-    elif name == "alpha":
-        alpha = float(theta_hat)
-        alpha_ci = tuple(float(v) for v in theta_ci)
-    pressure, pressure_ci, pressure_Pa, pressure_Pa_ci = float(fit_scene.pressure), None, None, None
-    if name == "pressure":
-        pressure, pressure_ci = float(theta_hat), tuple(float(v) for v in theta_ci)
-        pressure_Pa, pressure_Pa_ci = _pressure_in_pascals(pressure, q[0], R_L, cov,
-                                                           special.stdtrit(dof, 0.975))
+    # the others' values in the scene at the estimate (the reported curve's scene is the nearest node's)
+    at_estimate = fit_scene if sp is None else sp.scene_at(theta_hat)
+    values, intervals = {}, {}
+    for param in SHAPE_PARAMETERS.values():
+        x = param.get(at_estimate)
+        values[param.name] = None if x is None else float(param.reported(x, R_L))
+    derived = _given_thickness(fit_scene, mu_H, ci[0], R_L)
+    if sp is not None:
+        param = sp.param
+        x_hat = param.from_theta(theta_hat)
+        values[name] = float(param.reported(x_hat, R_L))
+        intervals[name] = tuple(float(param.reported(param.from_theta(v), R_L)) for v in theta_ci)
+        t = special.stdtrit(dof, 0.975)
+        for dq in param.derived:
+            value, interval = _linearised(dq, x_hat, param.dx_dtheta(theta_hat), q[0], R_L, cov, t)
+            derived[dq.name] = Estimate(value, interval, dq.unit, dq.label, dq.display_unit, dq.note, name)
     mu_ci = ci[0]
     runs = _runs_in_depth_order(resid, d)
     status, checks = _check_result(bool(res.success), mu_H, mu_ci, off_ci, bool(np.all(np.isfinite(resid))),
@@ -1197,9 +1239,7 @@ def _fit_result(fitted, mdl, sp, k, notes, keep, weights, baseline, curves_compu
     return FitResult(mu_H=mu_H, mu_H_ci95=mu_ci, offset=d0,
                      offset_ci95=off_ci, residual_rms=float(np.sqrt(np.mean(np.nan_to_num(resid, nan=mdl.big) ** 2))),
                      n=n, status=status, message=message, R_L=float(R_L), curve=fitted.curve, _model=model,
-                     beta=beta, beta_ci95=beta_ci, alpha=alpha, alpha_ci95=alpha_ci, fitted=fitted_names,
-                     pressure=pressure, pressure_ci95=pressure_ci, pressure_Pa=pressure_Pa,
-                     pressure_Pa_ci95=pressure_Pa_ci,
+                     shape_values=values, shape_ci95=intervals, derived=derived, fitted=fitted_names,
                      weights=weights, scene=fit_scene, curves_computed=curves_computed,
                      interpolation_error=fitted.interpolation_error, warnings=[t for _, t in found],
                      warning_codes=[code for code, _ in found], baseline_model=baseline, baseline=b0,
@@ -1207,23 +1247,42 @@ def _fit_result(fitted, mdl, sp, k, notes, keep, weights, baseline, curves_compu
                      point_weights=point_weights, **diagnostics)
 
 
-def _pressure_in_pascals(p, mu_H, R_L, cov, t):
-    """``p mu_H/R_L`` (Pa) and its interval from the covariance of (mu_H, ..., p) (p last)."""
-    value = p * mu_H / R_L
+def _linearised(dq, x, dx_dtheta, mu_H, R_L, cov, t):
+    """The derived quantity ``dq`` (:class:`shellbvp.shape_parameters.Derived`) and its interval
+    from the covariance of (mu_H, ..., theta) (theta, the shape parameter's search variable, last):
+    ``value +- t sd`` or, with ``dq.log_interval``, ``value exp(-+ t sd(ln value))``."""
+    value = dq.value(x, mu_H, R_L)
     if cov is None or not np.all(np.isfinite(cov)):
         return float(value), (math.nan, math.nan)
+    d_mu_H, d_x = dq.gradient(x, mu_H, R_L)
     g = np.zeros(cov.shape[0])
-    g[0], g[-1] = p / R_L, mu_H / R_L
+    g[0], g[-1] = d_mu_H, d_x * dx_dtheta
+    if dq.log_interval:
+        g = g / value
     half = t * math.sqrt(max(float(g @ cov @ g), 0.0))
+    if dq.log_interval:
+        return float(value), (float(value * math.exp(-half)), float(value * math.exp(half)))
     return float(value), (float(value - half), float(value + half))
+
+
+def _given_thickness(scene, mu_H, mu_H_ci, R_L):
+    """``{"mu": Estimate}`` of a scene with a thickness (mu*H over H, H taken as exact), else {}."""
+    from .units import format_in
+
+    eps = getattr(scene, "thickness", None)
+    if eps is None:
+        return {}
+    H = eps * R_L
+    return {"mu": Estimate(mu_H / H, (mu_H_ci[0] / H, mu_H_ci[1] / H), "Pa", "mu", "MPa",
+                           f"H = {format_in(H, 'um', 'length')}, eps = H/R_L = {eps:.3g}, beta = eps^2/3")}
 
 
 def _drop(pdt):
     return pdt[0], pdt[2]
 
 
-def _show(name, theta):
-    return f"{math.exp(theta):.3g}" if name == "beta" else f"{theta:.3g}"
+def _show(param, theta):
+    return f"{param.from_theta(theta):.3g}"
 
 
 def fit_record(scene, record, *, R_L, segment="loading", baseline="auto", **options):
@@ -1242,7 +1301,7 @@ def fit_record(scene, record, *, R_L, segment="loading", baseline="auto", **opti
         ``auto``: a constant baseline when the segment has an approach before contact
         (:func:`shellbvp.instrument.estimate_contact` finds one), none otherwise.
     **options
-        Passed to :func:`fit` (``fit_offset``, ``fit_beta``, ``weights``, ``tol``, ...).
+        Passed to :func:`fit` (``fit_offset``, ``free``, ``weights``, ``tol``, ...).
 
     Returns
     -------

@@ -11,6 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from .textdata import printable
+from .fitrecord import PARAMETER_UNITS
 from .fitting import diagnostics_lines
 from .thickness import model_error_line
 
@@ -196,7 +197,7 @@ def plot_fit_record(record, axes=None):
 def fit_summary_lines(record):
     """The text of a fit report (one string per line)."""
     p, iv = record.parameters, record.intervals
-    units = {"mu_H": "N/m", "offset": "m", "baseline": "N", "baseline_slope": "N/m", "beta": "", "alpha": ""}
+    units = {k: "" if u == "1" else u for k, u in PARAMETER_UNITS.items()}
     lines = [f"source: {record.source['file_name']}", f"sha256: {record.source['sha256']}",
              f"columns: {record.source['columns']}; units in the file: {record.source['units']}",
              f"fit: {'succeeded' if record.success else 'FAILED'} (status {record.status}); "
@@ -205,14 +206,19 @@ def fit_summary_lines(record):
     for name in record.fitted:
         lo, hi = iv[name]
         lines.append(f"{name} = {p[name]:.5g} {units.get(name, '')}   95% CI [{lo:.5g}, {hi:.5g}]")
+    for name in iv:
+        if name not in record.fitted:  # a fitted shape parameter's derived quantity
+            lo, hi = iv[name]
+            lines.append(f"{name} = {p[name]:.5g} {units.get(name, '')}   95% CI [{lo:.5g}, {hi:.5g}] (linearised)")
     lines.append(f"rms residual = {p['residual_rms']:.4g} N; R_L = {p['R_L']:.4g} m")
     lines += diagnostics_lines(record.quality, record.fitted, record.correlation, p)
     s = record.scene
     if s.thickness is not None and "beta" not in record.fitted:
-        H = s.thickness * p["R_L"]
-        lo, hi = iv["mu_H"]
-        lines.append(f"mu = {p['mu_H'] / H / 1e6:.5g} MPa   95% CI [{lo / H / 1e6:.5g}, {hi / H / 1e6:.5g}] "
-                     f"(thickness H = {H * 1e6:.4g} um, eps = {s.thickness:.3g})")
+        if "mu" not in iv:  # mu of a given thickness (a fitted one's is a line above)
+            H = s.thickness * p["R_L"]
+            lo, hi = iv["mu_H"]
+            lines.append(f"mu = {p['mu_H'] / H / 1e6:.5g} MPa   95% CI [{lo / H / 1e6:.5g}, {hi / H / 1e6:.5g}] "
+                         f"(thickness H = {H * 1e6:.4g} um, eps = {s.thickness:.3g})")
         lines.append(model_error_line(s))
     lines.append(f"scene: {s.describe(p['R_L'])}")
     lines += [f"warning: {w}" for w in record.warnings] or ["warnings: none"]

@@ -25,6 +25,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .materials import MooneyRivlin
+from .shape_parameters import SHAPE_PARAMETERS
 
 log = logging.getLogger(__name__)
 
@@ -71,6 +72,11 @@ def _check_uncertainty(scene, uncertainty, fit_kwargs):
     if not isinstance(uncertainty, dict) or not uncertainty:
         raise ValueError(f"uncertainty must be a non-empty mapping of {UNCERTAIN_PARAMETERS} to standard "
                          f"uncertainties; got {uncertainty!r}")
+    from .fitting import free_parameters
+
+    aliases = {k: v for k, v in fit_kwargs.items() if k.startswith("fit_") and k[4:] in SHAPE_PARAMETERS}
+    free, _ = free_parameters(fit_kwargs.get("free", ()), None, aliases)
+    fitted = {quantity: name for name in free for quantity in SHAPE_PARAMETERS[name].sets}
     scenes = {}
     for name, u in uncertainty.items():
         if name not in UNCERTAIN_PARAMETERS:
@@ -78,8 +84,9 @@ def _check_uncertainty(scene, uncertainty, fit_kwargs):
                              f"{UNCERTAIN_PARAMETERS}")
         if name == "alpha" and not isinstance(scene.material, MooneyRivlin):
             raise ValueError(f"uncertainty: alpha needs a Mooney-Rivlin scene; its material is {scene.material!r}")
-        if fit_kwargs.get(f"fit_{name}"):
-            raise ValueError(f"uncertainty: {name} is fitted (fit_{name}=True); its uncertainty comes from the fit")
+        if name in fitted:
+            raise ValueError(f"uncertainty: {name} is fitted (fit_{fitted[name]}=True); its uncertainty comes from "
+                             f"the fit")
         if isinstance(u, bool) or not isinstance(u, (int, float)) or not (math.isfinite(u) and u > 0):
             raise ValueError(f"uncertainty: {name} must have a finite uncertainty > 0; got {u!r}")
         x = _nominal(scene, name)
