@@ -350,6 +350,11 @@ _CACHE: OrderedDict = OrderedDict()
 _CACHE_SIZE = 32
 
 
+def clear_model_curves():
+    """Forget the model curves memoised in this process (the next fit computes its own)."""
+    _CACHE.clear()
+
+
 def _model_curve(scene, deltas, tol, counter=None, progress=None):
     """The curve of ``scene`` at ``deltas`` (memoised per process: repeated fits reuse it);
     ``progress(description, delta_max) -> (bar, callback)`` draws its progress."""

@@ -87,7 +87,7 @@ def test_a_broken_file_gets_its_row_and_the_others_are_fitted(folder):
 def test_the_model_curve_is_computed_once_for_the_batch(folder, monkeypatch):
     from shellbvp import fitting
 
-    monkeypatch.setattr(fitting, "_CACHE", type(fitting._CACHE)())  # an empty cache: count every curve
+    fitting.clear_model_curves()  # an empty cache: count every curve
     files = expand_inputs([str(folder / "data" / "seed_*.tsv")])
     assert [os.path.basename(f) for f in files] == ["seed_a.tsv", "seed_b.tsv", "seed_c.tsv"]
     seen = []
