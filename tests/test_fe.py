@@ -58,11 +58,11 @@ def test_scene_thickness_sets_beta_and_replace_keeps_them_consistent():
 def test_cli_thickness_with_a_unit_needs_the_radius(capsys):
     assert main(["solve", "--thickness", "50um", "--delta", "0.1"]) == 2
     assert "needs --radius" in capsys.readouterr().err
-    from shellbvp.cli import _scene, build_parser
+    from shellbvp.cli import build_parser, scene_from_args
 
     args = build_parser().parse_args(["solve", "--preset", "fit", "--thickness", "50um", "--radius", "0.3mm"])
-    assert _scene(args).beta == pytest.approx((50 / 300) ** 2 / 3)
-    assert _scene(build_parser().parse_args(["curve", "--thickness", "0.1"])).beta == pytest.approx(0.01 / 3)
+    assert scene_from_args(args).beta == pytest.approx((50 / 300) ** 2 / 3)
+    assert scene_from_args(build_parser().parse_args(["curve", "--thickness", "0.1"])).beta == pytest.approx(0.01 / 3)
 
 
 # ------------------------------------------------------------------ the indenter's surface

@@ -66,12 +66,12 @@ def test_files_labels_and_words():
 
 
 def test_the_command_line_chooses_it_by_name(capsys):
-    from shellbvp.cli import _scene, build_parser
+    from shellbvp.cli import build_parser, scene_from_args
 
     parser = build_parser()
     args = parser.parse_args(["curve", "--material", "yeoh:c2=0.1,c3=0.01"])
-    assert _scene(args).material == sb.Yeoh(0.1, 0.01)
-    assert _scene(parser.parse_args(["curve", "--material", "yeoh:c3=0.2"])).material == sb.Yeoh(0.0, 0.2)
+    assert scene_from_args(args).material == sb.Yeoh(0.1, 0.01)
+    assert scene_from_args(parser.parse_args(["curve", "--material", "yeoh:c3=0.2"])).material == sb.Yeoh(0.0, 0.2)
     for bad, says in (("yeoh:c2=-1", "c2 (Yeoh) must be a finite number >= 0"), ("yeoh:c4=1", "NAME one of c2, c3"),
                       ("yeoh:c2=1,c2=2", "once each"), ("yeoh:c2=exp(1)", "c2 must be a plain finite number")):
         with pytest.raises(SystemExit):

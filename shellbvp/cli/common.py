@@ -1,0 +1,398 @@
+"""What the commands share: the parser, number and unit arguments, the scene's options, output names."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+from pathlib import Path
+
+
+__all__ = ["Parser", "print_json_error", "plain_number", "plain_numbers", "quantity", "uncertain_value", "pressure_value", "say", "number_or", "thickness_value", "nondimensional", "material_spec", "material_help", "bending_families", "add_scene_options", "scene_from_args", "over_rim_radius", "require_sample", "nondimensional_thickness", "nondimensional_pressure", "checkpoint_seconds", "progress_bar", "curve_bars", "MAX_POINTS", "free_default_name", "strict_json", "output_dir", "check_report_path", "add_overwrite_option"]
+
+
+class Parser(argparse.ArgumentParser):
+    json_errors = False  # set by main when --json was asked for: errors are JSON on stdout too
+
+    def error(self, message):  # one line, exit 2 (argparse's own convention)
+        if Parser.json_errors:
+            print_json_error(message)
+        self.exit(2, f"shellbvp: error: {message}\n")
+
+
+def print_json_error(message):
+    """The one JSON document of a --json run that stopped on bad input (exit status 2)."""
+    print(json.dumps({"success": False, "status": None, "exit_status": 2, "message": str(message),
+                      "warnings": [], "warning_codes": []}))
+
+
+def plain_number(text):
+    """argparse type: a plain finite number (float() would also take 5_0, inf, nan, 1e999)."""
+    from ..units import plain_number
+
+    try:
+        return plain_number(text, "the value")
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+
+
+def plain_numbers(text, name):
+    """Comma-separated plain finite numbers of an option."""
+    from ..units import plain_number
+
+    return [plain_number(v, name) for v in text.split(",")]
+
+
+def quantity(kind):
+    """argparse type: a quantity with its unit (``0.3mm``, ``52N/m``), > 0; a bare number is an
+    error that says which unit to add.  Every subcommand takes dimensional options this way."""
+    from ..units import Quantity
+
+    def parse(text):
+        try:
+            return Quantity.parse(text, kind, "the value")  # argparse names the option
+        except ValueError as exc:
+            raise argparse.ArgumentTypeError(str(exc)) from None
+
+    parse.__name__ = f"{kind} with a unit"
+    return parse
+
+
+def uncertain_value(text):
+    """argparse type: ``VALUE`` or ``VALUE+-U`` (plain numbers) -> (value, U or None)."""
+    from ..uncertainty import parse_uncertain
+
+    try:
+        return parse_uncertain(text, "the value")
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+
+
+def pressure_value(text):
+    """argparse type: a plain number (``p R_L/(mu H)``) or a pressure with its unit (``0.2MPa``)."""
+    from ..units import Quantity, plain_number, split_quantity
+
+    try:
+        if split_quantity(text, "pressure", "the value")[1]:
+            return Quantity.parse(text, "pressure", "the value", positive=False)
+        return plain_number(text, "the value")
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+
+
+def say(line=""):
+    """Print a line that may hold text from a file or a user: control characters escaped
+    (shellbvp.textdata), so that a file cannot drive the terminal or forge a result line."""
+    from ..textdata import printable
+
+    print(printable(line))
+
+
+def number_or(kind):
+    """argparse type: a plain number (nondimensional) or a quantity with its unit (``50um``,
+    ``10mN``), which :func:`nondimensional` turns into the model's units."""
+    from ..units import Quantity, plain_number, split_quantity
+
+    def parse(text):
+        try:
+            if split_quantity(text, kind, "the value")[1]:
+                return Quantity.parse(text, kind, "the value")
+            return plain_number(text, "the value")
+        except ValueError as exc:
+            raise argparse.ArgumentTypeError(str(exc)) from None
+
+    parse.__name__ = f"number or {kind}"
+    return parse
+
+
+thickness_value = number_or("length")  # eps = H / R_L, or the thickness with its unit
+
+
+def nondimensional(args, value, option):
+    """``value`` of ``option`` in the model's units: a plain number as it is; a length over the rim
+    radius (``--radius``), a force over mu*H times it (``--muH`` too)."""
+    from ..units import Quantity
+
+    if not isinstance(value, Quantity):
+        return value
+    if value.kind == "length":
+        if args.radius is None:
+            raise ValueError(f"{option} {value} needs --radius (the rim radius, e.g. 0.3mm), or give it in "
+                             f"rim radii (a plain number)")
+        return value.si / args.radius.si
+    if args.radius is None or args.mu_h is None:
+        raise ValueError(f"{option} {value} needs --radius and --muH (e.g. 0.3mm and 52N/m), or give it in "
+                         f"mu*H R_L (a plain number)")
+    return value.si / (args.mu_h.si * args.radius.si)
+
+
+def material_spec(text):
+    """argparse type: ``FAMILY[:NAME=VALUE,...]`` (``--material yeoh:c2=0.1,c3=0.01``), a registered
+    material's family and its parameters by the names files use; read as data, never run."""
+    from ..materials import MATERIALS
+    from ..units import plain_number
+
+    try:
+        family, _, options = (t.strip() for t in text.partition(":"))
+        known = {f: c for f, c in MATERIALS.items() if c.cli}
+        if family not in known:
+            raise ValueError(f"unknown material {family!r}; one of {', '.join(known)}")
+        names = [p.name for p in known[family].parameters]
+        values = {}
+        for item in (t.strip() for t in options.split(",") if options):
+            name, equals, value = (t.strip() for t in item.partition("="))
+            if not equals or name not in names or name in values:
+                wanted = f"give NAME=VALUE once each, NAME one of {', '.join(names)}" if names else "takes no parameters"
+                raise ValueError(f"{family}: {wanted}; got {item!r}")
+            values[name] = plain_number(value, f"{family}: {name}")
+        material = known[family](**values)
+        material.validate()
+        return material
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+
+
+def material_help() -> str:
+    """What --material takes, from the registry of materials."""
+    from ..materials import MATERIALS
+
+    kinds = [c.family + "".join(f", {p.name} {p.range_text()}" for p in c.parameters)
+             for c in MATERIALS.values() if c.cli]
+    return ("a material as FAMILY[:NAME=VALUE,...], e.g. gent:Jm=1 (parameters not given keep their "
+            f"defaults): {'; '.join(kinds)}")
+
+
+def bending_families() -> tuple:
+    from ..materials import BENDINGS
+
+    return tuple(f for f, c in BENDINGS.items() if c.cli)
+
+
+def add_scene_options(p, uncertain=False, preset_required=False):
+    g = p.add_argument_group("scene (overrides of the preset)")
+    g.add_argument("--preset", default=None,
+                   help="built-in scene (see `shellbvp presets`); " + (
+                       "give it, or the sample's geometry: --indenter-radius (or --rho) and --rise (or --gamma) "
+                       "and --thickness (or --beta)" if preset_required else "default base"))
+    kind, note = (uncertain_value, "; VALUE+-U: with a standard uncertainty U") if uncertain else (plain_number, "")
+    shape = g.add_mutually_exclusive_group()
+    shape.add_argument("--gamma", type=kind, help=f"spheroid aspect parameter (< 1/rho; >0 bowl, <0 dome){note}")
+    shape.add_argument("--rise", type=quantity("length"),
+                       help="the shell's depth from its rim's plane to its pole, with its unit (with --radius): "
+                            "gamma = rise / R_L (a bowl indented from inside; a dome: --gamma < 0)")
+    tip = g.add_mutually_exclusive_group()
+    tip.add_argument("--rho", type=kind, help=f"indenter radius / rim radius (> 0){note}")
+    tip.add_argument("--indenter-radius", type=quantity("length"), dest="indenter_radius",
+                     help="the indenter's tip radius with its unit (with --radius): rho = it / R_L")
+    g.add_argument("--beta", type=kind, help=f"bending stiffness B/(mu R_L^2) (> 0){note}")
+    g.add_argument("--thickness", type=thickness_value,
+                   help="shell thickness: H/R_L in (0, 0.5], or with a unit (50um) together with --radius; "
+                        "sets beta = (H/R_L)^2/3, the bending stiffness of a 3D plate")
+    g.add_argument("--transverse-shear", action="store_true", default=None, dest="transverse_shear",
+                   help="with --thickness: add the shell's transverse shear compliance (forces at the thick "
+                        "shell's depth; removes most of the model's O(H/R_L) error, see docs/accuracy.md)")
+    m = g.add_mutually_exclusive_group()
+    m.add_argument("--alpha", type=kind, help=f"Mooney-Rivlin alpha in [0, 1]{note}")
+    m.add_argument("--gent-jm", type=plain_number, dest="gent_jm", help="Gent model with this Jm (> 0)")
+    m.add_argument("--neo-hookean", action="store_true", help="neo-Hookean material")
+    m.add_argument("--material", type=material_spec, metavar="FAMILY[:NAME=VALUE,...]",
+                   help=material_help())
+    g.add_argument("--xi", type=int, choices=(0, 1), help="1: full generalised tensions; 0: first approximation")
+    g.add_argument("--pressure", type=pressure_value,
+                   help="pressure below the shell (from the side away from the indenter; > 0 inflates a dome or "
+                        "cell): p R_L/(mu H), or with a unit (0.2MPa, 50kPa) together with --radius and --muH")
+    g.add_argument("--sealed", action="store_true", default=None,
+                   help="volume control: the shell encloses the volume it has when inflated at --pressure (a "
+                        "sealed capsule); the pressure becomes an unknown of every state")
+    g.add_argument("--contact", choices=("smooth", "paper"), help="contact-line model (default smooth)")
+    b = g.add_mutually_exclusive_group()
+    b.add_argument("--bending", choices=bending_families(),
+                   help="bending energy B in U = W + beta B: trace (the paper's, default) or rotation (convex)")
+    b.add_argument("--bending-formula", dest="bending_formula",
+                   help="a user bending energy B per beta in lambda_s, lambda_theta, kappa_s, kappa_theta, "
+                        "kappa_s0, kappa_theta0 (the reference curvatures)")
+    s = p.add_argument_group("solver")
+    s.add_argument("--tol", type=plain_number, default=1e-6, help="collocation tolerance (default 1e-6)")
+    s.add_argument("--max-nodes", type=int, default=10000, dest="max_nodes", help="largest collocation mesh of a state (default 10000)")
+
+
+def scene_from_args(args):
+    import shellbvp as sb
+
+    over = {k: getattr(args, k) for k in ("gamma", "rho", "beta", "xi", "contact", "sealed", "transverse_shear")
+            if getattr(args, k, None) is not None}
+    if args.alpha is not None:
+        over["material"] = sb.MooneyRivlin(args.alpha)
+    elif args.gent_jm is not None:
+        over["material"] = sb.Gent(args.gent_jm)
+    elif args.neo_hookean:
+        over["material"] = sb.NeoHookean()
+    elif args.material is not None:
+        over["material"] = args.material
+    if getattr(args, "bending", None):
+        from ..materials import bending_class
+
+        over["bending"] = bending_class(args.bending)()
+    elif getattr(args, "bending_formula", None):
+        over["bending"] = sb.BendingEnergy(args.bending_formula)
+    if getattr(args, "pressure", None) is not None:
+        over["pressure"] = nondimensional_pressure(args)
+    if getattr(args, "thickness", None) is not None:
+        over["thickness"] = nondimensional_thickness(args)
+    for name, length, what in (("rho", "indenter_radius", "--indenter-radius"), ("gamma", "rise", "--rise")):
+        if getattr(args, length, None) is not None:
+            over[name] = over_rim_radius(args, getattr(args, length), what)
+    return sb.Scene.preset(args.preset or "base", **over)
+
+
+def over_rim_radius(args, length, option):
+    """A lab length of the sample over the rim radius ``--radius``: the nondimensional number."""
+    radius = getattr(args, "radius", None)
+    if radius is None:
+        raise ValueError(f"{option} {length} is a length: it needs --radius (the rim radius R_L), or give "
+                         f"the ratio itself ({'--rho' if option == '--indenter-radius' else '--gamma'})")
+    return length.si / radius.si
+
+
+def require_sample(args):
+    """``fit`` names its sample: a preset, or the geometry (no silent default hemisphere)."""
+    if args.preset is not None:
+        return
+    missing = [what for what, given in (
+        ("the indenter: --indenter-radius (or --rho)", args.rho is not None or args.indenter_radius is not None),
+        ("the shell's shape: --rise (or --gamma)", args.gamma is not None or args.rise is not None),
+        ("its bending stiffness: --thickness (or --beta)", args.thickness is not None or args.beta is not None))
+        if not given]
+    if missing:
+        raise ValueError("fit needs the sample: --preset NAME (`shellbvp presets`), or its geometry; missing "
+                         + "; ".join(missing))
+
+
+def nondimensional_thickness(args):
+    """``--thickness`` as ``H / R_L``: a plain number as it is, a length through ``--radius``."""
+    from ..units import Quantity
+
+    if not isinstance(args.thickness, Quantity):
+        return args.thickness
+    radius = getattr(args, "radius", None)
+    if radius is None:
+        raise ValueError(f"--thickness {args.thickness} has a unit: it needs --radius (the nondimensional "
+                         f"thickness is H / R_L); or give that number itself")
+    return args.thickness.si / radius.si
+
+
+def nondimensional_pressure(args):
+    """``--pressure`` as ``p R_L/(mu H)``: a plain number as it is, a pressure with a unit through
+    ``--radius`` and ``--muH``."""
+    from ..units import Dimensions, Quantity
+
+    if not isinstance(args.pressure, Quantity):
+        return args.pressure
+    if args.command == "fit":
+        raise ValueError(f"fit: --pressure {args.pressure} has a unit, but the fit estimates mu*H, which makes it "
+                         f"nondimensional: give the start as p R_L/(mu H) (with --fit-pressure the fit reports "
+                         f"the pressure in Pa)")
+    radius, mu_h = getattr(args, "radius", None), getattr(args, "mu_h", None)
+    if radius is None or mu_h is None:
+        raise ValueError(f"--pressure {args.pressure} has a unit: it needs --radius and --muH (the nondimensional "
+                         f"pressure is p R_L/(mu H)); or give that number itself")
+    return Dimensions(R_L=radius.si, mu_H=mu_h.si).p(args.pressure.si)
+
+
+def checkpoint_seconds():
+    """Seconds between checkpoints of a running curve (to ``X.h5.partial``): 5, or
+    ``SHELLBVP_CHECKPOINT_SECONDS`` (0: after every point)."""
+    text = os.environ.get("SHELLBVP_CHECKPOINT_SECONDS", "5")
+    try:
+        value = float(text)
+    except ValueError:
+        value = -1.0
+    if not (math.isfinite(value) and value >= 0):
+        raise ValueError(f"SHELLBVP_CHECKPOINT_SECONDS must be a number of seconds >= 0; got {text!r}")
+    return value
+
+
+def progress_bar(total, unit, args):
+    """A progress bar on stderr (tqdm; none when quiet, not a terminal, or tqdm absent)."""
+    from ..progress import progress_bar, wanted
+
+    return progress_bar(total, desc=args.command, unit=unit, enabled=wanted(getattr(args, "quiet", False)))
+
+
+def curve_bars(args, leave=True):
+    """``progress`` for :func:`shellbvp.fit`: one bar per model curve, over delta."""
+    from ..progress import curve_progress, wanted
+
+    mode = wanted(getattr(args, "quiet", False))
+    if not mode:
+        return None
+    return lambda desc, delta_max: curve_progress(delta_max, desc, enabled=mode, leave=leave)
+
+
+MAX_POINTS = 100_000  # --points: each is a solve (~0.05-0.5 s); more is a typo, not a curve
+
+
+def free_default_name(preset, force):
+    """Without -o: ``<preset>.h5``, or (it exists, no --overwrite) the first free ``<preset>-N.h5``,
+    so that running the quick start twice neither fails nor replaces the first result."""
+    from pathlib import Path
+
+    name = Path(f"{preset}.h5")
+    n = 2
+    while not force and (name.exists() or Path(f"{name}.partial").exists()):
+        name = Path(f"{preset}-{n}.h5")
+        n += 1
+    return str(name)
+
+
+def strict_json(value):
+    """NaN and inf as null (JSON has neither; jq, JavaScript and most parsers refuse them)."""
+    import numpy as np
+
+    if isinstance(value, dict):
+        return {k: strict_json(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [strict_json(v) for v in value]
+    if isinstance(value, (bool, np.bool_)):
+        return bool(value)
+    if isinstance(value, (int, np.integer)):
+        return int(value)
+    if isinstance(value, (float, np.floating)):
+        return float(value) if math.isfinite(value) else None
+    return value
+
+
+def output_dir(path, what, files, suffix, force):
+    """A directory for one output per file (created if its parent exists); names checked now."""
+    from ..paths import check_output_path
+
+    d = Path(path)
+    if d.exists() and not d.is_dir():
+        raise ValueError(f"{what} {path}: with several files it must be a directory (one file each)")
+    if not d.exists():
+        if not d.parent.is_dir():
+            raise ValueError(f"{what} {path}: its parent directory does not exist")
+        d.mkdir()
+    stems = [Path(f).stem for f in files]
+    twice = sorted({s for s in stems if stems.count(s) > 1})
+    if twice:
+        raise ValueError(f"{what}: several input files are named {twice[0]!r} (their outputs would collide); "
+                         "fit them in separate calls")
+    for stem in stems:
+        check_output_path(d / f"{stem}{suffix}", overwrite=force)
+    return d
+
+
+def check_report_path(path, overwrite):
+    from ..paths import check_output_path
+
+    if not str(path).lower().endswith((".png", ".pdf")):
+        raise ValueError(f"--report must name a .png or .pdf file; got {path!r}")
+    return check_output_path(path, overwrite=overwrite)
+
+
+def add_overwrite_option(p, what):
+    """``--overwrite`` (``--force`` too, the older name, not shown: scripts keep working)."""
+    p.add_argument("--overwrite", action="store_true", dest="force", help=what)
+    p.add_argument("--force", action="store_true", dest="force", help=argparse.SUPPRESS)

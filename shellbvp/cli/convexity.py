@@ -1,0 +1,26 @@
+"""The ``convexity`` command: where the scene's energy is convex."""
+
+from __future__ import annotations
+
+
+from .common import add_scene_options, quantity, scene_from_args
+
+__all__ = ["add_parser", "run"]
+
+
+def add_parser(sub):
+    """The ``convexity`` subcommand's arguments, on ``sub`` (the subparsers)."""
+    cv = sub.add_parser("convexity", help="where the scene's energy is convex in stretch and curvature "
+                                          "(the Legendre condition; beyond it the contact edge becomes a corner)")
+    add_scene_options(cv)
+    cv.add_argument("--radius", "--rim-radius", type=quantity("length"),
+                    help="rim radius with its unit, for the lengths of --indenter-radius, --rise, --thickness")
+    cv.set_defaults(func=run)
+
+
+def run(args):
+    """``shellbvp convexity``: where the scene's energy is convex in stretch and curvature."""
+    from ..convexity import convexity_report
+
+    print(convexity_report(scene_from_args(args)))
+    return 0

@@ -1,0 +1,403 @@
+"""The ``fit`` command: mu*H (and the contact point) from measured data; a file, a batch or a force map."""
+
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+
+from ..shape_parameters import SHAPE_PARAMETERS
+from .common import (
+    add_overwrite_option, add_scene_options, check_report_path, curve_bars, output_dir, progress_bar,
+    quantity, require_sample, say, scene_from_args, strict_json,
+)
+
+__all__ = ["add_parser", "run"]
+
+
+def add_parser(sub):
+    """The ``fit`` subcommand's arguments, on ``sub`` (the subparsers)."""
+    f = sub.add_parser("fit", help="fit mu*H (and the contact point) to measured force-displacement data",
+                       description="Fit mu*H (and the contact point) to measured force-displacement data. "
+                       "Exit status: 0 the fit succeeded (warnings, if any, printed as 'warning: ...'); "
+                       "1 the fit ran but failed its checks (e.g. an interval not finite or wider than mu*H); "
+                       "2 bad input (one-line message).")
+    f.add_argument("data", nargs="*", help="instrument file(s) (CSV/TSV/text: displacement and force, optionally "
+                   "time); several files, a directory or a pattern fit each with the same settings (a batch)")
+    f.add_argument("--table", help="batch: write one row per file (CSV: file, status, mu*H and its interval, "
+                   "offset, baseline, residual, warnings, ...)")
+    f.add_argument("--example", action="store_true",
+                   help="use the synthetic Lepidium-like data shipped with shellbvp (README)")
+    add_scene_options(f, uncertain=True, preset_required=True)
+    f.add_argument("--workers", type=int, help="with VALUE+-U parameters: local processes for their fits "
+                                               "(default: all cores)")
+    f.add_argument("--scheduler", help="with VALUE+-U parameters: run their fits on this Dask scheduler")
+    f.add_argument("--radius", "--rim-radius", required=True, type=quantity("length"),
+                   help="rim radius R_L of the sample with its unit, e.g. 0.3mm")
+    f.add_argument("--columns", help="displacement,force columns by name or 0-based index (default 0,1)")
+    f.add_argument("--units", help="units of the two columns, e.g. mm,mN (default: from the header)")
+    f.add_argument("--invert", action="append", choices=("displacement", "force"),
+                   help="flip the sign of a column: an AFM height that falls as the tip goes in "
+                        "(displacement), compression recorded as negative (force); may be given twice")
+    f.add_argument("--segment", choices=("loading", "retraction", "all"), default="loading",
+                   help="rows to fit: loading (default: the approach and the loading, up to the deepest point; "
+                        "segments by the direction of the displacement over time), retraction, or all "
+                        "(every row, whatever its direction)")
+    f.add_argument("--baseline", choices=("auto", "none", "constant", "linear"), default="auto",
+                   help="force baseline fitted with the contact point: auto (default: constant when the data "
+                        "have an approach before contact, else none), none, constant, linear")
+    f.add_argument("--no-offset", action="store_true", dest="no_offset", help="do not fit the contact point")
+    for name, param in SHAPE_PARAMETERS.items():  # one of them at most
+        f.add_argument(f"--fit-{name}", action="store_true", dest=f"fit_{name}", help=param.fit_help)
+        f.add_argument(f"--{name}-range", dest=f"{name}_range", help=param.range_help)
+    f.add_argument("--weights", choices=("uniform", "relative", "mixed"),
+                   help="noise model: uniform (same force noise everywhere), relative (noise proportional "
+                        "to the force) or mixed (both, estimated; the default)")
+    f.add_argument("--json", action="store_true", help="print the result as one JSON document (also on errors)")
+    f.add_argument("-o", "--output", help="write the fit as a record (HDF5/NeXus: data, model, parameters with "
+                   "intervals, weights, warnings, scene, source file and its SHA-256); a batch: a directory "
+                   "(one <name>.h5 per file)")
+    f.add_argument("--report", help="write a one-page summary of the fit (.png or .pdf); a batch: a directory "
+                   "(one <name>.pdf per file)")
+    f.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
+    add_overwrite_option(f, "replace an existing output file (record, report, table)")
+    f.set_defaults(func=run)
+
+
+def _split_uncertain(args):
+    """``VALUE+-U`` options of ``fit``: the values go to the scene; returns {name: U}."""
+    uncertainty = {}
+    for name in ("gamma", "rho", "beta", "alpha"):
+        given = getattr(args, name)
+        if isinstance(given, tuple):
+            setattr(args, name, given[0])
+            if given[1] is not None:
+                uncertainty[name] = given[1]
+    if (args.workers is not None or args.scheduler) and not uncertainty:
+        raise ValueError("--workers and --scheduler run the fits of an uncertain geometry: give a parameter "
+                         "as VALUE+-U (e.g. --rho 0.333+-0.02)")
+    if args.scheduler and args.workers is not None:
+        raise ValueError("--workers sets the local pool; with --scheduler the cluster has its own workers")
+    return uncertainty
+
+
+def _fit_inputs(args):
+    """The scene, R_L and the reading and fitting options of ``fit``, checked before any work."""
+    require_sample(args)
+    scene = scene_from_args(args)
+    units = None
+    if args.units:
+        parts = [u.strip() for u in args.units.split(",")]
+        if len(parts) not in (2, 3):
+            raise ValueError(f"--units must be two units, displacement and force (and a third for time), "
+                             f"e.g. mm,mN; got {args.units!r}")
+        units = tuple(parts)
+    columns = [c.strip() for c in args.columns.split(",")] if args.columns else None
+    if columns is not None and len(columns) not in (2, 3):
+        raise ValueError(f"--columns must name two columns (displacement, force) or three (and time); "
+                         f"got {args.columns!r}")
+    free = tuple(name for name in SHAPE_PARAMETERS if getattr(args, f"fit_{name}"))
+    bounds = {}
+    for name, param in SHAPE_PARAMETERS.items():
+        text = getattr(args, f"{name}_range")
+        if text is not None:
+            bounds[name] = _search_range(param, text, args.radius.si)
+            if name not in free:
+                raise ValueError(f"--{name}-range needs --fit-{name}")
+    options = {"fit_offset": not args.no_offset, "free": free, "bounds": bounds, "weights": args.weights,
+               "tol": args.tol}
+    return scene, args.radius.si, {"columns": columns, "units": units, "invert": tuple(args.invert or ())}, options
+
+
+def _search_range(param, text, R_L):
+    """``--NAME-range LOW,HIGH`` as the nondimensional bounds of the shape parameter ``param``:
+    plain numbers as they are; with a unit (a parameter with a lab unit, e.g. 20um) through R_L."""
+    from ..units import Quantity, plain_number, split_quantity
+
+    parts = text.split(",")
+    try:
+        if len(parts) != 2:
+            raise ValueError
+        values = []
+        for part in parts:
+            if param.unit_kind and split_quantity(part, param.unit_kind, f"--{param.name}-range")[1]:
+                values.append(Quantity.parse(part, param.unit_kind, f"--{param.name}-range").si
+                              / param.report_scale(R_L))
+            else:
+                values.append(plain_number(part, f"--{param.name}-range"))
+    except ValueError:
+        unit = f" (plain, or with a {param.unit_kind} unit)" if param.unit_kind else ""
+        raise ValueError(f"--{param.name}-range must be two numbers LOW,HIGH{unit}; got {text!r}") from None
+    return tuple(values)
+
+
+def run(args):
+    """``shellbvp fit``: exit 0 (fit succeeded; warnings allowed), 1 (the fit ran but failed its
+    checks) or 2 (bad input: a ValueError, one line on stderr).  With ``--json`` stdout holds
+    exactly one JSON document in every case (errors: see :func:`main`).  Several files (or a
+    directory, a pattern, or ``--table``): a batch, see :func:`_fit_batch`; an AFM force map: every
+    curve into a map, see :func:`_fit_map`."""
+    if args.example == bool(args.data):
+        raise ValueError("give data files (or a directory) or --example (one of them)")
+    if len(args.data) == 1 and not any(ch in args.data[0] for ch in "*?[") and not Path(args.data[0]).exists():
+        raise ValueError(f"{args.data[0]}: no such file or directory")  # before the numerics are imported
+    from ..afm import is_afm_file, read_afm
+    from ..batch import expand_inputs, read_record
+    from ..fitting import example_data_path, fit_record
+    from ..paths import check_output_path
+
+    inputs = [str(example_data_path())] if args.example else args.data
+    files = expand_inputs(inputs)
+    uncertainty = _split_uncertain(args)
+    folder = any(Path(x).is_dir() for x in inputs)
+    map_curves = None
+    if len(files) == 1 and not folder and is_afm_file(files[0]):
+        require_sample(args)  # its one-line error before the file is read
+        curves = read_afm(files[0])
+        if len(curves) > 1:  # a force map: every curve, into a map
+            if uncertainty:
+                raise ValueError("VALUE+-U (the geometry's uncertainty) is for one curve, not a force map")
+            map_curves = curves
+    if map_curves is None and (len(files) > 1 or args.table or folder):
+        if uncertainty:
+            raise ValueError("VALUE+-U (the geometry's uncertainty) is for one file at a time, not a batch")
+        return _fit_batch(args, files)
+    if args.output is not None:
+        check_output_path(args.output, overwrite=args.force)
+    if args.report is not None:
+        check_report_path(args.report, overwrite=args.force)
+    scene, R_L, reading, options = _fit_inputs(args)
+    options["progress"] = curve_bars(args)
+    if map_curves is not None:
+        return _fit_map(args, files[0], map_curves, scene, R_L, reading, options)
+    record = read_record(files[0], **reading)
+    res, used = fit_record(scene, record, R_L=R_L, segment=args.segment, baseline=args.baseline, **options)
+    geometry = None
+    if uncertainty and res.success:
+        from ..sweep import dask_executor
+        from ..uncertainty import fit_with_geometry
+
+        # the same rows, baseline model and contact point as the nominal fit, at each perturbed geometry
+        kw = {k: v for k, v in options.items() if k != "progress"}
+        executor = dask_executor(args.scheduler) if args.scheduler else None
+        geometry = fit_with_geometry(scene, record.displacement[used], record.force[used], R_L=R_L,
+                                     uncertainty=uncertainty, executor=executor, workers=args.workers,
+                                     baseline=res.baseline_model, contact_guess=res.offset, **kw)
+    out = res.to_dict()
+    ok = res.success and (geometry is None or geometry.success)
+    if geometry is not None:
+        out["geometry"] = geometry.to_dict()
+        out["success"] = ok
+    out["exit_status"] = 0 if ok else 1
+    if args.json:
+        print(json.dumps(strict_json(out), allow_nan=False))
+    else:
+        _print_fit(res, record, used, args)
+        if geometry is not None:
+            if not geometry.success:
+                print(f"fit with the geometry's uncertainty failed: {geometry.message}")
+            g1, g2 = geometry.mu_H_ci95
+            print(f"geometry = mu*H 95% CI [{g1:.4g}, {g2:.4g}] N/m with the geometry's uncertainty "
+                  f"(u = {geometry.u_geometry:.3g} N/m; {geometry.fits_computed} fits)")
+            print(geometry.table())
+    if args.output or args.report:
+        if not res.success:
+            print(f"shellbvp: not writing {args.output or args.report}: the fit failed its checks", file=sys.stderr)
+        else:
+            _save_fit(res, record, used, args.output, args.report, args.segment, args.force, args.json)
+    return 0 if ok else 1
+
+
+def _fit_batch(args, files):
+    """``shellbvp fit A B ... [--table results.csv] [-o DIR] [--report DIR]``: every file with
+    the same scene and settings, one row each (status ok, failed or error), continuing past
+    a file that fails; exit 0 when every file was fitted, 1 otherwise."""
+    from ..batch import fit_files, write_table
+    from ..paths import check_output_path
+
+    if args.table is not None:
+        check_output_path(args.table, overwrite=args.force)
+    outdir = output_dir(args.output, "-o", files, ".h5", args.force) if args.output else None
+    repdir = output_dir(args.report, "--report", files, ".pdf", args.force) if args.report else None
+    scene, R_L, reading, options = _fit_inputs(args)
+    options["progress"] = curve_bars(args, leave=False)
+    bar = progress_bar(len(files), "file", args)
+
+    def step(row):
+        bar.update(1)
+        bar.set_postfix_str(f"{Path(row.file).name}: {row.status}")
+
+    try:
+        rows = fit_files(scene, files, R_L=R_L, segment=args.segment, baseline=args.baseline, on_file=step,
+                         **reading, **options)
+    finally:
+        bar.close()
+    for row in rows:
+        if row.status == "ok" and (outdir or repdir):
+            stem = Path(row.file).stem
+            _save_fit(row.result, row.record, row.used, outdir / f"{stem}.h5" if outdir else None,
+                      repdir / f"{stem}.pdf" if repdir else None, args.segment, args.force, True)
+    if args.table is not None:
+        write_table(args.table, rows, args.segment, overwrite=args.force)
+    ok = all(r.status == "ok" for r in rows)
+    if args.json:
+        docs = [{"file": r.file, "status": r.status, "message": r.message,
+                 **(r.result.to_dict() if r.result is not None else {})} for r in rows]
+        print(json.dumps(strict_json({"files": docs, "success": ok, "exit_status": 0 if ok else 1}),
+                         allow_nan=False))
+    else:
+        width = max(len(r.file) for r in rows)
+        for r in rows:
+            if r.result is not None and r.status != "error":
+                lo, hi = r.result.mu_H_ci95
+                text = f"mu*H = {r.result.mu_H:.4g} N/m  95% CI [{lo:.4g}, {hi:.4g}]"
+                if r.result.warnings:
+                    text += f"  ({len(r.result.warnings)} warning{'s' * (len(r.result.warnings) > 1)})"
+            else:
+                text = r.message
+            say(f"{r.file:<{width}}  {r.status:<6s}  {text}")
+        n_ok = sum(r.status == "ok" for r in rows)
+        print(f"{n_ok} of {len(rows)} files fitted" + (f"; table: {args.table}" if args.table else ""))
+    return 0 if ok else 1
+
+
+def _fit_map(args, path, curves, scene, R_L, reading, options):
+    """``shellbvp fit MAP.jpk-force-map [-o map.h5] [--table map.csv] [--report map.png]``: every
+    curve with the same scene; exit 0 when every curve was fitted, 1 otherwise."""
+    from ..afm import refuse_text_options
+    from ..batch import fit_map, write_table
+    from ..paths import check_output_path
+
+    refuse_text_options(path, **reading)
+    if args.table is not None:
+        check_output_path(args.table, overwrite=args.force)
+    options = dict(options, progress=curve_bars(args, leave=False))
+    bar = progress_bar(len(curves), "curve", args)
+
+    def step(row):
+        bar.update(1)
+        bar.set_postfix_str(row.status)
+
+    try:
+        fm = fit_map(scene, curves, R_L=R_L, path=path, segment=args.segment, baseline=args.baseline,
+                     on_curve=step, **options)
+    finally:
+        bar.close()
+    ok = all(r.status == "ok" for r in fm.rows)
+    if args.table is not None:
+        write_table(args.table, fm.rows, args.segment, overwrite=args.force)
+    if args.output is not None:
+        fm.to_hdf5(args.output, overwrite=args.force)
+    if args.report is not None:
+        fm.plot(args.report)
+    wrote = [w for w in (args.table, args.output, args.report) if w is not None]
+    if args.json:
+        docs = [{"file": r.file, "grid_index": list(c.grid), "status": r.status, "message": r.message,
+                 **(r.result.to_dict() if r.result is not None else {})} for c, r in zip(fm.curves, fm.rows)]
+        print(json.dumps(strict_json({"map": str(path), "shape": list(fm.shape), "curves": docs, "success": ok,
+                                       "exit_status": 0 if ok else 1}), allow_nan=False))
+        for w in wrote:
+            print(f"wrote {w}", file=sys.stderr)
+    else:
+        say(f"data   = {path}: a force map of {len(curves)} curves; fitted the {args.segment} segment of each")
+        say(f"scene  = {scene.describe(R_L)}")
+        say(f"map    = {fm.summary()}")
+        for w in wrote:
+            say(f"wrote {w}")
+    return 0 if ok else 1
+
+
+def _save_fit(res, record, used, output, report, segment, force, quiet_stdout=False):
+    """The fit's record (HDF5) and its one-page report (PNG/PDF), as asked (with --json the
+    'wrote' lines go to stderr: stdout holds the one JSON document)."""
+    import os
+    import tempfile
+
+    from ..fitrecord import read_fit, write_fit
+
+    if output:
+        write_fit(output, res, record, used, segment=segment, overwrite=force)
+        print(f"wrote {output}", file=sys.stderr if quiet_stdout else sys.stdout)
+    if report:
+        from ..plotting import fit_report
+
+        if output:
+            fit_report(read_fit(output), report)
+        else:  # the report alone: the record goes through a temporary file
+            fd, tmp = tempfile.mkstemp(suffix=".h5")
+            os.close(fd)
+            try:
+                write_fit(tmp, res, record, used, segment=segment, overwrite=True)
+                fit_report(read_fit(tmp), report)
+            finally:
+                os.unlink(tmp)
+        print(f"wrote {report}", file=sys.stderr if quiet_stdout else sys.stdout)
+
+
+def _print_fit(res, record, used, args):
+    """The fit in words, in the data's own units (and mu*H in N/m)."""
+    from ..units import format_in
+
+    du, fu = record.units["displacement"], record.units["force"]
+    if not res.success:
+        say(f"fit failed (status {res.status}): {res.message}")
+    counts = ", ".join(f"{k} {v}" for k, v in record.counts().items())
+    name = Path(record.path).name if args.example else record.path
+    say(f"data   = {name}: {len(record)} rows ({counts}); fitted the {args.segment} segment, "
+          f"{int(used.sum())} rows")
+    say(f"scene  = {res.scene.describe(res.R_L)}")
+    lo, hi = res.mu_H_ci95
+    say(f"mu*H   = {res.mu_H:.4g} N/m (um*MPa)   95% CI [{lo:.4g}, {hi:.4g}]")
+    for e in res.derived.values():
+        if e.of is None:  # from a given scene value (mu of a given thickness)
+            say(_estimate_line(e))
+    if res.thickness is not None:
+        from ..thickness import model_error_line
+
+        say(model_error_line(res.scene))
+    show = (lambda v, unit, kind: format_in(v, unit, kind).split(" ")[0])
+    if "offset" in res.fitted:
+        o1, o2 = res.offset_ci95
+        say(f"offset = {format_in(res.offset, du, 'length')}   95% CI [{show(o1, du, 'length')}, "
+              f"{show(o2, du, 'length')}] {du} (the contact point)")
+    if res.baseline_model != "none":
+        b1, b2 = res.baseline_ci95
+        say(f"baseline = {format_in(res.baseline, fu, 'force')}   95% CI [{show(b1, fu, 'force')}, "
+              f"{show(b2, fu, 'force')}] {fu} ({res.baseline_model})")
+    if res.baseline_model == "linear":
+        s1, s2 = res.baseline_slope_ci95
+        say(f"baseline slope = {res.baseline_slope:.4g} N/m   95% CI [{s1:.4g}, {s2:.4g}]")
+    for name, param in SHAPE_PARAMETERS.items():
+        if name in res.fitted:
+            v, (c1, c2) = res.shape_values[name], res.shape_ci95[name]
+            if param.display_unit:
+                unit = param.display_unit
+                value = format_in(v, unit, param.unit_kind)
+                interval = f"[{show(c1, unit, param.unit_kind)}, {show(c2, unit, param.unit_kind)}] {unit}"
+            else:
+                value, interval = f"{v:.4g}", f"[{c1:.4g}, {c2:.4g}]"
+            say(f"{name:<6s} = {value}   95% CI {interval} (profile likelihood; {res.curves_computed} model "
+                 f"curves){param.note}")
+            for e in res.derived.values():
+                if e.of == name:
+                    say(_estimate_line(e))
+    say(f"rms residual = {format_in(res.residual_rms, fu, 'force')} over {res.n} points; R_L = "
+          f"{args.radius}; {res.weights} weights")
+    from ..fitting import diagnostics_lines
+
+    for line in diagnostics_lines(res.quality, res.fitted, res.correlation,
+                                  {k: getattr(res, k) for k in ("noise_sigma", "aic", "bic", "runs_p",
+                                                                "residual_autocorrelation")},
+                                  lambda v: format_in(v, fu, "force")):
+        say(line)
+    for text in res.warnings:
+        say(f"warning: {text}")
+
+
+def _estimate_line(e):
+    """A line of a quantity a fit reports in lab units (``FitResult.derived``)."""
+    from ..units import unit_factor, unit_kind
+
+    f = unit_factor(e.display_unit, unit_kind(e.display_unit))
+    c1, c2 = e.ci95
+    return f"{e.label:<6s} = {e.value / f:.4g} {e.display_unit}   95% CI [{c1 / f:.4g}, {c2 / f:.4g}] ({e.note})"

@@ -1,0 +1,81 @@
+"""The ``plot`` command: figures of curve, sweep and fit files."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from .common import output_dir, plain_numbers
+
+__all__ = ["add_parser", "run"]
+
+
+def add_parser(sub):
+    """The ``plot`` subcommand's arguments, on ``sub`` (the subparsers)."""
+    pl = sub.add_parser("plot", help="plot curves (and profiles) from HDF5 files (needs matplotlib)")
+    pl.add_argument("files", nargs="+", help="curve files (`shellbvp curve`), sweep files (`shellbvp sweep`: one "
+                    "curve per finished combination) or fit files (`shellbvp fit -o`: data, model and residuals in "
+                    "SI units)")
+    pl.add_argument("-o", "--output", help="PNG or PDF (default curves.png; for fit files <name>.png next to "
+                    "each); for several fit files a directory (one <name>.png each)")
+    pl.add_argument("--profiles", help="also draw the deformed shell of the first file at these depths, e.g. 0.1,0.3")
+    pl.add_argument("--dpi", type=int, default=150, help="resolution of a PNG (default 150)")
+    pl.set_defaults(func=run)
+
+
+def run(args):
+    from ..fitrecord import is_fit_file, read_fit
+    from ..io import read_curve
+    from ..paths import check_output_path
+    from ..plotting import plot_curves, plot_fit_record, plot_profiles, require_matplotlib, save_figure, scene_label
+    from ..sweep import is_sweep_file, read_sweep
+
+    fits = [f for f in args.files if is_fit_file(f)]
+    if fits:
+        if len(fits) != len(args.files):
+            raise ValueError("plot either curve files or fit files, not both in one call")
+        if args.output is None:  # each figure next to its fit file
+            outs = [Path(name).with_suffix(".png") for name in fits]
+        elif len(fits) > 1 or Path(args.output).is_dir():
+            outdir = output_dir(args.output, "-o", fits, ".png", True)
+            outs = [outdir / (Path(name).stem + ".png") for name in fits]
+        else:
+            outs = [Path(args.output)]
+        plt = require_matplotlib()
+        for name, out in zip(fits, outs):
+            check_output_path(out, overwrite=True)
+            ax, _ = plot_fit_record(read_fit(name))
+            ax.figure.tight_layout()
+            try:
+                save_figure(ax.figure, out, dpi=args.dpi)
+            finally:
+                plt.close(ax.figure)
+            print(f"wrote {out}")
+        return 0
+    args.output = "curves.png" if args.output is None else args.output
+    check_output_path(args.output, overwrite=True)  # a figure is cheap to redraw: replaced
+    plt = require_matplotlib()
+    curves, labels = [], []
+    for name in args.files:
+        if is_sweep_file(name):  # a family: one curve per finished combination, labelled by its values
+            sw = read_sweep(name)
+            for i, c in sorted(sw.curves.items()):
+                curves.append(c)
+                labels.append(" ".join(f"{p}={sw.index[p][i]:.4g}" for p in sw.parameters))
+        else:
+            curves.append(read_curve(name))
+            labels.append(scene_label(curves[-1].scene))
+    if not curves:
+        raise ValueError(f"{', '.join(args.files)}: no finished curve to plot")
+    deltas = plain_numbers(args.profiles, "--profiles") if args.profiles else []
+    ncol = 2 if deltas else 1
+    fig, axes = plt.subplots(1, ncol, figsize=(6 * ncol, 4.8), squeeze=False)
+    plot_curves(curves, ax=axes[0, 0], labels=labels)
+    if deltas:
+        for d in deltas:
+            if not d > 0:
+                raise ValueError(f"--profiles depths must be > 0; got {d}")
+        plot_profiles(curves[0].scene, deltas, ax=axes[0, 1])
+    fig.tight_layout()
+    save_figure(fig, args.output, dpi=args.dpi)
+    print(f"wrote {args.output}")
+    return 0

@@ -1,0 +1,67 @@
+"""The ``validate`` command: the shell model against a 3D finite-element model."""
+
+from __future__ import annotations
+
+
+from .common import (
+    add_overwrite_option, add_scene_options, free_default_name, plain_number, plain_numbers, quantity,
+    scene_from_args,
+)
+
+__all__ = ["add_parser", "run"]
+
+
+def add_parser(sub):
+    """The ``validate`` subcommand's arguments, on ``sub`` (the subparsers)."""
+    v = sub.add_parser("validate", help="the shell model against a 3D finite-element model of the same scene "
+                       "(needs FElupe: pip install 'shellbvp[fe]')")
+    add_scene_options(v)
+    v.add_argument("--delta-max", type=plain_number, default=0.5, dest="delta_max",
+                   help="largest pole displacement (default 0.5); the depths are delta/H = 0.25, 0.5, 1, 2, 5, "
+                        "10, 25 below it and delta-max")
+    v.add_argument("--deltas", help="these pole displacements instead, comma-separated (/R_L)")
+    v.add_argument("--radius", "--rim-radius", type=quantity("length"), help="rim radius with its unit, for --thickness with a unit")
+    v.add_argument("--mesh-check", action="store_true", dest="mesh_check",
+                   help="also solve the 3D model on a coarser mesh and report the difference (~1.5x the time)")
+    v.add_argument("-o", "--output", help="output file (default <preset>-validate.h5, or -2, ... if that exists)")
+    add_overwrite_option(v, "replace an existing output file")
+    v.set_defaults(func=run)
+
+
+def run(args):
+    import time
+
+    from ..validation import validate
+
+    scene = scene_from_args(args)
+    if scene.thickness is None:
+        raise ValueError("validate needs --thickness (H/R_L, or with a unit and --radius)")
+    if scene.pressurised:
+        raise ValueError("validate: the 3D model has no internal pressure yet; use a scene without --pressure")
+    if not (0 < args.delta_max <= 2):
+        raise ValueError(f"--delta-max must be in (0, 2]; got {args.delta_max:g}")
+    deltas = None
+    if args.deltas:
+        deltas = plain_numbers(args.deltas, "--deltas")
+        if any(not 0 < d <= 2 for d in deltas) or any(b <= a for a, b in zip(deltas, deltas[1:])):
+            raise ValueError("--deltas must be increasing pole displacements in (0, 2]")
+    from ..paths import check_output_path
+
+    out = check_output_path(args.output if args.output is not None
+                            else free_default_name(f"{args.preset or 'base'}-validate", args.force), overwrite=args.force)
+    try:
+        import felupe  # noqa: F401
+    except ImportError:
+        raise ValueError("validate needs FElupe: pip install 'shellbvp[fe]'") from None
+    t0 = time.perf_counter()
+    shell = "with its transverse shear" if scene.transverse_shear else "Kirchhoff (no transverse shear)"
+    print(f"scene: {args.preset or 'base'}, eps = H/R_L = {scene.thickness:.4g}, beta = {scene.beta:.4g}; "
+          f"3D model (FElupe) and shell model, {shell}, at the same pole displacements", flush=True)
+    result = validate(scene, deltas=deltas, delta_max=args.delta_max, mesh_check=args.mesh_check, tol=args.tol,
+                      progress=lambda i, d, f: print(f"  FE: delta = {d:.4g}, F = {f:.5g}", flush=True))
+    print(result.table())
+    if not result.fe.success:
+        print(f"FE: {result.fe.message}")
+    result.to_hdf5(out, overwrite=args.force)
+    print(f"wrote {out} ({time.perf_counter() - t0:.1f} s)")
+    return 0 if result.fe.success else 1
