@@ -1,13 +1,15 @@
 """A census of the package's structure, from its source (nothing of it is run).
 
-    python benchmarks/architecture.py [--markdown] [--root CHECKOUT]
+    python benchmarks/architecture.py [--markdown] [--layers] [--root CHECKOUT]
 
 Counts what issue 43 names: comparisons with configuration names, modules and functions
 by length, ``.get`` on results, places that build a ``Solution``, function-level
 imports, module flags that tests patch.  The numbers are what the redesign is judged by;
 ``--markdown`` prints them as the table of benchmarks/results/architecture.md.  A ``.get`` is
 counted where its key is a result's field name; ``--verbose`` shows its receiver, which may
-be a dict of another kind.
+be a dict of another kind.  ``--layers`` prints the package's modules by floor: a module
+stands one floor above the highest module it imports (at its top or inside a function: an
+import made late for its cost is still a dependency), so every arrow points down.
 """
 
 from __future__ import annotations
@@ -79,12 +81,13 @@ def census(root=ROOT):
     names = configuration_names(root)
     out = {"step_loops": [], "name_comparisons": {}, "long_modules": {}, "long_functions": [], "result_gets": {},
            "solution_builds": {}, "function_imports": {}, "lines": 0}
-    for path in sorted((root / "shellbvp").glob("*.py")):
+    pkg = root / "shellbvp"
+    for path in sorted(pkg.rglob("*.py")):  # subpackages (materials/, cli/) too
         text = path.read_text()
         tree = ast.parse(text)
         nlines = text.count("\n")
         out["lines"] += nlines
-        mod = path.stem
+        mod = ".".join(path.relative_to(pkg).with_suffix("").parts)
         if nlines > MODULE_LINES:
             out["long_modules"][mod] = nlines
         for node in ast.walk(tree):
@@ -119,12 +122,57 @@ def census(root=ROOT):
     return out
 
 
+def layers(root=ROOT):
+    """{floor: [module, ...]} of ``shellbvp``: floor 1 imports no module of the package; every
+    other module stands one above the highest it imports (a subpackage is one module)."""
+    pkg = root / "shellbvp"
+    files = {p.stem: [p] for p in pkg.glob("*.py") if p.stem not in ("__init__", "__main__")}
+    files.update({d.name + "/": sorted(d.glob("*.py")) for d in pkg.iterdir()
+                  if d.is_dir() and (d / "__init__.py").exists()})
+    deps = {}
+    for mod, paths in files.items():
+        found = set()
+        for path in paths:
+            for node in ast.walk(ast.parse(path.read_text())):
+                if isinstance(node, ast.ImportFrom) and node.level >= 1:
+                    inside = path.parent != pkg  # a subpackage's ".x" is its own module
+                    if inside and node.level == 1:
+                        continue
+                    targets = [node.module] if node.module else [a.name for a in node.names]
+                    for t in targets:
+                        head = t.split(".")[0]
+                        name = head if head in files else head + "/"
+                        if name in files and name != mod:
+                            found.add(name)
+        deps[mod] = found
+    floor = {}
+
+    def level(mod, seen=()):
+        if mod not in floor:
+            if mod in seen:
+                raise ValueError(f"import cycle through {mod}")
+            floor[mod] = 1 + max((level(d, seen + (mod,)) for d in deps[mod]), default=0)
+        return floor[mod]
+
+    for mod in files:
+        level(mod)
+    out = {}
+    for mod, f in floor.items():
+        out.setdefault(f, []).append(mod)
+    return {f: sorted(out[f]) for f in sorted(out, reverse=True)}
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--markdown", action="store_true")
     ap.add_argument("--verbose", action="store_true", help="every .get with its line and receiver")
     ap.add_argument("--root", type=pathlib.Path, default=ROOT, help="another checkout (default: this one)")
+    ap.add_argument("--layers", action="store_true", help="the modules by floor of their imports")
     args = ap.parse_args(argv)
+    if args.layers:
+        for f, mods in layers(args.root).items():
+            print(f"{f:3d}  {', '.join(mods)}")
+        return 0
     c = census(args.root)
     total = lambda d: sum(d.values())  # noqa: E731
     gets = {}
