@@ -586,7 +586,7 @@ def _cold_other(scene, sysm, control, value, eps, **kw):
         if nxt.success:
             return None
         if is_point_load(states[-1]):  # a cold solve does not start from cur: smaller steps do not help it
-            return "point"
+            return "point-load limit"
         return "tip end" if passed_tip_end(nxt) else None
 
     steps = Steps(0.02, advance=lambda u, s, t: u + s if u + s <= _MARCH_DELTA_MAX else None,
@@ -599,7 +599,7 @@ def _cold_other(scene, sysm, control, value, eps, **kw):
                     f"continuation steps (delta reached {m.at:.3g}, {there})")
     if m.reason == "range":
         return fail(f"{control} = {value:g} was not reached on the branch for delta up to {m.at:.3g} ({there})")
-    if m.reason == "point":
+    if m.reason == "point-load limit":
         return fail(f"{control} = {value:g} not reached: the states up to delta = {m.at:.3g} are point-load "
                     f"limits ({there}) and no state was found at delta = {m.tried:.3g} ({m.failed.message})")
     if m.reason == "tip end":

@@ -164,8 +164,8 @@ def test_stopping_rules():
 
 def test_a_gent_curve_stops_where_the_material_locks():
     """Gent's energy diverges as (I1 - 3)/Jm -> 1: the curve stops with that reason once the
-    ratio passes continuation.GENT_LOCK (Jm 0.4 ran 400 steps into max_steps at delta 0.85)."""
-    from shellbvp.continuation import GENT_LOCK, gent_lock_ratio
+    ratio passes legs.GENT_LOCK (Jm 0.4 ran 400 steps into max_steps at delta 0.85)."""
+    from shellbvp.legs import GENT_LOCK, gent_lock_ratio
 
     c = sb.curve(sb.Scene.preset("base", material=sb.Gent(0.03)), delta_max=1.0, estimate_error=False)
     assert not c.complete and c.stop_reason.startswith("the Gent material locks")
@@ -317,23 +317,23 @@ def test_switch_search_stops_where_the_secant_puts_the_root_within_its_tolerance
 
 def test_the_plot_turn_is_the_angle_of_the_plotted_curve_whatever_the_force_scale():
     """The adaptive curve's refusal of a step that bends the plotted F(delta) too much
-    (continuation._plot_turn) measures the angle on axes scaled by delta_max and the largest
+    (legs.plot_turn) measures the angle on axes scaled by delta_max and the largest
     |F|: a force peak of a thin dome (F ~ 1e-4) turns as much as one of F ~ 1."""
     from types import SimpleNamespace as St
 
-    from shellbvp.continuation import MAX_PLOT_TURN, _plot_turn
+    from shellbvp.legs import MAX_PLOT_TURN, plot_turn
 
     for f in (1.0, 1e-4):
         up, top, down = St(delta=0.15, force=0.5 * f), St(delta=0.2, force=1.0 * f), St(delta=0.25, force=0.5 * f)
         # chords (0.1, 0.5) and (0.1, -0.5) on the scaled axes
-        assert _plot_turn(up, top, down, 0.5, f) == pytest.approx(2 * np.arctan2(0.5, 0.1), rel=1e-12)
-        assert _plot_turn(up, top, down, 0.5, f) > MAX_PLOT_TURN
+        assert plot_turn(up, top, down, 0.5, f) == pytest.approx(2 * np.arctan2(0.5, 0.1), rel=1e-12)
+        assert plot_turn(up, top, down, 0.5, f) > MAX_PLOT_TURN
         straight = St(delta=0.25, force=1.5 * f)
-        assert _plot_turn(up, top, straight, 0.5, f) == pytest.approx(0.0, abs=1e-7)
+        assert plot_turn(up, top, straight, 0.5, f) == pytest.approx(0.0, abs=1e-7)
     # with F's own unit (as in the arclength's (delta, lambda0, F)) the thin dome's peak is a turn
     # of 0.002 rad: its chords are nearly parallel
     up, top, down = St(delta=0.15, force=0.5e-4), St(delta=0.2, force=1e-4), St(delta=0.25, force=0.5e-4)
-    assert _plot_turn(up, top, down, 1.0, 1.0) == pytest.approx(2e-3, rel=1e-3)
+    assert plot_turn(up, top, down, 1.0, 1.0) == pytest.approx(2e-3, rel=1e-3)
 
 
 def test_a_curve_file_with_si_columns_plots_in_mm_and_mn(tmp_path):

@@ -116,13 +116,13 @@ def test_spheroidal_dome_pairs_with_its_bowl():
 
 
 # in the default suite (~26 s): marked slow, it failed unseen until 69c371e, after the adaptive
-# curve's steps moved (a force maximum of F ~ 1e-4 stepped over; continuation.MAX_PLOT_TURN)
+# curve's steps moved (a force maximum of F ~ 1e-4 stepped over; legs.MAX_PLOT_TURN)
 def test_dome_snaps_at_a_fold_in_delta():
     """Past its force maximum (F 3.28e-4 near delta 0.169) the dome's branch turns back in
     delta at 0.18289 (F about 1.4e-4): under displacement control it snaps there.  Natural
     continuation stops at the fold and says so; arclength continuation (the cap branch, its
     caps of 1e-12 .. 1e-5 flagged as pulling) resolves the force maximum (its steps follow
-    the turning of the plotted curve, continuation.MAX_PLOT_TURN: before, it stepped over the
+    the turning of the plotted curve, legs.MAX_PLOT_TURN: before, it stepped over the
     maximum, 2.93e-4 to 2.96e-4) and reaches the fold.  Whether it goes on round the fold
     depends on where its steps land (it did at coarser steps; now Newton overflows as the caps
     collapse below 1e-9, at the fold): past it, if it goes on, delta and F fall."""

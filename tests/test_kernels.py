@@ -367,7 +367,7 @@ def test_a_long_curve_starts_the_compiled_kernels_at_once(kw, starts, monkeypatc
             calls.append(1)
 
     monkeypatch.setattr(sc, "kernel_set", lambda model, structure: Recorder())
-    monkeypatch.setattr(sc, "_adaptive", lambda *a: iter(()))  # the decision only: legs with no state
-    monkeypatch.setattr(sc, "_natural", lambda *a: iter(()))
+    monkeypatch.setattr(sc, "adaptive", lambda *a: iter(()))  # the decision only: legs with no state
+    monkeypatch.setattr(sc, "natural", lambda *a: iter(()))
     sb.curve(SCENES["base"], **kw)
     assert calls == ([1] if starts else [])
