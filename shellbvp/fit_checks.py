@@ -1,0 +1,205 @@
+"""The checks a fit passes and the words it is judged by: its statuses and warnings, the
+trend and runs tests on the data and residuals, the diagnostics of the covariance, and the
+rating of a fit's quality (good, fair, poor)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from scipy import special
+
+__all__ = ["FIT_STATUS", "FIT_WARNINGS", "PLAUSIBLE_MU_H", "TREND_P", "RUNS_P", "RUNS_MIN_POINTS", "QUALITY_RULES",
+           "rank_trend", "runs_test", "runs_in_depth_order", "fit_diagnostics", "fit_quality", "diagnostics_lines",
+           "check_result"]
+
+
+#: Outcomes of a fit that ran (``FitResult.status``); ``success`` is ``status == 0``.
+#: Data the fit cannot use at all raise ``ValueError`` before any model curve is computed.
+FIT_STATUS = {
+    0: "the fit converged and passed its checks",
+    1: "the least-squares solver did not converge",
+    2: "the fitted mu*H is not positive",
+    3: "the model force is not finite at every data point",
+    4: "a 95 % interval (mu*H or the offset) is not finite",
+    5: "the 95 % interval of mu*H is wider than mu*H itself: the data do not determine mu*H",
+}
+
+
+#: Kinds of warning (``FitResult.warning_codes``; the texts are in ``FitResult.warnings``).
+FIT_WARNINGS = {
+    "residual_runs": "the residuals' signs form long runs (runs test): the model does not follow the data",
+    "implausible_mu_H": "mu*H is far outside the values of soft shells (PLAUSIBLE_MU_H): check the units",
+    "search_range": "a shape parameter's interval or search reached the end of its range",
+    "max_curves": "the number of model curves reached its limit",
+    "mixed_segments": "the fitted rows mix the loading and the retraction of an instrument record",
+    "several_loadings": "the record holds more than one loading pass; one was fitted, the others left out",
+}
+
+
+#: mu*H (N/m) of soft shells, from red-cell membranes (~1e-5) to thick rubber (~1e4); a fit
+#: outside this range gets a warning (a header in kN for data in mN gives 1e6 x the truth).
+PLAUSIBLE_MU_H = (1e-6, 1e5)
+
+
+#: One-sided p-value below which the force counts as not increasing with depth (Spearman).
+TREND_P = 0.01
+
+
+#: One-sided p-value of the runs test below which the residual pattern is a warning, and the
+#: least number of points for the test.
+RUNS_P = 1e-3
+
+
+RUNS_MIN_POINTS = 10
+
+
+def _average_ranks(x):
+    """Ranks 1..n of ``x``, ties given the mean of the ranks they share."""
+    _, inverse, counts = np.unique(x, return_inverse=True, return_counts=True)
+    return (np.cumsum(counts) - (counts - 1) / 2.0)[inverse]
+
+
+def rank_trend(d, f):
+    """Spearman's rank correlation of ``f`` with ``d`` and its one-sided p-values for an increase
+    and for a decrease, by the t approximation (as ``scipy.stats.spearmanr``)."""
+    rho = np.corrcoef(_average_ranks(d), _average_ranks(f))[0, 1]  # (a numpy float: 1/0 is inf)
+    dof = d.size - 2
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t = rho * np.sqrt(np.clip(dof / ((rho + 1.0) * (1.0 - rho)), 0, None))
+    return float(rho), float(special.stdtr(dof, -t)), float(special.stdtr(dof, t))
+
+
+def runs_test(residual):
+    """One-sided Wald–Wolfowitz runs test for too few runs of signs (a systematic misfit).
+
+    Parameters
+    ----------
+    residual : array_like
+        Residuals in the order of the data (by displacement); zeros are skipped.
+
+    Returns
+    -------
+    runs : int
+        Number of runs of equal sign.
+    p : float
+        P(so few runs or fewer) for independent signs (normal approximation).
+    """
+    sgn = np.sign(np.asarray(residual, float))
+    sgn = sgn[sgn != 0]
+    n1, n2 = int(np.sum(sgn > 0)), int(np.sum(sgn < 0))
+    n = n1 + n2
+    runs = 1 + int(np.sum(sgn[1:] != sgn[:-1])) if n else 0
+    if n1 == 0 or n2 == 0:
+        return runs, float(0.5 ** max(n - 1, 0))  # every sign the same
+    mean = 2.0 * n1 * n2 / n + 1
+    var = (mean - 1) * (mean - 2) / (n - 1)
+    return runs, float(special.ndtr((runs + 0.5 - mean) / math.sqrt(var))) if var > 0 else 1.0
+
+
+def runs_in_depth_order(resid, disp):
+    """``(runs, p)`` of :func:`runs_test` on the residuals in depth order (signs only: weights do
+    not matter); None for too few points or a non-finite residual."""
+    if resid.size < RUNS_MIN_POINTS or not np.all(np.isfinite(resid)):
+        return None
+    return runs_test(resid[np.argsort(disp, kind="stable")])
+
+
+def fit_diagnostics(cov, rss, n, k, weighted_resid, disp, runs) -> dict:
+    """The fit's correlation matrix (order of ``fitted``), the noise scale, AIC and BIC and two
+    residual diagnostics (the runs test's p, ``runs``, and the lag-1 autocorrelation in depth order)."""
+    corr = None
+    if cov is not None and np.all(np.isfinite(cov)):
+        sd = np.sqrt(np.diag(cov))
+        if np.all(sd > 0):
+            corr = np.clip(cov / np.outer(sd, sd), -1.0, 1.0)
+    dof = max(n - k, 1)
+    out = {"correlation": corr, "noise_sigma": float(math.sqrt(rss / dof)) if rss >= 0 else float("nan"),
+           "aic": float("nan"), "bic": float("nan"), "runs_p": float("nan"), "residual_autocorrelation": float("nan")}
+    if rss > 0 and n > 0:  # Gaussian with the noise model's relative weights and an estimated scale (k + 1)
+        ll = n * math.log(rss / n)
+        out["aic"], out["bic"] = float(ll + 2 * (k + 1)), float(ll + (k + 1) * math.log(n))
+    if runs is not None:
+        out["runs_p"] = runs[1]
+        c = np.asarray(weighted_resid, float)[np.argsort(disp, kind="stable")]
+        c = c - c.mean()
+        if np.dot(c, c) > 0:
+            out["residual_autocorrelation"] = float(np.dot(c[1:], c[:-1]) / np.dot(c, c))
+    return out
+
+
+#: Rules of :func:`fit_quality`: mu*H's 95 % half-width relative to mu*H for "good" and "fair",
+#: the largest absolute correlation of mu*H with another fitted parameter for "good".
+QUALITY_RULES = {"good_halfwidth": 0.05, "fair_halfwidth": 0.20, "good_correlation": 0.98}
+
+
+def fit_quality(success, warning_codes, mu_H, mu_ci, correlation=None, fitted=()) -> str:
+    """A transparent rating of one fit: ``good``, ``fair`` or ``poor``.
+
+    * poor: the fit failed its checks, or mu*H's 95 % interval is wider than +-20 % of it;
+    * good: succeeded without warnings, the interval within +-5 %, and mu*H not correlated with
+      another fitted parameter beyond abs(r) = 0.98 (then the data cannot tell them apart);
+    * fair: everything between.
+
+    The rules are :data:`QUALITY_RULES`; nanite rates curves with a trained regressor instead.
+    """
+    if not success or not (mu_H > 0) or not all(math.isfinite(v) for v in mu_ci):
+        return "poor"
+    half = (mu_ci[1] - mu_ci[0]) / 2 / mu_H
+    if half > QUALITY_RULES["fair_halfwidth"]:
+        return "poor"
+    r = 0.0
+    if correlation is not None and "mu_H" in fitted and len(fitted) > 1:
+        i = list(fitted).index("mu_H")
+        row = np.abs(np.delete(np.asarray(correlation, float)[i], i))
+        r = float(np.nanmax(row)) if row.size else 0.0
+    if not warning_codes and half <= QUALITY_RULES["good_halfwidth"] and r <= QUALITY_RULES["good_correlation"]:
+        return "good"
+    return "fair"
+
+
+def diagnostics_lines(quality, fitted, correlation, values, show_force=lambda v: f"{v:.4g} N") -> list:
+    """Two lines for a fit's summary: its quality rating and its diagnostics (``values``: noise_sigma,
+    aic, bic, runs_p, residual_autocorrelation)."""
+    rules = (f"rules: mu*H's 95 % interval within +-{100 * QUALITY_RULES['good_halfwidth']:g} % (good) or "
+             f"+-{100 * QUALITY_RULES['fair_halfwidth']:g} % (fair), no warnings, |corr(mu_H, .)| <= "
+             f"{QUALITY_RULES['good_correlation']:g}")
+    parts = []
+    if math.isfinite(values.get("noise_sigma", math.nan)):
+        parts.append(f"noise {show_force(values['noise_sigma'])}")
+    if math.isfinite(values.get("aic", math.nan)):
+        parts.append(f"AIC {values['aic']:.1f}, BIC {values['bic']:.1f}")
+    if math.isfinite(values.get("runs_p", math.nan)):
+        parts.append(f"runs test p = {values['runs_p']:.2g}, lag-1 autocorrelation "
+                     f"{values['residual_autocorrelation']:.2f}")
+    if correlation is not None and len(fitted) > 1:
+        c = np.asarray(correlation, float)
+        parts += [f"corr({a}, {b}) = {c[i, j]:+.2f}" for i, a in enumerate(fitted) for j, b in enumerate(fitted)
+                  if i < j]
+    return [f"quality = {quality} ({rules})", "diagnostics = " + ("; ".join(parts) if parts else "none")]
+
+
+def check_result(res_ok, mu_H, mu_ci, off_ci, resid_ok, n, runs):
+    """Status and warnings of a fitted result (see :data:`FIT_STATUS`, :data:`FIT_WARNINGS`)."""
+    warnings = []
+    if not res_ok:
+        status = 1
+    elif not mu_H > 0:
+        status = 2
+    elif not resid_ok:
+        status = 3
+    elif not all(math.isfinite(v) for v in (*mu_ci, *off_ci)):
+        status = 4
+    elif mu_ci[1] - mu_ci[0] > mu_H:
+        status = 5
+    else:
+        status = 0
+    if runs is not None and runs[1] < RUNS_P:
+        warnings.append(("residual_runs", f"the residuals' signs form {runs[0]} runs over {n} points "
+                         f"(runs test p = {runs[1]:.2g} < {RUNS_P:g}): a pattern the noise model does not explain; "
+                         "the model (scene, contact point, weights) does not follow the data"))
+    lo, hi = PLAUSIBLE_MU_H
+    if status != 2 and math.isfinite(mu_H) and not lo <= mu_H <= hi:
+        warnings.append(("implausible_mu_H", f"mu*H = {mu_H:.3g} N/m is far outside the range of soft shells "
+                         f"({lo:g} to {hi:g} N/m): check the units of the data (header or --units) and R_L"))
+    return status, warnings
