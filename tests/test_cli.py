@@ -195,3 +195,12 @@ def test_depths_and_forces_in_lab_units_are_made_nondimensional_by_the_scales(tm
     r = run("curve", "--delta-max", "60um", "--points", "2", "--radius", "0.3mm", "--muH", "52N/m", "-o", str(out), "-q")
     assert r.returncode == 0, r.stderr
     assert sb.read_curve(out).delta[-1] == pytest.approx(0.2, rel=1e-9)
+
+
+def test_validate_takes_its_depth_in_lab_units_with_the_rim_radius(tmp_path):
+    """validate --delta-max 1mm with --radius 0.3mm is 3.33 rim radii: refused by its range, in
+    rim radii, before the 3D model is built; without --radius the unit is refused by name."""
+    r = run("validate", "--thickness", "0.05", "--delta-max", "1mm", "--radius", "0.3mm", cwd=tmp_path)
+    assert r.returncode == 2 and "--delta-max must be in (0, 2]; got 3.33333" in r.stderr, r.stderr
+    r = run("validate", "--thickness", "0.05", "--delta-max", "100um", cwd=tmp_path)
+    assert r.returncode == 2 and "--delta-max 100 um needs --radius" in r.stderr, r.stderr

@@ -2,9 +2,8 @@
 
 from __future__ import annotations
 
-
 from .common import (
-    add_overwrite_option, add_scene_options, free_default_name, plain_number, plain_numbers, quantity,
+    add_overwrite_option, add_scene_options, free_default_name, nondimensional, number_or, plain_numbers, quantity,
     scene_from_args,
 )
 
@@ -16,11 +15,12 @@ def add_parser(sub):
     v = sub.add_parser("validate", help="the shell model against a 3D finite-element model of the same scene "
                        "(needs FElupe: pip install 'shellbvp[fe]')")
     add_scene_options(v)
-    v.add_argument("--delta-max", type=plain_number, default=0.5, dest="delta_max",
-                   help="largest pole displacement (default 0.5); the depths are delta/H = 0.25, 0.5, 1, 2, 5, "
-                        "10, 25 below it and delta-max")
+    v.add_argument("--delta-max", type=number_or("length"), default=0.5, dest="delta_max",
+                   help="largest pole displacement (default 0.5, in rim radii; with a unit, 90um, it needs --radius); "
+                        "the depths are delta/H = 0.25, 0.5, 1, 2, 5, 10, 25 below it and delta-max")
     v.add_argument("--deltas", help="these pole displacements instead, comma-separated (/R_L)")
-    v.add_argument("--radius", "--rim-radius", type=quantity("length"), help="rim radius with its unit, for --thickness with a unit")
+    v.add_argument("--radius", "--rim-radius", type=quantity("length"),
+                   help="rim radius with its unit, for --thickness and --delta-max with a unit")
     v.add_argument("--mesh-check", action="store_true", dest="mesh_check",
                    help="also solve the 3D model on a coarser mesh and report the difference (~1.5x the time)")
     v.add_argument("-o", "--output", help="output file (default <preset>-validate.h5, or -2, ... if that exists)")
@@ -34,6 +34,7 @@ def run(args):
     from ..validation import validate
 
     scene = scene_from_args(args)
+    args.delta_max = nondimensional(args, args.delta_max, "--delta-max")
     if scene.thickness is None:
         raise ValueError("validate needs --thickness (H/R_L, or with a unit and --radius)")
     if scene.pressurised:
