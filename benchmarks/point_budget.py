@@ -93,7 +93,7 @@ class Timers:
         import scipy.integrate._bvp as bvp
 
         import shellbvp.chain
-        import shellbvp.continuation
+        import shellbvp.recorder
         import shellbvp.steps
         import shellbvp.state
         from shellbvp.kernels import kernel_set
@@ -104,7 +104,7 @@ class Timers:
         for name in ("construct_global_jac", "splu"):
             self.wrap(bvp, name, LINALG)
         self.wrap(shellbvp.state, "diagnose", DIAGNOSIS)
-        self.wrap(shellbvp.continuation, "richardson_error", ESTIMATES)
+        self.wrap(shellbvp.recorder, "richardson_error", ESTIMATES)
         self.wrap(shellbvp.steps, "quadratic_guess", PREDICTOR)
         active = kernel_set(scene.model(), scene.structure).active
         model = scene.model()

@@ -174,11 +174,11 @@ def test_a_cold_solve_past_the_limit_finds_the_corner(base_curve):
 def test_without_a_corner_the_curve_stops_at_the_limit_at_once(monkeypatch):
     """If no corner state is found past the limit, the curve stops there with the reason after
     one failed step, instead of halving its step many times (the old 40-50 s stall)."""
-    import shellbvp.continuation as cont
+    import shellbvp.legs as legs
     import shellbvp.steps as steps
 
     failed = []
-    solve = cont.solve_from
+    solve = legs.solve_from
 
     def counted(*a, **k):
         sol = solve(*a, **k)
@@ -186,7 +186,7 @@ def test_without_a_corner_the_curve_stops_at_the_limit_at_once(monkeypatch):
             failed.append(sol.delta)
         return sol
 
-    for module in (cont, steps):  # the curve's arclength steps and its delta steps
+    for module in (legs, steps):  # the curve's arclength steps and its delta steps
         monkeypatch.setattr(module, "cross_convexity_limit", lambda *a, **k: None)
         monkeypatch.setattr(module, "solve_from", counted)
     c = sb.curve(BASE, delta_max=1.0, delta_start=0.55, estimate_error=False, topology="cap")
