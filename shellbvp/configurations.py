@@ -70,6 +70,11 @@ class Configuration:
     line_contact : bool
         Its outer contact on the tip is one circle carrying a ring force (zero width), whose
         ``curvature_excess`` says when it opens into a band.
+    measured : (str, str) or None
+        Where a switch criterion is measured on this configuration (``SWITCHES``), how to get
+        its state: ``"module:function"`` of ``state_at(recorded, name, settings)``, its state
+        at a recorded point's depth (None if there is none), and of ``solved_at(scene, name,
+        delta, near, settings)``, its state at another depth from a neighbour.
     pole_branch_end : bool
         A smooth lifted pole whose branch may end where its Legendre determinant vanishes
         (:mod:`shellbvp.lifted_ends`).
@@ -86,6 +91,7 @@ class Configuration:
     inner_edge: bool = False
     line_contact: bool = False
     pole_branch_end: bool = False
+    measured: tuple | None = None
 
     @property
     def single_cap(self) -> bool:
@@ -191,10 +197,12 @@ def _lifted(chain):
 _LIFTED_AGAIN = "shellbvp.liftoff:lifted_again"
 _SPLIT_AGAIN = "shellbvp.liftoff:split_again"
 _WALL_AGAIN = "shellbvp.cylinder:wall_again"
-register(Configuration("cap", "cap", ch.cap_chain, controls=("delta", "force", "lambda0", "arclength"), askable=True))
+register(Configuration("cap", "cap", ch.cap_chain, controls=("delta", "force", "lambda0", "arclength"), askable=True,
+                       measured=("shellbvp.switches:cap_state_at", "shellbvp.switches:cap_solved_at")))
 register(Configuration("point", "point", lambda eps, L, edge: ch.point_chain(POINT_S0, L), controls=("delta",)))
 register(Configuration("line", "lifted", _lifted(ch.line_chain), contacts=("smooth",), askable=True,
-                       again=_LIFTED_AGAIN, line_contact=True, pole_branch_end=True))
+                       again=_LIFTED_AGAIN, line_contact=True, pole_branch_end=True,
+                       measured=("shellbvp.switches:line_state_at", "shellbvp.switches:lifted_solved_at")))
 register(Configuration("annulus", "lifted", _lifted(ch.annulus_chain), contacts=("smooth",), askable=True,
                        again=_LIFTED_AGAIN, inner_edge=True, pole_branch_end=True))
 register(Configuration("cap+line(tip)", "split", _lifted(ch.cap_line_tip_chain), contacts=("smooth",),
@@ -202,7 +210,8 @@ register(Configuration("cap+line(tip)", "split", _lifted(ch.cap_line_tip_chain),
 register(Configuration("cap+band(tip)", "split", _lifted(ch.cap_band_tip_chain), contacts=("smooth",),
                        again=_SPLIT_AGAIN))
 register(Configuration("cap+line(cylinder)", "wall", ch.cap_line_cylinder_chain, contacts=("smooth",), askable=True,
-                       needs_tip_end=True, again=_WALL_AGAIN))
+                       needs_tip_end=True, again=_WALL_AGAIN,
+                       measured=("shellbvp.switches:wall_state_at", "shellbvp.switches:wall_solved_at")))
 register(Configuration("cap+band(cylinder)", "wall", ch.cap_band_cylinder_chain, contacts=("smooth",), askable=True,
                        needs_tip_end=True, again=_WALL_AGAIN))
 register(Configuration("cap+cylinder", "wall", ch.cylinder_chain, askable=True, needs_tip_end=True,

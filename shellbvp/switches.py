@@ -10,14 +10,15 @@ import math
 
 import numpy as np
 
-from .configurations import is_single_cap, names, switch_between
+from .configurations import configuration, is_single_cap, names, resolve, switch_between
 from .corner import edge_model, is_corner, limit_estimate
 from .cylinder import wall_state
 from .liftoff import liftoff_state, pole_clearance, solve_liftoff
 from .state import cross_convexity_limit, solve_from, system_like, warm_guess
 from .steps import solve_at_delta, step_nodes
 
-__all__ = ["locate_switches", "locate_corner_switch", "regula_falsi", "cap_of", "line_state_at"]
+__all__ = ["locate_switches", "locate_corner_switch", "regula_falsi", "cap_of", "line_state_at", "cap_state_at",
+           "cap_solved_at", "wall_state_at", "wall_solved_at", "lifted_solved_at"]
 
 log = logging.getLogger(__name__)
 
@@ -104,18 +105,12 @@ def locate_switches(builder, st):
         sol = cap_at(d, near)
         return (sol, sol.tip_end_margin) if sol.status in (0, 4) else (None, None)
 
-    def line_at(d, near):
-        return solve_liftoff(scene, "line", delta=d, guess=near, tol=st["tol"], max_nodes=st["max_nodes"],
-                             bc_tol=st["bc_tol"])
+    def state_of(on, s):  # the measured configuration's state at a recorded point's depth
+        return resolve(configuration(on).measured[0])(s, on, st)
 
-    def wall_line_at(d, near):
-        return wall_state(near, "cap+line(cylinder)", control="delta", value=d, tol=st["tol"],
-                          max_nodes=st["max_nodes"], bc_tol=st["bc_tol"])
-
-    # a configuration's state at a recorded point's depth, and solved at another depth from a neighbour
-    state_of = {"cap": cap_of, "line": lambda s: line_state_at(s, st),
-                "cap+line(cylinder)": lambda s: _wall_line_at(s, st)}
-    solve_on = {"cap": cap_at, "line": line_at, "cap+line(cylinder)": wall_line_at}
+    def solve_on(on):  # ... and solved at another depth from a neighbour
+        solve = resolve(configuration(on).measured[1])
+        return lambda d, near: solve(scene, on, d, near, st)
 
     for (k1, _, _, s1), (k2, _, _, s2) in zip(rows[:-1], rows[1:]):
         c1, c2 = cap_of(s1), cap_of(s2)
@@ -137,7 +132,7 @@ def locate_switches(builder, st):
         if not (s1.valid and s2.valid) or switch is None:
             continue
         on = switch.measured_on
-        ends = [s if s.topology == on else state_of[on](s) for s in (s1, s2)]
+        ends = [s if s.topology == on else state_of(on, s) for s in (s1, s2)]
         if switch.criteria == ("pole_clearance",):
             ends = [_with_pole_clearance(e) for e in ends]
             if any(e is None for e in ends) or not ends[0].pole_clearance * ends[1].pole_clearance < 0:
@@ -157,7 +152,7 @@ def locate_switches(builder, st):
         if not f1 * f2 < 0:
             continue
 
-        def solve_at(d, near, solve=solve_on[on], criterion=criterion, sign=switch.sign):
+        def solve_at(d, near, solve=solve_on(on), criterion=criterion, sign=switch.sign):
             sol = solve(d, near)
             usable = sol.status in (0, 4) if criterion == "tip_end_margin" else sol.success
             if usable and criterion == "pole_clearance":
@@ -232,10 +227,30 @@ def locate_corner_switch(smooth, corner, st, h=0.003):
             "jump_ls_after": float(corner.edge_jump_ls)}
 
 
-def _wall_line_at(sol, st):
-    """The cap+line(cylinder) state at a band point's delta (from the band), or None."""
-    line = wall_state(sol, "cap+line(cylinder)", tol=st["tol"], max_nodes=st["max_nodes"], bc_tol=st["bc_tol"])
+# -- how a switch criterion is measured on a configuration (``Configuration.measured``) ---------
+def cap_state_at(sol, topology, st):
+    """The single cap at a recorded point's depth (itself, or the cap it replaced)."""
+    return cap_of(sol)
+
+
+def cap_solved_at(scene, topology, d, near, st):
+    return solve_at_delta(scene, d, near, None, st)
+
+
+def wall_state_at(sol, topology, st):
+    """The ``topology`` wall state at a recorded wall point's delta (from it), or None."""
+    line = wall_state(sol, topology, tol=st["tol"], max_nodes=st["max_nodes"], bc_tol=st["bc_tol"])
     return line if line.success and not math.isnan(line.curvature_excess) else None
+
+
+def wall_solved_at(scene, topology, d, near, st):
+    return wall_state(near, topology, control="delta", value=d, tol=st["tol"], max_nodes=st["max_nodes"],
+                      bc_tol=st["bc_tol"])
+
+
+def lifted_solved_at(scene, topology, d, near, st):
+    return solve_liftoff(scene, topology, delta=d, guess=near, tol=st["tol"], max_nodes=st["max_nodes"],
+                         bc_tol=st["bc_tol"])
 
 
 def _touchdown_bracket(states, delta):
@@ -260,16 +275,16 @@ def _with_pole_clearance(line):
     return line
 
 
-def line_state_at(sol, st):
-    """The line state at a lift-off point's delta (the one its search converged, else from its
-    cap), or None."""
+def line_state_at(sol, topology, st):
+    """The line state (``topology``) at a lift-off point's delta (the one its search converged,
+    else from its cap), or None."""
     line = sol.line_state
     if line is not None and line.success and not math.isnan(line.curvature_excess) and line.delta == sol.delta:
         return line
     cap = cap_of(sol)
     if cap is None:
         return None
-    line = liftoff_state(cap, "line", tol=st["tol"], max_nodes=st["max_nodes"], bc_tol=st["bc_tol"])
+    line = liftoff_state(cap, topology, tol=st["tol"], max_nodes=st["max_nodes"], bc_tol=st["bc_tol"])
     return line if line.success and not math.isnan(line.curvature_excess) else None
 
 

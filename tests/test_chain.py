@@ -282,4 +282,7 @@ def test_every_switch_joins_registered_configurations_on_a_field_of_their_states
         assert {a, b} <= set(cf.CONFIGURATION_NAMES) and sw.measured_on in sw.between
         assert set(sw.criteria) <= fields and sw.sign in (1.0, -1.0)
         assert cf.switch_between(a, b) is sw is cf.switch_between(b, a)
+        # the configuration measured on says how its state is found at and near a point
+        state_at, solved_at = cf.configuration(sw.measured_on).measured
+        assert callable(cf.resolve(state_at)) and callable(cf.resolve(solved_at))
     assert cf.switch_between("cap", "cap") is None and cf.switch_between("point", "line") is None

@@ -303,7 +303,7 @@ def test_where_the_lines_pole_is_down_the_split_is_tried_before_the_annulus(monk
     assert line_here.topology == "line" and line_here.delta == split.delta and not line_here.valid
     from shellbvp.switches import line_state_at as _line_state_at
 
-    assert _line_state_at(split, {}) is line_here  # (no settings needed: nothing is solved)
+    assert _line_state_at(split, "line", {}) is line_here  # (no settings needed: nothing is solved)
     monkeypatch.setattr(OPTIONS, "split_first", False)
     again, tried_old = lo.valid_liftoff_state(cap, previous=line, last=line)
     assert [t.split(":")[0] for t in tried_old] == ["line", "annulus"], tried_old
