@@ -21,8 +21,9 @@ Discretisation: Rayleigh-Ritz with cubic Hermite elements (C^1) for all three of
 uniform mesh in S from ``S0`` to the rim.  The form holds ``u''`` and ``v''`` only multiplied
 by lower derivatives; C^1 fields make it the exact energy of the discrete fields, so no
 integration by parts is needed and the computed eigenvalues are upper bounds of the exact
-ones (to quadrature error: 6 Gauss points per element).  The smallest eigenvalues come from a
-dense generalised symmetric solver (``scipy.linalg.eigh``, a subset by index).
+ones (to quadrature error: 6 Gauss points per element).  The smallest eigenvalues come from
+shift-invert Lanczos (``scipy.sparse.linalg.eigsh``) about a shift that a banded Cholesky
+factorisation certifies to lie below the spectrum.
 
 Boundary conditions (states without contact: the inflated/pressurised shell):
 
@@ -61,9 +62,14 @@ from dataclasses import dataclass, field
 
 import numpy as np
 import scipy.linalg
+import scipy.sparse
+import scipy.sparse.linalg
 import sympy as sp
 
-__all__ = ["stability", "Stability", "default_modes", "default_elements"]
+from .geometry import Spheroid
+
+__all__ = ["stability", "Stability", "spectrum", "state_base", "sphere_base", "mesh", "default_modes",
+           "default_elements", "END_CONDITIONS", "sphere_stretch"]
 
 #: Gauss points per element.
 GAUSS = 6
@@ -155,6 +161,22 @@ def _form_functions(scene):
     return _numeric_form(json.dumps(scene.structure(), sort_keys=True))
 
 
+def state_base(state):
+    """The base state of ``state`` as a function of S: a dict of ``phi, ls, ks, dls, dks, lt``
+    from the inflated state's interpolant (``dls, dks`` its S-derivatives)."""
+    return functools.partial(_base_state, state)
+
+
+def sphere_base(stretch: float):
+    """The uniformly stretched sphere ``r = stretch sin S`` of the reference hemisphere (gamma = 1)
+    as a base state (no rim layer): the membrane state of a complete sphere under pressure."""
+    def base(S):
+        one = np.ones_like(S)
+        return {"phi": S.copy(), "ls": stretch * one, "ks": one / stretch, "dls": 0 * S, "dks": 0 * S,
+                "lt": stretch * one}
+    return base
+
+
 def _base_state(state, S):
     """The base symbols' values at S (dict by name) from an inflated state's interpolant."""
     sysm = state.system
@@ -166,13 +188,13 @@ def _base_state(state, S):
     return {"phi": phiS * S, "ls": ls, "ks": ks, "dls": dy[2], "dks": dy[3], "lt": lt}
 
 
-def _form_at(scene, state, S, n):
+def _form_at(scene, base_of, S, n):
     """The 9 x 9 form at the points S (shape (9, 9, len(S))) for mode n."""
     f, upper, params, shell_params, ref = _form_functions(scene)
     values = scene.values()
     R, Psi, dPsi, ks0, kt0 = (np.broadcast_to(np.asarray(v, float), S.shape)
                               for v in ref(S, *[values[p] for p in shell_params]))
-    base = _base_state(state, S)
+    base = base_of(S)
     r = base["lt"] * R
     args = (r, base["phi"], base["ls"], base["ks"], base["dls"], base["dks"], R, Psi, dPsi, ks0, kt0,
             *[values[p] for p in params], n)
@@ -196,32 +218,85 @@ def _hermite(xi, h):
     return H, dH, ddH
 
 
-def _assemble(scene, state, n, nodes):
-    """Stiffness K (4 x the form) and Gram M of (u, v, w) on the Hermite mesh, dense.
+def _assemble(scene, base_of, n, nodes):
+    """Stiffness K (4 x the form) and Gram M of (u, v, w) on the Hermite mesh (sparse CSR).
 
     Global dofs: per node ``(u, u', v, v', w, w')``, node-major; derivative dofs times the
     largest element length (so all dofs have the size of the fields)."""
     m = nodes.size
     ndof = 6 * m
-    K = np.zeros((ndof, ndof))
-    M = np.zeros((ndof, ndof))
     xg, wg = np.polynomial.legendre.leggauss(GAUSS)
     xg, wg = (xg + 1) / 2, wg / 2
     h = np.diff(nodes)
     S = (nodes[:-1, None] + h[:, None] * xg[None, :]).ravel()
-    A, area = _form_at(scene, state, S, n)
+    A, area = _form_at(scene, base_of, S, n)
     A = A.reshape(9, 9, m - 1, GAUSS)
     area = area.reshape(m - 1, GAUSS)
     hs = h.max()  # scale of the derivative dofs
-    for e in range(m - 1):
-        B = _element_basis(xg, h[e], hs)  # (9, 12, GAUSS)
-        Gval = B[[0, 3, 6]]  # (3, 12, GAUSS): u, v, w
-        idx = 6 * e + np.arange(12)
-        Ke = np.einsum("iag,ijg,jbg,g->ab", B, A[:, :, e, :], B, wg * h[e])
-        Me = np.einsum("iag,ibg,g->ab", Gval, Gval, wg * h[e] * area[e])
-        K[np.ix_(idx, idx)] += 4 * Ke
-        M[np.ix_(idx, idx)] += Me
+    B = np.stack([_element_basis(xg, he, hs) for he in h])  # (elements, 9, 12, GAUSS)
+    weights = wg[None, :] * h[:, None]
+    Ke = 4 * np.einsum("eiag,ijeg,ejbg,eg->eab", B, A, B, weights, optimize=True)
+    G = B[:, [0, 3, 6]]
+    Me = np.einsum("eiag,eibg,eg->eab", G, G, weights * area, optimize=True)
+    idx = 6 * np.arange(m - 1)[:, None] + np.arange(12)[None, :]
+    rows = np.broadcast_to(idx[:, :, None], Ke.shape).ravel()
+    cols = np.broadcast_to(idx[:, None, :], Ke.shape).ravel()
+    K = scipy.sparse.csr_matrix((Ke.ravel(), (rows, cols)), shape=(ndof, ndof))
+    M = scipy.sparse.csr_matrix((Me.ravel(), (rows, cols)), shape=(ndof, ndof))
     return K, M
+
+
+def _banded(A, bandwidth):
+    """The upper band of a symmetric sparse matrix in LAPACK's banded storage."""
+    coo = scipy.sparse.triu(A).tocoo()
+    ab = np.zeros((bandwidth + 1, A.shape[0]))
+    ab[bandwidth + coo.row - coo.col, coo.col] = coo.data
+    return ab
+
+
+def _smallest(K, M, count):
+    """The ``count`` smallest eigenvalues (and vectors) of K q = lambda M q, K symmetric, M
+    positive definite, both banded sparse: shift-invert Lanczos (``eigsh``) about a shift below
+    the spectrum, which a banded Cholesky factorisation of ``K - sigma M`` certifies (it
+    exists only when ``K - sigma M`` is positive definite)."""
+    coo = K.tocoo()
+    bandwidth = int(np.max(np.abs(coo.row - coo.col)))
+    Kb, Mb = _banded(K, bandwidth), _banded(M, bandwidth)
+
+    def factor(sigma):
+        try:
+            return scipy.linalg.cholesky_banded(Kb - sigma * Mb)
+        except np.linalg.LinAlgError:
+            return None
+
+    # bracket the smallest eigenvalue between a shift that factorises (below it) and one that
+    # does not, then bisect: Lanczos about a shift just below the spectrum converges fast
+    lo, hi, step = 0.0, None, 1.0
+    if factor(lo) is None:
+        hi = lo
+        while factor(lo) is None:
+            lo, step = lo - step, 4 * step
+            if step > 1e30:
+                raise RuntimeError("no shift below the spectrum found")
+    else:
+        hi = step
+        while factor(hi) is not None:
+            lo, hi, step = hi, hi + 4 * step, 4 * step
+    for _ in range(60):
+        if hi - lo <= 1e-3 * max(1.0, abs(lo)):
+            break
+        mid = (lo + hi) / 2
+        if factor(mid) is None:
+            hi = mid
+        else:
+            lo = mid
+    sigma = lo - 1e-3 * max(1.0, abs(lo))
+    chol = factor(sigma)
+    op = scipy.sparse.linalg.LinearOperator(K.shape, matvec=lambda x: scipy.linalg.cho_solve_banded(
+        (chol, False), x), dtype=float)
+    lam, X = scipy.sparse.linalg.eigsh(K, k=count, M=M, sigma=sigma, which="LM", OPinv=op, tol=1e-12)
+    order = np.argsort(lam)
+    return lam[order], X[:, order]
 
 
 @functools.lru_cache(maxsize=64)
@@ -246,26 +321,28 @@ def _element_basis(xg, h, hs):
     return _element_basis_cached(tuple(xg), float(h), float(hs))
 
 
-def _constraints(n, m):
-    """The reduced basis T (ndof x nfree) that imposes the pole (node 0) and rim (node m-1)
-    conditions: q = T q_free."""
+#: Dofs (of u, u', v, v', w, w') held at the end S = L: the held rim (``w'`` free: M_s = 0), or
+#: the equator of a complete sphere for modes symmetric (u = 0, w' = 0; Q and the in-plane
+#: shear vanish naturally) or antisymmetric (v = w = 0; w'' = 0 naturally) about it.
+END_CONDITIONS = {"pinned": (0, 2, 4), "symmetric": (0, 5), "antisymmetric": (2, 4)}
+
+
+def _constraints(n, m, end="pinned"):
+    """The reduced basis T (sparse, ndof x nfree) that imposes the pole (node 0) and end
+    (node m-1) conditions: q = T q_free."""
     ndof = 6 * m
-    fixed = {6 * (m - 1) + 0, 6 * (m - 1) + 2, 6 * (m - 1) + 4}  # u = v = w = 0 at the rim
+    fixed = {6 * (m - 1) + k for k in END_CONDITIONS[end]}
     if n == 0:
         fixed |= {0, 2, 5}  # u = v = 0, w' = 0
     elif n == 1:
-        fixed |= {4}  # w = 0; u + v = 0 below
+        fixed |= {2, 4}  # w = 0; v(S0) = -u(S0): v's dof is folded into u's column
     else:
         fixed |= {0, 2, 4, 5}
+    free = np.array([i for i in range(ndof) if i not in fixed])
+    rows, cols, vals = list(free), list(range(free.size)), [1.0] * free.size
     if n == 1:
-        fixed.add(2)  # v(S0) = -u(S0): eliminated into u's column
-    free = [i for i in range(ndof) if i not in fixed]
-    T = np.zeros((ndof, len(free)))
-    for k, i in enumerate(free):
-        T[i, k] = 1.0
-    if n == 1:
-        T[2, free.index(0)] = -1.0
-    return T
+        rows.append(2), cols.append(int(np.flatnonzero(free == 0)[0])), vals.append(-1.0)
+    return scipy.sparse.csr_matrix((vals, (rows, cols)), shape=(ndof, free.size))
 
 
 #: Grading at the pole: the first uniform element is split geometrically (ratio POLE_RATIO)
@@ -329,25 +406,55 @@ def stability(state, modes=None, *, elements: int | None = None, S0: float | Non
     if state.topology != "inflated":
         raise NotImplementedError(f"stability is built for states without contact (topology 'inflated'); "
                                   f"this state's is {state.topology!r}")
-    scene = state.scene
     sysm = state.system
     zeta = float(sysm.S_point(sysm.regions[0].start, None))
-    L = float(sysm.L)
     S0 = zeta if S0 is None else max(float(S0), zeta)
+    out = spectrum(state.scene, state_base(state), S0, float(sysm.L), modes, elements=elements, count=count,
+                   vectors=vectors)
+    out.wall_time = time.perf_counter() - t0
+    return out
+
+
+def spectrum(scene, base_of, S0, L, modes=None, *, elements=None, count=2, vectors=False, end="pinned"):
+    """The eigenvalues of :func:`stability` for a base state given as a function of S
+    (:func:`state_base`, :func:`sphere_base`) on [S0, L], with ``end`` conditions at L
+    (:data:`END_CONDITIONS`)."""
+    t0 = time.perf_counter()
     ne = elements or default_elements(scene)
     nodes = mesh(S0, L, ne)
     modes = default_modes(scene) if modes is None else np.asarray(sorted(set(int(n) for n in modes)))
     out = np.empty((modes.size, count))
     vecs = {}
     for k, n in enumerate(modes):
-        K, M = _assemble(scene, state, int(n), nodes)
-        T = _constraints(int(n), nodes.size)
-        Kr, Mr = T.T @ K @ T, T.T @ M @ T
-        Kr = (Kr + Kr.T) / 2
-        lam, X = scipy.linalg.eigh(Kr, Mr, subset_by_index=[0, count - 1])
+        K, M = _assemble(scene, base_of, int(n), nodes)
+        T = _constraints(int(n), nodes.size, end)
+        Kr, Mr = (T.T @ K @ T).tocsr(), (T.T @ M @ T).tocsr()
+        Kr = ((Kr + Kr.T) / 2).tocsr()
+        lam, X = _smallest(Kr, Mr, count)
         out[k] = lam
         if vectors:
             q = (T @ X[:, 0]).reshape(-1, 6)
             vecs[int(n)] = {"S": nodes, "u": q[:, 0], "v": q[:, 2], "w": q[:, 4]}
     return Stability(modes=modes, eigenvalues=out, elements=ne, S0=S0, vectors=vecs,
                      wall_time=time.perf_counter() - t0)
+
+
+def sphere_stretch(scene) -> float:
+    """The stretch of the complete sphere (the reference hemisphere, gamma = 1, continued
+    through its equator) under the scene's pressure in the membrane state with its uniform
+    bending moment: ``kappa_s tau_s + kappa_theta tau_theta = -p`` (the pressure below the bowl
+    pushes on its convex side) for ``r = stretch sin S`` (from the generated ``free_profile``)."""
+    from scipy.optimize import brentq
+
+    if scene.gamma != 1 or not isinstance(scene.shell, Spheroid):
+        raise ValueError("the sphere's membrane state is that of the hemisphere, gamma = 1")
+    mod = scene.model()
+    par = scene.parameters(mod)
+    S = np.array([0.7])
+
+    def residual(stretch):
+        y = np.array([[stretch], [1.0], [stretch], [1.0 / stretch], [0.0], [-stretch * math.cos(0.7)]])
+        prof = mod.free_profile(S, y, par)
+        return float((prof["tau_s"][0] + prof["tau_theta"][0]) / stretch + scene.pressure)
+
+    return brentq(residual, 0.5, 2.0, xtol=1e-14)
