@@ -98,6 +98,13 @@ class Stability:
         Where the mesh starts (the pole conditions are imposed there).
     wall_time : float
         Seconds (the form's derivation included on first use in a process).
+
+    Examples
+    --------
+    >>> import shellbvp as sb
+    >>> res = sb.stability(sb.inflate(sb.Scene(gamma=1, beta=1e-3)), modes=range(4), elements=20)
+    >>> res.stable, res.critical_mode, res.eigenvalues.shape
+    (True, 1, (4, 2))
     """
 
     modes: np.ndarray
@@ -399,6 +406,24 @@ def stability(state, modes=None, *, elements: int | None = None, S0: float | Non
     Returns
     -------
     Stability
+        ``.modes``, ``.eigenvalues`` (per mode the ``count`` smallest), ``.critical_mode``,
+        ``.stable``.
+
+    Raises
+    ------
+    NotImplementedError
+        For a state with contact (only the inflated, contact-free state is handled).
+
+    Examples
+    --------
+    The hemisphere under external pressure (below the bowl) buckles, next to its held rim, at
+    about 0.76 of the classical pressure ``4 sqrt(3 beta)`` (benchmarks/results/stability_pressure.md):
+
+    >>> import shellbvp as sb
+    >>> scene = sb.Scene(gamma=1, beta=1e-4, pressure=0.8 * 4 * (3e-4) ** 0.5)
+    >>> res = sb.stability(sb.inflate(scene))
+    >>> res.stable, res.critical_mode
+    (False, 11)
     """
     t0 = time.perf_counter()
     if not state.success:
