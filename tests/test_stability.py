@@ -1,4 +1,4 @@
-r"""Stability of states without contact against Fourier modes (shellbvp.stability; issue 44, item 2).
+r"""Stability of states without contact against Fourier modes (shellbvp.modal_stability; issue 44, item 2).
 
 * the unstressed hemisphere with its rim held: every eigenvalue of n = 0..6 positive (the held
   rim leaves no rigid motion), converged in the mesh and in the pole start S0;
@@ -23,7 +23,7 @@ import pytest
 from scipy.optimize import brentq
 
 import shellbvp as sb
-from shellbvp import stability as st
+from shellbvp import modal_stability as st
 from shellbvp.solution import Solution
 
 
@@ -108,6 +108,7 @@ def test_held_rim_hemisphere_buckles_below_the_classical_pressure_next_to_the_ri
 
 
 def test_states_with_contact_are_refused():
+    assert sb.stability is st.stability and sb.Stability is st.Stability
     with pytest.raises(NotImplementedError, match="without contact"):
         st.stability(Solution(success=True, status=0, topology="cap"))
     with pytest.raises(ValueError, match="did not converge"):
