@@ -159,8 +159,11 @@ def shallow_cap(beta=1e-5):
     d = np.array([a["distance"] for a in approach])
     lam = np.array([a["n0_eigenvalue"] for a in approach])
     exponent = float(np.polyfit(np.log(d), np.log(lam), 1)[0])
+    # at a fold lambda_0^2 is linear in p: its zero from the two nearest pressures
+    f = np.array([a["p_over_pc"] for a in approach])
+    zero = float(f[-1] - lam[-1] ** 2 * (f[-1] - f[-2]) / (lam[-1] ** 2 - lam[-2] ** 2))
     asym = held_rim(beta, scan=(0.5, 0.6, 0.7, 0.8), shell=shell, pc=pc, first_mode=1)
-    return {"beta": beta, "p_c": pc, "stall_p_over_pc": fold, "approach": approach, "n0_exponent": exponent,
+    return {"beta": beta, "p_c": pc, "stall_p_over_pc": fold, "approach": approach, "n0_exponent": exponent, "n0_zero_p_over_pc": zero,
             "asymmetric": asym, "seconds": time.perf_counter() - t0}
 
 
@@ -218,7 +221,8 @@ def main():
                   f"(bisection on its success, to 1e-4, solve_bvp's nodes limited to {FOLD_NODES});",
                   "* the n = 0 eigenvalue on the way there, at p = p_stall (1 - d): " + ", ".join(
                       f"d = {x['distance']:g}: {x['n0_eigenvalue']:.3g}" for x in cap["approach"])
-                  + f"; log-log slope {cap['n0_exponent']:.2f} (a fold: 1/2): the stop is the axisymmetric fold;",
+                  + f"; log-log slope {cap['n0_exponent']:.2f} (a fold: 1/2), and lambda_0^2, linear in p, "
+                  f"vanishes at p = {cap['n0_zero_p_over_pc']:.5f} p_c: the stop is the axisymmetric fold;",
                   (f"* the first non-axisymmetric crossing (n >= 1) comes before it: p = {a['p_over_pc']:.4f} p_c, "
                    f"n = {a['n']}, |w| peaking at S = {a['S_peak']:.3f} (rim at {5 * math.asin(0.2):.3f})."
                    if a["found"] else f"* no non-axisymmetric crossing on the scan ({a['note']})."),

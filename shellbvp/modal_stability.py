@@ -49,6 +49,16 @@ Boundary conditions (states without contact: the inflated/pressurised shell):
   (``inflation.EPS * L``) by default, with the conditions above imposed there; the result's
   change with ``S0`` is measured in the tests.
 
+Accuracy and cost (measured; tests/test_stability.py, benchmarks/stability_pressure.py): the
+default mesh has 24 elements per classical wavelength ``2 pi/k_c``, ``k_c = (3/beta)^(1/4)``;
+doubling it moves the critical pressures by less than 1e-4 of p_c.  Near the pole the form's
+coefficients (up to ``1/r^3``) are evaluated numerically from the generated expressions, and
+their cancellation leaves a floor of about 1e-4 of the eigenvalues' scale at S0 = 1.5e-4 (the
+rigid motions of a complete sphere come out at that level instead of 0), growing as S0 -> 0
+(1e-2 at S0 = 1e-5); regularised pole expressions per n would remove it.  The form is evaluated
+by ``sympy.lambdify`` (numpy, with CSE) of the 45 entries, about 2 s per structure and process;
+a state of beta 1e-5 (141 elements, n = 0..33) takes about 1 s.
+
 Only states without contact are handled here (topology ``"inflated"``); contact regions (the
 normal displacement following the tip, lift-off, walls) and junction terms are not built.
 """

@@ -113,3 +113,19 @@ def test_states_with_contact_are_refused():
         st.stability(Solution(success=True, status=0, topology="cap"))
     with pytest.raises(ValueError, match="did not converge"):
         st.stability(Solution(success=False, topology="inflated", message="no"))
+
+
+@pytest.mark.slow
+def test_pinned_shallow_cap_n0_eigenvalue_vanishes_at_the_inflation_fold():
+    """A spherical cap of radius 5 over the rim radius 1, beta 1e-5: the axisymmetric continuation
+    stops at 0.850 p_c (benchmarks/results/stability_pressure.md); the n = 0 eigenvalue goes to 0
+    there like the square root of the distance (a fold), and is positive before."""
+    beta = 1e-5
+    shell = sb.UserShell("5*sin(S/5)", "-5*cos(S/5)", "5*asin(1/5)")
+    pc = classical(beta) / 25
+    lam = {}
+    for d in (1e-2, 1e-3):
+        state = sb.inflate(sb.Scene(shell=shell, beta=beta, pressure=0.85 * (1 - d) * pc))
+        lam[d] = st.stability(state, modes=[0]).smallest[0]
+    assert lam[1e-3] > 0
+    assert lam[1e-2] / lam[1e-3] == pytest.approx(math.sqrt(10), rel=0.15)
