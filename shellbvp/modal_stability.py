@@ -21,7 +21,7 @@ Discretisation: Rayleigh-Ritz with cubic Hermite elements (C^1) for all three of
 uniform mesh in S from ``S0`` to the rim.  The form holds ``u''`` and ``v''`` only multiplied
 by lower derivatives; C^1 fields make it the exact energy of the discrete fields, so no
 integration by parts is needed and the computed eigenvalues are upper bounds of the exact
-ones (to quadrature error: 6 Gauss points per element).  The smallest eigenvalues come from
+ones (up to quadrature error, 6 Gauss points per element, and the pole's rounding floor below).  The smallest eigenvalues come from
 shift-invert Lanczos (``scipy.sparse.linalg.eigsh``) about a shift that a banded Cholesky
 factorisation certifies to lie below the spectrum.
 
@@ -39,7 +39,7 @@ Boundary conditions (states without contact: the inflated/pressurised shell):
   n     behaviour at S -> 0                          imposed at S0
   ====  ==========================================  ===================================
   0     u, v ~ S, w ~ const + S^2                   u = v = 0, w' = 0
-  1     u, v ~ const (u + v ~ S^2), w ~ S           u + v = 0, w = 0
+  1     u, v ~ const with u + v -> 0, w ~ S        u + v = 0, w = 0
   >= 2  u, v ~ S^(n-1), w ~ S^n                     u = v = w = 0, w' = 0
   ====  ==========================================  ===================================
 
