@@ -39,7 +39,7 @@ Boundary conditions (states without contact: the inflated/pressurised shell):
   n     behaviour at S -> 0                          imposed at S0
   ====  ==========================================  ===================================
   0     u, v ~ S, w ~ const + S^2                   u = v = 0, w' = 0
-  1     u, v ~ const with u + v -> 0, w ~ S        u + v = 0, w = 0
+  1     u, v ~ const with u + v -> 0, w ~ S         u + v = 0, w = 0
   >= 2  u, v ~ S^(n-1), w ~ S^n                     u = v = w = 0, w' = 0
   ====  ==========================================  ===================================
 
