@@ -39,13 +39,15 @@ Boundary conditions (states without contact: the inflated/pressurised shell):
   n     behaviour at S -> 0                          imposed at S0
   ====  ==========================================  ===================================
   0     u, v ~ S, w ~ const + S^2                   u = v = 0, w' = 0
-  1     u, v ~ const with u + v -> 0, w ~ S         u + v = 0, w = 0
+  1     u, v ~ const with u + v -> 0, w ~ S         u + v = 0, w = S0 w'
   >= 2  u, v ~ S^(n-1), w ~ S^n                     u = v = w = 0, w' = 0
   ====  ==========================================  ===================================
 
   The conditions imposed are those without which the energy diverges (the coefficients carry
   up to ``1/r^3``); higher-order ones (``u' = 0`` for n >= 3, ...) follow from finite energy in
-  the limit and are not imposed.  The mesh starts at ``S0``: the state's own pole start
+  the limit and are not imposed.  At n = 1, ``w = 0`` at S0 would hold the small circle S0 still
+  against the tilt ``w = a S``, at a bending energy of order ``a^2`` whatever S0 (the
+  correction of size ``a S0`` over the length S0): ``w = S0 w'`` there lets the tilt through.  The mesh starts at ``S0``: the state's own pole start
   (``inflation.EPS * L``) by default, with the conditions above imposed there; the result's
   change with ``S0`` is measured in the tests.
 
@@ -344,21 +346,24 @@ def _element_basis(xg, h, hs):
 END_CONDITIONS = {"pinned": (0, 2, 4), "symmetric": (0, 5), "antisymmetric": (2, 4)}
 
 
-def _constraints(n, m, end="pinned"):
+def _constraints(n, m, end="pinned", S0_over_hs=0.0):
     """The reduced basis T (sparse, ndof x nfree) that imposes the pole (node 0) and end
-    (node m-1) conditions: q = T q_free."""
+    (node m-1) conditions: q = T q_free.  ``S0_over_hs``: S0 over the derivative dofs' scale
+    (n = 1's ``w = S0 w'`` at S0)."""
     ndof = 6 * m
     fixed = {6 * (m - 1) + k for k in END_CONDITIONS[end]}
     if n == 0:
         fixed |= {0, 2, 5}  # u = v = 0, w' = 0
     elif n == 1:
-        fixed |= {2, 4}  # w = 0; v(S0) = -u(S0): v's dof is folded into u's column
+        fixed |= {2, 4}  # v(S0) = -u(S0), w(S0) = S0 w'(S0): folded into u's and w''s columns
     else:
         fixed |= {0, 2, 4, 5}
     free = np.array([i for i in range(ndof) if i not in fixed])
     rows, cols, vals = list(free), list(range(free.size)), [1.0] * free.size
     if n == 1:
-        rows.append(2), cols.append(int(np.flatnonzero(free == 0)[0])), vals.append(-1.0)
+        rows += [2, 4]
+        cols += [int(np.flatnonzero(free == 0)[0]), int(np.flatnonzero(free == 5)[0])]
+        vals += [-1.0, S0_over_hs]
     return scipy.sparse.csr_matrix((vals, (rows, cols)), shape=(ndof, free.size))
 
 
@@ -462,7 +467,7 @@ def spectrum(scene, base_of, S0, L, modes=None, *, elements=None, count=2, vecto
     vecs = {}
     for k, n in enumerate(modes):
         K, M = _assemble(scene, base_of, int(n), nodes)
-        T = _constraints(int(n), nodes.size, end)
+        T = _constraints(int(n), nodes.size, end, nodes[0] / np.diff(nodes).max())
         Kr, Mr = (T.T @ K @ T).tocsr(), (T.T @ M @ T).tocsr()
         Kr = ((Kr + Kr.T) / 2).tocsr()
         lam, X = _smallest(Kr, Mr, count)

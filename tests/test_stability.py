@@ -52,6 +52,8 @@ def test_complete_sphere_rigid_motions_and_degeneracy():
     scene = sb.Scene(gamma=1, beta=beta, pressure=0.95 * classical(beta))
     base = st.sphere_base(st.sphere_stretch(scene))
     sym = st.spectrum(scene, base, 1.5e-4, math.pi / 2, modes=range(6), elements=40, end="symmetric", count=3)
+    # (n = 0 and 1 checked here too: their normalisation and pole conditions; w = 0 instead of
+    # w = S0 w' at S0 for n = 1 puts its values 9 % off)
     anti = st.spectrum(scene, base, 1.5e-4, math.pi / 2, modes=range(6), elements=40, end="antisymmetric",
                        count=3)
     scale = sym.eigenvalues[2:, 0].max()
@@ -70,6 +72,11 @@ def test_complete_sphere_rigid_motions_and_degeneracy():
     assert anti.eigenvalues[2, 0] == pytest.approx(sym.eigenvalues[3, 0], abs=floor)
     assert anti.eigenvalues[2, 0] == pytest.approx(anti.eigenvalues[4, 0], abs=floor)
     assert abs(sym.eigenvalues[2, 0] - anti.eigenvalues[2, 0]) > 20 * floor  # even l and odd l differ
+    # n = 0 and 1: the first non-rigid eigenvalue (the second) is the same degree's
+    assert sym.eigenvalues[0, 1] == pytest.approx(sym.eigenvalues[2, 0], abs=floor)
+    assert anti.eigenvalues[0, 1] == pytest.approx(anti.eigenvalues[2, 0], abs=floor)
+    assert sym.eigenvalues[1, 1] == pytest.approx(sym.eigenvalues[3, 0], abs=floor)
+    assert anti.eigenvalues[1, 1] == pytest.approx(anti.eigenvalues[3, 0], abs=floor)
 
 
 def sphere_critical(beta, elements=None):
