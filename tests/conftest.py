@@ -45,3 +45,17 @@ def _fresh_code_cache(tmp_path_factory):
         os.environ.pop("SHELLBVP_CACHE_DIR", None)
     else:
         os.environ["SHELLBVP_CACHE_DIR"] = old
+
+
+@pytest.fixture
+def closed_form(monkeypatch):
+    """The fit's model curves replaced by :class:`fake_curves.FakeCurve` (counted as computed)."""
+    import shellbvp.fitting
+    from fake_curves import FakeCurve
+
+    def fake(scene, deltas, tol, counter=None, progress=None):
+        if counter is not None:
+            counter[0] += 1
+        return FakeCurve(scene, deltas)
+
+    monkeypatch.setattr(shellbvp.fitting, "_model_curve", fake)

@@ -11,36 +11,16 @@ import shellbvp as sb
 import shellbvp.fitting
 from shellbvp.units import beta_from_thickness
 
+from fake_curves import FakeCurve
+
 R_L, MU_H, D0 = 0.3e-3, 52.0, 0.01e-3
 H_TRUE = 40e-6  # eps = 0.133, beta = 0.00593
-
-
-class _FakeCurve:
-    """A model curve of closed form whose shape depends on beta (fast tests of the fit's logic)."""
-
-    def __init__(self, scene, deltas):
-        self.scene, self.delta = scene, np.asarray(deltas, float)
-        self.force = self.delta ** (1.3 + 20 * scene.beta) * (1 + scene.beta)
-        self.stop_reason, self.solutions = "closed form", []
-
-    def __len__(self):
-        return self.delta.size
-
-
-@pytest.fixture
-def closed_form(monkeypatch):
-    def fake(scene, deltas, tol, counter=None, progress=None):
-        if counter is not None:
-            counter[0] += 1
-        return _FakeCurve(scene, deltas)
-
-    monkeypatch.setattr(shellbvp.fitting, "_model_curve", fake)
 
 
 def _data(scene, seed=0, noise=0.02):
     x = np.linspace(0.01, 0.4, 40)
     rng = np.random.default_rng(seed)
-    force = MU_H * R_L * _FakeCurve(scene, x).force * (1 + noise * rng.standard_normal(x.size))
+    force = MU_H * R_L * FakeCurve(scene, x).force * (1 + noise * rng.standard_normal(x.size))
     return R_L * x + D0, force
 
 

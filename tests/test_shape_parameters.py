@@ -11,32 +11,14 @@ import shellbvp as sb
 import shellbvp.fitting
 from shellbvp.shape_parameters import DERIVED, SHAPE_PARAMETERS, Derived
 
+from fake_curves import FakeCurve
+
 R_L, MU_H, D0 = 0.3e-3, 52.0, 0.01e-3
-
-
-class _FakeCurve:
-    def __init__(self, scene, deltas):
-        self.scene, self.delta = scene, np.asarray(deltas, float)
-        self.force = self.delta ** (1.3 + 20 * scene.beta) * (1 + scene.beta)
-        self.stop_reason, self.solutions = "closed form", []
-
-    def __len__(self):
-        return self.delta.size
-
-
-@pytest.fixture
-def closed_form(monkeypatch):
-    def fake(scene, deltas, tol, counter=None, progress=None):
-        if counter is not None:
-            counter[0] += 1
-        return _FakeCurve(scene, deltas)
-
-    monkeypatch.setattr(shellbvp.fitting, "_model_curve", fake)
 
 
 def test_free_and_the_fit_name_aliases_are_one_path(closed_form):
     x = np.linspace(0.01, 0.4, 40)
-    force = MU_H * R_L * _FakeCurve(sb.Scene.preset("fit", beta=0.02), x).force
+    force = MU_H * R_L * FakeCurve(sb.Scene.preset("fit", beta=0.02), x).force
     force *= 1 + 0.02 * np.random.default_rng(1).standard_normal(x.size)
     d, scene = R_L * x + D0, sb.Scene.preset("fit")
     new = sb.fit(scene, d, force, R_L=R_L, free=("beta",), bounds={"beta": (1e-3, 0.1)})
