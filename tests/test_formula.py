@@ -334,7 +334,7 @@ def test_an_import_error_of_an_optional_part_is_one_line(monkeypatch, capsys):
     def refuse(args):
         raise ImportError("not loading compiled kernels: it belongs to another user (uid 1234)")
 
-    monkeypatch.setattr(cli, "_cmd_solve", refuse)
+    monkeypatch.setattr(cli.solve, "run", refuse)
     parser = cli.build_parser
     monkeypatch.setattr(cli, "build_parser", lambda: _with(parser(), refuse))
     assert cli.main(["solve", "--delta", "0.1"]) == 2
