@@ -39,7 +39,7 @@ from .lifted_ends import (
 from .liftoff import lift_off_suspected, replace_invalid_cap
 from .recorder import Recorder
 from .solution import Solution, default_eps
-from .state import check_delta, check_tol
+from .bounds import check_delta, check_tol
 from .switches import locate_switches
 from .version import __version__ as VERSION
 

@@ -150,7 +150,7 @@ def _check_settings(settings: dict) -> dict:
 
 def _check_scenes(base_scene, names, combos, delta_max, settings):
     """Every combination's scene and depth, checked before any curve (ValueError naming it)."""
-    from .state import check_delta, check_tol
+    from .bounds import check_delta, check_tol
 
     tol = settings.get("tol", 1e-6)
     check_tol(tol)
