@@ -169,12 +169,12 @@ def of(state) -> Configuration | None:
 
 
 def is_single_cap(state) -> bool:
-    conf = CONFIGURATIONS.get(state.topology)
+    conf = of(state)
     return conf is not None and conf.single_cap
 
 
 def is_point_load(state) -> bool:
-    conf = CONFIGURATIONS.get(state.topology)
+    conf = of(state)
     return conf is not None and conf.point_load
 
 

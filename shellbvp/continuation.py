@@ -234,6 +234,7 @@ class CurveRun:
         self._states = None
         self._finished = False
         self._pending = []  # states recorded by the switch search, not yet yielded
+        self.t0 = None  # when the iteration started
 
     def __iter__(self):
         if self._states is None:
@@ -302,7 +303,7 @@ class CurveRun:
         if self.stop is None:
             self.out.stop_reason = "interrupted"
             self.settings["after_last_point_s"] = time.perf_counter() - (
-                self.recorder.last_accepted or getattr(self, "t0", time.perf_counter()))
+                self.recorder.last_accepted or self.t0 or time.perf_counter())
         self._finish()
 
     def result(self) -> Curve:
@@ -317,7 +318,7 @@ class CurveRun:
             return
         self._finished = True
         self.recorder.finish()
-        self.settings["wall_time"] = time.perf_counter() - getattr(self, "t0", time.perf_counter())
+        self.settings["wall_time"] = time.perf_counter() - (self.t0 or time.perf_counter())
         log.info("curve: %s in %.2f s", self.out.summary(), self.settings["wall_time"])
 
 

@@ -807,7 +807,7 @@ def free_parameters(free=(), bounds=None, aliases=None):
 
 
 @dataclass
-class _ShapeParameter:
+class _ShapeSearch:
     """The shape parameter fitted with mu*H: its declaration, its search range, step and start
     in theta (``ln x`` or ``x``) and the scene at a theta."""
     param: ShapeParameter
@@ -822,7 +822,7 @@ class _ShapeParameter:
 
 
 def _search_of(scene, name, bounds):
-    """The :class:`_ShapeParameter` of the free parameter ``name`` (its bounds checked)."""
+    """The :class:`_ShapeSearch` of the free parameter ``name`` (its bounds checked)."""
     param = shape_parameter(name)
     why = param.unavailable(scene)
     if why:
@@ -830,7 +830,7 @@ def _search_of(scene, name, bounds):
     x0 = param.get(scene)
     lo, hi = _check_bounds(name, param.default_bounds(scene) if bounds is None else bounds, param.low_ok,
                            param.high_ok, x0)
-    return _ShapeParameter(param, (param.to_theta(lo), param.to_theta(hi)), param.step(scene), param.to_theta(x0),
+    return _ShapeSearch(param, (param.to_theta(lo), param.to_theta(hi)), param.step(scene), param.to_theta(x0),
                            lambda th: param.set(scene, param.from_theta(th)))
 
 

@@ -264,13 +264,14 @@ class Scene:
 
         number, text = (int, float), (str,)
         what = {number: "a number", text: "text", (dict,): "a mapping", (int,): "an integer", (bool,): "true or false"}
-        m = field(d, "material", (dict,), "")
-        family = field(m, "family", text, "material.")
-        try:
-            material_type = material_class(family)
-        except ValueError as exc:
-            raise ValueError(f"scene data: {exc}") from None
-        material = material_type.from_data(lambda key, kind: field(m, key, kind, "material."))
+        def registered(data, lookup, where):  # a material or bending energy by its registered family
+            try:
+                kind_of = lookup(field(data, "family", text, where))
+            except ValueError as exc:
+                raise ValueError(f"scene data: {exc}") from None
+            return kind_of.from_data(lambda key, kind: field(data, key, kind, where))
+
+        material = registered(field(d, "material", (dict,), ""), material_class, "material.")
         sh, tp = field(d, "shell", (dict,), ""), field(d, "tip", (dict,), "")
         kind = field(sh, "kind", text, "shell.")
         if kind == "spheroid":
@@ -286,13 +287,8 @@ class Scene:
             tip = UserTip(*(field(tp, k, text, "tip.") for k in "AB"), legacy_srepr=True)
         else:
             raise ValueError(f"scene data: unknown tip kind {kind!r}")
-        bd = d.get("bending", {"family": "trace"})  # files from before the choice: the paper's
-        family = field(bd, "family", text, "bending.")
-        try:
-            bending_type = bending_class(family)
-        except ValueError as exc:
-            raise ValueError(f"scene data: {exc}") from None
-        bend = bending_type.from_data(lambda key, kind: field(bd, key, kind, "bending."))
+        # files from before the choice hold no bending: the paper's
+        bend = registered(d.get("bending", {"family": "trace"}), bending_class, "bending.")
         return cls(gamma=field(d, "gamma", number, ""), rho=field(d, "rho", number, ""),
                    beta=field(d, "beta", number, ""), material=material, xi=field(d, "xi", (int,), ""),
                    contact=field(d, "contact", text, ""), shell=shell, tip=tip, bending=bend,

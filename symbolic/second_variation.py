@@ -230,7 +230,7 @@ class Series:
 
     @staticmethod
     def const(c0, k):
-        return Series(sp.sympify(c0), sp.zeros(k, 1), sp.zeros(k, k))
+        return Series(sp.sympify(c0, strict=True), sp.zeros(k, 1), sp.zeros(k, k))
 
     def _lift(self, other):
         return other if isinstance(other, Series) else Series.const(other, self.c1.rows)
@@ -261,7 +261,7 @@ class Series:
 
     def __truediv__(self, other):
         if not isinstance(other, Series):
-            return self * (1 / sp.sympify(other))
+            return self * (1 / sp.sympify(other, strict=True))
         return self * apply(lambda s: 1 / s, other)
 
     def __rtruediv__(self, other):
