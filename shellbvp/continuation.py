@@ -25,6 +25,7 @@ import numpy as np
 
 from .configurations import is_single_cap, names
 from .corner import edge_model
+from .curve_stability import assess, check_choice
 from .cylinder import best_wall_state, wall_contact_suspected
 from .io import POINT_FIELDS, Curve
 from .kernels import LONG_CURVE_POINTS, kernel_set
@@ -54,7 +55,7 @@ log = logging.getLogger(__name__)
 def curve(scene, delta_max: float = 0.5, *, deltas=None, force_max=None, lambda0_max=None,
           max_steps: int = 400, delta_start=None, delta_min=None, tol: float = 1e-6,
           max_nodes: int = 10000, ds_max=None, estimate_error: bool | str = "auto", callback=None,
-          topology: str = "auto"):
+          topology: str = "auto", stability: str = "off"):
     """Force–displacement curve of a scene by continuation.
 
     Parameters
@@ -101,6 +102,13 @@ def curve(scene, delta_max: float = 0.5, *, deltas=None, force_max=None, lambda0
         ``"auto"`` (smooth model): where the single cap would pull the shell, record
         the valid line or annular contact at that delta (``shellbvp.liftoff``);
         ``"cap"``: single-cap states only (flagged where invalid).
+    stability : {"off", "points", "locate"}
+        The stability of the states against non-axisymmetric modes
+        (:mod:`shellbvp.curve_stability`): ``"points"`` at every recorded state (point fields
+        ``stability_min``, ``critical_mode``; ``Curve.first_instability`` between two points),
+        ``"locate"`` with the first instability narrowed by states solved in between.
+        States the analysis does not handle read NaN (the reason in
+        ``settings["stability_note"]``).
 
     Returns
     -------
@@ -120,6 +128,7 @@ def curve(scene, delta_max: float = 0.5, *, deltas=None, force_max=None, lambda0
     >>> c.topology_summary()
     'line x1, cap x1 (switch line -> cap at delta = 0.113089)'
     """
+    check_choice(stability)
     run = iter_curve(scene, delta_max, deltas=deltas, force_max=force_max, lambda0_max=lambda0_max,
                      max_steps=max_steps, delta_start=delta_start, delta_min=delta_min, tol=tol,
                      max_nodes=max_nodes, ds_max=ds_max, estimate_error=estimate_error, topology=topology)
@@ -129,7 +138,9 @@ def curve(scene, delta_max: float = 0.5, *, deltas=None, force_max=None, lambda0
                 callback(run.snapshot(), sol)
     except KeyboardInterrupt:
         run.interrupt()
-    return run.result()
+    out = run.result()
+    assess(out, stability if not out.interrupted else "off")
+    return out
 
 
 def iter_curve(scene, delta_max: float = 0.5, *, deltas=None, force_max=None, lambda0_max=None,
@@ -190,12 +201,6 @@ estimate_error, topology
     if topology not in ("auto",) + names("cap"):
         raise ValueError(f"topology must be 'auto' or 'cap' for a curve; got {topology!r}")
     estimate_error = _error_mode(estimate_error)
-
-    settings = dict(tol=tol, max_nodes=max_nodes, delta_max=delta_max, force_max=force_max,
-                    lambda0_max=lambda0_max, max_steps=max_steps, delta_start=delta_start,
-                    delta_min=delta_min, ds_max=ds_max, estimate_error=estimate_error,
-                    mode="deltas" if deltas is not None else "adaptive", eps=default_eps(tol),
-                    bc_tol=1e-10, topology=topology)
 
     settings = dict(tol=tol, max_nodes=max_nodes, delta_max=delta_max, force_max=force_max,
                     lambda0_max=lambda0_max, max_steps=max_steps, delta_start=delta_start,

@@ -29,7 +29,13 @@ contact_edge and edge_jump_ls/ks, which read as NaN and "")::
                             error_method (strings: how force_error/delta_error were
                             made: richardson, calibrated, or empty: not estimated);
                             pressure (the pressure below the shell: the scene's, or
-                            under volume control the one that holds the volume)
+                            under volume control the one that holds the volume);
+                            stability_min, critical_mode (curve(stability=...): the
+                            smallest eigenvalue over Fourier modes and its n; NaN and -1
+                            where not computed, also in files that lack them)
+    /curve attrs            first_instability (JSON; with _delta, _force, _mode and, with
+                            SI columns, _delta_m, _force_N beside it): where the curve
+                            first loses axisymmetric stability, when it was looked for and found
     /curve/profiles/point_<i>   optional (profiles=True): S, region, r, z, ... at the
                             mesh nodes of point i (see Solution.profile)
 
@@ -125,6 +131,8 @@ class Curve:
     solutions: list = field(default_factory=list, repr=False)
     version: str = ""
     units: dict = None  # {"R_L": m, "mu_H": N/m} when the file had SI columns (to_hdf5(units=...))
+    #: the first unstable depth (shellbvp.curve_stability.FirstInstability), None if none was found
+    first_instability: object = None
 
     def __getattr__(self, name):
         points = self.__dict__.get("points", {})
@@ -169,8 +177,9 @@ class Curve:
             return f"0 points ({self.stop_reason})"
         d, F = self.points["delta"], self.points["force"]
         nvalid = int(np.sum(self.points["valid"]))
+        unstable = f"; {self.first_instability.summary()}" if self.first_instability is not None else ""
         return (f"{n} points, delta {d.min():.4g}..{d.max():.4g}, F {F.min():.4g}..{F.max():.4g}, "
-                f"{nvalid} valid; stopped: {self.stop_reason}")
+                f"{nvalid} valid; stopped: {self.stop_reason}{unstable}")
 
 
 def energy_residual(delta, energy, force):
@@ -238,6 +247,14 @@ def write_curve_group(g, curve, *, profiles=False, units=None):
     g["delta"].attrs["long_name"] = "pole displacement delta / R_L"
     g["force"].attrs["long_name"] = "indenter force F / (mu H R_L)"
     g["shear_delta"].attrs["long_name"] = "pole displacement added by transverse shear / R_L (0: not modelled)"
+    for k, (units_, name) in _STABILITY_DATASETS.items():
+        if k in g:
+            g[k].attrs["units"], g[k].attrs["long_name"] = units_, name
+    first = curve.first_instability
+    if first is not None:
+        g.attrs["first_instability"] = json.dumps(first.to_dict(), sort_keys=True)
+        g.attrs["first_instability_delta"], g.attrs["first_instability_force"] = first.delta, first.force
+        g.attrs["first_instability_mode"] = first.mode
     if dims is None:
         g.attrs["units"] = "nondimensional"
     else:
@@ -246,6 +263,9 @@ def write_curve_group(g, curve, *, profiles=False, units=None):
         g.attrs["R_L_m"], g.attrs["mu_H_N_per_m"] = R_L, mu_H
         g.create_dataset("delta_m", data=R_L * np.asarray(curve.points["delta"]))
         g.create_dataset("force_N", data=mu_H * R_L * np.asarray(curve.points["force"]))
+        if first is not None:
+            g.attrs["first_instability_delta_m"] = R_L * first.delta
+            g.attrs["first_instability_force_N"] = mu_H * R_L * first.force
     if curve.scene.pressure:
         _write_inflated(g.create_group("inflated"), curve.scene)
     if profiles:
@@ -302,10 +322,18 @@ def _missing_field(name, n):
     return np.full(n, value, dtype=object if isinstance(value, str) else float)
 
 
+#: Per-point stability fields (shellbvp.curve_stability): units and long names; read as "not
+#: computed" from files that lack them
+_STABILITY_DATASETS = {
+    "stability_min": ("1 (mu H / R_L^2 per squared displacement / R_L^2)",
+                      "smallest eigenvalue of the second variation over Fourier modes n (NaN: not computed)"),
+    "critical_mode": ("1", "the Fourier mode n of stability_min (-1: not computed)"),
+}
+
 #: Fields stored as strings; every other point field is numeric.
 _STRING_FIELDS = ("topology", "flags", "contact_edge", "error_method")
 #: Integer-valued fields (an empty curve stores them as float).
-_INTEGER_FIELDS = ("status", "nodes", "niter")
+_INTEGER_FIELDS = ("status", "nodes", "niter", "critical_mode")
 
 
 def _format_version(f):
@@ -397,6 +425,10 @@ def _points(g):
             points[k] = _missing_field(k, n)
         else:
             raise ValueError(f"dataset {k} missing")
+    from .curve_stability import STABILITY_FIELDS
+
+    for k, missing in STABILITY_FIELDS.items():
+        points[k] = _field(g, k, n) if k in g else np.full(n, missing, dtype=type(missing))
     points["topology"] = np.asarray(points["topology"], dtype=str)
     points["contact_edge"] = np.asarray(points["contact_edge"], dtype=str)
     unknown = sorted(set(points["contact_edge"]) - {"", "smooth", "corner", "paper", "pinned"})
@@ -446,7 +478,24 @@ def read_curve_group(g, version: str = ""):
         units = {"R_L": units[0], "mu_H": units[1]}
     return Curve(scene=scene, points=points, flags=flags, stop_reason=_text_attr(g, "stop_reason"),
                  complete=_bool_attr(g, "complete"), interrupted=_bool_attr(g, "interrupted"),
-                 settings=settings, version=version, units=units)
+                 settings=settings, version=version, units=units, first_instability=_first_instability(g))
+
+
+def _first_instability(g):
+    """The curve's first unstable depth (attribute ``first_instability``), or None."""
+    from .curve_stability import FirstInstability
+
+    if "first_instability" not in g.attrs:
+        return None
+    d = _json_attr(g, "first_instability")
+    try:
+        first = FirstInstability.from_dict(d)
+    except (KeyError, TypeError, ValueError) as exc:
+        raise ValueError(f"attribute first_instability must hold delta, force, mode, located and bracket "
+                         f"({type(exc).__name__}: {exc})") from None
+    if len(first.bracket) != 2 or not np.isfinite(first.delta):
+        raise ValueError("attribute first_instability: delta must be finite and bracket two numbers")
+    return first
 
 
 def read_curve(path):

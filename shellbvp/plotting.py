@@ -50,6 +50,10 @@ def plot_curves(curves, ax=None, labels=None, mark_invalid=True):
         if mark_invalid and len(c):
             bad = ~np.asarray(c.valid, bool)
             ax.plot(sx * c.delta[bad], sy * c.force[bad], "o", mfc="none", ms=4, color=line.get_color())
+        first = getattr(c, "first_instability", None)
+        if first is not None:  # where the axisymmetric branch stops being stable
+            ax.plot(sx * first.delta, sy * first.force, "x", ms=8, mew=1.5, color=line.get_color(),
+                    label=f"unstable from here (n = {first.mode})")
     ax.axhline(0, color="0.7", lw=0.5)
     if si:
         ax.set_xlabel("pole displacement (mm)")

@@ -36,6 +36,9 @@ def add_parser(sub):
     c.add_argument("--topology", choices=("auto", "cap"), default="auto",
                    help="auto (default): where the single contact cap would pull the shell, use the valid "
                         "lifted-off (line or annular) contact; cap: single cap only, flagged where invalid")
+    c.add_argument("--stability", choices=("off", "points", "locate"), default="off",
+                   help="stability of the states against non-axisymmetric modes: off (default); points: at "
+                        "every point; locate: and the first instability narrowed between two points")
     c.set_defaults(func=run)
 
 
@@ -94,6 +97,10 @@ def run(args):
     finally:
         bar.close()
     c = run.result()
+    if not c.interrupted:
+        from ..curve_stability import assess
+
+        assess(c, args.stability)
     if c.interrupted and out.exists():
         # Ctrl-C is as safe as kill -9: an earlier file stays; the finished points go to the checkpoint
         write_curve(c, partial, profiles=args.profiles, overwrite=True, units=units)
@@ -113,6 +120,8 @@ def run(args):
               f"{format_in(scale * float(min(c.force)), fu, 'force')} .. {format_in(scale * float(max(c.force)), fu, 'force')}")
     if len(c):
         print(f"  contact topologies along the curve: {c.topology_summary()}")
+    if c.settings.get("stability_note"):
+        print(f"  stability not computed where: {c.settings['stability_note']}")
     if c.interrupted:
         print("shellbvp: interrupted; the file holds the finished points (complete = False)", file=sys.stderr)
         return 130

@@ -1,0 +1,228 @@
+"""Where a curve stops being axisymmetric: the stability of its states, per point and located.
+
+:func:`assess` runs :func:`shellbvp.modal_stability.stability` on the states of a finished
+:class:`~shellbvp.io.Curve` and fills
+
+* per point ``stability_min`` (the smallest eigenvalue of the second variation over the modes
+  n = 0..N, in the package's units ``mu H / R_L^2`` per squared displacement; NaN: not computed)
+  and ``critical_mode`` (its n; -1: not computed);
+* per curve :attr:`Curve.first_instability <shellbvp.io.Curve.first_instability>`: the first
+  depth along the branch where a state is unstable, with its mode.
+
+``"points"`` evaluates every recorded state; ``"locate"`` then brackets the first sign change of
+``stability_min`` between two recorded states and narrows it by regula falsi on states solved at
+depths in between (the modes next to the critical one only; all modes again on the stable side
+of the final bracket).  A state the stability analysis does not handle gives NaN, and the reason
+is kept in the curve's settings (``stability_note``): nothing is guessed for it.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import asdict, dataclass
+
+import numpy as np
+
+__all__ = ["STABILITY_CHOICES", "STABILITY_FIELDS", "FirstInstability", "check_choice", "point_stability",
+           "assess", "locate_zero"]
+
+#: What ``curve(stability=...)`` accepts
+STABILITY_CHOICES = ("off", "points", "locate")
+#: Per-point fields of a curve added by :func:`assess`, with their value where not computed
+STABILITY_FIELDS = {"stability_min": math.nan, "critical_mode": -1}
+#: Modes each side of the critical one evaluated while a bracket is narrowed
+NEAR_MODES = 2
+#: Largest number of states solved to narrow a bracket
+MAX_REFINE = 12
+
+
+@dataclass(frozen=True)
+class FirstInstability:
+    """The first unstable depth along a curve.
+
+    Attributes
+    ----------
+    delta, force : float
+        Where the smallest eigenvalue crosses zero (package units), interpolated linearly
+        between the two states of the final bracket; with ``located`` False, the first unstable
+        recorded point's.
+    mode : int
+        The Fourier mode n that goes unstable.
+    located : bool
+        The crossing was narrowed to ``bracket`` by states solved in between.
+    bracket : (float, float)
+        The last stable and the first unstable depth known.
+    message : str
+        How it was found, or why it was not narrowed.
+    """
+
+    delta: float
+    force: float
+    mode: int
+    located: bool
+    bracket: tuple
+    message: str = ""
+
+    def to_dict(self) -> dict:
+        d = asdict(self)
+        d["bracket"] = list(self.bracket)
+        return d
+
+    @classmethod
+    def from_dict(cls, d) -> "FirstInstability":
+        return cls(delta=float(d["delta"]), force=float(d["force"]), mode=int(d["mode"]),
+                   located=bool(d["located"]), bracket=tuple(float(b) for b in d["bracket"]),
+                   message=str(d.get("message", "")))
+
+    def summary(self) -> str:
+        how = "" if self.located else f"; {self.message}"
+        return f"loses axisymmetric stability at delta = {self.delta:.6g} (n = {self.mode}{how})"
+
+
+def check_choice(stability) -> str:
+    """``stability`` if it is one of :data:`STABILITY_CHOICES`, else a one-line ValueError."""
+    if not (isinstance(stability, str) and stability in STABILITY_CHOICES):
+        raise ValueError(f"stability must be one of {STABILITY_CHOICES}; got {stability!r}")
+    return stability
+
+
+def point_stability(state, modes=None):
+    """(smallest eigenvalue, its mode, "") of ``state``, or (NaN, -1, why) where the analysis does
+    not handle it or fails."""
+    from .modal_stability import stability
+
+    if state is None or not state.success:
+        return math.nan, -1, "the state did not converge"
+    try:
+        res = stability(state, modes=modes)
+    except (ValueError, NotImplementedError) as exc:
+        return math.nan, -1, " ".join(str(exc).split())
+    return res.minimum, res.critical_mode, ""
+
+
+def locate_zero(f, a, fa, b, fb, *, xtol, max_evals=MAX_REFINE):
+    """Narrow a sign change of ``f`` from ``fa >= 0`` at ``a`` to ``fb < 0`` at ``b`` (Illinois
+    regula falsi): ``(a, fa, b, fb, evaluations)`` with ``|b - a| <= xtol`` or the evaluations
+    spent.  ``f(x)`` returns a number, or NaN where it cannot be evaluated (then the narrowing
+    stops there)."""
+    side = 0
+    n = 0
+    while abs(b - a) > xtol and n < max_evals:
+        x = b - fb * (b - a) / (fb - fa) if fa != fb else 0.5 * (a + b)
+        lo, hi = min(a, b), max(a, b)
+        margin = 0.05 * (hi - lo)  # keep the trial inside: regula falsi may stall on an end
+        x = min(max(x, lo + margin), hi - margin)
+        fx = f(x)
+        n += 1
+        if not math.isfinite(fx):
+            break
+        if fx >= 0:
+            a, fa = x, fx
+            if side == -1:
+                fb *= 0.5
+            side = -1
+        else:
+            b, fb = x, fx
+            if side == 1:
+                fa *= 0.5
+            side = 1
+    return a, fa, b, fb, n
+
+
+def assess(curve, choice: str = "points", *, delta_tol: float = 1e-4) -> None:
+    """Fill ``curve``'s stability fields and ``first_instability`` (see the module docstring).
+
+    Parameters
+    ----------
+    curve : Curve
+        A curve with its states in memory (``curve.solutions``, as :func:`shellbvp.curve`
+        returns it).
+    choice : {"off", "points", "locate"}
+    delta_tol : float
+        ``"locate"``: the width of the final bracket in delta.
+    """
+    choice = check_choice(choice)
+    n = len(curve)
+    mins = np.full(n, math.nan)
+    modes = np.full(n, -1, dtype=int)
+    curve.points["stability_min"], curve.points["critical_mode"] = mins, modes
+    curve.first_instability = None
+    curve.settings["stability"] = choice
+    if choice == "off" or n == 0:
+        return
+    t0 = time.perf_counter()
+    notes = []
+    try:
+        for i, sol in enumerate(curve.solutions):
+            mins[i], modes[i], why = point_stability(sol)
+            if why and why not in notes:
+                notes.append(why)
+        first = next((i for i in range(n) if mins[i] < 0), None)
+        if first is not None:
+            curve.first_instability = _first(curve, first, mins, modes, choice, delta_tol)
+    except KeyboardInterrupt:  # the curve is finished work: keep it, with what was assessed
+        notes.append("stability interrupted")
+    curve.settings["stability_note"] = "; ".join(notes)
+    curve.settings["stability_time"] = time.perf_counter() - t0
+
+
+def _first(curve, i, mins, modes, choice, delta_tol):
+    d, F = curve.points["delta"], curve.points["force"]
+    stable = [j for j in range(i) if np.isfinite(mins[j]) and mins[j] >= 0]
+    unlocated = dict(delta=float(d[i]), force=float(F[i]), mode=int(modes[i]), located=False)
+    if not stable:
+        return FirstInstability(**unlocated, bracket=(math.nan, float(d[i])),
+                                message="unstable from the first state analysed")
+    j = stable[-1]
+    bracket = (float(d[j]), float(d[i]))
+    if choice != "locate":
+        return FirstInstability(**unlocated, bracket=bracket, message="between two recorded points")
+    if j != i - 1 or not np.all(np.diff(d[j:i + 1]) > 0):
+        return FirstInstability(**unlocated, bracket=bracket,
+                                message="not narrowed: states between the bracket's ends were not analysed")
+    return _narrowed(curve, j, i, mins, modes, delta_tol)
+
+
+def _narrowed(curve, j, i, mins, modes, delta_tol):
+    from .modal_stability import default_modes
+    from .state import solve
+
+    sols, d = curve.solutions, curve.points["delta"]
+    st = curve.settings
+    near = {int(modes[i]), int(modes[j])}
+    every = default_modes(curve.scene)
+    chosen = np.array(sorted({int(m) for c in near for m in range(c - NEAR_MODES, c + NEAR_MODES + 1)
+                              if every[0] <= m <= every[-1]}))
+    states = {}
+
+    def f(delta):
+        guess = sols[j] if abs(delta - d[j]) <= abs(delta - d[i]) else sols[i]
+        try:
+            s = solve(curve.scene, delta=delta, guess=guess, tol=st.get("tol", 1e-6),
+                      max_nodes=st.get("max_nodes", 10000), estimate_error=False)
+        except ValueError:
+            return math.nan
+        if not s.success or s.topology not in (sols[j].topology, sols[i].topology):
+            return math.nan
+        lam, n, _ = point_stability(s, modes=chosen)
+        states[delta] = (s, n)
+        return lam
+
+    a, fa, b, fb, evals = locate_zero(f, float(d[j]), float(mins[j]), float(d[i]), float(mins[i]),
+                                      xtol=delta_tol)
+    mode = states[b][1] if b in states else int(modes[i])
+    stable_state = states[a][0] if a in states else sols[j]
+    check, check_mode, _ = point_stability(stable_state)  # every mode on the stable side
+    if a in states and not (check >= 0):
+        return FirstInstability(delta=float(d[i]), force=float(curve.points["force"][i]), mode=int(modes[i]),
+                                located=False, bracket=(float(d[j]), float(d[i])),
+                                message=f"not narrowed: mode {check_mode} is unstable inside the bracket")
+    Fa = float(states[a][0].force) if a in states else float(curve.points["force"][j])
+    Fb = float(states[b][0].force) if b in states else float(curve.points["force"][i])
+    t = fa / (fa - fb) if fa != fb else 0.5
+    located = abs(b - a) <= delta_tol
+    message = (f"narrowed to {abs(b - a):.2g} in delta by {evals} states" if located
+               else f"narrowed to {abs(b - a):.2g} in delta by {evals} states (not to {delta_tol:g})")
+    return FirstInstability(delta=a + t * (b - a), force=Fa + t * (Fb - Fa), mode=int(mode), located=located,
+                            bracket=(float(a), float(b)), message=message)

@@ -1,0 +1,124 @@
+"""Stability along a curve (shellbvp.curve_stability): the choices, the narrowing of a sign
+change, states the analysis refuses, and the fields and first instability in curve files."""
+
+import math
+
+import h5py
+import numpy as np
+import pytest
+
+import shellbvp as sb
+from shellbvp.curve_stability import FirstInstability, assess, check_choice, locate_zero
+
+
+@pytest.mark.parametrize("bad", ["on", "", None, 1, "Points"])
+def test_bad_choice_is_refused_before_any_solve(bad):
+    with pytest.raises(ValueError, match="stability must be one of"):
+        check_choice(bad)
+    with pytest.raises(ValueError, match="stability must be one of"):
+        sb.curve(sb.Scene.preset("base"), deltas=[0.1], stability=bad)
+
+
+@pytest.mark.parametrize("root", [0.2, 0.5, 0.93])
+def test_regula_falsi_narrows_a_sign_change_to_the_tolerance(root):
+    # a smooth function, curved so that plain regula falsi would stall on one end
+    f = lambda x: (root - x) * (1 + 5 * x ** 2)
+    a, fa, b, fb, n = locate_zero(f, 0.0, f(0.0), 1.0, f(1.0), xtol=1e-6, max_evals=40)
+    assert fa >= 0 > fb
+    assert abs(b - a) <= 1e-6
+    assert min(a, b) <= root <= max(a, b)
+    assert n <= 20
+
+
+def test_narrowing_stops_where_the_function_cannot_be_evaluated():
+    calls = []
+
+    def f(x):
+        calls.append(x)
+        return math.nan
+
+    a, fa, b, fb, n = locate_zero(f, 0.0, 1.0, 1.0, -1.0, xtol=1e-6)
+    assert (a, b, n) == (0.0, 1.0, 1) and len(calls) == 1
+
+
+def test_refused_states_read_nan_with_the_reason():
+    # the paper's contact conditions are not variational: no second variation for them
+    c = sb.curve(sb.Scene.preset("base", contact="paper"), deltas=[0.1, 0.2], estimate_error=False,
+                 stability="points")
+    assert np.all(np.isnan(c.points["stability_min"]))
+    assert np.all(c.points["critical_mode"] == -1)
+    assert c.first_instability is None
+    assert c.settings["stability"] == "points" and c.settings["stability_note"]
+
+
+def test_off_fills_not_computed_columns():
+    c = sb.curve(sb.Scene.preset("base"), deltas=[0.1], estimate_error=False)
+    assert np.isnan(c.points["stability_min"][0]) and c.points["critical_mode"][0] == -1
+    assert c.settings["stability"] == "off" and c.first_instability is None
+
+
+def test_first_instability_and_stability_fields_in_the_curve_file(tmp_path):
+    c = sb.curve(sb.Scene.preset("base"), deltas=[0.1, 0.2], estimate_error=False)
+    c.points["stability_min"] = np.array([0.5, -0.25])
+    c.points["critical_mode"] = np.array([3, 4])
+    c.first_instability = FirstInstability(delta=0.17, force=0.3, mode=4, located=True, bracket=(0.1699, 0.1701),
+                                           message="narrowed")
+    path = tmp_path / "c.h5"
+    c.to_hdf5(path, units={"R_L": 1e-3, "mu_H": 50.0})
+    back = sb.read_curve(path)
+    assert back.first_instability == c.first_instability
+    np.testing.assert_array_equal(back.points["stability_min"], [0.5, -0.25])
+    np.testing.assert_array_equal(back.points["critical_mode"], [3, 4])
+    assert "loses axisymmetric stability at delta = 0.17 (n = 4)" in back.summary()
+    with h5py.File(path) as f:
+        g = f["entry/curve"]
+        assert g.attrs["first_instability_mode"] == 4
+        assert g.attrs["first_instability_delta_m"] == pytest.approx(0.17e-3)
+        assert g.attrs["first_instability_force_N"] == pytest.approx(0.3 * 50.0 * 1e-3)
+        assert "mu H" in g["stability_min"].attrs["units"] and g["critical_mode"].attrs["units"] == "1"
+
+
+def test_files_without_stability_read_as_not_computed(tmp_path):
+    c = sb.curve(sb.Scene.preset("base"), deltas=[0.1], estimate_error=False)
+    path = tmp_path / "c.h5"
+    c.to_hdf5(path)
+    with h5py.File(path, "a") as f:
+        del f["entry/curve/stability_min"], f["entry/curve/critical_mode"]
+    back = sb.read_curve(path)
+    assert np.isnan(back.points["stability_min"][0]) and back.points["critical_mode"][0] == -1
+
+
+@pytest.mark.parametrize("text", ["[1, 2]", '{"delta": 0.1}', '{"delta": "x", "force": 0, "mode": 1, '
+                                                               '"located": true, "bracket": [0, 1]}'])
+def test_a_malformed_first_instability_is_named(tmp_path, text):
+    c = sb.curve(sb.Scene.preset("base"), deltas=[0.1], estimate_error=False)
+    path = tmp_path / "c.h5"
+    c.to_hdf5(path)
+    with h5py.File(path, "a") as f:
+        f["entry/curve"].attrs["first_instability"] = text
+    with pytest.raises(ValueError, match="first_instability"):
+        sb.read_curve(path)
+
+
+def test_assess_of_an_empty_curve_is_harmless():
+    c = sb.curve(sb.Scene.preset("base"), deltas=[0.1], estimate_error=False)
+    c.points = {k: v[:0] for k, v in c.points.items()}
+    c.solutions = []
+    assess(c, "locate")
+    assert c.first_instability is None and len(c.points["stability_min"]) == 0
+
+
+def test_cli_curve_stability_option(tmp_path):
+    import subprocess
+    import sys
+
+    r = subprocess.run([sys.executable, "-m", "shellbvp", "curve", "--preset", "flat", "--beta", "0.02", "--contact",
+                        "paper", "--points", "2", "--delta-max", "0.2", "--stability", "points", "-o", "s.h5"],
+                       capture_output=True, text=True, cwd=tmp_path, timeout=600)
+    assert r.returncode == 0, r.stderr
+    assert "stability not computed where:" in r.stdout
+    c = sb.read_curve(tmp_path / "s.h5")
+    assert c.settings["stability"] == "points" and np.all(np.isnan(c.points["stability_min"]))
+    bad = subprocess.run([sys.executable, "-m", "shellbvp", "curve", "--stability", "maybe"], capture_output=True,
+                         text=True, cwd=tmp_path, timeout=600)
+    assert bad.returncode == 2 and "--stability" in bad.stderr
