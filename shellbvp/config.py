@@ -82,6 +82,11 @@ class Options:
     health_seconds : float
         Seconds a sweep waits for a finished curve before it asks whether a Dask cluster is
         still there.
+    compile_in_background : bool
+        With numba and ``SHELLBVP_KERNELS=auto``, a structure whose kernels are not compiled
+        is compiled in a background process once the numpy kernels have taken
+        ``kernels.START_AFTER_S``; False (default): not compiled but by ``shellbvp compile``
+        (a compile, ~15-40 s, repays over many curves, not within one command).
 
     Examples
     --------
@@ -103,6 +108,7 @@ class Options:
     tighten: bool = True
     progress_seconds: float = field(default_factory=_progress_seconds)
     health_seconds: float = 10.0
+    compile_in_background: bool = False
 
 
 #: The options in force

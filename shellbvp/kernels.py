@@ -17,18 +17,21 @@ stays the reference and the fallback: without numba nothing changes.
 The choice is the environment variable ``SHELLBVP_KERNELS``:
 
 ``auto`` (default)
-    numba's kernels when numba is installed, never waited for.  The numpy
-    functions serve, timed, until they have taken ``START_AFTER_S`` (0.5 s) in this
-    process, about what loading compiled kernels costs, so a single solve never pays
+    numba's kernels when numba is installed and they are compiled, never waited for.
+    The numpy functions serve, timed, until they have taken ``START_AFTER_S`` (0.5 s) in
+    this process, about what loading compiled kernels costs, so a single solve never pays
     for them and a curve is repaid; a curve of ``LONG_CURVE_POINTS`` or more (every
     adaptive curve) loads kernels already compiled at its start (waiting would only add its
-    numpy time: loading in a thread holds the interpreter lock as the solve does).  Then
-    the kernels are loaded from the cache in a background thread (~0.5 s) or, the first
-    time for a structure, compiled in a background process (once per structure, ~15 s
-    on the other core; it finishes even if this process ends first, so the next run
-    finds them), and the solver switches when they are ready.  A process, not a thread, compiles: compiling is
-    Python work that would hold the interpreter lock and slow the solve it is meant
-    to speed up (benchmarks/results/kernels.md has the numbers).
+    numpy time: loading in a thread holds the interpreter lock as the solve does).  The
+    kernels are loaded from the cache in a background thread (~0.5 s) and the solver
+    switches when they are ready.  A structure whose kernels are not compiled yet stays on
+    numpy: compiling takes ~15-40 s on the other core of a 2-core machine, which no single
+    curve, solve or fit repays (a curve's numpy time is ~1 s), and it competed with the
+    user's own run.  ``shellbvp compile`` compiles them once, in the foreground (every
+    preset's structure, or a scene's); with the option ``compile_in_background``
+    (:func:`shellbvp.options`) a background process compiles them once the threshold is
+    passed (a process, not a thread: compiling is Python work that would hold the
+    interpreter lock and slow the solve it is meant to speed up; benchmarks/results/kernels.md).
 ``numpy``
     never compile; the numpy functions only.
 ``numba``
@@ -61,7 +64,8 @@ from pathlib import Path
 from .model import (description_key, holds_key, kernel_path, untrusted_bytecode, untrusted_reason, write_atomic,
                     write_bytecode)
 
-__all__ = ["CHOICES", "ENV", "LONG_CURVE_POINTS", "KernelSet", "kernel_choice", "kernel_set", "compile_kernels"]
+__all__ = ["CHOICES", "ENV", "LONG_CURVE_POINTS", "KernelSet", "kernel_choice", "kernel_set", "compile_kernels",
+           "compile_for"]
 
 log = logging.getLogger(__name__)
 
@@ -309,10 +313,27 @@ class KernelSet:
         return timed
 
     def _charge(self, seconds):
-        """Count time in the numpy kernels; past ``START_AFTER_S`` start the compiled ones."""
+        """Count time in the numpy kernels; past ``START_AFTER_S`` start the compiled ones
+        (where they are compiled already, or compiling in the background is allowed)."""
         self.numpy_seconds += seconds
         if self.numpy_seconds >= START_AFTER_S and self.status == "counting":
-            self._begin()
+            from .config import OPTIONS
+
+            if OPTIONS.compile_in_background or _ready(kernel_path(self._structure()), self.numpy.KEY):
+                self._begin()
+            else:
+                self._not_compiled()
+
+    def _not_compiled(self):
+        """Counting ends with numpy: this structure's kernels are not compiled, and one command
+        does not repay compiling them (``shellbvp compile`` does it once)."""
+        with self._lock:
+            if self.status != "counting":
+                return
+            self.status, self.active = "numpy", self.numpy
+            self.reason = "kernels not compiled for this structure (run `shellbvp compile` once)"
+        log.info("compiled kernels not used: %s", self.reason)
+        self.settled.set()
 
     def start_now(self):
         """auto: load compiled kernels now, not after ``START_AFTER_S`` of numpy work -- for a
@@ -407,6 +428,18 @@ def kernel_set(model, structure) -> KernelSet:
                 del _sets[k]
                 raise
     return ks
+
+
+def compile_for(scene) -> tuple[str, float]:
+    """Compile ``scene``'s kernels in this process, or load them if compiled already:
+    ``("compiled" | "loaded", seconds)``.  ImportError without numba."""
+    if _numba_version() is None:
+        raise ImportError("compiled kernels need numba: pip install 'shellbvp[fast]'")
+    model = scene.model()
+    fresh = not _ready(kernel_path(scene.structure()), model.KEY)
+    t0 = time.perf_counter()
+    KernelSet(model, "numba").start(scene.structure)
+    return ("compiled" if fresh else "loaded"), time.perf_counter() - t0
 
 
 def main(argv=None) -> int:

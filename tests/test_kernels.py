@@ -230,7 +230,8 @@ def _auto_base():
         scene = SCENES["base"]
         src = sbm.kernel_path(scene.structure())
         _AUTO["cold"] = not sk._compiled(src)
-        with mock.patch.dict(os.environ, {"SHELLBVP_KERNELS": "auto"}), mock.patch.object(sk, "START_AFTER_S", 0.0):
+        with mock.patch.dict(os.environ, {"SHELLBVP_KERNELS": "auto"}), mock.patch.object(sk, "START_AFTER_S", 0.0), \
+                sb.options(compile_in_background=True):
             ks = sk.kernel_set(scene.model(), scene.structure)
             _AUTO["before"] = (ks.status, ks.active.free_rhs is scene.model().free_rhs)
             sol = sb.solve(scene, delta=0.1)  # served by numpy while the kernels are started
@@ -350,9 +351,48 @@ def test_start_now_loads_compiled_kernels_of_a_counting_set_once(compiled, monke
         assert started == [1] and ks.status == "waiting" and ks.active is ks.numpy
     else:  # compiling is left to the threshold: beside a whole curve it slows the curve
         assert not started and ks.status == "counting"
-        ks._charge(sk.START_AFTER_S)  # the threshold still starts them
+        with sb.options(compile_in_background=True):
+            ks._charge(sk.START_AFTER_S)  # the threshold starts them where background compiles are allowed
         _join_kernel_threads()
         assert started == [1] and ks.status == "waiting"
+
+
+def test_by_default_a_command_never_compiles_kernels(monkeypatch):
+    """Past the threshold a structure not compiled stays on numpy (no background compile: it
+    cannot repay within one command); compiled ones are loaded."""
+    scene = SCENES["base"]
+    for compiled in (False, True):
+        ks = sk.KernelSet(scene.model(), "auto")
+        started = []
+        monkeypatch.setattr(ks, "_background", lambda: started.append(1))
+        monkeypatch.setattr(sk, "_numba_version", lambda: "0.0")
+        monkeypatch.setattr(sk, "holds_key", lambda src, key: True)
+        monkeypatch.setattr(sk, "_compiled", lambda src: compiled)
+        ks.start(scene.structure)
+        ks._charge(sk.START_AFTER_S)
+        _join_kernel_threads()
+        if compiled:
+            assert started == [1] and ks.status == "waiting"
+        else:
+            assert not started and ks.status == "numpy" and "shellbvp compile" in ks.reason
+            assert ks.settled.is_set() and ks.active is ks.numpy
+
+
+@needs_numba
+def test_the_compile_command_readies_a_scenes_kernels():
+    _auto_base()  # compiled once for this module
+    r = subprocess.run([sys.executable, "-m", "shellbvp", "compile", "--preset", "base"], capture_output=True,
+                       text=True, timeout=600)
+    assert r.returncode == 0, r.stderr
+    assert "scene: kernels loaded" in r.stdout and "1 structure(s) ready" in r.stdout
+
+
+def test_the_compile_command_without_numba_says_how_to_get_it(monkeypatch, capsys):
+    from shellbvp.cli import main
+
+    monkeypatch.setattr(sk, "_numba_version", lambda: None)
+    assert main(["compile", "--preset", "base"]) == 2
+    assert "pip install 'shellbvp[fast]'" in capsys.readouterr().err
 
 
 @pytest.mark.parametrize("kw, starts", [({}, True), ({"deltas": np.linspace(0.01, 0.5, sk.LONG_CURVE_POINTS)}, True),

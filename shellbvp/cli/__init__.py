@@ -7,6 +7,7 @@
     shellbvp plot A.h5 [B.h5 ...] -o fig.png [--profiles 0.1,0.3]   figures (matplotlib)
     shellbvp info FILE.h5                                            what a curve or sweep file holds
     shellbvp presets                                                 the built-in scenes
+    shellbvp compile [--preset NAME]                                 compile the kernels once (numba, [fast])
 
 Invalid input exits with status 2 and a one-line message naming the parameter.
 ``fit`` exits 0 when the fit succeeded (warnings allowed, printed as ``warning: ...``
@@ -21,14 +22,14 @@ from __future__ import annotations
 import logging
 import sys
 
-from . import convexity, curve, fit, info, plot, presets, report, solve, sweep, validate
+from . import compile, convexity, curve, fit, info, plot, presets, report, solve, sweep, validate
 from .common import Parser, print_json_error, scene_from_args
 
 __all__ = ["main", "build_parser", "scene_from_args"]
 
 #: The subcommands, in the order ``shellbvp --help`` lists them; each module holds its parser
 #: (``add_parser``) beside its handler (``run``)
-COMMANDS = (curve, solve, fit, sweep, plot, report, info, convexity, validate, presets)
+COMMANDS = (curve, solve, fit, sweep, plot, report, info, convexity, validate, presets, compile)
 
 
 def build_parser():
