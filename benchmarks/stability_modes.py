@@ -1,0 +1,177 @@
+"""Where the axisymmetric curves lose stability (issue 44, item 5).
+
+For every preset (smooth contact), every smooth scene of the stability grid
+(``benchmarks/stability.py``) and the convex thin dome (gamma -1, beta 1e-5) at rho 0.05,
+0.2 and 0.5: one ``sb.curve(scene, delta_max=..., stability="locate")`` in its own process
+with a time limit, and its verdict: stable to where the curve ends, the first instability
+(delta, delta over the shell's thickness ``H/R_L = sqrt(3 beta)``, F, the mode n), or states
+not analysed (and why).  The time of the stability analysis is reported beside the curve's.
+
+Writes benchmarks/results/stability_modes.json and .md.
+
+    python benchmarks/stability_modes.py                # everything (long: hours on 2 shared cores)
+    python benchmarks/stability_modes.py --only dome    # a subset (regex on the id)
+"""
+
+from __future__ import annotations
+
+import argparse
+import datetime
+import json
+import math
+import os
+import platform
+import re
+import signal
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+HERE = Path(__file__).parent
+sys.path.insert(0, str(HERE))
+
+from checkout import commit_label  # noqa: E402
+from stability import grid as stability_grid  # noqa: E402
+
+RESULTS = HERE / "results"
+DOME_RHOS = (0.05, 0.2, 0.5)
+
+
+def scenes(delta_max):
+    """(id, how to build the scene, delta_max) for every scene of the table."""
+    from shellbvp.scene import PRESETS
+
+    out = [(f"preset {name}", {"preset": name}, delta_max) for name in PRESETS]
+    out += [(f"grid {sid}", {"grid": over}, delta_max) for sid, _, over in stability_grid()]
+    out += [(f"dome beta=1e-5 rho={r:g}", {"preset": "dome", "over": {"beta": 1e-5, "rho": r}}, delta_max)
+            for r in DOME_RHOS]
+    return out
+
+
+def make_scene(how):
+    import shellbvp as sb
+
+    if "preset" in how:
+        return sb.Scene.preset(how["preset"], **how.get("over", {}))
+    from stability import make_scene as grid_scene
+
+    return grid_scene({"overrides": how["grid"], "contact": "smooth"})
+
+
+def worker(spec_path, out_path):
+    import numpy as np
+
+    import shellbvp as sb
+
+    spec = json.loads(Path(spec_path).read_text())
+    row = {"id": spec["id"]}
+    try:
+        scene = make_scene(spec["how"])
+    except ValueError as exc:
+        row["skipped"] = str(exc)
+        Path(out_path).write_text(json.dumps(row))
+        return
+    scene.model()
+
+    def alarm(signum, frame):
+        raise KeyboardInterrupt
+
+    signal.signal(signal.SIGALRM, alarm)
+    signal.setitimer(signal.ITIMER_REAL, spec["time_limit"])
+    t0 = time.perf_counter()
+    try:
+        c = sb.curve(scene, delta_max=spec["delta_max"], stability="locate", estimate_error=False)
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+    wall = time.perf_counter() - t0
+    smin = np.asarray(c.points["stability_min"], float)
+    first = c.first_instability
+    row.update(points=len(c), delta_end=float(c.delta.max()) if len(c) else math.nan, stop=c.stop_reason,
+               interrupted=c.interrupted, analysed=int(np.isfinite(smin).sum()),
+               note=c.settings.get("stability_note", ""), stability_s=c.settings.get("stability_time", math.nan),
+               total_s=wall, thickness=math.sqrt(3 * scene.beta),
+               first=None if first is None else first.to_dict())
+    Path(out_path).write_text(json.dumps(row))
+
+
+def run_one(spec, grace=60):
+    with tempfile.TemporaryDirectory() as d:
+        sp, op = Path(d) / "spec.json", Path(d) / "out.json"
+        sp.write_text(json.dumps(spec))
+        try:
+            subprocess.run([sys.executable, __file__, "--worker", str(sp), str(op)], timeout=spec["time_limit"] + grace,
+                           check=False)
+        except subprocess.TimeoutExpired:
+            return {"id": spec["id"], "killed": True}
+        if not op.exists():
+            return {"id": spec["id"], "crashed": True}
+        return json.loads(op.read_text())
+
+
+def verdict(r):
+    if r.get("skipped"):
+        return "skipped: " + r["skipped"]
+    if r.get("killed") or r.get("crashed"):
+        return "killed" if r.get("killed") else "crashed"
+    if r["analysed"] == 0:
+        return "not analysed: " + r["note"]
+    f = r["first"]
+    if f is None:
+        part = "" if r["analysed"] == r["points"] else f" ({r['points'] - r['analysed']} states not analysed)"
+        return f"stable to delta {r['delta_end']:.3g}{part}"
+    return (f"unstable from delta {f['delta']:.4g} (delta/H {f['delta'] / r['thickness']:.3g}), n = {f['mode']}"
+            + ("" if f["located"] else f"; {f['message']}"))
+
+
+def markdown(rows, meta):
+    lines = [f"# Where the axisymmetric curves lose stability (issue 44, item 5)", "",
+             f"Written by `benchmarks/stability_modes.py` at {meta['commit']} ({meta['date']}; {meta['machine']}).  "
+             f"`sb.curve(scene, delta_max={meta['delta_max']}, stability=\"locate\")`, smooth contact; H/R_L = "
+             "sqrt(3 beta) (the thickness of docs/accuracy.md's map).  A state the analysis does not handle is "
+             "not analysed (NaN), and the reason is given.", "",
+             "| scene | points | curve to delta | verdict | stability s | total s |", "|---|---|---|---|---|---|"]
+    for r in rows:
+        if r.get("skipped") or r.get("killed") or r.get("crashed"):
+            lines.append(f"| {r['id']} | | | {verdict(r)} | | |")
+            continue
+        lines.append(f"| {r['id']} | {r['points']} | {r['delta_end']:.3g} | {verdict(r)} | "
+                     f"{r['stability_s']:.1f} | {r['total_s']:.1f} |")
+    lost = [r for r in rows if r.get("first")]
+    done = [r for r in rows if r.get("analysed")]
+    lines += ["", f"{len(lost)} of {len(done)} analysed curves lose axisymmetric stability before their end.",
+              f"Total {meta['seconds']:.0f} s."]
+    return "\n".join(lines) + "\n"
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--worker", nargs=2, help=argparse.SUPPRESS)
+    ap.add_argument("--only", help="regex on the scene id")
+    ap.add_argument("--delta-max", type=float, default=1.0)
+    ap.add_argument("--time-limit", type=float, default=900.0, help="seconds per scene")
+    args = ap.parse_args()
+    if args.worker:
+        worker(*args.worker)
+        return 0
+    t0 = time.perf_counter()
+    rows = []
+    for sid, how, dmax in scenes(args.delta_max):
+        if args.only and not re.search(args.only, sid):
+            continue
+        r = run_one({"id": sid, "how": how, "delta_max": dmax, "time_limit": args.time_limit})
+        print(f"{sid}: {verdict(r)}", flush=True)
+        rows.append(r)
+    meta = {"commit": commit_label(), "date": datetime.date.today().isoformat(), "delta_max": args.delta_max,
+            "machine": f"{platform.platform()}, Python {platform.python_version()}, {os.cpu_count()} cores",
+            "seconds": time.perf_counter() - t0}
+    suffix = "" if not args.only else "-" + re.sub(r"[^A-Za-z0-9]+", "_", args.only).strip("_")
+    (RESULTS / f"stability_modes{suffix}.json").write_text(json.dumps({"meta": meta, "rows": rows}, indent=1))
+    (RESULTS / f"stability_modes{suffix}.md").write_text(markdown(rows, meta))
+    print(markdown(rows, meta))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
