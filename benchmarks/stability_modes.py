@@ -126,7 +126,7 @@ def verdict(r):
 
 
 def markdown(rows, meta):
-    lines = [f"# Where the axisymmetric curves lose stability (issue 44, item 5)", "",
+    lines = ["# Where the axisymmetric curves lose stability (issue 44, item 5)", "",
              f"Written by `benchmarks/stability_modes.py` at {meta['commit']} ({meta['date']}; {meta['machine']}).  "
              f"`sb.curve(scene, delta_max={meta['delta_max']}, stability=\"locate\")`, smooth contact; H/R_L = "
              "sqrt(3 beta) (the thickness of docs/accuracy.md's map).  A state the analysis does not handle is "
