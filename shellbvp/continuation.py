@@ -82,18 +82,12 @@ def curve(scene, delta_max: float = 0.5, *, deltas=None, force_max=None, lambda0
         the scale of F.
     estimate_error : {"auto", "full", False}
         Error estimates ``force_error``, ``delta_error`` at every point (``True`` means
-        ``"auto"``).  ``"full"``: a Richardson estimate (one Newton solve on the halved
-        mesh; +15-60 % CPU time on the work-precision scenes) at every point.  ``"auto"``: Richardson at the first and
-        last point, at every point whose contact configuration (topology,
-        contact_edge) differs from a neighbour's, and at every
-        ``RICHARDSON_EVERY``-th point; in between, no solve: the larger Richardson
-        ``error / max_residual`` of the two neighbouring Richardson points times the
-        point's own residual (against tol-1e-10 references:
-        ``benchmarks/results/error_estimates.md``).  The point field ``error_method``
-        says which ("richardson" or "calibrated").  A point whose estimate puts its relative
-        F error above ``tol`` (small F, at the end of the small-delta leg) is solved again at
-        a tighter tolerance (10 times, or twice the estimate's excess, up to three times) and
-        estimated by Richardson (``_Builder._tightened``).
+        ``"auto"``).  ``"full"``: a Richardson estimate (one Newton solve on the halved mesh;
+        +15-60 % CPU time) at every point.  ``"auto"``: Richardson at the ends, where the
+        configuration changes and at every ``RICHARDSON_EVERY``-th point, calibrated by the
+        residual in between (:class:`shellbvp.recorder.Recorder`;
+        ``benchmarks/results/error_estimates.md``); the point field ``error_method`` says which.
+        A point whose estimated F error exceeds ``tol`` is solved again, tighter.
     callback : callable, optional
         ``callback(curve_so_far, solution)`` after each accepted point (progress,
         checkpoints).  It may raise ``KeyboardInterrupt`` to stop the curve.  (To act on the
@@ -103,12 +97,9 @@ def curve(scene, delta_max: float = 0.5, *, deltas=None, force_max=None, lambda0
         the valid line or annular contact at that delta (``shellbvp.liftoff``);
         ``"cap"``: single-cap states only (flagged where invalid).
     stability : {"off", "points", "locate"}
-        The stability of the states against non-axisymmetric modes
-        (:mod:`shellbvp.curve_stability`): ``"points"`` at every recorded state (point fields
-        ``stability_min``, ``critical_mode``; ``Curve.first_instability`` between two points),
-        ``"locate"`` with the first instability narrowed by states solved in between.
-        States the analysis does not handle read NaN (the reason in
-        ``settings["stability_note"]``).
+        Stability against non-axisymmetric modes at every recorded state, and where it is
+        first lost (``Curve.first_instability``), narrowed by ``"locate"``
+        (:mod:`shellbvp.curve_stability`).
 
     Returns
     -------

@@ -73,7 +73,7 @@ class FirstInstability:
     def from_dict(cls, d) -> "FirstInstability":
         return cls(delta=float(d["delta"]), force=float(d["force"]), mode=int(d["mode"]),
                    located=bool(d["located"]), bracket=tuple(float(b) for b in d["bracket"]),
-                   message=str(d.get("message", "")))
+                   message=str(d["message"]) if "message" in d else "")
 
     def summary(self) -> str:
         how = "" if self.located else f"; {self.message}"
@@ -199,8 +199,8 @@ def _narrowed(curve, j, i, mins, modes, delta_tol):
     def f(delta):
         guess = sols[j] if abs(delta - d[j]) <= abs(delta - d[i]) else sols[i]
         try:
-            s = solve(curve.scene, delta=delta, guess=guess, tol=st.get("tol", 1e-6),
-                      max_nodes=st.get("max_nodes", 10000), estimate_error=False)
+            s = solve(curve.scene, delta=delta, guess=guess, tol=st["tol"], max_nodes=st["max_nodes"],
+                      estimate_error=False)
         except ValueError:
             return math.nan
         if not s.success or s.topology not in (sols[j].topology, sols[i].topology):

@@ -34,7 +34,17 @@ RICHARDSON_EVERY = 5
 
 class Recorder:
     """The accepted points of a curve (sorted into branch order at the end) and their error
-    estimates (``estimate_error``: "auto", "full" or False)."""
+    estimates (``estimate_error``: "auto", "full" or False).
+
+    ``"auto"``: a Richardson estimate (one Newton solve on the halved mesh) at the first and
+    last point, at every point whose configuration (topology, contact_edge) differs from its
+    neighbour's, at point-load states and at every ``RICHARDSON_EVERY``-th point; in between,
+    no solve: the larger Richardson ``error / max_residual`` of the two neighbouring Richardson
+    points times the point's own residual (against tol-1e-10 references:
+    ``benchmarks/results/error_estimates.md``).  A point whose estimate puts its relative F
+    error above ``tol`` (small F, at the end of the small-delta leg) is solved again at a
+    tighter tolerance (10 times, or twice the estimate's excess, up to three times) and
+    estimated by Richardson (:meth:`_tightened`)."""
 
     def __init__(self, out: Curve, estimate_error, settings):
         self.out, self.estimate_error = out, estimate_error

@@ -110,6 +110,15 @@ def run(args):
     write_curve(c, out, profiles=args.profiles, overwrite=True, units=units)
     partial.unlink(missing_ok=True)
     print(f"wrote {out}: {c.summary()} in {time.perf_counter() - t0:.1f} s")
+    _print_details(c, args, units)
+    if c.interrupted:
+        print("shellbvp: interrupted; the file holds the finished points (complete = False)", file=sys.stderr)
+        return 130
+    return 0 if c.complete else 1
+
+
+def _print_details(c, args, units):
+    """The lines under the summary: the range in lab units, the configurations, the stability note."""
     if units is not None and len(c):
         from ..units import force_unit_of, format_in
 
@@ -122,7 +131,3 @@ def run(args):
         print(f"  contact topologies along the curve: {c.topology_summary()}")
     if c.settings.get("stability_note"):
         print(f"  stability not computed where: {c.settings['stability_note']}")
-    if c.interrupted:
-        print("shellbvp: interrupted; the file holds the finished points (complete = False)", file=sys.stderr)
-        return 130
-    return 0 if c.complete else 1
