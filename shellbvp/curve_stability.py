@@ -214,7 +214,7 @@ def _narrowed(curve, j, i, mins, modes, delta_tol):
     mode = states[b][1] if b in states else int(modes[i])
     stable_state = states[a][0] if a in states else sols[j]
     check, check_mode, _ = point_stability(stable_state)  # every mode on the stable side
-    if a in states and not (check >= 0):
+    if a in states and check < 0:
         return FirstInstability(delta=float(d[i]), force=float(curve.points["force"][i]), mode=int(modes[i]),
                                 located=False, bracket=(float(d[j]), float(d[i])),
                                 message=f"not narrowed: mode {check_mode} is unstable inside the bracket")
