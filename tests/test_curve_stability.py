@@ -122,3 +122,31 @@ def test_cli_curve_stability_option(tmp_path):
     bad = subprocess.run([sys.executable, "-m", "shellbvp", "curve", "--stability", "maybe"], capture_output=True,
                          text=True, cwd=tmp_path, timeout=600)
     assert bad.returncode == 2 and "--stability" in bad.stderr
+
+
+def test_locate_narrows_the_first_sign_change_on_states_solved_between_points(monkeypatch):
+    """The machinery of "locate" on real states, with an eigenvalue known in closed form:
+    ``0.3 - delta`` in mode 4 (every other piece, the solves between the points included, is
+    the package's own)."""
+    import shellbvp.curve_stability as cs
+
+    evaluated = []
+
+    def fake(state, modes=None):
+        evaluated.append(state.delta)
+        return 0.3 - state.delta, 4, ""
+
+    monkeypatch.setattr(cs, "point_stability", fake)
+    scene = sb.Scene.preset("base")
+    c = sb.curve(scene, deltas=[0.1, 0.2, 0.25, 0.35, 0.4], estimate_error=False)
+    assess(c, "points")
+    first = c.first_instability
+    assert (first.delta, first.mode, first.located, first.bracket) == (0.35, 4, False, (0.25, 0.35))
+    assess(c, "locate", delta_tol=1e-5)
+    first = c.first_instability
+    assert first.located and first.mode == 4
+    assert first.bracket[0] <= 0.3 <= first.bracket[1] and first.bracket[1] - first.bracket[0] <= 1e-5
+    assert first.delta == pytest.approx(0.3, abs=1e-6)
+    assert first.force == pytest.approx(sb.solve(scene, delta=0.3).force, rel=1e-4)
+    assert "loses axisymmetric stability at delta = 0.3 (n = 4)" in c.summary()
+    np.testing.assert_array_equal(c.points["critical_mode"], 4)
