@@ -57,8 +57,9 @@ doubling it moves the critical pressures by less than 1e-4 of p_c.  Near the pol
 coefficients (up to ``1/r^3``) are evaluated numerically from the generated expressions, and
 their cancellation leaves a floor of about 1e-4 of the eigenvalues' scale at S0 = 1.5e-4 (the
 rigid motions of a complete sphere come out at that level instead of 0), growing as S0 -> 0
-(1e-2 at S0 = 1e-5); regularised pole expressions per n would remove it.  The form is evaluated
-by ``sympy.lambdify`` (numpy, with CSE) of the 45 entries, about 2 s per structure and process;
+(1e-2 at S0 = 1e-5); regularised pole expressions per n would remove it.  The form's 45 entries
+are generated code (``symbolic.second_variation.form_module_source``, numpy with CSE), derived
+once per structure into the code cache (``stability_<key>.py``, ~5-10 s) and imported after;
 a state of beta 1e-5 (141 elements, n = 0..33) takes about 1 s.
 
 Only states without contact are handled here (topology ``"inflated"``); contact regions (the
@@ -76,7 +77,6 @@ import numpy as np
 import scipy.linalg
 import scipy.sparse
 import scipy.sparse.linalg
-import sympy as sp
 
 from .geometry import Spheroid
 
@@ -152,26 +152,15 @@ class Stability:
 # ------------------------------------------------------------------------------ the form, numeric
 @functools.lru_cache(maxsize=16)
 def _numeric_form(structure_key):
-    """(upper-triangle entry functions of the 9 x 9 form, their argument names, reference-shell
-    functions) for a structure description (a hashable key)."""
+    """(upper-triangle entry function of the 9 x 9 form, the entries' (i, j), its parameter
+    names, the reference shell's parameter names, the reference-shell function) for a structure
+    description (a hashable key): the generated module of ``symbolic.second_variation``."""
     import json
 
-    from symbolic import second_variation as sv
-    from symbolic.build import structure_from_description
-    from symbolic.geometry import S as S_SYM
+    from .model import load_stability_module
 
-    st = structure_from_description(json.loads(structure_key))
-    res = sv.second_variation_of(st)
-    args = sv.BASE + res.params + (sv.N_MODE,)
-    upper = [(i, j) for i in range(9) for j in range(i, 9)]
-    entries = [res.matrix[i, j] for i, j in upper]
-    f = sp.lambdify(args, entries, "numpy", cse=True)
-    shell = st.shell
-    Psi = shell.Psi
-    ks0, kt0 = shell.curvatures()
-    ref_args = (S_SYM,) + tuple(shell.params)
-    ref = sp.lambdify(ref_args, [shell.R, Psi, sp.diff(Psi, S_SYM), ks0, kt0], "numpy")
-    return f, upper, [str(p) for p in res.params], [str(p) for p in shell.params], ref
+    mod = load_stability_module(json.loads(structure_key))
+    return mod.form, list(mod.UPPER), list(mod.PARAMS), list(mod.SHELL_PARAMS), mod.reference
 
 
 def _form_functions(scene):

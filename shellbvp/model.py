@@ -39,7 +39,8 @@ from pathlib import Path
 
 from symbolic.version import CODEGEN_VERSION, description_key, source_fingerprint
 
-__all__ = ["cache_dir", "structure_description", "description_key", "load_module", "module_path",
+__all__ = ["cache_dir", "structure_description", "description_key", "load_module", "load_stability_module",
+           "stability_description", "module_path",
            "kernel_path", "kernel_source_path", "holds_key", "write_atomic", "untrusted_reason",
            "untrusted_bytecode", "write_bytecode"]
 
@@ -179,37 +180,74 @@ def load_module(desc: dict, *, regenerate: bool = False):
     key = description_key(desc)
     if not regenerate and key in _loaded:
         return _loaded[key]
-    path = module_path(desc)
+
+    def generate():
+        from symbolic.build import generate_sources
+
+        return generate_sources(desc)
+
+    def write_kernels(path, kernel_src):
+        kpath = _kernel_path(path.parent, key)
+        if not holds_key(kpath, key):  # never rewritten when current: numba's cache stamps the file
+            write_atomic(kpath, kernel_src)
+
+    mod = _cached_or_generated(module_path(desc), key, generate, regenerate, write_kernels)
+    _loaded[key] = mod
+    return mod
+
+
+def stability_description(desc: dict) -> dict:
+    """The description of a structure's generated second variation (its own key)."""
+    return {**desc, "generated": "second_variation"}
+
+
+def load_stability_module(desc: dict):
+    """The generated second variation of a structure (``symbolic.second_variation``): the form's
+    entries and the reference shell, from memory, the cache, or a derivation (~5-10 s once)."""
+    sdesc = stability_description(desc)
+    key = description_key(sdesc)
+    if key in _loaded:
+        return _loaded[key]
+
+    def generate():
+        from symbolic.build import structure_from_description
+        from symbolic.second_variation import form_module_source
+        from symbolic.version import canonical_json
+
+        return form_module_source(structure_from_description(desc), canonical_json(sdesc)), None
+
+    mod = _cached_or_generated(cache_dir() / f"stability_{key[:20]}.py", key, generate)
+    _loaded[key] = mod
+    return mod
+
+
+def _cached_or_generated(path: Path, key: str, generate, regenerate=False, write_extra=None):
+    """The module of ``key`` at ``path`` in the code cache if it is there and trusted, else
+    ``generate()`` -> (source, extra) written there (or to a private directory) and imported;
+    ``write_extra(path, extra)`` writes what comes with it."""
     if path.parent.exists() and (why := untrusted_reason(path.parent) or untrusted_bytecode(path)):
         log.warning("not using the code cache %s: %s; generating into a private directory", path.parent, why)
         path = _private_dir() / path.name
     elif path.exists() and (why := untrusted_reason(path)):
         log.warning("not importing the cached module %s: %s; regenerating it", path, why)
         regenerate = True
-    mod = None
     if path.exists() and not regenerate:
         try:
-            mod = _import_file(path, key)
+            return _import_file(path, key)
         except Exception as exc:  # corrupt or foreign file: derive again
             log.warning("ignoring unusable cached module %s (%s); regenerating", path, exc)
-    if mod is None:
-        from symbolic.build import generate_sources
-
-        t0 = time.perf_counter()
-        src, kernel_src = generate_sources(desc)
-        log.info("derived and generated %s in %.2f s", path.name, time.perf_counter() - t0)
-        try:
-            write_atomic(path, src)
-        except OSError as exc:  # read-only cache: keep the module in a private temp dir
-            log.warning("cannot write the code cache %s (%s); using a temporary directory", path, exc)
-            path = _private_dir() / path.name
-            write_atomic(path, src)
-        kpath = _kernel_path(path.parent, key)
-        if not holds_key(kpath, key):  # never rewritten when current: numba's cache stamps the file
-            write_atomic(kpath, kernel_src)
-        mod = _import_file(path, key)
-    _loaded[key] = mod
-    return mod
+    t0 = time.perf_counter()
+    src, extra = generate()
+    log.info("derived and generated %s in %.2f s", path.name, time.perf_counter() - t0)
+    try:
+        write_atomic(path, src)
+    except OSError as exc:  # read-only cache: keep the module in a private temp dir
+        log.warning("cannot write the code cache %s (%s); using a temporary directory", path, exc)
+        path = _private_dir() / path.name
+        write_atomic(path, src)
+    if write_extra is not None:
+        write_extra(path, extra)
+    return _import_file(path, key)
 
 
 def kernel_path(desc: dict) -> Path:

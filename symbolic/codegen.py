@@ -23,7 +23,7 @@ from .dag import Program
 from .equations import CONTACT_STATES, FREE_STATES, Derivation
 from .version import CODEGEN_VERSION
 
-__all__ = ["FunctionSpec", "module_source", "function_specs", "lower", "docstring", "header",
+__all__ = ["FunctionSpec", "Printer", "module_source", "function_specs", "lower", "docstring", "header",
            "CODEGEN_VERSION"]
 
 
@@ -52,7 +52,7 @@ class FunctionSpec:
     lowered: tuple | None = field(default=None, repr=False, compare=False)  # cache of lower()
 
 
-class _Printer(NumPyPrinter):
+class Printer(NumPyPrinter):
     def __init__(self):
         super().__init__({"fully_qualified_modules": True, "allow_unknown_functions": False})
 
@@ -94,7 +94,7 @@ def lower(spec: FunctionSpec):
     if spec.lowered is not None:
         return spec.lowered
     prog = spec.program
-    printer = _Printer()
+    printer = Printer()
     flat = _flatten(spec.outputs)
     steps = prog.dependencies(flat)
     exprs = [prog.expression(s) for s in steps] + flat

@@ -96,7 +96,7 @@ from .materials import LS, LT
 
 __all__ = ["TRC", "DETC", "BASE", "FIELDS", "N_MODE", "invariant_form", "membrane_energy",
            "bending_family", "surface_energy_density", "SecondVariation", "second_variation",
-           "second_variation_of"]
+           "second_variation_of", "form_module_source", "FORM_UPPER"]
 
 #: The invariants of C = A^{-1} a: tr C and det C.
 TRC, DETC = sp.symbols("trC detC", positive=True)
@@ -471,3 +471,46 @@ def _second_variation(W, material_params, family, pressurised):
     params = (BETA,) + ((PRESSURE,) if pressurised else ()) + material_params
     return SecondVariation(matrix=matrix, first=first, energy=Lc.c0, W=Wi, family=family, params=params,
                            seconds=time.perf_counter() - t0)
+
+
+#: The upper triangle of the 9 x 9 form, in the order the generated ``form`` returns it
+FORM_UPPER = tuple((i, j) for i in range(9) for j in range(i, 9))
+
+
+def form_module_source(structure, description: str) -> str:
+    """Text of the generated numpy module of a structure's second variation.
+
+    It holds ``form(r, phi, ls, ks, dls, dks, R, Psi, dPsi, kappa_s0, kappa_theta0, *PARAMS, n)``,
+    the 45 entries of the form's upper triangle (:data:`FORM_UPPER`) at the points given, and
+    ``reference(S, *SHELL_PARAMS)``, the reference shell's ``R, Psi, Psi', kappa_s0,
+    kappa_theta0``; ``description`` is hashed into the module's ``KEY`` (``codegen.header``).
+    Deterministic: the same structure gives the same text.
+    """
+    from .codegen import Printer, header
+    from .geometry import S as S_SYM
+
+    res = second_variation_of(structure)
+    key, comments = header("second_variation.py", description)
+    printer = Printer()
+    shell = structure.shell
+    ks0, kt0 = shell.curvatures()
+    params = [str(p) for p in res.params]
+    shell_params = [str(p) for p in shell.params]
+
+    def function(name, args, exprs, doc):
+        temps, reduced = sp.cse(list(exprs), symbols=sp.numbered_symbols("t"), optimizations="basic")
+        lines = [f"def {name}({', '.join(args)}):", f'    """{doc}"""']
+        lines += [f"    {t} = {printer.doprint(e)}" for t, e in temps]
+        lines.append("    return [" + ", ".join(printer.doprint(e) for e in reduced) + "]")
+        return "\n".join(lines)
+
+    form = function("form", [str(b) for b in BASE] + params + [str(N_MODE)],
+                    [res.matrix[i, j] for i, j in FORM_UPPER],
+                    "The 45 entries of the form's upper triangle (UPPER) at the points given.")
+    ref = function("reference", [str(S_SYM)] + shell_params,
+                   [shell.R, shell.Psi, sp.diff(shell.Psi, S_SYM), ks0, kt0],
+                   "The reference shell's R, Psi, Psi', kappa_s0, kappa_theta0 at S.")
+    head = [*comments, '"""Generated second variation of one shellbvp structure (see the header)."""',
+            "import numpy", "", f"KEY = {key!r}", f"PARAMS = {tuple(params)!r}",
+            f"SHELL_PARAMS = {tuple(shell_params)!r}", f"UPPER = {FORM_UPPER!r}", ""]
+    return "\n".join(head) + "\n" + form + "\n\n\n" + ref + "\n"

@@ -136,3 +136,34 @@ def test_pinned_shallow_cap_n0_eigenvalue_vanishes_at_the_inflation_fold():
         lam[d] = st.stability(state, modes=[0]).smallest[0]
     assert lam[1e-3] > 0
     assert lam[1e-2] / lam[1e-3] == pytest.approx(math.sqrt(10), rel=0.15)
+
+
+def test_the_generated_form_is_the_derived_one():
+    """The form the eigenproblem evaluates (generated code in the code cache) against SymPy's
+    own evaluation of the derived matrix, at random base states and modes."""
+    import json
+
+    from symbolic import second_variation as sv
+    from symbolic.build import structure_from_description
+    from symbolic.geometry import S as S_SYM
+
+    scene = sb.Scene.preset("base")
+    f, upper, params, shell_params, ref = st._form_functions(scene)
+    structure = structure_from_description(json.loads(json.dumps(scene.structure(), sort_keys=True)))
+    res = sv.second_variation_of(structure)
+    assert [str(p) for p in res.params] == params
+    rng = np.random.default_rng(3)
+    args = sv.BASE + res.params + (sv.N_MODE,)
+    for n in (0, 1, 5):
+        values = [*rng.uniform(0.3, 1.5, len(sv.BASE)), *rng.uniform(0.05, 0.5, len(res.params)), n]
+        got = f(*values)
+        subs = dict(zip(args, values))
+        for (i, j), g in zip(upper, got):
+            want = float(res.matrix[i, j].subs(subs).evalf(30))
+            assert float(g) == pytest.approx(want, rel=1e-11, abs=1e-12 * (1 + abs(want)))
+    S = np.array([0.2, 0.7])
+    R, Psi, dPsi, ks0, kt0 = (np.broadcast_to(v, S.shape) for v in ref(S, *[scene.values()[p] for p in shell_params]))
+    shell = structure.shell
+    for k, expr in enumerate((shell.R, shell.Psi)):
+        want = [float(expr.subs({S_SYM: s, **{q: scene.values()[str(q)] for q in shell.params}})) for s in S]
+        np.testing.assert_allclose((R, Psi)[k], want, rtol=1e-12)

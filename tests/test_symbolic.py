@@ -338,10 +338,10 @@ def test_user_shell_and_tip_generate_code():
 def test_powers_are_printed_without_float_or_half_exponents():
     """numba compiles ``x**(-1.0)`` and ``x**(3/2)`` to calls of pow; the printer writes them as
     quotients and square roots (their values: test_generated_functions_equal_direct_sympy_evaluation)."""
-    from symbolic.codegen import _Printer
+    from symbolic.codegen import Printer
 
     x, y = sp.symbols("x y", positive=True)
-    printer = _Printer()
+    printer = Printer()
     expected = {1 / x: "1/(x)", x ** -3: "1/(x**3)", x ** sp.Rational(3, 2): "numpy.sqrt(x)**3",
                 x ** sp.Rational(-5, 2): "1/(numpy.sqrt(x)**5)", 1 / (x + y): "1/(x + y)",
                 sp.sqrt(x): "numpy.sqrt(x)", x ** 2: "x**2"}
