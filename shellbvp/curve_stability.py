@@ -9,10 +9,14 @@
 * per curve :attr:`Curve.first_instability <shellbvp.io.Curve.first_instability>`: the first
   depth along the branch where a state is unstable, with its mode.
 
-``"points"`` evaluates every recorded state; ``"locate"`` then brackets the first sign change of
-``stability_min`` between two recorded states and narrows it by regula falsi on states solved at
-depths in between (the modes next to the critical one only; all modes again on the stable side
-of the final bracket).  A state the stability analysis does not handle gives NaN, and the reason
+``"points"`` evaluates every recorded state.  ``"locate"`` evaluates about
+:data:`LOCATE_SAMPLES` states spread along the curve, then every state between the last stable
+and the first unstable one of them, brackets the first sign change of ``stability_min`` between
+two neighbouring states and narrows it by regula falsi on states solved at depths in between
+(the modes next to the critical one only; all modes again on the stable side of the final
+bracket).  It assumes that a curve does not go unstable and back between two sampled states
+(an unstable window shorter than the sample's spacing is missed); ``"points"`` makes no such
+assumption, at the cost of every state.  A state the stability analysis does not handle gives NaN, and the reason
 is kept in the curve's settings (``stability_note``): nothing is guessed for it.
 """
 
@@ -35,6 +39,8 @@ STABILITY_FIELDS = {"stability_min": math.nan, "critical_mode": -1}
 NEAR_MODES = 2
 #: Largest number of states solved to narrow a bracket
 MAX_REFINE = 12
+#: ``"locate"`` analyses about this many recorded states spread along the curve first
+LOCATE_SAMPLES = 8
 
 
 @dataclass(frozen=True)
@@ -153,11 +159,24 @@ def assess(curve, choice: str = "points", *, delta_tol: float = 1e-4) -> None:
         return
     t0 = time.perf_counter()
     notes = []
+
+    def analyse(i):
+        mins[i], modes[i], why = point_stability(curve.solutions[i])
+        if why and why not in notes:
+            notes.append(why)
+        return mins[i] < 0
+
     try:
-        for i, sol in enumerate(curve.solutions):
-            mins[i], modes[i], why = point_stability(sol)
-            if why and why not in notes:
-                notes.append(why)
+        if choice == "points":
+            for i in range(n):
+                analyse(i)
+        else:  # a sample first; every state only between its last stable and first unstable one
+            stride = max(1, math.ceil(n / LOCATE_SAMPLES))
+            sample = sorted(set(range(0, n, stride)) | {n - 1})
+            hit = next((k for k, i in enumerate(sample) if analyse(i)), None)
+            if hit is not None:
+                start = sample[hit - 1] + 1 if hit else 0
+                next((i for i in range(start, sample[hit]) if analyse(i)), None)
         first = next((i for i in range(n) if mins[i] < 0), None)
         if first is not None:
             curve.first_instability = _first(curve, first, mins, modes, choice, delta_tol)

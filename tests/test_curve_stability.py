@@ -149,4 +149,27 @@ def test_locate_narrows_the_first_sign_change_on_states_solved_between_points(mo
     assert first.delta == pytest.approx(0.3, abs=1e-6)
     assert first.force == pytest.approx(sb.solve(scene, delta=0.3).force, rel=1e-4)
     assert "loses axisymmetric stability at delta = 0.3 (n = 4)" in c.summary()
-    np.testing.assert_array_equal(c.points["critical_mode"], 4)
+    np.testing.assert_array_equal(c.points["critical_mode"], [4, 4, 4, 4, -1])  # analysed up to the first unstable
+
+
+def test_locate_samples_the_curve_then_analyses_only_the_bracket(monkeypatch):
+    import shellbvp.curve_stability as cs
+
+    seen = []
+
+    def fake(state, modes=None):
+        seen.append(round(state.delta, 6))
+        return 0.33 - state.delta, 2, ""
+
+    monkeypatch.setattr(cs, "point_stability", fake)
+    monkeypatch.setattr(cs, "LOCATE_SAMPLES", 4)
+    c = sb.curve(sb.Scene.preset("base"), deltas=np.linspace(0.05, 0.6, 12), estimate_error=False)
+    analysed = lambda: np.flatnonzero(np.isfinite(c.points["stability_min"]))
+    assess(c, "locate", delta_tol=1e-3)
+    d = c.points["delta"]
+    # the sample (every third point and the last), then the points after the last stable sample
+    assert list(analysed()) == [0, 3, 4, 5, 6], d[analysed()]
+    assert c.first_instability.located and c.first_instability.delta == pytest.approx(0.33, abs=1e-3)
+    seen.clear()
+    assess(c, "points")
+    assert len(analysed()) == 12
