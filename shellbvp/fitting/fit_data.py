@@ -10,6 +10,7 @@ import math
 import numpy as np
 
 from ..fit_checks import TREND_P, rank_trend
+from ..instrument import estimate_contact
 from ..shape_parameters import SHAPE_PARAMETERS, shape_parameter
 from .curves import N_DEPTHS, ModelCurves
 from .intervals import result_of
@@ -290,8 +291,6 @@ def fit_record(scene, record, *, R_L, segment="loading", baseline="auto", **opti
     >>> print(f"baseline {res.baseline * 1e3:.3f} mN, contact at {res.offset * 1e3:.4f} mm")
     baseline 0.050 mN, contact at 0.0100 mm
     """
-    from ..instrument import estimate_contact
-
     if baseline not in ("auto",) + BASELINES:
         raise ValueError(f"baseline must be one of {('auto',) + BASELINES}; got {baseline!r}")
     used = record.mask(segment)
@@ -301,17 +300,33 @@ def fit_record(scene, record, *, R_L, segment="loading", baseline="auto", **opti
                          f"{' and time' if record.time is not None else ''}); choose another with --segment "
                          f"(one of loading, retraction, all)")
     d, f = record.displacement[used], record.force[used]
-    guess = estimate_contact(d, f)
+    estimate = estimate_contact(d, f)
     if baseline == "auto":
-        baseline = "constant" if guess is not None else "none"
-    if not options.get("fit_offset", True):
-        guess = 0.0  # the contact point is known: displacements are measured from it
-    elif guess is None:
-        # no baseline to read: the record starts in contact.  Displacements measured from about
-        # the contact (the old convention) keep 0; otherwise the first row is the best guess.
-        lo = float(np.min(d))
-        guess = 0.0 if 0.0 <= lo and np.max(d) <= 3 * np.ptp(d) else lo
+        baseline = "constant" if estimate is not None else "none"
+    guess = _contact_guess(d, estimate, options.get("fit_offset", True))
     res = fit(scene, d, f, R_L=R_L, baseline=baseline, contact_guess=guess, **options)
+    _warn_of_segments(res, record, segment, used)
+    if segment == "loading":
+        record.relabel(res.offset)
+    return res, used
+
+
+def _contact_guess(d, estimate, fit_offset):
+    """The contact point (m) a fit of a record's rows at displacements ``d`` starts from, given
+    the ``estimate`` read from the approach's baseline (None: none could be read)."""
+    if not fit_offset:
+        return 0.0  # the contact point is known: displacements are measured from it
+    if estimate is not None:
+        return estimate
+    # no baseline to read: the record starts in contact.  Displacements measured from about
+    # the contact (the old convention) keep 0; otherwise the first row is the best guess.
+    lo = float(np.min(d))
+    return 0.0 if 0.0 <= lo and np.max(d) <= 3 * np.ptp(d) else lo
+
+
+def _warn_of_segments(res, record, segment, used):
+    """Warnings (added to ``res``) about the record's segments around the ``used`` rows: the
+    loading and the retraction fitted together, or loading passes left out."""
     counts = record.counts()
     if segment == "all" and counts.get("retraction") and counts.get("loading"):
         text = (f"the fitted rows mix the loading ({counts['loading']} rows) and the retraction "
@@ -328,5 +343,3 @@ def fit_record(scene, record, *, R_L, segment="loading", baseline="auto", **opti
                                 f"(the longest push) were fitted, {where} left out; if the passes differ (a "
                                 f"sample that changed, a re-test), cut the file and fit each")
             res.warning_codes.append("several_loadings")
-        record.relabel(res.offset)
-    return res, used
