@@ -40,6 +40,35 @@ def _plan(base_scene, grid, delta_max, settings, path, extend, restart):
     return meta, index, check_scenes(base_scene, names, combos, delta_max, settings), found is None
 
 
+def _compute_pending(index, scenes, delta_max, settings, writer, executor, workers, progress):
+    """The index's pending combinations, and those in error, computed through ``executor`` (None:
+    a local pool of ``workers``, or this process with ``workers=1``) and written by ``writer``
+    batch by batch as they finish: (curves by combination, computed, lost)."""
+    curves = {}
+
+    def on_records(records):
+        for rec in records:
+            if rec["status"] != "error":
+                curves[rec["index"]] = curve_of(rec, scenes[rec["index"]])
+        writer.add(records, curves)
+        if progress is not None:
+            for rec in records:
+                done[0] += 1
+                progress(rec, done[0], len(todo))
+
+    # pending cells, and those in error: an exception may be passing (memory, a worker killed);
+    # a curve that stopped early is a result and stays
+    todo = [i for i, st in enumerate(index["status"]) if st in ("pending", "error")]
+    done = [0]
+    own = local_pool(workers) if executor is None and workers != 1 and todo else None
+    try:
+        computed, lost = compute(todo, lambda i: (i, scenes[i], delta_max, settings), executor or own, on_records)
+    finally:
+        if own is not None:
+            own.shutdown(wait=True, cancel_futures=True)
+    return curves, computed, lost
+
+
 def sweep(base_scene, grid, *, delta_max, executor=None, out=None, workers=None, extend=False,
           restart=False, progress=None, max_cells=MAX_CELLS, **curve_settings) -> Sweep:
     """One curve per combination of ``grid`` values, through an executor, into one file.
@@ -130,30 +159,9 @@ def sweep(base_scene, grid, *, delta_max, executor=None, out=None, workers=None,
         # derive each structure's code here, once, before any worker needs it (they load it from the cache)
         for desc in {json.dumps(sc.structure(), sort_keys=True): sc.structure() for sc in scenes}.values():
             load_module(desc)
-        curves = {}
-
-        def on_records(records):
-            for rec in records:
-                if rec["status"] != "error":
-                    curves[rec["index"]] = curve_of(rec, scenes[rec["index"]])
-            writer.add(records, curves)
-            if progress is not None:
-                for rec in records:
-                    done[0] += 1
-                    progress(rec, done[0], len(todo))
-
-        # pending cells, and those in error: an exception may be passing (memory, a worker killed);
-        # a curve that stopped early is a result and stays
-        todo = [i for i, st in enumerate(index["status"]) if st in ("pending", "error")]
-        done = [0]
         t0 = time.perf_counter()
-        own = local_pool(workers) if executor is None and workers != 1 and todo else None
-        try:
-            computed, lost = compute(todo, lambda i: (i, scenes[i], delta_max, settings), executor or own,
-                                      on_records)
-        finally:
-            if own is not None:
-                own.shutdown(wait=True, cancel_futures=True)
+        curves, computed, lost = _compute_pending(index, scenes, delta_max, settings, writer, executor, workers,
+                                                  progress)
     log.info("sweep: %d curves computed in %.1f s (%d lost)", computed, time.perf_counter() - t0, lost)
     if path is not None:
         result = read_sweep(path)
