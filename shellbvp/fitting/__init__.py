@@ -43,13 +43,15 @@ models), :mod:`~shellbvp.fitting.profile` (a shape parameter's profile likelihoo
 
 from __future__ import annotations
 
-from ..fit_checks import FIT_STATUS, FIT_WARNINGS, PLAUSIBLE_MU_H, QUALITY_RULES, diagnostics_lines, fit_quality, runs_test
+from ..fit_checks import (FIT_STATUS, FIT_WARNINGS, PLAUSIBLE_MU_H, QUALITY_RULES, diagnostics_lines, fit_quality,
+                          runs_test)
 from ..instrument import read_force_csv
 from .curves import N_DEPTHS, clear_model_curves
 from .fit_data import example_data_path, fit, fit_record, free_parameters
 from .least_squares import BASELINES, DEFAULT_WEIGHTS, MODEL_PARAMETERS, WEIGHTS
 from .result import Estimate, FitResult
 
-__all__ = ["FitResult", "fit", "fit_quality", "diagnostics_lines", "QUALITY_RULES", "read_force_csv", "example_data_path", "WEIGHTS",
-           "DEFAULT_WEIGHTS", "FIT_STATUS", "FIT_WARNINGS", "PLAUSIBLE_MU_H", "runs_test", "BASELINES", "MODEL_PARAMETERS", "fit_record",
-           "Estimate", "free_parameters", "N_DEPTHS", "clear_model_curves"]
+__all__ = ["FitResult", "fit", "fit_quality", "diagnostics_lines", "QUALITY_RULES", "read_force_csv",
+           "example_data_path", "WEIGHTS", "DEFAULT_WEIGHTS", "FIT_STATUS", "FIT_WARNINGS", "PLAUSIBLE_MU_H",
+           "runs_test", "BASELINES", "MODEL_PARAMETERS", "fit_record", "Estimate", "free_parameters", "N_DEPTHS",
+           "clear_model_curves"]

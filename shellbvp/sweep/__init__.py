@@ -49,5 +49,6 @@ from .result import STATUSES, Sweep
 from .run import sweep
 from .work import run_curve
 
-__all__ = ["sweep", "check_grid", "MAX_CELLS", "die_with_parent", "read_sweep", "run_curve", "Sweep", "SWEEP_PARAMETERS", "STATUSES", "FORMAT",
-           "FORMAT_VERSION", "is_sweep_file", "dask_executor", "local_pool", "scene_at", "SCHEDULER_ADDRESS"]
+__all__ = ["sweep", "check_grid", "MAX_CELLS", "die_with_parent", "read_sweep", "run_curve", "Sweep",
+           "SWEEP_PARAMETERS", "STATUSES", "FORMAT", "FORMAT_VERSION", "is_sweep_file", "dask_executor",
+           "local_pool", "scene_at", "SCHEDULER_ADDRESS"]
