@@ -107,3 +107,18 @@ def _benchmark_pages():
 
 
 _benchmark_pages()
+
+
+def _skip_class_with_its_own_page(app, what, name, obj, skip, options):
+    """A public class defined in a module of a subpackage (``FitResult`` in
+    ``shellbvp.fitting.result``) has its own page (``shellbvp.FitResult``); the subpackage's page,
+    which re-exports it, does not describe it a second time: both descriptions would claim the
+    class's one canonical name."""
+    if what == "module" and isinstance(obj, type) and name in shellbvp.__all__ \
+            and getattr(shellbvp, name, None) is obj and obj.__module__.count(".") >= 2:
+        return True
+    return None
+
+
+def setup(app):
+    app.connect("autodoc-skip-member", _skip_class_with_its_own_page)

@@ -50,7 +50,7 @@ def _fresh_code_cache(tmp_path_factory):
 @pytest.fixture
 def closed_form(monkeypatch):
     """The fit's model curves replaced by :class:`fake_curves.FakeCurve` (counted as computed)."""
-    import shellbvp.fitting
+    import shellbvp.fitting.curves
     from fake_curves import FakeCurve
 
     def fake(scene, deltas, tol, counter=None, progress=None):
@@ -58,4 +58,4 @@ def closed_form(monkeypatch):
             counter[0] += 1
         return FakeCurve(scene, deltas)
 
-    monkeypatch.setattr(shellbvp.fitting, "_model_curve", fake)
+    monkeypatch.setattr(shellbvp.fitting.curves, "_model_curve", fake)

@@ -126,7 +126,7 @@ def test_fit_shape_parameter_logic_on_closed_form_curves(monkeypatch, name, trut
             counter[0] += 1
         return _FakeCurve(scene, deltas)
 
-    monkeypatch.setattr(sb.fitting, "_model_curve", fake)
+    monkeypatch.setattr(sb.fitting.curves, "_model_curve", fake)
     mat = (lambda a: sb.MooneyRivlin(a))
     scene0 = sb.Scene.preset("fit", **({"beta": start} if name == "beta" else {"material": mat(start)}))
     true_scene = scene0.replace(**({"beta": truth} if name == "beta" else {"material": mat(truth)}))
@@ -282,9 +282,9 @@ def test_model_force_at_another_mu_h_scales_the_shell_force_only(monkeypatch):
             counter[0] += 1
         return _FakeCurve(scene, deltas)
 
-    import shellbvp.fitting as fitting
+    import shellbvp.fitting.curves
 
-    monkeypatch.setattr(fitting, "_model_curve", fake)
+    monkeypatch.setattr(shellbvp.fitting.curves, "_model_curve", fake)
     scene = sb.Scene.preset("fit")
     x = np.linspace(-0.05, 0.4, 46)
     rng = np.random.default_rng(2)

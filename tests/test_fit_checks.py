@@ -72,7 +72,7 @@ def no_model_curves(monkeypatch):
     def forbidden(*a, **k):
         raise AssertionError("a model curve was computed before the data were checked")
 
-    monkeypatch.setattr(fitting, "_model_curve", forbidden)
+    monkeypatch.setattr(fitting.curves, "_model_curve", forbidden)
 
 
 def test_pure_noise_is_an_error(good, no_model_curves):
@@ -121,7 +121,7 @@ def test_infinite_values_are_an_error(good, no_model_curves):
         sb.fit(scene, disp, bad, R_L=R_L)
     nan = force.copy()
     nan[3] = np.nan  # a missing value is dropped, not an error (documented)
-    assert fitting._check_data(disp, nan, 2)[0].size == N - 1
+    assert fitting.fit_data._check_data(disp, nan, 2)[0].size == N - 1
 
 
 def test_data_shallower_than_the_model_starts(good):
@@ -143,7 +143,7 @@ def test_data_deeper_than_the_model_reaches(good, monkeypatch):
         def __len__(self):
             return self.delta.size
 
-    monkeypatch.setattr(fitting, "_model_curve", lambda scene, deltas, tol, counter=None, progress=None: Short(scene, deltas))
+    monkeypatch.setattr(fitting.curves, "_model_curve", lambda scene, deltas, tol, counter=None, progress=None: Short(scene, deltas))
     scene, disp, F, force = good
     with pytest.raises(ValueError, match=r"data reach delta = 0\.48.* model curve ends at delta = 0\.18.*end of the tip"):
         sb.fit(scene, disp, force, R_L=R_L)
@@ -304,12 +304,12 @@ def test_cli_data_deeper_than_the_scene_allows(good, tmp_path):
 
 
 def test_the_rank_trend_is_spearmans_test_as_scipy_computes_it():
-    """fitting.rank_trend (scipy.special only: scipy.stats costs 0.4 s to import) against
+    """fit_checks.rank_trend (scipy.special only: scipy.stats costs 0.4 s to import) against
     scipy.stats.spearmanr, ties and perfect correlation included."""
     import numpy as np
     from scipy import stats
 
-    from shellbvp.fitting import rank_trend
+    from shellbvp.fit_checks import rank_trend
 
     rng = np.random.default_rng(7)
     for n in (3, 6, 25, 120):

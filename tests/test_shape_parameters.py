@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import shellbvp as sb
-import shellbvp.fitting
+import shellbvp.fitting.intervals
 from shellbvp.shape_parameters import DERIVED, SHAPE_PARAMETERS, Derived
 
 from fake_curves import FakeCurve
@@ -55,9 +55,9 @@ def test_a_derived_interval_on_the_log_scale_stays_positive():
     plain = Derived("r", "1", "r", "", "", **ratio)
     logged = Derived("r", "1", "r", "", "", log_interval=True, **ratio)
     cov = np.diag([1.0, 0.0, 0.36])  # (mu_H, offset, theta); theta = ln x, x = 1: sd(ln x) = 0.6
-    value, (lo, hi) = shellbvp.fitting._linearised(plain, 1.0, 1.0, 2.0, 1.0, cov, 2.0)
+    value, (lo, hi) = shellbvp.fitting.intervals._linearised(plain, 1.0, 1.0, 2.0, 1.0, cov, 2.0)
     assert value == 2.0 and lo == pytest.approx(2.0 - 2 * math.sqrt(1 + 4 * 0.36)) and lo < 0
-    value, (lo, hi) = shellbvp.fitting._linearised(logged, 1.0, 1.0, 2.0, 1.0, cov, 2.0)
+    value, (lo, hi) = shellbvp.fitting.intervals._linearised(logged, 1.0, 1.0, 2.0, 1.0, cov, 2.0)
     half = 2 * math.sqrt(0.25 + 0.36)  # sd of ln(mu_H / x): (1/mu_H, -1) against the covariance
     assert (lo, hi) == pytest.approx((2 * math.exp(-half), 2 * math.exp(half))) and lo > 0
 

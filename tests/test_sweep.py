@@ -227,7 +227,8 @@ def test_a_dask_cluster_that_goes_away_mid_run_leaves_its_curves_pending(tmp_pat
     import importlib
     from concurrent.futures import Future
 
-    sw = importlib.import_module("shellbvp.sweep")  # the module (the package's attribute is the function)
+    sw = importlib.import_module("shellbvp.sweep")  # the subpackage (the package's attribute is the function)
+    from shellbvp.sweep.work import _executor_gone
 
     class Client:
         status = "closed"  # what a dask Client says once its scheduler is gone for good
@@ -243,7 +244,7 @@ def test_a_dask_cluster_that_goes_away_mid_run_leaves_its_curves_pending(tmp_pat
                    deltas=[0.1], estimate_error=False)
     assert res.computed == 0 and res.lost == 2 and sw.read_sweep(tmp_path / "g.h5").counts() == {"pending": 2}
     Client.status = "running"  # a live cluster that is merely slow is waited for
-    assert not sw._executor_gone(GoneExecutor())
+    assert not _executor_gone(GoneExecutor())
 
 
 def test_cli_sweep_and_info(tmp_path, capsys):

@@ -1,0 +1,345 @@
+"""The fits a user calls: :func:`fit` (measured displacement and force, checked before any
+model curve, then mu*H, the contact point, a baseline and optionally a shape parameter) and
+:func:`fit_record` (one segment of an instrument record); :func:`free_parameters` reads what
+a fit frees."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..fit_checks import TREND_P, rank_trend
+from ..instrument import estimate_contact
+from ..shape_parameters import SHAPE_PARAMETERS, shape_parameter
+from .curves import N_DEPTHS, ModelCurves
+from .intervals import result_of
+from .least_squares import BASELINES, DEFAULT_WEIGHTS, WEIGHTS, Fitted, LeastSquaresModel, NoiseModel
+from .profile import ProfileSearch, search_of
+
+__all__ = ["fit", "fit_record", "free_parameters", "example_data_path"]
+
+
+def example_data_path():
+    """Path of the synthetic Lepidium-like CSV shipped with the package (README example)."""
+    from pathlib import Path
+
+    return Path(__file__).parents[1] / "data" / "lepidium_synthetic.csv"
+
+
+def _check_data(d, f, k, origin=0.0):
+    """Checks of the data before any model curve; returns the finite rows, or raises ValueError.
+
+    ``k`` is the number of fitted parameters.  NaN rows are dropped (missing
+    values); infinite values, too few distinct displacements and a force that
+    does not increase with depth are errors.
+    """
+    if d.shape != f.shape:
+        raise ValueError(f"displacement and force must have the same length; got {d.size} and {f.size}")
+    for name, v in (("displacement", d), ("force", f)):
+        bad = np.flatnonzero(np.isinf(v))
+        if bad.size:
+            raise ValueError(f"{name} must be finite; got {v[bad[0]]} at index {bad[0]} "
+                             f"({bad.size} infinite values)")
+    keep = np.isfinite(d) & np.isfinite(f)
+    d, f = d[keep], f[keep]
+    need = max(3, k + 2)
+    if d.size < need:
+        raise ValueError(f"need at least {need} finite data points; got {d.size}")
+    distinct = np.unique(d).size
+    if distinct < need:
+        raise ValueError(f"displacement: need at least {need} distinct values to fit {k} parameters; got "
+                         f"{distinct} (the data are {d.size} points at {distinct} depth(s))")
+    if np.max(d) <= origin:
+        raise ValueError("displacement must reach positive values (indentation into the shell)" if origin == 0 else
+                         f"displacement must reach beyond the contact point guess {origin:g} m")
+    if np.ptp(f) == 0:
+        raise ValueError(f"force is constant ({f[0]:g} N at every point): it must increase with the depth "
+                         "of indentation")
+    rho, p, p_less = rank_trend(d, f)
+    if not p < TREND_P and p_less < TREND_P:
+        raise ValueError(f"force falls as the displacement grows (Spearman rank correlation {rho:.2f}): the "
+                         "displacement runs the other way (an AFM height falls as the tip goes in) or the "
+                         "compression is recorded as a negative force; flip one with --invert displacement or "
+                         "--invert force (read_instrument(..., invert=...))")
+    if not p < TREND_P:
+        raise ValueError(f"force does not increase with displacement (Spearman rank correlation {rho:.2f}, "
+                         f"one-sided p = {p:.2g}, needed < {TREND_P:g}): these data show no indentation "
+                         "response to fit (check the columns and their order with --columns)")
+    return d, f
+
+
+def fit(scene, displacement, force, *, R_L, fit_offset=True, free=(), bounds=None, weights=None, floor=0.05,
+        delta_max=None, tol=1e-6, loss="linear", baseline="none", contact_guess=None, progress=None, **aliases):
+    """Least-squares fit of mu*H (the displacement origin, and a shape parameter) to measured data.
+
+    Parameters
+    ----------
+    scene : Scene
+        Shape, indenter, material and beta (nondimensional); a free shape parameter's value
+        in it is the start of the search.
+    displacement, force : array_like
+        Measured indenter displacement (m, > 0 into the shell) and force (N).
+    R_L : float
+        Rim radius of the sample (m).
+    fit_offset : bool
+        Also fit the origin of the displacement (contact point).
+    baseline : {"none", "constant", "linear"}
+        Force baseline fitted with the contact point (as nanite does): ``"constant"`` adds
+        a force offset b0 (the force the instrument reads before contact), ``"linear"``
+        also a slope, ``b0 + b1 (d - d0)`` (a tilted baseline: drift or drag, continued
+        through contact).  It needs data before the contact point (the approach) to be
+        determined well.
+    contact_guess : float, optional
+        A first guess of the contact point (m; e.g. :func:`shellbvp.instrument.estimate_contact`):
+        the model curve is computed to 1.2 x the depth of the data beyond it.  Default 0
+        (displacements measured from about the contact point).
+    progress : callable, optional
+        ``progress(description, delta_max) -> (bar, callback)`` for each model curve computed
+        (e.g. ``lambda d, m: shellbvp.progress.curve_progress(m, d)``); None: silent.
+    free : sequence of str
+        Also fit a shape parameter, a name of :data:`shellbvp.shape_parameters.SHAPE_PARAMETERS`
+        (one at most), e.g. ``"beta"``, the Mooney–Rivlin ``"alpha"`` (subset of [0, 1]), the
+        ``"pressure"`` below the shell (nondimensional ``p R_L/(mu H)``; default range from 0 to
+        the larger of 4 times the scene's and ``40 sqrt(3 beta)``, i.e. Vella's ``tau = p R^2/(4
+        sqrt(B Y))`` up to 10 for a pole of unit curvature) or the shell's ``"thickness"``
+        (``H/R_L``, from the scene's; beta follows it).  With the pressure fitted, one curve gives
+        mu*H and the pressure in Pa (Vella et al. 2012's assay, with the full model); with the
+        thickness, H and the modulus mu = mu*H / H.
+    bounds : dict, optional
+        ``{name: (low, high)}``: the search range of the free parameter (nondimensional, as in
+        the scene); default the parameter's own.
+    **aliases
+        ``fit_<name>=True`` and ``<name>_bounds=(low, high)`` for each shape parameter (e.g.
+        ``fit_beta=True, beta_bounds=(1e-3, 0.1)``): the same as ``free`` and ``bounds``.
+    weights : {"uniform", "relative", "mixed"}, optional
+        Noise model: the same force noise at every point, noise proportional
+        to the force, or both (``sigma^2 = a^2 + b^2 F^2``, a and b estimated);
+        default :data:`DEFAULT_WEIGHTS` ("mixed", see benchmarks/fit_coverage.py).
+    floor : float
+        With relative weights, forces below ``floor * max|force|`` are weighted
+        as if they were that large (near the contact point F -> 0); in (0, 1].
+    delta_max : float, optional
+        Largest depth of the model curves (default: 1.2 x the largest measured depth/R_L).
+    tol : float
+        Collocation tolerance of the model curves.
+    loss : str
+        scipy.optimize.least_squares loss ('linear', or 'soft_l1' to damp outliers).
+
+    Returns
+    -------
+    FitResult
+        ``status`` (:data:`FIT_STATUS`) 0 only when the solver converged, mu*H > 0
+        and the 95 % intervals of mu*H and the offset are finite with mu*H's
+        narrower than mu*H itself.  ``warnings``: a residual sign pattern the
+        noise model does not explain (:func:`runs_test`, p < :data:`RUNS_P`, at
+        least :data:`RUNS_MIN_POINTS` points), mu*H outside :data:`PLAUSIBLE_MU_H`,
+        a shape parameter's interval at its search bound.
+
+    Raises
+    ------
+    ValueError
+        For arguments out of range and for data the fit cannot use, before any
+        model curve is computed: infinite values, fewer than ``max(3, p + 2)``
+        distinct displacements (p fitted parameters), a force that does not
+        increase with displacement (Spearman, one-sided p >= :data:`TREND_P`),
+        data too shallow for the model curve to start (one solve at its first
+        depth); and, once the curve is computed, data deeper than it reaches.
+
+    Examples
+    --------
+    The synthetic record shipped with the package (preset ``fit``, R_L = 0.3 mm,
+    mu*H = 52 N/m, 2 % noise); one model curve, about 3 s:
+
+    >>> import shellbvp as sb
+    >>> from shellbvp.fitting import example_data_path
+    >>> d, F = sb.read_force_csv(example_data_path())
+    >>> res = sb.fit(sb.Scene.preset("fit"), d, F, R_L=0.3e-3)
+    >>> print(f"mu*H = {res.mu_H:.2f} N/m [{res.mu_H_ci95[0]:.2f}, {res.mu_H_ci95[1]:.2f}], "
+    ...       f"offset {res.offset * 1e6:.2f} um")
+    mu*H = 51.91 N/m [51.53, 52.29], offset 9.95 um
+
+    Data the fit cannot use are refused before any curve is computed:
+
+    >>> sb.fit(sb.Scene.preset("fit"), d[:3], F[:3], R_L=0.3e-3)
+    Traceback (most recent call last):
+    ...
+    ValueError: ...
+    """
+    weights = DEFAULT_WEIGHTS if weights is None else weights
+    if weights not in WEIGHTS:
+        raise ValueError(f"weights must be one of {WEIGHTS}; got {weights!r}")
+    if not (isinstance(floor, (int, float)) and 0 < floor <= 1):
+        raise ValueError(f"floor (of relative weights, fraction of max |force|) must be in (0, 1]; got {floor!r}")
+    free, bounds = free_parameters(free, bounds, aliases)
+    if baseline not in BASELINES:
+        raise ValueError(f"baseline must be one of {BASELINES}; got {baseline!r}")
+    origin = 0.0 if contact_guess is None else contact_guess
+    if not (isinstance(origin, (int, float)) and math.isfinite(origin)):
+        raise ValueError(f"contact_guess (m) must be a finite number; got {contact_guess!r}")
+    d = np.asarray(displacement, float).ravel()
+    f = np.asarray(force, float).ravel()
+    keep = np.isfinite(d) & np.isfinite(f) if d.shape == f.shape else None
+    k = 1 + bool(fit_offset) + len(free) + (baseline != "none") + (baseline == "linear")
+    d, f = _check_data(d, f, k, float(origin))
+    if not (isinstance(R_L, (int, float)) and math.isfinite(R_L) and R_L > 0):
+        raise ValueError(f"R_L (rim radius, m) must be a finite number > 0; got {R_L!r}")
+    sp = search_of(scene, free[0], bounds.get(free[0])) if free else None
+    depth = (np.max(d) - origin) / R_L  # the deepest datum's delta, if the contact is at the guess
+    dm = 1.2 * depth if delta_max is None else float(delta_max)
+    if not (math.isfinite(dm) and dm > 0):
+        raise ValueError(f"delta_max must be > 0; got {delta_max!r}")
+    grid = dm * np.arange(1, N_DEPTHS + 1) / N_DEPTHS
+    counter = [0]
+    mdl = LeastSquaresModel(d, f, R_L, fit_offset, baseline, loss)
+    noise = NoiseModel(weights, floor)
+    if sp is None:
+        shape = ModelCurves(lambda th: scene, grid, tol, depth, counter, progress)
+        shape.add(None)
+        P, dP, top = shape.at(None)
+        res, rss, J, w = noise.irls(mdl, P, dP, top)
+        fitted = Fitted(res, rss, J, w, scene, shape.nodes[None], P, top)
+        notes = []
+    else:
+        search = ProfileSearch(sp, ModelCurves(sp.scene_at, grid, tol, depth, counter, progress), mdl, depth)
+        fitted = search.run(noise, k)
+        notes = search.notes
+    return result_of(fitted, mdl, sp, k, notes, keep, weights, baseline, counter[0])
+
+
+def free_parameters(free=(), bounds=None, aliases=None):
+    """``(free, bounds)`` of :func:`fit` checked, its ``fit_<name>`` and ``<name>_bounds``
+    aliases folded in: a tuple of shape parameter names (one at most) and ``{name: bounds}``."""
+    free = (free,) if isinstance(free, str) else tuple(free)
+    bounds = dict(bounds or {})
+    for key, value in (aliases or {}).items():
+        if key.startswith("fit_") and key[4:] in SHAPE_PARAMETERS:
+            free += (key[4:],) if value else ()
+        elif key.endswith("_bounds") and key[:-7] in SHAPE_PARAMETERS:
+            if value is not None:
+                bounds[key[:-7]] = value
+        else:
+            raise TypeError(f"fit() got an unexpected keyword argument {key!r}")
+    for name in free + tuple(bounds):
+        shape_parameter(name)
+    free = tuple(dict.fromkeys(free))
+    if len(free) > 1:
+        raise ValueError(f"{', '.join(f'fit_{n}' for n in SHAPE_PARAMETERS)}: fit one of "
+                         f"{', '.join(SHAPE_PARAMETERS)} at a time (each changes the curve's shape only weakly; two "
+                         f"with mu*H are not identifiable from one curve); got {', '.join(free)}")
+    return free, bounds
+
+
+def fit_record(scene, record, *, R_L, segment="loading", baseline="auto", **options):
+    """Fit one segment of an instrument record (:func:`shellbvp.instrument.read_instrument`).
+
+    Parameters
+    ----------
+    scene : Scene
+    record : InstrumentRecord
+    R_L : float
+        Rim radius (m).
+    segment : {"loading", "retraction", "all"}
+        Rows to fit (:meth:`InstrumentRecord.mask`): by default the pushing part, the
+        approach and the loading, never the retraction with it.
+    baseline : {"auto", "none", "constant", "linear"}
+        ``auto``: a constant baseline when the segment has an approach before contact
+        (:func:`shellbvp.instrument.estimate_contact` finds one), none otherwise.
+    **options
+        Passed to :func:`fit` (``fit_offset``, ``free``, ``weights``, ``tol``, ...).
+
+    Returns
+    -------
+    result : FitResult
+    used : ndarray of bool, shape (len(record),)
+        The rows fitted.  With ``segment="loading"`` the record's pushing rows are
+        relabelled at the fitted contact point (before it 'approach').
+
+    Raises
+    ------
+    ValueError
+        An unknown segment or baseline, a segment with fewer than 3 rows (the message
+        gives each segment's count), or what :func:`fit` refuses.
+
+    Examples
+    --------
+    An instrument record made from the shipped example (mu*H = 52 N/m, contact at
+    0.01 mm): an approach at a force baseline of 0.05 mN, the loading, and a
+    retraction that carries less force (hysteresis), in um and uN:
+
+    >>> import os, tempfile
+    >>> import numpy as np
+    >>> import shellbvp as sb
+    >>> from shellbvp.fitting import example_data_path
+    >>> d, F = sb.read_force_csv(example_data_path())             # m, N
+    >>> disp = np.r_[np.linspace(0, 9e-6, 10), d, d[::-1]]
+    >>> force = np.r_[np.zeros(10), F, 0.85 * F[::-1]] + 50e-6
+    >>> path = os.path.join(tempfile.mkdtemp(), "seed1.tsv")
+    >>> with open(path, "w") as fh:
+    ...     _ = fh.write("Time (s)\\tDisplacement (um)\\tForce (uN)\\n")
+    ...     _ = fh.writelines(f"{0.1 * i:.1f}\\t{a * 1e6:.3f}\\t{b * 1e6:.3f}\\n"
+    ...                       for i, (a, b) in enumerate(zip(disp, force)))
+    >>> rec = sb.read_instrument(path)
+    >>> res, used = sb.fit_record(sb.Scene.preset("fit"), rec, R_L=0.3e-3)
+    >>> res.success, res.fitted, res.baseline_model
+    (True, ('mu_H', 'offset', 'baseline'), 'constant')
+    >>> int(used.sum()), rec.counts()                 # approach and loading fitted, not the retraction
+    (50, {'approach': 10, 'loading': 40, 'retraction': 40})
+    >>> lo, hi = res.mu_H_ci95
+    >>> bool(lo < 52 < hi)
+    True
+    >>> print(f"baseline {res.baseline * 1e3:.3f} mN, contact at {res.offset * 1e3:.4f} mm")
+    baseline 0.050 mN, contact at 0.0100 mm
+    """
+    if baseline not in ("auto",) + BASELINES:
+        raise ValueError(f"baseline must be one of {('auto',) + BASELINES}; got {baseline!r}")
+    used = record.mask(segment)
+    if used.sum() < 3:
+        raise ValueError(f"{record.path}: the {segment} segment has {int(used.sum())} rows; the record's segments "
+                         f"are {record.counts()} (by the direction of the displacement in file order"
+                         f"{' and time' if record.time is not None else ''}); choose another with --segment "
+                         f"(one of loading, retraction, all)")
+    d, f = record.displacement[used], record.force[used]
+    estimate = estimate_contact(d, f)
+    if baseline == "auto":
+        baseline = "constant" if estimate is not None else "none"
+    guess = _contact_guess(d, estimate, options.get("fit_offset", True))
+    res = fit(scene, d, f, R_L=R_L, baseline=baseline, contact_guess=guess, **options)
+    _warn_of_segments(res, record, segment, used)
+    if segment == "loading":
+        record.relabel(res.offset)
+    return res, used
+
+
+def _contact_guess(d, estimate, fit_offset):
+    """The contact point (m) a fit of a record's rows at displacements ``d`` starts from, given
+    the ``estimate`` read from the approach's baseline (None: none could be read)."""
+    if not fit_offset:
+        return 0.0  # the contact point is known: displacements are measured from it
+    if estimate is not None:
+        return estimate
+    # no baseline to read: the record starts in contact.  Displacements measured from about
+    # the contact (the old convention) keep 0; otherwise the first row is the best guess.
+    lo = float(np.min(d))
+    return 0.0 if 0.0 <= lo and np.max(d) <= 3 * np.ptp(d) else lo
+
+
+def _warn_of_segments(res, record, segment, used):
+    """Warnings (added to ``res``) about the record's segments around the ``used`` rows: the
+    loading and the retraction fitted together, or loading passes left out."""
+    counts = record.counts()
+    if segment == "all" and counts.get("retraction") and counts.get("loading"):
+        text = (f"the fitted rows mix the loading ({counts['loading']} rows) and the retraction "
+                f"({counts['retraction']} rows) of the record: with hysteresis the two branches differ and the "
+                f"fit of both is biased; fit one with --segment loading or retraction")
+        res.warnings.append(text)
+        res.warning_codes.append("mixed_segments")
+    if segment == "loading":
+        others = record.other_pushes()
+        if others:
+            where = ", ".join(f"rows {a + 1}-{b + 1}" for a, b, _ in others)
+            rows = np.flatnonzero(used)
+            res.warnings.append(f"the record holds {len(others) + 1} loading passes: rows {rows[0] + 1}-{rows[-1] + 1} "
+                                f"(the longest push) were fitted, {where} left out; if the passes differ (a "
+                                f"sample that changed, a re-test), cut the file and fit each")
+            res.warning_codes.append("several_loadings")

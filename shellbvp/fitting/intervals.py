@@ -1,0 +1,118 @@
+"""A fit's intervals and its result: Wald (Student's t) intervals of the free parameters from
+the weighted Jacobian, the shape parameter's profile interval, the linearised intervals of
+the quantities in lab units that depend on mu*H too, the checks on the result (status and
+warnings) and the diagnostics, gathered in a :class:`~shellbvp.fitting.result.FitResult`
+(:func:`result_of`)."""
+
+from __future__ import annotations
+
+import logging
+import math
+
+import numpy as np
+from scipy import special
+
+from ..fit_checks import FIT_STATUS, check_result, fit_diagnostics, runs_in_depth_order
+from ..shape_parameters import SHAPE_PARAMETERS
+from .least_squares import MODEL_PARAMETERS, LeastSquaresModel
+from .result import Estimate, FitResult
+
+log = logging.getLogger(__name__)
+
+__all__ = ["result_of"]
+
+
+def result_of(fitted, mdl, sp, k, notes, keep, weights, baseline, curves_computed):
+    """The :class:`FitResult` of what a fit found: Wald (t) intervals of the free parameters
+    from the weighted Jacobian, the shape parameter's profile interval, status and warnings."""
+    res, rss, J, w, P, top, R_L = fitted.res, fitted.rss, fitted.J, fitted.w, fitted.P, fitted.top, mdl.R_L
+    d, f = mdl.d, mdl.f
+    n = d.size
+    dof = max(n - k, 1)
+    cov = None
+    try:
+        cov = np.linalg.inv(J.T @ J) * rss / dof
+        half_free = special.stdtrit(dof, 0.975) * np.sqrt(np.diag(cov))
+    except np.linalg.LinAlgError:
+        half_free = np.full(J.shape[1], np.nan)
+    q = mdl.full(res.x)
+    half = np.zeros(4)
+    half[mdl.free] = half_free[:int(np.sum(mdl.free))]
+    ci = [(float(v - h), float(v + h)) for v, h in zip(q, half)]
+    mu_H, d0, b0, b1 = (float(v) for v in q)
+    off_ci = ci[1]
+
+    def model(disp, mu_H, d0, b0=b0, b1=b1):
+        disp = np.asarray(disp, float)
+        return mu_H * R_L * LeastSquaresModel.shape(P, top, (disp - d0) / R_L) + b0 + b1 * (disp - d0)
+
+    resid = model(d, mu_H, d0) - f
+    name = sp.name if sp is not None else None
+    fitted_names = tuple(nm for nm, free in zip(MODEL_PARAMETERS, mdl.free) if free) + ((name,) if name else ())
+    fit_scene, theta_hat, theta_ci = fitted.scene, fitted.theta, fitted.theta_ci
+    # the others' values in the scene at the estimate (the reported curve's scene is the nearest node's)
+    at_estimate = fit_scene if sp is None else sp.scene_at(theta_hat)
+    values, intervals = {}, {}
+    for param in SHAPE_PARAMETERS.values():
+        x = param.get(at_estimate)
+        values[param.name] = None if x is None else float(param.reported(x, R_L))
+    derived = _given_thickness(fit_scene, mu_H, ci[0], R_L)
+    if sp is not None:
+        param = sp.param
+        x_hat = param.from_theta(theta_hat)
+        values[name] = float(param.reported(x_hat, R_L))
+        intervals[name] = tuple(float(param.reported(param.from_theta(v), R_L)) for v in theta_ci)
+        t = special.stdtrit(dof, 0.975)
+        for dq in param.derived:
+            value, interval = _linearised(dq, x_hat, param.dx_dtheta(theta_hat), q[0], R_L, cov, t)
+            derived[dq.name] = Estimate(value, interval, dq.unit, dq.label, dq.display_unit, dq.note, name)
+    mu_ci = ci[0]
+    runs = runs_in_depth_order(resid, d)
+    status, checks = check_result(bool(res.success), mu_H, mu_ci, off_ci, bool(np.all(np.isfinite(resid))),
+                                   resid.size, runs)
+    found = notes + checks
+    for _, text in found:
+        log.info("fit: warning: %s", text)
+    message = f"{FIT_STATUS[status]} (least squares: {res.message})"
+    point_weights = np.full(keep.size, np.nan)
+    point_weights[keep] = w / np.max(w)
+    diagnostics = fit_diagnostics(cov, rss, n, J.shape[1], w * resid, d, runs)
+    return FitResult(mu_H=mu_H, mu_H_ci95=mu_ci, offset=d0,
+                     offset_ci95=off_ci, residual_rms=float(np.sqrt(np.mean(np.nan_to_num(resid, nan=mdl.big) ** 2))),
+                     n=n, status=status, message=message, R_L=float(R_L), curve=fitted.curve, _model=model,
+                     shape_values=values, shape_ci95=intervals, derived=derived, fitted=fitted_names,
+                     weights=weights, scene=fit_scene, curves_computed=curves_computed,
+                     interpolation_error=fitted.interpolation_error, warnings=[t for _, t in found],
+                     warning_codes=[code for code, _ in found], baseline_model=baseline, baseline=b0,
+                     baseline_ci95=ci[2], baseline_slope=b1, baseline_slope_ci95=ci[3],
+                     point_weights=point_weights, **diagnostics)
+
+
+def _linearised(dq, x, dx_dtheta, mu_H, R_L, cov, t):
+    """The derived quantity ``dq`` (:class:`shellbvp.shape_parameters.Derived`) and its interval
+    from the covariance of (mu_H, ..., theta) (theta, the shape parameter's search variable, last):
+    ``value +- t sd`` or, with ``dq.log_interval``, ``value exp(-+ t sd(ln value))``."""
+    value = dq.value(x, mu_H, R_L)
+    if cov is None or not np.all(np.isfinite(cov)):
+        return float(value), (math.nan, math.nan)
+    d_mu_H, d_x = dq.gradient(x, mu_H, R_L)
+    g = np.zeros(cov.shape[0])
+    g[0], g[-1] = d_mu_H, d_x * dx_dtheta
+    if dq.log_interval:
+        g = g / value
+    half = t * math.sqrt(max(float(g @ cov @ g), 0.0))
+    if dq.log_interval:
+        return float(value), (float(value * math.exp(-half)), float(value * math.exp(half)))
+    return float(value), (float(value - half), float(value + half))
+
+
+def _given_thickness(scene, mu_H, mu_H_ci, R_L):
+    """``{"mu": Estimate}`` of a scene with a thickness (mu*H over H, H taken as exact), else {}."""
+    from ..units import format_in
+
+    eps = getattr(scene, "thickness", None)
+    if eps is None:
+        return {}
+    H = eps * R_L
+    return {"mu": Estimate(mu_H / H, (mu_H_ci[0] / H, mu_H_ci[1] / H), "Pa", "mu", "MPa",
+                           f"H = {format_in(H, 'um', 'length')}, eps = H/R_L = {eps:.3g}, beta = eps^2/3")}

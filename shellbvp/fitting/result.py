@@ -1,0 +1,258 @@
+"""What a fit reports: :class:`FitResult` (mu*H, the offset, the baseline and a shape
+parameter with their intervals, the checks' status and warnings, the diagnostics) and
+:class:`Estimate`, a quantity in lab units beside mu*H; a result's JSON form (``to_dict``)."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..fit_checks import fit_quality
+from ..shape_parameters import DERIVED, SHAPE_PARAMETERS
+from .least_squares import DEFAULT_WEIGHTS
+
+__all__ = ["Estimate", "FitResult"]
+
+
+@dataclass(frozen=True)
+class Estimate:
+    """A quantity a fit reports in lab units beside mu*H (``FitResult.derived``): its value,
+    95 % interval and how the CLI shows it (``label = value display_unit   95% CI [..] (note)``);
+    ``of`` names the fitted shape parameter it comes from (None: from a given scene value)."""
+    value: float
+    ci95: tuple
+    unit: str
+    label: str
+    display_unit: str
+    note: str
+    of: str | None = None
+
+
+@dataclass
+class FitResult:
+    """Result of :func:`fit` (SI units).
+
+    Attributes
+    ----------
+    mu_H : float
+        Shear modulus times thickness, N/m (= um*MPa).
+    mu_H_ci95 : (float, float)
+    offset, offset_ci95 : float, (float, float)
+        Displacement origin d0 in m (0 and (0, 0) when not fitted).
+    shape_values : dict
+        Every shape parameter of :data:`shellbvp.shape_parameters.SHAPE_PARAMETERS` by name:
+        its value in the fitted model (the scene's unless fitted; None where the scene has
+        none), in the parameter's reported unit.  Also ``res.<name>``: ``res.beta``,
+        ``res.alpha`` (Mooney–Rivlin alpha; None for other materials), ``res.pressure``
+        (nondimensional ``p R_L/(mu H)``).
+    shape_ci95 : dict
+        The fitted shape parameter's profile-likelihood 95 % interval (``res.<name>_ci95``;
+        None for the others).  A side that reached the search bound is the bound (see
+        ``message``).
+    derived : dict
+        Quantities in lab units that depend on mu*H too, by name (:class:`Estimate`): of the
+        fitted shape parameter, with a linearised 95 % interval (the covariance of mu*H and the
+        parameter, Student's t), e.g. ``res.pressure_Pa``, ``res.pressure_Pa_ci95`` (``p
+        mu_H/R_L``; None unless the pressure was fitted); and mu of a given thickness (``mu``).
+    fitted : tuple of str
+        The fitted parameters ("mu_H", "offset", and a shape parameter's name).
+    weights : str
+        The noise model, "uniform", "relative" or "mixed".
+    residual_rms : float
+        Root-mean-square force residual, N (unweighted).
+    n : int
+        Number of data points used.
+    status : int
+        Outcome, a key of :data:`FIT_STATUS` (0: converged and passed the checks
+        on the result: finite intervals, mu*H's narrower than mu*H).
+    success : bool
+        ``status == 0``.
+    message : str
+        ``FIT_STATUS[status]`` with details (the solver's message).
+    warnings : list of str
+        Findings that do not fail the fit but need a look (a residual pattern
+        the noise model does not explain, an implausible mu*H, a shape
+        parameter's interval at its search bound).
+    warning_codes : list of str
+        The kind of each warning, keys of :data:`FIT_WARNINGS` (same order).
+    curve : Curve
+        The model curve (nondimensional) at the fitted parameters.
+    scene : Scene
+        The scene of that curve (fitted beta or alpha).
+    curves_computed : int
+        Model curves computed for this fit (cached ones not counted).
+    interpolation_error : float or None
+        With beta or alpha fitted: ``max |F_interpolated - F_curve| / max |F|`` at
+        the estimate before its own curve was added (None otherwise).
+    R_L : float
+    baseline_model : str
+        The force baseline fitted, one of :data:`BASELINES`.
+    baseline, baseline_ci95 : float, (float, float)
+        Force baseline b0 (N) at the contact point and its 95 % interval (0 when not fitted).
+    baseline_slope, baseline_slope_ci95 : float, (float, float)
+        Its slope b1 (N/m) with ``baseline="linear"`` (0 otherwise).
+    point_weights : ndarray
+        The noise model's weight (1/sigma, largest 1) of each data point as given (NaN
+        where a value was missing).
+    correlation : ndarray or None
+        Correlation matrix of the fitted parameters (order of ``fitted``), from the linearised
+        covariance.
+    noise_sigma : float
+        The estimated noise (N) of the most weighted point; the weighted reduced chi-square is 1
+        by construction, since the noise scale is estimated from the residuals.
+    aic, bic : float
+        Akaike and Bayesian information criteria (Gaussian noise with the noise model's
+        weights and an estimated scale): compare models fitted to the same rows with the
+        same weights (lower is better).
+    runs_p, residual_autocorrelation : float
+        The runs test's p of the residuals' signs in depth order (small: a pattern) and their
+        lag-1 autocorrelation (near 0 for independent noise).
+    quality : str
+        ``good``, ``fair`` or ``poor`` (:func:`fit_quality`).
+
+    Examples
+    --------
+    >>> import shellbvp as sb
+    >>> from shellbvp.fitting import example_data_path
+    >>> d, F = sb.read_force_csv(example_data_path())
+    >>> res = sb.fit(sb.Scene.preset("fit"), d, F, R_L=0.3e-3)
+    >>> res.success, res.fitted, res.weights, res.n
+    (True, ('mu_H', 'offset'), 'mixed', 40)
+    >>> lo, hi = res.mu_H_ci95
+    >>> bool(lo < res.mu_H < hi), bool(lo < 52 < hi)       # the truth is 52 N/m
+    (True, True)
+    >>> print(f"{res.model_force(0.1e-3) * 1e3:.2f} mN at 0.1 mm")
+    14.03 mN at 0.1 mm
+    >>> res.baseline_model, res.baseline                   # no baseline unless asked for
+    ('none', 0.0)
+    """
+
+    mu_H: float
+    mu_H_ci95: tuple
+    offset: float
+    offset_ci95: tuple
+    residual_rms: float
+    n: int
+    status: int
+    message: str
+    R_L: float
+    curve: object = field(repr=False, default=None)
+    _model: object = field(repr=False, default=None)
+    shape_values: dict = field(default_factory=dict)
+    shape_ci95: dict = field(default_factory=dict)
+    derived: dict = field(default_factory=dict)
+    fitted: tuple = ("mu_H", "offset")
+    weights: str = DEFAULT_WEIGHTS
+    scene: object = field(repr=False, default=None)
+    curves_computed: int = 0
+    interpolation_error: float = None
+    warnings: list = field(default_factory=list)
+    warning_codes: list = field(default_factory=list)
+    baseline_model: str = "none"
+    baseline: float = 0.0
+    baseline_ci95: tuple = (0.0, 0.0)
+    baseline_slope: float = 0.0
+    baseline_slope_ci95: tuple = (0.0, 0.0)
+    point_weights: object = field(repr=False, default=None)
+    correlation: object = field(repr=False, default=None)
+    noise_sigma: float = float("nan")
+    aic: float = float("nan")
+    bic: float = float("nan")
+    runs_p: float = float("nan")
+    residual_autocorrelation: float = float("nan")
+
+    @property
+    def success(self):
+        """True when the fit converged and passed its checks (``status == 0``)."""
+        return self.status == 0
+
+    def __getattr__(self, name):
+        """``res.<p>`` and ``res.<p>_ci95`` of every shape parameter and derived quantity (None
+        where there is none)."""
+        base, ci = (name[:-5], True) if name.endswith("_ci95") else (name, False)
+        if base in SHAPE_PARAMETERS:
+            return self.__dict__.get("shape_ci95" if ci else "shape_values", {}).get(base)
+        if base in DERIVED:
+            e = self.__dict__.get("derived", {}).get(base)
+            return None if e is None else (e.ci95 if ci else e.value)
+        raise AttributeError(f"{type(self).__name__!r} object has no attribute {name!r}")
+
+    @property
+    def thickness(self):
+        """The shell's thickness H (m) when the scene was given one (``Scene(thickness=H/R_L)``,
+        ``--thickness``) or a fit estimated it: then beta is the 3D plate's and mu follows from
+        mu*H; None otherwise."""
+        if self.shape_values.get("thickness") is not None:
+            return self.shape_values["thickness"]
+        eps = getattr(self.scene, "thickness", None)
+        return None if eps is None else eps * self.R_L
+
+    @property
+    def mu(self):
+        """The shear modulus mu = mu*H / H (Pa), with the thickness known or fitted (else None)."""
+        e = self.derived.get("mu")
+        return None if e is None else e.value
+
+    @property
+    def mu_ci95(self):
+        """mu's 95 % interval (Pa): with a given thickness mu*H's over H (H taken as exact)."""
+        e = self.derived.get("mu")
+        return None if e is None else e.ci95
+
+    @property
+    def quality(self) -> str:
+        """``good``, ``fair`` or ``poor`` by the transparent rules of :func:`fit_quality`."""
+        return fit_quality(self.success, self.warning_codes, self.mu_H, self.mu_H_ci95, self.correlation,
+                           self.fitted)
+
+    @property
+    def model_error(self):
+        """``(error, extrapolated)``: the shell model's largest measured error in F against 3D
+        elasticity at this thickness over the mapped scenes (:func:`shellbvp.thickness.model_error`),
+        to stand beside the statistical interval; None without a thickness or a map for the model."""
+        from ..thickness import model_error
+
+        return model_error(self.scene)
+
+    def model_force(self, displacement, mu_H=None):
+        """Fitted model force (N) at displacements (m); with ``mu_H`` (N/m), the same model at
+        that mu*H (e.g. an end of ``mu_H_ci95``), offset and baseline as fitted."""
+        return self._model(np.asarray(displacement, float), self.mu_H if mu_H is None else float(mu_H), self.offset)
+
+    def to_dict(self):
+        """A JSON-ready dict (non-finite numbers as None, so the JSON is strict)."""
+        def num(v):
+            return None if v is None or not math.isfinite(v) else float(v)
+
+        ci = (lambda v: None if v is None else [num(x) for x in v])
+        shape = {}
+        for name in (*SHAPE_PARAMETERS, *DERIVED):
+            shape[name], shape[f"{name}_ci95"] = num(getattr(self, name)), ci(getattr(self, f"{name}_ci95"))
+        return {"mu_H": num(self.mu_H), "mu_H_ci95": ci(self.mu_H_ci95), "offset": num(self.offset),
+                "offset_ci95": ci(self.offset_ci95), **shape, "fitted": list(self.fitted),
+                "weights": self.weights, "residual": num(self.residual_rms), "residual_rms": num(self.residual_rms),
+                "n": self.n, "success": self.success, "status": self.status, "message": self.message,
+                "warnings": list(self.warnings), "warning_codes": list(self.warning_codes), "R_L": self.R_L,
+                "curves_computed": self.curves_computed, "interpolation_error": num(self.interpolation_error),
+                "baseline_model": self.baseline_model, "baseline": num(self.baseline),
+                "baseline_ci95": ci(self.baseline_ci95), "baseline_slope": num(self.baseline_slope),
+                "baseline_slope_ci95": ci(self.baseline_slope_ci95),
+                "thickness": None if self.thickness is None else num(self.thickness), "mu": None if self.mu is None
+                else num(self.mu), "mu_ci95": ci(self.mu_ci95),
+                "quality": self.quality, "noise_sigma": num(self.noise_sigma), "aic": num(self.aic),
+                "bic": num(self.bic), "runs_p": num(self.runs_p),
+                "residual_autocorrelation": num(self.residual_autocorrelation),
+                "correlation": None if self.correlation is None else
+                [[num(v) for v in row] for row in np.asarray(self.correlation)],
+                "model_error": None if self.model_error is None else num(self.model_error[0]),
+                "model_error_extrapolated": None if self.model_error is None else self.model_error[1],
+                "units": {"mu_H": "N/m (= um*MPa)", "offset": "m", "residual": "N (rms)",
+                          "residual_rms": "N", "R_L": "m",
+                          **{p.name: p.unit_text or p.unit for p in SHAPE_PARAMETERS.values()},
+                          **{d.name: d.unit for d in DERIVED.values()},
+                          "baseline": "N", "baseline_slope": "N/m", "thickness": "m", "mu": "Pa",
+                          "model_error": "1 (fraction of F)", "noise_sigma": "N (of the most weighted point)",
+                          "aic": "1", "bic": "1", "runs_p": "1", "residual_autocorrelation": "1",
+                          "correlation": "1 (order of fitted)"}}
