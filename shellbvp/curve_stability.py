@@ -136,7 +136,7 @@ def locate_zero(f, a, fa, b, fb, *, xtol, max_evals=MAX_REFINE):
     return a, fa, b, fb, n
 
 
-def assess(curve, choice: str = "points", *, delta_tol: float = 1e-4) -> None:
+def assess(curve, choice: str = "points", *, delta_tol: float = 1e-4, samples: int = LOCATE_SAMPLES) -> None:
     """Fill ``curve``'s stability fields and ``first_instability`` (see the module docstring).
 
     Parameters
@@ -147,6 +147,8 @@ def assess(curve, choice: str = "points", *, delta_tol: float = 1e-4) -> None:
     choice : {"off", "points", "locate"}
     delta_tol : float
         ``"locate"``: the width of the final bracket in delta.
+    samples : int
+        ``"locate"``: about how many states spread along the curve are analysed first.
     """
     choice = check_choice(choice)
     n = len(curve)
@@ -171,7 +173,7 @@ def assess(curve, choice: str = "points", *, delta_tol: float = 1e-4) -> None:
             for i in range(n):
                 analyse(i)
         else:  # a sample first; every state only between its last stable and first unstable one
-            stride = max(1, math.ceil(n / LOCATE_SAMPLES))
+            stride = max(1, math.ceil(n / samples))
             sample = sorted(set(range(0, n, stride)) | {n - 1})
             hit = next((k for k, i in enumerate(sample) if analyse(i)), None)
             if hit is not None:

@@ -162,10 +162,9 @@ def test_locate_samples_the_curve_then_analyses_only_the_bracket(monkeypatch):
         return 0.33 - state.delta, 2, ""
 
     monkeypatch.setattr(cs, "point_stability", fake)
-    monkeypatch.setattr(cs, "LOCATE_SAMPLES", 4)
     c = sb.curve(sb.Scene.preset("base"), deltas=np.linspace(0.05, 0.6, 12), estimate_error=False)
     analysed = lambda: np.flatnonzero(np.isfinite(c.points["stability_min"]))
-    assess(c, "locate", delta_tol=1e-3)
+    assess(c, "locate", delta_tol=1e-3, samples=4)
     d = c.points["delta"]
     # the sample (every third point and the last), then the points after the last stable sample
     assert list(analysed()) == [0, 3, 4, 5, 6], d[analysed()]
