@@ -87,6 +87,10 @@ class Options:
         is compiled in a background process once the numpy kernels have taken
         ``kernels.START_AFTER_S``; False (default): not compiled but by ``shellbvp compile``
         (a compile, ~15-40 s, repays over many curves, not within one command).
+    model_curve_cache : bool
+        A fit's model curves are kept in the code cache's ``curves/`` folder and read back by
+        the next fit of the same scene and depths, in any process (:mod:`shellbvp.fitting.curves`);
+        False: computed in every process.
 
     Examples
     --------
@@ -109,6 +113,7 @@ class Options:
     progress_seconds: float = field(default_factory=_progress_seconds)
     health_seconds: float = 10.0
     compile_in_background: bool = False
+    model_curve_cache: bool = True
 
 
 #: The options in force

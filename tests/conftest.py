@@ -47,6 +47,16 @@ def _fresh_code_cache(tmp_path_factory):
         os.environ["SHELLBVP_CACHE_DIR"] = old
 
 
+@pytest.fixture(autouse=True)
+def _model_curves_computed():
+    """Fits compute their model curves (the tests count them): the disk cache of kept curves is
+    off unless a test turns it on (tests/test_fit_curve_cache.py)."""
+    import shellbvp as sb
+
+    with sb.options(model_curve_cache=False):
+        yield
+
+
 @pytest.fixture
 def closed_form(monkeypatch):
     """The fit's model curves replaced by :class:`fake_curves.FakeCurve` (counted as computed)."""

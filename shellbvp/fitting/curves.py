@@ -1,12 +1,24 @@
-"""The model curves a fit interpolates: each computed once per process (memoised by scene,
-depths and tolerance), checked to start at the data's shallowest depth and to reach its
-deepest, and :class:`ModelCurves`, the nondimensional force F(delta; theta) interpolated
-across curves at nodes theta of a shape parameter (monotone cubic in delta, cubic spline in
-theta)."""
+"""The model curves a fit interpolates: each computed once (memoised per process by scene,
+depths and tolerance, and kept in the code cache's ``curves/`` folder for the next process),
+checked to start at the data's shallowest depth and to reach its deepest, and
+:class:`ModelCurves`, the nondimensional force F(delta; theta) interpolated across curves at
+nodes theta of a shape parameter (monotone cubic in delta, cubic spline in theta).
+
+A curve kept on disk is a curve file (``read_curve`` reads it as data, checked) named by a key
+of everything it depends on: the scene, the depths, the tolerance, the solver's options and the
+package's source (any edit of the code makes new keys).  A fit of a sample fitted before, in
+any process, then computes no curve (``FitResult.curves_computed`` counts the computed ones);
+``sb.options(model_curve_cache=False)`` turns the disk off."""
 
 from __future__ import annotations
 
+import dataclasses
+import functools
+import hashlib
+import json
+import logging
 from collections import OrderedDict
+from pathlib import Path
 
 import numpy as np
 from scipy.interpolate import CubicSpline, PchipInterpolator
@@ -15,6 +27,8 @@ __all__ = ["N_DEPTHS", "ModelCurves", "clear_model_curves"]
 
 #: Depths of every model curve (equally spaced up to delta_max).
 N_DEPTHS = 40
+
+log = logging.getLogger(__name__)
 
 # the model curves memoised in this process, the least recently used dropped first
 _CACHE: OrderedDict = OrderedDict()
@@ -39,16 +53,20 @@ def _model_curve(scene, deltas, tol, counter=None, progress=None):
     if key is not None and key in _CACHE:
         _CACHE.move_to_end(key)
         return _CACHE[key]
-    _check_model_start(scene, float(deltas[0]), tol)
-    bar, callback = progress("model curve", float(deltas[-1])) if progress is not None else (None, None)
-    try:
-        c = curve(scene, deltas=deltas, tol=tol, estimate_error=False, callback=callback)
-    finally:
-        if bar is not None:
-            bar.close()
-    if counter is not None:
-        counter[0] += 1
-    c.solutions = []  # profiles are not needed here; keep the cache small
+    path, disk_key = _disk_place(scene, deltas, tol)
+    c = _read_kept(path, disk_key)
+    if c is None:
+        _check_model_start(scene, float(deltas[0]), tol)
+        bar, callback = progress("model curve", float(deltas[-1])) if progress is not None else (None, None)
+        try:
+            c = curve(scene, deltas=deltas, tol=tol, estimate_error=False, callback=callback)
+        finally:
+            if bar is not None:
+                bar.close()
+        if counter is not None:
+            counter[0] += 1
+        c.solutions = []  # profiles are not needed here; keep the cache small
+        _keep(c, path, disk_key)
     if scene.transverse_shear:
         c = _with_shear(c)
     if key is not None:
@@ -56,6 +74,70 @@ def _model_curve(scene, deltas, tol, counter=None, progress=None):
         while len(_CACHE) > _CACHE_SIZE:
             _CACHE.popitem(last=False)
     return c
+
+
+@functools.cache
+def _code_fingerprint() -> str:
+    """The package's and the derivation's source, hashed once per process (part of every key)."""
+    from symbolic.version import source_fingerprint
+
+    root = Path(__file__).resolve().parent.parent
+    return source_fingerprint(*sorted({p.parent for p in root.rglob("*.py")}))
+
+
+def _disk_place(scene, deltas, tol):
+    """(path, key) of a model curve in the code cache's ``curves/`` folder, or (None, None)
+    where the disk cache is off, the scene does not describe itself as data, or the folder is
+    not trusted."""
+    from ..config import OPTIONS
+    from ..model import cache_dir, untrusted_reason
+    from ..version import __version__
+
+    if not OPTIONS.model_curve_cache:
+        return None, None
+    try:
+        solver = {k: v for k, v in dataclasses.asdict(OPTIONS).items() if k not in _NOT_NUMERICS}
+        payload = json.dumps({"scene": scene.to_dict(), "deltas": [float(x) for x in deltas], "tol": float(tol),
+                              "options": solver, "code": _code_fingerprint(), "version": __version__},
+                             sort_keys=True)
+    except (TypeError, ValueError, AttributeError):
+        return None, None
+    key = hashlib.sha256(payload.encode()).hexdigest()
+    folder = cache_dir() / "curves"
+    if folder.exists() and untrusted_reason(folder):
+        return None, None
+    return folder / f"curve_{key[:32]}.h5", key
+
+
+#: Options that do not change a curve's numbers (not part of a kept curve's key)
+_NOT_NUMERICS = ("progress_seconds", "health_seconds", "compile_in_background", "model_curve_cache")
+
+
+def _read_kept(path, key):
+    """The kept curve at ``path`` if it is there and holds ``key``, else None."""
+    from ..io import read_curve
+
+    if path is None or not path.exists():
+        return None
+    try:
+        c = read_curve(path)
+    except (ValueError, OSError) as exc:
+        log.info("ignoring the kept model curve %s: %s", path.name, exc)
+        return None
+    return c if c.settings.get("model_curve_key") == key and c.complete else None
+
+
+def _keep(c, path, key):
+    """Write the complete curve ``c`` to ``path`` (atomically); a cache that cannot be written is
+    skipped."""
+    if path is None or not c.complete:
+        return
+    c.settings["model_curve_key"] = key
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        c.to_hdf5(path, overwrite=True)
+    except OSError as exc:
+        log.info("model curve not kept (%s)", exc)
 
 
 def _with_shear(c):
