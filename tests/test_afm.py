@@ -125,3 +125,30 @@ def test_a_file_afmformats_cannot_read_is_one_line(tmp_path):
     bad.write_bytes(b"PK\x03\x04 not really a zip")
     with pytest.raises(ValueError, match="afmformats cannot read it"):
         read_afm(bad)
+
+
+def test_a_synthetic_jpk_force_map_file_is_read_by_afmformats_and_fitted_to_its_truth(tmp_path, capsys):
+    """benchmarks/make_force_map.py writes a JPK archive (afmformats' test map's property files,
+    channels encoded anew); afmformats reads it back, with no monkeypatch: the grid, the positions
+    and the tip from height and deflection, and `shellbvp fit` recovers every pixel's mu*H."""
+    import importlib.util
+
+    import h5py
+
+    bench = Path(__file__).resolve().parent.parent / "benchmarks" / "make_force_map.py"
+    spec = importlib.util.spec_from_file_location("_bench_make_force_map", bench)
+    maker = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(maker)
+    path = tmp_path / "cells.jpk-force-map"
+    truth = maker.write_map(path, n=3, points=150)
+    curves = read_afm(path)
+    assert [c.grid for c in curves] == [(ix, iy) for iy in range(3) for ix in range(3)]
+    assert curves[4].position == pytest.approx((0.0, 0.0), abs=1e-12)          # the middle of a 3 x 3 grid
+    rec = curves[4].record
+    assert rec.counts()["retraction"] == 150 and rec.contact_estimate is not None
+    np.testing.assert_allclose(np.ptp(rec.displacement), maker.CONTACT + maker.TOP * maker.R_L, rtol=1e-6)
+    out = tmp_path / "cells.h5"
+    assert main(["fit", str(path), "--preset", "fit", "--radius", f"{maker.R_L * 1e6:g}um", "-q", "-o", str(out)]) == 0
+    assert "9 fitted" in capsys.readouterr().out
+    with h5py.File(out) as f:
+        np.testing.assert_allclose(f["entry/map/mu_H"][()], truth, rtol=0.01)   # 1 % force noise, 150 rows
