@@ -247,6 +247,7 @@ def _fit_batch(args, files):
         print(json.dumps(strict_json({"files": docs, "success": ok, "exit_status": 0 if ok else 1}),
                          allow_nan=False))
     else:
+        say(f"scene  = {scene.describe(R_L)}")  # every file's, in lab units: a batch names its sample too
         width = max(len(r.file) for r in rows)
         for r in rows:
             if r.result is not None and r.status != "error":
