@@ -91,6 +91,39 @@ def test_a_force_map_is_fitted_curve_by_curve(synthetic_map, tmp_path):
         fm.to_hdf5(out)
 
 
+def test_a_force_map_file_reads_back_and_info_and_plot_take_it(synthetic_map, tmp_path, capsys):
+    """The map's NeXus file, read back as data (read_map_file), holds the fit's images; `shellbvp
+    info` summarises it and `shellbvp plot` draws its mu*H; a damaged one is one line naming the item."""
+    pytest.importorskip("matplotlib")
+    import h5py
+
+    from shellbvp.afm import is_map_file, read_map_file
+
+    scene, curves = synthetic_map
+    fm = fit_map(scene, curves, R_L=R_L, path="cells.jpk-force-map")
+    out = tmp_path / "map.h5"
+    fm.to_hdf5(out)
+    assert is_map_file(out) and not is_map_file(tmp_path / "nothing.h5")
+    back = read_map_file(out)
+    np.testing.assert_array_equal(back.mu_H, fm.image("mu_H"))
+    np.testing.assert_array_equal(back.mu_H_high, fm.image("mu_H_high"))
+    np.testing.assert_array_equal(back.status, fm.status_image())
+    np.testing.assert_allclose(back.x, fm.axes()[0])
+    np.testing.assert_allclose(back.y, fm.axes()[1])
+    assert back.sample == scene.describe(R_L) and back.source == "cells.jpk-force-map"
+    capsys.readouterr()
+    assert main(["info", str(out)]) == 0
+    text = capsys.readouterr().out
+    assert "grid:      2 x 2: 4 fitted, 0 failed their checks, 0 errors, 0 no curve" in text
+    assert f"median {np.median(fm.image('mu_H')):.4g} N/m" in text
+    png = tmp_path / "map.png"
+    assert main(["plot", str(out), "-o", str(png)]) == 0 and png.stat().st_size > 0
+    with h5py.File(out, "a") as f:
+        del f["entry/map/status"]
+    with pytest.raises(ValueError, match="incomplete or corrupt force-map file.*status is missing"):
+        read_map_file(out)
+
+
 def test_cli_fits_a_map_into_a_table_a_file_and_a_figure(synthetic_map, tmp_path, monkeypatch, capsys):
     pytest.importorskip("matplotlib")
     import shellbvp.afm as afm
