@@ -12,6 +12,8 @@ sample is minus the tip's position: the package's signs, no ``--invert`` needed.
   :class:`~shellbvp.instrument.InstrumentRecord` with its place on the map).
 * :class:`ForceMap` -- a force map fitted curve by curve (:func:`shellbvp.batch.fit_map`): the
   per-curve rows of a batch, images of mu*H and its interval, a NeXus file, a figure.
+* :func:`read_map_file` -- that NeXus file read back (:class:`MapFile`), for ``shellbvp info``
+  and ``shellbvp plot``.
 """
 
 from __future__ import annotations
@@ -22,8 +24,8 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["AFM_SUFFIXES", "AFMCurve", "ForceMap", "is_afm_file", "read_afm", "curves_from_afm",
-           "refuse_text_options", "MAP_FORMAT"]
+__all__ = ["AFM_SUFFIXES", "AFMCurve", "ForceMap", "MapFile", "is_afm_file", "read_afm", "curves_from_afm",
+           "refuse_text_options", "MAP_FORMAT", "is_map_file", "read_map_file", "draw_map"]
 
 #: File name endings read through afmformats (other text files go through shellbvp.instrument).
 AFM_SUFFIXES = (".jpk-force", ".jpk-force-map", ".jpk-qi-data", ".jpk-qi-series", ".ibw")
@@ -285,29 +287,130 @@ class ForceMap:
 
     def plot(self, out=None, ax=None):
         """The mu*H image (curves whose fit did not succeed left blank), with a colour bar."""
-        from .plotting import require_matplotlib
-
-        plt = require_matplotlib()
-        fig = None
-        if ax is None:
-            fig, ax = plt.subplots(figsize=(5.5, 4.5))
         x, y = self.axes()
-        img = self.image("mu_H")
-        nx, ny = self.shape
-        if x is not None and nx > 1 and ny > 1:
-            dx, dy = np.ptp(x) / (nx - 1) * 1e6, np.ptp(y) / (ny - 1) * 1e6
-            extent = (x.min() * 1e6 - dx / 2, x.max() * 1e6 + dx / 2, y.min() * 1e6 - dy / 2, y.max() * 1e6 + dy / 2)
-            ax.set_xlabel("x (um)")
-            ax.set_ylabel("y (um)")
-        else:
-            extent = None
-            ax.set_xlabel("grid index x")
-            ax.set_ylabel("grid index y")
-        im = ax.imshow(img, origin="lower", extent=extent, interpolation="nearest")
-        (fig or ax.figure).colorbar(im, ax=ax, label="mu*H (N/m)")
-        ax.set_title(f"{Path(self.path).name}: {sum(r.status == 'ok' for r in self.rows)} of {len(self.rows)} "
-                     "curves fitted", fontsize=9)
-        if out is not None:
-            (fig or ax.figure).savefig(out, dpi=150, bbox_inches="tight")
-            plt.close(fig or ax.figure)
-        return ax
+        title = (f"{Path(self.path).name}: {sum(r.status == 'ok' for r in self.rows)} of {len(self.rows)} "
+                 "curves fitted")
+        return draw_map(self.image("mu_H"), x, y, title, out=out, ax=ax)
+
+
+def draw_map(img, x, y, title, out=None, ax=None, dpi=150):
+    """A ``(ny, nx)`` image of mu*H (N/m) over the grid's cell centres ``x``, ``y`` (m; None: grid
+    indices), with a colour bar; saved to ``out`` when given."""
+    from .plotting import require_matplotlib
+
+    plt = require_matplotlib()
+    fig = None
+    if ax is None:
+        fig, ax = plt.subplots(figsize=(5.5, 4.5))
+    ny, nx = img.shape
+    if x is not None and nx > 1 and ny > 1:
+        dx, dy = np.ptp(x) / (nx - 1) * 1e6, np.ptp(y) / (ny - 1) * 1e6
+        extent = (x.min() * 1e6 - dx / 2, x.max() * 1e6 + dx / 2, y.min() * 1e6 - dy / 2, y.max() * 1e6 + dy / 2)
+        ax.set_xlabel("x (um)")
+        ax.set_ylabel("y (um)")
+    else:
+        extent = None
+        ax.set_xlabel("grid index x")
+        ax.set_ylabel("grid index y")
+    im = ax.imshow(img, origin="lower", extent=extent, interpolation="nearest")
+    (fig or ax.figure).colorbar(im, ax=ax, label="mu*H (N/m)")
+    ax.set_title(title, fontsize=9)
+    if out is not None:
+        (fig or ax.figure).savefig(out, dpi=dpi, bbox_inches="tight")
+        plt.close(fig or ax.figure)
+    return ax
+
+
+@dataclass
+class MapFile:
+    """What a force-map file (:meth:`ForceMap.to_hdf5`) holds, as :func:`read_map_file` reads it.
+
+    Attributes
+    ----------
+    path : str
+    mu_H, mu_H_low, mu_H_high : ndarray, shape (ny, nx)
+        mu*H and its 95 % interval (N/m); NaN where no curve was fitted.
+    status : ndarray of int, shape (ny, nx)
+        0 fitted, 1 failed its checks, 2 error, -1 no curve.
+    x, y : ndarray or None
+        The grid's cell centres (m), when the map file has them.
+    sample : str
+        The scene in lab units, as the fit described it.
+    source : str
+        The AFM file fitted.
+    """
+
+    path: str
+    mu_H: np.ndarray
+    mu_H_low: np.ndarray
+    mu_H_high: np.ndarray
+    status: np.ndarray
+    x: object
+    y: object
+    sample: str
+    source: str
+
+    def summary_lines(self) -> list:
+        """What ``shellbvp info`` prints."""
+        ny, nx = self.status.shape
+        counts = {name: int(np.sum(self.status == code)) for code, name in
+                  ((0, "fitted"), (1, "failed their checks"), (2, "errors"), (-1, "no curve"))}
+        mu = self.mu_H[self.status == 0]
+        lines = [f"source:    {self.source}", f"sample:    {self.sample}",
+                 f"grid:      {nx} x {ny}: " + ", ".join(f"{v} {k}" for k, v in counts.items())]
+        if mu.size:
+            lines.append(f"mu*H:      median {np.median(mu):.4g} N/m, quartiles {np.percentile(mu, 25):.4g}.."
+                         f"{np.percentile(mu, 75):.4g}, range {mu.min():.4g}..{mu.max():.4g}")
+        if self.x is not None:
+            lines.append(f"area:      x {self.x.min() * 1e6:.4g}..{self.x.max() * 1e6:.4g} um, "
+                         f"y {self.y.min() * 1e6:.4g}..{self.y.max() * 1e6:.4g} um (cell centres)")
+        return lines
+
+    def plot(self, out=None, ax=None, dpi=150):
+        fitted = int(np.sum(self.status == 0))
+        title = f"{Path(self.source).name}: {fitted} of {int(np.sum(self.status >= 0))} curves fitted"
+        return draw_map(self.mu_H, self.x, self.y, title, out=out, ax=ax, dpi=dpi)
+
+
+def is_map_file(path) -> bool:
+    """True when ``path`` is an HDF5 file of format :data:`MAP_FORMAT`."""
+    import h5py
+
+    try:
+        with h5py.File(path, "r") as h:
+            fmt = h.attrs.get("format")
+    except (OSError, ValueError):
+        return False
+    return isinstance(fmt, (str, bytes)) and (fmt.decode() if isinstance(fmt, bytes) else fmt) == MAP_FORMAT
+
+
+def read_map_file(path) -> MapFile:
+    """A force-map file, every item checked as data (:mod:`shellbvp.schema`).
+
+    Raises
+    ------
+    ValueError
+        Not a force-map file, or an item missing or malformed (naming it).
+    """
+    from . import schema as sc
+    from .paths import open_hdf5
+
+    with open_hdf5(path, fmt=MAP_FORMAT, group="entry/map", kind="force-map") as h:
+        try:
+            sc.format_version(h, MAP_FORMAT_VERSION)
+            m = h["entry/map"]
+            images = {k: sc.dataset(m, k, ndim=2) for k in ("mu_H", "mu_H_low", "mu_H_high")}
+            status = sc.dataset(m, "status", kind="int", ndim=2)
+            shapes = {a.shape for a in (*images.values(), status)}
+            if len(shapes) != 1:
+                raise ValueError(f"map images differ in shape ({sorted(shapes)})")
+            ny, nx = status.shape
+            x = y = None
+            if "x" in m and "y" in m:
+                x, y = sc.dataset(m, "x", length=nx), sc.dataset(m, "y", length=ny)
+            sample = sc.attr_text(h["entry/sample"], "description") if "entry/sample" in h else ""
+            source = sc.text_dataset(h["entry/source"], "file_name", ndim=0) if "entry/source" in h else ""
+        except (ValueError, KeyError, TypeError, OSError) as exc:
+            what = str(exc) if isinstance(exc, ValueError) else f"{type(exc).__name__}: {exc}"
+            raise ValueError(f"{path}: incomplete or corrupt force-map file ({what})") from None
+    return MapFile(path=str(path), **images, status=status.astype(int), x=x, y=y, sample=sample, source=source)

@@ -31,7 +31,8 @@ SI units, ``"1"`` nondimensional, ``""`` text)::
     /fit/warnings              (k,) the fit's warnings (text); attr codes
     /fit/sample                NXsample; attrs: scene (JSON, rebuilds the Scene), scene_<key>
     /fit/source                NXnote: file_name, sha256, columns (JSON), units (JSON), inverted
-                               (JSON list: the columns whose sign was flipped) -- text
+                               (JSON list: the columns whose sign was flipped), notes (JSON list: what
+                               reading left out of the file and why) -- text
 
 Written atomically (temporary file + rename); an existing file is replaced only with
 ``overwrite=True``.
@@ -96,7 +97,7 @@ class FitRecord:
     scene : Scene
     source : dict
         ``file_name``, ``sha256``, ``columns``, ``units`` (the units the file was in), ``inverted``
-        (the columns whose sign was flipped on reading).
+        (the columns whose sign was flipped on reading), ``notes`` (what reading left out and why).
     success : bool
     status : int
     message : str
@@ -228,6 +229,8 @@ def write_fit(path, result, record, used, *, segment="loading", overwrite=False)
             string_dataset(src, "columns", json.dumps({k: str(v) for k, v in record.columns.items()}))
             string_dataset(src, "units", json.dumps(record.units, ensure_ascii=False))
             string_dataset(src, "inverted", json.dumps(list(getattr(record, "inverted", ()))))
+            string_dataset(src, "notes", json.dumps(list(getattr(record, "notes", ())), ensure_ascii=False),
+                           "what reading left out of the source file and why (JSON list of text)")
 
 
 def _inverted(src):
@@ -240,6 +243,18 @@ def _inverted(src):
     if not (isinstance(inv, list) and all(x in ("displacement", "force") for x in inv)):
         raise ValueError("source/inverted must be a JSON list of 'displacement' and 'force'")
     return inv
+
+
+def _notes(src):
+    """The reading notes of a record's source (files before them: none)."""
+    from . import schema as sc
+
+    if "notes" not in src:
+        return []
+    notes = sc.parse_json(sc.text_dataset(src, "notes", ndim=0), "source/notes")
+    if not (isinstance(notes, list) and all(isinstance(x, str) for x in notes)):
+        raise ValueError("source/notes must be a JSON list of text")
+    return notes
 
 
 def _with_intervals(result):
@@ -353,7 +368,7 @@ def read_fit(path) -> FitRecord:
                       "sha256": sc.text_dataset(src, "sha256", ndim=0),
                       "columns": sc.parse_json(sc.text_dataset(src, "columns", ndim=0), "source/columns"),
                       "units": sc.parse_json(sc.text_dataset(src, "units", ndim=0), "source/units"),
-                      "inverted": _inverted(src)}
+                      "inverted": _inverted(src), "notes": _notes(src)}
             success = sc.attr_bool(e, "success")
             status = sc.attr_int(e, "status", low=0, high=99)
             if success != (status == 0):

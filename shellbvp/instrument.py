@@ -349,6 +349,9 @@ class InstrumentRecord:
     contact_estimate : float or None
         First estimate of the contact point (m) from the baseline (:func:`estimate_contact`),
         None when the loading starts in contact.
+    notes : tuple of str
+        What reading left out of the file and why (e.g. a time column whose unit is not a
+        time), the file's text in them escaped; printed with a fit and kept in its record.
     """
 
     path: str
@@ -363,6 +366,7 @@ class InstrumentRecord:
     header: list = field(default_factory=list)
     contact_estimate: object = None
     inverted: tuple = ()
+    notes: tuple = ()
 
     def __len__(self):
         return self.displacement.size
@@ -465,9 +469,10 @@ def read_instrument(path, *, columns=None, units=None, invert=()) -> InstrumentR
     dcol, fcol, tcol = _pick_columns(table, columns, path)
     roles = [("displacement", dcol), ("force", fcol)] + ([("time", tcol)] if tcol is not None else [])
     given = list(units) if units is not None else []
-    unit_names, factors = {}, {}
-    for k, (role, col) in enumerate(roles):
-        u = given[k] if k < len(given) and given[k] else (_column_unit(table, col) if table.header else None)
+    unit_names, factors, notes = {}, {}, []
+    for k, (role, col) in enumerate(list(roles)):
+        by_user = k < len(given) and bool(given[k])
+        u = given[k] if by_user else (_column_unit(table, col) if table.header else None)
         if u is None:
             if role == "time":
                 u = "s"
@@ -477,6 +482,11 @@ def read_instrument(path, *, columns=None, units=None, invert=()) -> InstrumentR
         try:
             factors[role] = unit_factor(u, _KIND[role])
         except ValueError as exc:
+            if role == "time" and not by_user:
+                # the time only orders the rows: a header unit that is not a time drops the column, not the file
+                roles.remove((role, col))
+                notes.append(_dropped_time_note(table, col, u, exc))
+                continue
             raise ValueError(f"{path}: {role} column: {exc}") from None
         unit_names[role] = normalize_unit(u)
     values = {role: [] for role, _ in roles}
@@ -508,11 +518,21 @@ def read_instrument(path, *, columns=None, units=None, invert=()) -> InstrumentR
     name = (lambda c: table.header[c] if c < len(table.header) and table.header[c] else c)
     return record_from_arrays(path, arr["displacement"], arr["force"], arr.get("time"), np.array(lines)[ok],
                               columns={role: name(col) for role, col in roles}, units=unit_names,
-                              header=list(table.header), inverted=tuple(sorted(flip)))
+                              header=list(table.header), inverted=tuple(sorted(flip)), notes=tuple(notes))
+
+
+def _dropped_time_note(table, col, unit, exc):
+    """The record's note on a time column left out for its unit; the file's text in it escaped
+    (:func:`shellbvp.textdata.printable`): it is shown and stored as data."""
+    from .textdata import printable
+
+    name = table.header[col] if col < len(table.header) else col
+    return printable(f"time column {name!r} not used: its unit {unit!r} is not a time ({exc}); the rows are "
+                     f"in the file's order")
 
 
 def record_from_arrays(path, displacement, force, time, line, *, columns, units, header=(), inverted=(),
-                       sha256=None) -> InstrumentRecord:
+                       sha256=None, notes=()) -> InstrumentRecord:
     """An :class:`InstrumentRecord` from SI arrays in the package's signs (any row order with a
     time column): sorted by time, segmented, the contact estimated.  ``line``: each row's line
     in the file (or its index)."""
@@ -526,7 +546,7 @@ def record_from_arrays(path, displacement, force, time, line, *, columns, units,
     labels = segment(arr["displacement"], t)
     rec = InstrumentRecord(path=str(path), sha256=sha256 or sha256_of(path), displacement=arr["displacement"],
                            force=arr["force"], time=t, line=line, segments=labels, columns=dict(columns),
-                           units=dict(units), header=list(header), inverted=tuple(inverted))
+                           units=dict(units), header=list(header), inverted=tuple(inverted), notes=tuple(notes))
     push = rec.mask("loading")
     if push.sum() >= 3:
         rec.contact_estimate = estimate_contact(rec.displacement[push], rec.force[push])

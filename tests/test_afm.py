@@ -91,6 +91,39 @@ def test_a_force_map_is_fitted_curve_by_curve(synthetic_map, tmp_path):
         fm.to_hdf5(out)
 
 
+def test_a_force_map_file_reads_back_and_info_and_plot_take_it(synthetic_map, tmp_path, capsys):
+    """The map's NeXus file, read back as data (read_map_file), holds the fit's images; `shellbvp
+    info` summarises it and `shellbvp plot` draws its mu*H; a damaged one is one line naming the item."""
+    pytest.importorskip("matplotlib")
+    import h5py
+
+    from shellbvp.afm import is_map_file, read_map_file
+
+    scene, curves = synthetic_map
+    fm = fit_map(scene, curves, R_L=R_L, path="cells.jpk-force-map")
+    out = tmp_path / "map.h5"
+    fm.to_hdf5(out)
+    assert is_map_file(out) and not is_map_file(tmp_path / "nothing.h5")
+    back = read_map_file(out)
+    np.testing.assert_array_equal(back.mu_H, fm.image("mu_H"))
+    np.testing.assert_array_equal(back.mu_H_high, fm.image("mu_H_high"))
+    np.testing.assert_array_equal(back.status, fm.status_image())
+    np.testing.assert_allclose(back.x, fm.axes()[0])
+    np.testing.assert_allclose(back.y, fm.axes()[1])
+    assert back.sample == scene.describe(R_L) and back.source == "cells.jpk-force-map"
+    capsys.readouterr()
+    assert main(["info", str(out)]) == 0
+    text = capsys.readouterr().out
+    assert "grid:      2 x 2: 4 fitted, 0 failed their checks, 0 errors, 0 no curve" in text
+    assert f"median {np.median(fm.image('mu_H')):.4g} N/m" in text
+    png = tmp_path / "map.png"
+    assert main(["plot", str(out), "-o", str(png)]) == 0 and png.stat().st_size > 0
+    with h5py.File(out, "a") as f:
+        del f["entry/map/status"]
+    with pytest.raises(ValueError, match="incomplete or corrupt force-map file.*status is missing"):
+        read_map_file(out)
+
+
 def test_cli_fits_a_map_into_a_table_a_file_and_a_figure(synthetic_map, tmp_path, monkeypatch, capsys):
     pytest.importorskip("matplotlib")
     import shellbvp.afm as afm
@@ -125,3 +158,30 @@ def test_a_file_afmformats_cannot_read_is_one_line(tmp_path):
     bad.write_bytes(b"PK\x03\x04 not really a zip")
     with pytest.raises(ValueError, match="afmformats cannot read it"):
         read_afm(bad)
+
+
+def test_a_synthetic_jpk_force_map_file_is_read_by_afmformats_and_fitted_to_its_truth(tmp_path, capsys):
+    """benchmarks/make_force_map.py writes a JPK archive (afmformats' test map's property files,
+    channels encoded anew); afmformats reads it back, with no monkeypatch: the grid, the positions
+    and the tip from height and deflection, and `shellbvp fit` recovers every pixel's mu*H."""
+    import importlib.util
+
+    import h5py
+
+    bench = Path(__file__).resolve().parent.parent / "benchmarks" / "make_force_map.py"
+    spec = importlib.util.spec_from_file_location("_bench_make_force_map", bench)
+    maker = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(maker)
+    path = tmp_path / "cells.jpk-force-map"
+    truth = maker.write_map(path, n=3, points=150)
+    curves = read_afm(path)
+    assert [c.grid for c in curves] == [(ix, iy) for iy in range(3) for ix in range(3)]
+    assert curves[4].position == pytest.approx((0.0, 0.0), abs=1e-12)          # the middle of a 3 x 3 grid
+    rec = curves[4].record
+    assert rec.counts()["retraction"] == 150 and rec.contact_estimate is not None
+    np.testing.assert_allclose(np.ptp(rec.displacement), maker.CONTACT + maker.TOP * maker.R_L, rtol=1e-6)
+    out = tmp_path / "cells.h5"
+    assert main(["fit", str(path), "--preset", "fit", "--radius", f"{maker.R_L * 1e6:g}um", "-q", "-o", str(out)]) == 0
+    assert "9 fitted" in capsys.readouterr().out
+    with h5py.File(out) as f:
+        np.testing.assert_allclose(f["entry/map/mu_H"][()], truth, rtol=0.01)   # 1 % force noise, 150 rows

@@ -204,3 +204,26 @@ def test_validate_takes_its_depth_in_lab_units_with_the_rim_radius(tmp_path):
     assert r.returncode == 2 and "--delta-max must be in (0, 2]; got 3.33333" in r.stderr, r.stderr
     r = run("validate", "--thickness", "0.05", "--delta-max", "100um", cwd=tmp_path)
     assert r.returncode == 2 and "--delta-max 100 um needs --radius" in r.stderr, r.stderr
+
+
+def test_sweep_takes_its_depth_and_force_in_lab_units_as_curve_does(tmp_path):
+    """sweep --delta-max 60um --force-max 5mN with --radius 0.3mm --muH 52N/m: every curve of the
+    file runs to delta = 60 um / R_L and stops at F = 5 mN / (mu H R_L); without a scale, a one-line
+    error names the one missing, before any curve."""
+    out = tmp_path / "g.h5"
+    r = run("sweep", "--rho", "0.2,0.25", "--delta-max", "60um", "-o", str(out), cwd=tmp_path)
+    assert r.returncode == 2 and "--delta-max 60 um needs --radius" in r.stderr, r.stderr
+    assert len(r.stderr.strip().splitlines()) == 1 and not out.exists()
+    r = run("sweep", "--rho", "0.2,0.25", "--delta-max", "0.2", "--force-max", "5mN", "--radius", "0.3mm",
+            "-o", str(out), cwd=tmp_path)
+    assert r.returncode == 2 and "missing --muH" in r.stderr and len(r.stderr.strip().splitlines()) == 1, r.stderr
+    assert not out.exists()
+    r = run("sweep", "--rho", "0.2,0.25", "--delta-max", "60um", "--force-max", "5mN", "--radius", "0.3mm",
+            "--muH", "52N/m", "--points", "3", "--workers", "1", "-q", "-o", str(out), cwd=tmp_path)
+    assert r.returncode == 1, r.stderr  # both curves stop at the force: 'stopped', not 'complete'
+    grid = sb.read_sweep(out)
+    assert grid.delta_max == pytest.approx(60e-6 / 0.3e-3, rel=1e-12)
+    assert sorted(grid.curves) == [0, 1]
+    for curve in grid.curves.values():
+        assert curve.force[-1] >= 5e-3 / (52 * 0.3e-3) > curve.force[-2]
+        assert "force_max" in curve.stop_reason

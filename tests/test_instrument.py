@@ -276,3 +276,39 @@ def test_units_beyond_the_tables_come_from_pint_and_only_for_such_a_unit(tmp_pat
             "print('pint' in sys.modules)")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "False"
+
+
+def test_a_time_column_whose_unit_is_not_a_time_is_dropped_and_the_record_says_so(truth, tmp_path, capsys):
+    """The time only orders the rows: a header unit that is no time (here volts, with a
+    right-to-left override in it, which would reorder a terminal line) drops that column, not the file; the note names it, escaped, and goes with the
+    fit to its summary, its JSON and its record.  A unit the user gives with --units is still an error."""
+    from shellbvp.cli import main
+
+    scene, t, d, f = truth
+    path = tmp_path / "volts.csv"
+    lines = ["Time (volts\u202e),Displacement (um),Force (uN)"]
+    lines += [f"{a:.3f},{b * 1e6:.6f},{c * 1e6:.6f}" for a, b, c in zip(t, d, f)]
+    path.write_text("\n".join(lines) + "\n")
+    rec = read_instrument(path)
+    assert rec.time is None and set(rec.columns) == {"displacement", "force"}
+    np.testing.assert_allclose(rec.displacement, d, rtol=1e-6, atol=1e-12)  # the file's order, every row
+    assert len(rec.notes) == 1
+    note = rec.notes[0]
+    assert "time column" in note and "not a time" in note and "volts\\u202e" in note and "\u202e" not in note
+    res, _ = fit_record(scene, rec, R_L=R_L)
+    assert res.success and res.mu_H_ci95[0] < MU_H < res.mu_H_ci95[1]
+    assert read_instrument(tmp_path / "volts.csv", units=("um", "uN", None)).notes == rec.notes
+    with pytest.raises(ValueError, match="time column: unknown time unit 'volts'"):
+        read_instrument(path, units=("um", "uN", "volts"))
+
+    out = tmp_path / "volts.h5"
+    capsys.readouterr()
+    assert main(["fit", str(path), "--preset", "fit", "--radius", "0.3mm", "-q", "-o", str(out)]) == 0
+    printed = capsys.readouterr().out
+    assert f"note: {note}" in printed.splitlines() and "\u202e" not in printed
+    assert sb.read_fit(out).source["notes"] == [note]
+    assert main(["fit", str(path), "--preset", "fit", "--radius", "0.3mm", "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["notes"] == [note]
+    plain = tmp_path / "seconds.csv"
+    plain.write_text("\n".join(["Time (s),Displacement (um),Force (uN)"] + lines[1:]) + "\n")
+    assert read_instrument(plain).notes == () and read_instrument(plain).time is not None

@@ -9,7 +9,7 @@ import os
 from pathlib import Path
 
 
-__all__ = ["Parser", "print_json_error", "plain_number", "plain_numbers", "quantity", "uncertain_value", "pressure_value", "say", "number_or", "thickness_value", "nondimensional", "material_spec", "material_help", "bending_families", "add_scene_options", "scene_from_args", "over_rim_radius", "require_sample", "nondimensional_thickness", "nondimensional_pressure", "checkpoint_seconds", "progress_bar", "curve_bars", "MAX_POINTS", "free_default_name", "strict_json", "output_dir", "check_report_path", "add_overwrite_option"]
+__all__ = ["Parser", "print_json_error", "plain_number", "plain_numbers", "quantity", "uncertain_value", "pressure_value", "say", "number_or", "thickness_value", "nondimensional", "add_radius_option", "add_mu_h_option", "material_spec", "material_help", "bending_families", "add_scene_options", "scene_from_args", "over_rim_radius", "require_sample", "nondimensional_thickness", "nondimensional_pressure", "checkpoint_seconds", "progress_bar", "curve_bars", "MAX_POINTS", "free_default_name", "strict_json", "output_dir", "check_report_path", "add_overwrite_option"]
 
 
 class Parser(argparse.ArgumentParser):
@@ -121,10 +121,24 @@ def nondimensional(args, value, option):
             raise ValueError(f"{option} {value} needs --radius (the rim radius, e.g. 0.3mm), or give it in "
                              f"rim radii (a plain number)")
         return value.si / args.radius.si
-    if args.radius is None or args.mu_h is None:
-        raise ValueError(f"{option} {value} needs --radius and --muH (e.g. 0.3mm and 52N/m), or give it in "
-                         f"mu*H R_L (a plain number)")
+    missing = [name for name, given in (("--radius", args.radius), ("--muH", getattr(args, "mu_h", None)))
+               if given is None]
+    if missing:
+        raise ValueError(f"{option} {value} needs --radius and --muH (e.g. 0.3mm and 52N/m; missing "
+                         f"{' and '.join(missing)}), or give it in mu*H R_L (a plain number)")
     return value.si / (args.mu_h.si * args.radius.si)
+
+
+def add_radius_option(p, what):
+    """``--radius`` (``--rim-radius``): the rim radius R_L with its unit, the length scale of the
+    options given in lab units (``what`` says which)."""
+    p.add_argument("--radius", "--rim-radius", type=quantity("length"),
+                   help=f"rim radius R_L with its unit, e.g. 0.3mm ({what})")
+
+
+def add_mu_h_option(p, what):
+    """``--muH``: mu*H with its unit, the force scale (with ``--radius``) of ``what``."""
+    p.add_argument("--muH", type=quantity("mu_H"), dest="mu_h", help=f"mu*H with its unit, e.g. 52N/m ({what})")
 
 
 def material_spec(text):

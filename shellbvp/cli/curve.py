@@ -7,8 +7,8 @@ import sys
 import time
 
 from .common import (
-    MAX_POINTS, add_overwrite_option, add_scene_options, checkpoint_seconds, free_default_name,
-    nondimensional, number_or, plain_number, quantity, scene_from_args,
+    MAX_POINTS, add_mu_h_option, add_overwrite_option, add_radius_option, add_scene_options, checkpoint_seconds,
+    free_default_name, nondimensional, number_or, plain_number, scene_from_args,
 )
 
 __all__ = ["add_parser", "run"]
@@ -26,9 +26,8 @@ def add_parser(sub):
     c.add_argument("--lambda0-max", type=plain_number, dest="lambda0_max", help="stop at this pole stretch")
     c.add_argument("--max-steps", type=int, default=400, dest="max_steps", help="most continuation steps of a curve (default 400)")
     c.add_argument("--profiles", action="store_true", help="store each point's profiles")
-    c.add_argument("--radius", "--rim-radius", type=quantity("length"),
-                   help="rim radius R_L with its unit, e.g. 0.3mm (with --muH: SI columns in the file)")
-    c.add_argument("--muH", type=quantity("mu_H"), dest="mu_h", help="mu*H with its unit, e.g. 52N/m")
+    add_radius_option(c, "with --muH: SI columns in the file")
+    add_mu_h_option(c, "with --radius: SI columns in the file")
     c.add_argument("-o", "--output", help="output file (default <preset>.h5, or <preset>-2.h5, ... if that exists)")
     add_overwrite_option(c, "replace an existing output file")
     c.add_argument("-q", "--quiet", action="store_true", help="no progress bar (there is none when stderr is not "

@@ -184,6 +184,7 @@ def run(args):
                                      uncertainty=uncertainty, executor=executor, workers=args.workers,
                                      baseline=res.baseline_model, contact_guess=res.offset, **kw)
     out = res.to_dict()
+    out["notes"] = list(record.notes)
     ok = res.success and (geometry is None or geometry.success)
     if geometry is not None:
         out["geometry"] = geometry.to_dict()
@@ -246,6 +247,7 @@ def _fit_batch(args, files):
         print(json.dumps(strict_json({"files": docs, "success": ok, "exit_status": 0 if ok else 1}),
                          allow_nan=False))
     else:
+        say(f"scene  = {scene.describe(R_L)}")  # every file's, in lab units: a batch names its sample too
         width = max(len(r.file) for r in rows)
         for r in rows:
             if r.result is not None and r.status != "error":
@@ -345,6 +347,8 @@ def _print_fit(res, record, used, args):
     name = Path(record.path).name if args.example else record.path
     say(f"data   = {name}: {len(record)} rows ({counts}); fitted the {args.segment} segment, "
           f"{int(used.sum())} rows")
+    for text in getattr(record, "notes", ()):
+        say(f"note: {text}")
     say(f"scene  = {res.scene.describe(res.R_L)}")
     lo, hi = res.mu_H_ci95
     say(f"mu*H   = {res.mu_H:.4g} N/m (um*MPa)   95% CI [{lo:.4g}, {hi:.4g}]")

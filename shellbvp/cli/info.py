@@ -1,4 +1,4 @@
-"""The ``info`` command: what a curve, sweep or fit file holds."""
+"""The ``info`` command: what a curve, sweep, fit or force-map file holds."""
 
 from __future__ import annotations
 
@@ -12,7 +12,7 @@ __all__ = ["add_parser", "run"]
 
 def add_parser(sub):
     """The ``info`` subcommand's arguments, on ``sub`` (the subparsers)."""
-    i = sub.add_parser("info", help="describe a curve file or a fit file")
+    i = sub.add_parser("info", help="describe a curve, sweep, fit or force-map file")
     i.add_argument("file")
     i.set_defaults(func=run)
 
@@ -61,6 +61,13 @@ def run(args):
         say(f"file:      {args.file} (a fit)")
         for line in fit_summary_lines(read_fit(args.file)):
             say(f"  {line}")
+        return 0
+    from ..afm import is_map_file, read_map_file
+
+    if os.path.isfile(args.file) and is_map_file(args.file):
+        say(f"file:      {args.file} (a force map fitted curve by curve)")
+        for line in read_map_file(args.file).summary_lines():
+            say(line)
         return 0
     if os.path.isfile(args.file) and is_sweep_file(args.file):
         return _sweep_info(args.file)

@@ -1,4 +1,4 @@
-"""The ``plot`` command: figures of curve, sweep and fit files."""
+"""The ``plot`` command: figures of curve, sweep, fit and force-map files."""
 
 from __future__ import annotations
 
@@ -13,10 +13,10 @@ def add_parser(sub):
     """The ``plot`` subcommand's arguments, on ``sub`` (the subparsers)."""
     pl = sub.add_parser("plot", help="plot curves (and profiles) from HDF5 files (needs matplotlib)")
     pl.add_argument("files", nargs="+", help="curve files (`shellbvp curve`), sweep files (`shellbvp sweep`: one "
-                    "curve per finished combination) or fit files (`shellbvp fit -o`: data, model and residuals in "
-                    "SI units)")
-    pl.add_argument("-o", "--output", help="PNG or PDF (default curves.png; for fit files <name>.png next to "
-                    "each); for several fit files a directory (one <name>.png each)")
+                    "curve per finished combination), fit files (`shellbvp fit -o`: data, model and residuals in "
+                    "SI units) or force-map files (`shellbvp fit MAP.jpk-force-map -o`: the image of mu*H)")
+    pl.add_argument("-o", "--output", help="PNG or PDF (default curves.png; for fit and force-map files <name>.png "
+                    "next to each); for several fit or force-map files a directory (one <name>.png each)")
     pl.add_argument("--profiles", help="also draw the deformed shell of the first file at these depths, e.g. 0.1,0.3")
     pl.add_argument("--dpi", type=int, default=150, help="resolution of a PNG (default 150)")
     pl.set_defaults(func=run)
@@ -29,6 +29,24 @@ def run(args):
     from ..plotting import plot_curves, plot_fit_record, plot_profiles, require_matplotlib, save_figure, scene_label
     from ..sweep import is_sweep_file, read_sweep
 
+    from ..afm import is_map_file, read_map_file
+
+    maps = [f for f in args.files if is_map_file(f)]
+    if maps:  # a force map's file: its mu*H image, one figure each
+        if len(maps) != len(args.files):
+            raise ValueError("plot either force-map files or curve and fit files, not both in one call")
+        if args.output is None:
+            outs = [Path(name).with_suffix(".png") for name in maps]
+        elif len(maps) > 1 or Path(args.output).is_dir():
+            outdir = output_dir(args.output, "-o", maps, ".png", True)
+            outs = [outdir / (Path(name).stem + ".png") for name in maps]
+        else:
+            outs = [Path(args.output)]
+        for name, out in zip(maps, outs):
+            check_output_path(out, overwrite=True)
+            read_map_file(name).plot(out, dpi=args.dpi)
+            print(f"wrote {out}")
+        return 0
     fits = [f for f in args.files if is_fit_file(f)]
     if fits:
         if len(fits) != len(args.files):

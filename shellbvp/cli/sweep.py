@@ -5,7 +5,10 @@ from __future__ import annotations
 import sys
 import time
 
-from .common import MAX_POINTS, add_overwrite_option, material_help, material_spec, plain_number
+from .common import (
+    MAX_POINTS, add_mu_h_option, add_overwrite_option, add_radius_option, material_help, material_spec, nondimensional,
+    number_or, plain_number,
+)
 
 __all__ = ["add_parser", "run"]
 
@@ -33,7 +36,12 @@ def add_parser(sub):
     g.add_argument("--pressure", help="pressure below the shell, nondimensional p R_L/(mu H): values to sweep")
     g.add_argument("--xi", type=int, choices=(0, 1), help="1: full generalised tensions; 0: first approximation")
     g.add_argument("--contact", choices=("smooth", "paper"), help="contact-line model (default smooth)")
-    w.add_argument("--delta-max", type=plain_number, default=0.5, dest="delta_max", help="depth of every curve (default 0.5)")
+    w.add_argument("--delta-max", type=number_or("length"), default=0.5, dest="delta_max",
+                   help="depth of every curve (default 0.5, in rim radii); with a unit (100um) it needs --radius")
+    w.add_argument("--force-max", type=number_or("force"), dest="force_max",
+                   help="stop every curve at this force; with a unit (10mN) it needs --radius and --muH")
+    add_radius_option(w, "for --delta-max and --force-max with a unit")
+    add_mu_h_option(w, "with --radius, for --force-max with a unit")
     w.add_argument("--points", type=int, help="N equally spaced depths up to delta-max (default: adaptive)")
     w.add_argument("--tol", type=plain_number, default=1e-6, help="collocation tolerance (default 1e-6)")
     w.add_argument("--max-nodes", type=int, default=10000, dest="max_nodes", help="largest collocation mesh of a state (default 10000)")
@@ -100,8 +108,12 @@ def run(args):
     elif args.material is not None:
         over["material"] = args.material
     base = sb.Scene.preset(args.preset, **over)
+    args.delta_max = nondimensional(args, args.delta_max, "--delta-max")
+    args.force_max = nondimensional(args, args.force_max, "--force-max")
     check_grid(base, grid, args.max_cells)  # before a scheduler is asked for anything
     settings = {"tol": args.tol, "max_nodes": args.max_nodes, "max_steps": args.max_steps, "topology": args.topology}
+    if args.force_max is not None:
+        settings["force_max"] = args.force_max
     if args.points is not None:
         if not 2 <= args.points <= MAX_POINTS:
             raise ValueError(f"--points must be in [2, {MAX_POINTS}]; got {args.points}")

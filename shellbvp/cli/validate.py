@@ -3,8 +3,8 @@
 from __future__ import annotations
 
 from .common import (
-    add_overwrite_option, add_scene_options, free_default_name, nondimensional, number_or, plain_numbers, quantity,
-    scene_from_args,
+    add_overwrite_option, add_radius_option, add_scene_options, free_default_name, nondimensional, number_or,
+    plain_numbers, scene_from_args,
 )
 
 __all__ = ["add_parser", "run"]
@@ -19,8 +19,7 @@ def add_parser(sub):
                    help="largest pole displacement (default 0.5, in rim radii; with a unit, 90um, it needs --radius); "
                         "the depths are delta/H = 0.25, 0.5, 1, 2, 5, 10, 25 below it and delta-max")
     v.add_argument("--deltas", help="these pole displacements instead, comma-separated (/R_L)")
-    v.add_argument("--radius", "--rim-radius", type=quantity("length"),
-                   help="rim radius with its unit, for --thickness and --delta-max with a unit")
+    add_radius_option(v, "for --thickness and --delta-max with a unit")
     v.add_argument("--mesh-check", action="store_true", dest="mesh_check",
                    help="also solve the 3D model on a coarser mesh and report the difference (~1.5x the time)")
     v.add_argument("-o", "--output", help="output file (default <preset>-validate.h5, or -2, ... if that exists)")
