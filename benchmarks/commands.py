@@ -9,7 +9,9 @@ clock) with its peak resident memory (``wait4``'s ``ru_maxrss``).  Sides:
 * this commit, ``[fast]``: numba installed and ``SHELLBVP_KERNELS=auto`` (what a user of the
   extra runs), the kernels compiled beforehand by the untimed warming run (``numba``).
 
-Warm: each side has its own code cache, filled by one untimed run of each command first, and
+Warm: each side has its own code cache, filled by one untimed run of each command first (a fit
+then reads the model curve that run kept, as a repeated fit of a sample does; "curve not kept"
+deletes the kept curves before each run: a sample's first fit), and
 the repeats alternate the sides (A B C A B C ...) so a noisy shared machine weighs on all
 alike; a ratio is the median of the per-repeat ratios.  Cold: the first run of ``curve`` with
 an empty code cache (the equations derived and their code generated), once per side.
@@ -52,6 +54,7 @@ COMMANDS = (
     ("curve (default base)", ["curve", "-o", "{out}.h5"], 0, True),
     ("solve --delta 0.2", ["solve", "--delta", "0.2"], 0, True),
     ("fit --example", ["fit", "--example", "--preset", "fit", "--radius", "0.3mm"], 0, True),
+    ("fit --example, curve not kept", ["fit", "--example", "--preset", "fit", "--radius", "0.3mm"], 0, False),
     ("fit a folder of 10 files", ["fit", "{folder}", "--preset", "fit", "--radius", "0.3mm", "--table",
                                   "{out}.csv"], 0, False),
     ("sweep 2x2 to delta 0.2", ["sweep", "--beta", "0.005,0.01", "--rho", "0.2,0.25", "--delta-max", "0.2",
@@ -61,7 +64,10 @@ COMMANDS = (
     ("force map 16x16 (one geometry)", ["fit", "{force_map}", "--preset", "fit", "--radius", "10um", "-o",
                                         "{out}.h5", "-q"], 0, False),
 )
-QUICK = ("bad option", "curve (default base)", "fit --example")
+QUICK = ("bad option", "curve (default base)", "fit --example", "fit --example, curve not kept")
+#: Commands run with the kept model curves deleted first (a sample fitted for the first time;
+#: every other fit reads the curve its warming run kept, as a repeated fit does)
+FRESH_CURVES = ("fit --example, curve not kept",)
 #: Commands of the issue not measured, and why (a line under the table)
 NOT_MEASURED = ("force map 16x16 with per-pixel shell height from a table: shellbvp fits a map with one geometry "
                 "(`shellbvp fit MAP --preset ...`, `batch.fit_map`); per-pixel geometry is not supported",)
@@ -163,6 +169,8 @@ def main(argv=None):
             for side in order[r % len(order):] + order[:r % len(order)]:
                 if side == args.baseline and not on_base:
                     continue
+                if name in FRESH_CURVES:
+                    shutil.rmtree(caches[side] / "curves", ignore_errors=True)
                 wall, rss, code, err = run(argv_of(cmd), env_of(side, caches[side]), work)
                 rows.setdefault(name, {}).setdefault(side, []).append((wall, rss, code))
         print(f"repeat {r + 1}/{repeat} done ({time.perf_counter() - t_start:.0f} s)", flush=True)
