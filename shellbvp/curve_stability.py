@@ -29,7 +29,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 __all__ = ["STABILITY_CHOICES", "STABILITY_FIELDS", "FirstInstability", "check_choice", "point_stability",
-           "assess", "locate_zero"]
+           "assess", "locate_zero", "first_instability_up_to"]
 
 #: What ``curve(stability=...)`` accepts
 STABILITY_CHOICES = ("off", "points", "locate")
@@ -247,3 +247,22 @@ def _narrowed(curve, j, i, mins, modes, delta_tol):
                else f"narrowed to {abs(b - a):.2g} in delta by {evals} states (not to {delta_tol:g})")
     return FirstInstability(delta=a + t * (b - a), force=Fa + t * (Fb - Fa), mode=int(mode), located=located,
                             bracket=(float(a), float(b)), message=message)
+
+
+#: Depths of the curve :func:`first_instability_up_to` analyses
+CHECK_DEPTHS = 12
+
+
+def first_instability_up_to(scene, delta_max: float, *, tol: float = 1e-6):
+    """(the first instability of ``scene``'s curve at or before ``delta_max``, or None; what was
+    not analysed): a curve at :data:`CHECK_DEPTHS` depths to ``delta_max``, ``"locate"``."""
+    from .continuation import curve
+
+    c = curve(scene, deltas=delta_max * np.arange(1, CHECK_DEPTHS + 1) / CHECK_DEPTHS, tol=tol,
+              estimate_error=False, stability="locate")
+    first = c.first_instability
+    note = c.settings.get("stability_note", "")
+    if not c.complete:
+        note = "; ".join(filter(None, [note, f"the curve stopped at delta = {c.delta.max() if len(c) else 0:.4g} "
+                                             f"({c.stop_reason})"]))
+    return (first if first is not None and first.delta <= delta_max else None), note

@@ -34,6 +34,7 @@ FIT_WARNINGS = {
     "max_curves": "the number of model curves reached its limit",
     "mixed_segments": "the fitted rows mix the loading and the retraction of an instrument record",
     "several_loadings": "the record holds more than one loading pass; one was fitted, the others left out",
+    "unstable_depths": "the fitted depths pass the first instability of the axisymmetric shell (fit(stability=True))",
 }
 
 

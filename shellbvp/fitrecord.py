@@ -213,6 +213,14 @@ def write_fit(path, result, record, used, *, segment="loading", overwrite=False)
             for name in _with_intervals(result):
                 number_dataset(p, f"{name}_ci95", np.asarray(getattr(result, f"{name}_ci95"), float),
                                PARAMETER_UNITS[name], f"95 % interval of {name}")
+            first = getattr(result, "first_instability", None)
+            if first is not None:  # fit(stability=True) found the shell unstable within the fitted depths
+                number_dataset(p, "first_instability_delta", float(first.delta), DIMENSIONLESS,
+                               "where the axisymmetric shell first loses stability: pole displacement / R_L")
+                number_dataset(p, "first_instability_displacement", result.offset + result.R_L * float(first.delta),
+                               "m", "the same as a displacement of the data (offset + R_L delta)")
+                number_dataset(p, "first_instability_mode", int(first.mode), DIMENSIONLESS,
+                               "the Fourier mode n that goes unstable")
             w = string_dataset(e, "warnings", list(result.warnings), "warnings of the fit")
             w.attrs["codes"] = np.array(list(result.warning_codes), dtype=h5py.string_dtype())
             s = e.create_group("sample")

@@ -53,6 +53,9 @@ def add_parser(sub):
     f.add_argument("--weights", choices=("uniform", "relative", "mixed"),
                    help="noise model: uniform (same force noise everywhere), relative (noise proportional "
                         "to the force) or mixed (both, estimated; the default)")
+    f.add_argument("--stability", action="store_true",
+                   help="also look for where the fitted shell stops being axisymmetric, up to the deepest fitted "
+                        "depth (a warning when the data pass it; seconds to a minute more)")
     f.add_argument("--json", action="store_true", help="print the result as one JSON document (also on errors)")
     f.add_argument("-o", "--output", help="write the fit as a record (HDF5/NeXus: data, model, parameters with "
                    "intervals, weights, warnings, scene, source file and its SHA-256); a batch: a directory "
@@ -105,7 +108,7 @@ def _fit_inputs(args):
             if name not in free:
                 raise ValueError(f"--{name}-range needs --fit-{name}")
     options = {"fit_offset": not args.no_offset, "free": free, "bounds": bounds, "weights": args.weights,
-               "tol": args.tol}
+               "tol": args.tol, "stability": args.stability}
     return scene, args.radius.si, {"columns": columns, "units": units, "invert": tuple(args.invert or ())}, options
 
 
@@ -396,6 +399,8 @@ def _print_fit(res, record, used, args):
         say(line)
     for text in res.warnings:
         say(f"warning: {text}")
+    if res.stability_note:
+        say(f"stability not analysed where: {res.stability_note}")
 
 
 def _estimate_line(e):

@@ -70,7 +70,8 @@ def _check_data(d, f, k, origin=0.0):
 
 
 def fit(scene, displacement, force, *, R_L, fit_offset=True, free=(), bounds=None, weights=None, floor=0.05,
-        delta_max=None, tol=1e-6, loss="linear", baseline="none", contact_guess=None, progress=None, **aliases):
+        delta_max=None, tol=1e-6, loss="linear", baseline="none", contact_guess=None, progress=None,
+        stability=False, **aliases):
     """Least-squares fit of mu*H (the displacement origin, and a shape parameter) to measured data.
 
     Parameters
@@ -97,6 +98,11 @@ def fit(scene, displacement, force, *, R_L, fit_offset=True, free=(), bounds=Non
     progress : callable, optional
         ``progress(description, delta_max) -> (bar, callback)`` for each model curve computed
         (e.g. ``lambda d, m: shellbvp.progress.curve_progress(m, d)``); None: silent.
+    stability : bool
+        Also look for the first loss of axisymmetric stability of the fitted scene up to the
+        deepest fitted depth (:func:`shellbvp.curve_stability.first_instability_up_to`; seconds
+        to a minute): a warning (``unstable_depths``) and ``FitResult.first_instability`` when
+        the data pass it.
     free : sequence of str
         Also fit a shape parameter, a name of :data:`shellbvp.shape_parameters.SHAPE_PARAMETERS`
         (one at most), e.g. ``"beta"``, the Mooney–Rivlin ``"alpha"`` (subset of [0, 1]), the
@@ -204,7 +210,25 @@ def fit(scene, displacement, force, *, R_L, fit_offset=True, free=(), bounds=Non
         search = ProfileSearch(sp, ModelCurves(sp.scene_at, grid, tol, depth, counter, progress), mdl, depth)
         fitted = search.run(noise, k)
         notes = search.notes
-    return result_of(fitted, mdl, sp, k, notes, keep, weights, baseline, counter[0])
+    res = result_of(fitted, mdl, sp, k, notes, keep, weights, baseline, counter[0])
+    if stability and res.scene is not None and math.isfinite(res.offset):
+        _check_axisymmetry(res, (float(np.max(d)) - res.offset) / R_L, tol)
+    return res
+
+
+def _check_axisymmetry(res, deepest, tol):
+    """``res.first_instability`` and a warning where the fitted scene's curve loses axisymmetric
+    stability before the deepest fitted depth ``deepest`` (delta)."""
+    from ..curve_stability import first_instability_up_to
+
+    first, note = first_instability_up_to(res.scene, deepest, tol=tol)
+    res.first_instability, res.stability_note = first, note
+    if first is not None:
+        res.warnings.append(
+            f"the fitted depths reach delta = {deepest:.4g} but the axisymmetric shell loses stability at delta = "
+            f"{first.delta:.4g} (mode n = {first.mode}, displacement {res.offset + first.delta * res.R_L:.4g} m): past "
+            f"it the shell is not axisymmetric and the model does not describe it; fit the data up to that depth")
+        res.warning_codes.append("unstable_depths")
 
 
 def free_parameters(free=(), bounds=None, aliases=None):

@@ -96,6 +96,10 @@ class FitResult:
     point_weights : ndarray
         The noise model's weight (1/sigma, largest 1) of each data point as given (NaN
         where a value was missing).
+    first_instability : FirstInstability or None
+        With ``fit(..., stability=True)``: where the fitted scene's curve first loses
+        axisymmetric stability, if within the fitted depths (:mod:`shellbvp.curve_stability`);
+        ``stability_note`` says what was not analysed.
     correlation : ndarray or None
         Correlation matrix of the fitted parameters (order of ``fitted``), from the linearised
         covariance.
@@ -162,6 +166,8 @@ class FitResult:
     bic: float = float("nan")
     runs_p: float = float("nan")
     residual_autocorrelation: float = float("nan")
+    first_instability: object = None
+    stability_note: str = ""
 
     @property
     def success(self):
@@ -246,6 +252,8 @@ class FitResult:
                 "residual_autocorrelation": num(self.residual_autocorrelation),
                 "correlation": None if self.correlation is None else
                 [[num(v) for v in row] for row in np.asarray(self.correlation)],
+                "first_instability": None if self.first_instability is None else self.first_instability.to_dict(),
+                "stability_note": self.stability_note,
                 "model_error": None if self.model_error is None else num(self.model_error[0]),
                 "model_error_extrapolated": None if self.model_error is None else self.model_error[1],
                 "units": {"mu_H": "N/m (= um*MPa)", "offset": "m", "residual": "N (rms)",
