@@ -5,7 +5,7 @@ Where the single-cap state needs a negative contact pressure near the pole
 there: a free inner cap around the pole, then contact on an annulus
 ``[S1, S2]`` (``topology="annulus"``) or on one circle (``"line"``, a
 zero-width annulus carrying a ring force), then the outer free region.  The
-systems are the chains ``annulus_chain`` and ``line_chain`` of :mod:`shellbvp.chain`; this module makes guesses,
+systems are the chains of ``shellbvp/configurations/annulus.py`` and ``line.py``; this module makes guesses,
 runs solve_bvp and diagnoses the result into a :class:`~shellbvp.state.Solution`
 with the same fields as a cap state, plus ``S1`` (inner edge), ``ring_force_inner``,
 ``contact_width`` and, for a line, ``curvature_excess`` (kappa_s at the line minus the

@@ -14,7 +14,7 @@ import time
 
 import numpy as np
 
-from .chain import FREE_STATES, ChainBVP, cap_chain
+from .chain import FREE_STATES, ChainBVP
 from .configurations import ASKED, CAP_REPLACEMENTS, configuration, is_point_load, is_single_cap, of, resolve
 from .corner import edge_model, edge_null_jump, is_corner, limit_estimate, near_limit, other_edge_root
 from .diagnosis import as_failure, diagnose
@@ -82,7 +82,7 @@ def _run_bvp(sysm, guess, tol, max_nodes, bc_tol):
 
 
 def make_system(scene, control, value, eps, edge=None):
-    """The single-cap system (``shellbvp.chain.cap_chain``) of a scene, control and value;
+    """The single-cap system (``shellbvp.configurations.cap``) of a scene, control and value;
     ``edge`` ("smooth", "corner", "paper") defaults to the scene's contact model."""
     return configuration("cap").system(scene, control, value, eps, edge)
 
@@ -93,7 +93,7 @@ def system_like(prev, control, value, eps):
     edge, sysm = edge_model(prev), prev.system
     if (isinstance(sysm, ChainBVP) and sysm.control == control and not sysm.volume_control
             and sysm.scene is prev.scene and hasattr(sysm, "tip_A")
-            and sysm.chain == cap_chain(eps, prev.scene.shell_length, edge)):
+            and sysm.chain == configuration("cap").chain(eps, prev.scene.shell_length, edge)):
         return sysm.with_value(value)
     return make_system(prev.scene, control, value, eps, edge)
 

@@ -1,0 +1,55 @@
+"""The contact configurations: one module each, registered in one place.
+
+A :class:`Configuration` is what a state's ``topology`` names: its chain of regions
+(built from the blocks of :mod:`shellbvp.chain`), the contact models and controls it exists
+for, its family (what kind of search finds it) and how its system is built.  Every other
+module asks the registry (:func:`configuration`, :func:`names`, :func:`of`,
+:func:`switch_between`; :mod:`shellbvp.configurations.registry`) instead of listing names.
+
+Each other module of this package declares one configuration:
+
+* ``ORDER``, an integer: where it stands among the configurations;
+* its chain declaration, ``<name>_chain(eps, L[, model])`` (a :class:`shellbvp.chain.Chain`);
+* ``CONFIGURATIONS``, a tuple holding its :class:`Configuration` (two where two configurations
+  are one declaration);
+* ``SWITCHES``, the :class:`Switch` es a curve locates between it and configurations
+  registered before it: a switch lives in the module of the later of its two configurations.
+
+On import the package finds its modules (:func:`discover`) and registers them in the order
+of their ``ORDER`` numbers (:func:`install`); a module without one, or two with the same,
+stop the import with a ValueError.  That order is :func:`names`' and therefore the order in
+which a state's candidates are tried and listed in files and messages, so it is written in
+the modules, not left to their file names.  The numbers go in tens, so that a configuration
+can stand between two others.
+
+Adding a configuration of an existing family is one new module here and its tests: copy
+the module of a configuration of its family (``line.py`` for a lifted pole, ``cap_band_tip.py``
+for a second zone on the tip, ``cap_line_cylinder.py`` for the cylinder), give it a new name,
+``ORDER`` and chain, and declare its switches.  Its family's search (``shellbvp.liftoff``,
+``shellbvp.cylinder``) finds it through :func:`names` and the traits it declares
+(``inner_edge``, ``line_contact``, ``pole_branch_end``, ``again``, ``measured``).
+``tests/test_configurations.py`` shows it with a copy of ``line.py`` made in a test.
+"""
+
+from __future__ import annotations
+
+import sys
+
+from .registry import (CAP_REPLACEMENTS, CONFIGURATIONS, FAMILIES, SWITCHES, Configuration, Switch, configuration,
+                       discover, family_of, install, is_point_load, is_single_cap, names, of, register,
+                       register_switch, resolve, switch_between, without_edge_model)
+
+__all__ = ["Configuration", "CONFIGURATIONS", "CONFIGURATION_NAMES", "FAMILIES", "configuration", "names",
+           "register", "family_of", "of", "is_single_cap", "is_point_load", "resolve", "CAP_REPLACEMENTS", "ASKED",
+           "Switch", "SWITCHES", "switch_between", "register_switch", "without_edge_model", "discover", "install",
+           "POINT_S0"]
+
+for _module in discover(sys.modules[__name__]):
+    install(_module)
+
+from .point import POINT_S0  # noqa: E402  (the point-load state's s0, which shellbvp.pointload reads)
+
+#: Every configuration's name (``Solution.topology``, a curve's per-point ``topology``)
+CONFIGURATION_NAMES = names()
+#: What ``solve(topology=...)`` accepts
+ASKED = ("auto",) + tuple(n for n, c in CONFIGURATIONS.items() if c.askable)
