@@ -257,3 +257,7 @@ def test_the_structure_census_holds_what_the_redesign_reached():
     assert census["solution_builds"] == {"diagnosis": 1, "solution": 1}
     receivers = {where.split("(")[1].rstrip(")") for where in census["result_gets"]}
     assert receivers <= {"sc", "s", "settings", "p"}, receivers
+    # configuration names are compared in the registry only, and the census knows every name
+    assert set(census["name_comparisons"]) <= {"configurations.registry"}, census["name_comparisons"]
+    from shellbvp.configurations import CONFIGURATION_NAMES
+    assert _load("architecture").configuration_names(BENCH.parent) == set(CONFIGURATION_NAMES)

@@ -12,8 +12,8 @@ Each other module of this package declares one configuration:
 * its chain declaration, ``<name>_chain(eps, L[, model])`` (a :class:`shellbvp.chain.Chain`);
 * ``CONFIGURATIONS``, a tuple holding its :class:`Configuration` (two where two configurations
   are one declaration);
-* ``SWITCHES``, the :class:`Switch` es a curve locates between it and configurations
-  registered before it: a switch lives in the module of the later of its two configurations.
+* ``SWITCHES``, a tuple of the switches (:class:`Switch`) a curve locates between it and
+  configurations registered before it: a switch lives in the module of the later of its two.
 
 On import the package finds its modules (:func:`discover`) and registers them in the order
 of their ``ORDER`` numbers (:func:`install`); a module without one, or two with the same,
