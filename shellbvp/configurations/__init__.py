@@ -38,6 +38,7 @@ import sys
 from .registry import (CAP_REPLACEMENTS, CONFIGURATIONS, FAMILIES, SWITCHES, Configuration, Switch, configuration,
                        discover, family_of, install, is_point_load, is_single_cap, names, of, register,
                        register_switch, resolve, switch_between, without_edge_model)
+from .point import POINT_S0  # the point-load state's s0, which shellbvp.pointload reads
 
 __all__ = ["Configuration", "CONFIGURATIONS", "CONFIGURATION_NAMES", "FAMILIES", "configuration", "names",
            "register", "family_of", "of", "is_single_cap", "is_point_load", "resolve", "CAP_REPLACEMENTS", "ASKED",
@@ -46,8 +47,6 @@ __all__ = ["Configuration", "CONFIGURATIONS", "CONFIGURATION_NAMES", "FAMILIES",
 
 for _module in discover(sys.modules[__name__]):
     install(_module)
-
-from .point import POINT_S0  # noqa: E402  (the point-load state's s0, which shellbvp.pointload reads)
 
 #: Every configuration's name (``Solution.topology``, a curve's per-point ``topology``)
 CONFIGURATION_NAMES = names()

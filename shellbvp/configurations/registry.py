@@ -54,7 +54,8 @@ class Configuration:
     controls : tuple of str
         What may be prescribed.
     askable : bool
-        Whether ``solve(topology=name)`` may ask for it.
+        Whether ``solve(topology=name)`` may ask for it (of the lifted family, the ones
+        :mod:`shellbvp.liftoff` searches).
     needs_tip_end : bool
         Whether it needs a tip that ends on a cylinder (``model.OMEGA_MAX``).
     again : str or None
@@ -132,6 +133,8 @@ CONFIGURATIONS: dict[str, Configuration] = {}
 
 
 def register(conf: Configuration) -> Configuration:
+    """Add a configuration after those registered (ValueError for an unknown family or a name
+    registered already)."""
     if conf.family not in FAMILIES:
         raise ValueError(f"family must be one of {FAMILIES}; got {conf.family!r}")
     if conf.name in CONFIGURATIONS:
