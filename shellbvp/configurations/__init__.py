@@ -22,13 +22,16 @@ which a state's candidates are tried and listed in files and messages, so it is 
 the modules, not left to their file names.  The numbers go in tens, so that a configuration
 can stand between two others.
 
-Adding a configuration of an existing family is one new module here and its tests: copy
-the module of a configuration of its family (``line.py`` for a lifted pole, ``cap_band_tip.py``
-for a second zone on the tip, ``cap_line_cylinder.py`` for the cylinder), give it a new name,
-``ORDER`` and chain, and declare its switches.  Its family's search (``shellbvp.liftoff``,
-``shellbvp.cylinder``) finds it through :func:`names` and the traits it declares
-(``inner_edge``, ``line_contact``, ``pole_branch_end``, ``again``, ``measured``).
-``tests/test_configurations.py`` shows it with a copy of ``line.py`` made in a test.
+Adding a configuration is one new module here and its tests: copy the module of a
+configuration of its family (``line.py`` for a lifted pole, ``cap_line_cylinder.py`` for the
+cylinder), give it a new name, ``ORDER`` and chain, set its traits (``askable``,
+``inner_edge``, ``line_contact``, ``pole_branch_end``, ``again``, ``measured``) and declare
+its switches.  The lifted-pole search (``shellbvp.liftoff``) tries every askable
+configuration of its family through :func:`names` and tells them apart by their traits, so
+a lifted configuration needs no other change (``tests/test_configurations.py`` adds a copy
+of ``line.py`` in a test and solves it).  A wall configuration also needs its guesses from
+its neighbours (``shellbvp.cylinder``, a table keyed by pairs of names), and a split one a
+search (``shellbvp.liftoff.second_zone_state`` looks for ``cap+line(tip)`` only).
 """
 
 from __future__ import annotations
