@@ -15,7 +15,7 @@ import time
 import numpy as np
 
 from .chain import FREE_STATES, ChainBVP
-from .configurations import ASKED, CAP_REPLACEMENTS, configuration, is_point_load, is_single_cap, names, of, resolve
+from .configurations import ASKED, CAP_REPLACEMENTS, asked, configuration, is_point_load, is_single_cap, of, resolve
 from .corner import edge_model, edge_null_jump, is_corner, limit_estimate, near_limit, other_edge_root
 from .diagnosis import as_failure, diagnose
 from .inflation import start_shape
@@ -283,9 +283,8 @@ def solve(scene, *, delta=None, lambda0=None, force=None, tol=1e-6, max_nodes=10
     eps = default_eps(tol) if eps is None else float(eps)
     if not 0 < eps < 0.5:
         raise ValueError(f"eps (pole start zeta = eps*Sc) must be in (0, 0.5); got {eps!r}")
-    asked = ("auto",) + names(having="askable")
-    if topology not in asked:
-        raise ValueError(f"topology must be one of {asked}; got {topology!r}")
+    if topology not in asked():
+        raise ValueError(f"topology must be one of {asked()}; got {topology!r}")
     if control == "delta":
         check_delta("delta", value, scene, tol)
     if topology != "auto":

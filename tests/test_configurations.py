@@ -58,7 +58,8 @@ def test_configurations_are_registered_in_the_order_of_their_modules():
     assert declared == cf.CONFIGURATION_NAMES == cf.names() == ORDER
     assert [s.between for s in cf.SWITCHES] == [s.between for m in modules for s in getattr(m, "SWITCHES", ())]
     assert "registry" not in {m.__name__.rpartition(".")[2] for m in modules}
-    assert cf.ASKED == ("auto", "cap", "line", "annulus", "cap+line(cylinder)", "cap+band(cylinder)", "cap+cylinder")
+    assert cf.ASKED == cf.asked() == ("auto", "cap", "line", "annulus", "cap+line(cylinder)", "cap+band(cylinder)",
+                                      "cap+cylinder")
 
 
 def test_each_module_declares_its_own_configuration_and_switches_to_earlier_ones():
@@ -103,7 +104,7 @@ def test_a_new_configuration_is_one_module(tmp_path, registry_restored):
     cf.install(module)
     assert cf.names("lifted") == ("line", "annulus", "line+corner", "line-copy")
     assert cf.switch_between("line-copy", "cap").criteria == ("pressure_min",)
-    assert registry.configuration("line-copy").line_contact
+    assert registry.configuration("line-copy").line_contact and cf.asked()[-1] == "line-copy"
     scene = sb.Scene.preset("base")
     copied = sb.solve(scene, delta=0.05, topology="line-copy", estimate_error=False)
     line = sb.solve(scene, delta=0.05, topology="line", estimate_error=False)

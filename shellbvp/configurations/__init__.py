@@ -38,20 +38,20 @@ from __future__ import annotations
 
 import sys
 
-from .registry import (CAP_REPLACEMENTS, CONFIGURATIONS, FAMILIES, SWITCHES, Configuration, Switch, configuration,
-                       discover, family_of, install, is_point_load, is_single_cap, names, of, register,
+from .registry import (CAP_REPLACEMENTS, CONFIGURATIONS, FAMILIES, SWITCHES, Configuration, Switch, asked,
+                       configuration, discover, family_of, install, is_point_load, is_single_cap, names, of, register,
                        register_switch, resolve, switch_between, without_edge_model)
 from .point import POINT_S0  # the point-load state's s0, which shellbvp.pointload reads
 
 __all__ = ["Configuration", "CONFIGURATIONS", "CONFIGURATION_NAMES", "FAMILIES", "configuration", "names",
            "register", "family_of", "of", "is_single_cap", "is_point_load", "resolve", "CAP_REPLACEMENTS", "ASKED",
            "Switch", "SWITCHES", "switch_between", "register_switch", "without_edge_model", "discover", "install",
-           "POINT_S0"]
+           "asked", "POINT_S0"]
 
 for _module in discover(sys.modules[__name__]):
     install(_module)
 
 #: Every configuration's name (``Solution.topology``, a curve's per-point ``topology``)
 CONFIGURATION_NAMES = names()
-#: What ``solve(topology=...)`` accepts
-ASKED = ("auto",) + tuple(n for n, c in CONFIGURATIONS.items() if c.askable)
+#: What ``solve(topology=...)`` accepts (:func:`asked`, as the package registers them)
+ASKED = asked()

@@ -31,7 +31,7 @@ from ..solution import attach_tip_table
 
 __all__ = ["Configuration", "CONFIGURATIONS", "FAMILIES", "configuration", "names", "register", "family_of", "of",
            "is_single_cap", "is_point_load", "resolve", "CAP_REPLACEMENTS", "Switch", "SWITCHES", "switch_between",
-           "register_switch", "without_edge_model", "discover", "install"]
+           "register_switch", "without_edge_model", "discover", "install", "asked"]
 
 FAMILIES = ("cap", "point", "lifted", "split", "wall")
 
@@ -156,6 +156,12 @@ def names(family: str | None = None, *, having: str | None = None) -> tuple:
     only those with that trait (an attribute, e.g. ``"pole_branch_end"``)."""
     return tuple(n for n, c in CONFIGURATIONS.items()
                  if (family is None or c.family == family) and (having is None or getattr(c, having)))
+
+
+def asked() -> tuple:
+    """What ``solve(topology=...)`` accepts: ``"auto"`` and the configurations registered as
+    ``askable``, in registration order."""
+    return ("auto",) + names(having="askable")
 
 
 def family_of(state) -> str:
