@@ -36,8 +36,13 @@ RESULT_KEYS = {
 
 
 def configuration_names(root):
-    """The registered names (``shellbvp/configurations.py``), or, in a checkout from before the
-    registry, the tuple ``chain.CONFIGURATION_NAMES``."""
+    """The registered names: declared in the modules of ``shellbvp/configurations/``, or in a
+    checkout from before that package registered in ``shellbvp/configurations.py``, or before
+    the registry the tuple ``chain.CONFIGURATION_NAMES``."""
+    package = root / "shellbvp" / "configurations"
+    if package.is_dir():
+        return {name for path in package.glob("*.py")
+                for name in re.findall(r'\bConfiguration\("([^"]+)"', path.read_text())}
     registry = root / "shellbvp" / "configurations.py"
     if registry.exists():
         return set(re.findall(r'register\(Configuration\("([^"]+)"', registry.read_text()))

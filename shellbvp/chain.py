@@ -39,16 +39,15 @@ run on the same t: ``v' = sum_k (b_k - a_k) S dV/dS``, ``v(0) = 0``, ``v(1) = V0
 about the cube of the states per node.  Guesses need only the regions' states and
 the unknowns before the pressure: :meth:`ChainBVP.solve` completes them.
 
-:func:`cap_chain`, :func:`point_chain`, :func:`annulus_chain` and
-:func:`line_chain` declare the basic chains (every configuration is registered in
-:mod:`shellbvp.configurations`); :class:`ChainBVP`
+:class:`Region`, :class:`Point` and the junctions are the blocks a chain is declared with
+(each configuration's chain is declared in its module of :mod:`shellbvp.configurations`,
+e.g. ``cap_chain`` in ``shellbvp/configurations/cap.py``); :class:`ChainBVP`
 assembles any chain into ``fun``, ``fun_jac``, ``bc``, ``bc_jac`` (analytic,
 from the generated Jacobians), end values, energy and profile.
 """
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -58,10 +57,7 @@ from .quadrature import gauss_points
 
 __all__ = ["Point", "Region", "ContactPole", "FreePole", "PointPole", "Edge", "TipEnd", "Line", "Kink", "Rim",
            "Chain",
-           "ChainBVP", "cap_chain", "point_chain", "annulus_chain", "line_chain", "cylinder_chain",
-           "cap_line_cylinder_chain", "cap_band_cylinder_chain", "cap_line_tip_chain", "cap_band_tip_chain",
-           "line_kink_chain",
-           "CONTROLS",
+           "ChainBVP", "CONTROLS",
            "SIZES", "FREE_STATES", "CONTACT_STATES", "CONTACT_KINDS", "REGION_CODES"]
 
 CONTROLS = ("delta", "lambda0", "force", "arclength")
@@ -208,93 +204,6 @@ class Chain:
 
 def _fields(j):
     return "(" + ", ".join(f"{k}={v!r}" for k, v in j.__dict__.items()) + ")"
-
-
-def cap_chain(eps: float, L: float, model: str = "smooth") -> Chain:
-    """Single contact cap: contact [zeta, Sc], free [Sc, L]; unknown ln Sc."""
-    Sc = Point("Sc", "ln_Sc")
-    return Chain("cap", (Region("contact", Point("zeta", "ln_Sc", math.log(eps)), Sc),
-                         Region("free", Sc, Point("L", None, math.log(L)))),
-                 (ContactPole(0), Edge(0, 1, model), Rim(1)), ("ln_Sc",), eps)
-
-
-def point_chain(s0: float, L: float) -> Chain:
-    """Point-load limit: the free region on [s0, L] alone."""
-    return Chain("point", (Region("free", Point("s0", None, math.log(s0)), Point("L", None, math.log(L))),),
-                 (PointPole(0), Rim(0)), ())
-
-
-def cylinder_chain(eps: float, L: float, model: str = "smooth") -> Chain:
-    """Contact running past the tip's end onto the cylinder: tip [zeta, S*], cylinder [S*, Sc],
-    free [Sc, L]; unknowns ln S*, ln Sc."""
-    Se, Sc = Point("S*", "ln_Send"), Point("Sc", "ln_Sc")
-    return Chain("cap+cylinder", (Region("contact", Point("zeta", "ln_Send", math.log(eps)), Se),
-                                  Region("cylinder", Se, Sc), Region("free", Sc, Point("L", None, math.log(L)))),
-                 (ContactPole(0), TipEnd(0), Edge(1, 2, model), Rim(2)), ("ln_Send", "ln_Sc"), eps)
-
-
-def cap_line_cylinder_chain(eps: float, L: float, model: str = "smooth") -> Chain:
-    """A cap on the tip and the free shell touching the cylinder on one circle S1: tip
-    [zeta, Sc], free [Sc, S1], free [S1, L]; unknowns ln Sc, ln S1, chi1 (the wall point touched)."""
-    Sc, S1 = Point("Sc", "ln_Sc"), Point("S1", "ln_S1")
-    return Chain("cap+line(cylinder)", (Region("contact", Point("zeta", "ln_Sc", math.log(eps)), Sc),
-                                        Region("free", Sc, S1), Region("free", S1, Point("L", None, math.log(L)))),
-                 (ContactPole(0), Edge(0, 1, model), Line(1, "cylinder"), Rim(2)), ("ln_Sc", "ln_S1", "chi1"), eps)
-
-
-def cap_band_cylinder_chain(eps: float, L: float, model: str = "smooth") -> Chain:
-    """A cap on the tip and a band of contact on the cylinder: tip [zeta, Sc], free [Sc, S1],
-    cylinder [S1, S2], free [S2, L]; unknowns ln Sc, ln S1, ln S2."""
-    Sc, S1, S2 = Point("Sc", "ln_Sc"), Point("S1", "ln_S1"), Point("S2", "ln_S2")
-    return Chain("cap+band(cylinder)", (Region("contact", Point("zeta", "ln_Sc", math.log(eps)), Sc),
-                                        Region("free", Sc, S1), Region("cylinder", S1, S2),
-                                        Region("free", S2, Point("L", None, math.log(L)))),
-                 (ContactPole(0), Edge(0, 1, model), Edge(2, 1, model), Edge(2, 3, model), Rim(3)),
-                 ("ln_Sc", "ln_S1", "ln_S2"), eps)
-
-
-def cap_line_tip_chain(eps: float, L: float) -> Chain:
-    """A cap and, beyond a lifted gap, a line of contact on the tip: tip [zeta, Sc], free
-    [Sc, S1], free [S1, L] with the line at S1 (on the tip); unknowns ln Sc, ln S1, chi1."""
-    Sc, S1 = Point("Sc", "ln_Sc"), Point("S1", "ln_S1")
-    return Chain("cap+line(tip)", (Region("contact", Point("zeta", "ln_Sc", math.log(eps)), Sc),
-                                   Region("free", Sc, S1), Region("free", S1, Point("L", None, math.log(L)))),
-                 (ContactPole(0), Edge(0, 1), Line(1, "contact"), Rim(2)), ("ln_Sc", "ln_S1", "chi1"), eps)
-
-
-def cap_band_tip_chain(eps: float, L: float) -> Chain:
-    """A cap and, beyond a lifted gap, a band of contact on the tip: tip [zeta, Sc], free [Sc, S1],
-    tip [S1, S2], free [S2, L]; unknowns ln Sc, ln S1, ln S2."""
-    Sc, S1, S2 = Point("Sc", "ln_Sc"), Point("S1", "ln_S1"), Point("S2", "ln_S2")
-    return Chain("cap+band(tip)", (Region("contact", Point("zeta", "ln_Sc", math.log(eps)), Sc),
-                                   Region("free", Sc, S1), Region("contact", S1, S2),
-                                   Region("free", S2, Point("L", None, math.log(L)))),
-                 (ContactPole(0), Edge(0, 1), Edge(2, 1), Edge(2, 3), Rim(3)), ("ln_Sc", "ln_S1", "ln_S2"), eps)
-
-
-def annulus_chain(eps: float, L: float) -> Chain:
-    """Lifted pole, contact on an annulus: free [zeta, S1], contact [S1, S2], free [S2, L]."""
-    S1, S2 = Point("S1", "ln_S1"), Point("S2", "ln_S2")
-    return Chain("annulus", (Region("free", Point("zeta", "ln_S1", math.log(eps)), S1), Region("contact", S1, S2),
-                             Region("free", S2, Point("L", None, math.log(L)))),
-                 (FreePole(0), Edge(1, 0), Edge(1, 2), Rim(2)), ("ln_S1", "ln_S2"), eps)
-
-
-def line_chain(eps: float, L: float) -> Chain:
-    """Lifted pole, contact on one circle S1: free [zeta, S1], free [S1, L]; unknowns ln S1, chi1."""
-    S1 = Point("S1", "ln_S1")
-    return Chain("line", (Region("free", Point("zeta", "ln_S1", math.log(eps)), S1),
-                          Region("free", S1, Point("L", None, math.log(L)))),
-                 (FreePole(0), Line(0), Rim(1)), ("ln_S1", "chi1"), eps)
-
-
-def line_kink_chain(eps: float, L: float) -> Chain:
-    """Lifted pole, an interior corner at S_k, contact on one circle S1: free [zeta, S_k],
-    free [S_k, S1], free [S1, L]; unknowns ln S_k, ln S1, chi1."""
-    Sk, S1 = Point("Sk", "ln_Sk"), Point("S1", "ln_S1")
-    return Chain("line+corner", (Region("free", Point("zeta", "ln_Sk", math.log(eps)), Sk), Region("free", Sk, S1),
-                                 Region("free", S1, Point("L", None, math.log(L)))),
-                 (FreePole(0), Kink(0), Line(1), Rim(2)), ("ln_Sk", "ln_S1", "chi1"), eps)
 
 
 # -- the assembler -------------------------------------------------------------------------------

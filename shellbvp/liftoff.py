@@ -5,7 +5,7 @@ Where the single-cap state needs a negative contact pressure near the pole
 there: a free inner cap around the pole, then contact on an annulus
 ``[S1, S2]`` (``topology="annulus"``) or on one circle (``"line"``, a
 zero-width annulus carrying a ring force), then the outer free region.  The
-systems are the chains ``annulus_chain`` and ``line_chain`` of :mod:`shellbvp.chain`; this module makes guesses,
+systems are the chains of ``shellbvp/configurations/annulus.py`` and ``line.py``; this module makes guesses,
 runs solve_bvp and diagnoses the result into a :class:`~shellbvp.state.Solution`
 with the same fields as a cap state, plus ``S1`` (inner edge), ``ring_force_inner``,
 ``contact_width`` and, for a line, ``curvature_excess`` (kappa_s at the line minus the
@@ -45,17 +45,21 @@ from .solution import (
 __all__ = ["solve_liftoff", "solve_liftoff_from", "make_liftoff_system", "liftoff_guess_from_cap",
            "liftoff_warm_guess", "liftoff_state", "valid_liftoff_state", "lift_off_suspected",
            "replace_invalid_cap", "pole_clearance", "split_state_from", "moved_guess", "lifted_again",
-           "split_again", "cap_lifted_off"]
+           "split_again", "cap_lifted_off", "searched_lifted"]
 
 
-#: The lifted-pole configurations that this module solves
-LIFTED = ("line", "annulus")
+def searched_lifted() -> tuple:
+    """The lifted-pole configurations that this module solves and searches, in the registry's
+    order: those of the family that ``solve(topology=...)`` may ask for (``line+corner`` is
+    declared, not searched)."""
+    return names("lifted", having="askable")
 
 
 def make_liftoff_system(scene, topology, control, value, eps):
     """The system of a lifted-pole configuration (``shellbvp.configurations``, family "lifted")."""
-    if topology not in LIFTED:
-        raise ValueError(f"topology must be one of {LIFTED}; got {topology!r}")
+    lifted = searched_lifted()
+    if topology not in lifted:
+        raise ValueError(f"topology must be one of {lifted}; got {topology!r}")
     return configuration(topology).system(scene, control, value, eps)
 
 
@@ -281,7 +285,7 @@ def valid_liftoff_state(cap: Solution, *, tol=1e-6, max_nodes=10000, bc_tol=1e-1
         if res.success and res.valid:
             return res, tried
         tried.append("point load: " + (res.message if not res.success else "; ".join(res.flags)))
-    order = LIFTED
+    order = searched_lifted()
     if previous is not None and previous.topology in order:
         order = (previous.topology,) + tuple(t for t in order if t != previous.topology)
     line_too_curved = False
@@ -353,7 +357,7 @@ def _split_possible(last, line, tol):
     not converge.  Without this, base at delta 0.1125 (after the line at 0.1; the line too
     curved here, the cap still pulling at its edge) spent 1.7 s of a 4.7 s curve on split
     guesses that find no state.  Without ``last`` (a single solve) it is always probed."""
-    if last is None or not (last.valid and last.topology in LIFTED):
+    if last is None or not (last.valid and last.topology in searched_lifted()):
         return True
     if line is None or not line.success:
         return True

@@ -2,7 +2,7 @@
 
 When the contact cap is exponentially small (``Sc`` below ~1e-30, which happens
 as delta -> 0) the cap's own equations leave double precision and the state is
-the point-load solution to exponential accuracy (``shellbvp.chain.point_chain``).
+the point-load solution to exponential accuracy (``shellbvp.configurations.point``).
 """
 
 from __future__ import annotations
@@ -63,7 +63,7 @@ def solve_point_load(scene, delta, *, tol=1e-6, max_nodes=10000, guess=None, bc_
     happens as delta -> 0) the cap's own equations leave double precision and
     the state is the point-load solution to exponential accuracy: the free
     region alone on ``[s0, L]`` with the point-load pole conditions
-    (``shellbvp.chain.point_chain``).
+    (``shellbvp.configurations.point``).
 
     Started from ``guess`` (a cap or point-load state at a nearby depth) if given, else
     (or if that fails) from the undeformed shell, and where that fails too, from the

@@ -14,8 +14,8 @@ import time
 
 import numpy as np
 
-from .chain import FREE_STATES, ChainBVP, cap_chain
-from .configurations import ASKED, CAP_REPLACEMENTS, configuration, is_point_load, is_single_cap, of, resolve
+from .chain import FREE_STATES, ChainBVP
+from .configurations import ASKED, CAP_REPLACEMENTS, asked, configuration, is_point_load, is_single_cap, of, resolve
 from .corner import edge_model, edge_null_jump, is_corner, limit_estimate, near_limit, other_edge_root
 from .diagnosis import as_failure, diagnose
 from .inflation import start_shape
@@ -82,7 +82,7 @@ def _run_bvp(sysm, guess, tol, max_nodes, bc_tol):
 
 
 def make_system(scene, control, value, eps, edge=None):
-    """The single-cap system (``shellbvp.chain.cap_chain``) of a scene, control and value;
+    """The single-cap system (``shellbvp.configurations.cap``) of a scene, control and value;
     ``edge`` ("smooth", "corner", "paper") defaults to the scene's contact model."""
     return configuration("cap").system(scene, control, value, eps, edge)
 
@@ -93,7 +93,7 @@ def system_like(prev, control, value, eps):
     edge, sysm = edge_model(prev), prev.system
     if (isinstance(sysm, ChainBVP) and sysm.control == control and not sysm.volume_control
             and sysm.scene is prev.scene and hasattr(sysm, "tip_A")
-            and sysm.chain == cap_chain(eps, prev.scene.shell_length, edge)):
+            and sysm.chain == configuration("cap").chain(eps, prev.scene.shell_length, edge)):
         return sysm.with_value(value)
     return make_system(prev.scene, control, value, eps, edge)
 
@@ -196,7 +196,8 @@ def solve_from(sysm, guess, *, tol=1e-6, max_nodes=10000, bc_tol=None):
     return res
 
 
-#: What ``solve(topology=...)`` accepts: "auto" and the configurations that may be asked for
+#: What ``solve(topology=...)`` accepts: "auto" and the configurations that may be asked for (as
+#: the package registers them; ``solve`` asks the registry, which one registered later joins)
 TOPOLOGIES = ASKED
 
 def solve(scene, *, delta=None, lambda0=None, force=None, tol=1e-6, max_nodes=10000, guess=None,
@@ -282,8 +283,8 @@ def solve(scene, *, delta=None, lambda0=None, force=None, tol=1e-6, max_nodes=10
     eps = default_eps(tol) if eps is None else float(eps)
     if not 0 < eps < 0.5:
         raise ValueError(f"eps (pole start zeta = eps*Sc) must be in (0, 0.5); got {eps!r}")
-    if topology not in TOPOLOGIES:
-        raise ValueError(f"topology must be one of {TOPOLOGIES}; got {topology!r}")
+    if topology not in asked():
+        raise ValueError(f"topology must be one of {asked()}; got {topology!r}")
     if control == "delta":
         check_delta("delta", value, scene, tol)
     if topology != "auto":

@@ -260,3 +260,7 @@ def test_the_structure_census_holds_what_the_redesign_reached():
     # fitting, sweep and the 3D reference are split by job: none of their modules over 600 lines
     split = {m: n for m, n in census["long_modules"].items() if m.split(".")[0] in ("fitting", "sweep", "fe")}
     assert not split, split
+    # configuration names are compared in the registry only, and the census knows every name
+    assert set(census["name_comparisons"]) <= {"configurations.registry"}, census["name_comparisons"]
+    from shellbvp.configurations import CONFIGURATION_NAMES
+    assert _load("architecture").configuration_names(BENCH.parent) == set(CONFIGURATION_NAMES)

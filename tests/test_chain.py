@@ -14,19 +14,29 @@ import pytest
 
 import shellbvp as sb
 from shellbvp import chain as ch
+from shellbvp.configurations.annulus import annulus_chain
+from shellbvp.configurations.cap import cap_chain
+from shellbvp.configurations.cap_band_cylinder import cap_band_cylinder_chain
+from shellbvp.configurations.cap_band_tip import cap_band_tip_chain
+from shellbvp.configurations.cap_cylinder import cylinder_chain
+from shellbvp.configurations.cap_line_cylinder import cap_line_cylinder_chain
+from shellbvp.configurations.cap_line_tip import cap_line_tip_chain
+from shellbvp.configurations.line import line_chain
+from shellbvp.configurations.line_corner import line_kink_chain
+from shellbvp.configurations.point import point_chain
 from shellbvp.inflation import system_parameters
 
 EPS = 1e-3
-CHAINS = {"cap": lambda L, contact: ch.cap_chain(EPS, L, contact),
-          "annulus": lambda L, contact: ch.annulus_chain(EPS, L),
-          "line": lambda L, contact: ch.line_chain(EPS, L),
-          "point": lambda L, contact: ch.point_chain(1e-12, L),
-          "cylinder": lambda L, contact: ch.cylinder_chain(EPS, L, contact),
-          "wall_line": lambda L, contact: ch.cap_line_cylinder_chain(EPS, L, contact),
-          "wall_band": lambda L, contact: ch.cap_band_cylinder_chain(EPS, L, contact),
-          "tip_line": lambda L, contact: ch.cap_line_tip_chain(EPS, L),
-          "tip_band": lambda L, contact: ch.cap_band_tip_chain(EPS, L),
-          "line_corner": lambda L, contact: ch.line_kink_chain(EPS, L)}
+CHAINS = {"cap": lambda L, contact: cap_chain(EPS, L, contact),
+          "annulus": lambda L, contact: annulus_chain(EPS, L),
+          "line": lambda L, contact: line_chain(EPS, L),
+          "point": lambda L, contact: point_chain(1e-12, L),
+          "cylinder": lambda L, contact: cylinder_chain(EPS, L, contact),
+          "wall_line": lambda L, contact: cap_line_cylinder_chain(EPS, L, contact),
+          "wall_band": lambda L, contact: cap_band_cylinder_chain(EPS, L, contact),
+          "tip_line": lambda L, contact: cap_line_tip_chain(EPS, L),
+          "tip_band": lambda L, contact: cap_band_tip_chain(EPS, L),
+          "line_corner": lambda L, contact: line_kink_chain(EPS, L)}
 CASES = [("cap", c, m) for c in ("smooth", "paper", "corner", "pinned")
          for m in ("delta", "lambda0", "force", "arclength")] + \
         [(k, "smooth", m) for k in ("annulus", "line", "line_corner") for m in ("delta", "lambda0", "force")] + \
@@ -123,7 +133,7 @@ def test_fun_kept_results_are_those_of_its_arguments(kind, sealed):
 
 
 def test_layout_table_is_generated_from_the_declaration():
-    text = ch.annulus_chain(EPS, 1.5).layout()
+    text = annulus_chain(EPS, 1.5).layout()
     assert "y[0:6]  region 0 free" in text and "y[6:8]  region 1 contact" in text and "y[8:14]" in text
     assert "[3:8]  Edge(kc=1, kf=0" in text and "[13:16]  Rim(k=2)" in text
 
@@ -131,9 +141,9 @@ def test_layout_table_is_generated_from_the_declaration():
 def test_control_the_chain_cannot_take_is_refused():
     scene = sb.Scene.preset("base")
     with pytest.raises(ValueError, match="only delta"):
-        ch.ChainBVP(scene, ch.point_chain(1e-12, scene.shell_length), "force", 0.3)
+        ch.ChainBVP(scene, point_chain(1e-12, scene.shell_length), "force", 0.3)
     with pytest.raises(ValueError, match="arclength"):
-        ch.ChainBVP(scene, ch.line_chain(EPS, scene.shell_length), "arclength", ARC)
+        ch.ChainBVP(scene, line_chain(EPS, scene.shell_length), "arclength", ARC)
 
 
 # -- regression: the states of the hand-written classes (commit 1109cdf), to 1e-10 ---------------------
@@ -179,7 +189,7 @@ def test_results_round_trip_through_pickle():
 
 def test_repr_shows_the_layout():
     scene = sb.Scene.preset("base")
-    text = repr(ch.ChainBVP(scene, ch.cap_chain(EPS, scene.shell_length), "delta", 0.2))
+    text = repr(ch.ChainBVP(scene, cap_chain(EPS, scene.shell_length), "delta", 0.2))
     assert "ChainBVP(delta=0.2)" in text and "ContactPole(k=0)" in text and "y[2:8]  region 1 free" in text
 
 
@@ -261,7 +271,7 @@ def test_every_configuration_is_registered_once_with_its_system():
     with pytest.raises(ValueError, match="topology must be one of"):
         cf.configuration("cap+line(tipp)")
     with pytest.raises(ValueError, match="registered already"):
-        cf.register(cf.Configuration("cap", "cap", ch.cap_chain))
+        cf.register(cf.Configuration("cap", "cap", cap_chain))
     with pytest.raises(ValueError, match="needs contact='smooth'"):
         cf.configuration("line").system(sb.Scene.preset("base", contact="paper"), "delta", 0.2, EPS)
     with pytest.raises(ValueError, match="control must be one of"):

@@ -1,9 +1,8 @@
-"""The contact configurations, registered in one place.
-
-A :class:`Configuration` is what a state's ``topology`` names: its chain of regions
-(``shellbvp.chain``), the contact models and controls it exists for, its family (what
-kind of search finds it) and how its system is built.  Every other module asks the
-registry (:func:`configuration`, :func:`names`) instead of listing names itself.
+"""The registry of contact configurations: :class:`Configuration`, :class:`Switch`, the
+look-ups every other module asks (:func:`configuration`, :func:`names`, :func:`of`,
+:func:`switch_between`) and how the package finds its configuration modules
+(:func:`discover`, :func:`install`).  The configurations themselves are declared in the
+other modules of :mod:`shellbvp.configurations`, one module each.
 
 Families:
 
@@ -22,20 +21,19 @@ Families:
 from __future__ import annotations
 
 import importlib
+import pkgutil
 from dataclasses import dataclass
 from typing import Callable
 
-from . import chain as ch
-from .inflation import system_parameters
-from .solution import attach_tip_table
+from .. import chain as ch
+from ..inflation import system_parameters
+from ..solution import attach_tip_table
 
-__all__ = ["Configuration", "CONFIGURATIONS", "CONFIGURATION_NAMES", "FAMILIES", "configuration", "names",
-           "register", "family_of", "of", "is_single_cap", "is_point_load", "resolve", "CAP_REPLACEMENTS", "ASKED",
-           "Switch", "SWITCHES", "switch_between"]
+__all__ = ["Configuration", "CONFIGURATIONS", "FAMILIES", "configuration", "names", "register", "family_of", "of",
+           "is_single_cap", "is_point_load", "resolve", "CAP_REPLACEMENTS", "Switch", "SWITCHES", "switch_between",
+           "register_switch", "without_edge_model", "discover", "install", "asked"]
 
 FAMILIES = ("cap", "point", "lifted", "split", "wall")
-#: Start of the point-load state's free region (its own eps; truncation error O(s0^2 ln^2 s0)).
-POINT_S0 = 1e-12
 
 
 @dataclass(frozen=True)
@@ -56,7 +54,8 @@ class Configuration:
     controls : tuple of str
         What may be prescribed.
     askable : bool
-        Whether ``solve(topology=name)`` may ask for it.
+        Whether ``solve(topology=name)`` may ask for it (of the lifted family, the ones
+        :mod:`shellbvp.liftoff` searches).
     needs_tip_end : bool
         Whether it needs a tip that ends on a cylinder (``model.OMEGA_MAX``).
     again : str or None
@@ -134,6 +133,8 @@ CONFIGURATIONS: dict[str, Configuration] = {}
 
 
 def register(conf: Configuration) -> Configuration:
+    """Add a configuration after those registered (ValueError for an unknown family or a name
+    registered already)."""
     if conf.family not in FAMILIES:
         raise ValueError(f"family must be one of {FAMILIES}; got {conf.family!r}")
     if conf.name in CONFIGURATIONS:
@@ -155,6 +156,12 @@ def names(family: str | None = None, *, having: str | None = None) -> tuple:
     only those with that trait (an attribute, e.g. ``"pole_branch_end"``)."""
     return tuple(n for n, c in CONFIGURATIONS.items()
                  if (family is None or c.family == family) and (having is None or getattr(c, having)))
+
+
+def asked() -> tuple:
+    """What ``solve(topology=...)`` accepts: ``"auto"`` and the configurations registered as
+    ``askable``, in registration order."""
+    return ("auto",) + names(having="askable")
 
 
 def family_of(state) -> str:
@@ -190,35 +197,6 @@ def resolve(path: str) -> Callable:
 CAP_REPLACEMENTS = (("wall", "shellbvp.cylinder:cap_onto_wall"), ("lifted", "shellbvp.liftoff:cap_lifted_off"))
 
 
-def _lifted(chain):
-    return lambda eps, L, edge: chain(eps, L)
-
-
-_LIFTED_AGAIN = "shellbvp.liftoff:lifted_again"
-_SPLIT_AGAIN = "shellbvp.liftoff:split_again"
-_WALL_AGAIN = "shellbvp.cylinder:wall_again"
-register(Configuration("cap", "cap", ch.cap_chain, controls=("delta", "force", "lambda0", "arclength"), askable=True,
-                       measured=("shellbvp.switches:cap_state_at", "shellbvp.switches:cap_solved_at")))
-register(Configuration("point", "point", lambda eps, L, edge: ch.point_chain(POINT_S0, L), controls=("delta",)))
-register(Configuration("line", "lifted", _lifted(ch.line_chain), contacts=("smooth",), askable=True,
-                       again=_LIFTED_AGAIN, line_contact=True, pole_branch_end=True,
-                       measured=("shellbvp.switches:line_state_at", "shellbvp.switches:lifted_solved_at")))
-register(Configuration("annulus", "lifted", _lifted(ch.annulus_chain), contacts=("smooth",), askable=True,
-                       again=_LIFTED_AGAIN, inner_edge=True, pole_branch_end=True))
-register(Configuration("cap+line(tip)", "split", _lifted(ch.cap_line_tip_chain), contacts=("smooth",),
-                       again=_SPLIT_AGAIN))
-register(Configuration("cap+band(tip)", "split", _lifted(ch.cap_band_tip_chain), contacts=("smooth",),
-                       again=_SPLIT_AGAIN))
-register(Configuration("cap+line(cylinder)", "wall", ch.cap_line_cylinder_chain, contacts=("smooth",), askable=True,
-                       needs_tip_end=True, again=_WALL_AGAIN,
-                       measured=("shellbvp.switches:wall_state_at", "shellbvp.switches:wall_solved_at")))
-register(Configuration("cap+band(cylinder)", "wall", ch.cap_band_cylinder_chain, contacts=("smooth",), askable=True,
-                       needs_tip_end=True, again=_WALL_AGAIN))
-register(Configuration("cap+cylinder", "wall", ch.cylinder_chain, askable=True, needs_tip_end=True,
-                       again=_WALL_AGAIN))
-register(Configuration("line+corner", "lifted", _lifted(ch.line_kink_chain), contacts=("smooth",),
-                       again=_LIFTED_AGAIN))
-
 @dataclass(frozen=True)
 class Switch:
     """Where a curve passes from one configuration to a neighbour: the depth at which
@@ -232,20 +210,23 @@ class Switch:
     sign: float = 1.0
 
 
-#: The switches a curve locates between neighbouring configurations
-SWITCHES = [
-    # the cap's contact pressure at its edge: where a lifted pole or a split contact takes over
-    *(Switch(frozenset({"cap", other}), "cap", ("pressure_min",)) for other in ("line", "annulus", "cap+line(tip)")),
-    # the lifted pole comes down onto the tip: a cap grows there
-    Switch(frozenset({"line", "cap+line(tip)"}), "line", ("pole_clearance",)),
-    # the line's curvature reaches the indenter's: the line opens into an annulus
-    Switch(frozenset({"line", "annulus"}), "line", ("curvature_excess",), -1.0),
-    # the free shell reaches the cylinder (or the contact the tip's end)
-    *(Switch(frozenset({"cap", wall}), "cap", ("wall_gap", "tip_end_margin"))
-      for wall in ("cap+line(cylinder)", "cap+band(cylinder)", "cap+cylinder")),
-    # the line on the cylinder opens into a band
-    Switch(frozenset({"cap+line(cylinder)", "cap+band(cylinder)"}), "cap+line(cylinder)", ("curvature_excess",), -1.0),
-]
+#: The switches a curve locates between neighbouring configurations (each declared in the module
+#: of the later of its two configurations, see :func:`register_switch`)
+SWITCHES: list = []
+
+
+def register_switch(switch: Switch) -> Switch:
+    """Add a switch between two registered configurations (ValueError if either is not
+    registered, if it is not measured on one of them, or if the pair has a switch already)."""
+    unknown = sorted(n for n in switch.between if n not in CONFIGURATIONS)
+    if unknown:
+        raise ValueError(f"switch between {sorted(switch.between)}: {unknown} not registered")
+    if switch.measured_on not in switch.between:
+        raise ValueError(f"switch between {sorted(switch.between)} measured on {switch.measured_on!r}")
+    if any(s.between == switch.between for s in SWITCHES):
+        raise ValueError(f"the switch between {sorted(switch.between)} is registered already")
+    SWITCHES.append(switch)
+    return switch
 
 
 def switch_between(a: str, b: str):
@@ -254,7 +235,38 @@ def switch_between(a: str, b: str):
     return next((s for s in SWITCHES if s.between == pair), None)
 
 
-#: Every configuration's name (``Solution.topology``, a curve's per-point ``topology``)
-CONFIGURATION_NAMES = names()
-#: What ``solve(topology=...)`` accepts
-ASKED = ("auto",) + tuple(n for n, c in CONFIGURATIONS.items() if c.askable)
+def without_edge_model(chain: Callable) -> Callable:
+    """A ``chain(eps, L)`` declared without a contact-edge model, called as the registry calls
+    every chain, ``chain(eps, L, edge)``: ``edge`` is not used (such a configuration exists for
+    the smooth contact model only, and its edges are the smooth ones)."""
+    return lambda eps, L, edge: chain(eps, L)
+
+
+def discover(package) -> list:
+    """The configuration modules of ``package`` (every module in it but this registry and
+    names starting with ``_``), imported, in the order of their ``ORDER`` numbers.
+
+    ValueError where a module has no integer ``ORDER`` or two modules have the same: the
+    order is that in which :func:`install` registers them, and :func:`names` lists them in it."""
+    here = __name__.rpartition(".")[2]
+    modules = [importlib.import_module(f"{package.__name__}.{info.name}")
+               for info in pkgutil.iter_modules(package.__path__)
+               if info.name != here and not info.name.startswith("_")]
+    taken = {}
+    for module in modules:
+        order = getattr(module, "ORDER", None)
+        if not isinstance(order, int) or isinstance(order, bool):
+            raise ValueError(f"configuration module {module.__name__} has no integer ORDER")
+        if order in taken:
+            raise ValueError(f"configuration modules {taken[order]} and {module.__name__} have the same ORDER {order}")
+        taken[order] = module.__name__
+    return sorted(modules, key=lambda module: module.ORDER)
+
+
+def install(module) -> None:
+    """Register a configuration module's ``CONFIGURATIONS`` (a tuple of :class:`Configuration`),
+    then its ``SWITCHES`` (a tuple of :class:`Switch`, optional), in their order."""
+    for conf in module.CONFIGURATIONS:
+        register(conf)
+    for switch in getattr(module, "SWITCHES", ()):
+        register_switch(switch)
