@@ -222,7 +222,21 @@ def _form_at(scene, base_of, S, n):
     A = np.empty((9, 9, S.size))
     for (i, j), e in zip(upper, out):
         A[i, j] = A[j, i] = np.broadcast_to(np.asarray(e, float), S.shape)
+    if "P" in base:  # on the tip: the constraint's curvature, -P/2 II(dx_t, dx_t) per deformed area
+        cu, cv = contact_coefficients(base, R, Psi)
+        A[0, 0] += cu
+        A[3, 3] += cv
     return A, R * Psi
+
+
+def contact_coefficients(base, R, Psi):
+    """The contact term's coefficients of ``u^2`` and ``v^2`` in the form (per dS, module
+    docstring): ``-P r psi kappa_s / 4`` and ``-P r psi kappa_theta / 4`` (zero where P = 0)."""
+    r = base["lt"] * R
+    weight = -0.25 * base["P"] * r * base["ls"] * Psi
+    with np.errstate(all="ignore"):
+        kt = np.where(base["P"] != 0, np.sin(base["phi"]) / r, 0.0)
+    return weight * base["ks"], weight * kt
 
 
 # ------------------------------------------------------------------------------ cubic Hermite FEM
@@ -346,14 +360,27 @@ def _element_basis(xg, h, hs):
 END_CONDITIONS = {"pinned": (0, 2, 4), "symmetric": (0, 5), "antisymmetric": (2, 4)}
 
 
-def _constraints(n, m, end="pinned", S0_over_hs=0.0):
+def _constraints(n, m, end="pinned", S0_over_hs=0.0, held=(), pole_held=False):
     """The reduced basis T (sparse, ndof x nfree) that imposes the pole (node 0) and end
     (node m-1) conditions: q = T q_free.  ``S0_over_hs``: S0 over the derivative dofs' scale
-    (n = 1's ``w = S0 w'`` at S0)."""
+    (n = 1's ``w = S0 w'`` at S0).  ``held``: nodes on the tip (``w = w' = 0``: the normal
+    displacement vanishes on the contact region, module docstring); ``pole_held``: the pole
+    touches the tip at a point (``w = 0`` at S0 for n = 0; the n >= 1 pole conditions hold it
+    already or let it slide)."""
     ndof = 6 * m
     fixed = {6 * (m - 1) + k for k in END_CONDITIONS[end]}
+    fixed |= {6 * i + k for i in held for k in (4, 5)}
+    tie_w = n == 1 and 0 not in held
+    if n == 1 and (held or pole_held):
+        # u = U + O(S^2), v = -U + O(S^2) at the axis: u' = v' = 0.  Where the pole carries a
+        # bending prestress (on the tip, or under a point load) the form's u u'' and v v''
+        # terms are not small, and without these conditions a layer at S0 lowers the energy
+        # without bound as the first element shrinks (measured: tests/test_stability_contact.py)
+        fixed |= {1, 3}
     if n == 0:
         fixed |= {0, 2, 5}  # u = v = 0, w' = 0
+        if pole_held:
+            fixed.add(4)
     elif n == 1:
         fixed |= {2, 4}  # v(S0) = -u(S0), w(S0) = S0 w'(S0): folded into u's and w''s columns
     else:
@@ -361,9 +388,13 @@ def _constraints(n, m, end="pinned", S0_over_hs=0.0):
     free = np.array([i for i in range(ndof) if i not in fixed])
     rows, cols, vals = list(free), list(range(free.size)), [1.0] * free.size
     if n == 1:
-        rows += [2, 4]
-        cols += [int(np.flatnonzero(free == 0)[0]), int(np.flatnonzero(free == 5)[0])]
-        vals += [-1.0, S0_over_hs]
+        rows += [2]
+        cols += [int(np.flatnonzero(free == 0)[0])]
+        vals += [-1.0]
+        if tie_w:
+            rows += [4]
+            cols += [int(np.flatnonzero(free == 5)[0])]
+            vals += [S0_over_hs]
     return scipy.sparse.csr_matrix((vals, (rows, cols)), shape=(ndof, free.size))
 
 
@@ -372,8 +403,11 @@ def _constraints(n, m, end="pinned", S0_over_hs=0.0):
 POLE_RATIO = 0.25
 
 
-def mesh(S0: float, L: float, elements: int) -> np.ndarray:
-    """Nodes on [S0, L]: ``elements`` uniform elements, the first split towards S0 geometrically."""
+def mesh(S0: float, L: float, elements: int, edge: float | None = None) -> np.ndarray:
+    """Nodes on [S0, L]: ``elements`` uniform elements, the first split towards S0 geometrically;
+    with ``edge`` (a contact edge inside (S0, L)) a node there and :data:`EDGE_LEVELS` nodes on
+    each side at ``h/2, h/4, ...`` from it (the mode's derivatives jump there: without the
+    grading the eigenvalues converged only like h)."""
     nodes = np.linspace(S0, L, elements + 1)
     h = nodes[1] - nodes[0]
     extra = []
@@ -381,7 +415,18 @@ def mesh(S0: float, L: float, elements: int) -> np.ndarray:
     while d > 4 * S0:
         extra.append(S0 + d)
         d *= POLE_RATIO
-    return np.concatenate([nodes[:1], np.array(extra[::-1]), nodes[1:]])
+    nodes = np.concatenate([nodes[:1], np.array(extra[::-1]), nodes[1:]])
+    if edge is None:
+        return nodes
+    steps = h * 0.5 ** np.arange(1, EDGE_LEVELS + 1)
+    near = np.concatenate([edge - steps, [edge], edge + steps])
+    near = near[(near > S0) & (near < L)]
+    far = nodes[np.abs(nodes - edge) >= h / 2]  # the uniform nodes closer than h/2 give way
+    return np.unique(np.concatenate([far, near]))
+
+
+#: Nodes on each side of a contact edge (:func:`mesh`).
+EDGE_LEVELS = 8
 
 
 def default_elements(scene) -> int:
@@ -441,33 +486,184 @@ def stability(state, modes=None, *, elements: int | None = None, S0: float | Non
     (False, 11)
     """
     t0 = time.perf_counter()
-    if not state.success:
-        raise ValueError(f"the state did not converge ({state.message}): no stability for it")
-    if state.topology != "inflated":
-        raise NotImplementedError(f"stability is built for states without contact (topology 'inflated'); "
-                                  f"this state's is {state.topology!r}")
+    check_supported(state)
     sysm = state.system
-    zeta = float(sysm.S_point(sysm.regions[0].start, None))
-    S0 = zeta if S0 is None else max(float(S0), zeta)
-    out = spectrum(state.scene, state_base(state), S0, float(sysm.L), modes, elements=elements, count=count,
-                   vectors=vectors)
+    if state.topology == "inflated":
+        zeta = float(sysm.S_point(sysm.regions[0].start, None))
+        S0 = zeta if S0 is None else max(float(S0), zeta)
+        out = spectrum(state.scene, state_base(state), S0, float(sysm.L), modes, elements=elements, count=count,
+                       vectors=vectors)
+    else:
+        contact = contact_of(state, S0)
+        out = spectrum(state.scene, contact.base, contact.S0, float(sysm.L), modes, elements=elements,
+                       count=count, vectors=vectors, contact=contact)
     out.wall_time = time.perf_counter() - t0
     return out
 
 
-def spectrum(scene, base_of, S0, L, modes=None, *, elements=None, count=2, vectors=False, end="pinned"):
+#: The topologies whose stability is built (``"inflated"``: no contact).
+SUPPORTED = ("inflated", "cap", "point")
+
+
+def check_supported(state):
+    """ValueError (one line, naming what is not supported) unless :func:`stability` handles
+    ``state``: a converged state of a topology in :data:`SUPPORTED` with the smooth contact
+    edge, under pressure (not volume) control."""
+    if not state.success:
+        raise ValueError(f"stability: the state did not converge ({state.message})")
+    if state.topology not in SUPPORTED:
+        raise ValueError(f"stability: topology {state.topology!r} is not supported (only "
+                         f"{', '.join(repr(t) for t in SUPPORTED)}: lift-off, wall and split contact are not built)")
+    if state.topology == "inflated":
+        return
+    scene = state.scene
+    if scene.contact != "smooth":
+        raise ValueError(f"stability: contact={scene.contact!r} is not variational (its edge conditions are not "
+                         f"the natural conditions of an energy); only contact='smooth' is supported")
+    if state.contact_edge == "corner":
+        raise ValueError("stability: a contact edge with a Weierstrass-Erdmann corner (contact_edge 'corner') "
+                         "is not supported, only the smooth edge")
+    if scene.sealed:
+        raise ValueError("stability: a sealed shell (volume control) in contact is not supported, only "
+                         "pressure control")
+
+
+@dataclass(eq=False)
+class Contact:
+    """What the tip adds to the eigenproblem of a state in contact (module docstring).
+
+    ``base``: the base state as a function of S, with the contact pressure ``P`` (0 off the
+    tip); ``S0``: where the mesh starts; ``Sc``: the contact edge (None when the cap lies
+    within [0, S0] or there is none: the pole is then held at a point); ``ring``: the
+    coefficients of ``u(Sc)^2`` and ``v(Sc)^2`` in the stiffness (the ring force's curvature
+    term); ``pole_force``: the axial force on the pole when it is held at a point, and
+    ``apex_curvature`` the tip's there.
+    """
+
+    base: object
+    S0: float
+    Sc: float | None
+    ring: tuple = (0.0, 0.0)
+    pole_force: float = 0.0
+    apex_curvature: float = 0.0
+
+
+def contact_of(state, S0=None) -> Contact:
+    """The :class:`Contact` of a cap or point-load state: the base state from the regions'
+    generated profiles (:func:`chain_base`), the contact edge Sc and its normal ring force
+    (``state.edge_forces``, ``-2 pi [r Q]``) with the tip's curvatures at Sc."""
+    check_supported(state)
+    from .inflation import EPS
+
+    sysm = state.system
+    L = float(sysm.L)
+    zeta = float(sysm.S_point(sysm.regions[0].start, state.p))
+    S0 = max(EPS * L, zeta) if S0 is None else max(float(S0), zeta)
+    base = chain_base(state)
+    apex = state.scene.tip.apex_curvature() / state.scene.rho
+    if state.topology == "point":
+        return Contact(base, S0, None, pole_force=float(state.force), apex_curvature=apex)
+    Sc = float(sysm.S_point(sysm.regions[0].end, state.p))
+    if Sc <= S0 * (1 + 1e-9):  # the cap lies within the pole's disc: a point contact there
+        return Contact(base, S0, None, pole_force=float(state.force), apex_curvature=apex)
+    edge = base(np.array([Sc * (1 - 1e-12)]))  # the tip's side of the edge
+    ring = -float(state.edge_forces[-1]) / (2 * np.pi)  # -(normal ring force per length) r_c
+    kt = float(np.sin(edge["phi"][0]) / (edge["lt"][0] * _reference(state.scene, np.array([Sc]))[0][0]))
+    return Contact(base, S0, Sc, ring=(ring * float(edge["ks"][0]), ring * kt), pole_force=0.0,
+                   apex_curvature=apex)
+
+
+def _reference(scene, S):
+    """(R, Psi) of the reference shell at S."""
+    f, upper, params, shell_params, ref = _form_functions(scene)
+    values = scene.values()
+    R, Psi, dPsi, ks0, kt0 = (np.broadcast_to(np.asarray(v, float), S.shape)
+                              for v in ref(S, *[values[p] for p in shell_params]))
+    return R, Psi
+
+
+#: Step in t of the directional derivative of the profiles (:func:`chain_base`).
+PROFILE_STEP = 1e-6
+
+
+def chain_base(state):
+    """The base state of any chain of regions as a function of S: ``phi, ls, ks, dls, dks, lt``
+    and the contact pressure ``P`` (0 in free regions), from each region's generated profile
+    (``*_profile``, as ``Solution.profile`` reads them) on the state's interpolant; ``dls, dks``
+    are the interpolant's derivatives where they are states of the region (``ls`` always,
+    ``ks`` in free regions; near the pole the form's 1/r^3 coefficients cancel, and a
+    difference quotient's rounding there moves n = 1 by percents), else the derivatives of the
+    profile along the interpolant (central difference of step :data:`PROFILE_STEP` in t along
+    ``(S'(t), y'(t))``: the tip's kappa_s)."""
+    from .chain import CONTACT_STATES, FREE_STATES
+
+    sysm, p = state.system, state.p
+    dsol = state.sol.derivative()
+    kernels = sysm.kernels.active
+    par = sysm.par_at(p)
+    edges = [float(sysm.S_point(reg.end, p)) for reg in sysm.regions[:-1]]
+
+    def base(S):
+        S = np.asarray(S, float)
+        out = {k: np.empty_like(S) for k in ("phi", "ls", "ks", "dls", "dks", "lt", "P")}
+        which = np.searchsorted(edges, S, side="right")
+        for k, reg in enumerate(sysm.regions):
+            sel = which == k
+            if not np.any(sel):
+                continue
+            Sk = S[sel]
+            t = sysm.t_of(k, Sk, p)
+            a, b = sysm.ln_S(reg.start, p), sysm.ln_S(reg.end, p)
+            y = state.sol(t)[sysm.rows(k)]
+            dy = dsol(t)[sysm.rows(k)]
+            dS = Sk * (b - a)
+            prof = getattr(kernels, f"{reg.kind}_profile")
+            h = PROFILE_STEP
+            f0 = prof(Sk, y, par)
+            fp = prof(Sk + h * dS, y + h * dy, par)
+            fm = prof(Sk - h * dS, y - h * dy, par)
+            for key, name in (("phi", "phi"), ("ls", "lambda_s"), ("ks", "kappa_s"), ("lt", "lambda_theta")):
+                out[key][sel] = np.broadcast_to(f0[name], Sk.shape)
+            states = FREE_STATES if reg.kind == "free" else CONTACT_STATES
+            for key, name, state_name in (("dls", "lambda_s", "ls"), ("dks", "kappa_s", "ks")):
+                if state_name in states:  # a state of the region: its interpolant's derivative
+                    out[key][sel] = dy[states.index(state_name)] / dS
+                else:
+                    out[key][sel] = np.broadcast_to((np.asarray(fp[name]) - np.asarray(fm[name])) / (2 * h),
+                                                    Sk.shape) / dS
+            out["P"][sel] = np.broadcast_to(f0["P"], Sk.shape) if reg.kind != "free" else 0.0
+        return out
+
+    return base
+
+
+def spectrum(scene, base_of, S0, L, modes=None, *, elements=None, count=2, vectors=False, end="pinned",
+             contact=None):
     """The eigenvalues of :func:`stability` for a base state given as a function of S
     (:func:`state_base`, :func:`sphere_base`) on [S0, L], with ``end`` conditions at L
-    (:data:`END_CONDITIONS`)."""
+    (:data:`END_CONDITIONS`) and, for a state on the tip, its :class:`Contact`."""
     t0 = time.perf_counter()
     ne = elements or default_elements(scene)
-    nodes = mesh(S0, L, ne)
+    nodes = mesh(S0, L, ne, None if contact is None else contact.Sc)
+    held, pole_held, point = (), False, {}
+    if contact is not None:
+        if contact.Sc is None:
+            pole_held = True
+        else:
+            ic = int(np.flatnonzero(nodes == contact.Sc)[0])
+            held = tuple(range(ic + 1))
+            point = {6 * ic: contact.ring[0], 6 * ic + 2: contact.ring[1]}
     modes = default_modes(scene) if modes is None else np.asarray(sorted(set(int(n) for n in modes)))
     out = np.empty((modes.size, count))
     vecs = {}
     for k, n in enumerate(modes):
         K, M = _assemble(scene, base_of, int(n), nodes)
-        T = _constraints(int(n), nodes.size, end, nodes[0] / np.diff(nodes).max())
+        extra = dict(point)
+        if pole_held and n == 1:  # the pole slides on the tip: -F kappa_apex U^2 / pi (U = u(S0))
+            extra[0] = extra.get(0, 0.0) - contact.pole_force * contact.apex_curvature / np.pi
+        if extra:
+            K = (K + scipy.sparse.csr_matrix((list(extra.values()), (list(extra), list(extra))), shape=K.shape))
+        T = _constraints(int(n), nodes.size, end, nodes[0] / np.diff(nodes).max(), held, pole_held)
         Kr, Mr = (T.T @ K @ T).tocsr(), (T.T @ M @ T).tocsr()
         Kr = ((Kr + Kr.T) / 2).tocsr()
         lam, X = _smallest(Kr, Mr, count)
