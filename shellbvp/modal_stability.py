@@ -25,7 +25,7 @@ ones (up to quadrature error, 6 Gauss points per element, and the pole's roundin
 shift-invert Lanczos (``scipy.sparse.linalg.eigsh``) about a shift that a banded Cholesky
 factorisation certifies to lie below the spectrum.
 
-Boundary conditions (states without contact: the inflated/pressurised shell):
+Boundary conditions (the inflated/pressurised shell; states on the tip below):
 
 * rim (``lambda_theta = 1, z = 0, M_s = 0``): the rim circle is held, so every displacement of
   it vanishes, ``u = v = w = 0``; ``w'`` is free (its natural condition is ``M_s = 0``).  With
@@ -61,8 +61,85 @@ rigid motions of a complete sphere come out at that level instead of 0), growing
 by ``sympy.lambdify`` (numpy, with CSE) of the 45 entries, about 2 s per structure and process;
 a state of beta 1e-5 (141 elements, n = 0..33) takes about 1 s.
 
-Only states without contact are handled here (topology ``"inflated"``); contact regions (the
-normal displacement following the tip, lift-off, walls) and junction terms are not built.
+States on the tip (topology ``"cap"`` with ``contact="smooth"``, ``"line"``, ``"point"``)
+---------------------------------------------------------------------------------------
+The tip is rigid, frictionless and fixed in space (displacement control).  Let ``g(x)`` be the
+signed distance of a point from the tip's surface (``g >= 0`` outside the tip).  The constraint
+is ``g(x(S, theta)) >= 0`` for every material point; its multiplier is the contact pressure,
+per ``dS dtheta`` ``p^ = P r psi`` on the cap ``[0, Sc]`` (``P`` the generated profile's), and
+at the edge the normal ring force ``f_c`` (for the whole circle: ``state.edge_forces``,
+``-2 pi [r Q]``; the smooth model's jump of Q, SPEC 2b).  The state is stationary for the
+Lagrangian
+
+.. math:: \mathcal L = \Pi - \int\!\!\int \hat p\, g\, dS\, d\theta
+          - \tfrac{f_c}{2\pi}\int g(x(S_c, \theta))\, d\theta
+
+(on the cap N points into the tip, so ``g = -w`` to first order, and the generated equilibrium
+is ``dPi/dw = -r psi P`` there, tests/test_second_variation.py).
+
+*Admissible perturbations.*  On a valid state ``P > 0`` on the cap and ``f_c > 0``: every point
+of the contact set carries a positive multiplier, the critical cone is the subspace
+``dg = 0`` there, i.e. ``w = 0`` on ``[0, Sc]``; ``u, v`` are free (frictionless).  With the
+bending energy the perturbations are H^2 (C^1), so ``w = 0`` on the cap implies ``w'(Sc) = 0``:
+``w = w' = 0`` is imposed at the cap's nodes.  On a state flagged invalid (``P < 0`` somewhere,
+a pulling ring) the same eigenproblem is that of the shell held on the tip over its contact set
+(an equality constraint): what the fold of its branch needs, nothing about lifting off.
+
+*The constraint's curvature.*  The second variation is that of ``L`` at fixed multipliers:
+``d^2 Pi - Int p^ d^2 g - f_c/(2 pi) Int d^2 g(Sc)``, with ``d^2 g = dx^T (Hess g) dx``.  For a
+tangential ``dx`` at a point of the tip's surface, ``Hess g`` is the surface's second
+fundamental form, positive for the convex tip seen from outside: ``d^2 g = kappa_s u^2 +
+kappa_theta v^2`` with the tip's principal curvatures (meridian, parallel), which on the cap
+are the shell's own ``kappa_s``, ``kappa_theta = sin(phi)/r`` (for a sphere of radius rho,
+``|x + dx - c| = rho + |dx_t|^2/(2 rho) + ...``: sliding along the tip with ``w = 0`` to first
+order leaves it outward at second order).  The form gains ``-P r psi (kappa_s u^2 +
+kappa_theta v^2)/4`` per dS on the cap (theta-average 1/2; the same at n = 0, where v is the
+torsion) and ``K`` gains ``-f_c/(2 pi) (kappa_s u^2 + kappa_theta v^2)`` at Sc: the contact
+destabilises sliding, like a ball resting on a ball.  Its sign is checked by the energy along
+the branch: ``d^2E/d delta^2 = dF/d delta`` equals ``d^2 Pi(x', x') - Int p^ kappa_s
+dt^2 - f_c kappa_s dt(Sc)^2`` (``x'`` the branch tangent at fixed S, ``dt`` the tangential
+component of ``x' + e_z``, the motion relative to the tip that moves down); measured on the base
+scene at delta 0.3 and 0.6 it agrees to 3e-5 and 3e-4 of dF/ddelta, with the opposite sign it
+misses by 0.5 % and 7 %, without the terms by 0.2 % and 3.4 % (tests/test_stability_contact.py).
+
+*The edge's motion.*  In the smooth model r, phi, lambda_s and kappa_s are continuous at Sc and
+Q jumps, so the gap just outside the cap grows like ``c s^3`` (s = S - Sc).  A perturbation with
+``w = w' = 0`` at Sc penetrates there only where ``c s^3 < eta w''(Sc) s^2/2``: over s = O(eta),
+by O(eta^3), and letting the edge move changes the energy at O(eta^3).  The points outside carry
+no multiplier and strict complementarity holds on the whole contact set, so the fixed active set
+``[0, Sc]`` is exact to second order.  (Not for the paper's edge, where lambda_s and kappa_s
+jump and which is not variational: refused.)  The branch tangent's ``u'`` jumps at Sc (lambda_s'
+does, and the edge moves), and so may a mode's: the C^1 elements resolve the kink by a layer, on
+a mesh graded towards Sc (:func:`mesh`; without it the eigenvalues converged like h).
+
+*A line contact* (topology ``"line"``: the pole lifted, the shell touching the tip on the
+circle S1, carrying a ring force; lambda_s and kappa_s continuous there, the shell's kappa_s
+below the tip's by ``gap = -curvature_excess > 0``).  Here the contact point can roll along the
+meridian, so the constraint is the smallest gap near S1.  In the frame of the contact point
+(sigma the arclength along t, heights along N) the tip is ``kappa_T sigma^2/2`` and the shell
+``kappa_S sigma^2/2``; displaced by ``eta (u t + w N)`` (u, w at sigma = 0 and ``w1 = dw/dsigma
+= w'/psi``; the frame turns with sigma by kappa_S) the gap is ``gap sigma^2/2 + eta sigma (gap
+u - w1) - eta w + eta^2 kappa_T u^2/2 + O(eta^3)`` at sigma = O(eta), whose minimum over sigma is
+``-eta w + eta^2 (kappa_S u^2/2 + u w1 - w1^2/(2 gap))``.  So ``w(S1) = 0`` (first order) and the
+ring's term in ``K`` is ``-f/(2 pi) (kappa_S u^2 + 2 u w1 - w1^2/gap + kappa_theta v^2)``: the
+rolling term ``+f w1^2/gap`` stiffens, without bound as the line opens into an annulus
+(gap -> 0, then refused).  (Check: a rigid rotation about the centre of a spherical tip,
+``u = Omega/kappa_T, w1 = Omega gap/kappa_T``, gives ``Omega^2/kappa_T``: the straight-line
+rotation's outward second-order motion, as it must.)
+
+*The pole.*  The mesh starts at ``S0 = max(EPS L, zeta)``; the cap's disc [0, S0] is left out.
+On the tip the pole conditions above hold with ``w = w' = 0``.  For every state in contact,
+n = 1 also has ``u' = v' = 0`` at S0 (the regular field is ``u = U + O(S^2)``): where the pole
+carries a bending prestress (a cap held at curvature 1/rho, a lifted cap bent by its line) the
+form's ``u u''`` terms are not small and without these conditions a layer at S0 lowers the
+energy without bound as the first element shrinks (the states without contact keep their
+conditions).  A cap or line within [0, S0] and a point load hold the pole at a point:
+``w(S0) = 0`` at n = 0 (delta is prescribed); at n = 1 the pole slides by ``U = u(S0)`` and
+``K`` gains ``-F kappa_apex U^2/pi`` (the limit of the cap's term); n >= 2 hold it already.
+
+Refused (ValueError, one line): the annulus, wall and split configurations,
+``contact="paper"``, a contact edge with a corner, a line whose gap is not positive, a sealed
+shell in contact.
 """
 
 from __future__ import annotations
@@ -360,18 +437,20 @@ def _element_basis(xg, h, hs):
 END_CONDITIONS = {"pinned": (0, 2, 4), "symmetric": (0, 5), "antisymmetric": (2, 4)}
 
 
-def _constraints(n, m, end="pinned", S0_over_hs=0.0, held=(), pole_held=False):
+def _constraints(n, m, end="pinned", S0_over_hs=0.0, held=(), pole_held=False, line=None):
     """The reduced basis T (sparse, ndof x nfree) that imposes the pole (node 0) and end
     (node m-1) conditions: q = T q_free.  ``S0_over_hs``: S0 over the derivative dofs' scale
     (n = 1's ``w = S0 w'`` at S0).  ``held``: nodes on the tip (``w = w' = 0``: the normal
     displacement vanishes on the contact region, module docstring); ``pole_held``: the pole
     touches the tip at a point (``w = 0`` at S0 for n = 0; the n >= 1 pole conditions hold it
-    already or let it slide)."""
+    already or let it slide); ``line``: the node of a line contact (``w = 0`` there)."""
     ndof = 6 * m
     fixed = {6 * (m - 1) + k for k in END_CONDITIONS[end]}
     fixed |= {6 * i + k for i in held for k in (4, 5)}
+    if line is not None:
+        fixed.add(6 * line + 4)
     tie_w = n == 1 and 0 not in held
-    if n == 1 and (held or pole_held):
+    if n == 1 and (held or pole_held or line is not None):
         # u = U + O(S^2), v = -U + O(S^2) at the axis: u' = v' = 0.  Where the pole carries a
         # bending prestress (on the tip, or under a point load) the form's u u'' and v v''
         # terms are not small, and without these conditions a layer at S0 lowers the energy
@@ -450,7 +529,8 @@ def stability(state, modes=None, *, elements: int | None = None, S0: float | Non
     Parameters
     ----------
     state : Solution
-        A converged state without contact: :func:`shellbvp.inflate`'s (topology ``"inflated"``).
+        A converged state: :func:`shellbvp.inflate`'s (topology ``"inflated"``), or one on the
+        tip (``"cap"`` with ``contact="smooth"``, ``"line"``, ``"point"``; module docstring).
     modes : iterable of int, optional
         The mode numbers n (default :func:`default_modes`).
     elements : int, optional
@@ -471,8 +551,10 @@ def stability(state, modes=None, *, elements: int | None = None, S0: float | Non
 
     Raises
     ------
-    NotImplementedError
-        For a state with contact (only the inflated, contact-free state is handled).
+    ValueError
+        One line naming what is not supported (:func:`check_supported`): a state that did not
+        converge, the annulus, wall and split contact, ``contact="paper"``, a cornered edge, a
+        line without a curvature gap, a sealed shell in contact.
 
     Examples
     --------
@@ -502,7 +584,7 @@ def stability(state, modes=None, *, elements: int | None = None, S0: float | Non
 
 
 #: The topologies whose stability is built (``"inflated"``: no contact).
-SUPPORTED = ("inflated", "cap", "point")
+SUPPORTED = ("inflated", "cap", "point", "line")
 
 
 def check_supported(state):
@@ -513,7 +595,7 @@ def check_supported(state):
         raise ValueError(f"stability: the state did not converge ({state.message})")
     if state.topology not in SUPPORTED:
         raise ValueError(f"stability: topology {state.topology!r} is not supported (only "
-                         f"{', '.join(repr(t) for t in SUPPORTED)}: lift-off, wall and split contact are not built)")
+                         f"{', '.join(repr(t) for t in SUPPORTED)}: annulus, wall and split contact are not built)")
     if state.topology == "inflated":
         return
     scene = state.scene
@@ -533,25 +615,26 @@ class Contact:
     """What the tip adds to the eigenproblem of a state in contact (module docstring).
 
     ``base``: the base state as a function of S, with the contact pressure ``P`` (0 off the
-    tip); ``S0``: where the mesh starts; ``Sc``: the contact edge (None when the cap lies
-    within [0, S0] or there is none: the pole is then held at a point); ``ring``: the
-    coefficients of ``u(Sc)^2`` and ``v(Sc)^2`` in the stiffness (the ring force's curvature
-    term); ``pole_force``: the axial force on the pole when it is held at a point, and
-    ``apex_curvature`` the tip's there.
+    tip); ``S0``: where the mesh starts; ``kind``: ``"cap"`` (w = w' = 0 on ``[S0, edge]``),
+    ``"line"`` (w = 0 at ``edge``) or ``"pole"`` (the contact lies within [0, S0] or is a point
+    load: the pole is held at a point); ``ring``: the edge's or line's quadratic form in the
+    stiffness, coefficients of ``u^2, v^2, 2 u w', w'^2`` at ``edge``; ``pole_force``: the
+    axial force on a pole held at a point, ``apex_curvature`` the tip's there.
     """
 
     base: object
     S0: float
-    Sc: float | None
-    ring: tuple = (0.0, 0.0)
+    kind: str
+    edge: float | None = None
+    ring: tuple = (0.0, 0.0, 0.0, 0.0)
     pole_force: float = 0.0
     apex_curvature: float = 0.0
 
 
 def contact_of(state, S0=None) -> Contact:
-    """The :class:`Contact` of a cap or point-load state: the base state from the regions'
-    generated profiles (:func:`chain_base`), the contact edge Sc and its normal ring force
-    (``state.edge_forces``, ``-2 pi [r Q]``) with the tip's curvatures at Sc."""
+    """The :class:`Contact` of a state on the tip (cap, line or point load): the base state from
+    the regions' generated profiles (:func:`chain_base`), the contact edge or line and its normal
+    ring force (``state.edge_forces``, ``-2 pi [r Q]``) with the tip's curvatures there."""
     check_supported(state)
     from .inflation import EPS
 
@@ -561,15 +644,29 @@ def contact_of(state, S0=None) -> Contact:
     S0 = max(EPS * L, zeta) if S0 is None else max(float(S0), zeta)
     base = chain_base(state)
     apex = state.scene.tip.apex_curvature() / state.scene.rho
+    pole = Contact(base, S0, "pole", pole_force=float(state.force), apex_curvature=apex)
     if state.topology == "point":
-        return Contact(base, S0, None, pole_force=float(state.force), apex_curvature=apex)
-    Sc = float(sysm.S_point(sysm.regions[0].end, state.p))
-    if Sc <= S0 * (1 + 1e-9):  # the cap lies within the pole's disc: a point contact there
-        return Contact(base, S0, None, pole_force=float(state.force), apex_curvature=apex)
-    edge = base(np.array([Sc * (1 - 1e-12)]))  # the tip's side of the edge
-    ring = -float(state.edge_forces[-1]) / (2 * np.pi)  # -(normal ring force per length) r_c
-    kt = float(np.sin(edge["phi"][0]) / (edge["lt"][0] * _reference(state.scene, np.array([Sc]))[0][0]))
-    return Contact(base, S0, Sc, ring=(ring * float(edge["ks"][0]), ring * kt), pole_force=0.0,
+        return pole
+    edge = float(sysm.S_point(sysm.regions[0].end, state.p))
+    if edge <= S0 * (1 + 1e-9):  # the cap or line lies within the pole's disc: a point contact
+        return pole
+    on_tip = base(np.array([edge * (1 - 1e-12)]))  # the cap's side of its edge
+    R = float(_reference(state.scene, np.array([edge]))[0][0])
+    kt = float(np.sin(on_tip["phi"][0]) / (on_tip["lt"][0] * R))
+    f = float(state.edge_forces[0]) / (2 * np.pi)  # the normal ring force per unit length, times r
+    if state.topology == "cap":
+        ks = float(on_tip["ks"][0])
+        return Contact(base, S0, "cap", edge, ring=(-f * ks, -f * kt, 0.0, 0.0), apex_curvature=apex)
+    # a line: the gap's second variation with the contact point rolling along the meridian,
+    # kappa_s u^2 + 2 u w'/psi - w'^2/(psi^2 gap) + kappa_theta v^2 (module docstring), with
+    # gap = kappa_s(tip) - kappa_s(shell) = -curvature_excess > 0 and kappa_s the shell's
+    gap = -float(state.curvature_excess)
+    if not gap > 0:
+        raise ValueError(f"stability: the line contact's curvature gap {gap:.3g} is not positive (the shell "
+                         f"bends as tightly as the tip there: an annulus), not supported")
+    psi = float(on_tip["ls"][0]) * float(_reference(state.scene, np.array([edge]))[1][0])
+    ks = float(on_tip["ks"][0])
+    return Contact(base, S0, "line", edge, ring=(-f * ks, -f * kt, -f / psi, f / (psi**2 * gap)),
                    apex_curvature=apex)
 
 
@@ -644,26 +741,30 @@ def spectrum(scene, base_of, S0, L, modes=None, *, elements=None, count=2, vecto
     (:data:`END_CONDITIONS`) and, for a state on the tip, its :class:`Contact`."""
     t0 = time.perf_counter()
     ne = elements or default_elements(scene)
-    nodes = mesh(S0, L, ne, None if contact is None else contact.Sc)
-    held, pole_held, point = (), False, {}
+    nodes = mesh(S0, L, ne, None if contact is None else contact.edge)
+    held, pole_held, line, extra = (), False, None, {}
     if contact is not None:
-        if contact.Sc is None:
-            pole_held = True
-        else:
-            ic = int(np.flatnonzero(nodes == contact.Sc)[0])
-            held = tuple(range(ic + 1))
-            point = {6 * ic: contact.ring[0], 6 * ic + 2: contact.ring[1]}
+        pole_held = contact.kind == "pole"
+        if contact.kind in ("cap", "line"):
+            i = int(np.flatnonzero(nodes == contact.edge)[0])
+            held = tuple(range(i + 1)) if contact.kind == "cap" else ()
+            line = i if contact.kind == "line" else None
+            hs = np.diff(nodes).max()  # the scale of the derivative dofs (_assemble)
+            uu, vv, uw, ww = contact.ring
+            extra = {(6 * i, 6 * i): uu, (6 * i + 2, 6 * i + 2): vv, (6 * i, 6 * i + 5): uw / hs,
+                     (6 * i + 5, 6 * i): uw / hs, (6 * i + 5, 6 * i + 5): ww / hs**2}
     modes = default_modes(scene) if modes is None else np.asarray(sorted(set(int(n) for n in modes)))
     out = np.empty((modes.size, count))
     vecs = {}
     for k, n in enumerate(modes):
         K, M = _assemble(scene, base_of, int(n), nodes)
-        extra = dict(point)
+        terms = dict(extra)
         if pole_held and n == 1:  # the pole slides on the tip: -F kappa_apex U^2 / pi (U = u(S0))
-            extra[0] = extra.get(0, 0.0) - contact.pole_force * contact.apex_curvature / np.pi
-        if extra:
-            K = (K + scipy.sparse.csr_matrix((list(extra.values()), (list(extra), list(extra))), shape=K.shape))
-        T = _constraints(int(n), nodes.size, end, nodes[0] / np.diff(nodes).max(), held, pole_held)
+            terms[0, 0] = terms.get((0, 0), 0.0) - contact.pole_force * contact.apex_curvature / np.pi
+        if terms:
+            rows, cols = zip(*terms)
+            K = K + scipy.sparse.csr_matrix((list(terms.values()), (rows, cols)), shape=K.shape)
+        T = _constraints(int(n), nodes.size, end, nodes[0] / np.diff(nodes).max(), held, pole_held, line)
         Kr, Mr = (T.T @ K @ T).tocsr(), (T.T @ M @ T).tocsr()
         Kr = ((Kr + Kr.T) / 2).tocsr()
         lam, X = _smallest(Kr, Mr, count)
