@@ -104,9 +104,9 @@ def branch_check(lo, mid, hi, S0=1e-3):
     pressure = -2 * math.pi * float(np.sum(W * base["P"] * base["lt"] * R * psi * base["ks"] * rel**2))
     # at the edge or line
     Se = np.array([edge])
-    (xl, xSl), (xh, xSh) = (_frame(s, Se)[:2] for s in (lo, hi))
-    _, _, _, be, te, Ne, psie, _, _, _ = _frame(mid, np.array([edge * (1 - 1e-12)]))
-    de, dSe = (xh - xl)[:, 0] / h, (xSh - xSl)[:, 0] / h
+    xl, xh = (_frame(s, Se)[0] for s in (lo, hi))
+    be, te = _frame(mid, np.array([edge * (1 - 1e-12)]))[3:5]
+    de = (xh - xl)[:, 0] / h
     ks = float(be["ks"][0])
     u0 = float(de @ te[:, 0]) + float(te[1, 0])
     f = float(mid.edge_forces[0])
@@ -114,7 +114,8 @@ def branch_check(lo, mid, hi, S0=1e-3):
         ring = -f * ks * u0**2
     else:  # the line: kappa_S u0^2 + 2 u0 w1 - w1^2/gap, w1 = d(dt . N)/dsigma
         gap = -float(mid.curvature_excess)
-        ring = -f * (ks * u0**2 + 2 * u0 * _slope_at_line(lo, mid, hi) - _slope_at_line(lo, mid, hi)**2 / gap)
+        w1 = _slope_at_line(lo, mid, hi)
+        ring = -f * (ks * u0**2 + 2 * u0 * w1 - w1**2 / gap)
     return (hi.force - lo.force) / h, elastic, pressure + ring
 
 
