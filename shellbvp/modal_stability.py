@@ -575,6 +575,17 @@ def stability(state, modes=None, *, elements: int | None = None, S0: float | Non
     >>> res = sb.stability(sb.inflate(scene))
     >>> res.stable, res.critical_mode
     (False, 11)
+
+    A state on the tip: the base scene's cap at delta 0.3 is stable, its softest mode n = 1 (the
+    cap sliding round the tip); the paper's contact model is refused:
+
+    >>> res = sb.stability(sb.solve(sb.Scene.preset("base"), delta=0.3), modes=range(4))
+    >>> res.stable, res.critical_mode
+    (True, 1)
+    >>> sb.stability(sb.solve(sb.Scene.preset("base").replace(contact="paper"), delta=0.3))
+    Traceback (most recent call last):
+    ...
+    ValueError: stability: contact='paper' is not variational ...; only contact='smooth' is supported
     """
     t0 = time.perf_counter()
     check_supported(state)

@@ -257,3 +257,25 @@ def test_unsupported_states_are_refused_in_one_line(state, match):
     with pytest.raises(ValueError, match=match) as err:
         st.stability(state)
     assert "\n" not in str(err.value) and str(err.value).startswith("stability: ")
+
+
+@pytest.mark.slow
+def test_dome_n0_eigenvalue_changes_sign_at_its_fold():
+    """The convex dome of tests/test_dome.py (rho 0.05, beta 1e-5) turns back in delta at
+    0.18289: the n = 0 eigenvalue is positive along its curve and changes sign between two
+    force-controlled states round the fold, within 1e-4 of it in delta
+    (benchmarks/results/stability_contact.md: Brent in F puts the zero at 0.182894, the
+    largest delta over F within 4e-11 of it)."""
+    shell = sb.UserShell("5*sin(S/5)", "5*cos(S/5)", "5*asin(1/5)")
+    scene = sb.Scene(rho=0.05, beta=1e-5, material=sb.MooneyRivlin(0.1), shell=shell)
+    curve = sb.curve(scene, delta_max=0.25)
+    assert "fold" in curve.stop_reason
+    assert all(st.stability(s, modes=[0]).smallest[0] > 0 for s in curve.solutions)
+    state, rows = curve.solutions[-1], []
+    for F in np.linspace(state.force, 1.2e-4, 9)[1:]:
+        state = sb.solve(scene, force=F, guess=state, estimate_error=False, tol=1e-8)
+        assert state.success, state.message
+        rows.append((state.delta, st.stability(state, modes=[0]).smallest[0]))
+    k = next(i for i in range(1, len(rows)) if rows[i - 1][1] > 0 >= rows[i][1])
+    assert all(lam > 0 for _, lam in rows[:k]) and all(lam < 0 for _, lam in rows[k:])
+    assert abs(rows[k - 1][0] - 0.18289) < 1e-4 and abs(rows[k][0] - 0.18289) < 1e-4
