@@ -61,8 +61,12 @@ rigid motions of a complete sphere come out at that level instead of 0), growing
 by ``sympy.lambdify`` (numpy, with CSE) of the 45 entries, about 2 s per structure and process;
 a state of beta 1e-5 (141 elements, n = 0..33) takes about 1 s.
 
-States on the tip (topology ``"cap"`` with ``contact="smooth"``, ``"line"``, ``"point"``)
----------------------------------------------------------------------------------------
+States on the tip (``contact="smooth"``: the cap, the point load, lifted and split contact)
+------------------------------------------------------------------------------------------
+Every chain of free regions and regions on the tip joined by smooth contact edges and lines
+(:data:`SUPPORTED`) is handled alike: ``w = w' = 0`` on each region on the tip, ``w = 0`` at a
+line, and at each edge and line the ring force's term below; the single cap serves to derive it.
+
 The tip is rigid, frictionless and fixed in space (displacement control).  Let ``g(x)`` be the
 signed distance of a point from the tip's surface (``g >= 0`` outside the tip).  The constraint
 is ``g(x(S, theta)) >= 0`` for every material point; its multiplier is the contact pressure,
@@ -144,8 +148,10 @@ Accuracy: on the base scene at delta 0.3 (cap, Sc 0.091) the eigenvalues of n = 
 less than 3e-4 with twice the elements or with S0 = 1e-3; the dome's first n >= 2 crossings
 (benchmarks/results/stability_contact.md) move by < 3e-7 in delta with twice the elements.
 
-Refused (ValueError, one line): the annulus, wall and split configurations,
-``contact="paper"``, a line whose gap is not positive, a sealed shell in contact, and a contact
+Refused (ValueError, one line): the shell lying on the indenter's cylinder (``"cap+cylinder"``,
+``"cap+band(cylinder)"``: the tip's end is a corner of the obstacle) and interior corners
+(``"line+corner"``), ``contact="paper"``, a line whose gap is not positive, more than one line,
+an edge inside [0, S0] of a configuration with several, a sealed shell in contact, and a contact
 edge with a Weierstrass-Erdmann corner (lambda_s, kappa_s jump there: the corner can move
 through the material, a degree of freedom of its own that the displacement modes do not
 carry; the base scene's edges have one from delta 0.62).
@@ -164,6 +170,7 @@ import scipy.sparse
 import scipy.sparse.linalg
 import sympy as sp
 
+from .chain import CONTACT_KINDS, CONTACT_STATES, FREE_STATES, Edge, Line
 from .geometry import Spheroid
 
 __all__ = ["stability", "Stability", "spectrum", "state_base", "sphere_base", "mesh", "default_modes",
@@ -446,20 +453,19 @@ def _element_basis(xg, h, hs):
 END_CONDITIONS = {"pinned": (0, 2, 4), "symmetric": (0, 5), "antisymmetric": (2, 4)}
 
 
-def _constraints(n, m, end="pinned", S0_over_hs=0.0, held=(), pole_held=False, line=None):
+def _constraints(n, m, end="pinned", S0_over_hs=0.0, held=(), pole_held=False, lines=()):
     """The reduced basis T (sparse, ndof x nfree) that imposes the pole (node 0) and end
     (node m-1) conditions: q = T q_free.  ``S0_over_hs``: S0 over the derivative dofs' scale
     (n = 1's ``w = S0 w'`` at S0).  ``held``: nodes on the tip (``w = w' = 0``: the normal
     displacement vanishes on the contact region, module docstring); ``pole_held``: the pole
     touches the tip at a point (``w = 0`` at S0 for n = 0; the n >= 1 pole conditions hold it
-    already or let it slide); ``line``: the node of a line contact (``w = 0`` there)."""
+    already or let it slide); ``lines``: the nodes of line contacts (``w = 0`` there)."""
     ndof = 6 * m
     fixed = {6 * (m - 1) + k for k in END_CONDITIONS[end]}
     fixed |= {6 * i + k for i in held for k in (4, 5)}
-    if line is not None:
-        fixed.add(6 * line + 4)
+    fixed |= {6 * i + 4 for i in lines}
     tie_w = n == 1 and 0 not in held
-    if n == 1 and (held or pole_held or line is not None):
+    if n == 1 and (held or pole_held or lines):
         # u = U + O(S^2), v = -U + O(S^2) at the axis: u' = v' = 0.  Where the pole carries a
         # bending prestress (on the tip, or under a point load) the form's u u'' and v v''
         # terms are not small, and without these conditions a layer at S0 lowers the energy
@@ -491,11 +497,11 @@ def _constraints(n, m, end="pinned", S0_over_hs=0.0, held=(), pole_held=False, l
 POLE_RATIO = 0.25
 
 
-def mesh(S0: float, L: float, elements: int, edge: float | None = None) -> np.ndarray:
+def mesh(S0: float, L: float, elements: int, edges=()) -> np.ndarray:
     """Nodes on [S0, L]: ``elements`` uniform elements, the first split towards S0 geometrically;
-    with ``edge`` (a contact edge inside (S0, L)) a node there and :data:`EDGE_LEVELS` nodes on
-    each side at ``h/2, h/4, ...`` from it (the mode's derivatives jump there: without the
-    grading the eigenvalues converged only like h)."""
+    at each of ``edges`` (contact edges and lines inside (S0, L)) a node and :data:`EDGE_LEVELS`
+    nodes on each side at ``h/2, h/4, ...`` from it (the mode's derivatives jump there: without
+    the grading the eigenvalues converged only like h)."""
     nodes = np.linspace(S0, L, elements + 1)
     h = nodes[1] - nodes[0]
     extra = []
@@ -504,13 +510,13 @@ def mesh(S0: float, L: float, elements: int, edge: float | None = None) -> np.nd
         extra.append(S0 + d)
         d *= POLE_RATIO
     nodes = np.concatenate([nodes[:1], np.array(extra[::-1]), nodes[1:]])
-    if edge is None:
-        return nodes
     steps = h * 0.5 ** np.arange(1, EDGE_LEVELS + 1)
-    near = np.concatenate([edge - steps, [edge], edge + steps])
-    near = near[(near > S0) & (near < L)]
-    far = nodes[np.abs(nodes - edge) >= h / 2]  # the uniform nodes closer than h/2 give way
-    return np.unique(np.concatenate([far, near]))
+    for edge in edges:
+        near = np.concatenate([edge - steps, [edge], edge + steps])
+        near = near[(near > S0) & (near < L)]
+        far = nodes[(np.abs(nodes - edge) >= h / 2) | np.isin(nodes, edges)]  # uniform nodes closer than h/2 give way
+        nodes = np.unique(np.concatenate([far, near]))
+    return nodes
 
 
 #: Nodes on each side of a contact edge (:func:`mesh`).
@@ -539,7 +545,7 @@ def stability(state, modes=None, *, elements: int | None = None, S0: float | Non
     ----------
     state : Solution
         A converged state: :func:`shellbvp.inflate`'s (topology ``"inflated"``), or one on the
-        tip (``"cap"`` with ``contact="smooth"``, ``"line"``, ``"point"``; module docstring).
+        tip with ``contact="smooth"`` (a topology in :data:`SUPPORTED`; module docstring).
     modes : iterable of int, optional
         The mode numbers n (default :func:`default_modes`).
     elements : int, optional
@@ -561,9 +567,10 @@ def stability(state, modes=None, *, elements: int | None = None, S0: float | Non
     Raises
     ------
     ValueError
-        One line naming what is not supported (:func:`check_supported`): a state that did not
-        converge, the annulus, wall and split contact, ``contact="paper"``, a cornered edge, a
-        line without a curvature gap, a sealed shell in contact.
+        One line naming what is not supported (:func:`check_supported`, :func:`contact_of`): a
+        state that did not converge, the shell on the indenter's cylinder, interior corners,
+        ``contact="paper"``, a cornered edge, a line without a curvature gap, a sealed shell in
+        contact.
 
     Examples
     --------
@@ -603,8 +610,9 @@ def stability(state, modes=None, *, elements: int | None = None, S0: float | Non
     return out
 
 
-#: The topologies whose stability is built (``"inflated"``: no contact).
-SUPPORTED = ("inflated", "cap", "point", "line")
+#: The topologies whose stability is built (``"inflated"``: no contact): every chain of free
+#: regions and regions on the tip joined by smooth edges and lines.
+SUPPORTED = ("inflated", "cap", "point", "line", "annulus", "cap+line(tip)", "cap+band(tip)", "cap+line(cylinder)")
 
 
 def check_supported(state):
@@ -615,7 +623,8 @@ def check_supported(state):
         raise ValueError(f"stability: the state did not converge ({state.message})")
     if state.topology not in SUPPORTED:
         raise ValueError(f"stability: topology {state.topology!r} is not supported (only "
-                         f"{', '.join(repr(t) for t in SUPPORTED)}: annulus, wall and split contact are not built)")
+                         f"{', '.join(repr(t) for t in SUPPORTED)}: the shell lying on the indenter's cylinder and "
+                         f"interior corners are not built)")
     if state.topology == "inflated":
         return
     scene = state.scene
@@ -635,59 +644,87 @@ class Contact:
     """What the tip adds to the eigenproblem of a state in contact (module docstring).
 
     ``base``: the base state as a function of S, with the contact pressure ``P`` (0 off the
-    tip); ``S0``: where the mesh starts; ``kind``: ``"cap"`` (w = w' = 0 on ``[S0, edge]``),
-    ``"line"`` (w = 0 at ``edge``) or ``"pole"`` (the contact lies within [0, S0] or is a point
-    load: the pole is held at a point); ``ring``: the edge's or line's quadratic form in the
-    stiffness, coefficients of ``u^2, v^2, 2 u w', w'^2`` at ``edge``; ``pole_force``: the
-    axial force on a pole held at a point, ``apex_curvature`` the tip's there.
+    tip); ``S0``: where the mesh starts; ``held``: the S-intervals on the tip (w = w' = 0);
+    ``lines``: the line contacts' S (w = 0); ``rings``: per edge or line ``(S, (a, b, c, d))``,
+    its quadratic form ``a u^2 + b v^2 + 2 c u w' + d w'^2`` in the stiffness; ``pole_held``:
+    the contact lies within [0, S0] or is a point load (the pole held at a point), with
+    ``pole_force`` the axial force there and ``apex_curvature`` the tip's.
     """
 
     base: object
     S0: float
-    kind: str
-    edge: float | None = None
-    ring: tuple = (0.0, 0.0, 0.0, 0.0)
+    held: tuple = ()
+    lines: tuple = ()
+    rings: tuple = ()
+    pole_held: bool = False
     pole_force: float = 0.0
     apex_curvature: float = 0.0
 
+    @property
+    def edges(self):
+        """Where the contact starts or ends inside the mesh, and the lines."""
+        return tuple(sorted({S for S, _ in self.rings} | {S for a, b in self.held for S in (a, b)
+                                                          if S > self.S0}))
+
+
+def _junction_points(sysm, p):
+    """(S, kind, inner region, outer region) of every contact edge and line, pole to rim, in the
+    order of ``Solution.edge_forces`` (``shellbvp.diagnosis``)."""
+    out = []
+    for j in sysm.junctions:
+        if isinstance(j, Edge):
+            out.append((float(sysm.S_point(sysm.regions[min(j.kc, j.kf)].end, p)), "edge", j.kc, j.kf))
+        elif isinstance(j, Line):
+            out.append((float(sysm.S_point(sysm.regions[j.k].end, p)), "line", j.k, j.k + 1))
+    return out
+
 
 def contact_of(state, S0=None) -> Contact:
-    """The :class:`Contact` of a state on the tip (cap, line or point load): the base state from
-    the regions' generated profiles (:func:`chain_base`), the contact edge or line and its normal
-    ring force (``state.edge_forces``, ``-2 pi [r Q]``) with the tip's curvatures there."""
+    """The :class:`Contact` of a state on the tip: the base state from the regions' generated
+    profiles (:func:`chain_base`), the regions on the tip, and at each contact edge and line
+    its normal ring force (``state.edge_forces``, ``-2 pi [r Q]``) with the curvatures there."""
     check_supported(state)
     from .inflation import EPS
 
-    sysm = state.system
+    sysm, p = state.system, state.p
     L = float(sysm.L)
-    zeta = float(sysm.S_point(sysm.regions[0].start, state.p))
+    zeta = float(sysm.S_point(sysm.regions[0].start, p))
     S0 = max(EPS * L, zeta) if S0 is None else max(float(S0), zeta)
     base = chain_base(state)
     apex = state.scene.tip.apex_curvature() / state.scene.rho
-    pole = Contact(base, S0, "pole", pole_force=float(state.force), apex_curvature=apex)
-    if state.topology == "point":
-        return pole
-    edge = float(sysm.S_point(sysm.regions[0].end, state.p))
-    if edge <= S0 * (1 + 1e-9):  # the cap or line lies within the pole's disc: a point contact
-        return pole
-    on_tip = base(np.array([edge * (1 - 1e-12)]))  # the cap's side of its edge
-    R = float(_reference(state.scene, np.array([edge]))[0][0])
-    kt = float(np.sin(on_tip["phi"][0]) / (on_tip["lt"][0] * R))
-    f = float(state.edge_forces[0]) / (2 * np.pi)  # the normal ring force per unit length, times r
-    if state.topology == "cap":
-        ks = float(on_tip["ks"][0])
-        return Contact(base, S0, "cap", edge, ring=(-f * ks, -f * kt, 0.0, 0.0), apex_curvature=apex)
-    # a line: the gap's second variation with the contact point rolling along the meridian,
-    # kappa_s u^2 + 2 u w'/psi - w'^2/(psi^2 gap) + kappa_theta v^2 (module docstring), with
-    # gap = kappa_s(tip) - kappa_s(shell) = -curvature_excess > 0 and kappa_s the shell's
-    gap = -float(state.curvature_excess)
-    if not gap > 0:
-        raise ValueError(f"stability: the line contact's curvature gap {gap:.3g} is not positive (the shell "
-                         f"bends as tightly as the tip there: an annulus), not supported")
-    psi = float(on_tip["ls"][0]) * float(_reference(state.scene, np.array([edge]))[1][0])
-    ks = float(on_tip["ks"][0])
-    return Contact(base, S0, "line", edge, ring=(-f * ks, -f * kt, -f / psi, f / (psi**2 * gap)),
-                   apex_curvature=apex)
+    points = _junction_points(sysm, p)
+    if state.topology == "point" or (state.topology in ("cap", "line") and points[0][0] <= S0 * (1 + 1e-9)):
+        # the cap or line lies within the pole's disc: a point contact there
+        return Contact(base, S0, pole_held=True, pole_force=float(state.force), apex_curvature=apex)
+    if points[0][0] <= S0 * (1 + 1e-9):
+        raise ValueError(f"stability: a contact edge at S = {points[0][0]:.3g} inside the mesh's start "
+                         f"S0 = {S0:.3g} of a {state.topology!r} state is not supported")
+    held = tuple((max(float(sysm.S_point(r.start, p)), S0), float(sysm.S_point(r.end, p)))
+                 for r in sysm.regions if r.kind in CONTACT_KINDS)
+    lines = [S for S, kind, _, _ in points if kind == "line"]
+    if len(lines) > 1:
+        raise ValueError("stability: more than one line contact is not supported")
+    rings = []
+    for (S, kind, k, other), force in zip(points, state.edge_forces):
+        side = S * (1 - 1e-12) if k < other else S * (1 + 1e-12)  # inside region k: the tip's side of an edge
+        at = base(np.array([side]))
+        R, Psi = (float(v[0]) for v in _reference(state.scene, np.array([S])))
+        kt = float(np.sin(at["phi"][0]) / (at["lt"][0] * R))
+        ks = float(at["ks"][0])
+        f = float(force) / (2 * np.pi)  # the normal ring force per unit length, times r
+        if kind == "edge":
+            rings.append((S, (-f * ks, -f * kt, 0.0, 0.0)))
+            continue
+        # a line: the gap's second variation with the contact point rolling along the meridian,
+        # kappa_S u^2 + 2 u w'/psi - w'^2/(psi^2 gap) + kappa_theta v^2 (module docstring), with
+        # gap = kappa_s(indenter) - kappa_s(shell) = -curvature_excess > 0, kappa_S the shell's
+        gap = -float(state.curvature_excess)
+        if not gap > 0:
+            raise ValueError(f"stability: the line contact's curvature gap {gap:.3g} is not positive (the shell "
+                             f"bends as tightly as the indenter there: a band), not supported")
+        psi = float(at["ls"][0]) * Psi
+        rings.append((S, (-f * ks, -f * kt, -f / psi, f / (psi**2 * gap))))
+    return Contact(base, S0, held=held, lines=tuple(lines), rings=tuple(rings), apex_curvature=apex)
 
 
 def _reference(scene, S):
@@ -712,8 +749,6 @@ def chain_base(state):
     difference quotient's rounding there moves n = 1 by percents), else the derivatives of the
     profile along the interpolant (central difference of step :data:`PROFILE_STEP` in t along
     ``(S'(t), y'(t))``: the tip's kappa_s)."""
-    from .chain import CONTACT_STATES, FREE_STATES
-
     sysm, p = state.system, state.p
     dsol = state.sol.derivative()
     kernels = sysm.kernels.active
@@ -761,18 +796,18 @@ def spectrum(scene, base_of, S0, L, modes=None, *, elements=None, count=2, vecto
     (:data:`END_CONDITIONS`) and, for a state on the tip, its :class:`Contact`."""
     t0 = time.perf_counter()
     ne = elements or default_elements(scene)
-    nodes = mesh(S0, L, ne, None if contact is None else contact.edge)
-    held, pole_held, line, extra = (), False, None, {}
+    nodes = mesh(S0, L, ne, () if contact is None else contact.edges)
+    held, pole_held, lines, extra = (), False, (), {}
     if contact is not None:
-        pole_held = contact.kind == "pole"
-        if contact.kind in ("cap", "line"):
-            i = int(np.flatnonzero(nodes == contact.edge)[0])
-            held = tuple(range(i + 1)) if contact.kind == "cap" else ()
-            line = i if contact.kind == "line" else None
-            hs = np.diff(nodes).max()  # the scale of the derivative dofs (_assemble)
-            uu, vv, uw, ww = contact.ring
-            extra = {(6 * i, 6 * i): uu, (6 * i + 2, 6 * i + 2): vv, (6 * i, 6 * i + 5): uw / hs,
-                     (6 * i + 5, 6 * i): uw / hs, (6 * i + 5, 6 * i + 5): ww / hs**2}
+        pole_held = contact.pole_held
+        held = tuple(int(i) for a, b in contact.held for i in np.flatnonzero((nodes >= a) & (nodes <= b)))
+        lines = tuple(int(np.flatnonzero(nodes == S)[0]) for S in contact.lines)
+        hs = np.diff(nodes).max()  # the scale of the derivative dofs (_assemble)
+        for S, (uu, vv, uw, ww) in contact.rings:
+            i = 6 * int(np.flatnonzero(nodes == S)[0])
+            for key, value in (((i, i), uu), ((i + 2, i + 2), vv), ((i, i + 5), uw / hs), ((i + 5, i), uw / hs),
+                               ((i + 5, i + 5), ww / hs**2)):
+                extra[key] = extra.get(key, 0.0) + value
     modes = default_modes(scene) if modes is None else np.asarray(sorted(set(int(n) for n in modes)))
     out = np.empty((modes.size, count))
     vecs = {}
@@ -784,7 +819,7 @@ def spectrum(scene, base_of, S0, L, modes=None, *, elements=None, count=2, vecto
         if terms:
             rows, cols = zip(*terms)
             K = K + scipy.sparse.csr_matrix((list(terms.values()), (rows, cols)), shape=K.shape)
-        T = _constraints(int(n), nodes.size, end, nodes[0] / np.diff(nodes).max(), held, pole_held, line)
+        T = _constraints(int(n), nodes.size, end, nodes[0] / np.diff(nodes).max(), held, pole_held, lines)
         Kr, Mr = (T.T @ K @ T).tocsr(), (T.T @ M @ T).tocsr()
         Kr = ((Kr + Kr.T) / 2).tocsr()
         lam, X = _smallest(Kr, Mr, count)
