@@ -148,9 +148,12 @@ Accuracy: on the base scene at delta 0.3 (cap, Sc 0.091) the eigenvalues of n = 
 less than 3e-4 with twice the elements or with S0 = 1e-3; the dome's first n >= 2 crossings
 (benchmarks/results/stability_contact.md) move by < 3e-7 in delta with twice the elements.
 
-Refused (ValueError, one line): the shell lying on the indenter's cylinder (``"cap+cylinder"``,
-``"cap+band(cylinder)"``: the tip's end is a corner of the obstacle) and interior corners
-(``"line+corner"``), ``contact="paper"``, a line whose gap is not positive, more than one line,
+A band on the indenter's cylinder is a region on the tip like the others (its meridian is
+straight: ``kappa_s = 0``, and only the hoop term remains).
+
+Refused (ValueError, one line): the contact running over the tip's end onto the cylinder
+(``"cap+cylinder"``: the obstacle has a corner there, across which material slides; the same
+issue as an edge's corner below) and interior corners (``"line+corner"``), ``contact="paper"``, a line whose gap is not positive, more than one line,
 an edge inside [0, S0] of a configuration with several, a sealed shell in contact, and a contact
 edge with a Weierstrass-Erdmann corner (lambda_s, kappa_s jump there: the corner can move
 through the material, a degree of freedom of its own that the displacement modes do not
@@ -568,7 +571,7 @@ def stability(state, modes=None, *, elements: int | None = None, S0: float | Non
     ------
     ValueError
         One line naming what is not supported (:func:`check_supported`, :func:`contact_of`): a
-        state that did not converge, the shell on the indenter's cylinder, interior corners,
+        state that did not converge, the contact over the tip's end, interior corners,
         ``contact="paper"``, a cornered edge, a line without a curvature gap, a sealed shell in
         contact.
 
@@ -612,7 +615,8 @@ def stability(state, modes=None, *, elements: int | None = None, S0: float | Non
 
 #: The topologies whose stability is built (``"inflated"``: no contact): every chain of free
 #: regions and regions on the tip joined by smooth edges and lines.
-SUPPORTED = ("inflated", "cap", "point", "line", "annulus", "cap+line(tip)", "cap+band(tip)", "cap+line(cylinder)")
+SUPPORTED = ("inflated", "cap", "point", "line", "annulus", "cap+line(tip)", "cap+band(tip)", "cap+line(cylinder)",
+             "cap+band(cylinder)")
 
 
 def check_supported(state):
@@ -623,8 +627,8 @@ def check_supported(state):
         raise ValueError(f"stability: the state did not converge ({state.message})")
     if state.topology not in SUPPORTED:
         raise ValueError(f"stability: topology {state.topology!r} is not supported (only "
-                         f"{', '.join(repr(t) for t in SUPPORTED)}: the shell lying on the indenter's cylinder and "
-                         f"interior corners are not built)")
+                         f"{', '.join(repr(t) for t in SUPPORTED)}: the contact running over the tip's end onto the "
+                         f"indenter's cylinder and interior corners are not built)")
     if state.topology == "inflated":
         return
     scene = state.scene
