@@ -144,6 +144,10 @@ conditions).  A cap or line within [0, S0] and a point load hold the pole at a p
 ``w(S0) = 0`` at n = 0 (delta is prescribed); at n = 1 the pole slides by ``U = u(S0)`` and
 ``K`` gains ``-F kappa_apex U^2/pi`` (the limit of the cap's term); n >= 2 hold it already.
 
+Cost: a state on the tip of the dome of beta 1e-5 (91 elements and the graded nodes, n = 0..33)
+takes 1-2.5 s, the base scene's (beta 0.01, n = 0..8) 0.1 s (the form's derivation, 2-5 s, once per
+process).
+
 Accuracy: on the base scene at delta 0.3 (cap, Sc 0.091) the eigenvalues of n = 0..3 move by
 less than 3e-4 with twice the elements or with S0 = 1e-3; the dome's first n >= 2 crossings
 (benchmarks/results/stability_contact.md) move by < 3e-7 in delta with twice the elements.
