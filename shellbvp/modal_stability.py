@@ -25,7 +25,7 @@ ones (up to quadrature error, 6 Gauss points per element, and the pole's roundin
 shift-invert Lanczos (``scipy.sparse.linalg.eigsh``) about a shift that a banded Cholesky
 factorisation certifies to lie below the spectrum.
 
-Boundary conditions (states without contact: the inflated/pressurised shell):
+Boundary conditions (the inflated/pressurised shell; states on the tip below):
 
 * rim (``lambda_theta = 1, z = 0, M_s = 0``): the rim circle is held, so every displacement of
   it vanishes, ``u = v = w = 0``; ``w'`` is free (its natural condition is ``M_s = 0``).  With
@@ -62,8 +62,107 @@ are generated code (``symbolic.second_variation.form_module_source``, numpy with
 once per structure into the code cache (``stability_<key>.py``, ~5-10 s) and imported after;
 a state of beta 1e-5 (141 elements, n = 0..33) takes about 1 s.
 
-Only states without contact are handled here (topology ``"inflated"``); contact regions (the
-normal displacement following the tip, lift-off, walls) and junction terms are not built.
+States on the tip (``contact="smooth"``: the cap, the point load, lifted and split contact)
+------------------------------------------------------------------------------------------
+Every chain of free regions and regions on the tip joined by smooth contact edges and lines
+(:data:`SUPPORTED`) is handled alike: ``w = w' = 0`` on each region on the tip, ``w = 0`` at a
+line, and at each edge and line the ring force's term below; the single cap serves to derive it.
+
+The tip is rigid, frictionless and fixed in space (displacement control).  Let ``g(x)`` be the
+signed distance of a point from the tip's surface (``g >= 0`` outside the tip).  The constraint
+is ``g(x(S, theta)) >= 0`` for every material point; its multiplier is the contact pressure,
+per ``dS dtheta`` ``p^ = P r psi`` on the cap ``[0, Sc]`` (``P`` the generated profile's), and
+at the edge the normal ring force ``f_c`` (for the whole circle: ``state.edge_forces``,
+``-2 pi [r Q]``; the smooth model's jump of Q, SPEC 2b).  The state is stationary for the
+Lagrangian
+
+.. math:: \mathcal L = \Pi - \int\!\!\int \hat p\, g\, dS\, d\theta
+          - \tfrac{f_c}{2\pi}\int g(x(S_c, \theta))\, d\theta
+
+(on the cap N points into the tip, so ``g = -w`` to first order, and the generated equilibrium
+is ``dPi/dw = -r psi P`` there, tests/test_second_variation.py).
+
+*Admissible perturbations.*  On a valid state ``P > 0`` on the cap and ``f_c > 0``: every point
+of the contact set carries a positive multiplier, the critical cone is the subspace
+``dg = 0`` there, i.e. ``w = 0`` on ``[0, Sc]``; ``u, v`` are free (frictionless).  With the
+bending energy the perturbations are H^2 (C^1), so ``w = 0`` on the cap implies ``w'(Sc) = 0``:
+``w = w' = 0`` is imposed at the cap's nodes.  On a state flagged invalid (``P < 0`` somewhere,
+a pulling ring) the same eigenproblem is that of the shell held on the tip over its contact set
+(an equality constraint): what the fold of its branch needs, nothing about lifting off.
+
+*The constraint's curvature.*  The second variation is the Lagrangian's at fixed multipliers:
+``d^2 Pi - Int p^ d^2 g - f_c/(2 pi) Int d^2 g(Sc)``, with ``d^2 g = dx^T (Hess g) dx``.  For a
+tangential ``dx`` at a point of the tip's surface, ``Hess g`` is the surface's second
+fundamental form, positive for the convex tip seen from outside: ``d^2 g = kappa_s u^2 +
+kappa_theta v^2`` with the tip's principal curvatures (meridian, parallel), which on the cap
+are the shell's own ``kappa_s``, ``kappa_theta = sin(phi)/r`` (for a sphere of radius rho,
+``|x + dx - c| = rho + |dx_t|^2/(2 rho) + ...``: sliding along the tip with ``w = 0`` to first
+order leaves it outward at second order).  The form gains ``-P r psi (kappa_s u^2 +
+kappa_theta v^2)/4`` per dS on the cap (theta-average 1/2; the same at n = 0, where v is the
+torsion) and ``K`` gains ``-f_c/(2 pi) (kappa_s u^2 + kappa_theta v^2)`` at Sc: the contact
+destabilises sliding, like a ball resting on a ball.  Its sign is checked by the energy along
+the branch: ``d^2E/d delta^2 = dF/d delta`` equals ``d^2 Pi(x', x') - Int p^ kappa_s
+dt^2 - f_c kappa_s dt(Sc)^2`` (``x'`` the branch tangent at fixed S, ``dt`` the tangential
+component of ``x' + e_z``, the motion relative to the tip that moves down); measured on the base
+scene at delta 0.3 and 0.6 (difference quotients over 1.25e-4 in delta) it agrees to 3e-5 and
+3e-4 of dF/ddelta, with the opposite sign it misses by 0.5 % and 7 %, without the terms by 0.2 %
+and 3.4 % (tests/test_stability_contact.py).
+
+*The edge's motion.*  In the smooth model r, phi, lambda_s and kappa_s are continuous at Sc and
+Q jumps, so the gap just outside the cap grows like ``c s^3`` (s = S - Sc).  A perturbation with
+``w = w' = 0`` at Sc penetrates there only where ``c s^3 < eta w''(Sc) s^2/2``: over s = O(eta),
+by O(eta^3), and letting the edge move changes the energy at O(eta^3).  The points outside carry
+no multiplier and strict complementarity holds on the whole contact set, so the fixed active set
+``[0, Sc]`` is exact to second order.  (Not for the paper's edge, where lambda_s and kappa_s
+jump and which is not variational: refused.)  The branch tangent's ``u'`` jumps at Sc (lambda_s'
+does, and the edge moves), and so may a mode's: the C^1 elements resolve the kink by a layer, on
+a mesh graded towards Sc (:func:`mesh`; without it the eigenvalues converged like h).
+
+*A line contact* (topology ``"line"``: the pole lifted, the shell touching the tip on the
+circle S1, carrying a ring force; lambda_s and kappa_s continuous there, the shell's kappa_s
+below the tip's by ``gap = -curvature_excess > 0``).  Here the contact point can roll along the
+meridian, so the constraint is the smallest gap near S1.  In the frame of the contact point
+(sigma the arclength along t, heights along N) the tip is ``kappa_T sigma^2/2`` and the shell
+``kappa_S sigma^2/2``; displaced by ``eta (u t + w N)`` (u, w at sigma = 0 and ``w1 = dw/dsigma
+= w'/psi``; the frame turns with sigma by kappa_S) the gap is ``gap sigma^2/2 + eta sigma (gap
+u - w1) - eta w + eta^2 kappa_T u^2/2 + O(eta^3)`` at sigma = O(eta), whose minimum over sigma is
+``-eta w + eta^2 (kappa_S u^2/2 + u w1 - w1^2/(2 gap))``.  So ``w(S1) = 0`` (first order) and the
+ring's term in ``K`` is ``-f/(2 pi) (kappa_S u^2 + 2 u w1 - w1^2/gap + kappa_theta v^2)``: the
+rolling term ``+f w1^2/gap`` stiffens, without bound as the line opens into an annulus
+(gap -> 0, then refused).  (Check: a rigid rotation about the centre of a spherical tip,
+``u = Omega/kappa_T, w1 = Omega gap/kappa_T``, gives ``Omega^2/kappa_T``: the straight-line
+rotation's outward second-order motion, as it must.)  Along a line branch the line rolls with the
+shell and the ring's term is small (4e-5 of dF/ddelta on the base scene at delta 0.1): the energy
+check there is one of consistency (to 5e-5), it does not decide the term's sign.
+
+*The pole.*  The mesh starts at ``S0 = max(EPS L, zeta)``; the cap's disc [0, S0] is left out.
+On the tip the pole conditions above hold with ``w = w' = 0``.  For every state in contact,
+n = 1 also has ``u' = v' = 0`` at S0 (the regular field is ``u = U + O(S^2)``): where the pole
+carries a bending prestress (a cap held at curvature 1/rho, a lifted cap bent by its line) the
+form's ``u u''`` terms are not small and without these conditions a layer at S0 lowers the
+energy without bound as the first element shrinks (the states without contact keep their
+conditions).  A cap or line within [0, S0] and a point load hold the pole at a point:
+``w(S0) = 0`` at n = 0 (delta is prescribed); at n = 1 the pole slides by ``U = u(S0)`` and
+``K`` gains ``-F kappa_apex U^2/pi`` (the limit of the cap's term); n >= 2 hold it already.
+
+Cost: a state on the tip of the dome of beta 1e-5 (91 elements and the graded nodes, n = 0..33)
+takes 1-2.5 s, the base scene's (beta 0.01, n = 0..8) 0.1 s (the form's derivation, 2-5 s, once per
+process).
+
+Accuracy: on the base scene at delta 0.3 (cap, Sc 0.091) the eigenvalues of n = 0..3 move by
+less than 3e-4 with twice the elements or with S0 = 1e-3; the dome's first n >= 2 crossings
+(benchmarks/results/stability_contact.md) move by < 3e-7 in delta with twice the elements.
+
+A band on the indenter's cylinder is a region on the tip like the others (its meridian is
+straight: ``kappa_s = 0``, and only the hoop term remains).
+
+Refused (ValueError, one line): the contact running over the tip's end onto the cylinder
+(``"cap+cylinder"``: the obstacle has a corner there, across which material slides; the same
+issue as an edge's corner below) and interior corners (``"line+corner"``), ``contact="paper"``, a line whose gap is not positive, more than one line,
+an edge inside [0, S0] of a configuration with several, a sealed shell in contact, and a contact
+edge with a Weierstrass-Erdmann corner (lambda_s, kappa_s jump there: the corner can move
+through the material, a degree of freedom of its own that the displacement modes do not
+carry; the base scene's edges have one from delta 0.62).
 """
 
 from __future__ import annotations
@@ -78,6 +177,7 @@ import scipy.linalg
 import scipy.sparse
 import scipy.sparse.linalg
 
+from .chain import CONTACT_KINDS, CONTACT_STATES, FREE_STATES, Edge, Line
 from .geometry import Spheroid
 
 __all__ = ["stability", "Stability", "spectrum", "state_base", "sphere_base", "mesh", "default_modes",
@@ -211,7 +311,21 @@ def _form_at(scene, base_of, S, n):
     A = np.empty((9, 9, S.size))
     for (i, j), e in zip(upper, out):
         A[i, j] = A[j, i] = np.broadcast_to(np.asarray(e, float), S.shape)
+    if "P" in base:  # on the tip: the constraint's curvature, -P/2 II(dx_t, dx_t) per deformed area
+        cu, cv = contact_coefficients(base, R, Psi)
+        A[0, 0] += cu
+        A[3, 3] += cv
     return A, R * Psi
+
+
+def contact_coefficients(base, R, Psi):
+    """The contact term's coefficients of ``u^2`` and ``v^2`` in the form (per dS, module
+    docstring): ``-P r psi kappa_s / 4`` and ``-P r psi kappa_theta / 4`` (zero where P = 0)."""
+    r = base["lt"] * R
+    weight = -0.25 * base["P"] * r * base["ls"] * Psi
+    with np.errstate(all="ignore"):
+        kt = np.where(base["P"] != 0, np.sin(base["phi"]) / r, 0.0)
+    return weight * base["ks"], weight * kt
 
 
 # ------------------------------------------------------------------------------ cubic Hermite FEM
@@ -335,14 +449,28 @@ def _element_basis(xg, h, hs):
 END_CONDITIONS = {"pinned": (0, 2, 4), "symmetric": (0, 5), "antisymmetric": (2, 4)}
 
 
-def _constraints(n, m, end="pinned", S0_over_hs=0.0):
+def _constraints(n, m, end="pinned", S0_over_hs=0.0, held=(), pole_held=False, lines=()):
     """The reduced basis T (sparse, ndof x nfree) that imposes the pole (node 0) and end
     (node m-1) conditions: q = T q_free.  ``S0_over_hs``: S0 over the derivative dofs' scale
-    (n = 1's ``w = S0 w'`` at S0)."""
+    (n = 1's ``w = S0 w'`` at S0).  ``held``: nodes on the tip (``w = w' = 0``: the normal
+    displacement vanishes on the contact region, module docstring); ``pole_held``: the pole
+    touches the tip at a point (``w = 0`` at S0 for n = 0; the n >= 1 pole conditions hold it
+    already or let it slide); ``lines``: the nodes of line contacts (``w = 0`` there)."""
     ndof = 6 * m
     fixed = {6 * (m - 1) + k for k in END_CONDITIONS[end]}
+    fixed |= {6 * i + k for i in held for k in (4, 5)}
+    fixed |= {6 * i + 4 for i in lines}
+    tie_w = n == 1 and 0 not in held
+    if n == 1 and (held or pole_held or lines):
+        # u = U + O(S^2), v = -U + O(S^2) at the axis: u' = v' = 0.  Where the pole carries a
+        # bending prestress (on the tip, or under a point load) the form's u u'' and v v''
+        # terms are not small, and without these conditions a layer at S0 lowers the energy
+        # without bound as the first element shrinks (measured: tests/test_stability_contact.py)
+        fixed |= {1, 3}
     if n == 0:
         fixed |= {0, 2, 5}  # u = v = 0, w' = 0
+        if pole_held:
+            fixed.add(4)
     elif n == 1:
         fixed |= {2, 4}  # v(S0) = -u(S0), w(S0) = S0 w'(S0): folded into u's and w''s columns
     else:
@@ -350,9 +478,13 @@ def _constraints(n, m, end="pinned", S0_over_hs=0.0):
     free = np.array([i for i in range(ndof) if i not in fixed])
     rows, cols, vals = list(free), list(range(free.size)), [1.0] * free.size
     if n == 1:
-        rows += [2, 4]
-        cols += [int(np.flatnonzero(free == 0)[0]), int(np.flatnonzero(free == 5)[0])]
-        vals += [-1.0, S0_over_hs]
+        rows += [2]
+        cols += [int(np.flatnonzero(free == 0)[0])]
+        vals += [-1.0]
+        if tie_w:
+            rows += [4]
+            cols += [int(np.flatnonzero(free == 5)[0])]
+            vals += [S0_over_hs]
     return scipy.sparse.csr_matrix((vals, (rows, cols)), shape=(ndof, free.size))
 
 
@@ -361,8 +493,11 @@ def _constraints(n, m, end="pinned", S0_over_hs=0.0):
 POLE_RATIO = 0.25
 
 
-def mesh(S0: float, L: float, elements: int) -> np.ndarray:
-    """Nodes on [S0, L]: ``elements`` uniform elements, the first split towards S0 geometrically."""
+def mesh(S0: float, L: float, elements: int, edges=()) -> np.ndarray:
+    """Nodes on [S0, L]: ``elements`` uniform elements, the first split towards S0 geometrically;
+    at each of ``edges`` (contact edges and lines inside (S0, L)) a node and :data:`EDGE_LEVELS`
+    nodes on each side at ``h/2, h/4, ...`` from it (the mode's derivatives jump there: without
+    the grading the eigenvalues converged only like h)."""
     nodes = np.linspace(S0, L, elements + 1)
     h = nodes[1] - nodes[0]
     extra = []
@@ -370,7 +505,18 @@ def mesh(S0: float, L: float, elements: int) -> np.ndarray:
     while d > 4 * S0:
         extra.append(S0 + d)
         d *= POLE_RATIO
-    return np.concatenate([nodes[:1], np.array(extra[::-1]), nodes[1:]])
+    nodes = np.concatenate([nodes[:1], np.array(extra[::-1]), nodes[1:]])
+    steps = h * 0.5 ** np.arange(1, EDGE_LEVELS + 1)
+    for edge in edges:
+        near = np.concatenate([edge - steps, [edge], edge + steps])
+        near = near[(near > S0) & (near < L)]
+        far = nodes[(np.abs(nodes - edge) >= h / 2) | np.isin(nodes, edges)]  # uniform nodes closer than h/2 give way
+        nodes = np.unique(np.concatenate([far, near]))
+    return nodes
+
+
+#: Nodes on each side of a contact edge (:func:`mesh`).
+EDGE_LEVELS = 8
 
 
 def default_elements(scene) -> int:
@@ -394,7 +540,8 @@ def stability(state, modes=None, *, elements: int | None = None, S0: float | Non
     Parameters
     ----------
     state : Solution
-        A converged state without contact: :func:`shellbvp.inflate`'s (topology ``"inflated"``).
+        A converged state: :func:`shellbvp.inflate`'s (topology ``"inflated"``), or one on the
+        tip with ``contact="smooth"`` (a topology in :data:`SUPPORTED`; module docstring).
     modes : iterable of int, optional
         The mode numbers n (default :func:`default_modes`).
     elements : int, optional
@@ -415,8 +562,11 @@ def stability(state, modes=None, *, elements: int | None = None, S0: float | Non
 
     Raises
     ------
-    NotImplementedError
-        For a state with contact (only the inflated, contact-free state is handled).
+    ValueError
+        One line naming what is not supported (:func:`check_supported`, :func:`contact_of`): a
+        state that did not converge, the contact over the tip's end, interior corners,
+        ``contact="paper"``, a cornered edge, a line without a curvature gap, a sealed shell in
+        contact.
 
     Examples
     --------
@@ -428,35 +578,245 @@ def stability(state, modes=None, *, elements: int | None = None, S0: float | Non
     >>> res = sb.stability(sb.inflate(scene))
     >>> res.stable, res.critical_mode
     (False, 11)
+
+    A state on the tip: the base scene's cap at delta 0.3 is stable, its softest mode n = 1 (the
+    cap sliding round the tip); the paper's contact model is refused:
+
+    >>> res = sb.stability(sb.solve(sb.Scene.preset("base"), delta=0.3), modes=range(4))
+    >>> res.stable, res.critical_mode
+    (True, 1)
+    >>> sb.stability(sb.solve(sb.Scene.preset("base").replace(contact="paper"), delta=0.3))
+    Traceback (most recent call last):
+    ...
+    ValueError: stability: contact='paper' is not variational ...; only contact='smooth' is supported
     """
     t0 = time.perf_counter()
-    if not state.success:
-        raise ValueError(f"the state did not converge ({state.message}): no stability for it")
-    if state.topology != "inflated":
-        raise NotImplementedError(f"stability is built for states without contact (topology 'inflated'); "
-                                  f"this state's is {state.topology!r}")
+    check_supported(state)
     sysm = state.system
-    zeta = float(sysm.S_point(sysm.regions[0].start, None))
-    S0 = zeta if S0 is None else max(float(S0), zeta)
-    out = spectrum(state.scene, state_base(state), S0, float(sysm.L), modes, elements=elements, count=count,
-                   vectors=vectors)
+    if state.topology == "inflated":
+        zeta = float(sysm.S_point(sysm.regions[0].start, None))
+        S0 = zeta if S0 is None else max(float(S0), zeta)
+        out = spectrum(state.scene, state_base(state), S0, float(sysm.L), modes, elements=elements, count=count,
+                       vectors=vectors)
+    else:
+        contact = contact_of(state, S0)
+        out = spectrum(state.scene, contact.base, contact.S0, float(sysm.L), modes, elements=elements,
+                       count=count, vectors=vectors, contact=contact)
     out.wall_time = time.perf_counter() - t0
     return out
 
 
-def spectrum(scene, base_of, S0, L, modes=None, *, elements=None, count=2, vectors=False, end="pinned"):
+#: The topologies whose stability is built (``"inflated"``: no contact): every chain of free
+#: regions and regions on the tip joined by smooth edges and lines.
+SUPPORTED = ("inflated", "cap", "point", "line", "annulus", "cap+line(tip)", "cap+band(tip)", "cap+line(cylinder)",
+             "cap+band(cylinder)")
+
+
+def check_supported(state):
+    """ValueError (one line, naming what is not supported) unless :func:`stability` handles
+    ``state``: a converged state of a topology in :data:`SUPPORTED` with the smooth contact
+    edge, under pressure (not volume) control."""
+    if not state.success:
+        raise ValueError(f"stability: the state did not converge ({state.message})")
+    if state.topology not in SUPPORTED:
+        raise ValueError(f"stability: topology {state.topology!r} is not supported (only "
+                         f"{', '.join(repr(t) for t in SUPPORTED)}: the contact running over the tip's end onto the "
+                         f"indenter's cylinder and interior corners are not built)")
+    if state.topology == "inflated":
+        return
+    scene = state.scene
+    if scene.contact != "smooth":
+        raise ValueError(f"stability: contact={scene.contact!r} is not variational (its edge conditions are not "
+                         f"the natural conditions of an energy); only contact='smooth' is supported")
+    if state.contact_edge == "corner":
+        raise ValueError("stability: a contact edge with a Weierstrass-Erdmann corner (contact_edge 'corner') "
+                         "is not supported, only the smooth edge")
+    if scene.sealed:
+        raise ValueError("stability: a sealed shell (volume control) in contact is not supported, only "
+                         "pressure control")
+
+
+@dataclass(eq=False)
+class Contact:
+    """What the tip adds to the eigenproblem of a state in contact (module docstring).
+
+    ``base``: the base state as a function of S, with the contact pressure ``P`` (0 off the
+    tip); ``S0``: where the mesh starts; ``held``: the S-intervals on the tip (w = w' = 0);
+    ``lines``: the line contacts' S (w = 0); ``rings``: per edge or line ``(S, (a, b, c, d))``,
+    its quadratic form ``a u^2 + b v^2 + 2 c u w' + d w'^2`` in the stiffness; ``pole_held``:
+    the contact lies within [0, S0] or is a point load (the pole held at a point), with
+    ``pole_force`` the axial force there and ``apex_curvature`` the tip's.
+    """
+
+    base: object
+    S0: float
+    held: tuple = ()
+    lines: tuple = ()
+    rings: tuple = ()
+    pole_held: bool = False
+    pole_force: float = 0.0
+    apex_curvature: float = 0.0
+
+    @property
+    def edges(self):
+        """Where the contact starts or ends inside the mesh, and the lines."""
+        return tuple(sorted({S for S, _ in self.rings} | {S for a, b in self.held for S in (a, b)
+                                                          if S > self.S0}))
+
+
+def _junction_points(sysm, p):
+    """(S, kind, inner region, outer region) of every contact edge and line, pole to rim, in the
+    order of ``Solution.edge_forces`` (``shellbvp.diagnosis``)."""
+    out = []
+    for j in sysm.junctions:
+        if isinstance(j, Edge):
+            out.append((float(sysm.S_point(sysm.regions[min(j.kc, j.kf)].end, p)), "edge", j.kc, j.kf))
+        elif isinstance(j, Line):
+            out.append((float(sysm.S_point(sysm.regions[j.k].end, p)), "line", j.k, j.k + 1))
+    return out
+
+
+def contact_of(state, S0=None) -> Contact:
+    """The :class:`Contact` of a state on the tip: the base state from the regions' generated
+    profiles (:func:`chain_base`), the regions on the tip, and at each contact edge and line
+    its normal ring force (``state.edge_forces``, ``-2 pi [r Q]``) with the curvatures there."""
+    check_supported(state)
+    from .inflation import EPS
+
+    sysm, p = state.system, state.p
+    L = float(sysm.L)
+    zeta = float(sysm.S_point(sysm.regions[0].start, p))
+    S0 = max(EPS * L, zeta) if S0 is None else max(float(S0), zeta)
+    base = chain_base(state)
+    apex = state.scene.tip.apex_curvature() / state.scene.rho
+    points = _junction_points(sysm, p)
+    if state.topology == "point" or (state.topology in ("cap", "line") and points[0][0] <= S0 * (1 + 1e-9)):
+        # the cap or line lies within the pole's disc: a point contact there
+        return Contact(base, S0, pole_held=True, pole_force=float(state.force), apex_curvature=apex)
+    if points[0][0] <= S0 * (1 + 1e-9):
+        raise ValueError(f"stability: a contact edge at S = {points[0][0]:.3g} inside the mesh's start "
+                         f"S0 = {S0:.3g} of a {state.topology!r} state is not supported")
+    held = tuple((max(float(sysm.S_point(r.start, p)), S0), float(sysm.S_point(r.end, p)))
+                 for r in sysm.regions if r.kind in CONTACT_KINDS)
+    lines = [S for S, kind, _, _ in points if kind == "line"]
+    if len(lines) > 1:
+        raise ValueError("stability: more than one line contact is not supported")
+    rings = []
+    for (S, kind, k, other), force in zip(points, state.edge_forces):
+        side = S * (1 - 1e-12) if k < other else S * (1 + 1e-12)  # inside region k: the tip's side of an edge
+        at = base(np.array([side]))
+        R, Psi = (float(v[0]) for v in _reference(state.scene, np.array([S])))
+        kt = float(np.sin(at["phi"][0]) / (at["lt"][0] * R))
+        ks = float(at["ks"][0])
+        f = float(force) / (2 * np.pi)  # the normal ring force per unit length, times r
+        if kind == "edge":
+            rings.append((S, (-f * ks, -f * kt, 0.0, 0.0)))
+            continue
+        # a line: the gap's second variation with the contact point rolling along the meridian,
+        # kappa_S u^2 + 2 u w'/psi - w'^2/(psi^2 gap) + kappa_theta v^2 (module docstring), with
+        # gap = kappa_s(indenter) - kappa_s(shell) = -curvature_excess > 0, kappa_S the shell's
+        gap = -float(state.curvature_excess)
+        if not gap > 0:
+            raise ValueError(f"stability: the line contact's curvature gap {gap:.3g} is not positive (the shell "
+                             f"bends as tightly as the indenter there: a band), not supported")
+        psi = float(at["ls"][0]) * Psi
+        rings.append((S, (-f * ks, -f * kt, -f / psi, f / (psi**2 * gap))))
+    return Contact(base, S0, held=held, lines=tuple(lines), rings=tuple(rings), apex_curvature=apex)
+
+
+def _reference(scene, S):
+    """(R, Psi) of the reference shell at S."""
+    f, upper, params, shell_params, ref = _form_functions(scene)
+    values = scene.values()
+    R, Psi, dPsi, ks0, kt0 = (np.broadcast_to(np.asarray(v, float), S.shape)
+                              for v in ref(S, *[values[p] for p in shell_params]))
+    return R, Psi
+
+
+#: Step in t of the directional derivative of the profiles (:func:`chain_base`).
+PROFILE_STEP = 1e-6
+
+
+def chain_base(state):
+    """The base state of any chain of regions as a function of S: ``phi, ls, ks, dls, dks, lt``
+    and the contact pressure ``P`` (0 in free regions), from each region's generated profile
+    (``*_profile``, as ``Solution.profile`` reads them) on the state's interpolant; ``dls, dks``
+    are the interpolant's derivatives where they are states of the region (``ls`` always,
+    ``ks`` in free regions; near the pole the form's 1/r^3 coefficients cancel, and a
+    difference quotient's rounding there moves n = 1 by percents), else the derivatives of the
+    profile along the interpolant (central difference of step :data:`PROFILE_STEP` in t along
+    ``(S'(t), y'(t))``: the tip's kappa_s)."""
+    sysm, p = state.system, state.p
+    dsol = state.sol.derivative()
+    kernels = sysm.kernels.active
+    par = sysm.par_at(p)
+    edges = [float(sysm.S_point(reg.end, p)) for reg in sysm.regions[:-1]]
+
+    def base(S):
+        S = np.asarray(S, float)
+        out = {k: np.empty_like(S) for k in ("phi", "ls", "ks", "dls", "dks", "lt", "P")}
+        which = np.searchsorted(edges, S, side="right")
+        for k, reg in enumerate(sysm.regions):
+            sel = which == k
+            if not np.any(sel):
+                continue
+            Sk = S[sel]
+            t = sysm.t_of(k, Sk, p)
+            a, b = sysm.ln_S(reg.start, p), sysm.ln_S(reg.end, p)
+            y = state.sol(t)[sysm.rows(k)]
+            dy = dsol(t)[sysm.rows(k)]
+            dS = Sk * (b - a)
+            prof = getattr(kernels, f"{reg.kind}_profile")
+            h = PROFILE_STEP
+            f0 = prof(Sk, y, par)
+            fp = prof(Sk + h * dS, y + h * dy, par)
+            fm = prof(Sk - h * dS, y - h * dy, par)
+            for key, name in (("phi", "phi"), ("ls", "lambda_s"), ("ks", "kappa_s"), ("lt", "lambda_theta")):
+                out[key][sel] = np.broadcast_to(f0[name], Sk.shape)
+            states = FREE_STATES if reg.kind == "free" else CONTACT_STATES
+            for key, name, state_name in (("dls", "lambda_s", "ls"), ("dks", "kappa_s", "ks")):
+                if state_name in states:  # a state of the region: its interpolant's derivative
+                    out[key][sel] = dy[states.index(state_name)] / dS
+                else:
+                    out[key][sel] = np.broadcast_to((np.asarray(fp[name]) - np.asarray(fm[name])) / (2 * h),
+                                                    Sk.shape) / dS
+            out["P"][sel] = np.broadcast_to(f0["P"], Sk.shape) if reg.kind != "free" else 0.0
+        return out
+
+    return base
+
+
+def spectrum(scene, base_of, S0, L, modes=None, *, elements=None, count=2, vectors=False, end="pinned",
+             contact=None):
     """The eigenvalues of :func:`stability` for a base state given as a function of S
     (:func:`state_base`, :func:`sphere_base`) on [S0, L], with ``end`` conditions at L
-    (:data:`END_CONDITIONS`)."""
+    (:data:`END_CONDITIONS`) and, for a state on the tip, its :class:`Contact`."""
     t0 = time.perf_counter()
     ne = elements or default_elements(scene)
-    nodes = mesh(S0, L, ne)
+    nodes = mesh(S0, L, ne, () if contact is None else contact.edges)
+    held, pole_held, lines, extra = (), False, (), {}
+    if contact is not None:
+        pole_held = contact.pole_held
+        held = tuple(int(i) for a, b in contact.held for i in np.flatnonzero((nodes >= a) & (nodes <= b)))
+        lines = tuple(int(np.flatnonzero(nodes == S)[0]) for S in contact.lines)
+        hs = np.diff(nodes).max()  # the scale of the derivative dofs (_assemble)
+        for S, (uu, vv, uw, ww) in contact.rings:
+            i = 6 * int(np.flatnonzero(nodes == S)[0])
+            for key, value in (((i, i), uu), ((i + 2, i + 2), vv), ((i, i + 5), uw / hs), ((i + 5, i), uw / hs),
+                               ((i + 5, i + 5), ww / hs**2)):
+                extra[key] = extra.get(key, 0.0) + value
     modes = default_modes(scene) if modes is None else np.asarray(sorted(set(int(n) for n in modes)))
     out = np.empty((modes.size, count))
     vecs = {}
     for k, n in enumerate(modes):
         K, M = _assemble(scene, base_of, int(n), nodes)
-        T = _constraints(int(n), nodes.size, end, nodes[0] / np.diff(nodes).max())
+        terms = dict(extra)
+        if pole_held and n == 1:  # the pole slides on the tip: -F kappa_apex U^2 / pi (U = u(S0))
+            terms[0, 0] = terms.get((0, 0), 0.0) - contact.pole_force * contact.apex_curvature / np.pi
+        if terms:
+            rows, cols = zip(*terms)
+            K = K + scipy.sparse.csr_matrix((list(terms.values()), (rows, cols)), shape=K.shape)
+        T = _constraints(int(n), nodes.size, end, nodes[0] / np.diff(nodes).max(), held, pole_held, lines)
         Kr, Mr = (T.T @ K @ T).tocsr(), (T.T @ M @ T).tocsr()
         Kr = ((Kr + Kr.T) / 2).tocsr()
         lam, X = _smallest(Kr, Mr, count)

@@ -114,10 +114,11 @@ def test_held_rim_hemisphere_buckles_below_the_classical_pressure_next_to_the_ri
     assert math.pi / 2 - peak < 3 * (3 * beta) ** 0.25  # within a few bending lengths of the rim
 
 
-def test_states_with_contact_are_refused():
+def test_unsupported_states_are_refused():
+    """States in contact: tests/test_stability_contact.py."""
     assert sb.stability is st.stability and sb.Stability is st.Stability
-    with pytest.raises(NotImplementedError, match="without contact"):
-        st.stability(Solution(success=True, status=0, topology="cap"))
+    with pytest.raises(ValueError, match="topology 'cap\\+cylinder' is not supported"):
+        st.stability(Solution(success=True, status=0, topology="cap+cylinder"))
     with pytest.raises(ValueError, match="did not converge"):
         st.stability(Solution(success=False, topology="inflated", message="no"))
 
