@@ -172,3 +172,37 @@ def test_locate_samples_the_curve_then_analyses_only_the_bracket(monkeypatch):
     seen.clear()
     assess(c, "points")
     assert len(analysed()) == 12
+
+
+# -- on states the analysis handles (states on the tip: tests/test_stability_contact.py) ------------
+DOME = dict(beta=1e-4, rho=0.2)  # the dome preset, thicker: its curve goes unstable in n = 3 near delta 0.278
+
+
+def test_locate_on_the_dome_brackets_a_true_sign_change():
+    scene = sb.Scene.preset("dome", **DOME)
+    c = sb.curve(scene, delta_max=0.35, stability="locate", estimate_error=False)
+    first = c.first_instability
+    assert first is not None and first.located and first.mode == 3, first
+    lo, hi = first.bracket
+    assert hi - lo <= 1e-4 and lo <= first.delta <= hi
+    # the states just outside the bracket, solved and analysed on their own, every mode
+    below = sb.stability(sb.solve(scene, delta=lo - 2e-3))
+    above = sb.stability(sb.solve(scene, delta=hi + 2e-3))
+    assert below.stable and not above.stable and above.critical_mode == 3
+    # "points" places it between the same neighbours
+    points = sb.curve(scene, delta_max=0.35, stability="points", estimate_error=False).first_instability
+    assert points.bracket[0] <= first.delta <= points.bracket[1]
+
+
+def test_a_fit_past_the_first_instability_warns_and_records_it(tmp_path):
+    scene = sb.Scene.preset("dome", **DOME)
+    R_L, mu_H = 1e-3, 40.0
+    c = sb.curve(scene, deltas=np.linspace(0.01, 0.34, 30), estimate_error=False)
+    d, F = c.delta * R_L, c.force * mu_H * R_L
+    deep = sb.fit(scene, d, F, R_L=R_L, fit_offset=False, stability=True)
+    assert "unstable_depths" in deep.warning_codes
+    assert deep.first_instability.mode == 3 and deep.first_instability.delta == pytest.approx(0.2776, abs=2e-3)
+    assert deep.to_dict()["first_instability"]["mode"] == 3
+    shallow = sb.fit(scene, d[d < 0.2 * R_L], F[d < 0.2 * R_L], R_L=R_L, fit_offset=False, stability=True)
+    assert shallow.first_instability is None and "unstable_depths" not in shallow.warning_codes
+    assert shallow.mu_H == pytest.approx(mu_H, rel=1e-3)
