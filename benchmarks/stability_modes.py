@@ -5,7 +5,7 @@ For every preset (smooth contact), every smooth scene of the stability grid
 0.2 and 0.5: one ``sb.curve(scene, delta_max=..., stability="locate")`` in its own process
 with a time limit, and its verdict: stable to where the curve ends, the first instability
 (delta, delta over the shell's thickness ``H/R_L = sqrt(3 beta)``, F, the mode n), or states
-not analysed (and why).  The time of the stability analysis is reported beside the curve's.
+not analysed (and why).  Every state is analysed in order up to the first unstable one (no sample).  The time of the stability analysis is reported beside the curve's.
 
 Writes benchmarks/results/stability_modes.json and .md.
 
@@ -64,6 +64,7 @@ def worker(spec_path, out_path):
     import numpy as np
 
     import shellbvp as sb
+    from shellbvp.curve_stability import assess
 
     spec = json.loads(Path(spec_path).read_text())
     row = {"id": spec["id"]}
@@ -82,14 +83,20 @@ def worker(spec_path, out_path):
     signal.setitimer(signal.ITIMER_REAL, spec["time_limit"])
     t0 = time.perf_counter()
     try:
-        c = sb.curve(scene, delta_max=spec["delta_max"], stability="locate", estimate_error=False)
+        c = sb.curve(scene, delta_max=spec["delta_max"], estimate_error=False)
+        # every state in order up to the first unstable one, then the crossing narrowed
+        assess(c, "locate", samples=max(len(c), 1))
     finally:
         signal.setitimer(signal.ITIMER_REAL, 0)
     wall = time.perf_counter() - t0
     smin = np.asarray(c.points["stability_min"], float)
     first = c.first_instability
+    done = np.isfinite(smin)
+    stop_at = len(c) if first is None else int(np.flatnonzero(smin < 0)[0]) + 1
     row.update(points=len(c), delta_end=float(c.delta.max()) if len(c) else math.nan, stop=c.stop_reason,
-               interrupted=c.interrupted, analysed=int(np.isfinite(smin).sum()),
+               interrupted=c.interrupted, analysed=int(done.sum()), refused=int(stop_at - done[:stop_at].sum()),
+               last_analysed=float(c.delta[done].max()) if done.any() else math.nan,
+               first_refused=float(c.delta[:stop_at][~done[:stop_at]].min()) if (~done[:stop_at]).any() else None,
                note=c.settings.get("stability_note", ""), stability_s=c.settings.get("stability_time", math.nan),
                total_s=wall, thickness=math.sqrt(3 * scene.beta),
                first=None if first is None else first.to_dict())
@@ -117,20 +124,22 @@ def verdict(r):
         return "killed" if r.get("killed") else "crashed"
     if r["analysed"] == 0:
         return "not analysed: " + r["note"]
+    refused = (f"; {r['refused']} states not analysed, from delta {r['first_refused']:.3g}: {r['note']}"
+               if r["refused"] else "")
     f = r["first"]
     if f is None:
-        part = "" if r["analysed"] == r["points"] else f" ({r['points'] - r['analysed']} states not analysed)"
-        return f"stable to delta {r['delta_end']:.3g}{part}"
+        return f"stable at every analysed state (to delta {r['last_analysed']:.3g}){refused}"
     return (f"unstable from delta {f['delta']:.4g} (delta/H {f['delta'] / r['thickness']:.3g}), n = {f['mode']}"
-            + ("" if f["located"] else f"; {f['message']}"))
+            + ("" if f["located"] else f"; {f['message']}") + refused)
 
 
 def markdown(rows, meta):
     lines = ["# Where the axisymmetric curves lose stability (issue 44, item 5)", "",
              f"Written by `benchmarks/stability_modes.py` at {meta['commit']} ({meta['date']}; {meta['machine']}).  "
-             f"`sb.curve(scene, delta_max={meta['delta_max']}, stability=\"locate\")`, smooth contact; H/R_L = "
-             "sqrt(3 beta) (the thickness of docs/accuracy.md's map).  A state the analysis does not handle is "
-             "not analysed (NaN), and the reason is given.", "",
+             f"`sb.curve(scene, delta_max={meta['delta_max']})`, smooth contact, then every state in order up to "
+             "the first unstable one (`assess(curve, \"locate\", samples=len(curve))`) and the crossing narrowed "
+             "between its neighbours; H/R_L = sqrt(3 beta) (the thickness of docs/accuracy.md's map).  A state the "
+             "analysis does not handle is not analysed, and the reason is given.", "",
              "| scene | points | curve to delta | verdict | stability s | total s |", "|---|---|---|---|---|---|"]
     for r in rows:
         if r.get("skipped") or r.get("killed") or r.get("crashed"):
