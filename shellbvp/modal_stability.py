@@ -63,7 +63,7 @@ once per structure into the code cache (``stability_<key>.py``, ~5-10 s) and imp
 a state of beta 1e-5 (141 elements, n = 0..33) takes about 1 s.
 
 States on the tip (``contact="smooth"``: the cap, the point load, lifted and split contact)
-------------------------------------------------------------------------------------------
+-------------------------------------------------------------------------------------------
 Every chain of free regions and regions on the tip joined by smooth contact edges and lines
 (:data:`SUPPORTED`) is handled alike: ``w = w' = 0`` on each region on the tip, ``w = 0`` at a
 line, and at each edge and line the ring force's term below; the single cap serves to derive it.
