@@ -198,24 +198,52 @@ def plot_fit_record(record, axes=None):
     return ax, axr
 
 
+def _display(record):
+    """``show(value, si_unit) -> (number text, unit)``: lengths and forces in the units of the data's
+    file (as the fit command prints them), everything else as stored."""
+    from .units import unit_factor
+
+    def factor(unit, kind):
+        try:
+            return unit_factor(unit, kind), unit
+        except (ValueError, TypeError, KeyError):
+            return None
+
+    units = record.source["units"] if isinstance(record.source["units"], dict) else {}
+    shown = {"m": factor(units.get("displacement"), "length"), "N": factor(units.get("force"), "force")}
+
+    def show(value, si_unit):
+        found = shown.get(si_unit)
+        if found is None:
+            return f"{value:.5g}", "" if si_unit == "1" else si_unit
+        f, unit = found
+        return f"{value / f:.5g}", unit
+
+    return show
+
+
 def fit_summary_lines(record):
-    """The text of a fit report (one string per line)."""
+    """The text of a fit report (one string per line), lengths and forces in the data's units."""
     p, iv = record.parameters, record.intervals
-    units = {k: "" if u == "1" else u for k, u in PARAMETER_UNITS.items()}
+    show = _display(record)
     lines = [f"source: {record.source['file_name']}", f"sha256: {record.source['sha256']}",
              f"columns: {record.source['columns']}; units in the file: {record.source['units']}",
+             *(f"note: {text}" for text in record.source["notes"]),
              f"fit: {'succeeded' if record.success else 'FAILED'} (status {record.status}); "
              f"{record.settings['segment']} segment, {int(p['n_points'])} rows; baseline {record.settings['baseline_model']}; "
              f"{record.settings['weights']} weights"]
-    for name in record.fitted:
-        lo, hi = iv[name]
-        lines.append(f"{name} = {p[name]:.5g} {units.get(name, '')}   95% CI [{lo:.5g}, {hi:.5g}]")
-    for name in iv:
-        if name not in record.fitted:  # a fitted shape parameter's derived quantity
-            lo, hi = iv[name]
-            lines.append(f"{name} = {p[name]:.5g} {units.get(name, '')}   95% CI [{lo:.5g}, {hi:.5g}] (linearised)")
-    lines.append(f"rms residual = {p['residual_rms']:.4g} N; R_L = {p['R_L']:.4g} m")
-    lines += diagnostics_lines(record.quality, record.fitted, record.correlation, p)
+
+    def line(name, extra=""):
+        value, unit = show(p[name], PARAMETER_UNITS[name])
+        lo, hi = (show(v, PARAMETER_UNITS[name])[0] for v in iv[name])
+        return f"{name} = {value} {unit}   95% CI [{lo}, {hi}] {unit}{extra}"
+
+    lines += [line(name) for name in record.fitted]
+    lines += [line(name, " (linearised)") for name in iv if name not in record.fitted]  # a shape parameter's derived
+    rms, R_L = show(p["residual_rms"], "N"), show(p["R_L"], "m")
+    lines.append(f"rms residual = {rms[0]} {rms[1]}; R_L = {R_L[0]} {R_L[1]}")
+    lines += diagnostics_lines(record.quality, record.fitted, record.correlation, p,
+                               lambda v: " ".join(show(v, "N")))
     s = record.scene
     if s.thickness is not None and "beta" not in record.fitted:
         if "mu" not in iv:  # mu of a given thickness (a fitted one's is a line above)

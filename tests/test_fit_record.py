@@ -138,9 +138,16 @@ def test_plot_and_report_of_a_fit_file(fit_file, tmp_path):
     assert r.returncode == 2 and ".png or .pdf" in r.stderr
     from shellbvp.plotting import fit_summary_lines
 
-    lines = fit_summary_lines(read_fit(path))
+    rec = read_fit(path)
+    lines = fit_summary_lines(rec)
     assert any(ln.startswith("mu_H = ") and "95% CI" in ln for ln in lines)
     assert any(ln.startswith("sha256: ") for ln in lines)
+    # lengths and forces in the data's own units, as the fit command prints them (not raw SI)
+    du, fu = rec.source["units"]["displacement"], rec.source["units"]["force"]
+    assert du != "m" and fu != "N"
+    offset = next(ln for ln in lines if ln.startswith("offset = "))
+    assert offset.endswith(f"] {du}") and f"{rec.parameters['offset']:.5g} m" not in offset
+    assert any(ln.startswith("rms residual = ") and f" {fu}; R_L = " in ln for ln in lines)
 
 
 def test_a_fit_file_is_not_replaced_without_force_and_a_corrupt_one_is_named(fit_file, instrument_file, tmp_path):
