@@ -24,15 +24,22 @@ def data():
     return scene, c.delta * 1e-3, c.force * 50.0 * 1e-3
 
 
-def test_a_kept_curve_is_read_back_with_the_same_fit(data, tmp_path, monkeypatch):
-    monkeypatch.setenv("SHELLBVP_CACHE_DIR", str(tmp_path))
+def _fit_twice(data, cache, between=lambda kept: None):
+    """Two fits of ``data`` with the disk cache on, the process's memo forgotten between them
+    (as in a new process); ``between(kept files)`` runs in between."""
     scene, d, F = data
     with sb.options(model_curve_cache=True):
         clear_model_curves()
         first = _fit(scene, d, F)
-        kept = list((tmp_path / "curves").glob("curve_*.h5"))
-        clear_model_curves()  # as a new process: only the disk holds it
-        again = _fit(scene, d, F)
+        kept = list((cache / "curves").glob("curve_*.h5"))
+        between(kept)
+        clear_model_curves()
+        return first, _fit(scene, d, F), kept
+
+
+def test_a_kept_curve_is_read_back_with_the_same_fit(data, tmp_path, monkeypatch):
+    monkeypatch.setenv("SHELLBVP_CACHE_DIR", str(tmp_path))
+    first, again, kept = _fit_twice(data, tmp_path)
     assert first.curves_computed == 1 and again.curves_computed == 0 and len(kept) == 1
     assert again.mu_H == first.mu_H and again.offset == first.offset
     assert first.mu_H == pytest.approx(50.0, rel=1e-3)
@@ -70,12 +77,5 @@ def test_a_change_of_scene_tolerance_or_options_misses(data, tmp_path, monkeypat
 
 def test_a_damaged_or_foreign_kept_file_is_ignored(data, tmp_path, monkeypatch):
     monkeypatch.setenv("SHELLBVP_CACHE_DIR", str(tmp_path))
-    scene, d, F = data
-    with sb.options(model_curve_cache=True):
-        clear_model_curves()
-        first = _fit(scene, d, F)
-        (kept,) = (tmp_path / "curves").glob("curve_*.h5")
-        kept.write_bytes(b"not a curve")
-        clear_model_curves()
-        again = _fit(scene, d, F)
-    assert again.curves_computed == 1 and again.mu_H == first.mu_H
+    first, again, kept = _fit_twice(data, tmp_path, lambda kept: [k.write_bytes(b"not a curve") for k in kept])
+    assert len(kept) == 1 and again.curves_computed == 1 and again.mu_H == first.mu_H

@@ -35,14 +35,7 @@ def run(args):
     if maps:  # a force map's file: its mu*H image, one figure each
         if len(maps) != len(args.files):
             raise ValueError("plot either force-map files or curve and fit files, not both in one call")
-        if args.output is None:
-            outs = [Path(name).with_suffix(".png") for name in maps]
-        elif len(maps) > 1 or Path(args.output).is_dir():
-            outdir = output_dir(args.output, "-o", maps, ".png", True)
-            outs = [outdir / (Path(name).stem + ".png") for name in maps]
-        else:
-            outs = [Path(args.output)]
-        for name, out in zip(maps, outs):
+        for name, out in zip(maps, _figure_paths(args.output, maps)):
             check_output_path(out, overwrite=True)
             read_map_file(name).plot(out, dpi=args.dpi)
             print(f"wrote {out}")
@@ -51,15 +44,8 @@ def run(args):
     if fits:
         if len(fits) != len(args.files):
             raise ValueError("plot either curve files or fit files, not both in one call")
-        if args.output is None:  # each figure next to its fit file
-            outs = [Path(name).with_suffix(".png") for name in fits]
-        elif len(fits) > 1 or Path(args.output).is_dir():
-            outdir = output_dir(args.output, "-o", fits, ".png", True)
-            outs = [outdir / (Path(name).stem + ".png") for name in fits]
-        else:
-            outs = [Path(args.output)]
         plt = require_matplotlib()
-        for name, out in zip(fits, outs):
+        for name, out in zip(fits, _figure_paths(args.output, fits)):
             check_output_path(out, overwrite=True)
             ax, _ = plot_fit_record(read_fit(name))
             ax.figure.tight_layout()
@@ -97,3 +83,14 @@ def run(args):
     save_figure(fig, args.output, dpi=args.dpi)
     print(f"wrote {args.output}")
     return 0
+
+
+def _figure_paths(output, names):
+    """One figure per file: beside each file (no ``-o``), in the directory ``-o`` names (several
+    files, or a directory), or ``-o`` itself (one file)."""
+    if output is None:
+        return [Path(name).with_suffix(".png") for name in names]
+    if len(names) > 1 or Path(output).is_dir():
+        outdir = output_dir(output, "-o", names, ".png", True)
+        return [outdir / (Path(name).stem + ".png") for name in names]
+    return [Path(output)]
