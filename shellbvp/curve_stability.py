@@ -24,66 +24,21 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import asdict, dataclass
-
 import numpy as np
 
+from .io import STABILITY_FIELDS, FirstInstability
+
 __all__ = ["STABILITY_CHOICES", "STABILITY_FIELDS", "FirstInstability", "check_choice", "point_stability",
-           "assess", "locate_zero", "first_instability_up_to"]
+           "assess", "locate_zero"]
 
 #: What ``curve(stability=...)`` accepts
 STABILITY_CHOICES = ("off", "points", "locate")
-#: Per-point fields of a curve added by :func:`assess`, with their value where not computed
-STABILITY_FIELDS = {"stability_min": math.nan, "critical_mode": -1}
 #: Modes each side of the critical one evaluated while a bracket is narrowed
 NEAR_MODES = 2
 #: Largest number of states solved to narrow a bracket
 MAX_REFINE = 12
 #: ``"locate"`` analyses about this many recorded states spread along the curve first
 LOCATE_SAMPLES = 8
-
-
-@dataclass(frozen=True)
-class FirstInstability:
-    """The first unstable depth along a curve.
-
-    Attributes
-    ----------
-    delta, force : float
-        Where the smallest eigenvalue crosses zero (package units), interpolated linearly
-        between the two states of the final bracket; with ``located`` False, the first unstable
-        recorded point's.
-    mode : int
-        The Fourier mode n that goes unstable.
-    located : bool
-        The crossing was narrowed to ``bracket`` by states solved in between.
-    bracket : (float, float)
-        The last stable and the first unstable depth known.
-    message : str
-        How it was found, or why it was not narrowed.
-    """
-
-    delta: float
-    force: float
-    mode: int
-    located: bool
-    bracket: tuple
-    message: str = ""
-
-    def to_dict(self) -> dict:
-        d = asdict(self)
-        d["bracket"] = list(self.bracket)
-        return d
-
-    @classmethod
-    def from_dict(cls, d) -> "FirstInstability":
-        return cls(delta=float(d["delta"]), force=float(d["force"]), mode=int(d["mode"]),
-                   located=bool(d["located"]), bracket=tuple(float(b) for b in d["bracket"]),
-                   message=str(d["message"]) if "message" in d else "")
-
-    def summary(self) -> str:
-        how = "" if self.located else f"; {self.message}"
-        return f"loses axisymmetric stability at delta = {self.delta:.6g} (n = {self.mode}{how})"
 
 
 def check_choice(stability) -> str:
@@ -248,21 +203,3 @@ def _narrowed(curve, j, i, mins, modes, delta_tol):
     return FirstInstability(delta=a + t * (b - a), force=Fa + t * (Fb - Fa), mode=int(mode), located=located,
                             bracket=(float(a), float(b)), message=message)
 
-
-#: Depths of the curve :func:`first_instability_up_to` analyses
-CHECK_DEPTHS = 12
-
-
-def first_instability_up_to(scene, delta_max: float, *, tol: float = 1e-6):
-    """(the first instability of ``scene``'s curve at or before ``delta_max``, or None; what was
-    not analysed): a curve at :data:`CHECK_DEPTHS` depths to ``delta_max``, ``"locate"``."""
-    from .continuation import curve
-
-    c = curve(scene, deltas=delta_max * np.arange(1, CHECK_DEPTHS + 1) / CHECK_DEPTHS, tol=tol,
-              estimate_error=False, stability="locate")
-    first = c.first_instability
-    note = c.settings.get("stability_note", "")
-    if not c.complete:
-        note = "; ".join(filter(None, [note, f"the curve stopped at delta = {c.delta.max() if len(c) else 0:.4g} "
-                                             f"({c.stop_reason})"]))
-    return (first if first is not None and first.delta <= delta_max else None), note

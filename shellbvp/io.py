@@ -47,7 +47,8 @@ replaced unless ``overwrite=True``.
 from __future__ import annotations
 
 import json
-from dataclasses import dataclass, field
+import math
+from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -57,7 +58,7 @@ from .nexus import new_file
 from .paths import open_hdf5
 from .schema import MAX_DATASET_BYTES
 
-__all__ = ["Curve", "POINT_FIELDS", "CAP_FIELD_DEFAULTS", "point_record", "energy_residual", "write_curve",
+__all__ = ["Curve", "FirstInstability", "STABILITY_FIELDS", "POINT_FIELDS", "CAP_FIELD_DEFAULTS", "point_record", "energy_residual", "write_curve",
            "read_curve", "write_curve_group", "read_curve_group", "FORMAT",
            "FORMAT_VERSION"]
 
@@ -82,6 +83,54 @@ V2_FIELD_DEFAULTS = {"legendre_min": float("nan"), "contact_edge": "", "edge_jum
 V3_FIELD_DEFAULTS = {"error_method": "", "pressure": float("nan"),  # pressure: the scene's, filled in on reading
                      "shear_delta": 0.0}
 _MISSING_FIELD_DEFAULTS = {**CAP_FIELD_DEFAULTS, **V2_FIELD_DEFAULTS, **V3_FIELD_DEFAULTS}
+#: Per-point stability fields (shellbvp.curve_stability), with their value where not computed
+#: (also what files without them read as)
+STABILITY_FIELDS = {"stability_min": math.nan, "critical_mode": -1}
+
+
+@dataclass(frozen=True)
+class FirstInstability:
+    """The first unstable depth along a curve.
+
+    Attributes
+    ----------
+    delta, force : float
+        Where the smallest eigenvalue crosses zero (package units), interpolated linearly
+        between the two states of the final bracket; with ``located`` False, the first unstable
+        recorded point's.
+    mode : int
+        The Fourier mode n that goes unstable.
+    located : bool
+        The crossing was narrowed to ``bracket`` by states solved in between.
+    bracket : (float, float)
+        The last stable and the first unstable depth known.
+    message : str
+        How it was found, or why it was not narrowed.
+    """
+
+    delta: float
+    force: float
+    mode: int
+    located: bool
+    bracket: tuple
+    message: str = ""
+
+    def to_dict(self) -> dict:
+        d = asdict(self)
+        d["bracket"] = list(self.bracket)
+        return d
+
+    @classmethod
+    def from_dict(cls, d) -> "FirstInstability":
+        return cls(delta=float(d["delta"]), force=float(d["force"]), mode=int(d["mode"]),
+                   located=bool(d["located"]), bracket=tuple(float(b) for b in d["bracket"]),
+                   message=str(d["message"]) if "message" in d else "")
+
+    def summary(self) -> str:
+        how = "" if self.located else f"; {self.message}"
+        return f"loses axisymmetric stability at delta = {self.delta:.6g} (n = {self.mode}{how})"
+
+
 
 
 @dataclass
@@ -131,7 +180,7 @@ class Curve:
     solutions: list = field(default_factory=list, repr=False)
     version: str = ""
     units: dict = None  # {"R_L": m, "mu_H": N/m} when the file had SI columns (to_hdf5(units=...))
-    #: the first unstable depth (shellbvp.curve_stability.FirstInstability), None if none was found
+    #: the first unstable depth (:class:`FirstInstability`, shellbvp.curve_stability), None if none was found
     first_instability: object = None
 
     def __getattr__(self, name):
@@ -425,8 +474,6 @@ def _points(g):
             points[k] = _missing_field(k, n)
         else:
             raise ValueError(f"dataset {k} missing")
-    from .curve_stability import STABILITY_FIELDS
-
     for k, missing in STABILITY_FIELDS.items():
         points[k] = _field(g, k, n) if k in g else np.full(n, missing, dtype=type(missing))
     points["topology"] = np.asarray(points["topology"], dtype=str)
@@ -483,8 +530,6 @@ def read_curve_group(g, version: str = ""):
 
 def _first_instability(g):
     """The curve's first unstable depth (attribute ``first_instability``), or None."""
-    from .curve_stability import FirstInstability
-
     if "first_instability" not in g.attrs:
         return None
     d = _json_attr(g, "first_instability")

@@ -100,8 +100,8 @@ def fit(scene, displacement, force, *, R_L, fit_offset=True, free=(), bounds=Non
         (e.g. ``lambda d, m: shellbvp.progress.curve_progress(m, d)``); None: silent.
     stability : bool
         Also look for the first loss of axisymmetric stability of the fitted scene up to the
-        deepest fitted depth (:func:`shellbvp.curve_stability.first_instability_up_to`; seconds
-        to a minute): a warning (``unstable_depths``) and ``FitResult.first_instability`` when
+        deepest fitted depth (a curve with ``stability="locate"``, :mod:`shellbvp.curve_stability`;
+        seconds to a minute): a warning (``unstable_depths``) and ``FitResult.first_instability`` when
         the data pass it.
     free : sequence of str
         Also fit a shape parameter, a name of :data:`shellbvp.shape_parameters.SHAPE_PARAMETERS`
@@ -216,13 +216,25 @@ def fit(scene, displacement, force, *, R_L, fit_offset=True, free=(), bounds=Non
     return res
 
 
-def _check_axisymmetry(res, deepest, tol):
-    """``res.first_instability`` and a warning where the fitted scene's curve loses axisymmetric
-    stability before the deepest fitted depth ``deepest`` (delta)."""
-    from ..curve_stability import first_instability_up_to
+#: Depths of the curve :func:`_check_axisymmetry` analyses
+CHECK_DEPTHS = 12
 
-    first, note = first_instability_up_to(res.scene, deepest, tol=tol)
-    res.first_instability, res.stability_note = first, note
+
+def _check_axisymmetry(res, deepest, tol):
+    """``res.first_instability`` and a warning where the fitted scene's curve (at
+    :data:`CHECK_DEPTHS` depths to ``deepest``, stability ``"locate"``) loses axisymmetric
+    stability before the deepest fitted depth ``deepest`` (delta); ``res.stability_note``: what
+    was not analysed."""
+    from ..continuation import curve
+
+    c = curve(res.scene, deltas=deepest * np.arange(1, CHECK_DEPTHS + 1) / CHECK_DEPTHS, tol=tol,
+              estimate_error=False, stability="locate")
+    first = c.first_instability if c.first_instability is not None and c.first_instability.delta <= deepest \
+        else None
+    notes = [c.settings.get("stability_note", "")]
+    if not c.complete:
+        notes.append(f"the curve stopped at delta = {c.delta.max() if len(c) else 0:.4g} ({c.stop_reason})")
+    res.first_instability, res.stability_note = first, "; ".join(filter(None, notes))
     if first is not None:
         res.warnings.append(
             f"the fitted depths reach delta = {deepest:.4g} but the axisymmetric shell loses stability at delta = "
