@@ -206,3 +206,17 @@ def test_a_fit_past_the_first_instability_warns_and_records_it(tmp_path):
     shallow = sb.fit(scene, d[d < 0.2 * R_L], F[d < 0.2 * R_L], R_L=R_L, fit_offset=False, stability=True)
     assert shallow.first_instability is None and "unstable_depths" not in shallow.warning_codes
     assert shallow.mu_H == pytest.approx(mu_H, rel=1e-3)
+
+
+def test_cli_fit_stability_option(tmp_path):
+    import json
+    import subprocess
+    import sys
+
+    r = subprocess.run([sys.executable, "-m", "shellbvp", "fit", "--example", "--preset", "fit", "--radius", "0.3mm",
+                        "--stability", "--json"], capture_output=True, text=True, cwd=tmp_path, timeout=600)
+    assert r.returncode == 0, r.stderr
+    out = json.loads(r.stdout)
+    # the example's depths stay on the stable branch (benchmarks/results/stability_modes.md: preset fit)
+    assert out["first_instability"] is None and "unstable_depths" not in out["warning_codes"]
+    assert isinstance(out["stability_note"], str)
