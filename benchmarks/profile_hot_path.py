@@ -66,7 +66,7 @@ def _category(key):
         return CATEGORIES[5]
     if "scipy/integrate/_bvp.py" in path or "scipy/interpolate" in path:
         return CATEGORIES[6]
-    if path.endswith("shellbvp/chain.py"):
+    if "shellbvp/chain/" in path:  # the assembler and its conditions
         return CATEGORIES[7]
     if path.endswith("shellbvp/state.py"):
         return CATEGORIES[8]
@@ -140,9 +140,9 @@ def profile_curve(make, repeat):
         newton_solves=_calls(st, "scipy/integrate/_bvp.py", "solve_newton"),
         jacobians=_calls(st, "scipy/integrate/_bvp.py", "construct_global_jac"),
         lu_factorisations=_calls(st, "", "splu"),
-        fun=_calls(st, "shellbvp/chain.py", "fun"),
-        fun_jac=_calls(st, "shellbvp/chain.py", "fun_jac"),
-        bc=_calls(st, "shellbvp/chain.py", "bc"),
+        fun=_calls(st, "shellbvp/chain/", "fun"),
+        fun_jac=_calls(st, "shellbvp/chain/", "fun_jac"),
+        bc=_calls(st, "shellbvp/chain/", "bc"),
         free_rhs=_calls(st, "model_", "free_rhs"),
         contact_rhs=_calls(st, "model_", "contact_rhs"),
     )

@@ -1,212 +1,21 @@
-r"""Contact configurations as data: a chain of regions and junctions, assembled into ONE
-multipoint BVP for ``scipy.integrate.solve_bvp``.
-
-The stacked layout (the one place it is defined)
-------------------------------------------------
-A configuration is an ordered list of regions ``k = 0 .. n-1`` from the pole to
-the rim, each of a kind (``"free"``: 6 states ``(lt, phiS, ls, ks, rQ, z)``;
-``"contact"``, the shell on the tip, and ``"cylinder"``, the shell on the
-indenter's cylinder: 2 states ``(chi, ls)``, ``chi = rho omega/S`` with omega
-running on past the tip's end ``omega_max`` along the cylinder; see
-``symbolic.equations``) on ``[S_a, S_b]``.  Every region is mapped
-geometrically onto the same ``t in [0, 1]``,
-
-    ``S_k(t) = exp(a_k + t (b_k - a_k))``,  ``a_k = ln S_a``, ``b_k = ln S_b``,
-
-so that ``dy/dt = (b_k - a_k) g_k(S, y)`` with ``g = S dy/dS`` from the
-generated code, and tiny caps stay well conditioned.  ``y`` stacks the
-regions' states in chain order (rows ``offset[k] : offset[k] + size[k]``);
-``y[:, 0]`` holds every region's start and ``y[:, -1]`` every region's end.
-
-Each end is a :class:`Point` with ``ln S = ln_offset + p[unknown]`` (or a
-fixed value): a pole start ``zeta = eps * Sc`` is the point ``Sc`` shifted by
-``ln eps``.  The unknown parameters ``p`` are, in this order, the
-configuration's own unknowns (``ln Sc``; ``ln S1, ln S2``; ``ln S1, chi1``),
-then ``lambda0`` where a contact cap reaches the pole and lambda0 is not
-prescribed, then ``delta`` unless it is prescribed.
-
-Conditions are the junctions' rows in chain order (pole, contact edges or
-lines, rim), then the control's row: the force at the last contact edge
-(``force``), the stretch at a lifted pole (``lambda0`` without a contact
-pole), or the pseudo-arclength condition (``arclength``,
-``sum_i t_i (X_i - Xhat_i)/s_i = 0`` over ``X = (delta, lambda0, F)``; its
-value is the tuple ``(Xhat, t, s)``).
-
-Volume control (a sealed shell, ``Scene.sealed``): the pressure is an unknown too
-(the last), and one state ``v`` (the last row) sums the regions' volumes, which all
-run on the same t: ``v' = sum_k (b_k - a_k) S dV/dS``, ``v(0) = 0``, ``v(1) = V0``
-(rows after the control's).  One state, not one per region: solve_bvp's LU costs
-about the cube of the states per node.  Guesses need only the regions' states and
-the unknowns before the pressure: :meth:`ChainBVP.solve` completes them.
-
-:class:`Region`, :class:`Point` and the junctions are the blocks a chain is declared with
-(each configuration's chain is declared in its module of :mod:`shellbvp.configurations`,
-e.g. ``cap_chain`` in ``shellbvp/configurations/cap.py``); :class:`ChainBVP`
-assembles any chain into ``fun``, ``fun_jac``, ``bc``, ``bc_jac`` (analytic,
-from the generated Jacobians), end values, energy and profile.
-"""
+"""The assembler: :class:`ChainBVP`, one chain's multipoint BVP (``fun``, ``fun_jac``, its
+boundary conditions from :mod:`shellbvp.chain.conditions`), solved, and the values of a
+solution (end values, profiles, energy, volume); the layout it stacks: :mod:`shellbvp.chain`."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 
-from .kernels import kernel_set
-from .quadrature import gauss_points
+from ..kernels import kernel_set
+from ..quadrature import gauss_points
+from .blocks import CONTACT_KINDS, REGION_CODES, SIZES, Chain, ContactPole, Edge, FreePole, Line, Point
+from .conditions import BoundaryConditions
 
-__all__ = ["Point", "Region", "ContactPole", "FreePole", "PointPole", "Edge", "TipEnd", "Line", "Kink", "Rim",
-           "Chain",
-           "ChainBVP", "CONTROLS",
-           "SIZES", "FREE_STATES", "CONTACT_STATES", "CONTACT_KINDS", "REGION_CODES"]
+__all__ = ["ChainBVP", "CONTROLS"]
 
 CONTROLS = ("delta", "lambda0", "force", "arclength")
-FREE_STATES = ("lt", "phiS", "ls", "ks", "rQ", "z")
-CONTACT_STATES = ("chi", "ls")
-SIZES = {"free": len(FREE_STATES), "contact": len(CONTACT_STATES), "cylinder": len(CONTACT_STATES)}
-CONTACT_KINDS = ("contact", "cylinder")  # the shell on the tip; on the indenter's cylinder r = rho A(omega_max)
-#: ``region`` codes of profiles: 0 on the tip, 1 free, 2 on the cylinder
-REGION_CODES = {"contact": 0, "free": 1, "cylinder": 2}
-_LS = FREE_STATES.index("ls")
-# states continuous across a line contact (rQ jumps: the ring force)
-_LINE_CONTINUOUS = [FREE_STATES.index(s) for s in ("lt", "phiS", "ls", "ks", "z")]
-# states continuous across an interior corner (ls, ks jump)
-_KINK_CONTINUOUS = [FREE_STATES.index(s) for s in ("lt", "phiS", "rQ", "z")]
 
 
-# -- declarations ---------------------------------------------------------------------------------
-@dataclass(frozen=True)
-class Point:
-    """A point on the S axis: ``ln S = ln_offset + p[unknown]``, or ``ln S = ln_offset`` if fixed."""
-
-    name: str
-    unknown: str | None = None
-    ln_offset: float = 0.0
-
-
-@dataclass(frozen=True)
-class Region:
-    kind: str  # "free" | "contact" (on the tip) | "cylinder" (on the indenter's side)
-    start: Point
-    end: Point
-
-
-@dataclass(frozen=True)
-class ContactPole:
-    """Regular pole of a contact cap (region ``k`` starts at zeta): 2 rows, uses lambda0."""
-
-    k: int
-    rows = 2
-
-
-@dataclass(frozen=True)
-class FreePole:
-    """Regular pole of a free cap (region ``k`` starts at zeta): 3 rows."""
-
-    k: int
-    rows = 3
-
-
-@dataclass(frozen=True)
-class PointPole:
-    """Point-load pole of the free region ``k`` at its start s0: 3 rows, uses delta."""
-
-    k: int
-    rows = 3
-
-
-@dataclass(frozen=True)
-class Edge:
-    """Contact edge between contact region ``kc`` and free region ``kf`` (adjacent): 5 rows.
-
-    ``model`` is ``"smooth"`` (variational) or ``"paper"``; see SPEC section 2b.
-    """
-
-    kc: int
-    kf: int
-    model: str = "smooth"
-    rows = 5
-
-
-@dataclass(frozen=True)
-class TipEnd:
-    """The shell passes from the tip (region ``k``) onto the cylinder (region ``k + 1``): 3 rows.
-
-    omega = omega_max at the end of one and the start of the other, and
-    ``[lambda_s dU/dlambda_s - U] = 0`` (``symbolic.equations.Derivation._build_tip_end``).
-    """
-
-    k: int
-    rows = 3
-
-
-@dataclass(frozen=True)
-class Line:
-    """Line contact between free regions ``k`` and ``k + 1`` at the indenter point ``chi1``: 8 rows.
-
-    r, phi, z on the indenter (3 rows, the smooth junction's first three; ``on`` the tip,
-    ``"contact"``, or the cylinder, ``"cylinder"``); lt, phiS, ls, ks, z continuous (5);
-    rQ jumps (the ring force).
-    """
-
-    k: int
-    on: str = "contact"
-    rows = 8
-
-
-@dataclass(frozen=True)
-class Kink:
-    """Interior Weierstrass-Erdmann corner between free regions ``k`` and ``k + 1``: 7 rows.
-
-    lt, phiS, rQ, z continuous (4); lambda_s and kappa_s jump with [tau_s] = [M_s] = 0 and the
-    Eshelby condition [lambda_s dU/dlambda_s - U] = 0 (3, ``kink_res``).  Where U is convex
-    the jump is 0 (the rows then hold for any S_k): only a state with a jump is a corner.
-    """
-
-    k: int
-    rows = 7
-
-
-@dataclass(frozen=True)
-class Rim:
-    """Simply supported rim at the end of region ``k``: 3 rows."""
-
-    k: int
-    rows = 3
-
-
-@dataclass(frozen=True)
-class Chain:
-    """A contact configuration: regions pole to rim, junctions, unknowns of its own."""
-
-    name: str
-    regions: tuple
-    junctions: tuple
-    unknowns: tuple  # configuration unknowns (before lambda0, delta)
-    eps: float | None = None  # pole start zeta = eps * (first contact or lift-off edge), if a regular pole
-
-    def layout(self) -> str:
-        """A table of the stacked layout (rows, S ranges, junction rows)."""
-        lines, row = [f"{self.name}: y rows, t in [0, 1]"], 0
-        for k, reg in enumerate(self.regions):
-            n = SIZES[reg.kind]
-            states = FREE_STATES if reg.kind == "free" else CONTACT_STATES
-            lines.append(f"  y[{row}:{row + n}]  region {k} {reg.kind:<7s} S in [{reg.start.name}, {reg.end.name}]"
-                         f"  ({', '.join(states)})")
-            row += n
-        lines.append("conditions:")
-        r = 0
-        for j in self.junctions:
-            lines.append(f"  [{r}:{r + j.rows}]  {type(j).__name__}{_fields(j)}")
-            r += j.rows
-        return "\n".join(lines)
-
-
-def _fields(j):
-    return "(" + ", ".join(f"{k}={v!r}" for k, v in j.__dict__.items()) + ")"
-
-
-# -- the assembler -------------------------------------------------------------------------------
 def _call_key(t, y, p, par):
     """The cheap part of what identifies a ``fun`` call (shapes, the unknowns' and parameters'
     bytes), compared before t and y are compared by value (:func:`_same_call`)."""
@@ -218,7 +27,7 @@ def _same_call(key, small, t, y) -> bool:
     return k_small == small and np.array_equal(ky, y) and np.array_equal(kt, t)
 
 
-class ChainBVP:
+class ChainBVP(BoundaryConditions):
     """fun, fun_jac, bc, bc_jac of one chain, scene, control mode and prescribed value.
 
     Parameters
@@ -381,7 +190,7 @@ class ChainBVP:
     def solve(self, x, y, p=None, **kwargs):
         """``shellbvp.solution.solve_bvp`` of this system from a guess (completed, see
         :meth:`complete`); keyword arguments go to solve_bvp."""
-        from .solution import solve_bvp
+        from ..solution import solve_bvp
 
         y, p = self.complete(x, y, p)
         return solve_bvp(self.fun, self.bc, x, y, p, fun_jac=self.fun_jac, bc_jac=self.bc_jac,
@@ -397,7 +206,7 @@ class ChainBVP:
         """``shellbvp.collocation.newton_on_mesh`` of this system from a guess (completed, see
         :meth:`complete`) on the fixed mesh ``x``: ``(y, p)`` (``p`` None when there are no
         unknowns), or None where that Newton does not converge."""
-        from .collocation import newton_on_mesh
+        from ..collocation import newton_on_mesh
 
         y, p = self.complete(x, y, p)
         if self.k:
@@ -472,14 +281,6 @@ class ChainBVP:
     def _jac(self, k):
         return getattr(self.kernels.active, self._jac_names[k])
 
-    @staticmethod
-    def _prefix(kind):
-        """Generated names of cylinder edges carry ``cyl_`` (``junction_cyl_smooth_res``)."""
-        return "cyl_" if kind == "cylinder" else ""
-
-    def _edge_function(self, j, what):
-        """junction_[cyl_]<model>_<what> of an edge, by its contact region's kind."""
-        return getattr(self.model, f"junction_{self._prefix(self.regions[j.kc].kind)}{j.model}_{what}")
 
     # -- ODE ------------------------------------------------------------------------------------
     #: fun's last results kept, by their arguments' values: after each Newton run solve_bvp
@@ -557,202 +358,6 @@ class ChainBVP:
                 if self.volume_control:
                     dfdp[v, self.col[point.unknown]] += sign * rate + (b - a) * vS[0] * S * dS_dln
         return (dfdy, dfdp) if dfdp is not None else dfdy
-
-    # -- conditions -------------------------------------------------------------------------------
-    def _edge_states(self, j: Edge, ya, yb):
-        """(point, yc, yf, contact state at start?, free state at start?) of an edge."""
-        rc, rf = self.rows(j.kc), self.rows(j.kf)
-        if j.kc < j.kf:
-            return self.regions[j.kc].end, yb[rc], ya[rf], False, True
-        return self.regions[j.kc].start, ya[rc], yb[rf], True, False
-
-    def _line_states(self, j: Line, ya, yb, q):
-        yin = yb[self.rows(j.k)]
-        return self.regions[j.k].end, np.array([q["chi1"], yin[_LS]]), yin, ya[self.rows(j.k + 1)]
-
-    def bc(self, ya, yb, p=None):
-        mod, par = self.model, self.par_at(p)
-        q = self.quantities(p)
-        parts = []
-        for j in self.junctions:
-            if isinstance(j, ContactPole):
-                y0 = ya[self.rows(j.k)]
-                parts.append(mod.pole_res(y0[0], y0[1], q["lambda0"], par))
-            elif isinstance(j, FreePole):
-                parts.append(mod.free_pole_res(self.S_point(self.regions[j.k].start, p), ya[self.rows(j.k)], par))
-            elif isinstance(j, PointPole):
-                parts.append(mod.point_load_res(self.S_point(self.regions[j.k].start, p), ya[self.rows(j.k)],
-                                                q["delta"], par))
-            elif isinstance(j, Edge):
-                point, yc, yf, _, _ = self._edge_states(j, ya, yb)
-                parts.append(self._edge_function(j, "res")(self.S_point(point, p), yc, yf, q["delta"], q["F"], par))
-            elif isinstance(j, TipEnd):
-                parts.append(mod.tip_end_res(self.S_point(self.regions[j.k].end, p), yb[self.rows(j.k)],
-                                             ya[self.rows(j.k + 1)], par))
-            elif isinstance(j, Line):
-                point, yc, yin, yout = self._line_states(j, ya, yb, q)
-                on_tip = self._line_function(j, "res")(self.S_point(point, p), yc, yin, q["delta"], q["F"], par)[:3]
-                parts += [on_tip, (yout - yin)[_LINE_CONTINUOUS]]
-            elif isinstance(j, Kink):
-                yl, yr = yb[self.rows(j.k)], ya[self.rows(j.k + 1)]
-                parts += [mod.kink_res(self.S_point(self.regions[j.k].end, p), yl, yr, par),
-                          (yr - yl)[_KINK_CONTINUOUS]]
-            elif isinstance(j, Rim):
-                parts.append(mod.rim_res(self.S_point(self.regions[j.k].end, p), yb[self.rows(j.k)], par))
-        if self.extra == "force":
-            _, S, yc, yf, _, _ = self._force_args(ya, yb, p, q)
-            parts.append(self._force_function("res")(S, yc, yf, q["delta"], q["F"], par))
-        elif self.extra == "pole_stretch":
-            parts.append([ya[self.rows(0)][_LS] - self.value])
-        elif self.extra == "arclength":
-            _, S, yc, yf, _, _ = self._force_args(ya, yb, p, q)
-            force = 2 * np.pi * self._force_function("res")(S, yc, yf, q["delta"], 0.0, par)[0]
-            X = np.array([q["delta"], q["lambda0"], force])
-            parts.append([np.sum(self.arc_tangent * (X - self.arc_point) / self.arc_scale)])
-        if self.volume_control:
-            parts += [[ya[self.n_shell]], [yb[self.n_shell] - self.enclosed_volume]]
-        return np.concatenate(parts)
-
-    def _line_function(self, j, what):
-        return getattr(self.model, f"junction_{self._prefix(j.on)}smooth_{what}")
-
-    def _force_function(self, what):
-        """force_[cyl_]<what> at the last contact edge (F of the free region beyond it)."""
-        j = self.force_at
-        return getattr(self.model, f"force_{self._prefix(self.regions[j.kc].kind if isinstance(j, Edge) else '')}"
-                                   f"{what}")
-
-    def _force_args(self, ya, yb, p, q):
-        """(point, S, yc, yf, free region, free state at its start?) of the force condition."""
-        j = self.force_at
-        if isinstance(j, Edge):
-            point, yc, yf, _, f_at_a = self._edge_states(j, ya, yb)
-            kf = j.kf
-        else:
-            point, yc, _, yf = self._line_states(j, ya, yb, q)
-            kf, f_at_a = j.k + 1, True
-        return point, self.S_point(point, p), yc, yf, kf, f_at_a
-
-    def _add_p(self, P, rows, name, values):
-        if name is not None and name in self.col:
-            P[rows, self.col[name]] += values
-
-    def _pressure_column(self, P, rows, dres_dpar):
-        """Under volume control, a condition's derivative in the pressure (an unknown)."""
-        if self.volume_control:
-            P[rows, self.col["pressure"]] += dres_dpar[..., self._i_pressure]
-
-    def bc_jac(self, ya, yb, p=None):
-        mod, par = self.model, self.par_at(p)
-        q = self.quantities(p)
-        m, n = self.n_conditions, self.n
-        A, B = np.zeros((m, n)), np.zeros((m, n))
-        P = np.zeros((m, self.k)) if self.k else None
-        vc = self.volume_control
-        r = 0
-        for j in self.junctions:
-            rows = slice(r, r + j.rows)
-            if isinstance(j, ContactPole):
-                o = self.offsets[j.k]
-                y0 = ya[self.rows(j.k)]
-                pj = mod.pole_jac(y0[0], y0[1], q["lambda0"], par)  # d/d(chi, ls, lambda0)
-                A[rows, o:o + 2] = pj[:, :2]
-                self._add_p(P, rows, "lambda0", pj[:, 2])
-                if vc:
-                    self._pressure_column(P, rows, mod.pole_jac_par(y0[0], y0[1], q["lambda0"], par))
-            elif isinstance(j, (FreePole, PointPole)):
-                point = self.regions[j.k].start
-                S = self.S_point(point, p)
-                if isinstance(j, FreePole):
-                    pj = mod.free_pole_jac(S, ya[self.rows(j.k)], par)  # d/d(y, S)
-                    self._add_p(P, rows, point.unknown, pj[:, 6] * S)
-                    if vc:
-                        self._pressure_column(P, rows, mod.free_pole_jac_par(S, ya[self.rows(j.k)], par))
-                else:
-                    pj = mod.point_load_jac(S, ya[self.rows(j.k)], q["delta"], par)  # d/d(y, delta)
-                    self._add_p(P, rows, "delta", pj[:, 6])
-                    if vc:
-                        self._pressure_column(P, rows, mod.point_load_jac_par(S, ya[self.rows(j.k)], q["delta"], par))
-                A[rows, self.rows(j.k)] = pj[:, :6]
-            elif isinstance(j, Edge):
-                point, yc, yf, c_at_a, f_at_a = self._edge_states(j, ya, yb)
-                S = self.S_point(point, p)
-                jj = self._edge_function(j, "jac")(S, yc, yf, q["delta"], q["F"], par)
-                (A if c_at_a else B)[rows, self.rows(j.kc)] = jj[:, 1:3]
-                (A if f_at_a else B)[rows, self.rows(j.kf)] = jj[:, 3:9]
-                self._add_p(P, rows, point.unknown, jj[:, 0] * S)
-                self._add_p(P, rows, "delta", jj[:, 9])
-                if vc:
-                    dpar = self._edge_function(j, "jac_par")(S, yc, yf, q["delta"], q["F"], par)
-                    self._pressure_column(P, rows, dpar)
-            elif isinstance(j, Line):
-                point, yc, yin, yout = self._line_states(j, ya, yb, q)
-                S = self.S_point(point, p)
-                on = slice(r, r + 3)
-                jj = self._line_function(j, "jac")(S, yc, yin, q["delta"], q["F"], par)[:3]
-                self._add_p(P, on, point.unknown, jj[:, 0] * S)
-                self._add_p(P, on, "chi1", jj[:, 1])
-                self._add_p(P, on, "delta", jj[:, 9])
-                if vc:
-                    self._pressure_column(P, on, self._line_function(j, "jac_par")(S, yc, yin, q["delta"], q["F"],
-                                                                                 par)[:3])
-                i0, o0 = self.offsets[j.k], self.offsets[j.k + 1]
-                B[on, i0:i0 + 6] = jj[:, 3:9]
-                B[on, i0 + _LS] += jj[:, 2]  # ls of the contact state is the inner region's
-                for row, c in enumerate(_LINE_CONTINUOUS, start=r + 3):
-                    A[row, o0 + c] = 1.0
-                    B[row, i0 + c] = -1.0
-            elif isinstance(j, TipEnd):
-                point = self.regions[j.k].end
-                S = self.S_point(point, p)
-                ej = mod.tip_end_jac(S, yb[self.rows(j.k)], ya[self.rows(j.k + 1)], par)  # d/d(S, yt, yw)
-                B[rows, self.rows(j.k)] = ej[:, 1:3]
-                A[rows, self.rows(j.k + 1)] = ej[:, 3:5]
-                self._add_p(P, rows, point.unknown, ej[:, 0] * S)
-                if vc:
-                    self._pressure_column(P, rows, mod.tip_end_jac_par(S, yb[self.rows(j.k)], ya[self.rows(j.k + 1)],
-                                                                       par))
-            elif isinstance(j, Kink):
-                point = self.regions[j.k].end
-                S = self.S_point(point, p)
-                yl, yr = yb[self.rows(j.k)], ya[self.rows(j.k + 1)]
-                kj = mod.kink_jac(S, yl, yr, par)  # d/d(S, yl, yr)
-                jump = slice(r, r + 3)
-                B[jump, self.rows(j.k)] = kj[:, 1:7]
-                A[jump, self.rows(j.k + 1)] = kj[:, 7:13]
-                self._add_p(P, jump, point.unknown, kj[:, 0] * S)
-                if vc:
-                    self._pressure_column(P, jump, mod.kink_jac_par(S, yl, yr, par))
-                l0, r0 = self.offsets[j.k], self.offsets[j.k + 1]
-                for row, c in enumerate(_KINK_CONTINUOUS, start=r + 3):
-                    A[row, r0 + c] = 1.0
-                    B[row, l0 + c] = -1.0
-            elif isinstance(j, Rim):
-                S = self.S_point(self.regions[j.k].end, p)
-                B[rows, self.rows(j.k)] = mod.rim_jac(S, yb[self.rows(j.k)], par)
-                if vc:
-                    self._pressure_column(P, rows, mod.rim_jac_par(S, yb[self.rows(j.k)], par))
-            r += j.rows
-        if self.extra in ("force", "arclength"):
-            w = 1.0 if self.extra == "force" else 2 * np.pi * self.arc_tangent[2] / self.arc_scale[2]
-            F = q["F"] if self.extra == "force" else 0.0
-            point, S, yc, yf, kf, f_at_a = self._force_args(ya, yb, p, q)
-            fj = w * self._force_function("jac")(S, yc, yf, q["delta"], F, par)  # d/d(Sc, yf, F)
-            (A if f_at_a else B)[r, self.rows(kf)] = fj[0, 1:7]
-            self._add_p(P, r, point.unknown, fj[0, 0] * S)
-            if vc:
-                self._pressure_column(P, r, w * self._force_function("jac_par")(S, yc, yf, q["delta"], F, par)[0])
-            if self.extra == "arclength":
-                w3 = self.arc_tangent / self.arc_scale  # weights of (delta, lambda0, F)
-                self._add_p(P, r, "lambda0", w3[1])
-                self._add_p(P, r, "delta", w3[0])
-        elif self.extra == "pole_stretch":
-            A[r, self.offsets[0] + _LS] = 1.0
-        if vc:
-            r += self.extra is not None
-            A[r, self.n_shell] = 1.0
-            B[r + 1, self.n_shell] = 1.0
-        return (A, B, P) if P is not None else (A, B)
 
     # -- values of a solution -----------------------------------------------------------------------
     def end_values(self, ya, yb, p=None):

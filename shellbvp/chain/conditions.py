@@ -1,0 +1,228 @@
+"""The boundary conditions of a chain: each junction's rows (``bc``) and their analytic
+Jacobians (``bc_jac``), then the control's row and the volume's, as
+:class:`~shellbvp.chain.ChainBVP` (which inherits them) assembles them (the rows' order:
+:mod:`shellbvp.chain`)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .blocks import FREE_STATES, ContactPole, Edge, FreePole, Kink, Line, PointPole, Rim, TipEnd
+
+__all__ = ["BoundaryConditions"]
+
+_LS = FREE_STATES.index("ls")
+# states continuous across a line contact (rQ jumps: the ring force)
+_LINE_CONTINUOUS = [FREE_STATES.index(s) for s in ("lt", "phiS", "ls", "ks", "z")]
+# states continuous across an interior corner (ls, ks jump)
+_KINK_CONTINUOUS = [FREE_STATES.index(s) for s in ("lt", "phiS", "rQ", "z")]
+
+
+class BoundaryConditions:
+    """``bc`` and ``bc_jac`` of a :class:`~shellbvp.chain.ChainBVP`: its base, using its layout
+    (``rows``, ``offsets``, ``S_point``, ``quantities``, ``par_at``)."""
+
+    @staticmethod
+    def _prefix(kind):
+        """Generated names of cylinder edges carry ``cyl_`` (``junction_cyl_smooth_res``)."""
+        return "cyl_" if kind == "cylinder" else ""
+
+    def _edge_function(self, j, what):
+        """junction_[cyl_]<model>_<what> of an edge, by its contact region's kind."""
+        return getattr(self.model, f"junction_{self._prefix(self.regions[j.kc].kind)}{j.model}_{what}")
+
+    # -- conditions -------------------------------------------------------------------------------
+    def _edge_states(self, j: Edge, ya, yb):
+        """(point, yc, yf, contact state at start?, free state at start?) of an edge."""
+        rc, rf = self.rows(j.kc), self.rows(j.kf)
+        if j.kc < j.kf:
+            return self.regions[j.kc].end, yb[rc], ya[rf], False, True
+        return self.regions[j.kc].start, ya[rc], yb[rf], True, False
+
+    def _line_states(self, j: Line, ya, yb, q):
+        yin = yb[self.rows(j.k)]
+        return self.regions[j.k].end, np.array([q["chi1"], yin[_LS]]), yin, ya[self.rows(j.k + 1)]
+
+    def bc(self, ya, yb, p=None):
+        mod, par = self.model, self.par_at(p)
+        q = self.quantities(p)
+        parts = []
+        for j in self.junctions:
+            if isinstance(j, ContactPole):
+                y0 = ya[self.rows(j.k)]
+                parts.append(mod.pole_res(y0[0], y0[1], q["lambda0"], par))
+            elif isinstance(j, FreePole):
+                parts.append(mod.free_pole_res(self.S_point(self.regions[j.k].start, p), ya[self.rows(j.k)], par))
+            elif isinstance(j, PointPole):
+                parts.append(mod.point_load_res(self.S_point(self.regions[j.k].start, p), ya[self.rows(j.k)],
+                                                q["delta"], par))
+            elif isinstance(j, Edge):
+                point, yc, yf, _, _ = self._edge_states(j, ya, yb)
+                parts.append(self._edge_function(j, "res")(self.S_point(point, p), yc, yf, q["delta"], q["F"], par))
+            elif isinstance(j, TipEnd):
+                parts.append(mod.tip_end_res(self.S_point(self.regions[j.k].end, p), yb[self.rows(j.k)],
+                                             ya[self.rows(j.k + 1)], par))
+            elif isinstance(j, Line):
+                point, yc, yin, yout = self._line_states(j, ya, yb, q)
+                on_tip = self._line_function(j, "res")(self.S_point(point, p), yc, yin, q["delta"], q["F"], par)[:3]
+                parts += [on_tip, (yout - yin)[_LINE_CONTINUOUS]]
+            elif isinstance(j, Kink):
+                yl, yr = yb[self.rows(j.k)], ya[self.rows(j.k + 1)]
+                parts += [mod.kink_res(self.S_point(self.regions[j.k].end, p), yl, yr, par),
+                          (yr - yl)[_KINK_CONTINUOUS]]
+            elif isinstance(j, Rim):
+                parts.append(mod.rim_res(self.S_point(self.regions[j.k].end, p), yb[self.rows(j.k)], par))
+        if self.extra == "force":
+            _, S, yc, yf, _, _ = self._force_args(ya, yb, p, q)
+            parts.append(self._force_function("res")(S, yc, yf, q["delta"], q["F"], par))
+        elif self.extra == "pole_stretch":
+            parts.append([ya[self.rows(0)][_LS] - self.value])
+        elif self.extra == "arclength":
+            _, S, yc, yf, _, _ = self._force_args(ya, yb, p, q)
+            force = 2 * np.pi * self._force_function("res")(S, yc, yf, q["delta"], 0.0, par)[0]
+            X = np.array([q["delta"], q["lambda0"], force])
+            parts.append([np.sum(self.arc_tangent * (X - self.arc_point) / self.arc_scale)])
+        if self.volume_control:
+            parts += [[ya[self.n_shell]], [yb[self.n_shell] - self.enclosed_volume]]
+        return np.concatenate(parts)
+
+    def _line_function(self, j, what):
+        return getattr(self.model, f"junction_{self._prefix(j.on)}smooth_{what}")
+
+    def _force_function(self, what):
+        """force_[cyl_]<what> at the last contact edge (F of the free region beyond it)."""
+        j = self.force_at
+        return getattr(self.model, f"force_{self._prefix(self.regions[j.kc].kind if isinstance(j, Edge) else '')}"
+                                   f"{what}")
+
+    def _force_args(self, ya, yb, p, q):
+        """(point, S, yc, yf, free region, free state at its start?) of the force condition."""
+        j = self.force_at
+        if isinstance(j, Edge):
+            point, yc, yf, _, f_at_a = self._edge_states(j, ya, yb)
+            kf = j.kf
+        else:
+            point, yc, _, yf = self._line_states(j, ya, yb, q)
+            kf, f_at_a = j.k + 1, True
+        return point, self.S_point(point, p), yc, yf, kf, f_at_a
+
+    def _add_p(self, P, rows, name, values):
+        if name is not None and name in self.col:
+            P[rows, self.col[name]] += values
+
+    def _pressure_column(self, P, rows, dres_dpar):
+        """Under volume control, a condition's derivative in the pressure (an unknown)."""
+        if self.volume_control:
+            P[rows, self.col["pressure"]] += dres_dpar[..., self._i_pressure]
+
+    def bc_jac(self, ya, yb, p=None):
+        mod, par = self.model, self.par_at(p)
+        q = self.quantities(p)
+        m, n = self.n_conditions, self.n
+        A, B = np.zeros((m, n)), np.zeros((m, n))
+        P = np.zeros((m, self.k)) if self.k else None
+        vc = self.volume_control
+        r = 0
+        for j in self.junctions:
+            rows = slice(r, r + j.rows)
+            if isinstance(j, ContactPole):
+                o = self.offsets[j.k]
+                y0 = ya[self.rows(j.k)]
+                pj = mod.pole_jac(y0[0], y0[1], q["lambda0"], par)  # d/d(chi, ls, lambda0)
+                A[rows, o:o + 2] = pj[:, :2]
+                self._add_p(P, rows, "lambda0", pj[:, 2])
+                if vc:
+                    self._pressure_column(P, rows, mod.pole_jac_par(y0[0], y0[1], q["lambda0"], par))
+            elif isinstance(j, (FreePole, PointPole)):
+                point = self.regions[j.k].start
+                S = self.S_point(point, p)
+                if isinstance(j, FreePole):
+                    pj = mod.free_pole_jac(S, ya[self.rows(j.k)], par)  # d/d(y, S)
+                    self._add_p(P, rows, point.unknown, pj[:, 6] * S)
+                    if vc:
+                        self._pressure_column(P, rows, mod.free_pole_jac_par(S, ya[self.rows(j.k)], par))
+                else:
+                    pj = mod.point_load_jac(S, ya[self.rows(j.k)], q["delta"], par)  # d/d(y, delta)
+                    self._add_p(P, rows, "delta", pj[:, 6])
+                    if vc:
+                        self._pressure_column(P, rows, mod.point_load_jac_par(S, ya[self.rows(j.k)], q["delta"], par))
+                A[rows, self.rows(j.k)] = pj[:, :6]
+            elif isinstance(j, Edge):
+                point, yc, yf, c_at_a, f_at_a = self._edge_states(j, ya, yb)
+                S = self.S_point(point, p)
+                jj = self._edge_function(j, "jac")(S, yc, yf, q["delta"], q["F"], par)
+                (A if c_at_a else B)[rows, self.rows(j.kc)] = jj[:, 1:3]
+                (A if f_at_a else B)[rows, self.rows(j.kf)] = jj[:, 3:9]
+                self._add_p(P, rows, point.unknown, jj[:, 0] * S)
+                self._add_p(P, rows, "delta", jj[:, 9])
+                if vc:
+                    dpar = self._edge_function(j, "jac_par")(S, yc, yf, q["delta"], q["F"], par)
+                    self._pressure_column(P, rows, dpar)
+            elif isinstance(j, Line):
+                point, yc, yin, yout = self._line_states(j, ya, yb, q)
+                S = self.S_point(point, p)
+                on = slice(r, r + 3)
+                jj = self._line_function(j, "jac")(S, yc, yin, q["delta"], q["F"], par)[:3]
+                self._add_p(P, on, point.unknown, jj[:, 0] * S)
+                self._add_p(P, on, "chi1", jj[:, 1])
+                self._add_p(P, on, "delta", jj[:, 9])
+                if vc:
+                    self._pressure_column(P, on, self._line_function(j, "jac_par")(S, yc, yin, q["delta"], q["F"],
+                                                                                 par)[:3])
+                i0, o0 = self.offsets[j.k], self.offsets[j.k + 1]
+                B[on, i0:i0 + 6] = jj[:, 3:9]
+                B[on, i0 + _LS] += jj[:, 2]  # ls of the contact state is the inner region's
+                for row, c in enumerate(_LINE_CONTINUOUS, start=r + 3):
+                    A[row, o0 + c] = 1.0
+                    B[row, i0 + c] = -1.0
+            elif isinstance(j, TipEnd):
+                point = self.regions[j.k].end
+                S = self.S_point(point, p)
+                ej = mod.tip_end_jac(S, yb[self.rows(j.k)], ya[self.rows(j.k + 1)], par)  # d/d(S, yt, yw)
+                B[rows, self.rows(j.k)] = ej[:, 1:3]
+                A[rows, self.rows(j.k + 1)] = ej[:, 3:5]
+                self._add_p(P, rows, point.unknown, ej[:, 0] * S)
+                if vc:
+                    self._pressure_column(P, rows, mod.tip_end_jac_par(S, yb[self.rows(j.k)], ya[self.rows(j.k + 1)],
+                                                                       par))
+            elif isinstance(j, Kink):
+                point = self.regions[j.k].end
+                S = self.S_point(point, p)
+                yl, yr = yb[self.rows(j.k)], ya[self.rows(j.k + 1)]
+                kj = mod.kink_jac(S, yl, yr, par)  # d/d(S, yl, yr)
+                jump = slice(r, r + 3)
+                B[jump, self.rows(j.k)] = kj[:, 1:7]
+                A[jump, self.rows(j.k + 1)] = kj[:, 7:13]
+                self._add_p(P, jump, point.unknown, kj[:, 0] * S)
+                if vc:
+                    self._pressure_column(P, jump, mod.kink_jac_par(S, yl, yr, par))
+                l0, r0 = self.offsets[j.k], self.offsets[j.k + 1]
+                for row, c in enumerate(_KINK_CONTINUOUS, start=r + 3):
+                    A[row, r0 + c] = 1.0
+                    B[row, l0 + c] = -1.0
+            elif isinstance(j, Rim):
+                S = self.S_point(self.regions[j.k].end, p)
+                B[rows, self.rows(j.k)] = mod.rim_jac(S, yb[self.rows(j.k)], par)
+                if vc:
+                    self._pressure_column(P, rows, mod.rim_jac_par(S, yb[self.rows(j.k)], par))
+            r += j.rows
+        if self.extra in ("force", "arclength"):
+            w = 1.0 if self.extra == "force" else 2 * np.pi * self.arc_tangent[2] / self.arc_scale[2]
+            F = q["F"] if self.extra == "force" else 0.0
+            point, S, yc, yf, kf, f_at_a = self._force_args(ya, yb, p, q)
+            fj = w * self._force_function("jac")(S, yc, yf, q["delta"], F, par)  # d/d(Sc, yf, F)
+            (A if f_at_a else B)[r, self.rows(kf)] = fj[0, 1:7]
+            self._add_p(P, r, point.unknown, fj[0, 0] * S)
+            if vc:
+                self._pressure_column(P, r, w * self._force_function("jac_par")(S, yc, yf, q["delta"], F, par)[0])
+            if self.extra == "arclength":
+                w3 = self.arc_tangent / self.arc_scale  # weights of (delta, lambda0, F)
+                self._add_p(P, r, "lambda0", w3[1])
+                self._add_p(P, r, "delta", w3[0])
+        elif self.extra == "pole_stretch":
+            A[r, self.offsets[0] + _LS] = 1.0
+        if vc:
+            r += self.extra is not None
+            A[r, self.n_shell] = 1.0
+            B[r + 1, self.n_shell] = 1.0
+        return (A, B, P) if P is not None else (A, B)
