@@ -210,7 +210,8 @@ def _display(record):
             return None
 
     units = record.source["units"] if isinstance(record.source["units"], dict) else {}
-    shown = {"m": factor(units.get("displacement"), "length"), "N": factor(units.get("force"), "force")}
+    shown = {si: factor(units[key], kind) if key in units else None
+             for si, key, kind in (("m", "displacement", "length"), ("N", "force", "force"))}
 
     def show(value, si_unit):
         found = shown.get(si_unit)
