@@ -149,7 +149,7 @@ def test_the_generated_form_is_the_derived_one():
     from symbolic.geometry import S as S_SYM
 
     scene = sb.Scene.preset("base")
-    f, upper, params, shell_params, ref = st._form_functions(scene)
+    f, upper, params, shell_params, ref = st.form_functions(scene)
     structure = structure_from_description(json.loads(json.dumps(scene.structure(), sort_keys=True)))
     res = sv.second_variation_of(structure)
     assert [str(p) for p in res.params] == params

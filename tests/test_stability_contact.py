@@ -23,6 +23,8 @@ import pytest
 
 import shellbvp as sb
 from shellbvp import modal_stability as st
+from shellbvp.modal_stability import fem
+from shellbvp.modal_stability.form import form_at
 from shellbvp.chain import CONTACT_KINDS
 from shellbvp.solution import Solution
 
@@ -32,7 +34,7 @@ def _frame(state, S):
     """Position, its first and second S-derivatives ((r, z) rows), the base fields, the tangent
     t and normal N, psi and psi' of ``state`` at the points S."""
     base = st.chain_base(state)(S)
-    f, upper, params, shell_params, ref = st._form_functions(state.scene)
+    f, upper, params, shell_params, ref = st.form_functions(state.scene)
     values = state.scene.values()
     R, Psi, dPsi, _, _ = (np.broadcast_to(np.asarray(v, float), S.shape)
                           for v in ref(S, *[values[p] for p in shell_params]))
@@ -97,7 +99,7 @@ def branch_check(lo, mid, hi, S0=1e-3):
     zeta[7] = dot(dS, N) - phS * u
     zeta[8] = dot(dSS, N) - 2 * phS * dot(dS, t) - phSS * u - phS**2 * w
     elastic_base = dict(base, P=np.zeros_like(S))
-    A, _ = st._form_at(mid.scene, lambda s: elastic_base, S, 0)
+    A, _ = form_at(mid.scene, lambda s: elastic_base, S, 0)
     elastic = 8 * math.pi * float(np.sum(W * np.einsum("ig,ijg,jg->g", zeta, A, zeta)))
     # the tangent relative to the tip along t (the pressure's term, 2 pi Int p^ kappa_s dt^2)
     rel = u + np.sin(base["phi"])
@@ -209,16 +211,16 @@ def test_n1_needs_the_slopes_held_at_the_start(monkeypatch, cap_state):
         return mesh
 
     def n1(ratio, slopes_held=True):
-        monkeypatch.setattr(st, "mesh", first_element(ratio))
+        monkeypatch.setattr(fem, "mesh", first_element(ratio))
         if not slopes_held:
-            full = st._constraints
+            full = fem._constraints
 
             def constraints(n, m, *args):
                 T = full(n, m, *args)
                 # release u'(S0), v'(S0): the columns of the reduced basis that carry them are absent,
                 # so rebuild with the two dofs free
                 return _release(T, (1, 3))
-            monkeypatch.setattr(st, "_constraints", constraints)
+            monkeypatch.setattr(fem, "_constraints", constraints)
         out = st.spectrum(state.scene, contact.base, contact.S0, float(state.system.L), [1], contact=contact)
         monkeypatch.undo()
         return out.smallest[0]

@@ -1,0 +1,140 @@
+"""What the indenter adds to a state's eigenproblem: which states are handled
+(:func:`check_supported`), the contact regions, edges and lines of a state (:func:`contact_of`)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..chain import CONTACT_KINDS, Edge, Kink, Line, TipEnd
+from ..configurations import CONFIGURATIONS, is_point_load, of
+from .form import chain_base, reference_shell
+
+
+#: Junctions whose stability is not built: an interior corner (Kink) and the contact running over
+#: the tip's end (TipEnd) move a material point in a way the displacement modes do not carry.
+#: Every other chain -- free regions and regions on the tip joined by smooth edges and lines -- is.
+NOT_BUILT = (Kink, TipEnd)
+
+
+def supported(conf) -> bool:
+    """Whether the stability of a registered configuration's states is built (no junction of its
+    chain in :data:`NOT_BUILT`); None (the inflated shell, no contact) is."""
+    if conf is None:
+        return True
+    return not any(isinstance(j, NOT_BUILT) for j in conf.chain(1e-3, 1.0, "smooth").junctions)
+
+
+def check_supported(state):
+    """ValueError (one line, naming what is not supported) unless :func:`stability` handles
+    ``state``: a converged state of a configuration whose chain is :func:`supported`, with the
+    smooth contact edge, under pressure (not volume) control."""
+    if not state.success:
+        raise ValueError(f"stability: the state did not converge ({state.message})")
+    conf = of(state)
+    if not supported(conf):
+        built = ", ".join(repr(c.name) for c in CONFIGURATIONS.values() if supported(c))
+        raise ValueError(f"stability: topology {state.topology!r} is not supported (only the inflated shell and "
+                         f"{built}: the contact running over the tip's end onto the indenter's cylinder and interior "
+                         f"corners are not built)")
+    if conf is None:
+        return
+    scene = state.scene
+    if scene.contact != "smooth":
+        raise ValueError(f"stability: contact={scene.contact!r} is not variational (its edge conditions are not "
+                         f"the natural conditions of an energy); only contact='smooth' is supported")
+    if state.contact_edge == "corner":
+        raise ValueError("stability: a contact edge with a Weierstrass-Erdmann corner (contact_edge 'corner') "
+                         "is not supported, only the smooth edge")
+    if scene.sealed:
+        raise ValueError("stability: a sealed shell (volume control) in contact is not supported, only "
+                         "pressure control")
+
+
+@dataclass(eq=False)
+class Contact:
+    """What the tip adds to the eigenproblem of a state in contact (module docstring).
+
+    ``base``: the base state as a function of S, with the contact pressure ``P`` (0 off the
+    tip); ``S0``: where the mesh starts; ``held``: the S-intervals on the tip (w = w' = 0);
+    ``lines``: the line contacts' S (w = 0); ``rings``: per edge or line ``(S, (a, b, c, d))``,
+    its quadratic form ``a u^2 + b v^2 + 2 c u w' + d w'^2`` in the stiffness; ``pole_held``:
+    the contact lies within [0, S0] or is a point load (the pole held at a point), with
+    ``pole_force`` the axial force there and ``apex_curvature`` the tip's.
+    """
+
+    base: object
+    S0: float
+    held: tuple = ()
+    lines: tuple = ()
+    rings: tuple = ()
+    pole_held: bool = False
+    pole_force: float = 0.0
+    apex_curvature: float = 0.0
+
+    @property
+    def edges(self):
+        """Where the contact starts or ends inside the mesh, and the lines."""
+        return tuple(sorted({S for S, _ in self.rings} | {S for a, b in self.held for S in (a, b)
+                                                          if S > self.S0}))
+
+
+def _junction_points(sysm, p):
+    """(S, kind (:class:`Edge` or :class:`Line`), inner region, outer region) of every contact edge
+    and line, pole to rim, in the order of ``Solution.edge_forces`` (``shellbvp.diagnosis``)."""
+    out = []
+    for j in sysm.junctions:
+        if isinstance(j, Edge):
+            out.append((float(sysm.S_point(sysm.regions[min(j.kc, j.kf)].end, p)), Edge, j.kc, j.kf))
+        elif isinstance(j, Line):
+            out.append((float(sysm.S_point(sysm.regions[j.k].end, p)), Line, j.k, j.k + 1))
+    return out
+
+
+def contact_of(state, S0=None) -> Contact:
+    """The :class:`Contact` of a state on the tip: the base state from the regions' generated
+    profiles (:func:`chain_base`), the regions on the tip, and at each contact edge and line
+    its normal ring force (``state.edge_forces``, ``-2 pi [r Q]``) with the curvatures there."""
+    check_supported(state)
+    from ..inflation import EPS
+
+    sysm, p = state.system, state.p
+    L = float(sysm.L)
+    zeta = float(sysm.S_point(sysm.regions[0].start, p))
+    S0 = max(EPS * L, zeta) if S0 is None else max(float(S0), zeta)
+    base = chain_base(state)
+    apex = state.scene.tip.apex_curvature() / state.scene.rho
+    points = _junction_points(sysm, p)
+    if is_point_load(state) or (len(points) == 1 and points[0][0] <= S0 * (1 + 1e-9)):
+        # the one contact (a cap or a line) lies within the pole's disc: a point contact there
+        return Contact(base, S0, pole_held=True, pole_force=float(state.force), apex_curvature=apex)
+    if points[0][0] <= S0 * (1 + 1e-9):
+        raise ValueError(f"stability: a contact edge at S = {points[0][0]:.3g} inside the mesh's start "
+                         f"S0 = {S0:.3g} of a {state.topology!r} state is not supported")
+    held = tuple((max(float(sysm.S_point(r.start, p)), S0), float(sysm.S_point(r.end, p)))
+                 for r in sysm.regions if r.kind in CONTACT_KINDS)
+    lines = [S for S, kind, _, _ in points if kind is Line]
+    if len(lines) > 1:
+        raise ValueError("stability: more than one line contact is not supported")
+    rings = []
+    for (S, kind, k, other), force in zip(points, state.edge_forces):
+        side = S * (1 - 1e-12) if k < other else S * (1 + 1e-12)  # inside region k: the tip's side of an edge
+        at = base(np.array([side]))
+        R, Psi = (float(v[0]) for v in reference_shell(state.scene, np.array([S])))
+        kt = float(np.sin(at["phi"][0]) / (at["lt"][0] * R))
+        ks = float(at["ks"][0])
+        f = float(force) / (2 * np.pi)  # the normal ring force per unit length, times r
+        if kind is Edge:
+            rings.append((S, (-f * ks, -f * kt, 0.0, 0.0)))
+            continue
+        # a line: the gap's second variation with the contact point rolling along the meridian,
+        # kappa_S u^2 + 2 u w'/psi - w'^2/(psi^2 gap) + kappa_theta v^2 (module docstring), with
+        # gap = kappa_s(indenter) - kappa_s(shell) = -curvature_excess > 0, kappa_S the shell's
+        gap = -float(state.curvature_excess)
+        if not gap > 0:
+            raise ValueError(f"stability: the line contact's curvature gap {gap:.3g} is not positive (the shell "
+                             f"bends as tightly as the indenter there: a band), not supported")
+        psi = float(at["ls"][0]) * Psi
+        rings.append((S, (-f * ks, -f * kt, -f / psi, f / (psi**2 * gap))))
+    return Contact(base, S0, held=held, lines=tuple(lines), rings=tuple(rings), apex_curvature=apex)
