@@ -16,14 +16,15 @@ two neighbouring states and narrows it by regula falsi on states solved at depth
 (the modes next to the critical one only; all modes again on the stable side of the final
 bracket).  It assumes that a curve does not go unstable and back between two sampled states
 (an unstable window shorter than the sample's spacing is missed); ``"points"`` makes no such
-assumption, at the cost of every state.  A state the stability analysis does not handle gives NaN, and the reason
-is kept in the curve's settings (``stability_note``): nothing is guessed for it.
+assumption, at the cost of every state.  A state the stability analysis does not handle gives
+NaN, and the reason is kept in the curve's settings (``stability_note``): nothing is guessed for it.
 """
 
 from __future__ import annotations
 
 import math
 import time
+
 import numpy as np
 
 from .io import STABILITY_FIELDS, FirstInstability
