@@ -70,7 +70,8 @@ def _check_data(d, f, k, origin=0.0):
 
 
 def fit(scene, displacement, force, *, R_L, fit_offset=True, free=(), bounds=None, weights=None, floor=0.05,
-        delta_max=None, tol=1e-6, loss="linear", baseline="none", contact_guess=None, progress=None, **aliases):
+        delta_max=None, tol=1e-6, loss="linear", baseline="none", contact_guess=None, progress=None, shared=None,
+        **aliases):
     """Least-squares fit of mu*H (the displacement origin, and a shape parameter) to measured data.
 
     Parameters
@@ -109,6 +110,12 @@ def fit(scene, displacement, force, *, R_L, fit_offset=True, free=(), bounds=Non
     bounds : dict, optional
         ``{name: (low, high)}``: the search range of the free parameter (nondimensional, as in
         the scene); default the parameter's own.
+    shared : tuple, optional
+        ``(model_curves, theta)``: F(delta) interpolated at ``theta`` across the node curves of a
+        :class:`~shellbvp.fitting.curves.ModelCurves` built by the caller (a force map with a
+        geometry per pixel, :func:`shellbvp.batch.fit_map`): no curve is computed, ``scene`` is
+        the one at ``theta`` (reported), ``delta_max`` and ``tol`` are the curves'; no shape
+        parameter may be free.
     **aliases
         ``fit_<name>=True`` and ``<name>_bounds=(low, high)`` for each shape parameter (e.g.
         ``fit_beta=True, beta_bounds=(1e-3, 0.1)``): the same as ``free`` and ``bounds``.
@@ -193,6 +200,10 @@ def fit(scene, displacement, force, *, R_L, fit_offset=True, free=(), bounds=Non
     counter = [0]
     mdl = LeastSquaresModel(d, f, R_L, fit_offset, baseline, loss)
     noise = NoiseModel(weights, floor)
+    if shared is not None:
+        if sp is not None:
+            raise ValueError(f"{sp.name} is given per pixel: it cannot also be fitted")
+        return _fit_on_shared(shared, scene, mdl, noise, depth, k, keep, weights, baseline)
     if sp is None:
         shape = ModelCurves(lambda th: scene, grid, tol, depth, counter, progress)
         shape.add(None)
@@ -205,6 +216,20 @@ def fit(scene, displacement, force, *, R_L, fit_offset=True, free=(), bounds=Non
         fitted = search.run(noise, k)
         notes = search.notes
     return result_of(fitted, mdl, sp, k, notes, keep, weights, baseline, counter[0])
+
+
+def _fit_on_shared(shared, scene, mdl, noise, depth, k, keep, weights, baseline):
+    """:func:`fit` on the curve interpolated at ``theta`` across shared node curves (no curve computed)."""
+    curves, theta = shared
+    P, dP, top = curves.at(theta)
+    if depth > curves.need * (1 + 1e-9):
+        raise ValueError(f"the data reach delta = {depth:.4g} (deepest displacement / R_L), beyond the shared "
+                         f"model curves' deepest data depth {curves.need:.4g}")
+    res, rss, J, w = noise.irls(mdl, P, dP, top)
+    near = min(curves.thetas, key=lambda t: abs(t - theta))
+    fitted = Fitted(res, rss, J, w, scene, curves.nodes[near], P, top,
+                    interpolation_error=getattr(curves, "interpolation_error", None))
+    return result_of(fitted, mdl, None, k, [], keep, weights, baseline, 0)
 
 
 def free_parameters(free=(), bounds=None, aliases=None):
