@@ -341,7 +341,11 @@ class ForceMap:
             string_dataset(c, "message", [printable(r.message) for r in self.rows], "the fit's message")
             s = entry.create_group("sample")
             s.attrs.update({"NX_class": "NXsample", "scene": self.scene.to_json(),
-                            "description": self.scene.describe(self.R_L), "R_L_m": float(self.R_L)})
+                            "description": self.scene.describe(self.R_L)
+                            + ("" if self.pixel_values is None else
+                               f"; in place of its {self.pixel_values.name}: {self.pixel_values.name} per pixel "
+                               f"from {printable(self.pixel_values.path)} (map/{self.pixel_values.name})"),
+                            "R_L_m": float(self.R_L)})
             src = entry.create_group("source")
             src.attrs["NX_class"] = "NXnote"
             string_dataset(src, "file_name", str(self.path))

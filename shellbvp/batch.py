@@ -332,7 +332,9 @@ def _pixel_values_checked(scene, curves, shape, table, R_L, options):
     the map (ValueError naming the table's line otherwise)."""
     from .shape_parameters import shape_parameter
 
-    if options.get("free") or any(k.startswith("fit_") and v for k, v in options.items()):
+    from .shape_parameters import SHAPE_PARAMETERS
+
+    if options.get("free") or any(options.get(f"fit_{name}") for name in SHAPE_PARAMETERS):
         raise ValueError(f"a map with {table.name} per pixel fits mu*H, the offset and the baseline on the "
                          f"table's geometry: no shape parameter is fitted with it")
     missing_grid = [c.index for c in curves if c.grid is None]
@@ -367,7 +369,7 @@ def shared_curves(scene, name, values, grid, need, tol, *, interpolation_tol=Non
     :class:`~shellbvp.fitting.curves.ModelCurves` on ``grid`` whose nodes reach ``need``.
 
     Nodes are spaced as the parameter's own search (:attr:`ShapeParameter.step`: a factor
-    sqrt 2 in the thickness) from the least to the largest value.  Then, as the profile
+    sqrt 2 in the thickness) from the least to the largest value, three at least.  Then, as the profile
     likelihood checks its estimate, a curve is computed at the middle of each interval between
     nodes and compared with the curve interpolated there before it: where
     ``max |F_interp - F| / max |F|`` exceeds ``interpolation_tol`` (default ``tol``, the
@@ -395,7 +397,8 @@ def shared_curves(scene, name, values, grid, need, tol, *, interpolation_tol=Non
                              f"data (delta = {need:.4g}): fit shallower data, or check the units and R_L")
 
     lo, hi = (param.to_theta(v) for v in (min(values), max(values)))
-    n = max(1, math.ceil((hi - lo) / param.step(scene) - 1e-9)) if hi > lo else 0
+    # at least three nodes: across two a spline in theta is a straight line
+    n = max(2, math.ceil((hi - lo) / param.step(scene) - 1e-9)) if hi > lo else 0
     for theta in np.linspace(lo, hi, n + 1):
         add(float(theta))
     errors, todo = [], [(a, b) for a, b in zip(curves.thetas[:-1], curves.thetas[1:])]

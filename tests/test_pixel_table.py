@@ -9,6 +9,7 @@ import pytest
 import shellbvp as sb
 from shellbvp.afm import AFMCurve
 from shellbvp.batch import fit_map, write_table
+from shellbvp.cli import main
 from shellbvp.fitting import clear_model_curves
 from shellbvp.instrument import record_from_arrays
 from shellbvp.pixel_table import PixelTable, read_pixel_table
@@ -152,3 +153,62 @@ def test_a_table_invalid_for_the_map_is_refused_before_any_curve(closed_form, tm
     with pytest.raises(ValueError, match="fit_alpha needs a Mooney-Rivlin material"):
         fit_map(scene.replace(material=sb.NeoHookean()), curves, R_L=R_L,
                 pixel_values=PixelTable("alpha", {(0, 0): 0.1}))
+
+
+def test_a_jpk_map_with_its_own_thickness_per_pixel_recovers_every_mu_h(tmp_path, capsys):
+    """benchmarks/make_force_map.py with a thickness per pixel: each pixel's curve from its own
+    scene (the full model), read by afmformats; `shellbvp fit --pixel-table` recovers every
+    pixel's mu*H within 1 % (1 % force noise), computing the nodes' curves, not the pixels'."""
+    import importlib.util
+    import json
+    from pathlib import Path
+
+    import h5py
+
+    pytest.importorskip("afmformats")
+    bench = Path(__file__).resolve().parent.parent / "benchmarks" / "make_force_map.py"
+    spec = importlib.util.spec_from_file_location("_bench_make_force_map", bench)
+    maker = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(maker)
+    path = tmp_path / "cells.jpk-force-map"
+    thickness = maker.thickness_pattern(4, 0.5e-6, 0.7e-6, levels=5)
+    assert np.unique(thickness).size == 3
+    truth = maker.write_map(path, n=4, points=150, thickness=thickness)
+    table = tmp_path / "thickness.csv"
+    maker.write_thickness_table(table, thickness)
+    clear_model_curves()
+    out = tmp_path / "cells.h5"
+    argv = ["fit", str(path), "--preset", "fit", "--radius", "10um", "--pixel-table", str(table), "-q", "-o", str(out)]
+    assert main(argv + ["--json"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    per_pixel = doc["per_pixel"]
+    assert per_pixel["parameter"] == "thickness" and per_pixel["unit"] == "m"
+    assert per_pixel["curves_computed"] == len(per_pixel["nodes"]) < 16
+    assert per_pixel["interpolation_error"] <= 1e-6
+    with h5py.File(out) as f:
+        np.testing.assert_allclose(f["entry/map/mu_H"][()], truth, rtol=0.01)
+        np.testing.assert_allclose(f["entry/map/thickness"][()], thickness, rtol=1e-9)
+    # one geometry for all (the preset's beta) fits the same map worse than the table's
+    assert main(["fit", str(path), "--preset", "fit", "--radius", "10um", "-q", "-o", str(tmp_path / "one.h5")]) in (0, 1)
+    with h5py.File(tmp_path / "one.h5") as f:
+        one = f["entry/map/mu_H"][()]
+    assert np.nanmax(np.abs(one / truth - 1)) > 0.05
+
+
+def test_cli_refuses_a_bad_pixel_table_in_one_line(tmp_path, capsys):
+    path = tmp_path / "cells.jpk-force-map"
+    path.write_bytes(b"")
+    bad = tmp_path / "t.csv"
+    bad.write_text("ix,iy,thickness_um\n0,0,0.5\n0,x,0.5\n")
+    assert main(["fit", str(path), "--preset", "fit", "--radius", "10um", "--pixel-table", str(bad)]) == 2
+    err = capsys.readouterr().err
+    assert "t.csv, line 3: column 'iy' must be a grid index" in err and err.count("\n") == 1
+    good = tmp_path / "g.csv"
+    good.write_text("ix,iy,thickness_um\n0,0,0.5\n")
+    assert main(["fit", str(path), "--preset", "fit", "--radius", "10um", "--thickness", "1um",
+                 "--pixel-table", str(good)]) == 2
+    assert "gives the thickness per pixel: leave out --thickness" in capsys.readouterr().err
+    csv_file = tmp_path / "one.csv"
+    csv_file.write_text("d,f\n0,0\n1,1\n2,2\n")
+    assert main(["fit", str(csv_file), "--preset", "fit", "--radius", "10um", "--pixel-table", str(good)]) == 2
+    assert "--pixel-table is for one force map" in capsys.readouterr().err
