@@ -49,7 +49,7 @@ class PixelTable:
     Examples
     --------
     >>> t = PixelTable("thickness", {(0, 0): 0.5, (1, 0): 0.7}, unit="um")
-    >>> t.nondimensional(R_L=10e-6)
+    >>> {p: round(x, 12) for p, x in t.nondimensional(R_L=10e-6).items()}      # H / R_L
     {(0, 0): 0.05, (1, 0): 0.07}
     """
 
