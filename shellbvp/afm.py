@@ -266,7 +266,7 @@ class ForceMap:
         nx, ny = self.shape
         text = (f"{len(self.rows)} curves on a {nx} x {ny} grid: {counts['ok']} fitted, {counts['failed']} failed "
                 f"their checks, {counts['error']} errors{spread}")
-        if self.pixel_values is not None:
+        if self.pixel_values is not None and self.pixel_nodes:
             from .units import format_in
 
             unit = self.pixel_unit()

@@ -222,9 +222,9 @@ def _fit_on_shared(shared, scene, mdl, noise, depth, k, keep, weights, baseline)
     """:func:`fit` on the curve interpolated at ``theta`` across shared node curves (no curve computed)."""
     curves, theta = shared
     P, dP, top = curves.at(theta)
-    if depth > curves.need * (1 + 1e-9):
+    if depth > top * (1 + 1e-9):
         raise ValueError(f"the data reach delta = {depth:.4g} (deepest displacement / R_L), beyond the shared "
-                         f"model curves' deepest data depth {curves.need:.4g}")
+                         f"model curves' end at delta = {top:.4g}")
     res, rss, J, w = noise.irls(mdl, P, dP, top)
     near = min(curves.thetas, key=lambda t: abs(t - theta))
     fitted = Fitted(res, rss, J, w, scene, curves.nodes[near], P, top,
