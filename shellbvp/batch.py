@@ -425,7 +425,7 @@ def shared_curves(scene, name, values, grid, need, tol, *, interpolation_tol=Non
 
 
 def _fit_map_per_pixel(scene, curves, named, shape, table, *, R_L, path, segment, baseline, on_curve, settings,
-                       **options):
+                       tol=1e-6, delta_max=None, progress=None, **options):
     """:func:`fit_map` with a shape parameter per pixel from ``table``."""
     from .afm import ForceMap
     from .fitting import N_DEPTHS, fit_record
@@ -443,15 +443,13 @@ def _fit_map_per_pixel(scene, curves, named, shape, table, *, R_L, path, segment
     if not records:
         raise ValueError(f"{table.path}: none of the map's pixels is in the table")
     depths = [v for v in _depths(records, segment, R_L).values() if math.isfinite(v) and v > 0]
-    kwargs = {k: v for k, v in options.items() if k not in ("delta_max", "progress")}
     shared = None
     if depths:
         need = max(depths)
-        dm = float(options["delta_max"]) if options.get("delta_max") is not None else 1.2 * need
+        dm = float(delta_max) if delta_max is not None else 1.2 * need
         grid = dm * np.arange(1, N_DEPTHS + 1) / N_DEPTHS
         values = [xs[c.grid] for c in curves if f"{path}#{c.index}" in records]
-        shared = shared_curves(scene, table.name, values, grid, need, options.get("tol", 1e-6),
-                               progress=options.get("progress"))
+        shared = shared_curves(scene, table.name, values, grid, need, tol, progress=progress)
     out = []
     for c, (name, rec) in zip(curves, named):
         if name not in rows:
@@ -460,7 +458,7 @@ def _fit_map_per_pixel(scene, curves, named, shape, table, *, R_L, path, segment
                 if shared is None:
                     raise ValueError("no depth of indentation could be read from any curve of the map")
                 res, used = fit_record(param.set(scene, x), rec, R_L=R_L, segment=segment, baseline=baseline,
-                                       shared=(shared, param.to_theta(x)), **kwargs)
+                                       shared=(shared, param.to_theta(x)), tol=tol, **options)
                 rows[name] = BatchRow(file=name, status="ok" if res.success else "failed", result=res, record=rec,
                                       used=used, message=res.message)
             except ValueError as exc:
