@@ -99,13 +99,13 @@ def read_pixel_table(path) -> PixelTable:
         column, two geometry columns, an unknown unit, a pixel index that is not an integer
         >= 0, a value that is not a finite number > 0 (alpha: >= 0), a pixel given twice.
     """
-    from .instrument import _bare_name, _number, _unit_of, read_table
+    from .instrument import cell_number, header_name_and_unit, read_table
 
     table = read_table(path)
     if not table.header:
         raise ValueError(f"{path}: no header row; the pixel table needs the columns ix, iy and one of "
                          f"{', '.join(PIXEL_PARAMETERS)} (e.g. thickness_um)")
-    names = [_bare_name(h) for h in table.header]
+    names = [header_name_and_unit(h)[0] for h in table.header]
     for need in ("ix", "iy"):
         if names.count(need) != 1:
             raise ValueError(f"{path}: needs one column {need!r} (the pixel's grid index); its columns are "
@@ -120,8 +120,8 @@ def read_pixel_table(path) -> PixelTable:
     unit = ""
     if table.header_units is not None and g < len(table.header_units) and table.header_units[g]:
         unit = table.header_units[g]
-    elif _unit_of(table.header[g]):
-        unit = _unit_of(table.header[g])
+    elif header_name_and_unit(table.header[g])[1]:
+        unit = header_name_and_unit(table.header[g])[1]
     if unit == "1":
         unit = ""
     kind = PIXEL_PARAMETERS[name]
@@ -140,13 +140,13 @@ def read_pixel_table(path) -> PixelTable:
             raise ValueError(f"{where}: {len(cells)} cells, the header has {len(table.header)}")
         pixel = []
         for col in (ix, iy):
-            v = _number(cells[col])
+            v = cell_number(cells[col])
             if v is None or not math.isfinite(v) or v < 0 or v != int(v):
                 raise ValueError(f"{where}: column {table.header[col]!r} must be a grid index (an integer >= 0); "
                                  f"got {cells[col]!r}")
             pixel.append(int(v))
         pixel = tuple(pixel)
-        v = _number(cells[g])
+        v = cell_number(cells[g])
         if v is None or not math.isfinite(v) or not (v >= 0 if name == "alpha" else v > 0):
             raise ValueError(f"{where}: column {table.header[g]!r} must be a finite number "
                              f"{'>= 0' if name == 'alpha' else '> 0'}; got {cells[g]!r}")
