@@ -11,7 +11,7 @@ clock) with its peak resident memory (``wait4``'s ``ru_maxrss``).  Sides:
 
 Warm: each side has its own code cache, filled by one untimed run of each command first (a fit
 then reads the model curve that run kept, as a repeated fit of a sample does; "curve not kept"
-deletes the kept curves before each run: a sample's first fit), and
+sets the kept curves aside for its runs: a sample's first fit; the others keep theirs), and
 the repeats alternate the sides (A B C A B C ...) so a noisy shared machine weighs on all
 alike; a ratio is the median of the per-repeat ratios.  Cold: the first run of ``curve`` with
 an empty code cache (the equations derived and their code generated), once per side.
@@ -23,7 +23,10 @@ Writes ``benchmarks/results/commands.md`` and ``.json`` (``--quick``: ``commands
 ``--only NAME``: ``commands-<name>.*``, the cold curve only when it is among them).
 
 The force map is a synthetic JPK ``.jpk-force-map`` of 16 x 16 curves of 500 + 500 points
-(``benchmarks/make_force_map.py``), written before the timing, read through afmformats.
+(``benchmarks/make_force_map.py``), written before the timing, read through afmformats; the map
+with a thickness per pixel has its pixels' shells 0.3 .. 1.0 um thick (8 levels, each pixel's
+curve from its own scene) and is fitted with that table (``--pixel-table``): warm (the node
+curves kept by the warming run) and with the kept curves set aside (every node computed).
 """
 
 from __future__ import annotations
@@ -63,14 +66,19 @@ COMMANDS = (
                                  "-o", "{out}.h5"], 0, False),
     ("force map 16x16 (one geometry)", ["fit", "{force_map}", "--preset", "fit", "--radius", "10um", "-o",
                                         "{out}.h5", "-q"], 0, False),
+    ("force map 16x16, thickness per pixel from a table", ["fit", "{thick_map}", "--preset", "fit", "--radius",
+                                                           "10um", "--pixel-table", "{thick_table}", "-o",
+                                                           "{out}.h5", "-q"], 0, False),
+    ("force map 16x16, thickness per pixel, curves not kept", ["fit", "{thick_map}", "--preset", "fit", "--radius",
+                                                               "10um", "--pixel-table", "{thick_table}", "-o",
+                                                               "{out}.h5", "-q"], 0, False),
 )
 QUICK = ("bad option", "curve (default base)", "fit --example", "fit --example, curve not kept")
 #: Commands run with the kept model curves deleted first (a sample fitted for the first time;
 #: every other fit reads the curve its warming run kept, as a repeated fit does)
-FRESH_CURVES = ("fit --example, curve not kept",)
+FRESH_CURVES = ("fit --example, curve not kept", "force map 16x16, thickness per pixel, curves not kept")
 #: Commands of the issue not measured, and why (a line under the table)
-NOT_MEASURED = ("force map 16x16 with per-pixel shell height from a table: shellbvp fits a map with one geometry "
-                "(`shellbvp fit MAP --preset ...`, `batch.fit_map`); per-pixel geometry is not supported",)
+NOT_MEASURED = ()
 
 
 def run(argv, env, cwd):
@@ -128,6 +136,13 @@ def main(argv=None):
         from make_force_map import write_map
 
         write_map(force_map, n=16, points=500)
+    thick_map, thick_table = work / "map16-thickness.jpk-force-map", work / "map16-thickness.csv"
+    if any("{thick_map}" in cmd for _, cmd, _, _ in commands):
+        from make_force_map import thickness_pattern, write_map, write_thickness_table
+
+        thickness = thickness_pattern(16, 0.3e-6, 1.0e-6)  # um 0.3 .. 1.0 in 8 levels, thicker in the middle
+        write_map(thick_map, n=16, points=500, thickness=thickness)
+        write_thickness_table(thick_table, thickness)
     sides = {args.baseline: {"PYTHONPATH": str(old), "SHELLBVP_KERNELS": "numpy"},
              "plain": {"PYTHONPATH": str(REPO), "SHELLBVP_KERNELS": "numpy"},
              "[fast]": {"PYTHONPATH": str(REPO), "SHELLBVP_KERNELS": "auto"}}
@@ -143,7 +158,8 @@ def main(argv=None):
 
     def argv_of(cmd):
         counter[0] += 1
-        return [a.format(out=work / f"out{counter[0]}", folder=folder, force_map=force_map) for a in cmd]
+        return [a.format(out=work / f"out{counter[0]}", folder=folder, force_map=force_map, thick_map=thick_map,
+                         thick_table=thick_table) for a in cmd]
 
     rows = {}
     t_start = time.perf_counter()
@@ -169,9 +185,16 @@ def main(argv=None):
             for side in order[r % len(order):] + order[:r % len(order)]:
                 if side == args.baseline and not on_base:
                     continue
-                if name in FRESH_CURVES:
-                    shutil.rmtree(caches[side] / "curves", ignore_errors=True)
+                kept, aside = caches[side] / "curves", caches[side] / "curves.aside"
+                if name in FRESH_CURVES:  # the kept curves set aside for this run, then put back for the others
+                    shutil.rmtree(aside, ignore_errors=True)
+                    if kept.exists():
+                        kept.rename(aside)
                 wall, rss, code, err = run(argv_of(cmd), env_of(side, caches[side]), work)
+                if name in FRESH_CURVES:
+                    shutil.rmtree(kept, ignore_errors=True)
+                    if aside.exists():
+                        aside.rename(kept)
                 rows.setdefault(name, {}).setdefault(side, []).append((wall, rss, code))
         print(f"repeat {r + 1}/{repeat} done ({time.perf_counter() - t_start:.0f} s)", flush=True)
     result = {"baseline": full, "commit": commit_label(), "repeat": repeat, "cold": cold, "rows": rows,
@@ -209,7 +232,8 @@ def report(res, base, sides) -> str:
             else:
                 ratios.append("-")
         lines.append(f"| {name} | " + " | ".join(t) + " | " + " | ".join(ratios) + " | " + " | ".join(m) + " |")
-    lines += ["", "Not measured: " + "; ".join(NOT_MEASURED) + "."]
+    if NOT_MEASURED:
+        lines += ["", "Not measured: " + "; ".join(NOT_MEASURED) + "."]
     if res["cold"]:
         lines += ["", "Cold (an empty code cache: the equations derived and their code generated, then the curve):",
                   "", "| command (cold) | " + " | ".join(f"{s} s" for s in sides) + " |",

@@ -17,7 +17,11 @@ gradient from ``--mu-low`` to ``--mu-high`` over the map), 1 % force noise (seed
 cantilever's deflection (force / spring constant), so that afmformats' tip position
 (height + force / k) is minus the depth.  The truth (mu*H per pixel) goes to ``<out>.truth.npy``.
 
-    python benchmarks/make_force_map.py map.jpk-force-map [--n 16] [--points 500]
+With ``--thickness LOW,HIGH`` (um) every pixel's shell has its own thickness (thicker towards the
+middle, 8 levels), its curve computed with its own scene, and the pixel table for ``shellbvp fit
+--pixel-table`` goes to ``<out>.thickness.csv``.
+
+    python benchmarks/make_force_map.py map.jpk-force-map [--n 16] [--points 500] [--thickness 0.3,1.0]
 """
 
 from __future__ import annotations
@@ -89,23 +93,55 @@ def encode(values, ab, what):
     return raw.astype(">i4").tobytes()
 
 
-def model_curves(mu_h, points, preset="fit", seed=3):
-    """(depth (m), force (N)) of every pixel: the model's curve at its mu*H, approach then retract."""
+def model_curves(mu_h, points, preset="fit", seed=3, thickness=None):
+    """(depth (m), force (N)) of every pixel: the model's curve at its mu*H, approach then retract.
+    ``thickness`` (m, an array like ``mu_h``): each pixel's curve is its own scene's, the preset at
+    that thickness (one curve computed per distinct value)."""
     from scipy.interpolate import PchipInterpolator
 
     import shellbvp as sb
 
-    c = sb.curve(sb.Scene.preset(preset), deltas=np.linspace(0.005, TOP, 120), estimate_error=False)
-    shape = PchipInterpolator(np.r_[0, c.delta], np.r_[0, c.force])
+    def shape_of(H):
+        scene = sb.Scene.preset(preset) if H is None else sb.Scene.preset(preset, thickness=H / R_L)
+        c = sb.curve(scene, deltas=np.linspace(0.005, TOP, 120), estimate_error=False)
+        if c.delta[-1] < TOP * (1 - 1e-9):
+            raise ValueError(f"the model curve at thickness {H} m ends at delta = {c.delta[-1]:.3g} ({c.stop_reason})")
+        return PchipInterpolator(np.r_[0, c.delta], np.r_[0, c.force])
+
+    shapes = {}
+    pixel_h = [None] * mu_h.size if thickness is None else [float(h) for h in np.ravel(thickness)]
+    for H in pixel_h:
+        if H not in shapes:
+            shapes[H] = shape_of(H)
     top = CONTACT + TOP * R_L
     depth = np.r_[np.linspace(0, top, points), np.linspace(top, 0, points)]
     x = np.clip((depth - CONTACT) / R_L, 0, TOP)
     rng = np.random.default_rng(seed)
-    return depth, [m * R_L * shape(x) * (1 + 0.01 * rng.standard_normal(depth.size)) for m in mu_h.ravel()]
+    return depth, [m * R_L * shapes[H](x) * (1 + 0.01 * rng.standard_normal(depth.size))
+                   for m, H in zip(mu_h.ravel(), pixel_h)]
 
 
-def write_map(out, n=16, points=500, mu_low=0.4e-3, mu_high=0.8e-3, preset="fit", pitch=2e-6):
-    """Write the N x N map to ``out``; returns the truth, mu*H (N/m) as an (n, n) array [iy, ix]."""
+def thickness_pattern(n, low=0.3e-6, high=1.0e-6, levels=8):
+    """(n, n) thickness (m) [iy, ix]: thicker towards the middle of the map (a cell's dome), in
+    ``levels`` steps from ``low`` to ``high``."""
+    iy, ix = np.mgrid[0:n, 0:n]
+    c = (n - 1) / 2
+    r = np.hypot(ix - c, iy - c) / max(np.hypot(c, c), 1e-12)
+    step = np.round((1 - r) * (levels - 1)) / max(levels - 1, 1)
+    return low + (high - low) * step
+
+
+def write_thickness_table(path, thickness):
+    """The pixel table of ``shellbvp fit --pixel-table``: ix, iy, thickness (um)."""
+    ny, nx = thickness.shape
+    rows = [f"{ix},{iy},{thickness[iy, ix] * 1e6:.9g}" for iy in range(ny) for ix in range(nx)]
+    Path(path).write_text("\n".join(["ix,iy,thickness_um", *rows]) + "\n")
+
+
+def write_map(out, n=16, points=500, mu_low=0.4e-3, mu_high=0.8e-3, preset="fit", pitch=2e-6, thickness=None):
+    """Write the N x N map to ``out``; returns the truth, mu*H (N/m) as an (n, n) array [iy, ix].
+    ``thickness``: (n, n) array (m) of each pixel's shell thickness (its curve from its own scene);
+    None: the preset's geometry everywhere."""
     tpl = {name: (TEMPLATE / name).read_text(encoding="latin-1") for name in
            ("header.properties", "shared-data-header.properties", "index-header.properties",
             "segment-0-header.properties", "segment-1-header.properties")}
@@ -115,7 +151,7 @@ def write_map(out, n=16, points=500, mu_low=0.4e-3, mu_high=0.8e-3, preset="fit"
                                                                   r"force\.scaling\.multiplier", key)))
     iy, ix = np.mgrid[0:n, 0:n]
     mu_h = mu_low + (mu_high - mu_low) * (0.6 * ix + 0.4 * iy) / max(1, n - 1)
-    depth, forces = model_curves(mu_h, points, preset)
+    depth, forces = model_curves(mu_h, points, preset, thickness=thickness)
     cx, cy = 0.0, 0.0
     size = pitch * n
     general = edit(tpl["header.properties"], {
@@ -174,11 +210,21 @@ def main(argv=None):
     ap.add_argument("--n", type=int, default=16, help="curves per side (default 16: 256 curves)")
     ap.add_argument("--points", type=int, default=500, help="points per segment (default 500)")
     ap.add_argument("--preset", default="fit", help="the model's scene (default fit)")
+    ap.add_argument("--thickness", metavar="LOW,HIGH",
+                    help="a shell thickness per pixel in um (e.g. 0.3,1.0: thicker towards the middle, 8 levels); "
+                         "the pixel table goes to <out>.thickness.csv (shellbvp fit --pixel-table)")
     args = ap.parse_args(argv)
     if not str(args.out).endswith(".jpk-force-map"):
         raise SystemExit("the output must end in .jpk-force-map")
-    truth = write_map(args.out, n=args.n, points=args.points, preset=args.preset)
+    thickness = None
+    if args.thickness:
+        low, high = (float(v) * 1e-6 for v in args.thickness.split(","))
+        thickness = thickness_pattern(args.n, low, high)
+    truth = write_map(args.out, n=args.n, points=args.points, preset=args.preset, thickness=thickness)
     np.save(f"{args.out}.truth.npy", truth)
+    if thickness is not None:
+        write_thickness_table(f"{args.out}.thickness.csv", thickness)
+        print(f"wrote {args.out}.thickness.csv: thickness {thickness.min() * 1e6:.3g} .. {thickness.max() * 1e6:.3g} um")
     print(f"wrote {args.out}: {args.n} x {args.n} curves of {args.points} + {args.points} points, "
           f"mu*H {truth.min() * 1e3:.3g} .. {truth.max() * 1e3:.3g} mN/m, R_L = {R_L * 1e6:g} um "
           f"(preset {args.preset}); truth in {args.out}.truth.npy")

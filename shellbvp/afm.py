@@ -169,6 +169,18 @@ class ForceMap:
         ``(nx, ny)``: the grid's size (from the curves' indices).
     scene : Scene
     R_L : float
+    pixel_values : PixelTable or None
+        A shape parameter per pixel (:mod:`shellbvp.pixel_table`), each pixel fitted with it
+        fixed; ``scene`` is then the scene the table's values were put into.
+    pixel_nodes : tuple of float
+        With ``pixel_values``: the values of the parameter (in its unit, the thickness in m)
+        at which model curves were computed; every pixel's curve is interpolated across them.
+    curves_computed : int or None
+        With ``pixel_values``: the model curves computed (the nodes, not the pixels).
+    interpolation_error : float or None
+        With ``pixel_values``: the largest ``max |F_interp - F| / max |F|`` at the curves
+        checked between nodes (:func:`shellbvp.batch.shared_curves`).
+    notes : list of str
     """
 
     path: str
@@ -179,6 +191,31 @@ class ForceMap:
     R_L: float
     segment: str = "loading"
     settings: dict = field(default_factory=dict)
+    pixel_values: object = None
+    pixel_nodes: tuple = ()
+    curves_computed: object = None
+    interpolation_error: object = None
+    notes: list = field(default_factory=list)
+
+    def pixel_image(self) -> np.ndarray:
+        """``(ny, nx)`` image of the per-pixel geometry value in its unit (the thickness in m,
+        :meth:`pixel_unit`), NaN where the table has none."""
+        from .shape_parameters import shape_parameter
+
+        nx, ny = self.shape
+        img = np.full((ny, nx), np.nan)
+        if self.pixel_values is None:
+            return img
+        param = shape_parameter(self.pixel_values.name)
+        for (ix, iy), x in self.pixel_values.nondimensional(self.R_L).items():
+            if ix < nx and iy < ny:
+                img[iy, ix] = param.reported(x, self.R_L)
+        return img
+
+    def pixel_unit(self) -> str:
+        from .shape_parameters import shape_parameter
+
+        return shape_parameter(self.pixel_values.name).unit if self.pixel_values is not None else ""
 
     def image(self, quantity="mu_H") -> np.ndarray:
         """``(ny, nx)`` image of ``mu_H``, ``mu_H_low``, ``mu_H_high`` (N/m), ``offset`` (m) or
@@ -227,8 +264,19 @@ class ForceMap:
         spread = (f"; mu*H median {np.median(mu):.4g} N/m, quartiles {np.percentile(mu, 25):.4g}.."
                   f"{np.percentile(mu, 75):.4g}" if mu.size else "")
         nx, ny = self.shape
-        return (f"{len(self.rows)} curves on a {nx} x {ny} grid: {counts['ok']} fitted, {counts['failed']} failed "
+        text = (f"{len(self.rows)} curves on a {nx} x {ny} grid: {counts['ok']} fitted, {counts['failed']} failed "
                 f"their checks, {counts['error']} errors{spread}")
+        if self.pixel_values is not None and self.pixel_nodes:
+            from .units import format_in
+
+            unit = self.pixel_unit()
+            show = ((lambda v: format_in(v, "um", "length")) if unit == "m" else (lambda v: f"{v:.4g}"))
+            err = self.interpolation_error
+            text += (f"; {self.pixel_values.name} per pixel from {self.pixel_values.path} "
+                     f"({show(min(self.pixel_nodes))} .. {show(max(self.pixel_nodes))}): {self.curves_computed} "
+                     f"model curves computed, {len(self.pixel_nodes)} nodes"
+                     + (f", interpolation error {err:.2g}" if err is not None else ""))
+        return text
 
     def to_hdf5(self, out, *, overwrite=False):
         """The map as a NeXus file, written atomically: ``/entry/map`` (NXdata: ``mu_H`` image
@@ -254,6 +302,10 @@ class ForceMap:
             if any(r.status == "ok" and r.result.pressure_Pa is not None for r in self.rows):
                 number_dataset(m, "pressure_Pa", self.image("pressure_Pa"), "Pa", "fitted pressure")
             number_dataset(m, "status", self.status_image(), "1", "0 fitted, 1 failed its checks, 2 error, -1 no curve")
+            if self.pixel_values is not None:
+                name = self.pixel_values.name
+                number_dataset(m, name, self.pixel_image(), self.pixel_unit(),
+                               f"{name} per pixel, given (from {printable(self.pixel_values.path)}); NaN: not given")
             if x is not None:
                 number_dataset(m, "x", x, "m", "position x of the grid's columns")
                 number_dataset(m, "y", y, "m", "position y of the grid's rows")
@@ -274,11 +326,26 @@ class ForceMap:
                                                             col(lambda r: r.mu_H_ci95[1])]).reshape(-1, 2),
                            "N/m", "95 % interval of mu*H")
             number_dataset(c, "offset", col(lambda r: r.offset), "m", "fitted contact point")
+            if self.pixel_values is not None:
+                img = self.pixel_image()
+                per_curve = np.array([img[cv.grid[1], cv.grid[0]] if cv.grid is not None else np.nan
+                                      for cv in self.curves], float)
+                number_dataset(c, name, per_curve, self.pixel_unit(), f"{name} per pixel, given")
+                number_dataset(c, f"{name}_nodes", np.array(self.pixel_nodes, float), self.pixel_unit(),
+                               f"the {name} values of the model curves computed (nodes); every pixel's curve "
+                               f"interpolated across them")
+                number_dataset(c, "interpolation_error", np.nan if self.interpolation_error is None
+                               else float(self.interpolation_error), "1",
+                               "largest max|F_interpolated - F|/max|F| at curves checked between nodes")
             string_dataset(c, "status", [r.status for r in self.rows], "ok, failed (its checks) or error")
             string_dataset(c, "message", [printable(r.message) for r in self.rows], "the fit's message")
             s = entry.create_group("sample")
             s.attrs.update({"NX_class": "NXsample", "scene": self.scene.to_json(),
-                            "description": self.scene.describe(self.R_L), "R_L_m": float(self.R_L)})
+                            "description": self.scene.describe(self.R_L)
+                            + ("" if self.pixel_values is None else
+                               f"; in place of its {self.pixel_values.name}: {self.pixel_values.name} per pixel "
+                               f"from {printable(self.pixel_values.path)} (map/{self.pixel_values.name})"),
+                            "R_L_m": float(self.R_L)})
             src = entry.create_group("source")
             src.attrs["NX_class"] = "NXnote"
             string_dataset(src, "file_name", str(self.path))

@@ -25,7 +25,7 @@ from .textdata import table_cell
 
 log = logging.getLogger(__name__)
 
-__all__ = ["BatchRow", "fit_files", "fit_records", "fit_map", "read_record", "expand_inputs", "write_table",
+__all__ = ["BatchRow", "fit_files", "fit_records", "fit_map", "shared_curves", "read_record", "expand_inputs", "write_table",
            "TABLE_COLUMNS", "DATA_SUFFIXES"]
 
 #: File names a directory given as input contributes (instrument exports are text tables).
@@ -81,6 +81,7 @@ class BatchRow:
         # names and messages are text from files: escaped for terminals and spreadsheets
         row.update({"file": table_cell(self.file), "status": self.status, "segment": segment,
                     "message": table_cell(self.message)})
+        row.update(self.extra)
         if self.record is not None:
             row["sha256"] = self.record.sha256
         r = self.result
@@ -235,7 +236,6 @@ def fit_records(scene, named, *, R_L, segment="loading", baseline="auto", on_fil
     ``ValueError`` in place of a record that could not be read (its row says why).  Records of
     comparable depth share one model curve."""
     from .fitting import fit_record
-    from .instrument import estimate_contact
 
     paths = [name for name, _ in named]
     records, rows = {}, {}
@@ -244,15 +244,7 @@ def fit_records(scene, named, *, R_L, segment="loading", baseline="auto", on_fil
             rows[path] = BatchRow(file=path, status="error", message=" ".join(str(rec).split()))
         else:
             records[path] = rec
-    depths = {}
-    for path, rec in records.items():
-        try:
-            m = rec.mask(segment)
-            d, f = rec.displacement[m], rec.force[m]
-            guess = estimate_contact(d, f)
-            depths[path] = (np.max(d) - (guess if guess is not None else min(0.0, np.min(d)))) / R_L
-        except ValueError:
-            pass
+    depths = _depths(records, segment, R_L)
     finite = [v for v in depths.values() if math.isfinite(v) and v > 0]
     common = 1.2 * max(finite) if finite else None
     out = []
@@ -278,12 +270,39 @@ def fit_records(scene, named, *, R_L, segment="loading", baseline="auto", on_fil
     return out
 
 
-def fit_map(scene, curves, *, R_L, path=None, segment="loading", baseline="auto", on_curve=None, **options):
+def _depths(records, segment, R_L) -> dict:
+    """``{name: deepest datum's delta}`` of each record's ``segment`` beyond its contact estimate
+    (records whose segment cannot be read are left out: their fits say why)."""
+    from .instrument import estimate_contact
+
+    depths = {}
+    for path, rec in records.items():
+        try:
+            m = rec.mask(segment)
+            d, f = rec.displacement[m], rec.force[m]
+            guess = estimate_contact(d, f)
+            depths[path] = (np.max(d) - (guess if guess is not None else min(0.0, np.min(d)))) / R_L
+        except ValueError:
+            pass
+    return depths
+
+
+def fit_map(scene, curves, *, R_L, path=None, segment="loading", baseline="auto", on_curve=None,
+            pixel_values=None, **options):
     """Fit every curve of a force map (:func:`shellbvp.afm.read_afm`) with one scene: a
     :class:`shellbvp.afm.ForceMap`.
 
     Curves of comparable depth share one model curve (:func:`fit_records`), so a
     map costs about one model curve plus a cheap least-squares fit per curve.
+
+    With ``pixel_values`` (a :class:`shellbvp.pixel_table.PixelTable`: a shape parameter per
+    pixel, e.g. the thickness from :func:`shellbvp.pixel_table.read_pixel_table`) each pixel's
+    scene is ``scene`` with that value, held fixed: model curves are computed at a few nodes
+    spanning the table's range (:func:`shared_curves`), and each pixel's mu*H, offset and
+    baseline are fitted on the curve interpolated at its value -- no curve per pixel.  A pixel
+    of the map missing from the table gets an error row naming it; a table that is not valid for
+    this map and scene (a pixel outside the grid, a value out of range, a map without grid
+    indices) is a ``ValueError`` before any curve.
     """
     from .afm import AFMCurve, ForceMap
 
@@ -291,18 +310,180 @@ def fit_map(scene, curves, *, R_L, path=None, segment="loading", baseline="auto"
         raise ValueError("fit_map: no curves")
     path = path or curves[0].record.path
     named = [(f"{path}#{c.index}", c.record) for c in curves]
-    rows = fit_records(scene, named, R_L=R_L, segment=segment, baseline=baseline, on_file=on_curve, **options)
     grids = [c.grid for c in curves if c.grid is not None]
     shape = (max(g[0] for g in grids) + 1, max(g[1] for g in grids) + 1) if grids else (len(curves), 1)
+    settings = {"baseline": baseline, **{k: v for k, v in options.items() if k != "progress"}}
+    if pixel_values is not None:
+        return _fit_map_per_pixel(scene, curves, named, shape, pixel_values, R_L=R_L, path=path, segment=segment,
+                                  baseline=baseline, on_curve=on_curve, settings=settings, **options)
+    rows = fit_records(scene, named, R_L=R_L, segment=segment, baseline=baseline, on_file=on_curve, **options)
     if not grids:  # no grid in the file: one row in file order
         curves = [AFMCurve(c.record, c.index, (i, 0), c.position, c.grid_geometry) for i, c in enumerate(curves)]
-    settings = {"baseline": baseline, **{k: v for k, v in options.items() if k != "progress"}}
     return ForceMap(path=str(path), curves=curves, rows=rows, shape=shape, scene=scene, R_L=R_L, segment=segment,
                     settings=settings)
 
 
+#: The most model curves a map with a geometry per pixel computes (nodes and checks)
+MAX_PIXEL_CURVES = 40
+
+
+def _pixel_values_checked(scene, curves, shape, table, R_L, options):
+    """``{(ix, iy): x}``: the table's nondimensional values, each checked against the scene and
+    the map (ValueError naming the table's line otherwise)."""
+    from .shape_parameters import shape_parameter
+
+    from .shape_parameters import SHAPE_PARAMETERS
+
+    if options.get("free") or any(options.get(f"fit_{name}") for name in SHAPE_PARAMETERS):
+        raise ValueError(f"a map with {table.name} per pixel fits mu*H, the offset and the baseline on the "
+                         f"table's geometry: no shape parameter is fitted with it")
+    missing_grid = [c.index for c in curves if c.grid is None]
+    if missing_grid:
+        raise ValueError(f"curve {missing_grid[0]} of the map has no grid index: a pixel table needs every "
+                         f"curve's (ix, iy)")
+    nx, ny = shape
+    param = shape_parameter(table.name)
+    if table.name != "thickness":  # a given thickness needs no start value in the scene
+        why = param.unavailable(scene)
+        if why:
+            raise ValueError(f"{table.path}: {why}")
+    xs = table.nondimensional(R_L)
+    for pixel, x in xs.items():
+        if not (pixel[0] < nx and pixel[1] < ny):
+            raise ValueError(f"{table.where(pixel)}: pixel {pixel} is outside the map's {nx} x {ny} grid")
+        given = f"{table.column} = {table.values[pixel]:g}"
+        if not (math.isfinite(x) and param.low_ok(x) and param.high_ok(x)):
+            raise ValueError(f"{table.where(pixel)}: {given} is out of the range of {param.description}"
+                             + (f" (H/R_L = {x:.4g}, R_L = {R_L:g} m)" if table.unit else ""))
+        try:
+            param.set(scene, x)
+        except ValueError as exc:
+            raise ValueError(f"{table.where(pixel)}: {given}: {exc}") from None
+    return xs
+
+
+def shared_curves(scene, name, values, grid, need, tol, *, interpolation_tol=None, progress=None,
+                  max_curves=MAX_PIXEL_CURVES):
+    """Model curves at nodes spanning ``values`` of the shape parameter ``name`` (nondimensional),
+    for fits with that parameter fixed at each value: a
+    :class:`~shellbvp.fitting.curves.ModelCurves` on ``grid`` whose nodes reach ``need``.
+
+    Nodes are spaced as the parameter's own search (:attr:`ShapeParameter.step`: a factor
+    sqrt 2 in the thickness) from the least to the largest value, three at least.  Then, as the profile
+    likelihood checks its estimate, a curve is computed at the middle of each interval between
+    nodes and compared with the curve interpolated there before it: where
+    ``max |F_interp - F| / max |F|`` exceeds ``interpolation_tol`` (default ``tol``, the
+    curves' own collocation tolerance) the interval's halves are checked in turn.  Every curve
+    computed joins the nodes, so the curves computed are the nodes; ``.interpolation_error`` is
+    the largest error of the last check of each interval (None with a single value), and
+    ``.notes`` says if ``max_curves`` stopped the refinement first.
+
+    Raises
+    ------
+    ValueError
+        A node's curve ends before ``need`` (the deepest data), or cannot be computed.
+    """
+    from .fitting.curves import ModelCurves
+    from .shape_parameters import shape_parameter
+
+    param = shape_parameter(name)
+    limit = tol if interpolation_tol is None else float(interpolation_tol)
+    curves = ModelCurves(lambda th: param.set(scene, param.from_theta(th)), grid, tol, need, [0], progress)
+    curves.notes = []
+
+    def add(theta):
+        if not curves.add(theta):
+            raise ValueError(f"the model curve at {name} = {param.from_theta(theta):.4g} ends before the deepest "
+                             f"data (delta = {need:.4g}): fit shallower data, or check the units and R_L")
+
+    lo, hi = (param.to_theta(v) for v in (min(values), max(values)))
+    # at least three nodes: across two a spline in theta is a straight line
+    n = max(2, math.ceil((hi - lo) / param.step(scene) - 1e-9)) if hi > lo else 0
+    for theta in np.linspace(lo, hi, n + 1):
+        add(float(theta))
+    errors, todo = [], [(a, b) for a, b in zip(curves.thetas[:-1], curves.thetas[1:])]
+    while todo:
+        a, b = todo.pop(0)
+        if curves.counter[0] >= max_curves:
+            curves.notes.append(f"stopped at {max_curves} model curves with intervals between nodes unchecked; "
+                                f"the interpolation error there is not known")
+            errors.append(math.nan)
+            break
+        mid = 0.5 * (a + b)
+        P, _, top = curves.at(mid)
+        add(mid)
+        c = curves.nodes[mid]
+        k = min(len(c), int(np.sum(grid <= top + 1e-15)))
+        err = float(np.max(np.abs(P(c.delta[:k]) - c.force[:k])) / np.max(np.abs(c.force[:k])))
+        log.info("shared curves: %s = %.4g: interpolation error %.2g", name, param.from_theta(mid), err)
+        if err > limit:
+            todo += [(a, mid), (mid, b)]
+        else:
+            errors.append(err)
+    curves.interpolation_error = max(errors) if errors else None
+    return curves
+
+
+def _fit_map_per_pixel(scene, curves, named, shape, table, *, R_L, path, segment, baseline, on_curve, settings,
+                       tol=1e-6, delta_max=None, progress=None, **options):
+    """:func:`fit_map` with a shape parameter per pixel from ``table``."""
+    from .afm import ForceMap
+    from .fitting import N_DEPTHS, fit_record
+    from .shape_parameters import shape_parameter
+
+    param = shape_parameter(table.name)
+    xs = _pixel_values_checked(scene, curves, shape, table, R_L, options)
+    rows, records = {}, {}
+    for c, (name, rec) in zip(curves, named):
+        if c.grid not in xs:
+            rows[name] = BatchRow(file=name, status="error", record=rec,
+                                  message=f"pixel {c.grid} is not in the pixel table {table.path}")
+        else:
+            records[name] = rec
+    if not records:
+        raise ValueError(f"{table.path}: none of the map's pixels is in the table")
+    depths = [v for v in _depths(records, segment, R_L).values() if math.isfinite(v) and v > 0]
+    shared = None
+    if depths:
+        need = max(depths)
+        dm = float(delta_max) if delta_max is not None else 1.2 * need
+        grid = dm * np.arange(1, N_DEPTHS + 1) / N_DEPTHS
+        values = [xs[c.grid] for c in curves if f"{path}#{c.index}" in records]
+        shared = shared_curves(scene, table.name, values, grid, need, tol, progress=progress)
+    out = []
+    for c, (name, rec) in zip(curves, named):
+        if name not in rows:
+            x = xs[c.grid]
+            try:
+                if shared is None:
+                    raise ValueError("no depth of indentation could be read from any curve of the map")
+                res, used = fit_record(param.set(scene, x), rec, R_L=R_L, segment=segment, baseline=baseline,
+                                       shared=(shared, param.to_theta(x)), tol=tol, **options)
+                rows[name] = BatchRow(file=name, status="ok" if res.success else "failed", result=res, record=rec,
+                                      used=used, message=res.message)
+            except ValueError as exc:
+                rows[name] = BatchRow(file=name, status="error", record=rec, message=" ".join(str(exc).split()))
+            rows[name].extra[_pixel_column(param)] = _num(param.reported(x, R_L))
+        log.info("map: %s: %s", name, rows[name].status)
+        out.append(rows[name])
+        if on_curve is not None:
+            on_curve(rows[name])
+    nodes = tuple(float(param.reported(param.from_theta(t), R_L)) for t in shared.thetas) if shared else ()
+    return ForceMap(path=str(path), curves=curves, rows=out, shape=shape, scene=scene, R_L=R_L, segment=segment,
+                    settings=settings, pixel_values=table,
+                    pixel_nodes=nodes, curves_computed=shared.counter[0] if shared else 0,
+                    interpolation_error=shared.interpolation_error if shared else None,
+                    notes=list(shared.notes) if shared else [])
+
+
+def _pixel_column(param) -> str:
+    """The results table's column of a per-pixel geometry value, with its unit."""
+    return _with_unit(f"{param.name} per pixel", param.unit)
+
+
 def write_table(path, rows, segment="loading", *, overwrite=False):
-    """Write the results table (CSV, :data:`TABLE_COLUMNS`) atomically.
+    """Write the results table (CSV, :data:`TABLE_COLUMNS`, then the rows' extra columns such as
+    a force map's geometry per pixel) atomically.
 
     Raises
     ------
@@ -316,9 +497,10 @@ def write_table(path, rows, segment="loading", *, overwrite=False):
         raise FileExistsError(f"{path} exists; pass overwrite=True (CLI: --overwrite) to replace it")
     check_output_path(path, overwrite=True)
     buf = io.StringIO()
-    w = csv.DictWriter(buf, fieldnames=TABLE_COLUMNS, lineterminator="\n")
+    extra = list(dict.fromkeys(k for row in rows for k in row.extra))
+    w = csv.DictWriter(buf, fieldnames=TABLE_COLUMNS + tuple(extra), lineterminator="\n")
     w.writeheader()
     for row in rows:
-        w.writerow(row.table_row(segment))
+        w.writerow({**dict.fromkeys(extra, ""), **row.table_row(segment)})
     with atomic_file(path) as tmp:
         tmp.write_text(buf.getvalue(), encoding="utf-8", newline="")

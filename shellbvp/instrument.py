@@ -39,7 +39,7 @@ from .segments import FIT_SEGMENTS, SEGMENTS, estimate_contact, segment, smoothe
 from .units import PLAIN_NUMBER, normalize_unit, unit_factor, unit_kind
 
 __all__ = ["InstrumentRecord", "Table", "read_table", "read_instrument", "read_force_csv", "segment",
-           "record_from_arrays",
+           "record_from_arrays", "header_name_and_unit", "cell_number",
            "estimate_contact", "SEGMENTS", "FIT_SEGMENTS", "sha256_of", "smoothed_slope"]
 
 #: Column names that say what a column holds (lower case, units removed): names that say it
@@ -117,6 +117,19 @@ def _unit_of(name):
         return normalize_unit(m.group(1))
     suffix = _unit_suffix(name)
     return normalize_unit(suffix) if suffix else None
+
+
+def header_name_and_unit(name):
+    """``(bare lower-case name, unit or None)`` of a column header: ``'Thickness (um)'`` and
+    ``'thickness_um'`` give ``('thickness', 'um')`` (other tables, such as a force map's pixel
+    table, name their columns as instrument files do)."""
+    return _bare_name(name), _unit_of(name)
+
+
+def cell_number(text):
+    """A table cell as a float as the instrument reader reads it (a decimal comma allowed; ""
+    and "nan" NaN), or None when it is no plain finite number."""
+    return _number(text)
 
 
 def _bare_name(name):

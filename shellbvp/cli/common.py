@@ -269,14 +269,16 @@ def over_rim_radius(args, length, option):
     return length.si / radius.si
 
 
-def require_sample(args):
-    """``fit`` names its sample: a preset, or the geometry (no silent default hemisphere)."""
+def require_sample(args, bending_per_pixel=False):
+    """``fit`` names its sample: a preset, or the geometry (no silent default hemisphere);
+    ``bending_per_pixel``: a force map's pixel table gives the thickness (or beta)."""
     if args.preset is not None:
         return
     missing = [what for what, given in (
         ("the indenter: --indenter-radius (or --rho)", args.rho is not None or args.indenter_radius is not None),
         ("the shell's shape: --rise (or --gamma)", args.gamma is not None or args.rise is not None),
-        ("its bending stiffness: --thickness (or --beta)", args.thickness is not None or args.beta is not None))
+        ("its bending stiffness: --thickness (or --beta)",
+         args.thickness is not None or args.beta is not None or bending_per_pixel))
         if not given]
     if missing:
         raise ValueError("fit needs the sample: --preset NAME (`shellbvp presets`), or its geometry; missing "

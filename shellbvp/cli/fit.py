@@ -34,6 +34,11 @@ def add_parser(sub):
     f.add_argument("--scheduler", help="with VALUE+-U parameters: run their fits on this Dask scheduler")
     f.add_argument("--radius", "--rim-radius", required=True, type=quantity("length"),
                    help="rim radius R_L of the sample with its unit, e.g. 0.3mm")
+    f.add_argument("--pixel-table", dest="pixel_table", metavar="CSV",
+                   help="a force map: the shell's geometry per pixel, a table with the columns ix, iy and one of "
+                        "thickness (with its unit: thickness_um, 'thickness (nm)'; bare: H/R_L), beta, alpha; "
+                        "each pixel fitted with its value fixed (model curves at a few values spanning the "
+                        "table's range, interpolated)")
     f.add_argument("--columns", help="displacement,force columns by name or 0-based index (default 0,1)")
     f.add_argument("--units", help="units of the two columns, e.g. mm,mN (default: from the header)")
     f.add_argument("--invert", action="append", choices=("displacement", "force"),
@@ -84,9 +89,30 @@ def _split_uncertain(args):
     return uncertainty
 
 
-def _fit_inputs(args):
+def _bending_per_pixel(pixel_values):
+    return pixel_values is not None and pixel_values.name in ("thickness", "beta")
+
+
+def _pixel_table(args, files, folder):
+    """``--pixel-table``'s table read and checked (before the map is read), or None."""
+    if args.pixel_table is None:
+        return None
+    from ..afm import is_afm_file
+    from ..pixel_table import read_pixel_table
+
+    if len(files) != 1 or folder or not is_afm_file(files[0]):
+        raise ValueError("--pixel-table is for one force map (an AFM file such as .jpk-force-map)")
+    table = read_pixel_table(args.pixel_table)
+    given = {"thickness": ("--thickness", "--beta"), "beta": ("--thickness", "--beta"), "alpha": ("--alpha",)}
+    clash = [o for o in given[table.name] if getattr(args, o[2:]) is not None]
+    if clash:
+        raise ValueError(f"{args.pixel_table} gives the {table.name} per pixel: leave out {', '.join(clash)}")
+    return table
+
+
+def _fit_inputs(args, pixel_values=None):
     """The scene, R_L and the reading and fitting options of ``fit``, checked before any work."""
-    require_sample(args)
+    require_sample(args, bending_per_pixel=_bending_per_pixel(pixel_values))
     scene = scene_from_args(args)
     units = None
     if args.units:
@@ -153,14 +179,18 @@ def run(args):
     files = expand_inputs(inputs)
     uncertainty = _split_uncertain(args)
     folder = any(Path(x).is_dir() for x in inputs)
+    pixel_values = _pixel_table(args, files, folder)
     map_curves = None
     if len(files) == 1 and not folder and is_afm_file(files[0]):
-        require_sample(args)  # its one-line error before the file is read
+        # its one-line error before the file is read
+        require_sample(args, bending_per_pixel=_bending_per_pixel(pixel_values))
         curves = read_afm(files[0])
         if len(curves) > 1:  # a force map: every curve, into a map
             if uncertainty:
                 raise ValueError("VALUE+-U (the geometry's uncertainty) is for one curve, not a force map")
             map_curves = curves
+    if pixel_values is not None and map_curves is None:
+        raise ValueError(f"--pixel-table is for a force map; {files[0]} holds one curve")
     if map_curves is None and (len(files) > 1 or args.table or folder):
         if uncertainty:
             raise ValueError("VALUE+-U (the geometry's uncertainty) is for one file at a time, not a batch")
@@ -169,10 +199,10 @@ def run(args):
         check_output_path(args.output, overwrite=args.force)
     if args.report is not None:
         check_report_path(args.report, overwrite=args.force)
-    scene, R_L, reading, options = _fit_inputs(args)
+    scene, R_L, reading, options = _fit_inputs(args, pixel_values)
     options["progress"] = curve_bars(args)
     if map_curves is not None:
-        return _fit_map(args, files[0], map_curves, scene, R_L, reading, options)
+        return _fit_map(args, files[0], map_curves, scene, R_L, reading, options, pixel_values)
     record = read_record(files[0], **reading)
     res, used = fit_record(scene, record, R_L=R_L, segment=args.segment, baseline=args.baseline, **options)
     geometry = None
@@ -266,9 +296,10 @@ def _fit_batch(args, files):
     return 0 if ok else 1
 
 
-def _fit_map(args, path, curves, scene, R_L, reading, options):
-    """``shellbvp fit MAP.jpk-force-map [-o map.h5] [--table map.csv] [--report map.png]``: every
-    curve with the same scene; exit 0 when every curve was fitted, 1 otherwise."""
+def _fit_map(args, path, curves, scene, R_L, reading, options, pixel_values=None):
+    """``shellbvp fit MAP.jpk-force-map [-o map.h5] [--table map.csv] [--report map.png]
+    [--pixel-table geometry.csv]``: every curve with the same scene (or with the table's geometry
+    per pixel); exit 0 when every curve was fitted, 1 otherwise."""
     from ..afm import refuse_text_options
     from ..batch import fit_map, write_table
     from ..paths import check_output_path
@@ -285,7 +316,7 @@ def _fit_map(args, path, curves, scene, R_L, reading, options):
 
     try:
         fm = fit_map(scene, curves, R_L=R_L, path=path, segment=args.segment, baseline=args.baseline,
-                     on_curve=step, **options)
+                     on_curve=step, pixel_values=pixel_values, **options)
     finally:
         bar.close()
     ok = all(r.status == "ok" for r in fm.rows)
@@ -297,16 +328,23 @@ def _fit_map(args, path, curves, scene, R_L, reading, options):
         fm.plot(args.report)
     wrote = [w for w in (args.table, args.output, args.report) if w is not None]
     if args.json:
-        docs = [{"file": r.file, "grid_index": list(c.grid), "status": r.status, "message": r.message,
+        docs = [{"file": r.file, "grid_index": list(c.grid), "status": r.status, "message": r.message, **r.extra,
                  **(r.result.to_dict() if r.result is not None else {})} for c, r in zip(fm.curves, fm.rows)]
-        print(json.dumps(strict_json({"map": str(path), "shape": list(fm.shape), "curves": docs, "success": ok,
-                                       "exit_status": 0 if ok else 1}), allow_nan=False))
+        per_pixel = {} if pixel_values is None else {"per_pixel": {
+            "parameter": pixel_values.name, "table": str(pixel_values.path), "unit": fm.pixel_unit(),
+            "nodes": list(fm.pixel_nodes), "curves_computed": fm.curves_computed,
+            "interpolation_error": fm.interpolation_error, "notes": fm.notes}}
+        print(json.dumps(strict_json({"map": str(path), "shape": list(fm.shape), "curves": docs, **per_pixel,
+                                      "success": ok, "exit_status": 0 if ok else 1}), allow_nan=False))
         for w in wrote:
             print(f"wrote {w}", file=sys.stderr)
     else:
         say(f"data   = {path}: a force map of {len(curves)} curves; fitted the {args.segment} segment of each")
-        say(f"scene  = {scene.describe(R_L)}")
+        say(f"scene  = {scene.describe(R_L)}" + ("" if pixel_values is None else
+                                                 f"; in place of its {pixel_values.name}: the pixel table's"))
         say(f"map    = {fm.summary()}")
+        for note in fm.notes:
+            say(f"note: {note}")
         for w in wrote:
             say(f"wrote {w}")
     return 0 if ok else 1

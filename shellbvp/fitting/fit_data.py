@@ -70,7 +70,7 @@ def _check_data(d, f, k, origin=0.0):
 
 
 def fit(scene, displacement, force, *, R_L, fit_offset=True, free=(), bounds=None, weights=None, floor=0.05,
-        delta_max=None, tol=1e-6, loss="linear", baseline="none", contact_guess=None, progress=None,
+        delta_max=None, tol=1e-6, loss="linear", baseline="none", contact_guess=None, progress=None, shared=None,
         stability=False, **aliases):
     """Least-squares fit of mu*H (the displacement origin, and a shape parameter) to measured data.
 
@@ -115,6 +115,12 @@ def fit(scene, displacement, force, *, R_L, fit_offset=True, free=(), bounds=Non
     bounds : dict, optional
         ``{name: (low, high)}``: the search range of the free parameter (nondimensional, as in
         the scene); default the parameter's own.
+    shared : tuple, optional
+        ``(model_curves, theta)``: F(delta) interpolated at ``theta`` across the node curves of a
+        :class:`~shellbvp.fitting.curves.ModelCurves` built by the caller (a force map with a
+        geometry per pixel, :func:`shellbvp.batch.fit_map`): no curve is computed, ``scene`` is
+        the one at ``theta`` (reported), ``delta_max`` and ``tol`` are the curves'; no shape
+        parameter may be free.
     **aliases
         ``fit_<name>=True`` and ``<name>_bounds=(low, high)`` for each shape parameter (e.g.
         ``fit_beta=True, beta_bounds=(1e-3, 0.1)``): the same as ``free`` and ``bounds``.
@@ -199,6 +205,13 @@ def fit(scene, displacement, force, *, R_L, fit_offset=True, free=(), bounds=Non
     counter = [0]
     mdl = LeastSquaresModel(d, f, R_L, fit_offset, baseline, loss)
     noise = NoiseModel(weights, floor)
+    if shared is not None:
+        if sp is not None:
+            raise ValueError(f"{sp.name} is given per pixel: it cannot also be fitted")
+        if stability:
+            raise ValueError("stability is checked for one fit at a time, not per pixel of a map on shared curves "
+                             "(each pixel would need a curve of its own)")
+        return _fit_on_shared(shared, scene, mdl, noise, depth, k, keep, weights, baseline)
     if sp is None:
         shape = ModelCurves(lambda th: scene, grid, tol, depth, counter, progress)
         shape.add(None)
@@ -241,6 +254,20 @@ def _check_axisymmetry(res, deepest, tol):
             f"{first.delta:.4g} (mode n = {first.mode}, displacement {res.offset + first.delta * res.R_L:.4g} m): past "
             f"it the shell is not axisymmetric and the model does not describe it; fit the data up to that depth")
         res.warning_codes.append("unstable_depths")
+
+
+def _fit_on_shared(shared, scene, mdl, noise, depth, k, keep, weights, baseline):
+    """:func:`fit` on the curve interpolated at ``theta`` across shared node curves (no curve computed)."""
+    curves, theta = shared
+    P, dP, top = curves.at(theta)
+    if depth > top * (1 + 1e-9):
+        raise ValueError(f"the data reach delta = {depth:.4g} (deepest displacement / R_L), beyond the shared "
+                         f"model curves' end at delta = {top:.4g}")
+    res, rss, J, w = noise.irls(mdl, P, dP, top)
+    near = min(curves.thetas, key=lambda t: abs(t - theta))
+    fitted = Fitted(res, rss, J, w, scene, curves.nodes[near], P, top,
+                    interpolation_error=getattr(curves, "interpolation_error", None))
+    return result_of(fitted, mdl, None, k, [], keep, weights, baseline, 0)
 
 
 def free_parameters(free=(), bounds=None, aliases=None):

@@ -1,0 +1,156 @@
+"""A force map's geometry per pixel, from a table (issue 46, item 3).
+
+A CSV (or any table :func:`shellbvp.instrument.read_table` reads) with the columns ``ix`` and
+``iy`` (the pixel on the map's grid, integers from 0) and ONE geometry column, named by a shape
+parameter of :data:`PIXEL_PARAMETERS` with its unit the way the package's tables write units:
+
+* ``thickness_um``, ``thickness (um)``, ``thickness [nm]`` ... -- the shell's thickness H, any
+  length unit; a bare ``thickness`` is the nondimensional ``H / R_L`` (as ``--thickness 0.05``);
+* ``beta`` -- the bending stiffness ``B/(mu R_L^2)`` (nondimensional);
+* ``alpha`` -- the Mooney-Rivlin alpha (nondimensional; needs a Mooney-Rivlin scene).
+
+The pressure is not among them: its nondimensional value ``p R_L/(mu H)`` depends on the mu*H
+the fit estimates, so a pressure in Pa cannot be held fixed before the fit.
+
+:func:`read_pixel_table` reads and checks the file (one-line ``ValueError`` naming the column or
+the row); :class:`PixelTable` holds it.  :func:`shellbvp.batch.fit_map` fits a map with it.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+__all__ = ["PIXEL_PARAMETERS", "PixelTable", "read_pixel_table"]
+
+#: Shape parameters a pixel table may give, with the kind of unit their column may carry
+#: ("" : nondimensional only).
+PIXEL_PARAMETERS = {"thickness": "length", "beta": "", "alpha": ""}
+
+
+@dataclass
+class PixelTable:
+    """A geometry value per pixel of a force map.
+
+    Attributes
+    ----------
+    name : str
+        The shape parameter (a key of :data:`PIXEL_PARAMETERS`).
+    values : dict
+        ``{(ix, iy): value}`` in ``unit``.
+    unit : str
+        The values' unit as the table wrote it (``"um"``); ``""``: nondimensional (the scene's
+        own value, e.g. ``H / R_L`` for the thickness).
+    path : str
+        Where the table came from (for messages).
+    lines : dict
+        ``{(ix, iy): line number in the file}`` (for messages).
+
+    Examples
+    --------
+    >>> t = PixelTable("thickness", {(0, 0): 0.5, (1, 0): 0.7}, unit="um")
+    >>> {p: round(x, 12) for p, x in t.nondimensional(R_L=10e-6).items()}      # H / R_L
+    {(0, 0): 0.05, (1, 0): 0.07}
+    """
+
+    name: str
+    values: dict
+    unit: str = ""
+    path: str = "the pixel table"
+    lines: dict = field(default_factory=dict)
+
+    def __post_init__(self):
+        if self.name not in PIXEL_PARAMETERS:
+            raise ValueError(f"a pixel table gives one of {', '.join(PIXEL_PARAMETERS)}; got {self.name!r}")
+        kind = PIXEL_PARAMETERS[self.name]
+        if self.unit:
+            from .units import unit_factor
+
+            if not kind:
+                raise ValueError(f"{self.path}: column {self.name!r} is nondimensional; got the unit {self.unit!r}")
+            self._factor = unit_factor(self.unit, kind)  # ValueError naming the unit's kind
+        else:
+            self._factor = None
+        if not self.values:
+            raise ValueError(f"{self.path}: no pixels")
+
+    @property
+    def column(self) -> str:
+        return f"{self.name} ({self.unit})" if self.unit else self.name
+
+    def where(self, pixel) -> str:
+        line = self.lines.get(pixel)
+        return f"{self.path}, line {line}" if line is not None else f"{self.path}, pixel {pixel}"
+
+    def nondimensional(self, R_L) -> dict:
+        """``{(ix, iy): x}``: the scene's nondimensional value of every pixel (a length over R_L)."""
+        if self._factor is None:
+            return dict(self.values)
+        return {p: v * self._factor / R_L for p, v in self.values.items()}
+
+
+def read_pixel_table(path) -> PixelTable:
+    """The table of a geometry value per pixel (module docstring): checked before any curve.
+
+    Raises
+    ------
+    ValueError
+        One line naming the file and the column or line: a missing ``ix``/``iy`` or geometry
+        column, two geometry columns, an unknown unit, a pixel index that is not an integer
+        >= 0, a value that is not a finite number > 0 (alpha: >= 0), a pixel given twice.
+    """
+    from .instrument import cell_number, header_name_and_unit, read_table
+
+    table = read_table(path)
+    if not table.header:
+        raise ValueError(f"{path}: no header row; the pixel table needs the columns ix, iy and one of "
+                         f"{', '.join(PIXEL_PARAMETERS)} (e.g. thickness_um)")
+    names = [header_name_and_unit(h)[0] for h in table.header]
+    for need in ("ix", "iy"):
+        if names.count(need) != 1:
+            raise ValueError(f"{path}: needs one column {need!r} (the pixel's grid index); its columns are "
+                             f"{', '.join(repr(h) for h in table.header)}")
+    geometry = [i for i, n in enumerate(names) if n in PIXEL_PARAMETERS]
+    if len(geometry) != 1:
+        what = "no" if not geometry else f"{len(geometry)} ({', '.join(table.header[i] for i in geometry)})"
+        raise ValueError(f"{path}: needs exactly one geometry column, one of {', '.join(PIXEL_PARAMETERS)} with "
+                         f"its unit (e.g. thickness_um, 'thickness (um)'); found {what}")
+    g = geometry[0]
+    name = names[g]
+    unit = ""
+    if table.header_units is not None and g < len(table.header_units) and table.header_units[g]:
+        unit = table.header_units[g]
+    elif header_name_and_unit(table.header[g])[1]:
+        unit = header_name_and_unit(table.header[g])[1]
+    if unit == "1":
+        unit = ""
+    kind = PIXEL_PARAMETERS[name]
+    if unit:
+        from .units import unit_kind
+
+        if not kind:
+            raise ValueError(f"{path}: column {table.header[g]!r}: {name} is nondimensional (no unit)")
+        if unit_kind(unit, extended=True) != kind:
+            raise ValueError(f"{path}: column {table.header[g]!r}: {unit!r} is not a {kind} unit")
+    ix, iy = names.index("ix"), names.index("iy")
+    values, lines = {}, {}
+    for cells, line in zip(table.rows, table.line):
+        where = f"{path}, line {line}"
+        if len(cells) != len(table.header):
+            raise ValueError(f"{where}: {len(cells)} cells, the header has {len(table.header)}")
+        pixel = []
+        for col in (ix, iy):
+            v = cell_number(cells[col])
+            if v is None or not math.isfinite(v) or v < 0 or v != int(v):
+                raise ValueError(f"{where}: column {table.header[col]!r} must be a grid index (an integer >= 0); "
+                                 f"got {cells[col]!r}")
+            pixel.append(int(v))
+        pixel = tuple(pixel)
+        v = cell_number(cells[g])
+        if v is None or not math.isfinite(v) or not (v >= 0 if name == "alpha" else v > 0):
+            raise ValueError(f"{where}: column {table.header[g]!r} must be a finite number "
+                             f"{'>= 0' if name == 'alpha' else '> 0'}; got {cells[g]!r}")
+        if pixel in values:
+            raise ValueError(f"{where}: pixel {pixel} again (first on line {lines[pixel]})")
+        values[pixel], lines[pixel] = v, line
+    return PixelTable(name, values, unit=unit, path=str(path), lines=lines)
