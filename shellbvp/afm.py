@@ -154,6 +154,16 @@ def curves_from_afm(datasets, path, *, sha256=None) -> list:
     return out
 
 
+def mu_H_spread(mu, with_range=False) -> str:
+    """Median and quartiles (and range) of mu*H values (N/m) in one unit that suits their size:
+    N/m, mN/m or uN/m (a cell wall's 0.0006 N/m reads 0.6 mN/m)."""
+    scale, unit = next(((f, u) for f, u in ((1.0, "N/m"), (1e-3, "mN/m"), (1e-6, "uN/m"))
+                        if abs(np.median(mu)) >= 0.1 * f), (1e-6, "uN/m"))
+    q = np.percentile(mu, [25, 50, 75]) / scale
+    text = f"median {q[1]:.4g} {unit}, quartiles {q[0]:.4g}..{q[2]:.4g} {unit}"
+    return text + (f", range {mu.min() / scale:.4g}..{mu.max() / scale:.4g} {unit}" if with_range else "")
+
+
 @dataclass
 class ForceMap:
     """Every curve of a force map fitted with one scene (:func:`shellbvp.batch.fit_map`).
@@ -261,8 +271,7 @@ class ForceMap:
     def summary(self) -> str:
         counts = {s: sum(r.status == s for r in self.rows) for s in ("ok", "failed", "error")}
         mu = np.array([r.result.mu_H for r in self.rows if r.status == "ok"])
-        spread = (f"; mu*H median {np.median(mu):.4g} N/m, quartiles {np.percentile(mu, 25):.4g}.."
-                  f"{np.percentile(mu, 75):.4g}" if mu.size else "")
+        spread = f"; mu*H {mu_H_spread(mu)}" if mu.size else ""
         nx, ny = self.shape
         text = (f"{len(self.rows)} curves on a {nx} x {ny} grid: {counts['ok']} fitted, {counts['failed']} failed "
                 f"their checks, {counts['error']} errors{spread}")
@@ -426,8 +435,7 @@ class MapFile:
         lines = [f"source:    {self.source}", f"sample:    {self.sample}",
                  f"grid:      {nx} x {ny}: " + ", ".join(f"{v} {k}" for k, v in counts.items())]
         if mu.size:
-            lines.append(f"mu*H:      median {np.median(mu):.4g} N/m, quartiles {np.percentile(mu, 25):.4g}.."
-                         f"{np.percentile(mu, 75):.4g}, range {mu.min():.4g}..{mu.max():.4g}")
+            lines.append(f"mu*H:      {mu_H_spread(mu, with_range=True)}")
         if self.x is not None:
             lines.append(f"area:      x {self.x.min() * 1e6:.4g}..{self.x.max() * 1e6:.4g} um, "
                          f"y {self.y.min() * 1e6:.4g}..{self.y.max() * 1e6:.4g} um (cell centres)")

@@ -115,7 +115,7 @@ def test_a_force_map_file_reads_back_and_info_and_plot_take_it(synthetic_map, tm
     assert main(["info", str(out)]) == 0
     text = capsys.readouterr().out
     assert "grid:      2 x 2: 4 fitted, 0 failed their checks, 0 errors, 0 no curve" in text
-    assert f"median {np.median(fm.image('mu_H')):.4g} N/m" in text
+    assert f"median {np.median(fm.image('mu_H')) * 1e3:.4g} mN/m" in text  # 0.045 N/m reads in mN/m
     png = tmp_path / "map.png"
     assert main(["plot", str(out), "-o", str(png)]) == 0 and png.stat().st_size > 0
     with h5py.File(out, "a") as f:
@@ -185,3 +185,13 @@ def test_a_synthetic_jpk_force_map_file_is_read_by_afmformats_and_fitted_to_its_
     assert "9 fitted" in capsys.readouterr().out
     with h5py.File(out) as f:
         np.testing.assert_allclose(f["entry/map/mu_H"][()], truth, rtol=0.01)   # 1 % force noise, 150 rows
+
+
+def test_a_maps_spread_of_mu_H_reads_in_a_unit_of_its_size():
+    from shellbvp.afm import mu_H_spread
+
+    assert mu_H_spread(np.array([0.0004, 0.0005998, 0.0009])) == \
+        "median 0.5998 mN/m, quartiles 0.4999..0.7499 mN/m"
+    assert mu_H_spread(np.array([39.9, 40.1, 52.0]), with_range=True) == \
+        "median 40.1 N/m, quartiles 40..46.05 N/m, range 39.9..52 N/m"
+    assert mu_H_spread(np.array([2e-7, 3e-7])).endswith("uN/m")
