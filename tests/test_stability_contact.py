@@ -269,7 +269,6 @@ def test_split_contact_eigenvalues_converge():
     (Solution(success=True, status=0, topology="cap+cylinder"), "topology 'cap\\+cylinder' is not supported"),
     (Solution(success=True, status=0, topology="cap+cylinder"), "over the tip's end"),
     (Solution(success=True, status=0, topology="cap", scene=sb.Scene(contact="paper")), "contact='smooth'"),
-    (Solution(success=True, status=0, topology="cap", scene=sb.Scene(), contact_edge="corner"), "corner"),
 ])
 def test_unsupported_states_are_refused_in_one_line(state, match):
     with pytest.raises(ValueError, match=match) as err:

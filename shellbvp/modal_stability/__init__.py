@@ -64,7 +64,7 @@ a state of beta 1e-5 (141 elements, n = 0..33) takes about 1 s.
 
 States on the tip (``contact="smooth"``: the cap, the point load, lifted and split contact)
 -------------------------------------------------------------------------------------------
-Every chain of free regions and regions on the tip joined by smooth contact edges and lines
+Every chain of free regions and regions on the tip joined by contact edges and lines
 (:func:`supported`) is handled alike: ``w = w' = 0`` on each region on the tip, ``w = 0`` at a
 line, and at each edge and line the ring force's term below; the single cap serves to derive it.
 
@@ -156,13 +156,51 @@ less than 3e-4 with twice the elements or with S0 = 1e-3; the dome's first n >= 
 A band on the indenter's cylinder is a region on the tip like the others (its meridian is
 straight: ``kappa_s = 0``, and only the hoop term remains).
 
+*Corners* (a contact edge past the convexity limit, ``contact_edge == "corner"``).  There lambda_s and kappa_s jump (SPEC 2b, ``shellbvp.corner``), and
+the displacement's class changes: the perturbed surface must keep one normal across the corner,
+i.e. the rotation of the normal about e_theta, ``omega = (w' + phi' u)/(lambda_s Psi)``
+(phi' = d phi/dS = lambda_s Psi kappa_s), is continuous, so ``w'`` jumps with lambda_s and
+kappa_s; ``u'`` and ``v'`` may jump (the energy holds them in L^2 only).  The mesh has twin nodes
+at the corner (:func:`fem.corner_ties`).  With ``w'`` held continuous instead (C^1 elements
+across the corner) the perturbed surface is kinked at first order and the piecewise form's
+``u u''`` and ``v v''`` terms leave point terms in ``u'(Sc)`` and ``v'(Sc)`` at the corner: the
+eigenvalues fell without bound as the mesh was refined (-2.5e3, -1.1e4 with 40, 80 elements on
+the base scene at delta 0.65).
+
+At second order the displacement still kinks the normal: on each side the normal turns by
+``R = -omega a/(lambda_s Psi) - q c/(lambda_s Psi r)`` (plus a part common to both), with
+``a = u' - phi' w``, ``c = v'``, ``q = v sin(phi) - n w`` (the theta-factors averaged).  The
+state that the energy sees is ``x0 + eta xi + eta^2 zeta`` with ``zeta`` restoring one normal;
+``zeta``'s first-order energy is a boundary term of the equilibrium, the moment ``r M_s`` (the
+conjugate of phi') times zeta's rotation at the corner.  On the tip's side of a contact edge the
+shell's normal is the tip's, so that side's total second-order rotation is fixed by the sliding;
+eliminating zeta, the corner adds
+
+.. math:: (rM_s)_+ R_+ - (rM_s)_- R_- + \big[(rM_s)_- - (rM_s)_+\big]
+          \frac{\kappa_s' u^2 + \kappa_\theta' v^2}{2\lambda_s\Psi}\Big|_{\rm tip\ side}
+
+(theta-averaged, :func:`fem.corner_energy`; ``kappa'`` the tip's curvatures' S-derivatives, zero
+on a spherical tip).  The moments
+differ across a contact edge (by 0.6-4 % on the base scene at delta 0.7-0.9).  Check
+(tests/test_stability_corner.py): along a path that slides the shell exactly along the spherical
+tip and keeps it smooth at the edge, the exact energy's second derivative equals the discrete
+form's to 7e-7 and 5e-6 at delta 0.7 and 0.9; without the term it misses by 25 %, with one moment
+for both sides by 0.4 %; the eigenvalues converge (n = 0..5 within 1e-4 from 40 to 160 elements)
+and step smoothly where the corner is born.  Not checked by that test: the torsion's part (v; its
+coefficient is the one that keeps the spectrum bounded, which the convergence shows) and the tip
+curvature's slope term (no non-spherical tip in the check).
+
+The corner itself stays at its material point: moving it through the material (its position a
+function of theta) is a degree of freedom of its own, with the Eshelby condition as its first
+variation, that the displacement modes do not carry.  A negative eigenvalue of a cornered state
+therefore proves it unstable; a positive one is stability against the perturbations that keep
+the corner where it is (``Stability.held_corners`` names them).
+
 Refused (ValueError, one line): the contact running over the tip's end onto the cylinder
-(``"cap+cylinder"``: the obstacle has a corner there, across which material slides; the same
-issue as an edge's corner below) and interior corners (``"line+corner"``), ``contact="paper"``, a line whose gap is not positive, more than one line,
-an edge inside [0, S0] of a configuration with several, a sealed shell in contact, and a contact
-edge with a Weierstrass-Erdmann corner (lambda_s, kappa_s jump there: the corner can move
-through the material, a degree of freedom of its own that the displacement modes do not
-carry; the base scene's edges have one from delta 0.62).
+(``"cap+cylinder"``: held on both sides of a corner of the obstacle, across which material
+would have to slide), an interior corner (``"line+corner"``: the package's searches find no state
+of it to check the corner's terms on), ``contact="paper"``, a line whose gap is not positive, more than one line,
+an edge inside [0, S0] of a configuration with several, and a sealed shell in contact.
 """
 
 from __future__ import annotations
@@ -214,9 +252,8 @@ def stability(state, modes=None, *, elements: int | None = None, S0: float | Non
     ------
     ValueError
         One line naming what is not supported (:func:`check_supported`, :func:`contact_of`): a
-        state that did not converge, the contact over the tip's end, interior corners,
-        ``contact="paper"``, a cornered edge, a line without a curvature gap, a sealed shell in
-        contact.
+        state that did not converge, the contact over the tip's end, ``contact="paper"``, a line
+        without a curvature gap, a sealed shell in contact.
 
     Examples
     --------

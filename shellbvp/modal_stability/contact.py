@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -12,9 +13,10 @@ from ..configurations import CONFIGURATIONS, is_point_load, of
 from .form import chain_base, reference_shell
 
 
-#: Junctions whose stability is not built: an interior corner (Kink) and the contact running over
-#: the tip's end (TipEnd) move a material point in a way the displacement modes do not carry.
-#: Every other chain -- free regions and regions on the tip joined by smooth edges and lines -- is.
+#: Junctions whose stability is not built: the contact running over the tip's end (TipEnd), where
+#: the shell is held on both sides of a corner, and an interior corner (Kink: no state of
+#: ``line+corner`` is found by the package's searches to check its terms on).  Every other chain --
+#: free regions and regions on the tip joined by edges (smooth or cornered) and lines -- is.
 NOT_BUILT = (Kink, TipEnd)
 
 
@@ -44,12 +46,28 @@ def check_supported(state):
     if scene.contact != "smooth":
         raise ValueError(f"stability: contact={scene.contact!r} is not variational (its edge conditions are not "
                          f"the natural conditions of an energy); only contact='smooth' is supported")
-    if state.contact_edge == "corner":
-        raise ValueError("stability: a contact edge with a Weierstrass-Erdmann corner (contact_edge 'corner') "
-                         "is not supported, only the smooth edge")
     if scene.sealed:
         raise ValueError("stability: a sealed shell (volume control) in contact is not supported, only "
                          "pressure control")
+
+
+@dataclass(frozen=True)
+class Corner:
+    """A Weierstrass-Erdmann corner of a contact edge at ``S``, where
+    lambda_s and kappa_s jump: ``ls``, ``dphi`` (= lambda_s Psi kappa_s, d phi/dS) and ``moment``
+    (``r M_s``, the conjugate of phi') on the sides before and after S, the continuous ``Psi, r,
+    phi`` there, ``tip_side`` (0 before, 1 after) and ``tip_slope``, the S-derivatives of the tip's
+    curvatures (kappa_s, kappa_theta) there (module docstring, "Corners")."""
+
+    S: float
+    ls: tuple
+    dphi: tuple
+    moment: tuple
+    Psi: float
+    r: float
+    phi: float
+    tip_side: int
+    tip_slope: tuple
 
 
 @dataclass(eq=False)
@@ -72,12 +90,13 @@ class Contact:
     pole_held: bool = False
     pole_force: float = 0.0
     apex_curvature: float = 0.0
+    corners: tuple = ()
 
     @property
     def edges(self):
-        """Where the contact starts or ends inside the mesh, and the lines."""
-        return tuple(sorted({S for S, _ in self.rings} | {S for a, b in self.held for S in (a, b)
-                                                          if S > self.S0}))
+        """Where the contact starts or ends inside the mesh, the lines and the corners."""
+        return tuple(sorted({S for S, _ in self.rings} | {S for a, b in self.held for S in (a, b) if S > self.S0}
+                            | {c.S for c in self.corners}))
 
 
 def _junction_points(sysm, p):
@@ -137,4 +156,26 @@ def contact_of(state, S0=None) -> Contact:
                              f"bends as tightly as the indenter there: a band), not supported")
         psi = float(at["ls"][0]) * Psi
         rings.append((S, (-f * ks, -f * kt, -f / psi, f / (psi**2 * gap))))
-    return Contact(base, S0, held=held, lines=tuple(lines), rings=tuple(rings), apex_curvature=apex)
+    return Contact(base, S0, held=held, lines=tuple(lines), rings=tuple(rings), apex_curvature=apex,
+                   corners=_corners(state, base))
+
+
+def _corners(state, base):
+    """The :class:`Corner` of every cornered contact edge (``Edge`` of model ``"corner"``)."""
+    sysm, p = state.system, state.p
+    out = []
+    for j in sysm.junctions:
+        if not (isinstance(j, Edge) and j.model == "corner"):
+            continue
+        k, tip_side = min(j.kc, j.kf), int(j.kc > j.kf)
+        S = float(sysm.S_point(sysm.regions[k].end, p))
+        sides = base(np.array([S * (1 - 1e-12), S * (1 + 1e-12)]))
+        R, Psi = (float(v[0]) for v in reference_shell(state.scene, np.array([S])))
+        r, phi = float(sides["lt"][1]) * R, float(sides["phi"][1])
+        ls = tuple(float(v) for v in sides["ls"])
+        dphi = tuple(float(l * Psi * k) for l, k in zip(ls, sides["ks"]))
+        # kappa_theta = sin(phi)/r: its S-derivative (cos(phi) phi' r - sin(phi) r')/r^2, r' = psi cos(phi)
+        kt = math.sin(phi) / r
+        slope = (float(sides["dks"][tip_side]), math.cos(phi) * (dphi[tip_side] - ls[tip_side] * Psi * kt) / r)
+        out.append(Corner(S, ls, dphi, tuple(r * float(v) for v in sides["Ms"]), Psi, r, phi, tip_side, slope))
+    return tuple(out)

@@ -43,6 +43,11 @@ class Stability:
         Where the mesh starts (the pole conditions are imposed there).
     wall_time : float
         Seconds (the form's derivation included on first use in a process).
+    held_corners : tuple of float
+        The S of the state's Weierstrass-Erdmann corners (cornered contact edges, interior kinks).
+        The perturbations keep each at its material point: a negative eigenvalue proves the state
+        unstable; a positive one is stability against the perturbations that keep the corners
+        there (the corner's own motion through the material is not a degree of freedom here).
 
     Examples
     --------
@@ -58,6 +63,7 @@ class Stability:
     S0: float
     vectors: dict = field(default_factory=dict)
     wall_time: float = math.nan
+    held_corners: tuple = ()
 
     @property
     def smallest(self) -> np.ndarray:
@@ -102,18 +108,19 @@ def assemble(scene, base_of, n, nodes):
     ndof = 6 * m
     xg, wg = np.polynomial.legendre.leggauss(GAUSS)
     xg, wg = (xg + 1) / 2, wg / 2
-    h = np.diff(nodes)
-    S = (nodes[:-1, None] + h[:, None] * xg[None, :]).ravel()
+    elements = np.flatnonzero(np.diff(nodes) > 0)  # a corner's twin nodes bound no element
+    h = nodes[elements + 1] - nodes[elements]
+    S = (nodes[elements, None] + h[:, None] * xg[None, :]).ravel()
     A, area = form_at(scene, base_of, S, n)
-    A = A.reshape(9, 9, m - 1, GAUSS)
-    area = area.reshape(m - 1, GAUSS)
+    A = A.reshape(9, 9, elements.size, GAUSS)
+    area = area.reshape(elements.size, GAUSS)
     hs = h.max()  # scale of the derivative dofs
     B = np.stack([_element_basis(xg, he, hs) for he in h])  # (elements, 9, 12, GAUSS)
     weights = wg[None, :] * h[:, None]
     Ke = 4 * np.einsum("eiag,ijeg,ejbg,eg->eab", B, A, B, weights, optimize=True)
     G = B[:, [0, 3, 6]]
     Me = np.einsum("eiag,eibg,eg->eab", G, G, weights * area, optimize=True)
-    idx = 6 * np.arange(m - 1)[:, None] + np.arange(12)[None, :]
+    idx = 6 * elements[:, None] + np.arange(12)[None, :]
     rows = np.broadcast_to(idx[:, :, None], Ke.shape).ravel()
     cols = np.broadcast_to(idx[:, None, :], Ke.shape).ravel()
     K = scipy.sparse.csr_matrix((Ke.ravel(), (rows, cols)), shape=(ndof, ndof))
@@ -202,18 +209,19 @@ def _element_basis(xg, h, hs):
 END_CONDITIONS = {"pinned": (0, 2, 4), "symmetric": (0, 5), "antisymmetric": (2, 4)}
 
 
-def _constraints(n, m, end="pinned", S0_over_hs=0.0, held=(), pole_held=False, lines=()):
+def _constraints(n, m, end="pinned", S0_over_hs=0.0, held=(), pole_held=False, lines=(), ties=()):
     """The reduced basis T (sparse, ndof x nfree) that imposes the pole (node 0) and end
     (node m-1) conditions: q = T q_free.  ``S0_over_hs``: S0 over the derivative dofs' scale
     (n = 1's ``w = S0 w'`` at S0).  ``held``: nodes on the tip (``w = w' = 0``: the normal
     displacement vanishes on the contact region, module docstring); ``pole_held``: the pole
     touches the tip at a point (``w = 0`` at S0 for n = 0; the n >= 1 pole conditions hold it
-    already or let it slide); ``lines``: the nodes of line contacts (``w = 0`` there)."""
+    already or let it slide); ``lines``: the nodes of line contacts (``w = 0`` there); ``ties``:
+    ``(dof, {dof: coefficient})``, a dof given by others (a corner's twin nodes, :func:`corner_ties`)."""
     ndof = 6 * m
     fixed = {6 * (m - 1) + k for k in END_CONDITIONS[end]}
     fixed |= {6 * i + k for i in held for k in (4, 5)}
     fixed |= {6 * i + 4 for i in lines}
-    tie_w = n == 1 and 0 not in held
+    tied = dict(ties)
     if n == 1 and (held or pole_held or lines):
         # u = U + O(S^2), v = -U + O(S^2) at the axis: u' = v' = 0.  Where the pole carries a
         # bending prestress (on the tip, or under a point load) the form's u u'' and v v''
@@ -225,20 +233,59 @@ def _constraints(n, m, end="pinned", S0_over_hs=0.0, held=(), pole_held=False, l
         if pole_held:
             fixed.add(4)
     elif n == 1:
-        fixed |= {2, 4}  # v(S0) = -u(S0), w(S0) = S0 w'(S0): folded into u's and w''s columns
+        tied[2] = {0: -1.0}  # v(S0) = -u(S0)
+        if 0 not in held:
+            tied[4] = {5: S0_over_hs}  # w(S0) = S0 w'(S0)
+        else:
+            fixed.add(4)
     else:
         fixed |= {0, 2, 4, 5}
-    free = np.array([i for i in range(ndof) if i not in fixed])
+    # a tied dof that is also held: its relation then constrains the dofs it is given by
+    for dof in [d for d in tied if d in fixed]:
+        fixed |= {k for k, c in tied.pop(dof).items() if c != 0}
+    free = np.array([i for i in range(ndof) if i not in fixed and i not in tied])
+    column = {int(i): k for k, i in enumerate(free)}
     rows, cols, vals = list(free), list(range(free.size)), [1.0] * free.size
-    if n == 1:
-        rows += [2]
-        cols += [int(np.flatnonzero(free == 0)[0])]
-        vals += [-1.0]
-        if tie_w:
-            rows += [4]
-            cols += [int(np.flatnonzero(free == 5)[0])]
-            vals += [S0_over_hs]
+    for dof, by in tied.items():
+        for k, c in by.items():
+            if k in column:
+                rows.append(dof)
+                cols.append(column[k])
+                vals.append(c)
     return scipy.sparse.csr_matrix((vals, (rows, cols)), shape=(ndof, free.size))
+
+
+def corner_ties(corner, i, hs):
+    """The twin nodes ``i`` (before) and ``i + 1`` (after) of a corner: u, v, w continuous, and the
+    normal's rotation about e_theta, ``(w' + phi' u)/lambda_s`` (per Psi), continuous -- so w' jumps
+    with lambda_s (module docstring, "Corners"); u' and v' may jump."""
+    j = i + 1
+    (lm, lp), (fm, fp) = corner.ls, corner.dphi
+    return [(6 * j, {6 * i: 1.0}), (6 * j + 2, {6 * i + 2: 1.0}), (6 * j + 4, {6 * i + 4: 1.0}),
+            (6 * j + 5, {6 * i + 5: lp / lm, 6 * i: hs * (lp / lm * fm - fp)})]
+
+
+def corner_energy(corner, i, n, hs):
+    """(dofs, 4 Q): the corner's term of the stiffness ``z^T 4 Q z`` over the twin nodes' dofs
+    ``z`` (module docstring, "Corners"): each side's moment times the second-order rotation of its
+    normal that the displacement makes, and on a contact edge the moments' difference times the
+    rotation that keeps the side on the tip."""
+    j = i + 1
+    (lm, lp), (fm, fp), (Mm, Mp) = corner.ls, corner.dphi, corner.moment
+    Psi, r = corner.Psi, corner.r
+    # z = (u, u'-, u'+, v, v'-, v'+, w, w'-) as dofs (derivatives times hs)
+    dofs = [6 * i, 6 * i + 1, 6 * j + 1, 6 * i + 2, 6 * i + 3, 6 * j + 3, 6 * i + 4, 6 * i + 5]
+    omega = np.array([fm, 0, 0, 0, 0, 0, 0, 1 / hs]) / (lm * Psi)  # (w'- + phi'- u)/(lambda- Psi)
+    # M+ a+/lambda+ - M- a-/lambda-, a = u' - phi' w; the same with v'
+    Ma = np.array([0, -Mm / (hs * lm), Mp / (hs * lp), 0, 0, 0, Mm * fm / lm - Mp * fp / lp, 0])
+    Mv = np.array([0, 0, 0, 0, -Mm / (hs * lm), Mp / (hs * lp), 0, 0])
+    q = np.array([0, 0, 0, math.sin(corner.phi), 0, 0, -n, 0])  # v sin(phi) - n w
+    Q = -(np.outer(omega, Ma) / (2 * Psi) + np.outer(q, Mv) / (2 * Psi * r))
+    ks1, kt1 = corner.tip_slope
+    c = (Mm - Mp) / (4 * corner.ls[corner.tip_side] * Psi)
+    Q[0, 0] += c * ks1
+    Q[3, 3] += c * kt1
+    return dofs, 4 * (Q + Q.T) / 2
 
 
 #: Grading at the pole: the first uniform element is split geometrically (ratio POLE_RATIO)
@@ -268,6 +315,22 @@ def mesh(S0: float, L: float, elements: int, edges=()) -> np.ndarray:
     return nodes
 
 
+def _held_nodes(nodes, intervals):
+    """The nodes on the tip: within one of the held S-intervals; of a corner's twin nodes at an
+    interval's end only the one on the interval's side (the element it bounds lies inside)."""
+    held = set()
+    for a, b in intervals:
+        held |= {int(i) for i in np.flatnonzero((nodes >= a) & (nodes <= b))}
+    twin = np.flatnonzero(np.diff(nodes) == 0)
+    for i in twin:  # nodes i, i + 1 at one S: keep each only if its element lies inside
+        for node, other in ((i, i - 1), (i + 1, i + 2)):
+            inside = 0 <= other < nodes.size and any(a <= min(nodes[node], nodes[other]) and
+                                                     max(nodes[node], nodes[other]) <= b for a, b in intervals)
+            if not inside:
+                held.discard(int(node))
+    return tuple(sorted(held))
+
+
 #: Nodes on each side of a contact edge (:func:`mesh`).
 EDGE_LEVELS = 8
 
@@ -286,6 +349,37 @@ def default_modes(scene) -> np.ndarray:
     return np.arange(0, int(math.ceil(1.3 * kc)) + 3)
 
 
+def stiffness(scene, base_of, n, nodes, contact=None):
+    """K and M of mode n on ``nodes`` before any constraint: the form (:func:`assemble`) with, for a
+    state on the tip, the rings' terms at the edges and lines, the pole's slide (n = 1) and the
+    corners' terms (:func:`corner_energy`; a corner's twin nodes are the two nodes at its S)."""
+    K, M = assemble(scene, base_of, n, nodes)
+    if contact is None:
+        return K, M
+    hs = np.diff(nodes).max()
+    terms = {}
+
+    def add(i, j, value):
+        terms[i, j] = terms.get((i, j), 0.0) + value
+
+    for S, (uu, vv, uw, ww) in contact.rings:
+        i = 6 * int(np.flatnonzero(nodes == S)[0])
+        for (a, b), value in (((i, i), uu), ((i + 2, i + 2), vv), ((i, i + 5), uw / hs), ((i + 5, i), uw / hs),
+                              ((i + 5, i + 5), ww / hs**2)):
+            add(a, b, value)
+    if contact.pole_held and n == 1:  # the pole slides on the tip: -F kappa_apex U^2 / pi (U = u(S0))
+        add(0, 0, -contact.pole_force * contact.apex_curvature / np.pi)
+    for c in contact.corners:
+        dofs, Q = corner_energy(c, int(np.flatnonzero(nodes == c.S)[0]), n, hs)
+        for a, da in enumerate(dofs):
+            for b, db in enumerate(dofs):
+                add(da, db, Q[a, b])
+    if terms:
+        rows, cols = zip(*terms)
+        K = K + scipy.sparse.csr_matrix((list(terms.values()), (rows, cols)), shape=K.shape)
+    return K, M
+
+
 def spectrum(scene, base_of, S0, L, modes=None, *, elements=None, count=2, vectors=False, end="pinned",
              contact=None):
     """The eigenvalues of :func:`stability` for a base state given as a function of S
@@ -294,29 +388,21 @@ def spectrum(scene, base_of, S0, L, modes=None, *, elements=None, count=2, vecto
     t0 = time.perf_counter()
     ne = elements or default_elements(scene)
     nodes = mesh(S0, L, ne, () if contact is None else contact.edges)
-    held, pole_held, lines, extra = (), False, (), {}
+    if contact is not None:
+        nodes = np.sort(np.concatenate([nodes, [c.S for c in contact.corners]]))  # a twin node at each corner
+    hs = np.diff(nodes).max()  # the scale of the derivative dofs (assemble)
+    held, pole_held, lines, ties = (), False, (), []
     if contact is not None:
         pole_held = contact.pole_held
-        held = tuple(int(i) for a, b in contact.held for i in np.flatnonzero((nodes >= a) & (nodes <= b)))
+        held = _held_nodes(nodes, contact.held)
         lines = tuple(int(np.flatnonzero(nodes == S)[0]) for S in contact.lines)
-        hs = np.diff(nodes).max()  # the scale of the derivative dofs (assemble)
-        for S, (uu, vv, uw, ww) in contact.rings:
-            i = 6 * int(np.flatnonzero(nodes == S)[0])
-            for key, value in (((i, i), uu), ((i + 2, i + 2), vv), ((i, i + 5), uw / hs), ((i + 5, i), uw / hs),
-                               ((i + 5, i + 5), ww / hs**2)):
-                extra[key] = extra.get(key, 0.0) + value
+        ties = [t for c in contact.corners for t in corner_ties(c, int(np.flatnonzero(nodes == c.S)[0]), hs)]
     modes = default_modes(scene) if modes is None else np.asarray(sorted(set(int(n) for n in modes)))
     out = np.empty((modes.size, count))
     vecs = {}
     for k, n in enumerate(modes):
-        K, M = assemble(scene, base_of, int(n), nodes)
-        terms = dict(extra)
-        if pole_held and n == 1:  # the pole slides on the tip: -F kappa_apex U^2 / pi (U = u(S0))
-            terms[0, 0] = terms.get((0, 0), 0.0) - contact.pole_force * contact.apex_curvature / np.pi
-        if terms:
-            rows, cols = zip(*terms)
-            K = K + scipy.sparse.csr_matrix((list(terms.values()), (rows, cols)), shape=K.shape)
-        T = _constraints(int(n), nodes.size, end, nodes[0] / np.diff(nodes).max(), held, pole_held, lines)
+        K, M = stiffness(scene, base_of, int(n), nodes, contact)
+        T = _constraints(int(n), nodes.size, end, nodes[0] / hs, held, pole_held, lines, ties)
         Kr, Mr = (T.T @ K @ T).tocsr(), (T.T @ M @ T).tocsr()
         Kr = ((Kr + Kr.T) / 2).tocsr()
         lam, X = _smallest(Kr, Mr, count)
@@ -325,4 +411,5 @@ def spectrum(scene, base_of, S0, L, modes=None, *, elements=None, count=2, vecto
             q = (T @ X[:, 0]).reshape(-1, 6)
             vecs[int(n)] = {"S": nodes, "u": q[:, 0], "v": q[:, 2], "w": q[:, 4]}
     return Stability(modes=modes, eigenvalues=out, elements=ne, S0=S0, vectors=vecs,
-                     wall_time=time.perf_counter() - t0)
+                     wall_time=time.perf_counter() - t0,
+                     held_corners=() if contact is None else tuple(c.S for c in contact.corners))

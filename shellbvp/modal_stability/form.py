@@ -102,8 +102,8 @@ PROFILE_STEP = 1e-6
 
 
 def chain_base(state):
-    """The base state of any chain of regions as a function of S: ``phi, ls, ks, dls, dks, lt``
-    and the contact pressure ``P`` (0 in free regions), from each region's generated profile
+    """The base state of any chain of regions as a function of S: ``phi, ls, ks, dls, dks, lt``,
+    the contact pressure ``P`` (0 in free regions) and the meridional moment ``Ms``, from each region's generated profile
     (``*_profile``, as ``Solution.profile`` reads them) on the state's interpolant; ``dls, dks``
     are the interpolant's derivatives where they are states of the region (``ls`` always,
     ``ks`` in free regions; near the pole the form's 1/r^3 coefficients cancel, and a
@@ -118,7 +118,7 @@ def chain_base(state):
 
     def base(S):
         S = np.asarray(S, float)
-        out = {k: np.empty_like(S) for k in ("phi", "ls", "ks", "dls", "dks", "lt", "P")}
+        out = {k: np.empty_like(S) for k in ("phi", "ls", "ks", "dls", "dks", "lt", "P", "Ms")}
         which = np.searchsorted(edges, S, side="right")
         for k, reg in enumerate(sysm.regions):
             sel = which == k
@@ -135,7 +135,8 @@ def chain_base(state):
             f0 = prof(Sk, y, par)
             fp = prof(Sk + h * dS, y + h * dy, par)
             fm = prof(Sk - h * dS, y - h * dy, par)
-            for key, name in (("phi", "phi"), ("ls", "lambda_s"), ("ks", "kappa_s"), ("lt", "lambda_theta")):
+            for key, name in (("phi", "phi"), ("ls", "lambda_s"), ("ks", "kappa_s"), ("lt", "lambda_theta"),
+                              ("Ms", "M_s")):
                 out[key][sel] = np.broadcast_to(f0[name], Sk.shape)
             states = FREE_STATES if reg.kind == "free" else CONTACT_STATES
             for key, name, state_name in (("dls", "lambda_s", "ls"), ("dks", "kappa_s", "ks")):
