@@ -174,17 +174,17 @@ import numpy as np
 
 from ..geometry import Spheroid
 from ..configurations import of
-from .contact import NOT_BUILT, Contact, check_supported, contact_of, supported
+from .contact import FRICTION, NOT_BUILT, Contact, check_friction, check_supported, contact_of, supported
 from .fem import END_CONDITIONS, Stability, default_elements, default_modes, mesh, spectrum
 from .form import chain_base, form_functions, sphere_base, state_base
 
 __all__ = ["stability", "Stability", "spectrum", "state_base", "sphere_base", "mesh", "default_modes",
            "default_elements", "END_CONDITIONS", "sphere_stretch", "NOT_BUILT", "supported", "Contact", "check_supported",
-           "contact_of", "chain_base", "form_functions"]
+           "contact_of", "chain_base", "form_functions", "FRICTION"]
 
 
 def stability(state, modes=None, *, elements: int | None = None, S0: float | None = None,
-              count: int = 2, vectors: bool = False) -> Stability:
+              count: int = 2, vectors: bool = False, friction: str = "frictionless") -> Stability:
     """The smallest eigenvalues of the second variation of ``state`` per Fourier mode.
 
     Parameters
@@ -203,6 +203,11 @@ def stability(state, modes=None, *, elements: int | None = None, S0: float | Non
         Eigenvalues per mode.
     vectors : bool
         Keep the eigenvector of each mode's smallest eigenvalue.
+    friction : {"frictionless", "sticking"}
+        The tip's tangential behaviour on the contact set: free sliding (``u, v`` free there), or
+        no slip (``u = v = 0`` there, the pole held at a point included).  The two bound the
+        stability of the state under any friction coefficient (module docstring, "Friction");
+        no effect without contact.
 
     Returns
     -------
@@ -241,6 +246,7 @@ def stability(state, modes=None, *, elements: int | None = None, S0: float | Non
     ValueError: stability: contact='paper' is not variational ...; only contact='smooth' is supported
     """
     t0 = time.perf_counter()
+    check_friction(friction)
     check_supported(state)
     sysm = state.system
     if of(state) is None:  # the inflated shell: no contact
@@ -249,7 +255,7 @@ def stability(state, modes=None, *, elements: int | None = None, S0: float | Non
         out = spectrum(state.scene, state_base(state), S0, float(sysm.L), modes, elements=elements, count=count,
                        vectors=vectors)
     else:
-        contact = contact_of(state, S0)
+        contact = contact_of(state, S0, friction)
         out = spectrum(state.scene, contact.base, contact.S0, float(sysm.L), modes, elements=elements,
                        count=count, vectors=vectors, contact=contact)
     out.wall_time = time.perf_counter() - t0

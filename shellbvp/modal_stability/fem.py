@@ -202,17 +202,23 @@ def _element_basis(xg, h, hs):
 END_CONDITIONS = {"pinned": (0, 2, 4), "symmetric": (0, 5), "antisymmetric": (2, 4)}
 
 
-def _constraints(n, m, end="pinned", S0_over_hs=0.0, held=(), pole_held=False, lines=()):
+def _constraints(n, m, end="pinned", S0_over_hs=0.0, held=(), pole_held=False, lines=(), stuck=(),
+                 stuck_points=()):
     """The reduced basis T (sparse, ndof x nfree) that imposes the pole (node 0) and end
     (node m-1) conditions: q = T q_free.  ``S0_over_hs``: S0 over the derivative dofs' scale
     (n = 1's ``w = S0 w'`` at S0).  ``held``: nodes on the tip (``w = w' = 0``: the normal
     displacement vanishes on the contact region, module docstring); ``pole_held``: the pole
     touches the tip at a point (``w = 0`` at S0 for n = 0; the n >= 1 pole conditions hold it
-    already or let it slide); ``lines``: the nodes of line contacts (``w = 0`` there)."""
+    already or let it slide); ``lines``: the nodes of line contacts (``w = 0`` there);
+    ``stuck``: the nodes of regions stuck to the tip (friction="sticking": ``u = v = 0`` on the
+    region, so ``u' = v' = 0`` at its nodes, its end nodes included, the fields being C^1);
+    ``stuck_points``: lines and a pole held at a point, stuck (``u = v = 0`` at the node only)."""
     ndof = 6 * m
     fixed = {6 * (m - 1) + k for k in END_CONDITIONS[end]}
     fixed |= {6 * i + k for i in held for k in (4, 5)}
     fixed |= {6 * i + 4 for i in lines}
+    fixed |= {6 * i + k for i in stuck for k in (0, 1, 2, 3)}
+    fixed |= {6 * i + k for i in stuck_points for k in (0, 2)}
     tie_w = n == 1 and 0 not in held
     if n == 1 and (held or pole_held or lines):
         # u = U + O(S^2), v = -U + O(S^2) at the axis: u' = v' = 0.  Where the pole carries a
@@ -230,14 +236,14 @@ def _constraints(n, m, end="pinned", S0_over_hs=0.0, held=(), pole_held=False, l
         fixed |= {0, 2, 4, 5}
     free = np.array([i for i in range(ndof) if i not in fixed])
     rows, cols, vals = list(free), list(range(free.size)), [1.0] * free.size
-    if n == 1:
+    if n == 1 and 0 not in fixed:  # v(S0) = -u(S0), unless the pole is stuck (u = v = 0 there)
         rows += [2]
         cols += [int(np.flatnonzero(free == 0)[0])]
         vals += [-1.0]
-        if tie_w:
-            rows += [4]
-            cols += [int(np.flatnonzero(free == 5)[0])]
-            vals += [S0_over_hs]
+    if tie_w:
+        rows += [4]
+        cols += [int(np.flatnonzero(free == 5)[0])]
+        vals += [S0_over_hs]
     return scipy.sparse.csr_matrix((vals, (rows, cols)), shape=(ndof, free.size))
 
 
@@ -294,11 +300,15 @@ def spectrum(scene, base_of, S0, L, modes=None, *, elements=None, count=2, vecto
     t0 = time.perf_counter()
     ne = elements or default_elements(scene)
     nodes = mesh(S0, L, ne, () if contact is None else contact.edges)
-    held, pole_held, lines, extra = (), False, (), {}
+    held, pole_held, lines, stuck, stuck_points, extra = (), False, (), (), (), {}
     if contact is not None:
         pole_held = contact.pole_held
         held = tuple(int(i) for a, b in contact.held for i in np.flatnonzero((nodes >= a) & (nodes <= b)))
         lines = tuple(int(np.flatnonzero(nodes == S)[0]) for S in contact.lines)
+        if contact.friction == "sticking":
+            # u = v = 0 wherever the shell touches the tip: the pressure's, the rings' and the
+            # pole's sliding terms then act on held dofs only (a line keeps its rolling term)
+            stuck, stuck_points = held, tuple(lines) + ((0,) if pole_held else ())
         hs = np.diff(nodes).max()  # the scale of the derivative dofs (assemble)
         for S, (uu, vv, uw, ww) in contact.rings:
             i = 6 * int(np.flatnonzero(nodes == S)[0])
@@ -316,7 +326,8 @@ def spectrum(scene, base_of, S0, L, modes=None, *, elements=None, count=2, vecto
         if terms:
             rows, cols = zip(*terms)
             K = K + scipy.sparse.csr_matrix((list(terms.values()), (rows, cols)), shape=K.shape)
-        T = _constraints(int(n), nodes.size, end, nodes[0] / np.diff(nodes).max(), held, pole_held, lines)
+        T = _constraints(int(n), nodes.size, end, nodes[0] / np.diff(nodes).max(), held, pole_held, lines, stuck,
+                         stuck_points)
         Kr, Mr = (T.T @ K @ T).tocsr(), (T.T @ M @ T).tocsr()
         Kr = ((Kr + Kr.T) / 2).tocsr()
         lam, X = _smallest(Kr, Mr, count)
