@@ -150,7 +150,23 @@ def verdict(first, rows, friction):
         return f"stable at every analysed state (to delta {max(r['delta'] for r in rows if not r[friction]['why']):.3g}){tail}"
     if not first["located"]:
         return f"unstable from delta <= {first['delta']:.4g} ({first.get('message', 'not narrowed')})"
-    return f"unstable from delta {first['delta']:.4g} (delta/H {first['delta_over_H']:.3g}), n = {first['mode']}"
+    return (f"unstable from delta {first['delta']:.6g} (bracket {first['bracket'][0]:.6g}-{first['bracket'][1]:.6g}; "
+            f"delta/H {first['delta_over_H']:.3g}), n = {first['mode']}")
+
+
+def unstable_ranges(rows, friction):
+    """The analysed states' deltas where ``friction``'s smallest eigenvalue is negative, as runs
+    of consecutive states ``"a-b"``."""
+    runs, current = [], None
+    for r in rows:
+        if r[friction]["min"] < 0:
+            current = [r["delta"], r["delta"]] if current is None else [current[0], r["delta"]]
+        elif current is not None:
+            runs.append(current)
+            current = None
+    if current is not None:
+        runs.append(current)
+    return ", ".join(f"{a:.4g}-{b:.4g}" if a != b else f"{a:.4g}" for a, b in runs) or "none"
 
 
 def markdown(results, meta):
@@ -171,7 +187,9 @@ def markdown(results, meta):
                      f"{verdict(r['sticking'], r['rows'], 'sticking')} | {s:.0f} |")
     lines += ["", "Per state: the smallest eigenvalue (its mode) and the n = 1 eigenvalue, frictionless | sticking.", ""]
     for r in results:
-        lines += [f"## {r['id']}", "", "| delta | topology | min frictionless (n) | n = 1 frictionless | "
+        lines += [f"## {r['id']}", "", "Analysed states with a negative eigenvalue: frictionless "
+                  f"{unstable_ranges(r['rows'], 'frictionless')}; sticking {unstable_ranges(r['rows'], 'sticking')}.",
+                  "", "| delta | topology | min frictionless (n) | n = 1 frictionless | "
                   "min sticking (n) | n = 1 sticking |", "|---|---|---|---|---|---|"]
         for row in r["rows"]:
             a, b = row["frictionless"], row["sticking"]
