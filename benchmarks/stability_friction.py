@@ -107,7 +107,7 @@ def run_case(cid, build, delta_max, analyse_from, reference):
     import numpy as np
 
     import shellbvp as sb
-    from shellbvp.modal_stability import default_modes
+    from shellbvp.modal_stability import default_elements, default_modes
 
     t0 = time.perf_counter()
     scene = build()
@@ -124,12 +124,24 @@ def run_case(cid, build, delta_max, analyse_from, reference):
             row[friction] = {"min": lam, "mode": mode, "n1": lam1, "why": why}
         rows.append(row)
     t_states = time.perf_counter() - t1
+    # the mesh: n = 1 and the crossing's mode at twice and four times the elements, on the first
+    # state unstable without friction and on the last state
+    first_bad = next((i for i, r in enumerate(rows) if r["frictionless"]["min"] < 0), None)
+    checks = []
+    for i in sorted({i for i in (first_bad, len(rows) - 1) if i is not None}):
+        modes = sorted({1, max(rows[i]["frictionless"]["mode"], 0)})
+        for friction in FRICTIONS:
+            base = default_elements(scene)
+            values = [sb.stability(states[i], modes=modes, friction=friction, elements=k * base).smallest.tolist()
+                      for k in (1, 2, 4)]
+            checks.append({"delta": rows[i]["delta"], "friction": friction, "modes": modes, "elements": base,
+                           "smallest": values})
     every = default_modes(scene)
     # the crossing narrowed with every mode for the beta 0.01 scenes (cheap), the modes near the
     # state-level critical one for the dome
     out = {"id": cid, "beta": scene.beta, "thickness": math.sqrt(3 * scene.beta), "reference": reference,
            "curve_points": len(curve), "curve_end": float(curve.delta.max()), "stop": curve.stop_reason,
-           "rows": rows, "curve_s": t_curve, "states_s": t_states}
+           "rows": rows, "mesh_checks": checks, "curve_s": t_curve, "states_s": t_states}
     for friction in FRICTIONS:
         modes = None
         crit = {r[friction]["mode"] for r in rows if r[friction]["min"] < 0}
@@ -175,14 +187,15 @@ def markdown(results, meta):
              "`sb.stability(state, friction=...)` on every state of `sb.curve(scene, delta_max=...)` (smooth "
              "contact; the dome's from delta 0.08), each first sign change narrowed to 1e-4 in delta between its "
              "neighbours.  Frictionless: u, v free on the contact set; sticking: u = v = 0 there (docs/stability.md). "
-             "Under any friction coefficient the smallest eigenvalue lies between the two columns' (for the "
-             "frictionless state), so an instability with a sticking tip is one under any friction.  H/R_L = "
+             "Any friction coefficient's verdict on the (frictionless) state lies between the two: stable without "
+             "friction, stable with any; unstable with sticking, unstable with any.  H/R_L = "
              "sqrt(3 beta).", "",
              "| scene | curve to delta | frictionless (stability_modes.md) | frictionless | sticking | s |",
              "|---|---|---|---|---|---|"]
     for r in results:
         s = r["curve_s"] + r["states_s"] + r["frictionless_locate_s"] + r["sticking_locate_s"]
-        lines.append(f"| {r['id']} | {r['curve_end']:.3g} ({r['stop']}) | {r['reference']} | "
+        stop = r["stop"].split(":")[0]  # the reason's first clause
+        lines.append(f"| {r['id']} | {r['curve_end']:.3g} ({stop}) | {r['reference']} | "
                      f"{verdict(r['frictionless'], r['rows'], 'frictionless')} | "
                      f"{verdict(r['sticking'], r['rows'], 'sticking')} | {s:.0f} |")
     lines += ["", "Per state: the smallest eigenvalue (its mode) and the n = 1 eigenvalue, frictionless | sticking.", ""]
@@ -198,6 +211,13 @@ def markdown(results, meta):
                 continue
             lines.append(f"| {row['delta']:.4g} | {row['topology']} | {a['min']:.4g} ({a['mode']}) | {a['n1']:.4g} | "
                          f"{b['min']:.4g} ({b['mode']}) | {b['n1']:.4g} |")
+        lines += ["", "The mesh: the smallest eigenvalue of each mode at the default elements E, 2E and 4E (at a pole "
+                  "held at a point, n = 1 depends on the first element's length against the mesh's start S0, whose "
+                  "ratio alternates with E: the values alternate).", "",
+                  "| delta | friction | E | mode: E, 2E, 4E |", "|---|---|---|---|"]
+        for c in r["mesh_checks"]:
+            per = "; ".join(f"n = {n}: " + ", ".join(f"{v[k]:.4g}" for v in c["smallest"]) for k, n in enumerate(c["modes"]))
+            lines.append(f"| {c['delta']:.4g} | {c['friction']} | {c['elements']} | {per} |")
         lines.append("")
     lines.append(f"Total {meta['seconds']:.0f} s.")
     return "\n".join(lines) + "\n"

@@ -180,7 +180,10 @@ process).
 
 Accuracy: on the base scene at delta 0.3 (cap, Sc 0.091) the eigenvalues of n = 0..3 move by
 less than 3e-4 with twice the elements or with S0 = 1e-3; the dome's first n >= 2 crossings
-(benchmarks/results/stability_contact.md) move by < 3e-7 in delta with twice the elements.
+(benchmarks/results/stability_contact.md) move by < 3e-7 in delta with twice the elements.  At
+a pole held at a point, n = 1 depends on the first element's length against S0 (the sharp tip,
+rho 0.05, at delta 0.05: frictionless -1.89 and -3.19 with the ratio 15.6 and 7.8, sticking 1.54
+and 1.51; benchmarks/results/stability_friction.md): its sign, not its size, is what is known.
 
 A band on the indenter's cylinder is a region on the tip like the others (its meridian is
 straight: ``kappa_s = 0``, and only the hoop term remains).
