@@ -215,8 +215,8 @@ def test_n1_needs_the_slopes_held_at_the_start(monkeypatch, cap_state):
         if not slopes_held:
             full = fem._constraints
 
-            def constraints(n, m, *args):
-                T = full(n, m, *args)
+            def constraints(n, m, *args, **kwargs):
+                T = full(n, m, *args, **kwargs)
                 # release u'(S0), v'(S0): the columns of the reduced basis that carry them are absent,
                 # so rebuild with the two dofs free
                 return _release(T, (1, 3))

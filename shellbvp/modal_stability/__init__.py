@@ -145,13 +145,45 @@ conditions).  A cap or line within [0, S0] and a point load hold the pole at a p
 ``w(S0) = 0`` at n = 0 (delta is prescribed); at n = 1 the pole slides by ``U = u(S0)`` and
 ``K`` gains ``-F kappa_apex U^2/pi`` (the limit of the cap's term); n >= 2 hold it already.
 
+*Friction* (``friction="sticking"``).  All of the above is the frictionless tip: ``u, v`` free on
+the contact set.  The other bound is a tip to which the shell sticks, no material point in
+contact slipping: ``u = v = 0`` on each region on the tip, at each line, and at a pole held at a
+point (``U = u(S0) = 0`` at n = 1; n = 0 and n >= 2 hold it already).  On a region, ``u = 0`` on
+the interval makes ``u' = 0`` at its interior nodes, and at its end nodes the one-sided
+derivative from inside is 0 too; the elements are C^1, so ``u'`` is continuous and 0 there (an
+element on which a field vanishes has all four of its dofs 0): ``u = u' = v = v' = 0`` at every
+node of the region, its ends included.  The exact field need not be C^1 in ``u, v`` (the form
+holds ``u''`` only times lower derivatives: ``u`` is H^1), so a mode's ``u'`` may jump where it
+leaves the stuck region; as at the frictionless edge the graded mesh resolves that kink by a
+layer (the base cap at delta 0.3: n = 0..4 move by < 5e-5 with twice the elements).  At a line
+and a held pole only ``u = v = 0`` at the node: the material beside it is not in contact.  The
+pressure's, the rings' and the pole's curvature terms are quadratic in ``u, v`` where they act
+and vanish; a line keeps its rolling term ``+f w1^2/gap`` (with ``u = 0`` the gap's minimum
+moves to the neighbouring material: rolling, which sticking allows).
+
+Why these are the two bounds.  The sticking perturbations are a subspace of the frictionless
+ones, with the same stiffness and Gram matrices on it, so by the min-max characterisation each
+mode's k-th eigenvalue with sticking is at least the frictionless one (exactly so for the
+discrete problems: the sticking basis spans a subspace of the frictionless one's;
+tests/test_stability_friction.py).  A tip with any friction coefficient mu > 0 lies between:
+the frictionless state carries no tangential traction, strictly inside every Coulomb cone, so a
+small perturbation that does not slip needs tangential tractions of its own size, which the
+cone admits -- a state unstable with a sticking tip is unstable for every mu; and friction only
+dissipates on slip, so a state that minimises the energy over the larger, frictionless set is
+stable for every mu.  Between the two the verdict depends on mu and on how the contact slips.
+Both concern the frictionless base state: friction during loading changes the axisymmetric
+state itself (tangential traction on the cap), which neither accounts for.
+
 Cost: a state on the tip of the dome of beta 1e-5 (91 elements and the graded nodes, n = 0..33)
 takes 1-2.5 s, the base scene's (beta 0.01, n = 0..8) 0.1 s (the form's derivation, 2-5 s, once per
 process).
 
 Accuracy: on the base scene at delta 0.3 (cap, Sc 0.091) the eigenvalues of n = 0..3 move by
 less than 3e-4 with twice the elements or with S0 = 1e-3; the dome's first n >= 2 crossings
-(benchmarks/results/stability_contact.md) move by < 3e-7 in delta with twice the elements.
+(benchmarks/results/stability_contact.md) move by < 3e-7 in delta with twice the elements.  At
+a pole held at a point, n = 1 depends on the first element's length against S0 (the sharp tip,
+rho 0.05, at delta 0.05: frictionless -1.89 and -3.19 with the ratio 15.6 and 7.8, sticking 1.54
+and 1.51; benchmarks/results/stability_friction.md): its sign, not its size, is what is known.
 
 A band on the indenter's cylinder is a region on the tip like the others (its meridian is
 straight: ``kappa_s = 0``, and only the hoop term remains).
@@ -212,17 +244,17 @@ import numpy as np
 
 from ..geometry import Spheroid
 from ..configurations import of
-from .contact import NOT_BUILT, Contact, check_supported, contact_of, supported
+from .contact import FRICTION, NOT_BUILT, Contact, check_friction, check_supported, contact_of, supported
 from .fem import END_CONDITIONS, Stability, default_elements, default_modes, mesh, spectrum
 from .form import chain_base, form_functions, sphere_base, state_base
 
 __all__ = ["stability", "Stability", "spectrum", "state_base", "sphere_base", "mesh", "default_modes",
            "default_elements", "END_CONDITIONS", "sphere_stretch", "NOT_BUILT", "supported", "Contact", "check_supported",
-           "contact_of", "chain_base", "form_functions"]
+           "contact_of", "chain_base", "form_functions", "FRICTION"]
 
 
 def stability(state, modes=None, *, elements: int | None = None, S0: float | None = None,
-              count: int = 2, vectors: bool = False) -> Stability:
+              count: int = 2, vectors: bool = False, friction: str = "frictionless") -> Stability:
     """The smallest eigenvalues of the second variation of ``state`` per Fourier mode.
 
     Parameters
@@ -241,6 +273,11 @@ def stability(state, modes=None, *, elements: int | None = None, S0: float | Non
         Eigenvalues per mode.
     vectors : bool
         Keep the eigenvector of each mode's smallest eigenvalue.
+    friction : {"frictionless", "sticking"}
+        The tip's tangential behaviour on the contact set: free sliding (``u, v`` free there), or
+        no slip (``u = v = 0`` there, the pole held at a point included).  The two bound the
+        stability of the state under any friction coefficient (module docstring, "Friction");
+        no effect without contact.
 
     Returns
     -------
@@ -278,6 +315,7 @@ def stability(state, modes=None, *, elements: int | None = None, S0: float | Non
     ValueError: stability: contact='paper' is not variational ...; only contact='smooth' is supported
     """
     t0 = time.perf_counter()
+    check_friction(friction)
     check_supported(state)
     sysm = state.system
     if of(state) is None:  # the inflated shell: no contact
@@ -286,7 +324,7 @@ def stability(state, modes=None, *, elements: int | None = None, S0: float | Non
         out = spectrum(state.scene, state_base(state), S0, float(sysm.L), modes, elements=elements, count=count,
                        vectors=vectors)
     else:
-        contact = contact_of(state, S0)
+        contact = contact_of(state, S0, friction)
         out = spectrum(state.scene, contact.base, contact.S0, float(sysm.L), modes, elements=elements,
                        count=count, vectors=vectors, contact=contact)
     out.wall_time = time.perf_counter() - t0

@@ -13,6 +13,10 @@ from ..configurations import CONFIGURATIONS, is_point_load, of
 from .form import chain_base, reference_shell
 
 
+#: The tip's tangential behaviour on the contact set: free sliding, or no slip (the two bounds
+#: of any friction coefficient; :mod:`shellbvp.modal_stability`).
+FRICTION = ("frictionless", "sticking")
+
 #: Junctions whose stability is not built: the contact running over the tip's end (TipEnd), where
 #: the shell is held on both sides of a corner, and an interior corner (Kink: no state of
 #: ``line+corner`` is found by the package's searches to check its terms on).  Every other chain --
@@ -70,6 +74,12 @@ class Corner:
     tip_slope: tuple
 
 
+def check_friction(friction):
+    """ValueError (one line) unless ``friction`` is one of :data:`FRICTION`."""
+    if friction not in FRICTION:
+        raise ValueError(f"stability: friction must be one of {', '.join(map(repr, FRICTION))}, not {friction!r}")
+
+
 @dataclass(eq=False)
 class Contact:
     """What the tip adds to the eigenproblem of a state in contact (module docstring).
@@ -79,7 +89,8 @@ class Contact:
     ``lines``: the line contacts' S (w = 0); ``rings``: per edge or line ``(S, (a, b, c, d))``,
     its quadratic form ``a u^2 + b v^2 + 2 c u w' + d w'^2`` in the stiffness; ``pole_held``:
     the contact lies within [0, S0] or is a point load (the pole held at a point), with
-    ``pole_force`` the axial force there and ``apex_curvature`` the tip's.
+    ``pole_force`` the axial force there and ``apex_curvature`` the tip's; ``friction``: one of
+    :data:`FRICTION`, ``"sticking"`` also holding ``u = v = 0`` wherever the shell touches the tip.
     """
 
     base: object
@@ -91,6 +102,7 @@ class Contact:
     pole_force: float = 0.0
     apex_curvature: float = 0.0
     corners: tuple = ()
+    friction: str = "frictionless"
 
     @property
     def edges(self):
@@ -111,10 +123,12 @@ def _junction_points(sysm, p):
     return out
 
 
-def contact_of(state, S0=None) -> Contact:
+def contact_of(state, S0=None, friction: str = "frictionless") -> Contact:
     """The :class:`Contact` of a state on the tip: the base state from the regions' generated
     profiles (:func:`chain_base`), the regions on the tip, and at each contact edge and line
-    its normal ring force (``state.edge_forces``, ``-2 pi [r Q]``) with the curvatures there."""
+    its normal ring force (``state.edge_forces``, ``-2 pi [r Q]``) with the curvatures there;
+    ``friction`` one of :data:`FRICTION`."""
+    check_friction(friction)
     check_supported(state)
     from ..inflation import EPS
 
@@ -127,7 +141,8 @@ def contact_of(state, S0=None) -> Contact:
     points = _junction_points(sysm, p)
     if is_point_load(state) or (len(points) == 1 and points[0][0] <= S0 * (1 + 1e-9)):
         # the one contact (a cap or a line) lies within the pole's disc: a point contact there
-        return Contact(base, S0, pole_held=True, pole_force=float(state.force), apex_curvature=apex)
+        return Contact(base, S0, pole_held=True, pole_force=float(state.force), apex_curvature=apex,
+                       friction=friction)
     if points[0][0] <= S0 * (1 + 1e-9):
         raise ValueError(f"stability: a contact edge at S = {points[0][0]:.3g} inside the mesh's start "
                          f"S0 = {S0:.3g} of a {state.topology!r} state is not supported")
@@ -157,7 +172,7 @@ def contact_of(state, S0=None) -> Contact:
         psi = float(at["ls"][0]) * Psi
         rings.append((S, (-f * ks, -f * kt, -f / psi, f / (psi**2 * gap))))
     return Contact(base, S0, held=held, lines=tuple(lines), rings=tuple(rings), apex_curvature=apex,
-                   corners=_corners(state, base))
+                   corners=_corners(state, base), friction=friction)
 
 
 def _corners(state, base):

@@ -209,18 +209,25 @@ def _element_basis(xg, h, hs):
 END_CONDITIONS = {"pinned": (0, 2, 4), "symmetric": (0, 5), "antisymmetric": (2, 4)}
 
 
-def _constraints(n, m, end="pinned", S0_over_hs=0.0, held=(), pole_held=False, lines=(), ties=()):
+def _constraints(n, m, end="pinned", S0_over_hs=0.0, held=(), pole_held=False, lines=(), stuck=(),
+                 stuck_points=(), ties=()):
     """The reduced basis T (sparse, ndof x nfree) that imposes the pole (node 0) and end
     (node m-1) conditions: q = T q_free.  ``S0_over_hs``: S0 over the derivative dofs' scale
     (n = 1's ``w = S0 w'`` at S0).  ``held``: nodes on the tip (``w = w' = 0``: the normal
     displacement vanishes on the contact region, module docstring); ``pole_held``: the pole
     touches the tip at a point (``w = 0`` at S0 for n = 0; the n >= 1 pole conditions hold it
-    already or let it slide); ``lines``: the nodes of line contacts (``w = 0`` there); ``ties``:
-    ``(dof, {dof: coefficient})``, a dof given by others (a corner's twin nodes, :func:`corner_ties`)."""
+    already or let it slide); ``lines``: the nodes of line contacts (``w = 0`` there);
+    ``stuck``: the nodes of regions stuck to the tip (friction="sticking": ``u = v = 0`` on the
+    region, so ``u' = v' = 0`` at its nodes, its end nodes included, the fields being C^1);
+    ``stuck_points``: lines and a pole held at a point, stuck (``u = v = 0`` at the node only);
+    ``ties``: ``(dof, {dof: coefficient})``, a dof given by others (a corner's twin nodes,
+    :func:`corner_ties`; n = 1's pole), dropped with the dofs it is given by where it is held."""
     ndof = 6 * m
     fixed = {6 * (m - 1) + k for k in END_CONDITIONS[end]}
     fixed |= {6 * i + k for i in held for k in (4, 5)}
     fixed |= {6 * i + 4 for i in lines}
+    fixed |= {6 * i + k for i in stuck for k in (0, 1, 2, 3)}
+    fixed |= {6 * i + k for i in stuck_points for k in (0, 2)}
     tied = dict(ties)
     if n == 1 and (held or pole_held or lines):
         # u = U + O(S^2), v = -U + O(S^2) at the axis: u' = v' = 0.  Where the pole carries a
@@ -391,18 +398,23 @@ def spectrum(scene, base_of, S0, L, modes=None, *, elements=None, count=2, vecto
     if contact is not None:
         nodes = np.sort(np.concatenate([nodes, [c.S for c in contact.corners]]))  # a twin node at each corner
     hs = np.diff(nodes).max()  # the scale of the derivative dofs (assemble)
-    held, pole_held, lines, ties = (), False, (), []
+    held, pole_held, lines, ties, stuck, stuck_points = (), False, (), [], (), ()
     if contact is not None:
         pole_held = contact.pole_held
         held = _held_nodes(nodes, contact.held)
         lines = tuple(int(np.flatnonzero(nodes == S)[0]) for S in contact.lines)
         ties = [t for c in contact.corners for t in corner_ties(c, int(np.flatnonzero(nodes == c.S)[0]), hs)]
+        if contact.friction == "sticking":
+            # u = v = 0 wherever the shell touches the tip: the pressure's, the rings' and the
+            # pole's sliding terms then act on held dofs only (a line keeps its rolling term)
+            stuck, stuck_points = held, tuple(lines) + ((0,) if pole_held else ())
     modes = default_modes(scene) if modes is None else np.asarray(sorted(set(int(n) for n in modes)))
     out = np.empty((modes.size, count))
     vecs = {}
     for k, n in enumerate(modes):
         K, M = stiffness(scene, base_of, int(n), nodes, contact)
-        T = _constraints(int(n), nodes.size, end, nodes[0] / hs, held, pole_held, lines, ties)
+        T = _constraints(int(n), nodes.size, end, nodes[0] / hs, held, pole_held, lines, stuck=stuck,
+                         stuck_points=stuck_points, ties=ties)
         Kr, Mr = (T.T @ K @ T).tocsr(), (T.T @ M @ T).tocsr()
         Kr = ((Kr + Kr.T) / 2).tocsr()
         lam, X = _smallest(Kr, Mr, count)
