@@ -181,3 +181,27 @@ def test_the_corner_joins_the_smooth_edge(base_scene):
     assert [s.contact_edge for s in states] == ["smooth", "smooth", "corner"]
     a, b, c = (st.stability(s, modes=[0, 2, 3], elements=160).smallest for s in states)
     assert np.all(np.abs(c - b) < 1.5 * np.abs(b - a))
+
+
+# -- the pole's rounding floor --------------------------------------------------------------------
+def test_a_negative_eigenvalue_that_moves_with_the_mesh_start_is_refused(base_scene, monkeypatch):
+    """A negative eigenvalue is recomputed with the mesh starting 10 times further from the pole:
+    one that keeps its sign and value (the cap at delta 0.3 with a negative shift standing in for a
+    genuine instability) is reported; one that changes (the pole's floor, as on a thick shell's
+    lifted pole near its fold: -1.2e6 and -2.8e4) is refused in one line."""
+    state = sb.solve(base_scene, delta=0.3)
+    spectrum = st.spectrum
+
+    def shifted(depends_on_S0):
+        def fake(scene, base_of, S0, L, modes=None, **kw):
+            out = spectrum(scene, base_of, S0, L, modes, **kw)
+            out.eigenvalues = out.eigenvalues - (10.0 if not depends_on_S0 else 1e-3 / S0)
+            return out
+        return fake
+
+    monkeypatch.setattr(st, "spectrum", shifted(False))
+    res = st.stability(state, modes=[0, 1], elements=40)
+    assert not res.stable
+    monkeypatch.setattr(st, "spectrum", shifted(True))
+    with pytest.raises(ValueError, match=r"mode n = \d is not resolved at the pole"):
+        st.stability(state, modes=[0, 1], elements=40)
