@@ -44,7 +44,7 @@ class Stability:
     wall_time : float
         Seconds (the form's derivation included on first use in a process).
     held_corners : tuple of float
-        The S of the state's Weierstrass-Erdmann corners (cornered contact edges, interior kinks).
+        The S of the state's cornered contact edges (Weierstrass-Erdmann corners, ``contact_edge``).
         The perturbations keep each at its material point: a negative eigenvalue proves the state
         unstable; a positive one is stability against the perturbations that keep the corners
         there (the corner's own motion through the material is not a degree of freedom here).
