@@ -74,6 +74,7 @@ def worker(spec_path, out_path):
             per_model[model] = {"seconds": time.perf_counter() - t1,
                                 "ratio": [float(i.ratio) for i in inds], "n": [float(i.n) for i in inds],
                                 "S": [float(i.S) for i in inds]}
+        screen = screened_pass(c.solutions, per_model["strip"]["ratio"])
         assess(c, "locate", samples=max(len(c), 1))
     finally:
         signal.setitimer(signal.ITIMER_REAL, 0)
@@ -88,8 +89,32 @@ def worker(spec_path, out_path):
                stability_s=c.settings.get("stability_time", math.nan), note=c.settings.get("stability_note", ""),
                delta=[float(d) for d in c.delta], Sc=[float(s.Sc) if s is not None else math.nan for s in c.solutions],
                stability_min=[float(v) for v in smin], critical_mode=[int(m) for m in c.points["critical_mode"]],
-               first=None if first is None else first.to_dict(), models=per_model, at_crossing=at_crossing)
+               first=None if first is None else first.to_dict(), models=per_model, at_crossing=at_crossing,
+               screen=screen)
     Path(out_path).write_text(json.dumps(row))
+
+
+def screened_pass(states, strip_ratio):
+    """Every state in order up to the first unstable one, twice: every mode (as ``assess`` does
+    before narrowing), and screened -- modes n = 0, 1 only where the strip indicator is silent
+    (ratio >= 1), every mode where it fires.  Times and the first unstable index of each: what
+    using the indicator as a screen for n >= 2 would save, and whether it would change a verdict."""
+    from shellbvp.curve_stability import point_stability
+
+    out = {}
+    if states:
+        point_stability(states[0], modes=[0])  # the form's derivation (once per process) outside the timing
+    for name, screened in (("full", False), ("screened", True)):
+        t0 = time.perf_counter()
+        first = None
+        for i, s in enumerate(states):
+            modes = [0, 1] if screened and not strip_ratio[i] < 1 else None
+            lam, _, _ = point_stability(s, modes=modes)
+            if lam < 0:
+                first = i
+                break
+        out[name] = {"seconds": time.perf_counter() - t0, "first_unstable": first}
+    return out
 
 
 def run_one(spec, grace=60):
@@ -193,6 +218,14 @@ def summarise(rows):
                    f"fires on {alarms} of {stable_states} states analysed stable, on {stable_curves_fired} curves "
                    f"that stay stable; silent at the located crossing (ratio >= 1 there) on {len(late)}"
                    + (f" ({', '.join(late)})" if late else "") + f"; {t_ind:.1f} s for every state of every curve.")
+    scr = [r for r in done if r.get("screen")]
+    changed = [r["id"] for r in scr if r["screen"]["full"]["first_unstable"] != r["screen"]["screened"]["first_unstable"]]
+    t_full = sum(r["screen"]["full"]["seconds"] for r in scr)
+    t_scr = sum(r["screen"]["screened"]["seconds"] for r in scr)
+    out.append(f"* `strip` as a screen (modes n = 0, 1 only at states where it is silent, every mode where it "
+               f"fires; every state in order up to the first unstable one, no narrowing): {t_scr:.0f} s against "
+               f"{t_full:.0f} s with every mode; first unstable state changed on {len(changed)} curves"
+               + (f" ({', '.join(changed)})" if changed else "") + ".")
     t_st = sum(r["stability_s"] for r in done if math.isfinite(r["stability_s"]))
     out.append(f"* the eigenvalue analysis (every state up to the first unstable one, then narrowed): {t_st:.0f} s; "
                f"the curves themselves {sum(r['curve_s'] for r in done):.0f} s.")

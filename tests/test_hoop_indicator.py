@@ -103,3 +103,17 @@ def test_bad_input_and_failed_states():
         sb.hoop_indicator(state, model="cylinder")
     failed = sb.hoop_indicator(Solution(status=1, success=False))
     assert math.isnan(failed.ratio) and not failed.fires
+
+
+@pytest.mark.slow  # ~25 s: code is generated for the cap's shell
+def test_pinned_shallow_cap_under_pressure_fires_before_its_n7_instability():
+    """A spherical cap of radius 5 over the rim radius 1, beta 1e-5 (tests/test_stability.py):
+    n = 7 goes unstable at 0.734 p_c (benchmarks/results/stability_pressure.md).  The strip
+    indicator fires before: already at 0.70 p_c, where every mode is still stable."""
+    beta = 1e-5
+    shell = sb.UserShell("5*sin(S/5)", "-5*cos(S/5)", "5*asin(1/5)")
+    p_c = 4 * math.sqrt(3 * beta) / 25
+    state = sb.inflate(sb.Scene(shell=shell, beta=beta, pressure=0.70 * p_c))
+    assert sb.stability(state, modes=range(2, 12)).stable
+    ind = sb.hoop_indicator(state)
+    assert ind.fires and ind.ratio < 0.6, ind.ratio
