@@ -25,7 +25,7 @@ _LAZY = {"curve": "continuation", "iter_curve": "continuation", "CurveRun": "con
          "read_instrument": "instrument", "fit_files": "batch", "read_fit": "fitrecord",
          "sweep": "sweep", "read_sweep": "sweep", "Sweep": "sweep",
          "fit_with_geometry": "uncertainty", "GeometryFit": "uncertainty", "convexity_limits": "convexity",
-         "inflate": "inflation", "stability": "modal_stability", "Stability": "modal_stability", "options": "config", "Options": "config", "fe_curve": "fe", "FECurve": "fe", "validate": "validation",
+         "inflate": "inflation", "stability": "modal_stability", "hoop_indicator": "wrinkling", "HoopIndicator": "wrinkling", "Stability": "modal_stability", "options": "config", "Options": "config", "fe_curve": "fe", "FECurve": "fe", "validate": "validation",
          "Validation": "validation"}
 
 
@@ -51,6 +51,8 @@ __all__ = [
     "inflate",
     "stability",
     "Stability",
+    "hoop_indicator",
+    "HoopIndicator",
     "curve",
     "iter_curve",
     "options",
