@@ -344,19 +344,20 @@ def _check_pole_floor(out, solve):
     """ValueError (one line) if a negative eigenvalue is the pole's rounding floor, not the state's.
 
     Near the pole the form's coefficients (up to 1/r^3) cancel; where the pole is strongly
-    compressed and bent (a thick shell's lifted pole near its fold: lambda0 0.38, kappa_s 71 at
-    beta 0.2) the rounding left is larger than the energy, and an n >= 2 eigenvalue of -1e6
-    appears that moves with the mesh's start (-2.8e4 with it 10 times further out, +10 with 64
-    times).  A genuine instability's eigenvalue barely depends on where the mesh starts (the modes
-    live on the bending length): each negative one is recomputed with S0 times
-    :data:`POLE_CHECK_FACTOR` and must keep its sign and agree to 10 %."""
+    compressed and bent (a thick shell's lifted pole near its fold: lambda0 0.37, kappa_s 71 at
+    beta 0.2) the rounding left is larger than the energy: n = 2 reads -1.2e6 and -1.9e4 with the
+    mesh starting 10 times further out, and n = 0 changes sign (benchmarks/results/stability_contact.md).
+    A genuine instability's eigenvalue hardly depends on where the mesh starts (the modes live on
+    the bending length): each negative one is recomputed with S0 times :data:`POLE_CHECK_FACTOR`
+    and must stay negative and within a factor 10 (not closer: near a crossing the eigenvalue is
+    small and moves by its own size)."""
     negative = [int(n) for n, lam in zip(out.modes, out.smallest) if lam < 0]
     if not negative:
         return
     check = solve(negative, out.S0 * POLE_CHECK_FACTOR, count=1)
     for n, far in zip(check.modes, check.smallest):
         near = float(out.smallest[list(out.modes).index(n)])
-        if not (far < 0 and abs(far - near) <= 0.1 * max(abs(far), abs(near))):
+        if not (far < 0 and max(-far, -near) <= 10 * min(-far, -near)):
             raise ValueError(f"stability: mode n = {n} is not resolved at the pole (smallest eigenvalue {near:.3g} "
                              f"with the mesh from S0 = {out.S0:.3g}, {far:.3g} from {out.S0 * POLE_CHECK_FACTOR:.3g}): "
                              f"the form's coefficients there cancel below double precision")
