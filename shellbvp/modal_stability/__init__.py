@@ -349,18 +349,22 @@ def _check_pole_floor(out, solve):
     mesh starting 10 times further out, and n = 0 changes sign (benchmarks/results/stability_contact.md).
     A genuine instability's eigenvalue hardly depends on where the mesh starts (the modes live on
     the bending length): each negative one is recomputed with S0 times :data:`POLE_CHECK_FACTOR`
-    and must stay negative and within a factor 10 (not closer: near a crossing the eigenvalue is
-    small and moves by its own size)."""
+    and must stay negative and within a factor 10 of itself -- or move by less than 1 % of the
+    state's eigenvalues (the median over modes of their magnitudes): near a crossing the
+    eigenvalue is small and moving the mesh's start moves the crossing (the deep dome of the grid,
+    gamma -2, at delta 0.367: -1.96e-4 and -0.94e-4, against eigenvalues of order 1)."""
     negative = [int(n) for n, lam in zip(out.modes, out.smallest) if lam < 0]
     if not negative:
         return
+    scale = float(np.median(np.abs(out.eigenvalues)))
     check = solve(negative, out.S0 * POLE_CHECK_FACTOR, count=1)
     for n, far in zip(check.modes, check.smallest):
         near = float(out.smallest[list(out.modes).index(n)])
-        if not (far < 0 and max(-far, -near) <= 10 * min(-far, -near)):
+        agrees = far < 0 and max(-far, -near) <= 10 * min(-far, -near)
+        if not (agrees or abs(far - near) <= 0.01 * scale):
             raise ValueError(f"stability: mode n = {n} is not resolved at the pole (smallest eigenvalue {near:.3g} "
                              f"with the mesh from S0 = {out.S0:.3g}, {far:.3g} from {out.S0 * POLE_CHECK_FACTOR:.3g}): "
-                             f"the form's coefficients there cancel below double precision")
+                             "the form's coefficients there cancel below double precision")
 
 
 def sphere_stretch(scene) -> float:
