@@ -205,3 +205,24 @@ def test_a_negative_eigenvalue_that_moves_with_the_mesh_start_is_refused(base_sc
     monkeypatch.setattr(st, "spectrum", shifted(True))
     with pytest.raises(ValueError, match=r"mode n = \d is not resolved at the pole"):
         st.stability(state, modes=[0, 1], elements=40)
+
+
+def test_a_negative_eigenvalue_is_recomputed_on_a_finer_mesh(monkeypatch):
+    """Next to the convexity limit the default mesh does not resolve the edge's layer (measured on
+    the grid's gamma = 2 at delta 0.739: n = 1 at -1.66, 0.418, 0.933 with 40, 160, 640 elements):
+    a negative eigenvalue is recomputed with 4 times the elements and the finer one kept."""
+    state = sb.solve(sb.Scene.preset("base"), delta=0.3)
+    spectrum = st.spectrum
+
+    def coarse_is_wrong(scene, base_of, S0, L, modes=None, elements=None, **kw):
+        out = spectrum(scene, base_of, S0, L, modes, elements=elements, **kw)
+        if elements == 40:  # the coarse mesh reads n = 1 negative
+            out.eigenvalues[list(out.modes).index(1)] -= 10.0
+        return out
+
+    monkeypatch.setattr(st, "spectrum", coarse_is_wrong)
+    res = st.stability(state, modes=[0, 1, 2], elements=40)
+    assert res.refined == (1,) and res.stable
+    fine = spectrum(state.scene, st.contact_of(state).base, st.contact_of(state).S0, float(state.system.L), [1],
+                    elements=160, contact=st.contact_of(state))
+    assert res.smallest[1] == pytest.approx(fine.smallest[0], rel=1e-9)

@@ -43,6 +43,9 @@ class Stability:
         Where the mesh starts (the pole conditions are imposed there).
     wall_time : float
         Seconds (the form's derivation included on first use in a process).
+    refined : tuple of int
+        The modes whose negative eigenvalue was recomputed on a finer mesh (:func:`shellbvp.stability`);
+        their rows of ``eigenvalues`` are the finer mesh's.
     held_corners : tuple of float
         The S of the state's cornered contact edges (Weierstrass-Erdmann corners, ``contact_edge``).
         The perturbations keep each at its material point: a negative eigenvalue proves the state
@@ -64,6 +67,7 @@ class Stability:
     vectors: dict = field(default_factory=dict)
     wall_time: float = math.nan
     held_corners: tuple = ()
+    refined: tuple = ()
 
     @property
     def smallest(self) -> np.ndarray:
