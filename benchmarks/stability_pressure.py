@@ -19,14 +19,14 @@ trace bending, xi = 1; the pressure below the bowl pushes on its convex side):
   crossing;
 * ``clamped caps``: the same cap with its rim clamped (``Scene(rim="clamped")``: the slope held
   too), at beta chosen for the cap parameters lambda of the literature's tables (default 6, 8,
-  12), against Huang 1964 / Teng & Rotter 1989b (first asymmetric bifurcation, p/p_c and n) and
+  12; and a cap of sphere radius 10 at lambda 8), against Huang 1964 / Teng & Rotter 1989b (first asymmetric bifurcation, p/p_c and n) and
   Budiansky 1959 (axisymmetric snap, lambda <= 8).
 
 Writes benchmarks/results/stability_pressure.md (and .json).
 
     python benchmarks/stability_pressure.py            # beta 1e-4, 1e-5, 1e-6, the caps
     python benchmarks/stability_pressure.py --betas 1e-4
-    python benchmarks/stability_pressure.py --only clamped --lambdas 6 8 12   # the other rows from the .json
+    python benchmarks/stability_pressure.py --only clamped --lambdas 6 8 12 --shallower 8   # others from the .json
 """
 
 from __future__ import annotations
@@ -186,20 +186,26 @@ def shallow_cap(beta=1e-5, rim="pinned", bracket=(0.84, 0.86), scan=(0.5, 0.6, 0
             "asymmetric": asym, "seconds": time.perf_counter() - t0}
 
 
-#: The cap's rise over the rim radius (sphere radius 5 over the rim radius 1)
-CAP_RISE = 5 - math.sqrt(24)
+def cap_shell(radius=5):
+    """A spherical cap of the given sphere radius over the rim radius 1 (``CAP`` for 5)."""
+    return (f"{radius:g}*sin(S/{radius:g})", f"-{radius:g}*cos(S/{radius:g})", f"{radius:g}*asin(1/{radius:g})")
 
 
-def cap_lambda(beta):
+def cap_rise(radius=5):
+    """The cap's rise H over the rim radius."""
+    return radius - math.sqrt(radius**2 - 1)
+
+
+def cap_lambda(beta, radius=5):
     """The cap parameter ``lambda = 2 [3 (1 - nu^2)]^(1/4) sqrt(H/h)`` (the literature's tables'
     definition, benchmarks/results/stability_literature.md) of the cap at ``beta``, with our
     nu = 1/2 (incompressible): ``sqrt(6 H/h)``, ``h = sqrt(3 beta)``."""
-    return math.sqrt(6 * CAP_RISE / math.sqrt(3 * beta))
+    return math.sqrt(6 * cap_rise(radius) / math.sqrt(3 * beta))
 
 
-def cap_beta(lam):
+def cap_beta(lam, radius=5):
     """The beta of the cap whose :func:`cap_lambda` is ``lam``."""
-    return (6 * CAP_RISE / lam**2) ** 2 / 3
+    return (6 * cap_rise(radius) / lam**2) ** 2 / 3
 
 
 #: Clamped shallow caps, first asymmetric bifurcation: lambda -> (Huang 1964 p_cr/p_c, n, Teng &
@@ -229,7 +235,7 @@ def _min_over(res, first_mode):
     return float(res.smallest[keep][k]), int(res.modes[keep][k])
 
 
-def clamped_cap(lam, f0=0.5):
+def clamped_cap(lam, radius=5, f0=0.5):
     """The clamped cap of cap parameter ``lam`` followed along its axisymmetric branch in p/p_c
     from ``f0`` (each state solved from the one before: ``inflate(..., start=)``), with its
     spectrum at every step: the first crossing over n >= 1 (refined by regula falsi), and the
@@ -237,8 +243,8 @@ def clamped_cap(lam, f0=0.5):
     fails, where n = 0 is negative or where the volume jumps: another branch) down to
     ``BRANCH_MIN_STEP``."""
     t0 = time.perf_counter()
-    beta, shell = cap_beta(lam), sb.UserShell(*CAP)
-    pc = classical(beta) / 25
+    beta, shell = cap_beta(lam, radius), sb.UserShell(*cap_shell(radius))
+    pc = classical(beta) / radius**2
 
     def solve(f, start=None):
         return sb.inflate(sb.Scene(shell=shell, beta=beta, pressure=f * pc, rim="clamped"), max_nodes=FOLD_NODES,
@@ -280,7 +286,8 @@ def clamped_cap(lam, f0=0.5):
     exponent = float(np.polyfit(np.log(end - fb[near]), np.log(lam0[near]), 1)[0]) if near.sum() >= 3 else math.nan
     # lambda_0^2 is linear in p at a fold: its zero from the last two states
     zero = float(fb[-1] - lam0[-1] ** 2 * (fb[-1] - fb[-2]) / (lam0[-1] ** 2 - lam0[-2] ** 2))
-    return {"lambda_table": lam, "lambda": cap_lambda(beta), "beta": beta, "rim": "clamped", "p_c": pc,
+    return {"lambda_table": lam, "radius": radius, "lambda": cap_lambda(beta, radius), "beta": beta, "rim": "clamped",
+            "p_c": pc,
             "branch_end_p_over_pc": end, "n0_exponent": exponent, "n0_zero_p_over_pc": zero,
             "branch": [list(b) for b in branch],
             "asymmetric": asym or {"found": False, "note": f"none up to the branch's end {end:.4f}"},
@@ -316,25 +323,29 @@ def _refine_crossing(solve, a, b, rtol=1e-4):
     return {"found": True, "p_over_pc": f, "bracket": [fa, fb], "n": n, "S_peak": S_peak}
 
 
-def clamped_caps(lambdas):
+def clamped_caps(lambdas, shallower=()):
+    """The clamped caps of sphere radius 5 at ``lambdas``, and of radius 10 (half as steep: the
+    shallow-shell theory's error, of order the angle squared, a quarter) at ``shallower``."""
     out = []
-    for lam in lambdas:
-        print(f"clamped cap lambda {lam:g}, beta {cap_beta(lam):.4g}", flush=True)
-        out.append(clamped_cap(lam))
+    for radius, lams in ((5, lambdas), (10, shallower)):
+        for lam in lams:
+            print(f"clamped cap radius {radius}, lambda {lam:g}, beta {cap_beta(lam, radius):.4g}", flush=True)
+            out.append(clamped_cap(lam, radius))
     return out
 
 
 def _clamped_lines(caps):
-    lines = ["", "## Clamped shallow caps (sphere radius 5, rim radius 1, `rim=\"clamped\"`) against the literature",
+    lines = ["", "## Clamped shallow caps (sphere radius 5 and 10, rim radius 1, `rim=\"clamped\"`) against the "
+             "literature",
              "",
              "The cap of the section above with its rim clamped (lambda_theta = 1, z = 0 and the slope held, "
              "phi(L) = Phi(L); the modes hold u = v = w = w' = 0 there), at the beta whose cap parameter "
              "lambda = 2 [3 (1 - nu^2)]^(1/4) sqrt(H/h) is the tables' with our nu = 1/2 "
              "(lambda = sqrt(6 H/h), h = sqrt(3 beta); `benchmarks/results/stability_literature.md`).  "
-             "p_c = 4 sqrt(3 beta)/25 is the classical pressure of the sphere of radius 5 with nu = 1/2, "
+             "p_c = 4 sqrt(3 beta)/R^2 is the classical pressure of the sphere of radius R with nu = 1/2, "
              "the tables' p_c = 2 E h^2/(R^2 sqrt(3 (1 - nu^2))) with their nu.  `asymmetric`: the first "
-             "crossing of the smallest eigenvalue over n >= 1 (bracketed on a scan of p/p_c, refined by "
-             "regula falsi to 1e-4); `fold`: the end of the axisymmetric branch, followed from 0.5 p_c in "
+             "sign change of the smallest eigenvalue over n >= 1 along the branch below, refined by regula "
+             "falsi to 1e-4 in p/p_c; `fold`: the end of the axisymmetric branch, followed from 0.5 p_c in "
              "steps of 0.01 p_c (each state solved from the one before, `inflate(..., start=)`) that halve "
              "where Newton fails, the n = 0 eigenvalue turns negative or the volume jumps (another branch), "
              "down to 1e-4; with the log-log slope of the n = 0 eigenvalue over the last 5 % before it (a "
@@ -343,10 +354,10 @@ def _clamped_lines(caps):
              "at 1.1 p_c, a state of another, unstable branch; hence the march.)  "
              "Literature: Huang 1964 and Teng & Rotter 1989b (nu = 1/3) for the asymmetric bifurcation, "
              "Budiansky 1959 (nu = 0.3) for the axisymmetric snap; transcribed by the AQUINAS authors.", "",
-             "| lambda | beta | p_c | asymmetric p/p_c (ours) | n (ours) | Huang 1964 p/p_c, n | Teng & Rotter "
+             "| R | lambda | beta | p_c | asymmetric p/p_c (ours) | n (ours) | Huang 1964 p/p_c, n | Teng & Rotter "
              "p/p_c, n | ours / Huang | fold p/p_c (ours; lambda_0^2 zero) | n = 0 slope | Budiansky 1959 "
              "| time |",
-             "|---|---|---|---|---|---|---|---|---|---|---|---|"]
+             "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for c in caps:
         lam, a = c["lambda_table"], c["asymmetric"]
         hu = HUANG.get(lam)
@@ -354,7 +365,7 @@ def _clamped_lines(caps):
         ours = f"{a['p_over_pc']:.4f} | {a['n']}" if a["found"] else f"-- ({a['note']}) | --"
         ratio = f"{a['p_over_pc'] / hu[0]:.3f}" if hu and a["found"] else "--"
         bud = f"{BUDIANSKY[lam]:.3f}" if lam in BUDIANSKY else "--"
-        lines.append(f"| {lam:g} | {c['beta']:.3g} | {c['p_c']:.4g} | {ours} | {lit} | {ratio} "
+        lines.append(f"| {c.get('radius', 5)} | {lam:g} | {c['beta']:.3g} | {c['p_c']:.4g} | {ours} | {lit} | {ratio} "
                      f"| {c['branch_end_p_over_pc']:.4f} ({c['n0_zero_p_over_pc']:.4f}) | {c['n0_exponent']:.2f} "
                      f"| {bud} | {c['seconds']:.0f} s |")
     lines += ["", "What differs between the two sides (so agreement is expected to a few per cent, not to the "
@@ -362,7 +373,7 @@ def _clamped_lines(caps):
               "own, so rows of equal lambda are compared, which assumes p/p_c depends on nu only through "
               "lambda: the clamped edge's in-plane condition brings nu in as well); shallow-shell "
               "(Donnell-Mushtari-Vlasov) theory with small strains against our shell with its exact spherical "
-              "geometry (half-angle 11.5 degrees) and finite strains; the incompressible Mooney-Rivlin material "
+              "geometry (half-angle 11.5 degrees at R = 5, 5.7 at R = 10) and finite strains; the incompressible Mooney-Rivlin material "
               "(its strains here are of order 1e-3, so nearly linear) with bending stiffness beta = h^2/3."]
     return lines
 
@@ -375,6 +386,8 @@ def main():
     ap.add_argument("--cap-only", action="store_true", help="only the shallow caps")
     ap.add_argument("--lambdas", type=float, nargs="*", default=[6, 8, 12],
                     help="cap parameters of the clamped caps (none: no clamped caps)")
+    ap.add_argument("--shallower", type=float, nargs="*", default=[8],
+                    help="cap parameters of clamped caps of sphere radius 10 (half as steep)")
     ap.add_argument("--only", choices=["clamped"],
                     help="only the clamped caps; the other results are those of stability_pressure.json")
     args = ap.parse_args()
@@ -397,14 +410,12 @@ def main():
         cap = shallow_cap()
     elif args.only != "clamped":
         cap = None
-    clamped = clamped_caps(args.lambdas)
+    clamped = clamped_caps(args.lambdas, args.shallower)
     OUT.mkdir(exist_ok=True)
     meta = {"machine": platform.platform(), "python": platform.python_version(),
             "date": time.strftime("%Y-%m-%d")}
     if args.only == "clamped":  # the other rows keep their run's
         meta = {**last["meta"], "clamped": meta}
-    (OUT / "stability_pressure.json").write_text(json.dumps({"meta": meta, "rows": rows, "cap": cap,
-                                                             "clamped": clamped}, indent=1))
     lines = ["# The hemisphere under external pressure: first zero eigenvalue against p_c = 4 sqrt(3 beta)", "",
              "Written by `benchmarks/stability_pressure.py` (issue 44).  gamma = 1, Mooney-Rivlin 0.1, trace "
              "bending, xi = 1; the pressure below the bowl pushes on its convex side.  `sphere`: the complete "
@@ -444,12 +455,16 @@ def main():
     if clamped:
         lines += _clamped_lines(clamped)
     if args.only == "clamped":
+        total = f" (total {meta['total_seconds']:.0f} s)" if "total_seconds" in meta else ""
         lines += ["", f"The clamped caps: {time.perf_counter() - t0:.0f} s, {meta['clamped']['date']}; the rows above "
-                  f"from the run of {meta['date']}."]
+                  f"from the run of {meta['date']}{total}."]
     else:
-        lines += ["", f"Total {time.perf_counter() - t0:.0f} s, {meta['date']}."]
+        meta["total_seconds"] = time.perf_counter() - t0
+        lines += ["", f"Total {meta['total_seconds']:.0f} s, {meta['date']}."]
     lines[-1] += f" {meta['machine']}, Python {meta['python']}; 2 shared cores."
     lines.append("")
+    (OUT / "stability_pressure.json").write_text(json.dumps({"meta": meta, "rows": rows, "cap": cap,
+                                                             "clamped": clamped}, indent=1))
     (OUT / "stability_pressure.md").write_text("\n".join(lines))
     print("\n".join(lines))
 
