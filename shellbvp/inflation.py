@@ -125,8 +125,9 @@ def inflate(scene, tol: float = TOL, max_nodes: int = _MAX_NODES, *, start: Infl
         if not (isinstance(start, InflatedState) and start.success
                 and start.scene.replace(pressure=target) == scene):
             raise ValueError("start must be a converged inflated state of the same scene at another pressure")
-        # every other node of its mesh (keeping the ends): solve_bvp only adds nodes, so a chain
-        # of solves would otherwise grow its mesh to max_nodes
+        # every other node of its mesh (keeping the ends): solve_bvp only adds nodes, so along a
+        # chain of solves the mesh would only grow (a clamped cap over 60 steps of p: 900 -> 1740
+        # nodes; thinned 860 -> 1510)
         keep = np.unique(np.r_[np.arange(0, start.x.size, 2), start.x.size - 1])
         return _finish(_solve(_system(scene, target), start.x[keep], start.y[:, keep], tol, max_nodes))
     sysm = _system(scene, 0.0)
