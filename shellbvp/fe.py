@@ -356,7 +356,7 @@ def fe_curve(scene, thickness, deltas, *, mesh_check=False, progress=None, **set
     scene : Scene
         Shell, indenter and material (one with a ``felupe_model``); beta, xi, the
         bending energy and the contact model are the shell model's and play no part here.
-        Pressurised scenes are refused.
+        Pressurised scenes and a clamped rim are refused.
     thickness : float
         eps = H / R_L, in (0, 0.5].
     deltas : array_like
@@ -391,6 +391,8 @@ def fe_curve(scene, thickness, deltas, *, mesh_check=False, progress=None, **set
         raise ValueError("deltas must be finite, > 0 and increasing")
     if scene.pressurised:
         raise ValueError("pressure: the 3D reference has no internal pressure yet; use a scene with pressure 0")
+    if scene.rim != "pinned":
+        raise ValueError(f"rim: the 3D reference's rim is pinned at its mid-thickness point; got rim={scene.rim!r}")
     _check_material(scene)
     unknown = set(settings) - set(FE_DEFAULTS)
     if unknown:

@@ -17,9 +17,13 @@ from .geometry import SphereTip, Spheroid, UserShell, UserTip
 from .materials import MATERIALS, Bending, Gent, Material, MooneyRivlin, TraceBending
 from .model import load_module, structure_description
 
-__all__ = ["Scene", "PRESETS", "CONTACT_MODELS"]
+__all__ = ["Scene", "PRESETS", "CONTACT_MODELS", "RIMS"]
 
 CONTACT_MODELS = ("smooth", "paper")
+#: What is held at the rim S = L besides its circle (lambda_theta = 1, z = 0): ``pinned``
+#: leaves the rotation free (M_s = 0), ``clamped`` holds the slope at the reference's,
+#: phi(L) = Phi(L).
+RIMS = ("pinned", "clamped")
 
 
 def _finite(name, value):
@@ -82,6 +86,12 @@ class Scene:
         and :func:`shellbvp.validate` compare forces at ``delta + shear_delta``.  It removes
         most of the model's O(eps) error against 3D elasticity (``docs/accuracy.md``).
         Needs ``thickness``.  Default False.
+    rim : {"pinned", "clamped"}
+        What holds the rim circle (``lambda_theta = 1``, ``z = 0`` in both): ``"pinned"`` (simply
+        supported, the rotation free, ``M_s = 0``; default) or ``"clamped"`` (the slope held at the
+        reference's, ``phi(L) = Phi(L)``).  Clamped is offered for the shell under pressure
+        before contact (:func:`shellbvp.inflate` and its :func:`shellbvp.stability`); a solve in
+        contact refuses it.
 
     Raises
     ------
@@ -121,6 +131,7 @@ class Scene:
     sealed: bool = False
     thickness: float = None
     transverse_shear: bool = False
+    rim: str = "pinned"
 
     def __post_init__(self):
         rho = _finite("rho", self.rho)
@@ -180,6 +191,8 @@ class Scene:
         if self.transverse_shear and self.thickness is None:
             raise ValueError("transverse_shear needs the shell's thickness (thickness = H / R_L in (0, 0.5])")
         object.__setattr__(self, "transverse_shear", bool(self.transverse_shear))
+        if not isinstance(self.rim, str) or self.rim not in RIMS:
+            raise ValueError(f"rim must be one of {RIMS}; got {self.rim!r}")
 
     # -- presets -----------------------------------------------------------------
     @classmethod
@@ -240,6 +253,7 @@ class Scene:
             **({"sealed": True} if self.sealed else {}),
             **({"thickness": self.thickness} if self.thickness is not None else {}),
             **({"transverse_shear": True} if self.transverse_shear else {}),
+            **({"rim": self.rim} if self.rim != "pinned" else {}),
         }
 
     @classmethod
@@ -296,7 +310,8 @@ class Scene:
                    sealed=field(d, "sealed", (bool,), "") if "sealed" in d else False,
                    thickness=field(d, "thickness", number, "") if "thickness" in d else None,
                    transverse_shear=field(d, "transverse_shear", (bool,), "") if "transverse_shear" in d
-                   else False)
+                   else False,
+                   rim=field(d, "rim", text, "") if "rim" in d else "pinned")
 
     def describe(self, R_L: float | None = None) -> str:
         """The scene in words, one line; with the rim radius ``R_L`` (m) its lengths in lab units.
@@ -340,6 +355,8 @@ class Scene:
         parts.append(f"{self.contact} contact" + ("" if self.xi == 1 else ", first approximation xi 0"))
         if self.pressure or self.sealed:
             parts.append(f"pressure p R_L/(mu H) {self.pressure:g}" + (", sealed" if self.sealed else ""))
+        if self.rim != "pinned":
+            parts.append(f"{self.rim} rim")
         return "; ".join(parts)
 
     def to_json(self) -> str:

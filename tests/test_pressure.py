@@ -89,6 +89,18 @@ def test_negative_pressure_deflates_and_zero_pressure_is_the_reference():
     assert scene.reference_volume() == pytest.approx(2 * math.pi / 3, rel=1e-10)  # the hemisphere
 
 
+def test_inflate_from_a_state_at_another_pressure_finds_the_same_state():
+    scene = sb.Scene.preset("dome", pressure=-0.02)
+    before = inflate(scene)
+    fresh = inflate(scene.replace(pressure=-0.025))
+    stepped = inflate(scene.replace(pressure=-0.025), start=before)
+    assert stepped.success
+    assert stepped.pole_rise == pytest.approx(fresh.pole_rise, rel=1e-6)
+    assert stepped.volume_change == pytest.approx(fresh.volume_change, rel=1e-6)
+    with pytest.raises(ValueError, match="start must be a converged inflated state of the same scene"):
+        inflate(scene.replace(pressure=-0.025, beta=0.02), start=before)
+
+
 def test_energy_identity_with_the_pressure_work(delta=0.25):
     """F = d(E_elastic - p V)/d delta, E from the profiles, F from the axial force (with p r^2/2)."""
     scene = sb.Scene.preset("dome", pressure=0.1)

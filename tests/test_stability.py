@@ -13,7 +13,10 @@ r"""Stability of states without contact against Fourier modes (shellbvp.modal_st
   the base state shifts it by about 1 %);
 * the hemisphere with its rim held buckles first in modes next to the rim, below p_c;
 * the pinned shallow cap's n = 0 eigenvalue vanishes like a fold's where its inflation stops (slow:
-  code is generated for its shell).
+  code is generated for its shell);
+* a clamped rim (``Scene.rim``) holds the reference slope in the inflated state and ``w'`` in the
+  modes; on the same base state (the unstressed shell) its eigenvalues are those of a subspace of
+  the pinned rim's, so not below them, mode by mode.
 """
 
 from __future__ import annotations
@@ -121,6 +124,50 @@ def test_unsupported_states_are_refused():
         st.stability(Solution(success=True, status=0, topology="cap+cylinder"))
     with pytest.raises(ValueError, match="did not converge"):
         st.stability(Solution(success=False, topology="inflated", message="no"))
+
+
+def test_clamped_rim_holds_the_reference_slope_and_takes_a_moment():
+    scene = sb.Scene(gamma=0.5, beta=3e-3, pressure=-0.03)  # the bowl inflated from inside
+    rims = {}
+    for rim in ("pinned", "clamped"):
+        state = sb.inflate(scene.replace(rim=rim))
+        assert state.success, state.message
+        rims[rim] = {k: v[-1] for k, v in state.profile().items()}
+    L = scene.shell_length
+    reference = float(scene.model().reference_shell(L, scene.parameters())["Phi"])
+    assert reference == pytest.approx(math.pi / 2, abs=1e-14)  # the spheroid meets its rim vertically
+    clamped, pinned = rims["clamped"], rims["pinned"]
+    assert clamped["phi"] == pytest.approx(reference, abs=1e-9)
+    assert abs(pinned["phi"] - reference) > 1e-3  # the pinned rim turns under this pressure
+    for rim in (clamped, pinned):  # both hold the rim circle
+        assert rim["r"] == pytest.approx(1.0, abs=1e-9) and abs(rim["z"]) < 1e-9
+    assert abs(pinned["M_s"]) < 1e-9 < abs(clamped["M_s"])
+
+
+def test_clamped_rim_holds_w_prime_and_stiffens_the_same_base_state():
+    scene = sb.Scene(gamma=1, beta=1e-3)  # no pressure: both rims hold the unstressed shell
+    modes = range(5)
+    out = {rim: st.stability(sb.inflate(scene.replace(rim=rim)), modes=modes, elements=30, vectors=True)
+           for rim in ("pinned", "clamped")}
+    for n in modes:
+        clamped, pinned = out["clamped"].vectors[n], out["pinned"].vectors[n]
+        assert clamped["w"][-1] == 0 and clamped["dw"][-1] == 0
+        assert abs(pinned["dw"][-1]) > 1e-3 * np.abs(pinned["dw"]).max()  # free: the wiring decides
+    assert np.all(out["clamped"].eigenvalues[:, 0] >= out["pinned"].eigenvalues[:, 0] * (1 - 1e-12))
+    assert np.any(out["clamped"].eigenvalues[:, 0] > out["pinned"].eigenvalues[:, 0] * 1.001)
+
+
+def test_rim_is_validated_and_clamped_is_refused_in_contact():
+    with pytest.raises(ValueError, match=r"^rim must be one of \('pinned', 'clamped'\); got 'fixed'$"):
+        sb.Scene(rim="fixed")
+    scene = sb.Scene.preset("base", rim="clamped")
+    assert scene.structure() == sb.Scene.preset("base").structure()  # the generated code is shared
+    assert "rim" not in sb.Scene.preset("base").to_dict()            # files of pinned scenes as before
+    assert sb.Scene.from_dict(scene.to_dict()) == scene
+    with pytest.raises(ValueError, match=r"rim='clamped' is offered for the shell under pressure before contact"):
+        sb.solve(scene, delta=0.1)
+    with pytest.raises(ValueError, match=r"^rim: the 3D reference's rim is pinned"):
+        sb.fe_curve(scene.replace(material=sb.NeoHookean()), thickness=0.1, deltas=[0.05])
 
 
 @pytest.mark.slow

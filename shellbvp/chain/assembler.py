@@ -8,7 +8,7 @@ import numpy as np
 
 from ..kernels import kernel_set
 from ..quadrature import gauss_points
-from .blocks import CONTACT_KINDS, REGION_CODES, SIZES, Chain, ContactPole, Edge, FreePole, Line, Point
+from .blocks import CONTACT_KINDS, REGION_CODES, SIZES, Chain, ContactPole, Edge, FreePole, Line, Point, Rim
 from .conditions import BoundaryConditions
 
 __all__ = ["ChainBVP", "CONTROLS"]
@@ -97,6 +97,18 @@ class ChainBVP(BoundaryConditions):
         self.force_at = next((j for j in reversed(self.junctions) if isinstance(j, (Edge, Line))), None)
         self.n_conditions = (sum(j.rows for j in self.junctions) + (self.extra is not None)
                              + (2 if self.volume_control else 0))
+        self.rim_slope = self._clamped_rim_slope()
+
+    def _clamped_rim_slope(self):
+        """``Phi(L)/L``, the reference slope over L that a clamped rim holds (``phiS`` at the rim),
+        or None for the pinned rim.  Clamped is offered before contact only (a pole and a rim)."""
+        if self.scene.rim == "pinned":
+            return None
+        if any(not isinstance(j, (FreePole, Rim)) for j in self.chain.junctions):
+            raise ValueError(f"rim={self.scene.rim!r} is offered for the shell under pressure before contact "
+                             f"(sb.inflate) only; the {self.chain.name} configuration touches the indenter")
+        L = self.L
+        return float(self.model.reference_shell(L, self.par)["Phi"]) / L
 
     def _set_value(self, value):
         self.value = float("nan")

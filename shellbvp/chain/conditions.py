@@ -16,6 +16,10 @@ _LS = FREE_STATES.index("ls")
 _LINE_CONTINUOUS = [FREE_STATES.index(s) for s in ("lt", "phiS", "ls", "ks", "z")]
 # states continuous across an interior corner (ls, ks jump)
 _KINK_CONTINUOUS = [FREE_STATES.index(s) for s in ("lt", "phiS", "rQ", "z")]
+_PHIS = FREE_STATES.index("phiS")
+# the generated rim rows are (lt - 1, the moment's m, z); a clamped rim holds its slope instead
+# of M_s = 0: phi/S - Phi(L)/L, linear in the states and free of the run-time parameters
+_RIM_MOMENT_ROW = 1
 
 
 class BoundaryConditions:
@@ -71,7 +75,7 @@ class BoundaryConditions:
                 parts += [mod.kink_res(self.S_point(self.regions[j.k].end, p), yl, yr, par),
                           (yr - yl)[_KINK_CONTINUOUS]]
             elif isinstance(j, Rim):
-                parts.append(mod.rim_res(self.S_point(self.regions[j.k].end, p), yb[self.rows(j.k)], par))
+                parts.append(self._rim_res(self.S_point(self.regions[j.k].end, p), yb[self.rows(j.k)], par))
         if self.extra == "force":
             _, S, yc, yf, _, _ = self._force_args(ya, yb, p, q)
             parts.append(self._force_function("res")(S, yc, yf, q["delta"], q["F"], par))
@@ -85,6 +89,25 @@ class BoundaryConditions:
         if self.volume_control:
             parts += [[ya[self.n_shell]], [yb[self.n_shell] - self.enclosed_volume]]
         return np.concatenate(parts)
+
+    def _rim_res(self, S, y, par):
+        res = self.model.rim_res(S, y, par)
+        if self.rim_slope is None:
+            return res
+        res = np.array(res, float)
+        res[_RIM_MOMENT_ROW] = y[_PHIS] - self.rim_slope
+        return res
+
+    def _rim_jac(self, S, y, par, what="jac"):
+        """d/dy (``what="jac"``) or d/dpar (``"jac_par"``) of the rim rows."""
+        dres = getattr(self.model, f"rim_{what}")(S, y, par)
+        if self.rim_slope is None:
+            return dres
+        dres = np.array(dres, float)
+        dres[_RIM_MOMENT_ROW] = 0.0
+        if what == "jac":
+            dres[_RIM_MOMENT_ROW, _PHIS] = 1.0
+        return dres
 
     def _line_function(self, j, what):
         return getattr(self.model, f"junction_{self._prefix(j.on)}smooth_{what}")
@@ -202,9 +225,9 @@ class BoundaryConditions:
                     B[row, l0 + c] = -1.0
             elif isinstance(j, Rim):
                 S = self.S_point(self.regions[j.k].end, p)
-                B[rows, self.rows(j.k)] = mod.rim_jac(S, yb[self.rows(j.k)], par)
+                B[rows, self.rows(j.k)] = self._rim_jac(S, yb[self.rows(j.k)], par)
                 if vc:
-                    self._pressure_column(P, rows, mod.rim_jac_par(S, yb[self.rows(j.k)], par))
+                    self._pressure_column(P, rows, self._rim_jac(S, yb[self.rows(j.k)], par, "jac_par"))
             r += j.rows
         if self.extra in ("force", "arclength"):
             w = 1.0 if self.extra == "force" else 2 * np.pi * self.arc_tangent[2] / self.arc_scale[2]

@@ -28,7 +28,8 @@ factorisation certifies to lie below the spectrum.
 Boundary conditions (the inflated/pressurised shell; states on the tip below):
 
 * rim (``lambda_theta = 1, z = 0, M_s = 0``): the rim circle is held, so every displacement of
-  it vanishes, ``u = v = w = 0``; ``w'`` is free (its natural condition is ``M_s = 0``).  With
+  it vanishes, ``u = v = w = 0``; ``w'`` is free (its natural condition is ``M_s = 0``).  A
+  clamped rim (``Scene.rim = "clamped"``, the slope held) holds ``w' = 0`` too.  With
   the rim circle fixed, the surface that closes the shell at the rim stays the flat disc, across
   which ``(x, y, 0)/2`` has no flux: the pressure's term is the exact volume, no rim term is left.
   Rigid motions move the rim, so none survives at n = 1 (no tilt to remove).
@@ -323,7 +324,8 @@ def stability(state, modes=None, *, elements: int | None = None, S0: float | Non
         S0 = zeta if S0 is None else max(float(S0), zeta)
 
         def solve(modes, S0, elements=elements, **kw):
-            return spectrum(state.scene, state_base(state), S0, float(sysm.L), modes, elements=elements, **kw)
+            return spectrum(state.scene, state_base(state), S0, float(sysm.L), modes, elements=elements,
+                            end=state.scene.rim, **kw)
     else:
         def solve(modes, S0, elements=elements, **kw):
             contact = contact_of(state, S0, friction)

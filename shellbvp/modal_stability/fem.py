@@ -36,7 +36,8 @@ class Stability:
     stable : bool
         Every eigenvalue positive.
     vectors : dict
-        Per mode, the eigenvector of its smallest eigenvalue as fields ``S, u, v, w`` at the nodes.
+        Per mode, the eigenvector of its smallest eigenvalue as fields ``S, u, v, w`` and ``dw``
+        (``w'``) at the nodes.
     elements : int
         Elements of the mesh in S.
     S0 : float
@@ -207,10 +208,11 @@ def _element_basis(xg, h, hs):
     return _element_basis_cached(tuple(xg), float(h), float(hs))
 
 
-#: Dofs (of u, u', v, v', w, w') held at the end S = L: the held rim (``w'`` free: M_s = 0), or
-#: the equator of a complete sphere for modes symmetric (u = 0, w' = 0; Q and the in-plane
-#: shear vanish naturally) or antisymmetric (v = w = 0; w'' = 0 naturally) about it.
-END_CONDITIONS = {"pinned": (0, 2, 4), "symmetric": (0, 5), "antisymmetric": (2, 4)}
+#: Dofs (of u, u', v, v', w, w') held at the end S = L: the held rim, pinned (``w'`` free:
+#: M_s = 0) or clamped (``w'`` held too: the slope is), named as ``Scene.rim``; or the equator of
+#: a complete sphere for modes symmetric (u = 0, w' = 0; Q and the in-plane shear vanish
+#: naturally) or antisymmetric (v = w = 0; w'' = 0 naturally) about it.
+END_CONDITIONS = {"pinned": (0, 2, 4), "clamped": (0, 2, 4, 5), "symmetric": (0, 5), "antisymmetric": (2, 4)}
 
 
 def _constraints(n, m, end="pinned", S0_over_hs=0.0, held=(), pole_held=False, lines=(), stuck=(),
@@ -425,7 +427,8 @@ def spectrum(scene, base_of, S0, L, modes=None, *, elements=None, count=2, vecto
         out[k] = lam
         if vectors:
             q = (T @ X[:, 0]).reshape(-1, 6)
-            vecs[int(n)] = {"S": nodes, "u": q[:, 0], "v": q[:, 2], "w": q[:, 4]}
+            vecs[int(n)] = {"S": nodes, "u": q[:, 0], "v": q[:, 2], "w": q[:, 4],
+                            "dw": q[:, 5] / np.diff(nodes).max()}  # w' from its dof (assemble's scale)
     return Stability(modes=modes, eigenvalues=out, elements=ne, S0=S0, vectors=vecs,
                      wall_time=time.perf_counter() - t0,
                      held_corners=() if contact is None else tuple(c.S for c in contact.corners))
