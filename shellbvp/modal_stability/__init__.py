@@ -344,22 +344,38 @@ REFINE_FACTOR = 4
 
 def _refine_negative(out, solve):
     """Recompute each mode with a negative eigenvalue on :data:`REFINE_FACTOR` times the elements
-    and keep the finer eigenvalues (``out.refined``: those modes).
+    and keep the finer eigenvalues (``out.refined``: those modes); where the finer one is still
+    negative but differs from the coarser by more than a factor 2, once more on REFINE_FACTOR
+    times those: the finest is kept if it is positive or within a factor 2 of the one before, else
+    a ValueError (one line): not resolved in the mesh.
 
     Where a contact edge is close to its convexity limit its free side has a layer whose width
     falls with the Legendre determinant there; the default mesh does not resolve it, and at a
     corner just born the corner's terms then give negative eigenvalues that are not the state's
     (the grid's gamma = 2 at delta 0.739, lambda_s jumping by 0.005: n = 1 at -1.66, 0.418, 0.933
-    with 40, 160, 640 elements).  A negative verdict is worth the finer mesh."""
+    with 40, 160, 640 elements).  A negative verdict is worth the finer meshes."""
     negative = [int(n) for n, lam in zip(out.modes, out.smallest) if lam < 0]
     if not negative:
         return
-    fine = solve(negative, out.S0, elements=REFINE_FACTOR * out.elements, count=out.eigenvalues.shape[1],
-                 vectors=bool(out.vectors))
-    for n, values in zip(fine.modes, fine.eigenvalues):
-        out.eigenvalues[list(out.modes).index(n)] = values
-    out.vectors.update(fine.vectors)
-    out.refined = tuple(int(n) for n in fine.modes)
+    elements, coarse = out.elements, {int(n): float(lam) for n, lam in zip(out.modes, out.smallest)}
+    for _ in range(2):
+        elements *= REFINE_FACTOR
+        fine = solve(negative, out.S0, elements=elements, count=out.eigenvalues.shape[1], vectors=bool(out.vectors))
+        for n, values in zip(fine.modes, fine.eigenvalues):
+            out.eigenvalues[list(out.modes).index(n)] = values
+        out.vectors.update(fine.vectors)
+        out.refined = tuple(sorted(set(out.refined) | {int(n) for n in fine.modes}))
+        unsure = [int(n) for n, lam in zip(fine.modes, fine.smallest)
+                  if lam < 0 and not 0.5 * coarse[int(n)] >= lam >= 2 * coarse[int(n)]]
+        if not unsure:
+            return
+        if elements > out.elements * REFINE_FACTOR:  # the second refinement: did the sign hold?
+            raise ValueError(f"stability: mode n = {unsure[0]} is not resolved in the mesh (smallest eigenvalue "
+                             f"{coarse[unsure[0]]:.3g} with {elements // REFINE_FACTOR} elements, "
+                             f"{float(fine.smallest[list(fine.modes).index(unsure[0])]):.3g} with {elements}); "
+                             f"a contact edge next to its convexity limit has a layer thinner than the mesh")
+        negative = unsure
+        coarse = {int(n): float(lam) for n, lam in zip(fine.modes, fine.smallest)}
 
 
 #: A negative eigenvalue is recomputed with the mesh starting this many times further from the
