@@ -25,10 +25,7 @@ import math
 import os
 import platform
 import re
-import signal
-import subprocess
 import sys
-import tempfile
 import time
 from pathlib import Path
 
@@ -36,7 +33,8 @@ HERE = Path(__file__).parent
 sys.path.insert(0, str(HERE))
 
 from checkout import commit_label  # noqa: E402
-from stability_modes import make_scene, scenes  # noqa: E402
+from stability_modes import scenes, time_limit, worker_scene  # noqa: E402
+from stability_modes import run_one as run_scene  # noqa: E402
 
 RESULTS = HERE / "results"
 MODELS = ("strip", "band")
@@ -48,23 +46,12 @@ def worker(spec_path, out_path):
     import shellbvp as sb
     from shellbvp.curve_stability import assess
 
-    spec = json.loads(Path(spec_path).read_text())
-    row = {"id": spec["id"]}
-    try:
-        scene = make_scene(spec["how"])
-    except ValueError as exc:
-        row["skipped"] = str(exc)
-        Path(out_path).write_text(json.dumps(row))
+    started = worker_scene(spec_path, out_path)
+    if started is None:
         return
-    scene.model()
-
-    def alarm(signum, frame):
-        raise KeyboardInterrupt
-
-    signal.signal(signal.SIGALRM, alarm)
-    signal.setitimer(signal.ITIMER_REAL, spec["time_limit"])
+    spec, row, scene = started
     t0 = time.perf_counter()
-    try:
+    with time_limit(spec["time_limit"]):
         c = sb.curve(scene, delta_max=spec["delta_max"], estimate_error=False)
         curve_s = time.perf_counter() - t0
         per_model = {}
@@ -76,8 +63,6 @@ def worker(spec_path, out_path):
                                 "S": [float(i.S) for i in inds]}
         screen = screened_pass(c.solutions, per_model["strip"]["ratio"])
         assess(c, "locate", samples=max(len(c), 1))
-    finally:
-        signal.setitimer(signal.ITIMER_REAL, 0)
     smin = np.asarray(c.points["stability_min"], float)
     first = c.first_instability
     at_crossing = {}
@@ -118,17 +103,7 @@ def screened_pass(states, strip_ratio):
 
 
 def run_one(spec, grace=60):
-    with tempfile.TemporaryDirectory() as d:
-        sp, op = Path(d) / "spec.json", Path(d) / "out.json"
-        sp.write_text(json.dumps(spec))
-        try:
-            subprocess.run([sys.executable, __file__, "--worker", str(sp), str(op)], timeout=spec["time_limit"] + grace,
-                           check=False)
-        except subprocess.TimeoutExpired:
-            return {"id": spec["id"], "killed": True}
-        if not op.exists():
-            return {"id": spec["id"], "crashed": True}
-        return json.loads(op.read_text())
+    return run_scene(spec, grace, script=__file__)
 
 
 def compare(r, model):

@@ -16,6 +16,7 @@ Writes benchmarks/results/stability_modes.json and .md.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import datetime
 import json
 import math
@@ -60,12 +61,9 @@ def make_scene(how):
     return grid_scene({"overrides": how["grid"], "contact": "smooth"})
 
 
-def worker(spec_path, out_path):
-    import numpy as np
-
-    import shellbvp as sb
-    from shellbvp.curve_stability import assess
-
+def worker_scene(spec_path, out_path):
+    """(spec, row, scene) of a worker's spec file, or None where the scene is refused (its row,
+    with the reason, written to ``out_path``)."""
     spec = json.loads(Path(spec_path).read_text())
     row = {"id": spec["id"]}
     try:
@@ -73,21 +71,40 @@ def worker(spec_path, out_path):
     except ValueError as exc:
         row["skipped"] = str(exc)
         Path(out_path).write_text(json.dumps(row))
-        return
+        return None
     scene.model()
+    return spec, row, scene
 
+
+@contextlib.contextmanager
+def time_limit(seconds):
+    """KeyboardInterrupt after ``seconds`` (a curve keeps what it finished and stops)."""
     def alarm(signum, frame):
         raise KeyboardInterrupt
 
     signal.signal(signal.SIGALRM, alarm)
-    signal.setitimer(signal.ITIMER_REAL, spec["time_limit"])
-    t0 = time.perf_counter()
+    signal.setitimer(signal.ITIMER_REAL, seconds)
     try:
+        yield
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+
+
+def worker(spec_path, out_path):
+    import numpy as np
+
+    import shellbvp as sb
+    from shellbvp.curve_stability import assess
+
+    started = worker_scene(spec_path, out_path)
+    if started is None:
+        return
+    spec, row, scene = started
+    t0 = time.perf_counter()
+    with time_limit(spec["time_limit"]):
         c = sb.curve(scene, delta_max=spec["delta_max"], estimate_error=False)
         # every state in order up to the first unstable one, then the crossing narrowed
         assess(c, "locate", samples=max(len(c), 1))
-    finally:
-        signal.setitimer(signal.ITIMER_REAL, 0)
     wall = time.perf_counter() - t0
     smin = np.asarray(c.points["stability_min"], float)
     first = c.first_instability
@@ -103,12 +120,13 @@ def worker(spec_path, out_path):
     Path(out_path).write_text(json.dumps(row))
 
 
-def run_one(spec, grace=60):
+def run_one(spec, grace=60, script=__file__):
+    """One scene in its own process (``script --worker spec out``): its row, or killed/crashed."""
     with tempfile.TemporaryDirectory() as d:
         sp, op = Path(d) / "spec.json", Path(d) / "out.json"
         sp.write_text(json.dumps(spec))
         try:
-            subprocess.run([sys.executable, __file__, "--worker", str(sp), str(op)], timeout=spec["time_limit"] + grace,
+            subprocess.run([sys.executable, script, "--worker", str(sp), str(op)], timeout=spec["time_limit"] + grace,
                            check=False)
         except subprocess.TimeoutExpired:
             return {"id": spec["id"], "killed": True}
