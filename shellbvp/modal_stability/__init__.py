@@ -233,7 +233,10 @@ Refused (ValueError, one line): the contact running over the tip's end onto the 
 (``"cap+cylinder"``: held on both sides of a corner of the obstacle, across which material
 would have to slide), an interior corner (``"line+corner"``: the package's searches find no state
 of it to check the corner's terms on), ``contact="paper"``, a line whose gap is not positive, more than one line,
-an edge inside [0, S0] of a configuration with several, and a sealed shell in contact.
+an edge inside [0, S0] of a configuration with several, a sealed shell in contact, and a state
+whose negative eigenvalue is not resolved: it still moves on 16 times the elements (an edge next
+to its convexity limit) or with the mesh starting 10 times further from the pole (the form's
+1/r^3 coefficients cancelling there; :func:`stability`'s checks).
 """
 
 from __future__ import annotations
@@ -291,7 +294,8 @@ def stability(state, modes=None, *, elements: int | None = None, S0: float | Non
     ValueError
         One line naming what is not supported (:func:`check_supported`, :func:`contact_of`): a
         state that did not converge, the contact over the tip's end, ``contact="paper"``, a line
-        without a curvature gap, a sealed shell in contact.
+        without a curvature gap, a sealed shell in contact, a negative eigenvalue not resolved in
+        the mesh or at the pole (module docstring).
 
     Examples
     --------
@@ -369,7 +373,7 @@ def _refine_negative(out, solve):
                   if lam < 0 and not 0.5 * coarse[int(n)] >= lam >= 2 * coarse[int(n)]]
         if not unsure:
             return
-        if elements > out.elements * REFINE_FACTOR:  # the second refinement: did the sign hold?
+        if elements > out.elements * REFINE_FACTOR:  # still moving after the second refinement
             raise ValueError(f"stability: mode n = {unsure[0]} is not resolved in the mesh (smallest eigenvalue "
                              f"{coarse[unsure[0]]:.3g} with {elements // REFINE_FACTOR} elements, "
                              f"{float(fine.smallest[list(fine.modes).index(unsure[0])]):.3g} with {elements}); "
