@@ -80,7 +80,9 @@ def parse_formula(formula, symbols: dict, *, name: str, legacy_srepr: bool = Fal
         formula and the offending piece.
     """
     if isinstance(formula, sp.Basic):
-        if not isinstance(formula, sp.Expr) or isinstance(formula, sp.logic.boolalg.Boolean):
+        # a Symbol is also a Boolean in SymPy: a bare name ("omega") is an expression here
+        boolean = isinstance(formula, sp.logic.boolalg.Boolean) and not isinstance(formula, sp.Symbol)
+        if not isinstance(formula, sp.Expr) or boolean:
             raise TypeError(f"{name} must be an expression, not {type(formula).__name__} ({formula})")
         for s in formula.free_symbols:
             if s.name not in symbols:

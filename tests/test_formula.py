@@ -85,6 +85,18 @@ def test_non_expressions_are_type_errors(bad):
         sb.StrainEnergy(bad)
 
 
+def test_a_bare_name_is_an_expression():
+    """SymPy's Symbol is also a Boolean: a formula that is a bare name ("omega", the paraboloid
+    tip's A) must pass as an expression, parsed again from a scene's stored description (it was
+    refused there, so a UserTip("omega", ...) scene could not be solved)."""
+    from symbolic.build import structure_from_description
+
+    omega = sp.Symbol("omega")
+    assert parse_formula(omega, {"omega": omega}, name="A(omega)") == omega
+    scene = sb.Scene(tip=sb.UserTip("omega", "omega**2/2"))
+    assert structure_from_description(scene.structure()).tip is not None
+
+
 @pytest.mark.parametrize("bad", ["lambda_s == lambda_theta", "lambda_s < 1", "1 if lambda_s else 2",
                                  "lambda_s and lambda_theta", "'lambda_s'", "", "   ", "(", "1,2"])
 def test_non_formulas_are_value_errors(bad):
