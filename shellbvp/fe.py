@@ -10,13 +10,17 @@ the solid itself, so that a user sees the model's error for his own scene:
   0.4999); the scene's energy on the isochoric invariants, from its material's module
   (``felupe_model``: Mooney-Rivlin, neo-Hookean, Gent, ...; user energies
   ``W(lambda_s, lambda_theta)`` have no unique 3D form: refused);
-* the rim: pinned at its mid-thickness point (the shell model's simple support);
+* the rim (:mod:`shellbvp.fe_rim`): the shell model's simple support as the rim face held
+  plane and turning about its fixed mid-thickness point (pinning that point alone does not
+  converge under refinement); a clamped rim holds the whole face;
 * the indenter: rigid and frictionless, the scene's tip on its cylinder, pressed on the
   surface that faces it (the shell model presses the mid-surface); a penalty on the
   penetration at Gauss points of that surface with the exact (consistent) tangent
-  (:mod:`shellbvp.fe_contact`);
-* delta: the mid-surface pole's displacement, as in the shell model; each requested delta
-  is reached by a secant iteration on the indenter's position;
+  (:mod:`shellbvp.fe_contact`); first touch where it happens (the pole, or a ring where the
+  surface is more curved than the tip);
+* the depths: the mid-surface pole's displacement delta, as in the shell model (each reached
+  by a secant iteration on the indenter's position), or the indenter's displacement from
+  first touch, as an instrument records it (``at="indenter"``); both are reported;
 * the force ``F / (mu R_L H)`` (nondimensional as in :func:`shellbvp.curve`).
 
 Needs FElupe (``pip install 'shellbvp[fe]'``).  Nondimensional: mu = 1, R_L = 1.
@@ -31,6 +35,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .fe_contact import PenaltyContact, TipSurface
+from .fe_rim import RIM_FACES, HingedFace
 from .materials import MATERIALS
 
 __all__ = ["fe_curve", "FECurve", "TipSurface", "FE_DEFAULTS"]
@@ -46,6 +51,7 @@ FE_DEFAULTS = {
     "band": 1e-5,               # the penalty is smoothed over penetrations below band * H
     "tol": 1e-9,                # Newton: residual norm / contact force
     "delta_tol": 1e-7,          # secant on the indenter: |delta - target| / max(target, H)
+    "rim_face": "plane",        # the rim face held plane, turning about its mid-thickness point (RIM_FACES)
 }
 
 
@@ -94,10 +100,11 @@ class _Model:
     pole_mid: int          # the mid-surface pole's point
     eps: float
     elements: tuple
+    face: object = None    # HingedFace: the rim face's own unknowns (None: its dofs fixed or free)
 
 
 def _build(scene, eps, *, through_thickness, element_length, pole_refinement, bulk, penalty, gauss_points,
-           band=1e-5):
+           band=1e-5, rim_face="plane"):
     fem = _felupe()
     s_tab, R_tab, Z_tab, Phi_tab = _meridian(scene)
     total = s_tab[-1]
@@ -138,13 +145,17 @@ def _build(scene, eps, *, through_thickness, element_length, pole_refinement, bu
     region = fem.RegionBiQuadraticQuad(mesh)
     field = fem.FieldsMixed(region, n=3, axisymmetric=True)
     solid = fem.SolidBody(fem.NearlyIncompressible(_material(scene, fem), bulk=bulk), field)
-    # boundary: the axis (r = 0) cannot move radially; the rim's mid-thickness point is pinned
+    # boundary: the axis (r = 0) cannot move radially; the rim's mid-thickness point is pinned and
+    # its face turns about it, held plane (simple support) or held fixed (clamped)
     axis = np.flatnonzero(points[:, 1] == 0.0)
     rim_mid = node(n_t, ncol - 1)
-    fixed = np.unique(np.concatenate([2 * axis + 1, [2 * rim_mid, 2 * rim_mid + 1]]))
+    face_nodes = np.array([node(i, ncol - 1) for i in range(2 * n_t + 1)])
+    held = face_nodes if scene.rim == "clamped" else [rim_mid]
+    face = HingedFace(points, face_nodes, rim_mid) if scene.rim != "clamped" and rim_face == "plane" else None
+    fixed = np.unique(np.concatenate([2 * axis + 1, 2 * np.asarray(held), 2 * np.asarray(held) + 1]))
     top = np.array([node(2 * n_t, j) for j in range(ncol)])  # t = +eps/2: faces the indenter
     contact = PenaltyContact(TipSurface(scene), points, top, penalty / eps, gauss_points, field, band * eps)
-    return _Model(mesh, region, field, solid, contact, fixed, node(n_t, 0), eps, (n_s, n_t))
+    return _Model(mesh, region, field, solid, contact, fixed, node(n_t, 0), eps, (n_s, n_t), face)
 
 
 def _check_material(scene):
@@ -173,6 +184,8 @@ class _Solver:
         ndof = int(np.sum(model.field.fieldsizes))
         free = np.ones(ndof, bool)
         free[model.fixed] = False
+        if model.face is not None:
+            free[model.face.dofs] = False  # moved through the face's own unknowns
         self.free = np.flatnonzero(free)
         self.newton_iterations = 0
         self.history = [self.save()]  # converged states (values, indenter) for the predictor
@@ -217,6 +230,25 @@ class _Solver:
         rc, Kc, F, _ = m.contact.evaluate(m.field[0].values.ravel())
         return r + rc, rc, Kc, F
 
+    def _system(self, r, K):
+        """(K_reduced, r_reduced, J): the Newton system in the unknowns the rim leaves free (J maps
+        a reduced step to the full dofs; None where the unknowns are plain dofs)."""
+        face = self.m.face
+        if face is None:
+            return (None if K is None else K[self.free][:, self.free].tocsc()), r[self.free], None
+        if K is None:
+            return None, np.r_[r[self.free], face.residual(r, self.m.field[0].values.ravel())], None
+        return face.reduce(r, K, self.free, self.m.field[0].values.ravel())
+
+    def _advance(self, dq, scale):
+        """The state moved by ``scale`` times the reduced Newton step ``dq``."""
+        m = self.m
+        full = np.zeros(int(np.sum(m.field.fieldsizes)))
+        full[self.free] = scale * dq[: self.free.size]
+        m.field += full
+        if m.face is not None:
+            m.face.step(m.field[0].values, dq[self.free.size:], scale)
+
     def delta(self):
         """The mid-surface pole's displacement, positive down."""
         return -float(self.m.field[0].values[self.m.pole_mid, 0])
@@ -228,11 +260,13 @@ class _Solver:
 
         m, saved = self.m, self.save()
         self._predict(a)
+        if m.face is not None:
+            m.face.project(m.field[0].values)  # the predictor extrapolates off the face's line
         self.indenter = a
         r, rc, Kc, F = self._residual()
         du = np.inf
         for it in range(self.max_iterations):
-            rf = r[self.free]
+            rf = self._system(r, None)[1]
             norm = np.linalg.norm(rf)
             if not np.isfinite(norm):
                 break
@@ -243,25 +277,29 @@ class _Solver:
                 self.force = F
                 self._remember()
                 return True
-            K = (m.solid.assemble.matrix(m.field) + Kc).tocsc()
+            K, rr, J = self._system(r, (m.solid.assemble.matrix(m.field) + Kc).tocsc())
             try:
-                dx = splu(K[self.free][:, self.free].tocsc()).solve(-rf)
+                dq = splu(K).solve(-rr)
             except RuntimeError:  # singular: no equilibrium from here
                 break
             full = np.zeros(r.size)
-            full[self.free] = dx
+            if J is None:
+                full[self.free] = dq
+            else:
+                full = J @ dq
             if not np.all(np.isfinite(full)) or np.max(np.abs(full[: m.contact.ndof_u])) > 0.5:
                 break
             # backtracking on the residual's norm: contact enters and leaves the active set
             step, du = 1.0, np.inf
+            base = self.save()
             for _ in range(8):
-                m.field += step * full
+                self._advance(dq, step)
                 r, rc, Kc, F = self._residual()
-                new = np.linalg.norm(r[self.free])
+                new = np.linalg.norm(self._system(r, None)[1])
                 if np.isfinite(new) and new <= (1 - 1e-4 * step) * norm:
                     du = np.max(np.abs(full[: m.contact.ndof_u])) if step == 1.0 else np.inf
                     break
-                m.field -= step * full
+                self.restore(base)
                 step *= 0.5
             else:
                 r, rc, Kc, F = self._residual()
@@ -270,7 +308,7 @@ class _Solver:
                     self.force = F
                     self._remember()
                     return True
-                m.field += step * full  # no descent: take the short step and go on
+                self._advance(dq, step)  # no descent: take the short step and go on
                 r, rc, Kc, F = self._residual()
         self.restore(saved)
         return False
@@ -348,24 +386,28 @@ class FECurve:
                 f"{self.elements[0]}x{self.elements[1]} elements, {self.wall_time:.1f} s; {self.message}")
 
 
-def fe_curve(scene, thickness, deltas, *, mesh_check=False, progress=None, **settings) -> FECurve:
+def fe_curve(scene, thickness, deltas, *, at="pole", mesh_check=False, progress=None, **settings) -> FECurve:
     """Indent the scene's shell as a 3D axisymmetric solid of thickness ``eps`` (FElupe).
 
     Parameters
     ----------
     scene : Scene
-        Shell, indenter and material (one with a ``felupe_model``); beta, xi, the
-        bending energy and the contact model are the shell model's and play no part here.
-        Pressurised scenes and a clamped rim are refused.
+        Shell, indenter, material (one with a ``felupe_model``) and rim (``"pinned"``: the rim
+        face held plane and turning about its mid-thickness point; ``"clamped"``: held); beta,
+        xi, the bending energy and the contact model are the shell model's and play no part
+        here.  Pressurised scenes are refused.
     thickness : float
         eps = H / R_L, in (0, 0.5].
     deltas : array_like
-        Mid-surface pole displacements, increasing, > 0.
+        Depths, increasing, > 0: of the mid-surface pole (``at="pole"``, the shell model's delta)
+        or of the indenter from first touch (``at="indenter"``, what an instrument records).
+    at : {"pole", "indenter"}
+        What ``deltas`` are.  Both are reported (``delta`` and ``indenter``).
     mesh_check : bool
         Also solve on a mesh with 2/3 the elements each way and report the difference
         (``mesh_error``).
     progress : callable, optional
-        Called as ``progress(i, delta, force)`` after each depth.
+        Called as ``progress(i, depth, force)`` after each depth.
     **settings
         Override :data:`FE_DEFAULTS`.
 
@@ -389,35 +431,82 @@ def fe_curve(scene, thickness, deltas, *, mesh_check=False, progress=None, **set
     deltas = np.atleast_1d(np.asarray(deltas, dtype=float))
     if deltas.size == 0 or not np.all(np.isfinite(deltas)) or np.any(deltas <= 0) or np.any(np.diff(deltas) <= 0):
         raise ValueError("deltas must be finite, > 0 and increasing")
+    if at not in ("pole", "indenter"):
+        raise ValueError(f"at must be 'pole' or 'indenter'; got {at!r}")
     if scene.pressurised:
         raise ValueError("pressure: the 3D reference has no internal pressure yet; use a scene with pressure 0")
-    if scene.rim != "pinned":
-        raise ValueError(f"rim: the 3D reference's rim is pinned at its mid-thickness point; got rim={scene.rim!r}")
     _check_material(scene)
     unknown = set(settings) - set(FE_DEFAULTS)
     if unknown:
         raise ValueError(f"unknown FE setting(s) {sorted(unknown)}; known: {sorted(FE_DEFAULTS)}")
     opts = {**FE_DEFAULTS, **settings}
-    F, apex, rc, ok, msg, elements = _path(scene, eps, deltas, opts, progress)
+    if opts["rim_face"] not in RIM_FACES:
+        raise ValueError(f"rim_face must be one of {RIM_FACES}; got {opts['rim_face']!r}")
+    path = _indenter_path if at == "indenter" else _pole_path
+    out = path(scene, eps, deltas, opts, progress)
     err = np.full(deltas.size, np.nan)
     if mesh_check:
         coarse = {**opts, "element_length": opts["element_length"] * 1.5,
                   "through_thickness": max(2, round(opts["through_thickness"] * 2 / 3))}
-        Fc = _path(scene, eps, deltas, coarse, None)[0]
-        err = np.abs(F - Fc) / np.abs(F)
-    return FECurve(scene, eps, deltas, F, apex, rc, err, ok, msg, elements,
-                   settings=opts, wall_time=time.perf_counter() - t0)
+        Fc = path(scene, eps, deltas, coarse, None).force
+        err = np.abs(out.force - Fc) / np.abs(out.force)
+    return FECurve(scene, eps, out.delta, out.force, out.indenter, out.contact_radius, err, out.success,
+                   out.message, out.elements, settings={**opts, "at": at}, wall_time=time.perf_counter() - t0)
 
 
-def _path(scene, eps, deltas, opts, progress):
+@dataclass
+class _Path:
+    delta: np.ndarray
+    indenter: np.ndarray
+    force: np.ndarray
+    contact_radius: np.ndarray
+    success: bool
+    message: str
+    elements: tuple
+
+
+def _start(scene, eps, n, opts):
+    """The model with its solver, and empty arrays for ``n`` depths."""
     model = _build(scene, eps, through_thickness=opts["through_thickness"],
-                      element_length=opts["element_length"], pole_refinement=opts["pole_refinement"],
-                      bulk=opts["bulk"], penalty=opts["penalty"], gauss_points=opts["gauss_points"],
-                      band=opts["band"])
+                   element_length=opts["element_length"], pole_refinement=opts["pole_refinement"],
+                   bulk=opts["bulk"], penalty=opts["penalty"], gauss_points=opts["gauss_points"],
+                   band=opts["band"], rim_face=opts["rim_face"])
     model.contact.bind(model.mesh.points)
-    solver = _Solver(model, opts["tol"])
-    n = deltas.size
-    F, apex, rc = (np.full(n, np.nan) for _ in range(3))
+    return model, _Solver(model, opts["tol"]), _Path(*(np.full(n, np.nan) for _ in range(4)), False, "",
+                                                    model.elements)
+
+
+def _record(out, i, model, solver):
+    _, _, F_i, rc_i = model.contact.evaluate(model.field[0].values.ravel(), with_matrix=False)
+    out.force[i], out.indenter[i], out.delta[i], out.contact_radius[i] = F_i / model.eps, solver.indenter, \
+        solver.delta(), rc_i
+
+
+def _ended(out, message, success=False):
+    out.success, out.message = success, message
+    return out
+
+
+def _indenter_path(scene, eps, targets, opts, progress):
+    """The indenter moved to each target (its displacement from first touch)."""
+    model, solver, out = _start(scene, eps, targets.size, opts)
+    step = 0.5 * eps
+    solver.move(min(0.02 * eps, 0.5 * targets[0]))  # a first touch: the predictor's second state
+    for i, a in enumerate(targets):
+        # in steps the Newton can take (as _pole_path), then onto the target
+        while a - solver.indenter > 1.5 * step and solver.move(solver.indenter + step):
+            step = min(1.5 * step, 0.25 * max(solver.indenter, eps) + 0.5 * eps)
+        if not solver.move(a):
+            return _ended(out, f"no equilibrium beyond the indenter's displacement {solver.indenter:.4g}")
+        _record(out, i, model, solver)
+        if progress is not None:
+            progress(i, a, out.force[i])
+    return _ended(out, "all requested depths computed", True)
+
+
+def _pole_path(scene, eps, deltas, opts, progress):
+    """Each mid-surface pole displacement reached by a secant on the indenter."""
+    model, solver, out = _start(scene, eps, deltas.size, opts)
     done_delta, done_apex, slope = 0.0, 0.0, 1.0
     step = 0.5 * eps
     if solver.move(min(0.02 * eps, 0.5 * deltas[0])):  # a first touch: the predictor's second state
@@ -428,7 +517,7 @@ def _path(scene, eps, deltas, opts, progress):
         while target - done_delta > 1.5 * step:
             a = done_apex + slope * step
             if not solver.move(a):
-                return F, apex, rc, False, f"no equilibrium beyond delta = {done_delta:.4g}", model.elements
+                return _ended(out, f"no equilibrium beyond delta = {done_delta:.4g}")
             d = solver.delta()
             slope = (a - done_apex) / max(d - done_delta, 1e-12)
             done_delta, done_apex = d, a
@@ -439,7 +528,7 @@ def _path(scene, eps, deltas, opts, progress):
         for _ in range(12):
             base = solver.save()
             if not solver.move(a):
-                return F, apex, rc, False, f"no equilibrium at delta = {target:.4g}", model.elements
+                return _ended(out, f"no equilibrium at delta = {target:.4g}")
             d = solver.delta()
             if abs(d - target) <= tol:
                 break
@@ -449,12 +538,12 @@ def _path(scene, eps, deltas, opts, progress):
             a = a1 + slope * (target - d1)
             solver.restore(base) if abs(d - target) > abs(points[-2][1] - target) else None
         else:
-            return F, apex, rc, False, f"the secant on the indenter did not reach delta = {target:.4g}", model.elements
-        _, _, F_i, rc_i = model.contact.evaluate(model.field[0].values.ravel(), with_matrix=False)
-        F[i], apex[i], rc[i] = F_i / eps, a, rc_i
+            return _ended(out, f"the secant on the indenter did not reach delta = {target:.4g}")
+        _record(out, i, model, solver)
+        out.delta[i] = target if abs(d - target) <= tol else d
         if done_delta > 0 and d != done_delta:
             slope = (a - done_apex) / (d - done_delta)
         done_delta, done_apex = d, a
         if progress is not None:
-            progress(i, target, F[i])
-    return F, apex, rc, True, "all requested depths computed", model.elements
+            progress(i, target, out.force[i])
+    return _ended(out, "all requested depths computed", True)

@@ -133,7 +133,23 @@ class PenaltyContact:
         return xq
 
     def bind(self, points):
+        """Fix the reference surface; ``z0`` becomes the apex height of first touch."""
         self.X_ref = points[self.edges]
+        self.z0 = self.apex = self.first_touch()
+
+    def first_touch(self):
+        """The apex height at which the descending indenter first touches the undeformed surface
+        (at its Gauss points): at the pole, or on a ring where the surface is more curved than the
+        tip (a bowl's inner surface under a blunter tip)."""
+        from scipy.optimize import brentq
+
+        xq = self._at_points(np.zeros(self.ndof_u))
+        gap = lambda apex: float(np.min(self.tip.distance(xq, apex)[0]))  # noqa: E731
+        hi = self.z0 + 1.0
+        while gap(hi) <= 0:  # the tip above every point it could reach
+            hi += 1.0
+        lo = self.z0  # the apex at the pole: touching there, or already through a ring
+        return self.z0 if gap(lo) >= 0 else brentq(gap, lo, hi, xtol=1e-14, rtol=1e-14)
 
     def evaluate(self, u, with_matrix=True):
         from scipy.sparse import coo_matrix
