@@ -38,7 +38,7 @@ from .fe_contact import PenaltyContact, TipSurface
 from .fe_rim import RIM_FACES, HingedFace
 from .materials import MATERIALS
 
-__all__ = ["fe_curve", "FECurve", "TipSurface", "FE_DEFAULTS"]
+__all__ = ["fe_curve", "FECurve", "TipSurface", "FE_DEFAULTS", "check_solid_scene"]
 
 #: Mesh, material and contact settings of :func:`fe_curve` (all nondimensional).
 FE_DEFAULTS = {
@@ -156,6 +156,14 @@ def _build(scene, eps, *, through_thickness, element_length, pole_refinement, bu
     top = np.array([node(2 * n_t, j) for j in range(ncol)])  # t = +eps/2: faces the indenter
     contact = PenaltyContact(TipSurface(scene), points, top, penalty / eps, gauss_points, field, band * eps)
     return _Model(mesh, region, field, solid, contact, fixed, node(n_t, 0), eps, (n_s, n_t), face)
+
+
+def check_solid_scene(scene):
+    """ValueError, in one line, where the scene has no solid here (before any work): a material
+    without a 3D form, or an internal pressure."""
+    if scene.pressurised:
+        raise ValueError("pressure: the 3D reference has no internal pressure yet; use a scene with pressure 0")
+    _check_material(scene)
 
 
 def _check_material(scene):
@@ -433,9 +441,7 @@ def fe_curve(scene, thickness, deltas, *, at="pole", mesh_check=False, progress=
         raise ValueError("deltas must be finite, > 0 and increasing")
     if at not in ("pole", "indenter"):
         raise ValueError(f"at must be 'pole' or 'indenter'; got {at!r}")
-    if scene.pressurised:
-        raise ValueError("pressure: the 3D reference has no internal pressure yet; use a scene with pressure 0")
-    _check_material(scene)
+    check_solid_scene(scene)
     unknown = set(settings) - set(FE_DEFAULTS)
     if unknown:
         raise ValueError(f"unknown FE setting(s) {sorted(unknown)}; known: {sorted(FE_DEFAULTS)}")

@@ -27,7 +27,8 @@ SI units, ``"1"`` nondimensional, ``""`` text)::
                                (beta (1), alpha (1, NaN for other materials), pressure (1), pressure_Pa
                                (Pa, NaN unless fitted), ...) -- scalars; correlation (k, k); <name>_ci95
                                (2,) for each parameter fitted and its derived quantities; attrs: fitted,
-                               baseline_model, weights, segment
+                               baseline_model, weights, segment, model (shell or solid: what
+                               delta is, the mid-surface pole's or the indenter's displacement)
     /fit/warnings              (k,) the fit's warnings (text); attr codes
     /fit/sample                NXsample; attrs: scene (JSON, rebuilds the Scene), scene_<key>
     /fit/source                NXnote: file_name, sha256, columns (JSON), units (JSON), inverted
@@ -91,7 +92,7 @@ class FitRecord:
         derived quantities.
     fitted : list of str
     settings : dict
-        ``baseline_model``, ``weights``, ``segment``.
+        ``baseline_model``, ``weights``, ``segment``, ``model`` (``"shell"`` or ``"solid"``).
     warnings : list of str
     warning_codes : list of str
     scene : Scene
@@ -192,11 +193,12 @@ def write_fit(path, result, record, used, *, segment="loading", overwrite=False)
             x = result.offset + result.R_L * delta
             number_dataset(m, "displacement", x, "m", "displacement: offset + R_L delta")
             number_dataset(m, "force", result.model_force(x), "N", "model force: baseline + mu_H R_L F")
-            number_dataset(m, "delta", delta, DIMENSIONLESS, "pole displacement / R_L")
+            number_dataset(m, "delta", delta, DIMENSIONLESS, "indenter displacement / R_L (the 3D solid's)"
+                           if result.model == "solid" else "pole displacement / R_L")
             number_dataset(m, "F", F, DIMENSIONLESS, "force / (mu H R_L)")
             p = e.create_group("parameters")
             p.attrs.update({"NX_class": "NXparameters", "baseline_model": result.baseline_model,
-                            "weights": result.weights, "segment": segment,
+                            "weights": result.weights, "segment": segment, "model": result.model,
                             "fitted": np.array(list(result.fitted), dtype=h5py.string_dtype())})
             values = {"mu_H": result.mu_H, "offset": result.offset, "baseline": result.baseline,
                       "baseline_slope": result.baseline_slope, "R_L": result.R_L,
@@ -368,6 +370,9 @@ def read_fit(path) -> FitRecord:
                     raise ValueError(f"parameters/correlation must be {len(fitted)} x {len(fitted)} (fitted); got "
                                      f"{correlation.shape}")
             settings = {k: sc.attr_text(p, k) for k in ("baseline_model", "weights", "segment")}
+            settings["model"] = sc.attr_text(p, "model") if "model" in p.attrs else "shell"  # files before it: shell
+            if settings["model"] not in ("shell", "solid"):
+                raise ValueError(f"parameters.model must be 'shell' or 'solid'; got {settings['model']!r}")
             warnings = sc.text_dataset(e, "warnings")
             codes = [sc.text(s, "warnings.codes") for s in np.atleast_1d(e["warnings"].attrs.get("codes", []))]
             scene = Scene.from_dict(sc.parse_json(sc.attr_text(e["sample"], "scene"), "sample.scene"))

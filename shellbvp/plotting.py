@@ -223,6 +223,11 @@ def _display(record):
     return show
 
 
+#: A fit's model in words (``FitRecord.settings["model"]``).
+_MODEL_WORDS = {"shell": "the shell model (its mid-surface pole's displacement as the data's)",
+                "solid": "the 3D solid (its indenter's displacement from first touch as the data's)"}
+
+
 def fit_summary_lines(record):
     """The text of a fit report (one string per line), lengths and forces in the data's units."""
     p, iv = record.parameters, record.intervals
@@ -232,7 +237,7 @@ def fit_summary_lines(record):
              *(f"note: {text}" for text in record.source["notes"]),
              f"fit: {'succeeded' if record.success else 'FAILED'} (status {record.status}); "
              f"{record.settings['segment']} segment, {int(p['n_points'])} rows; baseline {record.settings['baseline_model']}; "
-             f"{record.settings['weights']} weights"]
+             f"{record.settings['weights']} weights; model: " + _MODEL_WORDS[record.settings.get("model", "shell")]]
 
     def line(name, extra=""):
         value, unit = show(p[name], PARAMETER_UNITS[name])
@@ -252,7 +257,8 @@ def fit_summary_lines(record):
             lo, hi = iv["mu_H"]
             lines.append(f"mu = {p['mu_H'] / H / 1e6:.5g} MPa   95% CI [{lo / H / 1e6:.5g}, {hi / H / 1e6:.5g}] "
                          f"(thickness H = {H * 1e6:.4g} um, eps = {s.thickness:.3g})")
-        lines.append(model_error_line(s))
+        if record.settings.get("model", "shell") == "shell":
+            lines.append(model_error_line(s))
     lines.append(f"scene: {s.describe(p['R_L'])}")
     lines += [f"warning: {w}" for w in record.warnings] or ["warnings: none"]
     lines.append(f"shellbvp {record.version}; {record.message}")

@@ -61,6 +61,11 @@ def add_parser(sub):
     f.add_argument("--stability", action="store_true",
                    help="also look for where the fitted shell stops being axisymmetric, up to the deepest fitted "
                         "depth (a warning when the data pass it; seconds to a minute more)")
+    f.add_argument("--model", choices=("shell", "solid"), default="shell",
+                   help="what is compared with the data: shell (the shell model, default; its mid-surface pole's "
+                        "displacement taken as the data's) or solid (the shell as a 3D solid of the given "
+                        "--thickness, indented by the indenter's displacement as the instrument records it; "
+                        "needs '.[fe]'; one FE curve per sample, kept in the code cache)")
     f.add_argument("--json", action="store_true", help="print the result as one JSON document (also on errors)")
     f.add_argument("-o", "--output", help="write the fit as a record (HDF5/NeXus: data, model, parameters with "
                    "intervals, weights, warnings, scene, source file and its SHA-256); a batch: a directory "
@@ -133,8 +138,12 @@ def _fit_inputs(args, pixel_values=None):
             bounds[name] = _search_range(param, text, args.radius.si)
             if name not in free:
                 raise ValueError(f"--{name}-range needs --fit-{name}")
+    if args.model == "solid":
+        from ..fitting.solid import check_solid_fit
+
+        check_solid_fit(scene, free)
     options = {"fit_offset": not args.no_offset, "free": free, "bounds": bounds, "weights": args.weights,
-               "tol": args.tol, "stability": args.stability}
+               "tol": args.tol, "stability": args.stability, "model": args.model}
     return scene, args.radius.si, {"columns": columns, "units": units, "invert": tuple(args.invert or ())}, options
 
 
@@ -396,7 +405,9 @@ def _print_fit(res, record, used, args):
     for e in res.derived.values():
         if e.of is None:  # from a given scene value (mu of a given thickness)
             say(_estimate_line(e))
-    if res.thickness is not None:
+    if res.model == "solid":
+        say(_solid_line(res.curve))
+    elif res.thickness is not None:
         from ..thickness import model_error_line
 
         say(model_error_line(res.scene))
@@ -439,6 +450,13 @@ def _print_fit(res, record, used, args):
         say(f"warning: {text}")
     if res.stability_note:
         say(f"stability not analysed where: {res.stability_note}")
+
+
+def _solid_line(c):
+    """What the solid fitted is: its mesh, its displacement, where its curve came from."""
+    where = "kept in the code cache" if c.kept else f"computed in {c.wall_time:.1f} s"
+    return (f"model  = 3D solid (FElupe, {c.elements[0]}x{c.elements[1]} quadratic elements, rim face hinged at "
+            f"mid-thickness), its indenter's displacement from first touch as the data's; curve {where}")
 
 
 def _estimate_line(e):

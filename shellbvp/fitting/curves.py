@@ -23,7 +23,7 @@ from pathlib import Path
 import numpy as np
 from scipy.interpolate import CubicSpline, PchipInterpolator
 
-__all__ = ["N_DEPTHS", "ModelCurves", "clear_model_curves"]
+__all__ = ["N_DEPTHS", "ModelCurves", "clear_model_curves", "code_fingerprint"]
 
 #: Depths of every model curve (equally spaced up to delta_max).
 N_DEPTHS = 40
@@ -77,7 +77,7 @@ def _model_curve(scene, deltas, tol, counter=None, progress=None):
 
 
 @functools.cache
-def _code_fingerprint() -> str:
+def code_fingerprint() -> str:
     """The package's and the derivation's source, hashed once per process (part of every key)."""
     from symbolic.version import source_fingerprint
 
@@ -98,7 +98,7 @@ def _disk_place(scene, deltas, tol):
     try:
         solver = {k: v for k, v in dataclasses.asdict(OPTIONS).items() if k not in _NOT_NUMERICS}
         payload = json.dumps({"scene": scene.to_dict(), "deltas": [float(x) for x in deltas], "tol": float(tol),
-                              "options": solver, "code": _code_fingerprint(), "version": __version__},
+                              "options": solver, "code": code_fingerprint(), "version": __version__},
                              sort_keys=True)
     except (TypeError, ValueError, AttributeError):
         return None, None
@@ -181,21 +181,26 @@ def _beyond_message(c, need):
 class ModelCurves:
     """Nondimensional force F(delta; theta) from model curves at nodes theta_k on one delta grid.
 
+    ``source(scene, grid, tol, counter, progress)`` computes a node's curve: the shell model's
+    (default; delta the mid-surface pole's displacement) or the solid's
+    (:func:`shellbvp.fitting.solid.solid_curve`; delta the indenter's displacement).
     Every node must reach ``need`` (the deepest datum): without a shape
     parameter (one node, theta None) a curve that ends before it is a
     ValueError; with one, ``add`` returns False.  F is a cubic spline across
     the nodes at each depth and a monotone cubic (PCHIP) in delta.
     """
 
-    def __init__(self, scene_at, grid, tol, need, counter, progress=None):
+    def __init__(self, scene_at, grid, tol, need, counter, progress=None, source=None):
         self.scene_at, self.grid, self.tol, self.need, self.counter = scene_at, grid, tol, need, counter
         self.progress = progress
+        # what computes a node's curve: the shell model's (default) or the solid's
+        self.source = _model_curve if source is None else source
         self.nodes = {}  # theta -> curve
         self._spline = None
 
     def add(self, theta):
         """Compute the node curve at theta; False if it does not reach the data."""
-        c = _model_curve(self.scene_at(theta), self.grid, self.tol, self.counter, self.progress)
+        c = self.source(self.scene_at(theta), self.grid, self.tol, self.counter, self.progress)
         if len(c) < 3:
             raise ValueError(f"the model curve of this scene could not be computed to the data's depths "
                              f"({c.stop_reason})")

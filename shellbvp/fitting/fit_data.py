@@ -16,6 +16,7 @@ from .curves import N_DEPTHS, ModelCurves
 from .intervals import result_of
 from .least_squares import BASELINES, DEFAULT_WEIGHTS, WEIGHTS, Fitted, LeastSquaresModel, NoiseModel
 from .profile import ProfileSearch, search_of
+from .solid import FIT_MODELS, check_solid_fit, solid_curve
 
 __all__ = ["fit", "fit_record", "free_parameters", "example_data_path"]
 
@@ -71,7 +72,7 @@ def _check_data(d, f, k, origin=0.0):
 
 def fit(scene, displacement, force, *, R_L, fit_offset=True, free=(), bounds=None, weights=None, floor=0.05,
         delta_max=None, tol=1e-6, loss="linear", baseline="none", contact_guess=None, progress=None, shared=None,
-        stability=False, **aliases):
+        stability=False, model="shell", **aliases):
     """Least-squares fit of mu*H (the displacement origin, and a shape parameter) to measured data.
 
     Parameters
@@ -79,6 +80,13 @@ def fit(scene, displacement, force, *, R_L, fit_offset=True, free=(), bounds=Non
     scene : Scene
         Shape, indenter, material and beta (nondimensional); a free shape parameter's value
         in it is the start of the search.
+    model : {"shell", "solid"}
+        What is compared with the data: the shell model's curve (its delta, the mid-surface
+        pole's displacement, taken as the data's displacement) or the scene's 3D solid
+        (:func:`shellbvp.fe_curve`; needs ``scene.thickness`` and the ``fe`` extra), indented by
+        the indenter's displacement from first touch, as an instrument records it
+        (:mod:`shellbvp.fitting.solid`).  The solid fits mu*H, the contact point and a
+        baseline; shape parameters, ``stability`` and shared curves are shell-only.
     displacement, force : array_like
         Measured indenter displacement (m, > 0 into the shell) and force (N).
     R_L : float
@@ -184,6 +192,13 @@ def fit(scene, displacement, force, *, R_L, fit_offset=True, free=(), bounds=Non
     if not (isinstance(floor, (int, float)) and 0 < floor <= 1):
         raise ValueError(f"floor (of relative weights, fraction of max |force|) must be in (0, 1]; got {floor!r}")
     free, bounds = free_parameters(free, bounds, aliases)
+    if model not in FIT_MODELS:
+        raise ValueError(f"model must be one of {FIT_MODELS}; got {model!r}")
+    if model == "solid":
+        check_solid_fit(scene, free)
+        if stability or shared is not None:
+            raise ValueError("model='solid': the stability check and shared curves (force maps with a geometry per "
+                             "pixel) are the shell model's; use model='shell' for them")
     if baseline not in BASELINES:
         raise ValueError(f"baseline must be one of {BASELINES}; got {baseline!r}")
     origin = 0.0 if contact_guess is None else contact_guess
@@ -213,7 +228,8 @@ def fit(scene, displacement, force, *, R_L, fit_offset=True, free=(), bounds=Non
                              "(each pixel would need a curve of its own)")
         return _fit_on_shared(shared, scene, mdl, noise, depth, k, keep, weights, baseline)
     if sp is None:
-        shape = ModelCurves(lambda th: scene, grid, tol, depth, counter, progress)
+        shape = ModelCurves(lambda th: scene, grid, tol, depth, counter, progress,
+                            source=solid_curve if model == "solid" else None)
         shape.add(None)
         P, dP, top = shape.at(None)
         res, rss, J, w = noise.irls(mdl, P, dP, top)
@@ -223,7 +239,7 @@ def fit(scene, displacement, force, *, R_L, fit_offset=True, free=(), bounds=Non
         search = ProfileSearch(sp, ModelCurves(sp.scene_at, grid, tol, depth, counter, progress), mdl, depth)
         fitted = search.run(noise, k)
         notes = search.notes
-    res = result_of(fitted, mdl, sp, k, notes, keep, weights, baseline, counter[0])
+    res = result_of(fitted, mdl, sp, k, notes, keep, weights, baseline, counter[0], model)
     if stability and res.scene is not None and math.isfinite(res.offset):
         _check_axisymmetry(res, (float(np.max(d)) - res.offset) / R_L, tol)
     return res

@@ -22,7 +22,7 @@ log = logging.getLogger(__name__)
 __all__ = ["result_of"]
 
 
-def result_of(fitted, mdl, sp, k, notes, keep, weights, baseline, curves_computed):
+def result_of(fitted, mdl, sp, k, notes, keep, weights, baseline, curves_computed, fit_model="shell"):
     """The :class:`FitResult` of what a fit found: Wald (t) intervals of the free parameters
     from the weighted Jacobian, the shape parameter's profile interval, status and warnings."""
     res, rss, J, w, P, top, R_L = fitted.res, fitted.rss, fitted.J, fitted.w, fitted.P, fitted.top, mdl.R_L
@@ -85,7 +85,7 @@ def result_of(fitted, mdl, sp, k, notes, keep, weights, baseline, curves_compute
                      interpolation_error=fitted.interpolation_error, warnings=[t for _, t in found],
                      warning_codes=[code for code, _ in found], baseline_model=baseline, baseline=b0,
                      baseline_ci95=ci[2], baseline_slope=b1, baseline_slope_ci95=ci[3],
-                     point_weights=point_weights, **diagnostics)
+                     point_weights=point_weights, model=fit_model, **diagnostics)
 
 
 def _linearised(dq, x, dx_dtheta, mu_H, R_L, cov, t):

@@ -77,8 +77,12 @@ class FitResult:
         parameter's interval at its search bound).
     warning_codes : list of str
         The kind of each warning, keys of :data:`FIT_WARNINGS` (same order).
-    curve : Curve
-        The model curve (nondimensional) at the fitted parameters.
+    model : str
+        What was compared with the data: ``"shell"`` (the shell model) or ``"solid"`` (the 3D
+        solid, :mod:`shellbvp.fitting.solid`).
+    curve : Curve or SolidCurve
+        The model curve (nondimensional) at the fitted parameters: its ``delta`` is the
+        mid-surface pole's displacement (shell) or the indenter's (solid), / R_L.
     scene : Scene
         The scene of that curve (fitted beta or alpha).
     curves_computed : int
@@ -168,6 +172,7 @@ class FitResult:
     residual_autocorrelation: float = float("nan")
     first_instability: object = None
     stability_note: str = ""
+    model: str = "shell"
 
     @property
     def success(self):
@@ -217,10 +222,11 @@ class FitResult:
     def model_error(self):
         """``(error, extrapolated)``: the shell model's largest measured error in F against 3D
         elasticity at this thickness over the mapped scenes (:func:`shellbvp.thickness.model_error`),
-        to stand beside the statistical interval; None without a thickness or a map for the model."""
+        to stand beside the statistical interval; None without a thickness or a map for the model,
+        and for the solid (its error is its mesh's)."""
         from ..thickness import model_error
 
-        return model_error(self.scene)
+        return None if self.model == "solid" else model_error(self.scene)
 
     def model_force(self, displacement, mu_H=None):
         """Fitted model force (N) at displacements (m); with ``mu_H`` (N/m), the same model at
@@ -238,7 +244,7 @@ class FitResult:
             shape[name], shape[f"{name}_ci95"] = num(getattr(self, name)), ci(getattr(self, f"{name}_ci95"))
         return {"mu_H": num(self.mu_H), "mu_H_ci95": ci(self.mu_H_ci95), "offset": num(self.offset),
                 "offset_ci95": ci(self.offset_ci95), **shape, "fitted": list(self.fitted),
-                "weights": self.weights, "residual": num(self.residual_rms), "residual_rms": num(self.residual_rms),
+                "model": self.model, "weights": self.weights, "residual": num(self.residual_rms), "residual_rms": num(self.residual_rms),
                 "n": self.n, "success": self.success, "status": self.status, "message": self.message,
                 "warnings": list(self.warnings), "warning_codes": list(self.warning_codes), "R_L": self.R_L,
                 "curves_computed": self.curves_computed, "interpolation_error": num(self.interpolation_error),

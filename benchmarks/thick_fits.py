@@ -1,0 +1,208 @@
+"""Fits of thick and curved shells against records made by the 3D solid (issue 54).
+
+Five scenes outside the shell model's mapped error (SPEC section 10; issue 54's table): the
+paper's seed (gamma 2.5, rho 1/3, eps 1/6), a hemisphere (rho 1/3, eps 1/6), a prolate shell
+(gamma 2, rho 0.2, eps 0.05), a shallow one (gamma 0.5, rho 0.2, eps 0.05) and the seed at eps
+0.1; mu = 1 MPa, R_L = 0.3 mm, neo-Hookean.  Each record is what an instrument writes: the
+indenter's displacement (an approach at zero force, contact at 10 um, then the loading to 0.25
+R_L), the force with 1 % noise and a floor of 0.1 % of its largest value.  It is made by the
+package's solid (``sb.fe_curve(at="indenter")``) on a mesh 1.5x finer each way than the
+fitting model's, so the solid's fit is checked against a solid it was not computed on.
+
+Each record is fitted as a user would (``read_instrument`` + ``fit_record``, the CLI's path):
+the shell model (default), the shell model with transverse shear, and the solid
+(``model="solid"``).  Reported: mu*H and its 95 % interval against the truth, the printed
+model error (the shell's map) and whether truth lies within it, the quality rating.
+
+Then the solid's convergence on the paper's seed (the rim face hinged against the pinned
+mid-thickness point; three meshes) and, with ``--timing``, whole ``shellbvp fit`` commands on
+the seed's record: the shell and the solid, cold (no kept model curve) and warm, as ratios
+measured in one run.
+
+    python benchmarks/thick_fits.py [--workers 2] [--timing] [--only seed]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import platform
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+import zlib
+from concurrent.futures import ProcessPoolExecutor
+from pathlib import Path
+
+import numpy as np
+
+HERE = Path(__file__).resolve().parent
+sys.path.insert(0, str(HERE.parent))  # this checkout's package
+
+import shellbvp as sb  # noqa: E402
+
+R_L = 0.3e-3          # m
+MU = 1e6              # Pa
+CONTACT = 10e-6       # m: where the indenter first touches, in the record's displacement
+DEPTH = 0.25          # deepest indenter displacement / R_L
+NOISE, FLOOR = 0.01, 0.001
+#: name: (gamma, rho, eps) -- issue 54's five scenes
+SCENES = {
+    "seed": (2.5, 1 / 3, 1 / 6),
+    "hemisphere": (1.0, 1 / 3, 1 / 6),
+    "prolate": (2.0, 0.2, 0.05),
+    "shallow": (0.5, 0.2, 0.05),
+    "seed eps 0.1": (2.5, 1 / 3, 0.1),
+}
+#: the record's mesh: 1.5x finer each way than the fitting model's (FE_DEFAULTS: 0.5 H, 3 through H)
+RECORD_MESH = dict(element_length=0.33, through_thickness=4)
+FITS = {"shell": dict(), "shell, shear": dict(transverse_shear=True), "solid": dict(model="solid")}
+
+
+def scene_of(gamma, rho, eps, **over):
+    return sb.Scene(gamma=gamma, rho=rho, material=sb.NeoHookean(), thickness=eps, **over)
+
+
+def make_record(name, folder):
+    """The instrument-like record of scene ``name`` as a TSV file (um, uN); returns its path."""
+    gamma, rho, eps = SCENES[name]
+    depths = DEPTH * np.arange(1, 51) / 50
+    t0 = time.perf_counter()
+    fe = sb.fe_curve(scene_of(gamma, rho, eps), eps, depths, at="indenter", **RECORD_MESH)
+    if not fe.success:
+        raise RuntimeError(f"{name}: the record's solid failed: {fe.message}")
+    rng = np.random.default_rng(zlib.crc32(name.encode()))
+    force = MU * eps * R_L * R_L * fe.force          # F / (mu R_L H) -> N, H = eps R_L
+    approach = np.linspace(0.0, CONTACT, 15, endpoint=False)
+    disp = np.r_[approach, CONTACT + depths * R_L]
+    clean = np.r_[np.zeros(approach.size), force]
+    noisy = clean * (1 + NOISE * rng.normal(size=clean.size)) + FLOOR * force.max() * rng.normal(size=clean.size)
+    path = Path(folder) / f"{name.replace(' ', '_')}.tsv"
+    path.write_text("Displacement (um)\tForce (uN)\n" + "".join(f"{d * 1e6:.6f}\t{f * 1e6:.6f}\n"
+                                                                for d, f in zip(disp, noisy)))
+    return path, time.perf_counter() - t0
+
+
+def fit_case(job):
+    name, path, label = job
+    gamma, rho, eps = SCENES[name]
+    over = {k: v for k, v in FITS[label].items() if k != "model"}
+    scene = scene_of(gamma, rho, eps, **over)
+    rec = sb.read_instrument(path)
+    t0 = time.perf_counter()
+    res, _ = sb.fit_record(scene, rec, R_L=R_L, model=FITS[label].get("model", "shell"))
+    truth = MU * eps * R_L
+    err = res.model_error
+    lo, hi = res.mu_H_ci95
+    return {"scene": name, "fit": label, "truth": truth, "mu_H": res.mu_H, "ci95": [lo, hi],
+            "error": res.mu_H / truth - 1, "in_ci": bool(lo <= truth <= hi),
+            "model_error": None if err is None else err[0],
+            "in_bound": None if err is None else bool(abs(res.mu_H / truth - 1) <= err[0] + (hi - lo) / 2 / res.mu_H),
+            "quality": res.quality, "success": res.success, "seconds": time.perf_counter() - t0,
+            "warnings": list(res.warning_codes)}
+
+
+def convergence():
+    """The seed's solid on three meshes, the rim face hinged and the mid-thickness point pinned."""
+    scene = scene_of(*SCENES["seed"])
+    depths = [0.02, 0.1, 0.3]
+    meshes = [dict(element_length=0.5, through_thickness=3), dict(element_length=0.33, through_thickness=4),
+              dict(element_length=0.25, through_thickness=6)]
+    rows = []
+    for face in ("plane", "point"):
+        forces = []
+        for mesh in meshes:
+            t0 = time.perf_counter()
+            c = sb.fe_curve(scene, 1 / 6, depths, at="indenter", rim_face=face, **mesh)
+            forces.append(c.force)
+            rows.append({"rim_face": face, **mesh, "elements": list(c.elements), "force": list(map(float, c.force)),
+                         "seconds": time.perf_counter() - t0})
+        for row, f in zip(rows[-3:], forces):
+            row["vs_finest"] = list(map(float, f / forces[-1] - 1))
+    return rows
+
+
+def timing(path, cache):
+    """Whole ``shellbvp fit`` commands on the seed's record: cold (no kept curve) and warm."""
+    base = ["shellbvp", "fit", str(path), "--radius", "0.3mm", "--rise", "0.75mm", "--indenter-radius", "0.1mm",
+            "--thickness", "50um", "--neo-hookean", "-q"]
+    exe = str(Path(sys.executable).parent / "shellbvp")
+    env = dict(__import__("os").environ, SHELLBVP_CACHE_DIR=str(cache))
+    subprocess.run([exe, "curve", "--delta-max", "0.05", "-o", str(Path(cache) / "warm.h5"), "-q"], env=env,
+                   capture_output=True, check=True)  # the generated code in place: "cold" is the model curve's
+    out = {}
+    for label, extra in (("shell", []), ("solid", ["--model", "solid"])):
+        for kept in ("curves", "solid_curves"):
+            shutil.rmtree(Path(cache) / kept, ignore_errors=True)
+        for state in ("cold", "warm"):
+            t0 = time.perf_counter()
+            r = subprocess.run([exe, *base[1:], *extra], env=env, capture_output=True, text=True)
+            out[f"{label} {state}"] = time.perf_counter() - t0
+            if r.returncode != 0:
+                raise RuntimeError(f"{label} {state}: {r.stderr or r.stdout}")
+    return out
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--workers", type=int, default=2)
+    ap.add_argument("--only", choices=list(SCENES))
+    ap.add_argument("--timing", action="store_true")
+    ap.add_argument("--no-convergence", action="store_true")
+    args = ap.parse_args()
+    names = [args.only] if args.only else list(SCENES)
+    folder = Path(tempfile.mkdtemp())
+    t0 = time.perf_counter()
+    with ProcessPoolExecutor(args.workers) as pool:
+        made = dict(zip(names, pool.map(make_record, names, [folder] * len(names))))
+        jobs = [(n, made[n][0], label) for n in names for label in FITS]
+        fits = list(pool.map(fit_case, jobs))
+        conv = None if args.no_convergence else pool.submit(convergence).result()
+    result = {"scenes": {n: dict(zip(("gamma", "rho", "eps"), SCENES[n]), record_seconds=made[n][1]) for n in names},
+              "fits": fits, "convergence": conv, "machine": platform.platform(), "version": sb.__version__,
+              "seconds": time.perf_counter() - t0}
+    if args.timing:
+        with tempfile.TemporaryDirectory() as cache:
+            result["timing"] = timing(made[names[0]][0], cache)
+    out = HERE / "results" / "thick_fits.json"
+    out.write_text(json.dumps(result, indent=1))
+    (HERE / "results" / "thick_fits.md").write_text(report(result))
+    print(report(result))
+
+
+def report(r):
+    lines = ["# Fits of thick and curved shells against the solid's records (issue 54)", "",
+             "`python benchmarks/thick_fits.py --timing` (the module's docstring says how the records are made; "
+             f"{r['machine']}, shellbvp {r['version']}, {r['seconds']:.0f} s).", "",
+             "| scene | truth mu*H (N/m) | fit | mu*H [95 % CI] | error | truth in CI | printed model error | "
+             "truth within it | quality | s |", "|---|---|---|---|---|---|---|---|---|---|"]
+    for f in r["fits"]:
+        me = "-" if f["model_error"] is None else f"{100 * f['model_error']:.0f} %"
+        inside = "-" if f["in_bound"] is None else ("yes" if f["in_bound"] else "**no**")
+        lines.append(f"| {f['scene']} | {f['truth']:.4g} | {f['fit']} | {f['mu_H']:.4g} [{f['ci95'][0]:.4g}, "
+                     f"{f['ci95'][1]:.4g}] | {100 * f['error']:+.1f} % | {'yes' if f['in_ci'] else 'no'} | {me} | "
+                     f"{inside} | {f['quality']} | {f['seconds']:.1f} |")
+    if r.get("convergence"):
+        lines += ["", "The solid's convergence on the paper's seed (indenter at 0.02, 0.1, 0.3 R_L; force against "
+                  "the finest mesh):", "", "| rim face | element length / H | through H | elements | vs finest | s |",
+                  "|---|---|---|---|---|---|"]
+        for c in r["convergence"]:
+            vs = ", ".join(f"{100 * v:+.2f} %" for v in c["vs_finest"])
+            lines.append(f"| {c['rim_face']} | {c['element_length']} | {c['through_thickness']} | "
+                         f"{c['elements'][0]}x{c['elements'][1]} | {vs} | {c['seconds']:.1f} |")
+    if r.get("timing"):
+        t = r["timing"]
+        lines += ["", "Whole `shellbvp fit` commands on the seed's record (cold: no kept model curve; the "
+                  "generated code in place):", "",
+                  "| command | s | / shell cold |", "|---|---|---|"]
+        for k, v in t.items():
+            lines.append(f"| {k} | {v:.2f} | {v / t['shell cold']:.2f}x |")
+        lines.append(f"\nsolid cold / shell cold = {t['solid cold'] / t['shell cold']:.1f}x; "
+                     f"solid warm / shell warm = {t['solid warm'] / t['shell warm']:.2f}x")
+    return "\n".join(lines) + "\n"
+
+
+if __name__ == "__main__":
+    main()

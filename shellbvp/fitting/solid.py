@@ -1,0 +1,264 @@
+"""The solid as a fitting model (``fit(..., model="solid")``): the scene's shell as a 3D
+axisymmetric solid (:func:`shellbvp.fe_curve`), indented by the instrument's own displacement.
+
+Why: the shell model's delta is its mid-surface pole's displacement; an instrument records
+the indenter's, which also compresses and thins the wall under the tip.  On thick samples
+(eps = H/R_L of 0.1-0.2) that difference and the shell's own error bias a shell fit of mu*H
+by 6-20 % (issue 54).  The solid has neither: its abscissa is the indenter's displacement from
+first touch (at the pole or on a ring, where it really is), divided by R_L.
+
+For a material whose energy scales with mu at fixed shape parameters (neo-Hookean,
+Mooney-Rivlin at a given alpha, Gent at a given Jm, ...), the solid's force is mu times one
+curve: ``F_SI = mu_H R_L F(d / R_L)`` with ``F = force / (mu R_L H)``, exactly the shell
+model's form.  One solid curve per scene and depth grid serves every mu*H, the contact
+point and the baseline; it is kept on disk (:func:`solid_curve`) like a shell model curve.
+
+A kept solid curve is data from disk: a JSON file in the code cache's ``solid_curves/``
+folder, named by a hash of everything it depends on (scene, depths, the FE's settings, the
+package's source) and carrying a SHA-256 of its own contents.  It is used only when that
+checksum, its key, its depths and its finite forces all check; otherwise it is ignored and
+computed again.  A folder or file another user owns or may write is not read.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import logging
+import math
+from collections import OrderedDict
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..config import OPTIONS
+from ..fe import FE_DEFAULTS, check_solid_scene, fe_curve
+from ..model import cache_dir, untrusted_reason
+from ..paths import atomic_file
+from ..version import __version__
+from .curves import code_fingerprint
+
+__all__ = ["SolidCurve", "solid_curve", "clear_solid_curves", "check_solid_fit", "FIT_MODELS", "MAX_KEPT_BYTES"]
+
+log = logging.getLogger(__name__)
+
+#: What a fit can compare with the data: the shell model's curve or the 3D solid's.
+FIT_MODELS = ("shell", "solid")
+
+#: A kept solid curve larger than this is not read (40 depths take about 4 kB).
+MAX_KEPT_BYTES = 1 << 20
+
+#: Format of a kept solid curve (a new one makes new keys).
+FORMAT = 1
+
+# the solid curves of this process (a batch or a map on one grid computes one), least recent out first
+_MEMO: OrderedDict = OrderedDict()
+_MEMO_SIZE = 8
+
+
+@dataclass
+class SolidCurve:
+    """The solid's force against the indenter's displacement, nondimensional.
+
+    Attributes
+    ----------
+    scene : Scene
+    delta : ndarray
+        The indenter's displacement from first touch / R_L at the depths reached (the fit's
+        abscissa: named as the shell curve's so that a fit reads either).
+    force : ndarray
+        Indenter force / (mu R_L H) there.
+    pole_delta : ndarray
+        The mid-surface pole's displacement / R_L there (the shell model's delta).
+    contact_radius : ndarray
+        Radius of the outermost surface point in contact / R_L.
+    complete : bool
+        Every requested depth reached.
+    stop_reason : str
+    elements : tuple
+        Elements along the meridian and through the thickness.
+    wall_time : float
+        Seconds the FE took (0 for a kept curve read back).
+    kept : bool
+        Read from the code cache.
+    """
+
+    scene: object
+    delta: np.ndarray
+    force: np.ndarray
+    pole_delta: np.ndarray
+    contact_radius: np.ndarray
+    complete: bool
+    stop_reason: str
+    elements: tuple
+    wall_time: float = 0.0
+    kept: bool = False
+    settings: dict = field(default_factory=dict)
+
+    def __len__(self):
+        return int(self.delta.size)
+
+
+def check_solid_fit(scene, free=()):
+    """ValueError, in one line, where the solid cannot be this fit's model (before any work)."""
+    if scene.thickness is None:
+        raise ValueError("model='solid' needs the shell's thickness (thickness = H/R_L; --thickness with a unit "
+                         "and --radius): the solid is meshed at that thickness")
+    if free:
+        raise ValueError(f"model='solid' fits mu*H, the contact point and a baseline; fitting {', '.join(free)} "
+                         f"with the solid is not supported yet: fit it with model='shell'")
+    if scene.transverse_shear:
+        raise ValueError("transverse_shear is a correction of the shell model; the solid has its shear already: "
+                         "drop --transverse-shear with --model solid")
+    check_solid_scene(scene)
+
+
+def solid_curve(scene, grid, tol=None, counter=None, progress=None) -> SolidCurve:
+    """The solid's curve of ``scene`` at the indenter displacements ``grid`` (/ R_L): read back
+    from the code cache when kept there and sound, else computed (``fe_curve(at="indenter")``)
+    and kept.  ``tol`` (the shell model's) plays no part; ``counter[0]`` counts computed curves;
+    ``progress(description, depth_max) -> (bar, callback)`` draws a bar."""
+    grid = np.asarray(grid, float)
+    memo = (scene, tuple(grid.tolist()))
+    if memo in _MEMO:
+        _MEMO.move_to_end(memo)
+        return _MEMO[memo]
+    path, key = _place(scene, grid)
+    c = _read_kept(path, key, scene, grid)
+    if c is None:
+        c = _computed(scene, grid, counter, progress)
+        if c.complete:
+            _keep(c, path, key)
+    _MEMO[memo] = c
+    while len(_MEMO) > _MEMO_SIZE:
+        _MEMO.popitem(last=False)
+    return c
+
+
+def clear_solid_curves():
+    """Forget the solid curves memoised in this process (the disk's stay)."""
+    _MEMO.clear()
+
+
+def _computed(scene, grid, counter, progress):
+    bar, callback = progress("solid curve", float(grid[-1])) if progress is not None else (None, None)
+    try:
+        fe = fe_curve(scene, scene.thickness, grid, at="indenter",
+                      progress=None if callback is None else _fe_progress(callback))
+    finally:
+        if bar is not None:
+            bar.close()
+    if counter is not None:
+        counter[0] += 1
+    reached = int(np.argmax(~np.isfinite(fe.force))) if not np.all(np.isfinite(fe.force)) else grid.size
+    return SolidCurve(scene, grid[:reached].copy(), fe.force[:reached], fe.delta[:reached],
+                      fe.contact_radius[:reached], bool(fe.success), fe.message, tuple(fe.elements), fe.wall_time,
+                      settings=dict(fe.settings))
+
+
+def _fe_progress(callback):
+    """fe_curve's ``progress(i, depth, force)`` drawn by a curve bar's ``callback(curve, sol)``."""
+    class _Point:
+        def __init__(self, delta, force):
+            self.delta, self.force = delta, force
+
+    done = []
+
+    def step(i, depth, force):
+        done.append(depth)
+        callback(done, _Point(float(depth), float(force)))
+
+    return step
+
+
+def _place(scene, grid):
+    """(path, key) of the kept curve, or (None, None) where the disk is off or not trusted."""
+    if not OPTIONS.model_curve_cache:
+        return None, None
+    try:
+        payload = json.dumps({"format": FORMAT, "scene": scene.to_dict(), "grid": [float(x) for x in grid],
+                              "fe": FE_DEFAULTS, "code": code_fingerprint(), "version": __version__},
+                             sort_keys=True)
+    except (TypeError, ValueError, AttributeError):
+        return None, None
+    key = hashlib.sha256(payload.encode()).hexdigest()
+    folder = cache_dir() / "solid_curves"
+    if folder.exists() and untrusted_reason(folder):
+        log.info("solid curves not kept: the folder %s is not trusted (%s)", folder, untrusted_reason(folder))
+        return None, None
+    return folder / f"solid_{key[:32]}.json", key
+
+
+def _checksum(record):
+    body = {k: v for k, v in record.items() if k != "sha256"}
+    return hashlib.sha256(json.dumps(body, sort_keys=True).encode()).hexdigest()
+
+
+def _read_kept(path, key, scene, grid):
+    """The kept curve at ``path`` when it is sound and holds ``key`` and ``grid``, else None (why: logged)."""
+    if path is None or not path.is_file():
+        return None
+    why = untrusted_reason(path)
+    try:
+        if why is None and path.stat().st_size > MAX_KEPT_BYTES:
+            why = f"larger than {MAX_KEPT_BYTES} bytes"
+        record = None if why else json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, ValueError, UnicodeDecodeError) as exc:
+        why = f"unreadable ({type(exc).__name__})"
+    if why is None:
+        why = _unsound(record, key, grid)
+    if why is not None:
+        log.info("ignoring the kept solid curve %s: %s", path.name, why)
+        return None
+    n = grid.size
+    return SolidCurve(scene, grid.copy(), np.array(record["force"], float), np.array(record["pole_delta"], float),
+                      np.array(record["contact_radius"], float), True, record["stop_reason"][:200],
+                      tuple(int(e) for e in record["elements"][:2]), 0.0, True,
+                      settings={"at": "indenter", "points": n})
+
+
+def _unsound(record, key, grid):
+    """Why a kept record cannot be used, or None."""
+    if not isinstance(record, dict):
+        return "not a record"
+    if record.get("sha256") != _checksum(record):
+        return "its checksum does not match its contents (damaged or edited)"
+    if record.get("key") != key or record.get("format") != FORMAT:
+        return "made for another scene, grid or version"
+    try:
+        depths = np.array(record["grid"], float)
+        arrays = [np.array(record[k], float) for k in ("force", "pole_delta", "contact_radius")]
+        elements = record["elements"]
+    except (KeyError, TypeError, ValueError):
+        return "fields missing or not numbers"
+    if depths.shape != grid.shape or not np.array_equal(depths, grid):
+        return "its depths are not the requested ones"
+    if any(a.shape != grid.shape or not np.all(np.isfinite(a)) for a in arrays):
+        return "an array of the wrong length or with a non-finite value"
+    if not (isinstance(elements, list) and len(elements) == 2 and all(isinstance(e, int) for e in elements)):
+        return "elements are not two integers"
+    if not isinstance(record.get("stop_reason"), str):
+        return "no stop reason"
+    return None
+
+
+def _keep(c, path, key):
+    """Write the complete curve ``c`` (atomically); a cache that cannot be written is skipped."""
+    if path is None:
+        return
+    record = {"format": FORMAT, "key": key, "grid": [float(x) for x in c.delta],
+              "force": [float(x) for x in c.force], "pole_delta": [float(x) for x in c.pole_delta],
+              "contact_radius": [float(x) for x in c.contact_radius], "elements": [int(e) for e in c.elements],
+              "stop_reason": c.stop_reason, "units": {"grid": "indenter displacement / R_L",
+                                                       "force": "F / (mu R_L H)", "pole_delta": "1 (/ R_L)",
+                                                       "contact_radius": "1 (/ R_L)"}}
+    if not all(math.isfinite(x) for x in record["force"]):
+        return
+    record["sha256"] = _checksum(record)
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        with atomic_file(path) as tmp:
+            tmp.write_text(json.dumps(record, sort_keys=True), encoding="utf-8")
+    except OSError as exc:
+        log.info("solid curve not kept (%s)", exc)
+
