@@ -58,7 +58,8 @@ SCENES = {
 }
 #: the record's mesh: 1.5x finer each way than the fitting model's (FE_DEFAULTS: 0.5 H, 3 through H)
 RECORD_MESH = dict(element_length=0.33, through_thickness=4)
-FITS = {"shell": dict(), "shell, shear": dict(transverse_shear=True), "solid": dict(model="solid")}
+FITS = {"shell": dict(model="shell"), "shell, shear": dict(model="shell", transverse_shear=True),
+        "solid": dict(model="solid"), "auto (default)": dict(model="auto")}
 
 
 def scene_of(gamma, rho, eps, **over):
@@ -92,7 +93,7 @@ def fit_case(job):
     scene = scene_of(gamma, rho, eps, **over)
     rec = sb.read_instrument(path)
     t0 = time.perf_counter()
-    res, _ = sb.fit_record(scene, rec, R_L=R_L, model=FITS[label].get("model", "shell"))
+    res, _ = sb.fit_record(scene, rec, R_L=R_L, model=FITS[label]["model"])
     truth = MU * eps * R_L
     err = res.model_error
     lo, hi = res.mu_H_ci95
@@ -101,6 +102,7 @@ def fit_case(job):
             "model_error": None if err is None else err[0],
             "in_bound": None if err is None else bool(abs(res.mu_H / truth - 1) <= err[0] + (hi - lo) / 2 / res.mu_H),
             "quality": res.quality, "success": res.success, "seconds": time.perf_counter() - t0,
+            "model": res.model, "model_note": res.model_note,
             "warnings": list(res.warning_codes)}
 
 
@@ -130,12 +132,12 @@ def timing(path, cache):
             "--thickness", "50um", "--neo-hookean", "-q"]
     exe = str(Path(sys.executable).parent / "shellbvp")
     env = dict(__import__("os").environ, SHELLBVP_CACHE_DIR=str(cache))
-    subprocess.run([exe, "curve", "--delta-max", "0.05", "-o", str(Path(cache) / "warm.h5"), "-q"], env=env,
-                   capture_output=True, check=True)  # the generated code in place: "cold" is the model curve's
+    # the scene's code generated first (a shell fit, its curve then dropped): "cold" is the model curve's
+    subprocess.run([exe, *base[1:], "--model", "shell"], env=env, capture_output=True, check=True)
     out = {}
-    for label, extra in (("shell", []), ("solid", ["--model", "solid"])):
+    for label, extra in (("shell", ["--model", "shell"]), ("solid", ["--model", "solid"]), ("auto", [])):
         for kept in ("curves", "solid_curves"):
-            shutil.rmtree(Path(cache) / kept, ignore_errors=True)
+            shutil.rmtree(Path(cache) / kept, ignore_errors=True)  # each command cold, then warm
         for state in ("cold", "warm"):
             t0 = time.perf_counter()
             r = subprocess.run([exe, *base[1:], *extra], env=env, capture_output=True, text=True)
@@ -181,7 +183,8 @@ def report(r):
     for f in r["fits"]:
         me = "-" if f["model_error"] is None else f"{100 * f['model_error']:.0f} %"
         inside = "-" if f["in_bound"] is None else ("yes" if f["in_bound"] else "**no**")
-        lines.append(f"| {f['scene']} | {f['truth']:.4g} | {f['fit']} | {f['mu_H']:.4g} [{f['ci95'][0]:.4g}, "
+        label = f"{f['fit']}: {f['model']}" if f["fit"].startswith("auto") else f["fit"]
+        lines.append(f"| {f['scene']} | {f['truth']:.4g} | {label} | {f['mu_H']:.4g} [{f['ci95'][0]:.4g}, "
                      f"{f['ci95'][1]:.4g}] | {100 * f['error']:+.1f} % | {'yes' if f['in_ci'] else 'no'} | {me} | "
                      f"{inside} | {f['quality']} | {f['seconds']:.1f} |")
     if r.get("convergence"):

@@ -134,10 +134,12 @@ def fit_diagnostics(cov, rss, n, k, weighted_resid, disp, runs) -> dict:
 QUALITY_RULES = {"good_halfwidth": 0.05, "fair_halfwidth": 0.20, "good_correlation": 0.98}
 
 
-def fit_quality(success, warning_codes, mu_H, mu_ci, correlation=None, fitted=()) -> str:
+def fit_quality(success, warning_codes, mu_H, mu_ci, correlation=None, fitted=(), model_error=None) -> str:
     """A transparent rating of one fit: ``good``, ``fair`` or ``poor``.
 
-    * poor: the fit failed its checks, or mu*H's 95 % interval is wider than +-20 % of it;
+    * poor: the fit failed its checks, mu*H's 95 % interval is wider than +-20 % of it, or the
+      model's own error (``model_error``, a fraction, where known) is larger than that
+      interval: then the interval does not say how well mu*H is known;
     * good: succeeded without warnings, the interval within +-5 %, and mu*H not correlated with
       another fitted parameter beyond abs(r) = 0.98 (then the data cannot tell them apart);
     * fair: everything between.
@@ -147,7 +149,7 @@ def fit_quality(success, warning_codes, mu_H, mu_ci, correlation=None, fitted=()
     if not success or not (mu_H > 0) or not all(math.isfinite(v) for v in mu_ci):
         return "poor"
     half = (mu_ci[1] - mu_ci[0]) / 2 / mu_H
-    if half > QUALITY_RULES["fair_halfwidth"]:
+    if half > QUALITY_RULES["fair_halfwidth"] or (model_error is not None and model_error > half):
         return "poor"
     r = 0.0
     if correlation is not None and "mu_H" in fitted and len(fitted) > 1:
@@ -163,8 +165,8 @@ def diagnostics_lines(quality, fitted, correlation, values, show_force=lambda v:
     """Two lines for a fit's summary: its quality rating and its diagnostics (``values``: noise_sigma,
     aic, bic, runs_p, residual_autocorrelation)."""
     rules = (f"rules: mu*H's 95 % interval within +-{100 * QUALITY_RULES['good_halfwidth']:g} % (good) or "
-             f"+-{100 * QUALITY_RULES['fair_halfwidth']:g} % (fair), no warnings, |corr(mu_H, .)| <= "
-             f"{QUALITY_RULES['good_correlation']:g}")
+             f"+-{100 * QUALITY_RULES['fair_halfwidth']:g} % (fair) and wider than the model's error where known, "
+             f"no warnings, |corr(mu_H, .)| <= {QUALITY_RULES['good_correlation']:g}")
     parts = []
     if math.isfinite(values.get("noise_sigma", math.nan)):
         parts.append(f"noise {show_force(values['noise_sigma'])}")

@@ -22,13 +22,16 @@ SI units, ``"1"`` nondimensional, ``""`` text)::
       delta, F                 (m,) 1: the nondimensional curve
     /fit/parameters            NXparameters: mu_H (N/m), offset (m), baseline (N),
                                baseline_slope (N/m), R_L (m), residual_rms (N), n_points (1),
-                               noise_sigma (N), aic, bic, runs_p, residual_autocorrelation, and every
+                               noise_sigma (N), aic, bic, runs_p, residual_autocorrelation, model_error
+                               (1: the shell model's error beside the interval; NaN: none), and every
                                shape parameter and derived quantity of shellbvp.shape_parameters
                                (beta (1), alpha (1, NaN for other materials), pressure (1), pressure_Pa
                                (Pa, NaN unless fitted), ...) -- scalars; correlation (k, k); <name>_ci95
                                (2,) for each parameter fitted and its derived quantities; attrs: fitted,
                                baseline_model, weights, segment, model (shell or solid: what
-                               delta is, the mid-surface pole's or the indenter's displacement)
+                               delta is, the mid-surface pole's or the indenter's displacement),
+                               model_note (why that model, with model auto), model_error_source
+                               (measured: on this scene by the solid; map: the mapped scenes' bound)
     /fit/warnings              (k,) the fit's warnings (text); attr codes
     /fit/sample                NXsample; attrs: scene (JSON, rebuilds the Scene), scene_<key>
     /fit/source                NXnote: file_name, sha256, columns (JSON), units (JSON), inverted
@@ -62,7 +65,7 @@ FIT_FORMAT_VERSION = 1
 #: The fit's own scalar parameters in ``/fit/parameters`` with their units.
 _FIT_UNITS = {"mu_H": "N/m", "offset": "m", "baseline": "N", "baseline_slope": "N/m", "R_L": "m", "residual_rms": "N",
               "n_points": DIMENSIONLESS, "noise_sigma": "N", "aic": DIMENSIONLESS, "bic": DIMENSIONLESS,
-              "runs_p": DIMENSIONLESS, "residual_autocorrelation": DIMENSIONLESS}
+              "runs_p": DIMENSIONLESS, "residual_autocorrelation": DIMENSIONLESS, "model_error": DIMENSIONLESS}
 #: Units of the scalar parameters in ``/fit/parameters``: the fit's own, every shape parameter's and
 #: every derived quantity's (:mod:`shellbvp.shape_parameters`).
 PARAMETER_UNITS = {**_FIT_UNITS, **{p.name: p.unit for p in SHAPE_PARAMETERS.values()},
@@ -130,8 +133,10 @@ class FitRecord:
         """``good``, ``fair`` or ``poor`` (:func:`shellbvp.fitting.fit_quality`), from what the file holds."""
         from .fitting import fit_quality
 
+        error = self.parameters.get("model_error", math.nan)
         return fit_quality(self.success, self.warning_codes, self.parameters["mu_H"],
-                           self.intervals.get("mu_H", (math.nan, math.nan)), self.correlation, self.fitted)
+                           self.intervals.get("mu_H", (math.nan, math.nan)), self.correlation, self.fitted,
+                           error if math.isfinite(error) else None)
 
 
 def write_fit(path, result, record, used, *, segment="loading", overwrite=False):
@@ -199,10 +204,12 @@ def write_fit(path, result, record, used, *, segment="loading", overwrite=False)
             p = e.create_group("parameters")
             p.attrs.update({"NX_class": "NXparameters", "baseline_model": result.baseline_model,
                             "weights": result.weights, "segment": segment, "model": result.model,
+                            "model_note": result.model_note, "model_error_source": _error_source(result),
                             "fitted": np.array(list(result.fitted), dtype=h5py.string_dtype())})
             values = {"mu_H": result.mu_H, "offset": result.offset, "baseline": result.baseline,
                       "baseline_slope": result.baseline_slope, "R_L": result.R_L,
                       "residual_rms": result.residual_rms, "n_points": result.n,
+                      "model_error": math.nan if result.model_error is None else result.model_error[0],
                       **{k: getattr(result, k) for k in ("noise_sigma", "aic", "bic", "runs_p",
                                                           "residual_autocorrelation")},
                       **{k: np.nan if getattr(result, k) is None else getattr(result, k)
@@ -241,6 +248,13 @@ def write_fit(path, result, record, used, *, segment="loading", overwrite=False)
             string_dataset(src, "inverted", json.dumps(list(getattr(record, "inverted", ()))))
             string_dataset(src, "notes", json.dumps(list(getattr(record, "notes", ())), ensure_ascii=False),
                            "what reading left out of the source file and why (JSON list of text)")
+
+
+def _error_source(result):
+    """Where a fit's ``model_error`` comes from: measured on this scene by the solid, the map, or none."""
+    if result.model_error is None:
+        return ""
+    return "measured" if result.measured_model_error is not None else "map"
 
 
 def _inverted(src):
@@ -371,6 +385,8 @@ def read_fit(path) -> FitRecord:
                                      f"{correlation.shape}")
             settings = {k: sc.attr_text(p, k) for k in ("baseline_model", "weights", "segment")}
             settings["model"] = sc.attr_text(p, "model") if "model" in p.attrs else "shell"  # files before it: shell
+            for k in ("model_note", "model_error_source"):
+                settings[k] = sc.attr_text(p, k) if k in p.attrs else ""
             if settings["model"] not in ("shell", "solid"):
                 raise ValueError(f"parameters.model must be 'shell' or 'solid'; got {settings['model']!r}")
             warnings = sc.text_dataset(e, "warnings")

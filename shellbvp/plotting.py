@@ -257,7 +257,9 @@ def fit_summary_lines(record):
             lo, hi = iv["mu_H"]
             lines.append(f"mu = {p['mu_H'] / H / 1e6:.5g} MPa   95% CI [{lo / H / 1e6:.5g}, {hi / H / 1e6:.5g}] "
                          f"(thickness H = {H * 1e6:.4g} um, eps = {s.thickness:.3g})")
-        if record.settings.get("model", "shell") == "shell":
+        if record.settings.get("model_note"):
+            lines.append(f"model: {record.settings['model_note']}")
+        if record.settings.get("model", "shell") == "shell" and record.settings.get("model_error_source") != "measured":
             lines.append(model_error_line(s))
     lines.append(f"scene: {s.describe(p['R_L'])}")
     lines += [f"warning: {w}" for w in record.warnings] or ["warnings: none"]

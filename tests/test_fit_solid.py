@@ -91,9 +91,44 @@ def test_the_solid_recovers_mu_h_from_its_own_finer_record_where_the_shell_is_bi
     lo, hi = res.mu_H_ci95
     assert lo < MU_H < hi and res.mu_H == pytest.approx(MU_H, rel=0.01)
     assert res.offset_ci95[0] < 5e-6 < res.offset_ci95[1] and res.model_error is None
-    shell = sb.fit(SCENE, d, F, R_L=R_L)
+    shell = sb.fit(SCENE, d, F, R_L=R_L, model="shell")
     assert not shell.mu_H_ci95[0] < MU_H < shell.mu_H_ci95[1]
     assert res.to_dict()["model"] == "solid" and shell.to_dict()["model"] == "shell"
+    # the default measures the shell's error with the solid (the curve memoised: none computed)
+    auto = sb.fit(SCENE, d, F, R_L=R_L)
+    assert auto.model == "solid" and auto.mu_H == res.mu_H and auto.curves_computed == 0
+    assert auto.measured_model_error == pytest.approx(abs(shell.mu_H / res.mu_H - 1))
+    assert "beyond the shell's interval" in auto.model_note and auto.quality == res.quality
+
+
+def test_auto_keeps_the_shell_where_the_solid_is_not_used_and_says_why():
+    d, F = np.linspace(0, 1e-4, 12), 3e-3 * np.linspace(0, 1, 12) ** 1.5
+    reasons = {"no thickness given": sb.Scene(material=sb.NeoHookean()),
+               "eps = 0.02 < 0.05": SCENE.replace(thickness=0.02),
+               "asked for with transverse shear": SCENE.replace(transverse_shear=True)}
+    for why, scene in reasons.items():
+        choice, note = solid.auto_model(scene)
+        assert choice == "shell" and why in note
+    assert solid.auto_model(SCENE, free=("beta",))[0] == "shell" and solid.auto_model(SCENE)[0] == "both"
+    res = sb.fit(sb.Scene(material=sb.NeoHookean()), d, F, R_L=R_L)
+    assert res.model == "shell" and "no thickness given" in res.model_note and res.measured_model_error is None
+
+
+def test_shell_or_solid_keeps_the_shell_within_its_interval():
+    from shellbvp.fitting.result import FitResult
+
+    def result(mu_H, half, model):
+        return FitResult(mu_H=mu_H, mu_H_ci95=(mu_H * (1 - half), mu_H * (1 + half)), offset=0.0,
+                         offset_ci95=(0.0, 0.0), residual_rms=0.0, n=20, status=0, message="", R_L=R_L, model=model)
+
+    kept = solid.shell_or_solid(result(10.1, 0.02, "shell"), result(10.0, 0.01, "solid"))
+    assert kept.model == "shell" and kept.measured_model_error == pytest.approx(0.01)
+    assert kept.model_error == (pytest.approx(0.01), False)
+    moved = solid.shell_or_solid(result(9.0, 0.02, "shell"), result(10.0, 0.01, "solid"))
+    assert moved.model == "solid" and moved.model_error is None and "-10 %" in moved.model_note
+    # a shell kept beside an error larger than its interval cannot be rated good or fair
+    assert result(10.0, 0.02, "shell").quality == "good"
+    assert sb.fitting.fit_quality(True, [], 10.0, (9.8, 10.2), model_error=0.05) == "poor"
 
 
 def test_cli_model_solid_writes_and_reads_back(tmp_path, capsys):
@@ -107,7 +142,7 @@ def test_cli_model_solid_writes_and_reads_back(tmp_path, capsys):
             "--neo-hookean", "--model", "solid", "-o", str(out), "-q"]
     assert main(args) == 0
     text = capsys.readouterr().out
-    assert "model  = 3D solid" in text and "indenter's displacement" in text
+    assert "solid  = FElupe" in text and "indenter's displacement" in text
     rec = sb.read_fit(out)
     assert rec.settings["model"] == "solid" and rec.parameters["mu_H"] == pytest.approx(MU_H, rel=0.01)
     assert main(["info", str(out)]) == 0

@@ -61,11 +61,13 @@ def add_parser(sub):
     f.add_argument("--stability", action="store_true",
                    help="also look for where the fitted shell stops being axisymmetric, up to the deepest fitted "
                         "depth (a warning when the data pass it; seconds to a minute more)")
-    f.add_argument("--model", choices=("shell", "solid"), default="shell",
-                   help="what is compared with the data: shell (the shell model, default; its mid-surface pole's "
-                        "displacement taken as the data's) or solid (the shell as a 3D solid of the given "
+    f.add_argument("--model", choices=("auto", "shell", "solid"), default="auto",
+                   help="what is compared with the data: shell (the shell model; its mid-surface pole's "
+                        "displacement taken as the data's), solid (the shell as a 3D solid of the given "
                         "--thickness, indented by the indenter's displacement as the instrument records it; "
-                        "needs '.[fe]'; one FE curve per sample, kept in the code cache)")
+                        "needs '.[fe]'; one FE curve per sample, kept in the code cache) or auto (default: with a "
+                        "thickness of at least 0.05 R_L, both, and the shell where the solid measures its error "
+                        "within the interval, else the solid; otherwise the shell); the summary says which and why")
     f.add_argument("--json", action="store_true", help="print the result as one JSON document (also on errors)")
     f.add_argument("-o", "--output", help="write the fit as a record (HDF5/NeXus: data, model, parameters with "
                    "intervals, weights, warnings, scene, source file and its SHA-256); a batch: a directory "
@@ -405,9 +407,11 @@ def _print_fit(res, record, used, args):
     for e in res.derived.values():
         if e.of is None:  # from a given scene value (mu of a given thickness)
             say(_estimate_line(e))
+    if res.model_note:
+        say(f"model  = {res.model_note}")
     if res.model == "solid":
         say(_solid_line(res.curve))
-    elif res.thickness is not None:
+    elif res.thickness is not None and res.measured_model_error is None:
         from ..thickness import model_error_line
 
         say(model_error_line(res.scene))
@@ -455,8 +459,8 @@ def _print_fit(res, record, used, args):
 def _solid_line(c):
     """What the solid fitted is: its mesh, its displacement, where its curve came from."""
     where = "kept in the code cache" if c.kept else f"computed in {c.wall_time:.1f} s"
-    return (f"model  = 3D solid (FElupe, {c.elements[0]}x{c.elements[1]} quadratic elements, rim face hinged at "
-            f"mid-thickness), its indenter's displacement from first touch as the data's; curve {where}")
+    return (f"solid  = FElupe, {c.elements[0]}x{c.elements[1]} quadratic elements, the rim face hinged at "
+            f"mid-thickness; its indenter's displacement from first touch as the data's; curve {where}")
 
 
 def _estimate_line(e):

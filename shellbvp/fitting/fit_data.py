@@ -5,6 +5,7 @@ a fit frees."""
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -16,7 +17,7 @@ from .curves import N_DEPTHS, ModelCurves
 from .intervals import result_of
 from .least_squares import BASELINES, DEFAULT_WEIGHTS, WEIGHTS, Fitted, LeastSquaresModel, NoiseModel
 from .profile import ProfileSearch, search_of
-from .solid import FIT_MODELS, check_solid_fit, solid_curve
+from .solid import FIT_MODELS, auto_model, check_solid_fit, shell_or_solid, solid_curve
 
 __all__ = ["fit", "fit_record", "free_parameters", "example_data_path"]
 
@@ -72,7 +73,7 @@ def _check_data(d, f, k, origin=0.0):
 
 def fit(scene, displacement, force, *, R_L, fit_offset=True, free=(), bounds=None, weights=None, floor=0.05,
         delta_max=None, tol=1e-6, loss="linear", baseline="none", contact_guess=None, progress=None, shared=None,
-        stability=False, model="shell", **aliases):
+        stability=False, model="auto", **aliases):
     """Least-squares fit of mu*H (the displacement origin, and a shape parameter) to measured data.
 
     Parameters
@@ -80,13 +81,18 @@ def fit(scene, displacement, force, *, R_L, fit_offset=True, free=(), bounds=Non
     scene : Scene
         Shape, indenter, material and beta (nondimensional); a free shape parameter's value
         in it is the start of the search.
-    model : {"shell", "solid"}
+    model : {"auto", "shell", "solid"}
         What is compared with the data: the shell model's curve (its delta, the mid-surface
         pole's displacement, taken as the data's displacement) or the scene's 3D solid
         (:func:`shellbvp.fe_curve`; needs ``scene.thickness`` and the ``fe`` extra), indented by
         the indenter's displacement from first touch, as an instrument records it
         (:mod:`shellbvp.fitting.solid`).  The solid fits mu*H, the contact point and a
         baseline; shape parameters, ``stability`` and shared curves are shell-only.
+        ``"auto"`` (default): where the solid can be this fit's model and is affordable
+        (:func:`shellbvp.fitting.solid.auto_model`), both are fitted and the shell's error on
+        this scene is measured by the solid at the level of mu*H: the shell is reported where
+        that error lies within its interval, the solid otherwise; else the shell, with its
+        mapped error.  ``FitResult.model_note`` says which and why.
     displacement, force : array_like
         Measured indenter displacement (m, > 0 into the shell) and force (N).
     R_L : float
@@ -217,7 +223,6 @@ def fit(scene, displacement, force, *, R_L, fit_offset=True, free=(), bounds=Non
     if not (math.isfinite(dm) and dm > 0):
         raise ValueError(f"delta_max must be > 0; got {delta_max!r}")
     grid = dm * np.arange(1, N_DEPTHS + 1) / N_DEPTHS
-    counter = [0]
     mdl = LeastSquaresModel(d, f, R_L, fit_offset, baseline, loss)
     noise = NoiseModel(weights, floor)
     if shared is not None:
@@ -227,22 +232,31 @@ def fit(scene, displacement, force, *, R_L, fit_offset=True, free=(), bounds=Non
             raise ValueError("stability is checked for one fit at a time, not per pixel of a map on shared curves "
                              "(each pixel would need a curve of its own)")
         return _fit_on_shared(shared, scene, mdl, noise, depth, k, keep, weights, baseline)
-    if sp is None:
-        shape = ModelCurves(lambda th: scene, grid, tol, depth, counter, progress,
-                            source=solid_curve if model == "solid" else None)
-        shape.add(None)
-        P, dP, top = shape.at(None)
-        res, rss, J, w = noise.irls(mdl, P, dP, top)
-        fitted = Fitted(res, rss, J, w, scene, shape.nodes[None], P, top)
-        notes = []
-    else:
-        search = ProfileSearch(sp, ModelCurves(sp.scene_at, grid, tol, depth, counter, progress), mdl, depth)
-        fitted = search.run(noise, k)
-        notes = search.notes
-    res = result_of(fitted, mdl, sp, k, notes, keep, weights, baseline, counter[0], model)
-    if stability and res.scene is not None and math.isfinite(res.offset):
-        _check_axisymmetry(res, (float(np.max(d)) - res.offset) / R_L, tol)
-    return res
+    def run(name):
+        counter = [0]
+        if sp is None:
+            shape = ModelCurves(lambda th: scene, grid, tol, depth, counter, progress,
+                                source=solid_curve if name == "solid" else None)
+            shape.add(None)
+            P, dP, top = shape.at(None)
+            res, rss, J, w = noise.irls(mdl, P, dP, top)
+            fitted = Fitted(res, rss, J, w, scene, shape.nodes[None], P, top)
+            notes = []
+        else:
+            search = ProfileSearch(sp, ModelCurves(sp.scene_at, grid, tol, depth, counter, progress), mdl, depth)
+            fitted = search.run(noise, k)
+            notes = search.notes
+        res = result_of(fitted, mdl, sp, k, notes, keep, weights, baseline, counter[0], name)
+        if stability and res.scene is not None and math.isfinite(res.offset):
+            _check_axisymmetry(res, (float(np.max(d)) - res.offset) / R_L, tol)
+        return res
+
+    if model != "auto":
+        return run(model)
+    choice, why = auto_model(scene, free, stability)
+    if choice == "shell":
+        return dataclasses.replace(run("shell"), model_note=why)
+    return shell_or_solid(run("shell"), run("solid"))
 
 
 #: Depths of the curve :func:`_check_axisymmetry` analyses

@@ -80,6 +80,11 @@ class FitResult:
     model : str
         What was compared with the data: ``"shell"`` (the shell model) or ``"solid"`` (the 3D
         solid, :mod:`shellbvp.fitting.solid`).
+    model_note : str
+        With ``model="auto"``: which model was reported and why.
+    measured_model_error : float or None
+        With ``model="auto"`` where both were fitted: ``|mu_H(shell) / mu_H(solid) - 1|``, the
+        shell model's error on this scene measured by the solid (None otherwise).
     curve : Curve or SolidCurve
         The model curve (nondimensional) at the fitted parameters: its ``delta`` is the
         mid-surface pole's displacement (shell) or the indenter's (solid), / R_L.
@@ -173,6 +178,8 @@ class FitResult:
     first_instability: object = None
     stability_note: str = ""
     model: str = "shell"
+    model_note: str = ""
+    measured_model_error: float = None
 
     @property
     def success(self):
@@ -215,18 +222,24 @@ class FitResult:
     @property
     def quality(self) -> str:
         """``good``, ``fair`` or ``poor`` by the transparent rules of :func:`fit_quality`."""
+        error = self.model_error
         return fit_quality(self.success, self.warning_codes, self.mu_H, self.mu_H_ci95, self.correlation,
-                           self.fitted)
+                           self.fitted, None if error is None else error[0])
 
     @property
     def model_error(self):
-        """``(error, extrapolated)``: the shell model's largest measured error in F against 3D
-        elasticity at this thickness over the mapped scenes (:func:`shellbvp.thickness.model_error`),
-        to stand beside the statistical interval; None without a thickness or a map for the model,
-        and for the solid (its error is its mesh's)."""
+        """``(error, extrapolated)``: the shell model's error to stand beside the statistical
+        interval -- measured on this scene by the solid (``measured_model_error``, a fraction
+        of mu*H) where ``model="auto"`` fitted both, else its largest measured error in F against
+        3D elasticity at this thickness over the mapped scenes (:func:`shellbvp.thickness.model_error`);
+        None without a thickness or a map for the model, and for the solid (its error is its mesh's)."""
         from ..thickness import model_error
 
-        return None if self.model == "solid" else model_error(self.scene)
+        if self.model == "solid":
+            return None
+        if self.measured_model_error is not None:
+            return self.measured_model_error, False
+        return model_error(self.scene)
 
     def model_force(self, displacement, mu_H=None):
         """Fitted model force (N) at displacements (m); with ``mu_H`` (N/m), the same model at
@@ -244,7 +257,8 @@ class FitResult:
             shape[name], shape[f"{name}_ci95"] = num(getattr(self, name)), ci(getattr(self, f"{name}_ci95"))
         return {"mu_H": num(self.mu_H), "mu_H_ci95": ci(self.mu_H_ci95), "offset": num(self.offset),
                 "offset_ci95": ci(self.offset_ci95), **shape, "fitted": list(self.fitted),
-                "model": self.model, "weights": self.weights, "residual": num(self.residual_rms), "residual_rms": num(self.residual_rms),
+                "model": self.model, "model_note": self.model_note,
+                "measured_model_error": num(self.measured_model_error), "weights": self.weights, "residual": num(self.residual_rms), "residual_rms": num(self.residual_rms),
                 "n": self.n, "success": self.success, "status": self.status, "message": self.message,
                 "warnings": list(self.warnings), "warning_codes": list(self.warning_codes), "R_L": self.R_L,
                 "curves_computed": self.curves_computed, "interpolation_error": num(self.interpolation_error),

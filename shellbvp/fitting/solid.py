@@ -22,7 +22,9 @@ computed again.  A folder or file another user owns or may write is not read.
 
 from __future__ import annotations
 
+import dataclasses
 import hashlib
+import importlib.util
 import json
 import logging
 import math
@@ -38,12 +40,19 @@ from ..paths import atomic_file
 from ..version import __version__
 from .curves import code_fingerprint
 
-__all__ = ["SolidCurve", "solid_curve", "clear_solid_curves", "check_solid_fit", "FIT_MODELS", "MAX_KEPT_BYTES"]
+__all__ = ["SolidCurve", "solid_curve", "clear_solid_curves", "check_solid_fit", "auto_model", "shell_or_solid",
+           "FIT_MODELS", "AUTO_SOLID_EPS", "MAX_KEPT_BYTES"]
 
 log = logging.getLogger(__name__)
 
-#: What a fit can compare with the data: the shell model's curve or the 3D solid's.
-FIT_MODELS = ("shell", "solid")
+#: What a fit can compare with the data: the shell model's curve, the 3D solid's, or the one of
+#: them this scene needs (:func:`auto_model`).
+FIT_MODELS = ("auto", "shell", "solid")
+
+#: ``model="auto"`` measures the shell against the solid from this thickness (eps = H/R_L) up:
+#: thinner shells need a finer solid mesh (its cost grows like 1/eps^2: benchmarks/results/
+#: thick_fits.md), and their shell model is within a few percent of the solid.
+AUTO_SOLID_EPS = 0.05
 
 #: A kept solid curve larger than this is not read (40 depths take about 4 kB).
 MAX_KEPT_BYTES = 1 << 20
@@ -111,6 +120,52 @@ def check_solid_fit(scene, free=()):
         raise ValueError("transverse_shear is a correction of the shell model; the solid has its shear already: "
                          "drop --transverse-shear with --model solid")
     check_solid_scene(scene)
+
+
+def auto_model(scene, free=(), stability=False):
+    """``(choice, why)`` of ``model="auto"``: ``"shell"`` with the reason the solid is not used
+    here, or ``"both"`` (fit both; :func:`shell_or_solid` keeps one)."""
+    eps = scene.thickness
+    if eps is None:
+        return "shell", "shell model (no thickness given: the 3D solid needs one; --thickness)"
+    if free:
+        return "shell", f"shell model (fitting {', '.join(free)}: the solid fits mu*H only)"
+    if stability:
+        return "shell", "shell model (the stability check is the shell model's)"
+    if scene.transverse_shear:
+        return "shell", "shell model (asked for with transverse shear)"
+    try:
+        check_solid_scene(scene)
+    except ValueError as exc:
+        return "shell", f"shell model (no 3D solid for this scene: {exc})"
+    if eps < AUTO_SOLID_EPS:
+        return "shell", (f"shell model (eps = {eps:.3g} < {AUTO_SOLID_EPS:g}: the solid costs too much to measure "
+                         f"the shell by default; --model solid uses it)")
+    if importlib.util.find_spec("felupe") is None:
+        return "shell", "shell model (the 3D solid needs FElupe: pip install 'shellbvp[fe]')"
+    return "both", ""
+
+
+def shell_or_solid(shell, solid):
+    """The fit to report of the shell's and the solid's on the same data: the shell where its
+    error on this scene, measured by the solid as the difference of their mu*H, lies within
+    its 95 % interval; the solid otherwise (``model_note`` says which and why)."""
+    computed = shell.curves_computed + solid.curves_computed
+    if not solid.success:
+        return dataclasses.replace(shell, curves_computed=computed, model_note=(
+            f"shell model (the 3D solid's fit failed: {solid.message}; its error is not measured)"))
+    if not shell.success:
+        return dataclasses.replace(solid, curves_computed=computed, model_note=(
+            f"3D solid (the shell model's fit failed: {shell.message})"))
+    error = shell.mu_H / solid.mu_H - 1
+    half = (shell.mu_H_ci95[1] - shell.mu_H_ci95[0]) / 2 / shell.mu_H
+    words = (f"the shell model's error on this scene, measured by the 3D solid: {100 * error:+.2g} % in mu*H "
+             f"(shell {shell.mu_H:.4g}, solid {solid.mu_H:.4g} N/m)")
+    if abs(error) <= half:
+        return dataclasses.replace(shell, curves_computed=computed, measured_model_error=abs(error),
+                                   model_note=f"shell model: {words}, within its interval (+-{100 * half:.2g} %)")
+    return dataclasses.replace(solid, curves_computed=computed, measured_model_error=abs(error),
+                               model_note=f"3D solid: {words}, beyond the shell's interval (+-{100 * half:.2g} %)")
 
 
 def solid_curve(scene, grid, tol=None, counter=None, progress=None) -> SolidCurve:
