@@ -38,7 +38,7 @@ from .fe_contact import PenaltyContact, TipSurface
 from .fe_rim import RIM_FACES, HingedFace
 from .materials import MATERIALS
 
-__all__ = ["fe_curve", "FECurve", "TipSurface", "FE_DEFAULTS", "check_solid_scene"]
+__all__ = ["fe_curve", "FECurve", "TipSurface", "FE_DEFAULTS", "check_solid_scene", "coarser"]
 
 #: Mesh, material and contact settings of :func:`fe_curve` (all nondimensional).
 FE_DEFAULTS = {
@@ -156,6 +156,12 @@ def _build(scene, eps, *, through_thickness, element_length, pole_refinement, bu
     top = np.array([node(2 * n_t, j) for j in range(ncol)])  # t = +eps/2: faces the indenter
     contact = PenaltyContact(TipSurface(scene), points, top, penalty / eps, gauss_points, field, band * eps)
     return _Model(mesh, region, field, solid, contact, fixed, node(n_t, 0), eps, (n_s, n_t), face)
+
+
+def coarser(settings):
+    """The mesh of a mesh check: ``settings`` with 2/3 the elements each way."""
+    return {**settings, "element_length": settings["element_length"] * 1.5,
+            "through_thickness": max(2, round(settings["through_thickness"] * 2 / 3))}
 
 
 def check_solid_scene(scene):
@@ -452,9 +458,7 @@ def fe_curve(scene, thickness, deltas, *, at="pole", mesh_check=False, progress=
     out = path(scene, eps, deltas, opts, progress)
     err = np.full(deltas.size, np.nan)
     if mesh_check:
-        coarse = {**opts, "element_length": opts["element_length"] * 1.5,
-                  "through_thickness": max(2, round(opts["through_thickness"] * 2 / 3))}
-        Fc = path(scene, eps, deltas, coarse, None).force
+        Fc = path(scene, eps, deltas, coarser(opts), None).force
         err = np.abs(out.force - Fc) / np.abs(out.force)
     return FECurve(scene, eps, out.delta, out.force, out.indenter, out.contact_radius, err, out.success,
                    out.message, out.elements, settings={**opts, "at": at}, wall_time=time.perf_counter() - t0)

@@ -31,7 +31,8 @@ SI units, ``"1"`` nondimensional, ``""`` text)::
                                baseline_model, weights, segment, model (shell or solid: what
                                delta is, the mid-surface pole's or the indenter's displacement),
                                model_note (why that model, with model auto), model_error_source
-                               (measured: on this scene by the solid; map: the mapped scenes' bound)
+                               (measured: on this scene by the solid; map: the mapped scenes' bound;
+                               mesh: the solid's own, by its mesh check)
     /fit/warnings              (k,) the fit's warnings (text); attr codes
     /fit/sample                NXsample; attrs: scene (JSON, rebuilds the Scene), scene_<key>
     /fit/source                NXnote: file_name, sha256, columns (JSON), units (JSON), inverted
@@ -254,6 +255,8 @@ def _error_source(result):
     """Where a fit's ``model_error`` comes from: measured on this scene by the solid, the map, or none."""
     if result.model_error is None:
         return ""
+    if result.model == "solid":
+        return "mesh"
     return "measured" if result.measured_model_error is not None else "map"
 
 

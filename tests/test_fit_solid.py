@@ -35,7 +35,7 @@ def test_refusals_name_the_parameter_before_any_work():
 def _fake_fe(calls):
     """fe_curve's stand-in: F = depth^1.5, the pole 0.9 x the indenter (the kept file's mechanics,
     not the FE's, are under test)."""
-    def fe_curve(scene, eps, grid, at, progress=None):
+    def fe_curve(scene, eps, grid, at, progress=None, **settings):
         calls.append(len(grid))
         g = np.asarray(grid, float)
         return FECurve(scene, eps, 0.9 * g, g**1.5, g, 0.1 * g, np.full(g.size, np.nan), True, "done", (4, 2),
@@ -140,9 +140,12 @@ def test_cli_model_solid_writes_and_reads_back(tmp_path, capsys):
     out = tmp_path / "fit.h5"
     args = ["fit", str(data), "--radius", "1mm", "--gamma", "1", "--rho", "0.25", "--thickness", "150um",
             "--neo-hookean", "--model", "solid", "-o", str(out), "-q"]
+    assert main(args[:-3] + ["--mesh-check", "--json"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert doc["model"] == "solid" and 0 <= doc["mesh_error"] < 0.01 and doc["curves_computed"] == 2
     assert main(args) == 0
     text = capsys.readouterr().out
-    assert "solid  = FElupe" in text and "indenter's displacement" in text
+    assert "solid  = FElupe" in text and "indenter's displacement" in text and "curve kept" not in text
     rec = sb.read_fit(out)
     assert rec.settings["model"] == "solid" and rec.parameters["mu_H"] == pytest.approx(MU_H, rel=0.01)
     assert main(["info", str(out)]) == 0

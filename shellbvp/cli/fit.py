@@ -68,6 +68,9 @@ def add_parser(sub):
                         "needs '.[fe]'; one FE curve per sample, kept in the code cache) or auto (default: with a "
                         "thickness of at least 0.05 R_L, both, and the shell where the solid measures its error "
                         "within the interval, else the solid; otherwise the shell); the summary says which and why")
+    f.add_argument("--mesh-check", action="store_true", dest="mesh_check",
+                   help="where the 3D solid is the model: fit again on a mesh with 2/3 the elements each way and "
+                        "report the change of mu*H as the solid's error (one more, cheaper FE curve)")
     f.add_argument("--json", action="store_true", help="print the result as one JSON document (also on errors)")
     f.add_argument("-o", "--output", help="write the fit as a record (HDF5/NeXus: data, model, parameters with "
                    "intervals, weights, warnings, scene, source file and its SHA-256); a batch: a directory "
@@ -145,7 +148,7 @@ def _fit_inputs(args, pixel_values=None):
 
         check_solid_fit(scene, free)
     options = {"fit_offset": not args.no_offset, "free": free, "bounds": bounds, "weights": args.weights,
-               "tol": args.tol, "stability": args.stability, "model": args.model}
+               "tol": args.tol, "stability": args.stability, "model": args.model, "mesh_check": args.mesh_check}
     return scene, args.radius.si, {"columns": columns, "units": units, "invert": tuple(args.invert or ())}, options
 
 
@@ -410,7 +413,7 @@ def _print_fit(res, record, used, args):
     if res.model_note:
         say(f"model  = {res.model_note}")
     if res.model == "solid":
-        say(_solid_line(res.curve))
+        say(_solid_line(res.curve, res.mesh_error))
     elif res.thickness is not None and res.measured_model_error is None:
         from ..thickness import model_error_line
 
@@ -456,11 +459,13 @@ def _print_fit(res, record, used, args):
         say(f"stability not analysed where: {res.stability_note}")
 
 
-def _solid_line(c):
-    """What the solid fitted is: its mesh, its displacement, where its curve came from."""
+def _solid_line(c, mesh_error):
+    """What the solid fitted is: its mesh and its error, its displacement, where its curve came from."""
     where = "kept in the code cache" if c.kept else f"computed in {c.wall_time:.1f} s"
-    return (f"solid  = FElupe, {c.elements[0]}x{c.elements[1]} quadratic elements, the rim face hinged at "
-            f"mid-thickness; its indenter's displacement from first touch as the data's; curve {where}")
+    error = ("--mesh-check measures its mesh's error" if mesh_error is None else
+             f"mu*H {100 * mesh_error:.2g} % off on a mesh 2/3 as fine")
+    return (f"solid  = FElupe, {c.elements[0]}x{c.elements[1]} quadratic elements ({error}), the rim face hinged "
+            f"at mid-thickness; its indenter's displacement from first touch as the data's; curve {where}")
 
 
 def _estimate_line(e):

@@ -6,6 +6,7 @@ a fit frees."""
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 
 import numpy as np
@@ -73,7 +74,7 @@ def _check_data(d, f, k, origin=0.0):
 
 def fit(scene, displacement, force, *, R_L, fit_offset=True, free=(), bounds=None, weights=None, floor=0.05,
         delta_max=None, tol=1e-6, loss="linear", baseline="none", contact_guess=None, progress=None, shared=None,
-        stability=False, model="auto", **aliases):
+        stability=False, model="auto", mesh_check=False, **aliases):
     """Least-squares fit of mu*H (the displacement origin, and a shape parameter) to measured data.
 
     Parameters
@@ -93,6 +94,10 @@ def fit(scene, displacement, force, *, R_L, fit_offset=True, free=(), bounds=Non
         this scene is measured by the solid at the level of mu*H: the shell is reported where
         that error lies within its interval, the solid otherwise; else the shell, with its
         mapped error.  ``FitResult.model_note`` says which and why.
+    mesh_check : bool
+        Where the solid is the reported model: fit again on the solid's curve on a mesh with 2/3
+        the elements each way, and report the change of mu*H as the solid's error
+        (``FitResult.mesh_error``; one more solid curve, cheaper than the first).
     displacement, force : array_like
         Measured indenter displacement (m, > 0 into the shell) and force (N).
     R_L : float
@@ -232,11 +237,11 @@ def fit(scene, displacement, force, *, R_L, fit_offset=True, free=(), bounds=Non
             raise ValueError("stability is checked for one fit at a time, not per pixel of a map on shared curves "
                              "(each pixel would need a curve of its own)")
         return _fit_on_shared(shared, scene, mdl, noise, depth, k, keep, weights, baseline)
-    def run(name):
+    def run(name, coarse=False):
         counter = [0]
         if sp is None:
-            shape = ModelCurves(lambda th: scene, grid, tol, depth, counter, progress,
-                                source=solid_curve if name == "solid" else None)
+            source = functools.partial(solid_curve, coarse=coarse) if name == "solid" else None
+            shape = ModelCurves(lambda th: scene, grid, tol, depth, counter, progress, source=source)
             shape.add(None)
             P, dP, top = shape.at(None)
             res, rss, J, w = noise.irls(mdl, P, dP, top)
@@ -252,11 +257,16 @@ def fit(scene, displacement, force, *, R_L, fit_offset=True, free=(), bounds=Non
         return res
 
     if model != "auto":
-        return run(model)
-    choice, why = auto_model(scene, free, stability)
-    if choice == "shell":
-        return dataclasses.replace(run("shell"), model_note=why)
-    return shell_or_solid(run("shell"), run("solid"))
+        res = run(model)
+    else:
+        choice, why = auto_model(scene, free, stability)
+        res = dataclasses.replace(run("shell"), model_note=why) if choice == "shell" else \
+            shell_or_solid(run("shell"), run("solid"))
+    if mesh_check and res.model == "solid" and res.success:
+        coarse = run("solid", coarse=True)
+        res = dataclasses.replace(res, mesh_error=abs(coarse.mu_H / res.mu_H - 1),
+                                  curves_computed=res.curves_computed + coarse.curves_computed)
+    return res
 
 
 #: Depths of the curve :func:`_check_axisymmetry` analyses

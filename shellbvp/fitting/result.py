@@ -85,6 +85,10 @@ class FitResult:
     measured_model_error : float or None
         With ``model="auto"`` where both were fitted: ``|mu_H(shell) / mu_H(solid) - 1|``, the
         shell model's error on this scene measured by the solid (None otherwise).
+    mesh_error : float or None
+        With ``fit(..., mesh_check=True)`` and the solid reported: ``|mu_H(coarser mesh) / mu_H -
+        1|``, the solid's discretisation error in mu*H (quadratic elements: a bound of the finer
+        mesh's error about 1.25x itself); None otherwise.
     curve : Curve or SolidCurve
         The model curve (nondimensional) at the fitted parameters: its ``delta`` is the
         mid-surface pole's displacement (shell) or the indenter's (solid), / R_L.
@@ -180,6 +184,7 @@ class FitResult:
     model: str = "shell"
     model_note: str = ""
     measured_model_error: float = None
+    mesh_error: float = None
 
     @property
     def success(self):
@@ -232,11 +237,12 @@ class FitResult:
         interval -- measured on this scene by the solid (``measured_model_error``, a fraction
         of mu*H) where ``model="auto"`` fitted both, else its largest measured error in F against
         3D elasticity at this thickness over the mapped scenes (:func:`shellbvp.thickness.model_error`);
-        None without a thickness or a map for the model, and for the solid (its error is its mesh's)."""
+        None without a thickness or a map for the model; for the solid, its mesh's error where
+        checked (``mesh_error``), else None."""
         from ..thickness import model_error
 
         if self.model == "solid":
-            return None
+            return None if self.mesh_error is None else (self.mesh_error, False)
         if self.measured_model_error is not None:
             return self.measured_model_error, False
         return model_error(self.scene)
@@ -258,7 +264,8 @@ class FitResult:
         return {"mu_H": num(self.mu_H), "mu_H_ci95": ci(self.mu_H_ci95), "offset": num(self.offset),
                 "offset_ci95": ci(self.offset_ci95), **shape, "fitted": list(self.fitted),
                 "model": self.model, "model_note": self.model_note,
-                "measured_model_error": num(self.measured_model_error), "weights": self.weights, "residual": num(self.residual_rms), "residual_rms": num(self.residual_rms),
+                "measured_model_error": num(self.measured_model_error), "mesh_error": num(self.mesh_error),
+                "weights": self.weights, "residual": num(self.residual_rms), "residual_rms": num(self.residual_rms),
                 "n": self.n, "success": self.success, "status": self.status, "message": self.message,
                 "warnings": list(self.warnings), "warning_codes": list(self.warning_codes), "R_L": self.R_L,
                 "curves_computed": self.curves_computed, "interpolation_error": num(self.interpolation_error),

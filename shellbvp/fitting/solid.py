@@ -34,7 +34,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..config import OPTIONS
-from ..fe import FE_DEFAULTS, check_solid_scene, fe_curve
+from ..fe import FE_DEFAULTS, check_solid_scene, coarser, fe_curve
 from ..model import cache_dir, untrusted_reason
 from ..paths import atomic_file
 from ..version import __version__
@@ -122,28 +122,34 @@ def check_solid_fit(scene, free=()):
     check_solid_scene(scene)
 
 
+#: How the summary names the shell model: what it takes the data's displacement to be.
+SHELL_WORDS = "shell model, its mid-surface pole's displacement taken as the data's"
+
+
 def auto_model(scene, free=(), stability=False):
     """``(choice, why)`` of ``model="auto"``: ``"shell"`` with the reason the solid is not used
     here, or ``"both"`` (fit both; :func:`shell_or_solid` keeps one)."""
     eps = scene.thickness
+    reason = None
     if eps is None:
-        return "shell", "shell model (no thickness given: the 3D solid needs one; --thickness)"
-    if free:
-        return "shell", f"shell model (fitting {', '.join(free)}: the solid fits mu*H only)"
-    if stability:
-        return "shell", "shell model (the stability check is the shell model's)"
-    if scene.transverse_shear:
-        return "shell", "shell model (asked for with transverse shear)"
-    try:
-        check_solid_scene(scene)
-    except ValueError as exc:
-        return "shell", f"shell model (no 3D solid for this scene: {exc})"
-    if eps < AUTO_SOLID_EPS:
-        return "shell", (f"shell model (eps = {eps:.3g} < {AUTO_SOLID_EPS:g}: the solid costs too much to measure "
-                         f"the shell by default; --model solid uses it)")
-    if importlib.util.find_spec("felupe") is None:
-        return "shell", "shell model (the 3D solid needs FElupe: pip install 'shellbvp[fe]')"
-    return "both", ""
+        reason = "no thickness given: the 3D solid needs --thickness"
+    elif free:
+        reason = f"fitting {', '.join(free)}: the solid fits mu*H only"
+    elif stability:
+        reason = "the stability check is the shell model's"
+    elif scene.transverse_shear:
+        reason = "asked for with transverse shear"
+    elif eps < AUTO_SOLID_EPS:
+        reason = (f"eps = {eps:.3g} < {AUTO_SOLID_EPS:g}: the solid costs too much to measure the shell by "
+                  f"default; --model solid uses it")
+    else:
+        try:
+            check_solid_scene(scene)
+        except ValueError as exc:
+            reason = f"no 3D solid for this scene: {exc}"
+    if reason is None and importlib.util.find_spec("felupe") is None:
+        reason = "the 3D solid needs FElupe: pip install 'shellbvp[fe]'"
+    return ("both", "") if reason is None else ("shell", f"{SHELL_WORDS} ({reason})")
 
 
 def shell_or_solid(shell, solid):
@@ -153,7 +159,7 @@ def shell_or_solid(shell, solid):
     computed = shell.curves_computed + solid.curves_computed
     if not solid.success:
         return dataclasses.replace(shell, curves_computed=computed, model_note=(
-            f"shell model (the 3D solid's fit failed: {solid.message}; its error is not measured)"))
+            f"{SHELL_WORDS} (the 3D solid's fit failed: {solid.message}; its error is not measured)"))
     if not shell.success:
         return dataclasses.replace(solid, curves_computed=computed, model_note=(
             f"3D solid (the shell model's fit failed: {shell.message})"))
@@ -163,25 +169,27 @@ def shell_or_solid(shell, solid):
              f"(shell {shell.mu_H:.4g}, solid {solid.mu_H:.4g} N/m)")
     if abs(error) <= half:
         return dataclasses.replace(shell, curves_computed=computed, measured_model_error=abs(error),
-                                   model_note=f"shell model: {words}, within its interval (+-{100 * half:.2g} %)")
+                                   model_note=f"{SHELL_WORDS}; {words}, within its interval (+-{100 * half:.2g} %)")
     return dataclasses.replace(solid, curves_computed=computed, measured_model_error=abs(error),
                                model_note=f"3D solid: {words}, beyond the shell's interval (+-{100 * half:.2g} %)")
 
 
-def solid_curve(scene, grid, tol=None, counter=None, progress=None) -> SolidCurve:
+def solid_curve(scene, grid, tol=None, counter=None, progress=None, *, coarse=False) -> SolidCurve:
     """The solid's curve of ``scene`` at the indenter displacements ``grid`` (/ R_L): read back
     from the code cache when kept there and sound, else computed (``fe_curve(at="indenter")``)
     and kept.  ``tol`` (the shell model's) plays no part; ``counter[0]`` counts computed curves;
-    ``progress(description, depth_max) -> (bar, callback)`` draws a bar."""
+    ``progress(description, depth_max) -> (bar, callback)`` draws a bar; ``coarse``: on the mesh
+    check's mesh (2/3 the elements each way, :func:`shellbvp.fe.coarser`)."""
     grid = np.asarray(grid, float)
-    memo = (scene, tuple(grid.tolist()))
+    settings = coarser(FE_DEFAULTS) if coarse else dict(FE_DEFAULTS)
+    memo = (scene, tuple(grid.tolist()), coarse)
     if memo in _MEMO:
         _MEMO.move_to_end(memo)
         return _MEMO[memo]
-    path, key = _place(scene, grid)
+    path, key = _place(scene, grid, settings)
     c = _read_kept(path, key, scene, grid)
     if c is None:
-        c = _computed(scene, grid, counter, progress)
+        c = _computed(scene, grid, counter, progress, settings)
         if c.complete:
             _keep(c, path, key)
     _MEMO[memo] = c
@@ -195,11 +203,11 @@ def clear_solid_curves():
     _MEMO.clear()
 
 
-def _computed(scene, grid, counter, progress):
+def _computed(scene, grid, counter, progress, settings):
     bar, callback = progress("solid curve", float(grid[-1])) if progress is not None else (None, None)
     try:
         fe = fe_curve(scene, scene.thickness, grid, at="indenter",
-                      progress=None if callback is None else _fe_progress(callback))
+                      progress=None if callback is None else _fe_progress(callback), **settings)
     finally:
         if bar is not None:
             bar.close()
@@ -226,13 +234,13 @@ def _fe_progress(callback):
     return step
 
 
-def _place(scene, grid):
+def _place(scene, grid, settings):
     """(path, key) of the kept curve, or (None, None) where the disk is off or not trusted."""
     if not OPTIONS.model_curve_cache:
         return None, None
     try:
         payload = json.dumps({"format": FORMAT, "scene": scene.to_dict(), "grid": [float(x) for x in grid],
-                              "fe": FE_DEFAULTS, "code": code_fingerprint(), "version": __version__},
+                              "fe": settings, "code": code_fingerprint(), "version": __version__},
                              sort_keys=True)
     except (TypeError, ValueError, AttributeError):
         return None, None
