@@ -42,7 +42,7 @@ def _estimate_columns(name, unit):
 
 #: Columns of the results table, with their units: a shape parameter's and its derived
 #: quantities' (:mod:`shellbvp.shape_parameters`) are filled where it was fitted.
-TABLE_COLUMNS = ("file", "status", "quality", "mu_H (N/m)", "mu_H 95% low (N/m)", "mu_H 95% high (N/m)", "offset (m)",
+TABLE_COLUMNS = ("file", "status", "quality", "model", "model error (1)", "mu_H (N/m)", "mu_H 95% low (N/m)", "mu_H 95% high (N/m)", "offset (m)",
                  "offset 95% low (m)", "offset 95% high (m)", "baseline (N)", "baseline 95% low (N)",
                  "baseline 95% high (N)", "baseline slope (N/m)", "baseline model",
                  *(c for p in SHAPE_PARAMETERS.values() for c in _estimate_columns(p.name, p.unit)),
@@ -107,6 +107,8 @@ class BatchRow:
                 for d in p.derived:
                     put(d.name, r.derived[d.name].value, r.derived[d.name].ci95, d.unit)
         row["quality"] = r.quality
+        row["model"] = r.model
+        row["model error (1)"] = "" if r.model_error is None else _num(r.model_error[0])
         row["baseline model"] = r.baseline_model
         row["residual rms (N)"] = _num(r.residual_rms)
         row["points"] = str(r.n)

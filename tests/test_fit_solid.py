@@ -98,7 +98,7 @@ def test_the_solid_recovers_mu_h_from_its_own_finer_record_where_the_shell_is_bi
     auto = sb.fit(SCENE, d, F, R_L=R_L)
     assert auto.model == "solid" and auto.mu_H == res.mu_H and auto.curves_computed == 0
     assert auto.measured_model_error == pytest.approx(abs(shell.mu_H / res.mu_H - 1))
-    assert "beyond the shell's interval" in auto.model_note and auto.quality == res.quality
+    assert "is beyond the shell's interval" in auto.model_note and auto.quality == res.quality
 
 
 def test_auto_keeps_the_shell_where_the_solid_is_not_used_and_says_why():
@@ -152,3 +152,10 @@ def test_cli_model_solid_writes_and_reads_back(tmp_path, capsys):
     assert "model: the 3D solid" in capsys.readouterr().out
     assert main(args[:-5] + ["--model", "solid", "--fit-alpha", "-q"]) == 2
     assert "not supported yet" in capsys.readouterr().err
+
+
+def test_auto_without_felupe_keeps_the_shell_and_says_how_to_install(monkeypatch):
+    real = solid.importlib.util.find_spec
+    monkeypatch.setattr(solid.importlib.util, "find_spec", lambda name, *a: None if name == "felupe" else real(name, *a))
+    choice, note = solid.auto_model(SCENE)
+    assert choice == "shell" and "pip install 'shellbvp[fe]'" in note

@@ -165,13 +165,13 @@ def shell_or_solid(shell, solid):
             f"3D solid (the shell model's fit failed: {shell.message})"))
     error = shell.mu_H / solid.mu_H - 1
     half = (shell.mu_H_ci95[1] - shell.mu_H_ci95[0]) / 2 / shell.mu_H
-    words = (f"the shell model's error on this scene, measured by the 3D solid: {100 * error:+.2g} % in mu*H "
-             f"(shell {shell.mu_H:.4g}, solid {solid.mu_H:.4g} N/m)")
+    measured = (f"{100 * error:+.2g} % in mu*H on this scene, measured by the 3D solid (shell {shell.mu_H:.4g}, "
+                f"solid {solid.mu_H:.4g} N/m)")
     if abs(error) <= half:
-        return dataclasses.replace(shell, curves_computed=computed, measured_model_error=abs(error),
-                                   model_note=f"{SHELL_WORDS}; {words}, within its interval (+-{100 * half:.2g} %)")
-    return dataclasses.replace(solid, curves_computed=computed, measured_model_error=abs(error),
-                               model_note=f"3D solid: {words}, beyond the shell's interval (+-{100 * half:.2g} %)")
+        return dataclasses.replace(shell, curves_computed=computed, measured_model_error=abs(error), model_note=(
+            f"{SHELL_WORDS}; its error, {measured}, is within its interval (+-{100 * half:.2g} %)"))
+    return dataclasses.replace(solid, curves_computed=computed, measured_model_error=abs(error), model_note=(
+        f"3D solid; the shell model's error, {measured}, is beyond the shell's interval (+-{100 * half:.2g} %)"))
 
 
 def solid_curve(scene, grid, tol=None, counter=None, progress=None, *, coarse=False) -> SolidCurve:
