@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import argparse
 import cProfile
+import importlib
 import io
 import json
 import platform
@@ -59,20 +60,22 @@ class _Counter:
         self.newton = 0
 
     def __enter__(self):
-        orig = fe._Solver.solve
+        # the Newton class: fe_newton.Newton, or fe._Solver before it (to measure older commits)
+        self.cls = getattr(fe, "_Solver", None) or importlib.import_module("shellbvp.fe_newton").Newton
+        orig = self.cls.solve
         counter = self
 
-        def solve(solver, a):
+        def solve(solver, *args, **kwargs):
             before = solver.newton_iterations
-            ok = orig(solver, a)
+            ok = orig(solver, *args, **kwargs)
             counter.newton += solver.newton_iterations - before
             return ok
 
-        self._orig, fe._Solver.solve = orig, solve
+        self._orig, self.cls.solve = orig, solve
         return self
 
     def __exit__(self, *exc):
-        fe._Solver.solve = self._orig
+        self.cls.solve = self._orig
 
 
 def shell_deltas(scene, eps, depths, at, fe_curve):
