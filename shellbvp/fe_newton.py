@@ -205,7 +205,7 @@ class Newton:
                     x2 = lu.solve(b[self.free] if J is None else J.T @ b)
                     with np.errstate(divide="ignore", invalid="ignore"):  # no contact: no indenter step
                         da = (dq[self.pole] + delta - self.delta()) / x2[self.pole]
-                    dq = dq - da * x2
+                        dq = dq - da * x2
             except RuntimeError:  # singular: no equilibrium from here
                 break
             full = self._full(dq, J)
