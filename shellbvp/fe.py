@@ -35,6 +35,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .fe_contact import PenaltyContact, TipSurface
+from .fe_newton import Newton
 from .fe_rim import RIM_FACES, HingedFace
 from .materials import MATERIALS
 
@@ -50,7 +51,7 @@ FE_DEFAULTS = {
     "gauss_points": 4,          # per element edge of the contact surface
     "band": 1e-5,               # the penalty is smoothed over penetrations below band * H
     "tol": 1e-9,                # Newton: residual norm / contact force
-    "delta_tol": 1e-7,          # secant on the indenter: |delta - target| / max(target, H)
+    "delta_tol": 1e-7,          # pole control: |delta - target| / max(target, H)
     "rim_face": "plane",        # the rim face held plane, turning about its mid-thickness point (RIM_FACES)
 }
 
@@ -183,164 +184,6 @@ def _material(scene, fem):
     """The scene's material on the isochoric invariants (its module's ``felupe_model``)."""
     _check_material(scene)
     return scene.material.felupe_model(fem)
-
-
-# ---------------------------------------------------------------- Newton and the path
-#: A Newton that can no longer reduce its residual by a line search has met rounding; below
-#: this residual relative to the contact force it is converged (F to about this accuracy).
-STALL = 1e-6
-
-class _Solver:
-    """Newton on the solid + contact at a given apex height, with the state kept for warm starts."""
-
-    def __init__(self, model, tol, max_iterations=15):
-        self.m, self.tol, self.max_iterations = model, tol, max_iterations
-        ndof = int(np.sum(model.field.fieldsizes))
-        free = np.ones(ndof, bool)
-        free[model.fixed] = False
-        if model.face is not None:
-            free[model.face.dofs] = False  # moved through the face's own unknowns
-        self.free = np.flatnonzero(free)
-        self.newton_iterations = 0
-        self.history = [self.save()]  # converged states (values, indenter) for the predictor
-
-    def save(self):
-        return [f.values.copy() for f in self.m.field.fields], self.indenter
-
-    def restore(self, saved):
-        values, self.indenter = saved
-        for f, v in zip(self.m.field.fields, values):
-            f.values[...] = v
-        self.m.contact.apex = self.m.contact.z0 - self.indenter
-
-    @property
-    def indenter(self):
-        """The indenter's displacement from first touch, positive down."""
-        return self.m.contact.z0 - self.m.contact.apex
-
-    @indenter.setter
-    def indenter(self, a):
-        self.m.contact.apex = self.m.contact.z0 - a
-
-    def _remember(self):
-        self.history = (self.history + [self.save()])[-3:]
-
-    def _predict(self, a):
-        """The secant predictor: the field extrapolated from the two converged states nearest in
-        the indenter's position (without it the tip's step lands as a deep penetration)."""
-        if len(self.history) < 2:
-            return
-        (v0, a0), (v1, a1) = sorted(self.history, key=lambda h: abs(h[1] - a))[:2]
-        if a1 == a0:
-            return
-        t = (a - a1) / (a1 - a0)
-        for f, x0, x1 in zip(self.m.field.fields, v0, v1):
-            f.values[...] = x1 + t * (x1 - x0)
-
-    def _residual(self):
-        m = self.m
-        with np.errstate(invalid="ignore", divide="ignore", over="ignore"):  # trial states may invert
-            r = np.asarray(m.solid.assemble.vector(m.field).todense()).ravel()
-        rc, Kc, F, _ = m.contact.evaluate(m.field[0].values.ravel())
-        return r + rc, rc, Kc, F
-
-    def _system(self, r, K):
-        """(K_reduced, r_reduced, J): the Newton system in the unknowns the rim leaves free (J maps
-        a reduced step to the full dofs; None where the unknowns are plain dofs)."""
-        face = self.m.face
-        if face is None:
-            return (None if K is None else K[self.free][:, self.free].tocsc()), r[self.free], None
-        if K is None:
-            return None, np.r_[r[self.free], face.residual(r, self.m.field[0].values.ravel())], None
-        return face.reduce(r, K, self.free, self.m.field[0].values.ravel())
-
-    def _advance(self, dq, scale):
-        """The state moved by ``scale`` times the reduced Newton step ``dq``."""
-        m = self.m
-        full = np.zeros(int(np.sum(m.field.fieldsizes)))
-        full[self.free] = scale * dq[: self.free.size]
-        m.field += full
-        if m.face is not None:
-            m.face.step(m.field[0].values, dq[self.free.size:], scale)
-
-    def delta(self):
-        """The mid-surface pole's displacement, positive down."""
-        return -float(self.m.field[0].values[self.m.pole_mid, 0])
-
-    def solve(self, a):
-        """Newton with the indenter at ``a``, from the current state; True when converged (the
-        state kept), else False (the state restored)."""
-        from scipy.sparse.linalg import splu
-
-        m, saved = self.m, self.save()
-        self._predict(a)
-        if m.face is not None:
-            m.face.project(m.field[0].values)  # the predictor extrapolates off the face's line
-        self.indenter = a
-        r, rc, Kc, F = self._residual()
-        du = np.inf
-        for it in range(self.max_iterations):
-            rf = self._system(r, None)[1]
-            norm = np.linalg.norm(rf)
-            if not np.isfinite(norm):
-                break
-            # converged: the residual small against the contact force, or (at loads so small that
-            # the residual meets rounding first) a full Newton step that moved nothing
-            if it > 0 and (norm <= self.tol * np.linalg.norm(rc) or du <= 1e-13):
-                self.newton_iterations += it
-                self.force = F
-                self._remember()
-                return True
-            K, rr, J = self._system(r, (m.solid.assemble.matrix(m.field) + Kc).tocsc())
-            try:
-                dq = splu(K).solve(-rr)
-            except RuntimeError:  # singular: no equilibrium from here
-                break
-            full = np.zeros(r.size)
-            if J is None:
-                full[self.free] = dq
-            else:
-                full = J @ dq
-            if not np.all(np.isfinite(full)) or np.max(np.abs(full[: m.contact.ndof_u])) > 0.5:
-                break
-            # backtracking on the residual's norm: contact enters and leaves the active set
-            step, du = 1.0, np.inf
-            base = self.save()
-            for _ in range(8):
-                self._advance(dq, step)
-                r, rc, Kc, F = self._residual()
-                new = np.linalg.norm(self._system(r, None)[1])
-                if np.isfinite(new) and new <= (1 - 1e-4 * step) * norm:
-                    du = np.max(np.abs(full[: m.contact.ndof_u])) if step == 1.0 else np.inf
-                    break
-                self.restore(base)
-                step *= 0.5
-            else:
-                r, rc, Kc, F = self._residual()
-                if norm <= STALL * np.linalg.norm(rc):  # stalled at rounding, well converged
-                    self.newton_iterations += it + 1
-                    self.force = F
-                    self._remember()
-                    return True
-                self._advance(dq, step)  # no descent: take the short step and go on
-                r, rc, Kc, F = self._residual()
-        self.restore(saved)
-        return False
-
-    def move(self, a, min_fraction=1e-3):
-        """From the current state to the indenter at ``a``: steps that grow after a success and
-        halve after a failure, down to ``min_fraction`` of the way."""
-        start = self.indenter
-        step = a - start
-        while abs(a - self.indenter) > 1e-15:
-            target = self.indenter + step if abs(a - self.indenter) > abs(step) else a
-            if self.solve(target):
-                step *= 1.5
-            else:
-                step *= 0.5
-                if abs(step) < min_fraction * abs(a - start):
-                    return False
-        return True
 
 
 @dataclass
@@ -482,7 +325,7 @@ def _start(scene, eps, n, opts):
                    bulk=opts["bulk"], penalty=opts["penalty"], gauss_points=opts["gauss_points"],
                    band=opts["band"], rim_face=opts["rim_face"])
     model.contact.bind(model.mesh.points)
-    return model, _Solver(model, opts["tol"]), _Path(*(np.full(n, np.nan) for _ in range(4)), False, "",
+    return model, Newton(model, opts["tol"], opts["delta_tol"]), _Path(*(np.full(n, np.nan) for _ in range(4)), False, "",
                                                     model.elements)
 
 
@@ -499,61 +342,29 @@ def _ended(out, message, success=False):
 
 def _indenter_path(scene, eps, targets, opts, progress):
     """The indenter moved to each target (its displacement from first touch)."""
-    model, solver, out = _start(scene, eps, targets.size, opts)
-    step = 0.5 * eps
-    solver.move(min(0.02 * eps, 0.5 * targets[0]))  # a first touch: the predictor's second state
-    for i, a in enumerate(targets):
-        # in steps the Newton can take (as _pole_path), then onto the target
-        while a - solver.indenter > 1.5 * step and solver.move(solver.indenter + step):
-            step = min(1.5 * step, 0.25 * max(solver.indenter, eps) + 0.5 * eps)
-        if not solver.move(a):
-            return _ended(out, f"no equilibrium beyond the indenter's displacement {solver.indenter:.4g}")
-        _record(out, i, model, solver)
-        if progress is not None:
-            progress(i, a, out.force[i])
-    return _ended(out, "all requested depths computed", True)
+    return _march(scene, eps, targets, opts, progress, pole=False)
 
 
 def _pole_path(scene, eps, deltas, opts, progress):
-    """Each mid-surface pole displacement reached by a secant on the indenter."""
-    model, solver, out = _start(scene, eps, deltas.size, opts)
-    done_delta, done_apex, slope = 0.0, 0.0, 1.0
+    """Each mid-surface pole displacement reached with the indenter's position as an unknown."""
+    return _march(scene, eps, deltas, opts, progress, pole=True)
+
+
+def _march(scene, eps, targets, opts, progress, pole):
+    model, solver, out = _start(scene, eps, targets.size, opts)
+    # a first touch under indenter control (pole control needs a contact to move the pole)
+    if not solver.move(min(0.02 * eps, 0.5 * targets[0])):
+        return _ended(out, "no equilibrium at first touch")
     step = 0.5 * eps
-    if solver.move(min(0.02 * eps, 0.5 * deltas[0])):  # a first touch: the predictor's second state
-        done_delta, done_apex = solver.delta(), solver.indenter
-        slope = done_apex / max(done_delta, 1e-15)
-    for i, target in enumerate(deltas):
-        # march towards the target in steps the Newton can take, then a secant on the apex
-        while target - done_delta > 1.5 * step:
-            a = done_apex + slope * step
-            if not solver.move(a):
-                return _ended(out, f"no equilibrium beyond delta = {done_delta:.4g}")
-            d = solver.delta()
-            slope = (a - done_apex) / max(d - done_delta, 1e-12)
-            done_delta, done_apex = d, a
-            step = min(1.5 * step, 0.25 * max(d, eps) + 0.5 * eps)
-        tol = opts["delta_tol"] * max(target, eps)
-        a = done_apex + slope * (target - done_delta)
-        points = [(done_apex, done_delta)]
-        for _ in range(12):
-            base = solver.save()
-            if not solver.move(a):
-                return _ended(out, f"no equilibrium at delta = {target:.4g}")
-            d = solver.delta()
-            if abs(d - target) <= tol:
-                break
-            points.append((a, d))
-            (a0, d0), (a1, d1) = points[-2], points[-1]
-            slope = (a1 - a0) / (d1 - d0) if d1 != d0 else slope
-            a = a1 + slope * (target - d1)
-            solver.restore(base) if abs(d - target) > abs(points[-2][1] - target) else None
-        else:
-            return _ended(out, f"the secant on the indenter did not reach delta = {target:.4g}")
+    cap = lambda x: 0.25 * max(x, eps) + 0.5 * eps  # noqa: E731
+    for i, target in enumerate(targets):
+        reached, step = solver.march(target, pole, step, cap)
+        if not reached:
+            where = f"delta = {solver.delta():.4g}" if pole else f"the indenter's displacement {solver.indenter:.4g}"
+            return _ended(out, f"no equilibrium beyond {where}")
         _record(out, i, model, solver)
-        out.delta[i] = target if abs(d - target) <= tol else d
-        if done_delta > 0 and d != done_delta:
-            slope = (a - done_apex) / (d - done_delta)
-        done_delta, done_apex = d, a
+        if pole:
+            out.delta[i] = target
         if progress is not None:
             progress(i, target, out.force[i])
     return _ended(out, "all requested depths computed", True)

@@ -100,12 +100,12 @@ class HingedFace:
         vals = np.r_[np.ones(nf), np.tile(e, m), (s[:, None] * de[None, :]).ravel()]
         J = sparse.csc_matrix((vals, (rows, cols)), shape=(ndof, nf + m + 1))
         rf = r[self.dofs].reshape(-1, 2)
-        G = sparse.lil_matrix((nf + m + 1, nf + m + 1))
         coupling = rf @ de                                  # d2u/(ds dtheta) = e'
-        G[nf + np.arange(m), nf + m] = coupling[:, None]
-        G[nf + m, nf + np.arange(m)] = coupling[None, :]
-        G[nf + m, nf + m] = -float(np.sum(s * (rf @ e)))      # d2u/dtheta2 = -s e
-        Kq = (J.T @ K @ J + G.tocsc()).tocsc()
+        face = nf + np.arange(m)
+        G = sparse.csc_matrix((np.r_[coupling, coupling, -float(np.sum(s * (rf @ e)))],   # d2u/dtheta2 = -s e
+                               (np.r_[face, np.full(m, nf + m), nf + m], np.r_[np.full(m, nf + m), face, nf + m])),
+                              shape=(nf + m + 1, nf + m + 1))
+        Kq = (J.T @ K @ J + G).tocsc()
         return Kq, J.T @ r, J
 
     def step(self, values, dq_face, scale):
