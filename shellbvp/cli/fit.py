@@ -225,7 +225,8 @@ def run(args):
         from ..uncertainty import fit_with_geometry
 
         # the same rows, baseline model and contact point as the nominal fit, at each perturbed geometry
-        kw = {k: v for k, v in options.items() if k != "progress"}
+        kw = {k: v for k, v in options.items() if k not in ("progress", "mesh_check")}
+        kw["model"] = res.model  # the nominal fit's model at every perturbed geometry
         executor = dask_executor(args.scheduler) if args.scheduler else None
         geometry = fit_with_geometry(scene, record.displacement[used], record.force[used], R_L=R_L,
                                      uncertainty=uncertainty, executor=executor, workers=args.workers,
