@@ -84,7 +84,7 @@ def test_fit_with_transverse_shear_recovers_a_thick_shells_modulus(capsys):
     assert np.all(np.isfinite(F))
     own = sb.fit(scene, deltas * R_L, F, R_L=R_L, fit_offset=False)
     assert own.success and own.mu_H == pytest.approx(mu_H, rel=2e-3)
-    kirchhoff = sb.fit(scene.replace(transverse_shear=False), deltas * R_L, F, R_L=R_L, fit_offset=False)
+    kirchhoff = sb.fit(scene.replace(transverse_shear=False), deltas * R_L, F, R_L=R_L, fit_offset=False, model="shell")
     assert kirchhoff.mu_H < 0.98 * mu_H
     assert main(["solve", "--transverse-shear", "--delta", "0.1"]) == 2
     assert "transverse_shear needs the shell's thickness" in capsys.readouterr().err
@@ -113,9 +113,37 @@ def test_the_measured_model_error_is_the_benchmarks():
                 worst = max(worst, float(np.nanmax(err)))
             assert bound == pytest.approx(worst, abs=6e-4), (key, eps)
     scene = sb.Scene(thickness=0.05)
-    assert model_error(scene) == (pytest.approx(0.242), False)
-    assert model_error(scene.replace(transverse_shear=True)) == (pytest.approx(0.060), False)
+    assert model_error(scene) == (pytest.approx(0.242), False)                # in F: larger than in mu*H
+    assert model_error(scene.replace(transverse_shear=True)) == (pytest.approx(0.102), False)   # in mu*H
     assert model_error(sb.Scene(thickness=0.17))[1]                         # extrapolated
     assert 0.060 < model_error(sb.Scene(thickness=0.03))[0] < 0.242          # between the mapped ones
     assert model_error(sb.Scene(beta=0.01)) is None
     assert model_error(sb.Scene(thickness=0.05, bending=sb.BendingEnergy("(kappa_s - kappa_s0)**2 + (kappa_theta - kappa_theta0)**2"))) is None
+
+
+def test_fit_level_bound_is_the_largest_error_of_the_mapped_fits_and_holds_on_held_out_scenes():
+    """FIT_MODEL_ERROR is the largest error of the shell's fitted mu*H on the solid's records of the
+    map's scenes (benchmarks/results/thick_fits_mapped_eps*.json); the bound the package prints
+    (the larger of that and the map in F) holds on the five held-out scenes of thick_fits.json."""
+    import json
+    from pathlib import Path
+
+    from shellbvp.thickness import FIT_EPS, FIT_MODEL_ERROR, model_error
+
+    results = Path(__file__).parents[1] / "benchmarks/results"
+    for i, eps in enumerate(FIT_EPS):
+        fits = json.loads((results / f"thick_fits_mapped_eps{eps:g}.json").read_text())["fits"]
+        for shear in (False, True):
+            label = "shell, shear" if shear else "shell"
+            worst = max(abs(f["error"]) for f in fits if f["fit"] == label)
+            assert FIT_MODEL_ERROR[shear][i] == pytest.approx(worst, abs=5e-4), (eps, shear)
+    held = json.loads((results / "thick_fits.json").read_text())
+    checked = 0
+    for f in held["fits"]:
+        if f["fit"].startswith("shell"):
+            s = held["scenes"][f["scene"]]
+            scene = sb.Scene(gamma=s["gamma"], rho=s["rho"], material=sb.NeoHookean(), thickness=s["eps"],
+                             transverse_shear=f["fit"] == "shell, shear")
+            assert abs(f["error"]) <= model_error(scene)[0], f
+            checked += 1
+    assert checked >= 10
