@@ -156,12 +156,14 @@ def test_fit_names_its_sample_in_lab_units(capsys):
     assert main(["fit", "--example", "--radius", "0.3mm", "--rho", "0.3333", "--gamma", "2.5"]) == 2
     assert "missing its bending stiffness" in capsys.readouterr().err
     assert main(["fit", "--example", "--rim-radius", "0.3mm", "--indenter-radius", "100um", "--rise", "0.75mm",
-                 "--thickness", "15um", "--json"]) == 0
+                 "--thickness", "15um", "--json", "--model", "shell"]) == 0      # the scene's units, not the model
     lab = json.loads(capsys.readouterr().out)
-    assert main(["fit", "--example", "--radius", "0.3mm", "--preset", "fit", "--thickness", "0.05", "--json"]) == 0
+    assert main(["fit", "--example", "--radius", "0.3mm", "--preset", "fit", "--thickness", "0.05", "--json",
+                 "--model", "shell"]) == 0
     preset = json.loads(capsys.readouterr().out)
     assert lab["mu_H"] == pytest.approx(preset["mu_H"], rel=1e-9)
-    assert main(["fit", "--example", "--radius", "0.3mm", "--preset", "fit", "--thickness", "15um"]) == 0
+    assert main(["fit", "--example", "--radius", "0.3mm", "--preset", "fit", "--thickness", "15um", "--model",
+                 "shell"]) == 0
     out = capsys.readouterr().out
     assert "scene  = preset fit with thickness; shell: spheroid, rise 750 um (gamma 2.5)" in out
     assert "indenter: sphere of radius 100 um" in out and "thickness 15 um" in out

@@ -185,14 +185,14 @@ def test_fit_with_a_thickness_reports_mu(tmp_path, capsys):
     from shellbvp.fitting import example_data_path
 
     d, F = sb.read_force_csv(example_data_path())
-    res = sb.fit(sb.Scene.preset("fit", thickness=50 / 300), d, F, R_L=0.3e-3)
+    res = sb.fit(sb.Scene.preset("fit", thickness=50 / 300), d, F, R_L=0.3e-3, model="shell")
     assert res.success and res.thickness == pytest.approx(50e-6)
     assert res.mu == pytest.approx(res.mu_H / 50e-6) and res.mu_ci95[0] < res.mu < res.mu_ci95[1]
     assert json.loads(json.dumps(res.to_dict()))["mu"] == pytest.approx(res.mu)
     assert sb.fit(sb.Scene.preset("fit"), d, F, R_L=0.3e-3).mu is None
     out = tmp_path / "f.h5"
     assert main(["fit", "--example", "--preset", "fit", "--radius", "0.3mm", "--thickness", "50um",
-                 "-o", str(out)]) == 0
+                 "--model", "shell", "-o", str(out)]) == 0
     text = capsys.readouterr().out
     assert "mu     = " in text and "MPa" in text and "eps = H/R_L = 0.167" in text
     assert main(["info", str(out)]) == 0

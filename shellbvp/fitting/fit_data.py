@@ -237,7 +237,9 @@ def fit(scene, displacement, force, *, R_L, fit_offset=True, free=(), bounds=Non
             raise ValueError("stability is checked for one fit at a time, not per pixel of a map on shared curves "
                              "(each pixel would need a curve of its own)")
         return _fit_on_shared(shared, scene, mdl, noise, depth, k, keep, weights, baseline)
+
     def run(name, coarse=False):
+        """The fit with model ``name`` (the solid on the mesh check's mesh with ``coarse``)."""
         counter = [0]
         if sp is None:
             source = functools.partial(solid_curve, coarse=coarse) if name == "solid" else None
