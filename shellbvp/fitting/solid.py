@@ -187,7 +187,7 @@ def solid_curve(scene, grid, tol=None, counter=None, progress=None, *, coarse=Fa
         _MEMO.move_to_end(memo)
         return _MEMO[memo]
     path, key = _place(scene, grid, settings)
-    c = _read_kept(path, key, scene, grid)
+    c = _read_kept(path, key, scene, grid, settings)
     if c is None:
         c = _computed(scene, grid, counter, progress, settings)
         if c.complete:
@@ -257,7 +257,7 @@ def _checksum(record):
     return hashlib.sha256(json.dumps(body, sort_keys=True).encode()).hexdigest()
 
 
-def _read_kept(path, key, scene, grid):
+def _read_kept(path, key, scene, grid, settings):
     """The kept curve at ``path`` when it is sound and holds ``key`` and ``grid``, else None (why: logged)."""
     if path is None or not path.is_file():
         return None
@@ -273,11 +273,10 @@ def _read_kept(path, key, scene, grid):
     if why is not None:
         log.info("ignoring the kept solid curve %s: %s", path.name, why)
         return None
-    n = grid.size
     return SolidCurve(scene, grid.copy(), np.array(record["force"], float), np.array(record["pole_delta"], float),
                       np.array(record["contact_radius"], float), True, record["stop_reason"][:200],
                       tuple(int(e) for e in record["elements"][:2]), 0.0, True,
-                      settings={"at": "indenter", "points": n})
+                      settings={**settings, "at": "indenter"})  # the settings its key holds, as computed
 
 
 def _unsound(record, key, grid):
