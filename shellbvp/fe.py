@@ -21,6 +21,8 @@ the solid itself, so that a user sees the model's error for his own scene:
 * the depths: the mid-surface pole's displacement delta, as in the shell model (each reached
   by a secant iteration on the indenter's position), or the indenter's displacement from
   first touch, as an instrument records it (``at="indenter"``); both are reported;
+* a pressure: a follower load on the inner surface (:mod:`shellbvp.fe_pressure`), applied
+  before the indenter touches; depths from the inflated state;
 * the force ``F / (mu R_L H)`` (nondimensional as in :func:`shellbvp.curve`).
 
 Needs FElupe (``pip install 'shellbvp[fe]'``).  Nondimensional: mu = 1, R_L = 1.
@@ -36,6 +38,7 @@ import numpy as np
 
 from .fe_contact import PenaltyContact, TipSurface
 from .fe_newton import Newton
+from .fe_pressure import FollowerPressure
 from .fe_rim import RIM_FACES, HingedFace
 from .materials import MATERIALS
 
@@ -102,6 +105,7 @@ class _Model:
     eps: float
     elements: tuple
     face: object = None    # HingedFace: the rim face's own unknowns (None: its dofs fixed or free)
+    pressure: object = None  # FollowerPressure on the inner surface (None: no pressure)
 
 
 def _build(scene, eps, *, through_thickness, element_length, pole_refinement, bulk, penalty, gauss_points,
@@ -156,7 +160,11 @@ def _build(scene, eps, *, through_thickness, element_length, pole_refinement, bu
     fixed = np.unique(np.concatenate([2 * axis + 1, 2 * np.asarray(held), 2 * np.asarray(held) + 1]))
     top = np.array([node(2 * n_t, j) for j in range(ncol)])  # t = +eps/2: faces the indenter
     contact = PenaltyContact(TipSurface(scene), points, top, penalty / eps, gauss_points, field, band * eps)
-    return _Model(mesh, region, field, solid, contact, fixed, node(n_t, 0), eps, (n_s, n_t), face)
+    pressure = None
+    if scene.pressure:  # p R_L/(mu H) on the shell is P = p H/R_L on the solid's inner surface (t = -eps/2)
+        bottom = np.array([node(0, j) for j in range(ncol)])
+        pressure = FollowerPressure(points, bottom, scene.pressure * eps, int(np.sum(field.fieldsizes)), gauss_points)
+    return _Model(mesh, region, field, solid, contact, fixed, node(n_t, 0), eps, (n_s, n_t), face, pressure)
 
 
 def coarser(settings):
@@ -167,9 +175,10 @@ def coarser(settings):
 
 def check_solid_scene(scene):
     """ValueError, in one line, where the scene has no solid here (before any work): a material
-    without a 3D form, or an internal pressure."""
-    if scene.pressurised:
-        raise ValueError("pressure: the 3D reference has no internal pressure yet; use a scene with pressure 0")
+    without a 3D form, or volume control."""
+    if scene.sealed:
+        raise ValueError("sealed: the 3D reference has no volume control yet; use a scene with sealed=False "
+                         "(a pressure is held)")
     _check_material(scene)
 
 
@@ -252,7 +261,10 @@ def fe_curve(scene, thickness, deltas, *, at="pole", mesh_check=False, progress=
         Shell, indenter, material (one with a ``felupe_model``) and rim (``"pinned"``: the rim
         face held plane and turning about its mid-thickness point; ``"clamped"``: held); beta,
         xi, the bending energy and the contact model are the shell model's and play no part
-        here.  Pressurised scenes are refused.
+        here.  A pressure ``p R_L/(mu H)`` acts on the inner surface as ``p H/R_L`` (a follower
+        load, :mod:`shellbvp.fe_pressure`): the solid is inflated first, and its depths are
+        measured from the inflated state, as the shell model's.  Volume control (``sealed``) is
+        refused.
     thickness : float
         eps = H / R_L, in (0, 0.5].
     deltas : array_like
@@ -352,6 +364,8 @@ def _pole_path(scene, eps, deltas, opts, progress):
 
 def _march(scene, eps, targets, opts, progress, pole):
     model, solver, out = _start(scene, eps, targets.size, opts)
+    if model.pressure is not None and not solver.inflate():
+        return _ended(out, f"no inflated state at pressure {scene.pressure:g}")
     # a first touch under indenter control (pole control needs a contact to move the pole)
     if not solver.move(min(0.02 * eps, 0.5 * targets[0])):
         return _ended(out, "no equilibrium at first touch")

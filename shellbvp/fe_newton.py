@@ -96,6 +96,7 @@ class Newton:
         self.shift = np.zeros(ndof)  # a rigid axial shift of the displacement field
         self.shift[0:model.contact.ndof_u:2] = 1.0
         self.newton_iterations = 0
+        self.pole0 = 0.0  # the pole's axial displacement that delta is measured from (the inflated state's)
         self.history = [self.save()]  # converged states (values, indenter, delta) for the predictor
 
     # ------------------------------------------------------------ state
@@ -118,7 +119,7 @@ class Newton:
 
     def delta(self):
         """The mid-surface pole's displacement, positive down."""
-        return -float(self.m.field[0].values[self.m.pole_mid, 0])
+        return self.pole0 - float(self.m.field[0].values[self.m.pole_mid, 0])
 
     def _remember(self):
         self.history = (self.history + [self.save()])[-3:]
@@ -141,12 +142,19 @@ class Newton:
 
     # ------------------------------------------------------------ the system
     def residual(self):
-        """``(r, r_contact, K_contact, F)`` at the current state (full dofs)."""
+        """``(r, load, K_load, F)`` at the current state (full dofs): the residual, the norm of the
+        loads it is measured against (the contact's and the pressure's), their tangent and the
+        indenter's force.  (A rigid axial shift leaves the pressure's load unchanged: the pole
+        control's border is the contact's alone.)"""
         m = self.m
+        u = m.field[0].values.ravel()
         with np.errstate(invalid="ignore", divide="ignore", over="ignore"):  # trial states may invert
             r = np.asarray(m.solid.assemble.vector(m.field).todense()).ravel()
-        rc, Kc, F, _ = m.contact.evaluate(m.field[0].values.ravel())
-        return r + rc, rc, Kc, F
+        rc, Kc, F, _ = m.contact.evaluate(u)
+        if m.pressure is None:
+            return r + rc, np.linalg.norm(rc), Kc, F
+        rp, Kp = m.pressure.evaluate(u)
+        return r + rc + rp, np.linalg.norm(rc) + np.linalg.norm(rp), Kc + Kp, F
 
     def system(self, r, K):
         """``(K_reduced, r_reduced, J)``: the Newton system in the unknowns the rim leaves free
@@ -185,7 +193,7 @@ class Newton:
         self._predict(delta if pole else a, pole)
         if m.face is not None:
             m.face.project(m.field[0].values)  # the predictor extrapolates off the face's line
-        r, rc, Kc, F = self.residual()
+        r, load, K_load, F = self.residual()
         du = np.inf
         for it in range(self.max_iterations):
             rf = self.system(r, None)[1]
@@ -194,14 +202,14 @@ class Newton:
                 break
             # converged: the residual small against the contact force, or (at loads so small that
             # the residual meets rounding first) a full Newton step that moved nothing
-            if it > 0 and (norm <= self.tol * np.linalg.norm(rc) or du <= 1e-13) and self._on_target(delta):
+            if it > 0 and (norm <= self.tol * load or du <= 1e-13) and self._on_target(delta):
                 return self._converged(it, F)
-            K, rr, J = self.system(r, m.solid.assemble.matrix(m.field) + Kc)
+            K, rr, J = self.system(r, m.solid.assemble.matrix(m.field) + K_load)
             try:
                 lu = LinearSolve(K)
                 dq, da = lu.solve(-rr), 0.0
                 if pole:  # the indenter's step that puts the pole at delta
-                    b = Kc @ self.shift
+                    b = K_load @ self.shift
                     x2 = lu.solve(b[self.free] if J is None else J.T @ b)
                     with np.errstate(divide="ignore", invalid="ignore"):  # no contact: no indenter step
                         da = (dq[self.pole] + delta - self.delta()) / x2[self.pole]
@@ -218,7 +226,7 @@ class Newton:
             for _ in range(8):
                 self.advance(dq, step)
                 self.indenter = base[1] + step * da
-                r, rc, Kc, F = self.residual()
+                r, load, K_load, F = self.residual()
                 new = np.linalg.norm(self.system(r, None)[1])
                 if np.isfinite(new) and new <= (1 - 1e-4 * step) * norm * (GROW if step == 1.0 else 1.0):
                     du = np.max(np.abs(full[: m.contact.ndof_u])) if step == 1.0 else np.inf
@@ -226,12 +234,12 @@ class Newton:
                 self.restore(base)
                 step *= 0.5
             else:
-                r, rc, Kc, F = self.residual()
-                if norm <= STALL * np.linalg.norm(rc) and self._on_target(delta):  # stalled at rounding
+                r, load, K_load, F = self.residual()
+                if norm <= STALL * load and self._on_target(delta):  # stalled at rounding
                     return self._converged(it + 1, F)
                 self.advance(dq, step)  # no descent: take the short step and go on
                 self.indenter = base[1] + step * da
-                r, rc, Kc, F = self.residual()
+                r, load, K_load, F = self.residual()
         self.restore(saved)
         return False
 
@@ -245,6 +253,26 @@ class Newton:
         self.newton_iterations += iterations
         self.force = F
         self._remember()
+        return True
+
+    def inflate(self, first=0.25, smallest=1e-3):
+        """The pressure's load factor from 0 to 1 with the indenter away (steps grow after a
+        success and halve after a failure); the inflated state is then the path's start: first
+        touch on its surface, delta measured from its pole.  False where it is not reached."""
+        load, done, step = self.m.pressure, 0.0, first
+        self.indenter = -1.0  # the tip one R_L above the surface: no contact while inflating
+        while done < 1.0:
+            load.scale = min(1.0, done + step)
+            if self.solve(self.indenter):
+                done, step = load.scale, 1.5 * step
+            else:
+                load.scale, step = done, 0.5 * step
+                if step < smallest:
+                    return False
+        u = self.m.field[0].values
+        self.pole0 = float(u[self.m.pole_mid, 0])
+        self.m.contact.z0 = self.m.contact.apex = self.m.contact.first_touch(u.ravel())
+        self.history = [self.save()]
         return True
 
     def move(self, a, min_fraction=1e-3):

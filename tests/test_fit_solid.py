@@ -25,7 +25,7 @@ def test_refusals_name_the_parameter_before_any_work():
              (SCENE, {"free": ("alpha",)}, "fitting alpha with the solid is not supported"),
              (SCENE.replace(transverse_shear=True), {}, "drop --transverse-shear"),
              (SCENE, {"stability": True}, "the stability check"),
-             (SCENE.replace(pressure=0.5), {}, "pressure"),
+             (SCENE.replace(sealed=True), {}, "sealed"),
              (SCENE, {"model": "beam"}, "model must be one of")]
     for scene, extra, text in cases:
         with pytest.raises(ValueError, match=text):

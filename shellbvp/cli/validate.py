@@ -36,8 +36,9 @@ def run(args):
     args.delta_max = nondimensional(args, args.delta_max, "--delta-max")
     if scene.thickness is None:
         raise ValueError("validate needs --thickness (H/R_L, or with a unit and --radius)")
-    if scene.pressurised:
-        raise ValueError("validate: the 3D model has no internal pressure yet; use a scene without --pressure")
+    from ..fe import check_solid_scene
+
+    check_solid_scene(scene)
     if not (0 < args.delta_max <= 2):
         raise ValueError(f"--delta-max must be in (0, 2]; got {args.delta_max:g}")
     deltas = None
