@@ -97,16 +97,27 @@ class Newton:
         self.shift[0:model.contact.ndof_u:2] = 1.0
         self.newton_iterations = 0
         self.pole0 = 0.0  # the pole's axial displacement that delta is measured from (the inflated state's)
+        self.V0 = None    # a sealed shell's volume (held, the pressure an unknown); None: the pressure given
         self.history = [self.save()]  # converged states (values, indenter, delta) for the predictor
 
     # ------------------------------------------------------------ state
     def save(self):
-        return [f.values.copy() for f in self.m.field.fields], self.indenter, self.delta()
+        return [f.values.copy() for f in self.m.field.fields], self.indenter, self.delta(), self.pressure
 
     def restore(self, saved):
-        values, self.indenter, _ = saved
+        values, self.indenter, _, self.pressure = saved
         for f, v in zip(self.m.field.fields, values):
             f.values[...] = v
+
+    @property
+    def pressure(self):
+        """The pressure on the inner surface (mu), 0 without one."""
+        return 0.0 if self.m.pressure is None else self.m.pressure.P
+
+    @pressure.setter
+    def pressure(self, P):
+        if self.m.pressure is not None:
+            self.m.pressure.P = P
 
     @property
     def indenter(self):
@@ -139,6 +150,8 @@ class Newton:
             f.values[...] = x1 + t * (x1 - x0)
         if pole:
             self.indenter = h1[1] + t * (h1[1] - h0[1])
+        if self.V0 is not None:
+            self.pressure = h1[3] + t * (h1[3] - h0[3])
 
     # ------------------------------------------------------------ the system
     def residual(self):
@@ -207,17 +220,12 @@ class Newton:
             K, rr, J = self.system(r, m.solid.assemble.matrix(m.field) + K_load)
             try:
                 lu = LinearSolve(K)
-                dq, da = lu.solve(-rr), 0.0
-                if pole:  # the indenter's step that puts the pole at delta
-                    b = K_load @ self.shift
-                    x2 = lu.solve(b[self.free] if J is None else J.T @ b)
-                    with np.errstate(divide="ignore", invalid="ignore"):  # no contact: no indenter step
-                        da = (dq[self.pole] + delta - self.delta()) / x2[self.pole]
-                        dq = dq - da * x2
-            except RuntimeError:  # singular: no equilibrium from here
+                dq = lu.solve(-rr)
+                dq, da, dP = self._bordered(lu, dq, K_load, J, delta)
+            except (RuntimeError, np.linalg.LinAlgError):  # singular: no equilibrium from here
                 break
             full = self._full(dq, J)
-            if not (np.all(np.isfinite(full)) and np.isfinite(da)) or np.max(np.abs(full[: m.contact.ndof_u])) > 0.5:
+            if not (np.all(np.isfinite(full)) and np.isfinite(da + dP)) or np.max(np.abs(full[: m.contact.ndof_u])) > 0.5:
                 break
             # backtracking on the residual's norm (a full step may raise it): contact enters and
             # leaves the active set
@@ -225,7 +233,7 @@ class Newton:
             base = self.save()
             for _ in range(8):
                 self.advance(dq, step)
-                self.indenter = base[1] + step * da
+                self.indenter, self.pressure = base[1] + step * da, base[3] + step * dP
                 r, load, K_load, F = self.residual()
                 new = np.linalg.norm(self.system(r, None)[1])
                 if np.isfinite(new) and new <= (1 - 1e-4 * step) * norm * (GROW if step == 1.0 else 1.0):
@@ -238,13 +246,46 @@ class Newton:
                 if norm <= STALL * load and self._on_target(delta):  # stalled at rounding
                     return self._converged(it + 1, F)
                 self.advance(dq, step)  # no descent: take the short step and go on
-                self.indenter = base[1] + step * da
+                self.indenter, self.pressure = base[1] + step * da, base[3] + step * dP
                 r, load, K_load, F = self.residual()
         self.restore(saved)
         return False
 
+    def _bordered(self, lu, dq, K_load, J, delta):
+        """``(dq, da, dP)``: the Newton step ``dq = K^-1 (-r)`` corrected for the bordered
+        unknowns -- the indenter's position under pole control (the pole at ``delta``), a sealed
+        shell's pressure (the volume at ``V0``) -- each with its linearised constraint (a Schur
+        complement of one or two rows)."""
+        cols, rows, rhs = [], [], []
+        reduced = (lambda v: v[self.free]) if J is None else (lambda v: J.T @ v)  # noqa: E731
+        if delta is not None:
+            cols.append(reduced(K_load @ self.shift))
+            row = np.zeros(dq.size)
+            row[self.pole] = 1.0
+            rows.append(row)
+            rhs.append(self.delta() - delta)
+        if self.V0 is not None:
+            u = self.m.field[0].values.ravel()
+            g = reduced(self.m.pressure.gradient(u))
+            cols.append(-g)
+            rows.append(g)
+            rhs.append(self.V0 - self.m.pressure.volume(u))
+        if not cols:
+            return dq, 0.0, 0.0
+        X = np.column_stack([lu.solve(c) for c in cols])
+        R = np.array(rows)
+        y = np.linalg.solve(R @ X, R @ dq - np.array(rhs))
+        return dq - X @ y, (y[0] if delta is not None else 0.0), (y[-1] if self.V0 is not None else 0.0)
+
+    def seal(self):
+        """From here on the volume below the inner surface is held (its pressure an unknown)."""
+        self.V0 = self.m.pressure.volume(self.m.field[0].values.ravel())
+        self.history = [self.save()]
+
     def _on_target(self, delta):
-        return delta is None or abs(self.delta() - delta) <= self._delta_tol(delta)
+        volume_held = self.V0 is None or abs(self.m.pressure.volume(self.m.field[0].values.ravel()) - self.V0) <= \
+            1e-10 * abs(self.V0)
+        return volume_held and (delta is None or abs(self.delta() - delta) <= self._delta_tol(delta))
 
     def _delta_tol(self, delta):
         return self.delta_tol * max(delta, self.m.eps)
