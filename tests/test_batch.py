@@ -109,6 +109,30 @@ def test_batch_outputs_are_checked_before_any_fit(folder):
     assert r.returncode == 2 and "no file matches" in r.stderr
 
 
+
+def test_a_given_thickness_fills_the_tables_thickness_mu_and_E(folder, tmp_path):
+    """Issue 56 item 7: with --thickness given (not fitted), the table carried mu*H only; the
+    thickness, mu = mu*H / H and E = 3 mu are known, so their columns are filled (no interval on H)."""
+    from shellbvp.batch import write_table
+
+    H = 5e-6
+    files = [str(folder / "data" / f"{name}.tsv") for name in ("seed_a", "seed_b")]
+    rows = fit_files(sb.Scene.preset("fit", thickness=H / R_L), files, R_L=R_L)
+    assert [r.status for r in rows] == ["ok", "ok"], [r.message for r in rows]
+    write_table(tmp_path / "t.csv", rows)
+    with open(tmp_path / "t.csv", newline="") as fh:
+        table = list(csv.DictReader(fh))
+    for row, r in zip(table, rows):
+        mu_H, low, high = (float(row[c]) for c in ("mu_H (N/m)", "mu_H 95% low (N/m)", "mu_H 95% high (N/m)"))
+        assert float(row["thickness (m)"]) == pytest.approx(H, rel=1e-6)
+        assert row["thickness 95% low (m)"] == row["thickness 95% high (m)"] == ""
+        assert float(row["mu (Pa)"]) == pytest.approx(mu_H / H, rel=1e-6)
+        assert float(row["mu 95% low (Pa)"]) == pytest.approx(low / H, rel=1e-6)
+        assert float(row["E (Pa)"]) == pytest.approx(3 * mu_H / H, rel=1e-6)
+        assert float(row["E 95% high (Pa)"]) == pytest.approx(3 * high / H, rel=1e-6)
+        assert r.result.E == pytest.approx(3 * r.result.mu) and r.result.to_dict()["E"] is not None
+
+
 # -- progress bars ----------------------------------------------------------------------------------
 def test_progress_bar_is_silent_without_tqdm_or_when_not_wanted(monkeypatch, capsys):
     from shellbvp import progress
