@@ -70,7 +70,7 @@ def test_batch_of_three_files_gives_a_table_of_three_rows(folder):
     assert sorted(p.name for p in (folder / "fits").iterdir()) == ["seed_a.h5", "seed_b.h5", "seed_c.h5"]
     assert "3 of 3 files fitted" in r.stdout
     # the batch names its sample in lab units, as a single fit does
-    assert "scene  = preset fit; shell: spheroid, rise 750 um (gamma 2.5) on a rim radius of 300 um" in r.stdout
+    assert "scene  = preset fit; shell: spheroidal bowl (indented from inside), rise 750 um (gamma 2.5) on a rim radius of 300 um" in r.stdout
 
 
 def test_a_broken_file_gets_its_row_and_the_others_are_fitted(folder):

@@ -79,6 +79,7 @@ def run(args):
           f"material={mat!r} bending={s.bending!r} shell={s.shell!r} tip={s.tip!r}"
           + (f" pressure={s.pressure:g} (delta from the inflated pole)" if s.pressure else "")
           + (" sealed (volume control: the pressure is per point)" if s.sealed else ""))
+    say(f"sample:    {s.describe(None if c.units is None else c.units['R_L'])}")  # bowl or dome, lab lengths
     say(f"curve:     {c.summary()}")
     say(f"complete:  {c.complete}  interrupted: {c.interrupted}")
     res = c.energy_residual
