@@ -88,12 +88,13 @@ def string_dataset(group, name, values, long_name=None):
 
 
 def file_header(f, fmt: str, version: int) -> None:
-    """The root attributes every file of the package carries: format, format_version,
-    package_version and the time it was created (UTC)."""
+    """The root attributes every file of the package carries: NX_class (NXroot), format,
+    format_version, package_version and the time it was created (UTC)."""
     import datetime as _dt
 
     from .version import __version__
 
+    f.attrs["NX_class"] = "NXroot"
     f.attrs["format"] = fmt
     f.attrs["format_version"] = version
     f.attrs["package_version"] = __version__

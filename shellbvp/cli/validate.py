@@ -58,7 +58,9 @@ def run(args):
     shell = "with its transverse shear" if scene.transverse_shear else "Kirchhoff (no transverse shear)"
     print(f"scene: {args.preset or 'base'}, eps = H/R_L = {scene.thickness:.4g}, beta = {scene.beta:.4g}; "
           f"3D model (FElupe) and shell model, {shell}, at the same pole displacements", flush=True)
+    print(f"sample: {scene.describe(None if args.radius is None else args.radius.si)}", flush=True)
     result = validate(scene, deltas=deltas, delta_max=args.delta_max, mesh_check=args.mesh_check, tol=args.tol,
+                      R_L=None if args.radius is None else args.radius.si,
                       progress=lambda i, d, f: print(f"  FE: delta = {d:.4g}, F = {f:.5g}", flush=True))
     print(result.table())
     if not result.fe.success:

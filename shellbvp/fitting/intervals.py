@@ -107,7 +107,8 @@ def _linearised(dq, x, dx_dtheta, mu_H, R_L, cov, t):
 
 
 def _given_thickness(scene, mu_H, mu_H_ci, R_L):
-    """``{"mu": Estimate}`` of a scene with a thickness (mu*H over H, H taken as exact), else {}."""
+    """``{"mu": Estimate, "E": Estimate}`` of a scene with a thickness (mu*H over H, H taken as
+    exact; E = 3 mu, incompressible), else {}: the same quantities a fitted thickness gives."""
     from ..units import format_in
 
     eps = getattr(scene, "thickness", None)
@@ -115,4 +116,6 @@ def _given_thickness(scene, mu_H, mu_H_ci, R_L):
         return {}
     H = eps * R_L
     return {"mu": Estimate(mu_H / H, (mu_H_ci[0] / H, mu_H_ci[1] / H), "Pa", "mu", "MPa",
-                           f"H = {format_in(H, 'um', 'length')}, eps = H/R_L = {eps:.3g}, beta = eps^2/3")}
+                           f"H = {format_in(H, 'um', 'length')}, eps = H/R_L = {eps:.3g}, beta = eps^2/3"),
+            "E": Estimate(3 * mu_H / H, (3 * mu_H_ci[0] / H, 3 * mu_H_ci[1] / H), "Pa", "E", "MPa",
+                          "E = 3 mu, incompressible")}
