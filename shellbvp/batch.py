@@ -398,7 +398,7 @@ def shared_curves(scene, name, values, grid, need, tol, *, interpolation_tol=Non
     def add(theta):
         if not curves.add(theta):
             raise ValueError(f"the model curve at {name} = {param.from_theta(theta):.4g} ends before the deepest "
-                             f"data (delta = {need:.4g}): fit shallower data, or check the units and R_L")
+                             f"data (delta = {need:.4g}): fit shallower data (--max-depth), or check the units and R_L")
 
     lo, hi = (param.to_theta(v) for v in (min(values), max(values)))
     # at least three nodes: across two a spline in theta is a straight line

@@ -23,7 +23,8 @@ SI units, ``"1"`` nondimensional, ``""`` text)::
     /fit/parameters            NXparameters: mu_H (N/m), offset (m), baseline (N),
                                baseline_slope (N/m), R_L (m), residual_rms (N), n_points (1),
                                noise_sigma (N), aic, bic, runs_p, residual_autocorrelation, model_error
-                               (1: the shell model's error beside the interval; NaN: none), and every
+                               (1: the shell model's error beside the interval; NaN: none), max_depth
+                               (m: the fitting range's deepest depth; NaN: all data), and every
                                shape parameter and derived quantity of shellbvp.shape_parameters
                                (beta (1), alpha (1, NaN for other materials), pressure (1), pressure_Pa
                                (Pa, NaN unless fitted), ...) -- scalars; correlation (k, k); <name>_ci95
@@ -66,7 +67,8 @@ FIT_FORMAT_VERSION = 1
 #: The fit's own scalar parameters in ``/fit/parameters`` with their units.
 _FIT_UNITS = {"mu_H": "N/m", "offset": "m", "baseline": "N", "baseline_slope": "N/m", "R_L": "m", "residual_rms": "N",
               "n_points": DIMENSIONLESS, "noise_sigma": "N", "aic": DIMENSIONLESS, "bic": DIMENSIONLESS,
-              "runs_p": DIMENSIONLESS, "residual_autocorrelation": DIMENSIONLESS, "model_error": DIMENSIONLESS}
+              "runs_p": DIMENSIONLESS, "residual_autocorrelation": DIMENSIONLESS, "model_error": DIMENSIONLESS,
+              "max_depth": "m"}
 #: Units of the scalar parameters in ``/fit/parameters``: the fit's own, every shape parameter's and
 #: every derived quantity's (:mod:`shellbvp.shape_parameters`).
 PARAMETER_UNITS = {**_FIT_UNITS, **{p.name: p.unit for p in SHAPE_PARAMETERS.values()},
@@ -211,6 +213,7 @@ def write_fit(path, result, record, used, *, segment="loading", overwrite=False)
                       "baseline_slope": result.baseline_slope, "R_L": result.R_L,
                       "residual_rms": result.residual_rms, "n_points": result.n,
                       "model_error": math.nan if result.model_error is None else result.model_error[0],
+                      "max_depth": math.nan if result.max_depth is None else result.max_depth,
                       **{k: getattr(result, k) for k in ("noise_sigma", "aic", "bic", "runs_p",
                                                           "residual_autocorrelation")},
                       **{k: np.nan if getattr(result, k) is None else getattr(result, k)

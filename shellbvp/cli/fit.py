@@ -8,7 +8,7 @@ from pathlib import Path
 
 from ..shape_parameters import SHAPE_PARAMETERS
 from .common import (
-    add_overwrite_option, add_scene_options, check_report_path, curve_bars, output_dir, progress_bar,
+    add_overwrite_option, add_scene_options, check_report_path, curve_bars, number_or, output_dir, progress_bar,
     quantity, require_sample, say, scene_from_args, strict_json,
 )
 
@@ -52,6 +52,9 @@ def add_parser(sub):
                    help="force baseline fitted with the contact point: auto (default: constant when the data "
                         "have an approach before contact, else none), none, constant, linear")
     f.add_argument("--no-offset", action="store_true", dest="no_offset", help="do not fit the contact point")
+    f.add_argument("--max-depth", dest="max_depth", type=number_or("length"),
+                   help="fitting range: leave out rows deeper than this beyond the contact point's first guess, "
+                        "a length (2um) or a plain number (a fraction of R_L, as the warnings give it)")
     for name, param in SHAPE_PARAMETERS.items():  # one of them at most
         f.add_argument(f"--fit-{name}", action="store_true", dest=f"fit_{name}", help=param.fit_help)
         f.add_argument(f"--{name}-range", dest=f"{name}_range", help=param.range_help)
@@ -148,8 +151,19 @@ def _fit_inputs(args, pixel_values=None):
 
         check_solid_fit(scene, free)
     options = {"fit_offset": not args.no_offset, "free": free, "bounds": bounds, "weights": args.weights,
-               "tol": args.tol, "stability": args.stability, "model": args.model, "mesh_check": args.mesh_check}
+               "tol": args.tol, "stability": args.stability, "model": args.model, "mesh_check": args.mesh_check,
+               "max_depth": _max_depth(args.max_depth, args.radius.si)}
     return scene, args.radius.si, {"columns": columns, "units": units, "invert": tuple(args.invert or ())}, options
+
+
+def _max_depth(given, R_L):
+    """``--max-depth`` in m: a length as it is, a plain number as a fraction of R_L; None if not given."""
+    if given is None:
+        return None
+    depth = given.si if hasattr(given, "si") else given * R_L
+    if not depth > 0:
+        raise ValueError(f"--max-depth must be a depth > 0 (a length, or a fraction of R_L); got {given}")
+    return depth
 
 
 def _search_range(param, text, R_L):
@@ -358,6 +372,9 @@ def _fit_map(args, path, curves, scene, R_L, reading, options, pixel_values=None
         say(f"scene  = {scene.describe(R_L)}" + ("" if pixel_values is None else
                                                  f"; in place of its {pixel_values.name}: the pixel table's"))
         say(f"map    = {fm.summary()}")
+        for code, (where, text) in fm.warning_counts().items():
+            cells = ", ".join(map(str, where[:8])) + (", ..." if len(where) > 8 else "")
+            say(f"warning: {len(where)} curve{'s' * (len(where) > 1)} ({cells}): {text}")
         for note in fm.notes:
             say(f"note: {note}")
         for w in wrote:
@@ -445,6 +462,9 @@ def _print_fit(res, record, used, args):
             for e in res.derived.values():
                 if e.of == name:
                     say(_estimate_line(e))
+    if res.max_depth is not None:
+        say(f"range  = depths up to {format_in(res.max_depth, du, 'length')} beyond the contact point's first guess "
+            f"(--max-depth; deeper rows left out)")
     say(f"rms residual = {format_in(res.residual_rms, fu, 'force')} over {res.n} points; R_L = "
           f"{args.radius}; {res.weights} weights")
     from ..fitting import diagnostics_lines

@@ -56,10 +56,10 @@ def _model_curve(scene, deltas, tol, counter=None, progress=None):
     path, disk_key = _disk_place(scene, deltas, tol)
     c = _read_kept(path, disk_key)
     if c is None:
-        _check_model_start(scene, float(deltas[0]), tol)
+        first = _model_start(scene, deltas, tol)  # shallower depths: the point-load limit (ModelCurves)
         bar, callback = progress("model curve", float(deltas[-1])) if progress is not None else (None, None)
         try:
-            c = curve(scene, deltas=deltas, tol=tol, estimate_error=False, callback=callback)
+            c = curve(scene, deltas=deltas[first:], tol=tol, estimate_error=False, callback=callback)
         finally:
             if bar is not None:
                 bar.close()
@@ -152,30 +152,56 @@ def _with_shear(c):
     return dataclasses.replace(c, points=points, flags=list(c.flags[:n]))
 
 
-def _check_model_start(scene, delta, tol):
-    """ValueError unless the model curve can start at its shallowest depth ``delta`` (one solve).
+#: The shallowest depths (indices of the curve's depths, doubling) a model curve may start from;
+#: beyond the last the data are refused as too shallow against R_L.
+START_TRIALS = (0, 1, 3, 7)
 
-    A curve at requested depths starts from a single contact cap; at depths where
-    the scene's contact is the point-load limit (far shallower than the shell's
-    size) it cannot start, so data that shallow are reported before the curve.
+
+def _model_start(scene, deltas, tol):
+    """The index of the first of ``deltas`` the model curve can start from (one solve per trial
+    of :data:`START_TRIALS`), or ValueError.
+
+    A curve at requested depths starts from a single contact cap; at depths where the scene's
+    contact is the point-load limit (the cap exponentially small) it cannot, and there the
+    point-load solution is the model's state (:func:`point_load_forces` gives its force).
+    Data whose depths are nearly all in that limit are refused before the curve.
     """
     from ..configurations import is_single_cap
     from ..state import solve
 
-    sol = solve(scene, delta=delta, tol=tol, estimate_error=False, topology="cap")
-    if not (sol.success and is_single_cap(sol)):
-        why = (sol.message if not sol.success else "the contact there is the point-load limit (the contact cap "
-               "is exponentially small), from which the model curve cannot start")
-        raise ValueError(f"the model curve cannot start at its shallowest depth delta = {delta:.3g} "
-                         f"(1/{N_DEPTHS} of delta_max = 1.2 x the deepest data depth / R_L): {why}. "
-                         f"Check the displacement units and the rim radius R_L (--radius): data this shallow "
-                         f"against R_L do not determine mu*H with this scene")
+    why = ""
+    for i in START_TRIALS:
+        if i >= len(deltas) - 2:
+            break
+        sol = solve(scene, delta=float(deltas[i]), tol=tol, estimate_error=False, topology="cap")
+        if sol.success and is_single_cap(sol):
+            return i
+        why = sol.message if not sol.success else "the contact there is the point-load limit (the contact cap is " \
+                                                   "exponentially small)"
+    raise ValueError(f"the model curve cannot start at its shallowest depths, up to delta = {deltas[i]:.3g} "
+                     f"({i + 1}/{len(deltas)} of delta_max = 1.2 x the deepest data depth / R_L): {why}. The data are "
+                     f"this shallow against R_L: check the displacement units and the rim radius R_L (--radius)")
+
+
+def point_load_forces(scene, deltas, tol):
+    """The model's nondimensional force at ``deltas`` shallower than its curve's first depth: the
+    point-load limit of the smooth contact (:func:`shellbvp.pointload.solve_point_load`), each
+    solved from the shallower one's state; NaN where a solve fails."""
+    from ..pointload import solve_point_load
+
+    out, prev = [], None
+    for d in deltas:
+        sol = solve_point_load(scene, float(d), tol=tol, guess=prev)
+        prev = sol if sol.success else None
+        out.append(float(sol.force) if sol.success else np.nan)
+    return np.array(out)
 
 
 def _beyond_message(c, need):
     return (f"the data reach delta = {need:.4g} (deepest displacement / R_L) but the model curve ends at "
             f"delta = {c.delta[-1]:.4g} ({c.stop_reason}): the model cannot explain the deepest points; "
-            f"fit the data up to delta = {c.delta[-1]:.4g} x R_L, or check the units and R_L (--radius)")
+            f"fit the data up to that depth (--max-depth {c.delta[-1]:.4g}, a fraction of R_L; fit(max_depth=...) in "
+            f"m), or check the units and R_L (--radius)")
 
 
 class ModelCurves:
@@ -196,6 +222,7 @@ class ModelCurves:
         # what computes a node's curve: the shell model's (default) or the solid's
         self.source = _model_curve if source is None else source
         self.nodes = {}  # theta -> curve
+        self.forces = {}  # theta -> F at the grid's depths (the point-load limit's below the curve's first)
         self._spline = None
 
     def add(self, theta):
@@ -209,6 +236,12 @@ class ModelCurves:
                 return False
             raise ValueError(_beyond_message(c, self.need))
         self.nodes[theta] = c
+        shallow = self.grid[self.grid < c.delta[0] * (1 - 1e-9)] if self.source is _model_curve else self.grid[:0]
+        F = np.r_[point_load_forces(self.scene_at(theta), shallow, self.tol), c.force]
+        if not np.all(np.isfinite(F[:shallow.size])):
+            raise ValueError(f"the point-load limit below the model curve's first depth delta = {c.delta[0]:.3g} "
+                             f"could not be solved: the data are too shallow for this scene")
+        self.forces[theta] = F
         self._spline = None
         return True
 
@@ -219,8 +252,8 @@ class ModelCurves:
     def _table(self):
         if self._spline is None:
             th = self.thetas
-            m = min(len(self.nodes[t]) for t in th)
-            rows = np.array([np.r_[0.0, self.nodes[t].force[:m]] for t in th])
+            m = min(len(self.forces[t]) for t in th)
+            rows = np.array([np.r_[0.0, self.forces[t][:m]] for t in th])
             self.top = float(self.grid[m - 1])
             self.x = np.r_[0.0, self.grid[:m]]
             self._spline = rows[0] if len(th) == 1 else CubicSpline(th, rows, axis=0)

@@ -12,7 +12,7 @@ import math
 import numpy as np
 from scipy import special
 
-from ..fit_checks import FIT_STATUS, check_result, fit_diagnostics, runs_in_depth_order
+from ..fit_checks import FIT_STATUS, check_result, contact_misfit, fit_diagnostics, runs_in_depth_order
 from ..shape_parameters import SHAPE_PARAMETERS
 from .least_squares import MODEL_PARAMETERS, LeastSquaresModel
 from .result import Estimate, FitResult
@@ -68,8 +68,9 @@ def result_of(fitted, mdl, sp, k, notes, keep, weights, baseline, curves_compute
             derived[dq.name] = Estimate(value, interval, dq.unit, dq.label, dq.display_unit, dq.note, name)
     mu_ci = ci[0]
     runs = runs_in_depth_order(resid, d)
+    contact = contact_misfit(resid, d, model(d, mu_H, d0, 0.0, 0.0))
     status, checks = check_result(bool(res.success), mu_H, mu_ci, off_ci, bool(np.all(np.isfinite(resid))),
-                                   resid.size, runs)
+                                   resid.size, runs, contact)
     found = notes + checks
     for _, text in found:
         log.info("fit: warning: %s", text)
