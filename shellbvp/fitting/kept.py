@@ -119,7 +119,7 @@ def keep(path: Path | None, write, *, what: str) -> bool:
         return True
     except (OSError, ValueError) as exc:
         reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else ' '.join(str(exc).split())
-        _warn_once(path.parent, f"cannot keep {what} in {path.parent} ({reason}); fits compute their own")
+        _warn_once(("keep", path.parent), f"cannot keep {what} in {path.parent} ({reason}); fits compute their own")
         return False
     finally:
         if tmp is not None and os.path.lexists(tmp):
