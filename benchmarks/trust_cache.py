@@ -14,7 +14,8 @@
 Every input is a fresh ``python -m shellbvp`` process on the packaged example record; the
 reference is the same fit with a clean cache.  Run only these::
 
-    python3 benchmarks/trust_tally.py --only keptcurves,cachefolders,kernels,fulldisk [--quick]
+    python3 benchmarks/trust_tally.py --only keptcurves,cachefolders,kernels,fulldisk \
+        --out benchmarks/results/trust_cache.md     # ~8.5 min on 2 cores; --quick: ~2 min
 """
 
 from __future__ import annotations

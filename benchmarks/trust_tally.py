@@ -1079,7 +1079,8 @@ def tally(records):
 def report(records, *, args, wall, head, dirty, kind_times):
     lines = ["# Trust tally: hostile and malformed input", "",
              f"Commit measured: `{head}`" + (f" plus uncommitted changes in {dirty}" if dirty else "") + ".  ",
-             f"Command: `python3 benchmarks/trust_tally.py{' --quick' if args.quick else ''}` "
+             f"Command: `python3 benchmarks/trust_tally.py{' --quick' if args.quick else ''}"
+             f"{' --only ' + args.only if args.only else ''}` "
              f"(Python {sys.version.split()[0]}, each kind seeded with `random.Random(0)`).  ",
              f"Wall time: {wall:.1f} s on a 2-core shared machine.", "",
              "Each input is classified as exactly one of: **clear error** (ValueError/TypeError with a "
