@@ -453,7 +453,8 @@ def test_damaged_compiled_kernels_are_discarded_and_compiled_again(tmp_path, mon
     src.write_text("KEY = 'k'\n")
     cache = tmp_path / "__pycache__"
     cache.mkdir(mode=0o700)
-    files = [cache / "kernels_0123.rhs-12.py311.nbi", cache / "kernels_0123.rhs-12.py311.1.nbc", src.with_suffix(".ready")]
+    files = [cache / "kernels_0123.rhs-12.py311.nbi", cache / "kernels_0123.rhs-12.py311.1.nbc",
+             src.with_suffix(".ready")]
     other = cache / "kernels_9999.rhs-12.py311.nbi"  # another structure's: kept
     for f in [*files, other]:
         f.write_bytes(b"x")
