@@ -34,6 +34,12 @@ def print_json_error(message):
                       "warnings": [], "warning_codes": []}))
 
 
+def os_error_line(exc: OSError) -> str:
+    """One line for a file that could not be written or read (a full disk, a read-only folder)."""
+    text = exc.strerror or str(exc)
+    return " ".join((f"{text}: {exc.filename}" if exc.filename else text).split())
+
+
 def plain_number(text):
     """argparse type: a plain finite number (float() would also take 5_0, inf, nan, 1e999)."""
     from ..units import plain_number

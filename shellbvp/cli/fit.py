@@ -7,9 +7,10 @@ import sys
 from pathlib import Path
 
 from ..shape_parameters import SHAPE_PARAMETERS
+from ..textdata import printable
 from .common import (
-    add_overwrite_option, add_scene_options, check_report_path, curve_bars, number_or, output_dir, progress_bar,
-    quantity, require_sample, say, scene_from_args, strict_json,
+    add_overwrite_option, add_scene_options, check_report_path, curve_bars, number_or, os_error_line, output_dir,
+    progress_bar, quantity, require_sample, say, scene_from_args, strict_json,
 )
 
 __all__ = ["add_parser", "run"]
@@ -252,6 +253,11 @@ def run(args):
         out["geometry"] = geometry.to_dict()
         out["success"] = ok
     out["exit_status"] = 0 if ok else 1
+    written = not (args.output or args.report) or not res.success
+    if args.json and not written:  # written first: the one JSON document says whether it was
+        written = _save_or_error(res, record, used, args)
+        if written is not True:
+            out.update(exit_status=2, write_error=written)
     if args.json:
         print(json.dumps(strict_json(out), allow_nan=False))
     else:
@@ -266,9 +272,22 @@ def run(args):
     if args.output or args.report:
         if not res.success:
             print(f"shellbvp: not writing {args.output or args.report}: the fit failed its checks", file=sys.stderr)
-        else:
-            _save_fit(res, record, used, args.output, args.report, args.segment, args.force, args.json)
+        elif written is not True:  # the result is printed; the file could not be written (a full disk)
+            written = written or _save_or_error(res, record, used, args)
+            if written is not True:
+                print(f"shellbvp: error: {printable(written)}", file=sys.stderr)
+                return 2
     return 0 if ok else 1
+
+
+def _save_or_error(res, record, used, args):
+    """True once the fit's record (and report) are written, else the one-line reason (a full
+    disk: the partial file is removed, the fit's result stands)."""
+    try:
+        _save_fit(res, record, used, args.output, args.report, args.segment, args.force, args.json)
+    except OSError as exc:
+        return os_error_line(exc)
+    return True
 
 
 def _fit_batch(args, files):

@@ -8,7 +8,10 @@ A curve kept on disk is a curve file (``read_curve`` reads it as data, checked) 
 of everything it depends on: the scene, the depths, the tolerance, the solver's options and the
 package's source (any edit of the code makes new keys).  A fit of a sample fitted before, in
 any process, then computes no curve (``FitResult.curves_computed`` counts the computed ones);
-``sb.options(model_curve_cache=False)`` turns the disk off."""
+``sb.options(model_curve_cache=False)`` turns the disk off.  A kept curve is data from disk
+(:mod:`shellbvp.fitting.kept`): used only when it is this user's, carries a checksum of its
+contents that matches, and holds the requested scene and depths with finite forces; a bad one
+is set aside with a warning and computed again."""
 
 from __future__ import annotations
 
@@ -22,6 +25,8 @@ from pathlib import Path
 
 import numpy as np
 from scipy.interpolate import CubicSpline, PchipInterpolator
+
+from .kept import keep, kept_folder, read_kept
 
 __all__ = ["N_DEPTHS", "ModelCurves", "clear_model_curves", "code_fingerprint"]
 
@@ -54,7 +59,7 @@ def _model_curve(scene, deltas, tol, counter=None, progress=None):
         _CACHE.move_to_end(key)
         return _CACHE[key]
     path, disk_key = _disk_place(scene, deltas, tol)
-    c = _read_kept(path, disk_key)
+    c = _read_kept(path, disk_key, scene, deltas)
     if c is None:
         first = _model_start(scene, deltas, tol)  # shallower depths: the point-load limit (ModelCurves)
         bar, callback = progress("model curve", float(deltas[-1])) if progress is not None else (None, None)
@@ -87,10 +92,9 @@ def code_fingerprint() -> str:
 
 def _disk_place(scene, deltas, tol):
     """(path, key) of a model curve in the code cache's ``curves/`` folder, or (None, None)
-    where the disk cache is off, the scene does not describe itself as data, or the folder is
-    not trusted."""
+    where the disk cache is off, the scene does not describe itself as data, or the folder
+    cannot hold curves (:func:`shellbvp.fitting.kept.kept_folder`: one warning)."""
     from ..config import OPTIONS
-    from ..model import cache_dir, untrusted_reason
     from ..version import __version__
 
     if not OPTIONS.model_curve_cache:
@@ -103,8 +107,8 @@ def _disk_place(scene, deltas, tol):
     except (TypeError, ValueError, AttributeError):
         return None, None
     key = hashlib.sha256(payload.encode()).hexdigest()
-    folder = cache_dir() / "curves"
-    if folder.exists() and untrusted_reason(folder):
+    folder = kept_folder("curves", KEPT_WHAT)
+    if folder is None:
         return None, None
     return folder / f"curve_{key[:32]}.h5", key
 
@@ -112,32 +116,69 @@ def _disk_place(scene, deltas, tol):
 #: Options that do not change a curve's numbers (not part of a kept curve's key)
 _NOT_NUMERICS = ("progress_seconds", "health_seconds", "compile_in_background", "model_curve_cache")
 
+#: What the cache's warnings call a kept shell curve
+KEPT_WHAT = "model curves"
 
-def _read_kept(path, key):
-    """The kept curve at ``path`` if it is there and holds ``key``, else None."""
+#: A kept model curve larger than this is not read (40 depths take about 50 kB).
+MAX_KEPT_BYTES = 4 << 20
+
+
+def content_checksum(c) -> str:
+    """SHA-256 of everything a curve holds (scene, settings but this checksum, stop reason,
+    completeness, flags and every point field): a kept curve carries it in
+    ``settings["kept_sha256"]`` and is used only when it matches."""
+    head = {"scene": c.scene.to_dict(), "settings": {k: v for k, v in c.settings.items() if k != "kept_sha256"},
+            "stop_reason": str(c.stop_reason), "complete": bool(c.complete), "flags": [str(f) for f in c.flags]}
+    h = hashlib.sha256(json.dumps(head, sort_keys=True, default=str).encode())
+    for name in sorted(c.points):
+        values = np.asarray(c.points[name])
+        h.update(name.encode())
+        h.update(np.ascontiguousarray(values, float).tobytes() if values.dtype.kind in "fiub"
+                 else json.dumps([str(v) for v in values.tolist()]).encode())
+    return h.hexdigest()
+
+
+def _unsound(c, key, scene, deltas):
+    """Why the curve ``c`` read from the cache cannot serve as ``scene``'s at ``deltas``, or None."""
+    if c.settings.get("kept_sha256") != content_checksum(c):
+        return "its checksum does not match its contents (damaged or edited)"
+    if c.settings.get("model_curve_key") != key or not c.complete:
+        return "made for another scene, grid or version, or not complete"
+    if c.scene != scene:
+        return "its scene is not the requested one"
+    delta, force = np.asarray(c.delta, float), np.asarray(c.force, float)
+    if delta.shape != np.shape(deltas) or not np.array_equal(delta, np.asarray(deltas, float)):
+        return "its depths are not the requested ones"
+    if not (np.all(np.isfinite(force)) and np.all(np.diff(delta) > 0)):
+        return "a non-finite force or depths not increasing"
+    return None
+
+
+def _read_kept(path, key, scene, deltas):
+    """The kept curve at ``path`` when it is sound and holds ``key``, ``scene`` and ``deltas``,
+    else None (a bad one set aside with a warning)."""
     from ..io import read_curve
 
-    if path is None or not path.exists():
-        return None
-    try:
-        c = read_curve(path)
-    except (ValueError, OSError) as exc:
-        log.info("ignoring the kept model curve %s: %s", path.name, exc)
-        return None
-    return c if c.settings.get("model_curve_key") == key and c.complete else None
+    return read_kept(path, read_curve, lambda c: _unsound(c, key, scene, deltas), what="model curve",
+                     max_bytes=MAX_KEPT_BYTES)
 
 
 def _keep(c, path, key):
-    """Write the complete curve ``c`` to ``path`` (atomically); a cache that cannot be written is
-    skipped."""
+    """Write the complete curve ``c`` to ``path`` (atomically, read back and checked); a cache
+    that cannot be written is skipped with one warning."""
+    from ..io import read_curve, write_curve
+
     if path is None or not c.complete:
         return
     c.settings["model_curve_key"] = key
-    try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        c.to_hdf5(path, overwrite=True)
-    except OSError as exc:
-        log.info("model curve not kept (%s)", exc)
+    c.settings["kept_sha256"] = content_checksum(c)
+
+    def write(tmp):
+        write_curve(c, tmp, overwrite=True)
+        if (why := _unsound(read_curve(tmp), key, c.scene, c.delta)) is not None:
+            raise ValueError(f"the curve read back is not the one written: {why}")
+
+    keep(path, write, what=KEPT_WHAT)
 
 
 def _with_shear(c):
