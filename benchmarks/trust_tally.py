@@ -60,6 +60,7 @@ import numpy as np
 import sympy as sp
 
 import shellbvp as sb
+import trust_work  # issue 59: oversized work, dead options (its kinds join KINDS)
 
 ROOT = Path(__file__).resolve().parent.parent
 RESULTS = ROOT / "benchmarks" / "results"
@@ -74,6 +75,7 @@ KINDS = {
     "sweepfiles": "7. tampered sweep files",
     "inputs": "8. hostile inputs to fit and batches",
 }
+KINDS.update(trust_work.KINDS)
 FORMULA_LIMIT = 30.0  # s: a formula call that has not returned by then is recorded as a DEFECT (hang)
 SLOW_SOLVE = 30.0  # s: solves slower than this are listed in the report
 CLI_TIMEOUT = 120  # s
@@ -1188,6 +1190,8 @@ def main(argv=None):
     dirty = ", ".join(f"`{d}/`" for d in dirty)
     funcs = {"formulas": kind_formulas, "hdf5": kind_hdf5, "csv": kind_csv, "scenes": kind_scenes, "cli": kind_cli,
              "fitrecords": kind_fitrecords, "sweepfiles": kind_sweepfiles, "inputs": kind_inputs}
+    funcs.update(trust_work.FUNCS)
+    sizes = {**trust_work.SIZES, **sizes}
     records, kind_times = [], {}
     t0 = time.perf_counter()
     with tempfile.TemporaryDirectory(prefix="trust-tally-") as td:

@@ -81,6 +81,9 @@ def run(args):
           + (" sealed (volume control: the pressure is per point)" if s.sealed else ""))
     say(f"curve:     {c.summary()}")
     say(f"complete:  {c.complete}  interrupted: {c.interrupted}")
+    from ..curve_stability import verdict
+
+    say(verdict(c))
     res = c.energy_residual
     if np.any(np.isfinite(res)):
         say(f"energy identity: max |dE/ddelta - F| = {np.nanmax(np.abs(res)):.3g}")

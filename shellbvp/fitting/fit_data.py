@@ -281,6 +281,7 @@ def _check_axisymmetry(res, deepest, tol):
     stability before the deepest fitted depth ``deepest`` (delta); ``res.stability_note``: what
     was not analysed."""
     from ..continuation import curve
+    from ..curve_stability import verdict
 
     c = curve(res.scene, deltas=deepest * np.arange(1, CHECK_DEPTHS + 1) / CHECK_DEPTHS, tol=tol,
               estimate_error=False, stability="locate")
@@ -290,6 +291,7 @@ def _check_axisymmetry(res, deepest, tol):
     if not c.complete:
         notes.append(f"the curve stopped at delta = {c.delta.max() if len(c) else 0:.4g} ({c.stop_reason})")
     res.first_instability, res.stability_note = first, "; ".join(filter(None, notes))
+    res.stability_verdict = verdict(c)
     if first is not None:
         res.warnings.append(
             f"the fitted depths reach delta = {deepest:.4g} but the axisymmetric shell loses stability at delta = "
