@@ -75,7 +75,6 @@ KINDS = {
     "sweepfiles": "7. tampered sweep files",
     "inputs": "8. hostile inputs to fit and batches",
 }
-KINDS.update(trust_work.KINDS)
 FORMULA_LIMIT = 30.0  # s: a formula call that has not returned by then is recorded as a DEFECT (hang)
 SLOW_SOLVE = 30.0  # s: solves slower than this are listed in the report
 CLI_TIMEOUT = 120  # s
@@ -128,6 +127,8 @@ KIND_NOTES = {
            "`plot` on non-files, unknown commands) in a temporary directory, timeout 120 s; with --json "
            "stdout must parse as one strict JSON document (no NaN) whose exit_status is the exit status.",
 }
+KINDS.update(trust_work.KINDS)
+KIND_NOTES.update(trust_work.KIND_NOTES)
 
 
 # -- recording and classifying ------------------------------------------------------------------------
