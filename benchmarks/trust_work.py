@@ -9,7 +9,8 @@
   parser against the handler's source and the shared helpers it calls), and invalid node budgets
   are refused.
 
-Run: ``python3 benchmarks/trust_tally.py --only work,options`` (about 2-3 minutes).
+Run: ``python3 benchmarks/trust_tally.py --only options,work --out benchmarks/results/trust_work.md`` (about
+3 minutes; results/trust_work.md: 252 inputs, 0 defects).
 """
 
 from __future__ import annotations
