@@ -60,6 +60,7 @@ import numpy as np
 import sympy as sp
 
 import shellbvp as sb
+import trust_cache
 import trust_work  # issue 59: oversized work, dead options (its kinds join KINDS)
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -75,12 +76,13 @@ KINDS = {
     "sweepfiles": "7. tampered sweep files",
     "inputs": "8. hostile inputs to fit and batches",
 }
+KINDS.update(trust_cache.KINDS)  # issue 59: the code cache and full disks (benchmarks/trust_cache.py)
 FORMULA_LIMIT = 30.0  # s: a formula call that has not returned by then is recorded as a DEFECT (hang)
 SLOW_SOLVE = 30.0  # s: solves slower than this are listed in the report
 CLI_TIMEOUT = 120  # s
 
 
-KIND_NOTES = {
+KIND_NOTES = {**trust_cache.KIND_NOTES,
     "formulas": "Inputs: 20 valid formulas (must be accepted and read as SymPy reads them; a user shell is "
                 "rescaled to R(L) = 1, as documented), each payload against each of the four constructors, "
                 "~50 special strings (3000-character formulas, parentheses nested 50-5000 deep, huge powers, "
@@ -1080,7 +1082,8 @@ def tally(records):
 def report(records, *, args, wall, head, dirty, kind_times):
     lines = ["# Trust tally: hostile and malformed input", "",
              f"Commit measured: `{head}`" + (f" plus uncommitted changes in {dirty}" if dirty else "") + ".  ",
-             f"Command: `python3 benchmarks/trust_tally.py{' --quick' if args.quick else ''}` "
+             f"Command: `python3 benchmarks/trust_tally.py{' --quick' if args.quick else ''}"
+             f"{' --only ' + args.only if args.only else ''}` "
              f"(Python {sys.version.split()[0]}, each kind seeded with `random.Random(0)`).  ",
              f"Wall time: {wall:.1f} s on a 2-core shared machine.", "",
              "Each input is classified as exactly one of: **clear error** (ValueError/TypeError with a "
@@ -1184,13 +1187,14 @@ def main(argv=None):
     if args.quick:
         sizes = {"formulas": 60, "hdf5": 15, "csv": 20, "scenes": 8, "cli": 10, "fitrecords": 15, "sweepfiles": 10,
                  "inputs": 20}
+    sizes.update(trust_cache.sizes(args.quick))
     kinds = args.only.split(",") if args.only else list(KINDS)
     head = git("rev-parse", "--short", "HEAD")
     dirty = sorted({ln[3:].split("/")[0] for ln in git("status", "--porcelain").splitlines()
                     if ln[3:].startswith(("shellbvp/", "symbolic/"))})
     dirty = ", ".join(f"`{d}/`" for d in dirty)
     funcs = {"formulas": kind_formulas, "hdf5": kind_hdf5, "csv": kind_csv, "scenes": kind_scenes, "cli": kind_cli,
-             "fitrecords": kind_fitrecords, "sweepfiles": kind_sweepfiles, "inputs": kind_inputs}
+             "fitrecords": kind_fitrecords, "sweepfiles": kind_sweepfiles, "inputs": kind_inputs, **trust_cache.FUNCS}
     funcs.update(trust_work.FUNCS)
     sizes = {**trust_work.SIZES, **sizes}
     records, kind_times = [], {}

@@ -26,7 +26,7 @@ _LAZY = {"curve": "continuation", "iter_curve": "continuation", "CurveRun": "con
          "sweep": "sweep", "read_sweep": "sweep", "Sweep": "sweep",
          "fit_with_geometry": "uncertainty", "GeometryFit": "uncertainty", "convexity_limits": "convexity",
          "inflate": "inflation", "stability": "modal_stability", "hoop_indicator": "wrinkling", "HoopIndicator": "wrinkling", "Stability": "modal_stability", "options": "config", "Options": "config", "fe_curve": "fe", "FECurve": "fe", "validate": "validation",
-         "Validation": "validation"}
+         "Validation": "validation", "read_validation": "validation"}
 
 
 def __getattr__(name):
@@ -62,6 +62,7 @@ __all__ = [
     "FECurve",
     "validate",
     "Validation",
+    "read_validation",
     "Curve",
     "read_curve",
     "fit",

@@ -275,6 +275,12 @@ class ForceMap:
         nx, ny = self.shape
         text = (f"{len(self.rows)} curves on a {nx} x {ny} grid: {counts['ok']} fitted, {counts['failed']} failed "
                 f"their checks, {counts['error']} errors{spread}")
+        rated = [r.result.quality for r in self.rows if r.result is not None and r.status != "error"]
+        if rated:
+            text += "; quality " + ", ".join(f"{q} {rated.count(q)}" for q in ("good", "fair", "poor"))
+        warned = self.warning_counts()
+        if warned:
+            text += "; warnings: " + ", ".join(f"{code} in {len(where)}" for code, (where, _) in warned.items())
         if self.pixel_values is not None and self.pixel_nodes:
             from .units import format_in
 
@@ -286,6 +292,20 @@ class ForceMap:
                      f"model curves computed, {len(self.pixel_nodes)} nodes"
                      + (f", interpolation error {err:.2g}" if err is not None else ""))
         return text
+
+    def warning_counts(self) -> dict:
+        """``{code: (grid cells or indices of the curves with that warning, its first text)}``
+        over the curves fitted (codes of :data:`shellbvp.fit_checks.FIT_WARNINGS`)."""
+        out = {}
+        for c, row in zip(self.curves, self.rows):
+            if row.result is None or row.status == "error":
+                continue
+            cell = c.grid if c.grid is not None else c.index
+            for code, text in zip(row.result.warning_codes, row.result.warnings):
+                where, _ = out.setdefault(code, ([], text))
+                if cell not in where:
+                    where.append(cell)
+        return out
 
     def to_hdf5(self, out, *, overwrite=False):
         """The map as a NeXus file, written atomically: ``/entry/map`` (NXdata: ``mu_H`` image

@@ -104,8 +104,10 @@ class BatchRow:
         for name, p in SHAPE_PARAMETERS.items():
             if name in r.fitted:
                 put(name, r.shape_values[name], r.shape_ci95[name], p.unit)
-                for d in p.derived:
-                    put(d.name, r.derived[d.name].value, r.derived[d.name].ci95, d.unit)
+        if "thickness" not in r.fitted and r.thickness is not None:
+            put("thickness", r.thickness, None, "m")  # given: exact, no interval
+        for name, e in r.derived.items():  # a fitted parameter's, and mu and E of a given thickness
+            put(name, e.value, e.ci95, e.unit)
         row["quality"] = r.quality
         row["model"] = r.model
         row["model error (1)"] = "" if r.model_error is None else _num(r.model_error[0])
@@ -396,7 +398,7 @@ def shared_curves(scene, name, values, grid, need, tol, *, interpolation_tol=Non
     def add(theta):
         if not curves.add(theta):
             raise ValueError(f"the model curve at {name} = {param.from_theta(theta):.4g} ends before the deepest "
-                             f"data (delta = {need:.4g}): fit shallower data, or check the units and R_L")
+                             f"data (delta = {need:.4g}): fit shallower data (--max-depth), or check the units and R_L")
 
     lo, hi = (param.to_theta(v) for v in (min(values), max(values)))
     # at least three nodes: across two a spline in theta is a straight line

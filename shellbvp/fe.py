@@ -21,6 +21,9 @@ the solid itself, so that a user sees the model's error for his own scene:
 * the depths: the mid-surface pole's displacement delta, as in the shell model (each reached
   by a secant iteration on the indenter's position), or the indenter's displacement from
   first touch, as an instrument records it (``at="indenter"``); both are reported;
+* a pressure: a follower load on the inner surface (:mod:`shellbvp.fe_pressure`), applied
+  before the indenter touches; depths from the inflated state; a sealed shell holds the
+  volume below that surface with the pressure an unknown (a bordered Newton system);
 * the force ``F / (mu R_L H)`` (nondimensional as in :func:`shellbvp.curve`).
 
 Needs FElupe (``pip install 'shellbvp[fe]'``).  Nondimensional: mu = 1, R_L = 1.
@@ -37,6 +40,7 @@ import numpy as np
 from .config import OPTIONS
 from .fe_contact import PenaltyContact, TipSurface
 from .fe_newton import Newton
+from .fe_pressure import FollowerPressure
 from .fe_rim import RIM_FACES, HingedFace
 from .materials import MATERIALS
 
@@ -112,6 +116,7 @@ class _Model:
     eps: float
     elements: tuple
     face: object = None    # HingedFace: the rim face's own unknowns (None: its dofs fixed or free)
+    pressure: object = None  # FollowerPressure on the inner surface (None: no pressure)
 
 
 def _build(scene, eps, *, through_thickness, element_length, pole_refinement, bulk, penalty, gauss_points,
@@ -166,7 +171,11 @@ def _build(scene, eps, *, through_thickness, element_length, pole_refinement, bu
     fixed = np.unique(np.concatenate([2 * axis + 1, 2 * np.asarray(held), 2 * np.asarray(held) + 1]))
     top = np.array([node(2 * n_t, j) for j in range(ncol)])  # t = +eps/2: faces the indenter
     contact = PenaltyContact(TipSurface(scene), points, top, penalty / eps, gauss_points, field, band * eps)
-    return _Model(mesh, region, field, solid, contact, fixed, node(n_t, 0), eps, (n_s, n_t), face)
+    pressure = None
+    if scene.pressurised:  # p R_L/(mu H) on the shell is P = p H/R_L on the solid's inner surface (t = -eps/2)
+        bottom = np.array([node(0, j) for j in range(ncol)])
+        pressure = FollowerPressure(points, bottom, scene.pressure * eps, int(np.sum(field.fieldsizes)), gauss_points)
+    return _Model(mesh, region, field, solid, contact, fixed, node(n_t, 0), eps, (n_s, n_t), face, pressure)
 
 
 @dataclass(frozen=True)
@@ -238,9 +247,7 @@ def coarser(settings):
 
 def check_solid_scene(scene):
     """ValueError, in one line, where the scene has no solid here (before any work): a material
-    without a 3D form, or an internal pressure."""
-    if scene.pressurised:
-        raise ValueError("pressure: the 3D reference has no internal pressure yet; use a scene with pressure 0")
+    without a 3D form."""
     _check_material(scene)
 
 
@@ -274,6 +281,9 @@ class FECurve:
         The indenter's displacement from first touch.
     contact_radius : ndarray
         Radius of the outermost surface point in contact (deformed), / R_L.
+    pressure : ndarray
+        The pressure ``p R_L/(mu H)`` at each depth: a sealed shell's (its volume held), else
+        the scene's.
     mesh_error : ndarray
         ``|F - F_coarse| / F``: the force on a mesh with 2/3 the elements each way (NaN unless
         ``mesh_check``); quadratic elements converge at least like h^2, so this bounds the
@@ -301,6 +311,7 @@ class FECurve:
     force: np.ndarray
     indenter: np.ndarray
     contact_radius: np.ndarray
+    pressure: np.ndarray
     mesh_error: np.ndarray
     success: bool
     message: str
@@ -324,7 +335,10 @@ def fe_curve(scene, thickness, deltas, *, at="pole", mesh_check=False, progress=
         Shell, indenter, material (one with a ``felupe_model``) and rim (``"pinned"``: the rim
         face held plane and turning about its mid-thickness point; ``"clamped"``: held); beta,
         xi, the bending energy and the contact model are the shell model's and play no part
-        here.  Pressurised scenes are refused.
+        here.  A pressure ``p R_L/(mu H)`` acts on the inner surface as ``p H/R_L`` (a follower
+        load, :mod:`shellbvp.fe_pressure`): the solid is inflated first, and its depths are
+        measured from the inflated state, as the shell model's.  ``sealed``: the volume below
+        the inner surface is then held, its pressure an unknown (``FECurve.pressure``).
     thickness : float
         eps = H / R_L, in (0, 0.5].
     deltas : array_like
@@ -380,7 +394,7 @@ def fe_curve(scene, thickness, deltas, *, at="pole", mesh_check=False, progress=
     if mesh_check:
         Fc = path(scene, eps, deltas, coarser(opts), None).force
         err = np.abs(out.force - Fc) / np.abs(out.force)
-    return FECurve(scene, eps, out.delta, out.force, out.indenter, out.contact_radius, err, out.success,
+    return FECurve(scene, eps, out.delta, out.force, out.indenter, out.contact_radius, out.pressure, err, out.success,
                    out.message, out.elements, settings={**opts, "at": at}, wall_time=time.perf_counter() - t0)
 
 
@@ -390,6 +404,7 @@ class _Path:
     indenter: np.ndarray
     force: np.ndarray
     contact_radius: np.ndarray
+    pressure: np.ndarray
     success: bool
     message: str
     elements: tuple
@@ -402,7 +417,7 @@ def _start(scene, eps, n, opts):
                    bulk=opts["bulk"], penalty=opts["penalty"], gauss_points=opts["gauss_points"],
                    band=opts["band"], rim_face=opts["rim_face"])
     model.contact.bind(model.mesh.points)
-    return model, Newton(model, opts["tol"], opts["delta_tol"]), _Path(*(np.full(n, np.nan) for _ in range(4)), False, "",
+    return model, Newton(model, opts["tol"], opts["delta_tol"]), _Path(*(np.full(n, np.nan) for _ in range(5)), False, "",
                                                     model.elements)
 
 
@@ -410,6 +425,7 @@ def _record(out, i, model, solver):
     _, _, F_i, rc_i = model.contact.evaluate(model.field[0].values.ravel(), with_matrix=False)
     out.force[i], out.indenter[i], out.delta[i], out.contact_radius[i] = F_i / model.eps, solver.indenter, \
         solver.delta(), rc_i
+    out.pressure[i] = solver.pressure / model.eps
 
 
 def _ended(out, message, success=False):
@@ -429,6 +445,10 @@ def _pole_path(scene, eps, deltas, opts, progress):
 
 def _march(scene, eps, targets, opts, progress, pole):
     model, solver, out = _start(scene, eps, targets.size, opts)
+    if scene.pressure and not solver.inflate():
+        return _ended(out, f"no inflated state at pressure {scene.pressure:g}")
+    if scene.sealed:
+        solver.seal()
     # a first touch under indenter control (pole control needs a contact to move the pole)
     if not solver.move(min(0.02 * eps, 0.5 * targets[0])):
         return _ended(out, "no equilibrium at first touch")

@@ -137,19 +137,21 @@ class PenaltyContact:
         self.X_ref = points[self.edges]
         self.z0 = self.apex = self.first_touch()
 
-    def first_touch(self):
-        """The apex height at which the descending indenter first touches the undeformed surface
-        (at its Gauss points): at the pole, or on a ring where the surface is more curved than the
-        tip (a bowl's inner surface under a blunter tip)."""
+    def first_touch(self, u=None):
+        """The apex height at which the descending indenter first touches the surface, undeformed
+        or displaced by ``u`` (at its Gauss points): at the pole, or on a ring where the surface
+        is more curved than the tip (a bowl's inner surface under a blunter tip)."""
         from scipy.optimize import brentq
 
-        xq = self._at_points(np.zeros(self.ndof_u))
+        u = np.zeros(self.ndof_u) if u is None else np.asarray(u)[: self.ndof_u]
+        xq = self._at_points(u)
+        pole = float(self.X_ref[0, 0, 0] + u[2 * self.edges[0, 0]])
         gap = lambda apex: float(np.min(self.tip.distance(xq, apex)[0]))  # noqa: E731
-        hi = self.z0 + 1.0
+        hi = pole + 1.0
         while gap(hi) <= 0:  # the tip above every point it could reach
             hi += 1.0
-        lo = self.z0  # the apex at the pole: touching there, or already through a ring
-        return self.z0 if gap(lo) >= 0 else brentq(gap, lo, hi, xtol=1e-14, rtol=1e-14)
+        lo = pole  # the apex at the pole: touching there, or already through a ring
+        return lo if gap(lo) >= 0 else brentq(gap, lo, hi, xtol=1e-14, rtol=1e-14)
 
     def evaluate(self, u, with_matrix=True):
         from scipy.sparse import coo_matrix

@@ -96,16 +96,28 @@ class Newton:
         self.shift = np.zeros(ndof)  # a rigid axial shift of the displacement field
         self.shift[0:model.contact.ndof_u:2] = 1.0
         self.newton_iterations = 0
+        self.pole0 = 0.0  # the pole's axial displacement that delta is measured from (the inflated state's)
+        self.V0 = None    # a sealed shell's volume (held, the pressure an unknown); None: the pressure given
         self.history = [self.save()]  # converged states (values, indenter, delta) for the predictor
 
     # ------------------------------------------------------------ state
     def save(self):
-        return [f.values.copy() for f in self.m.field.fields], self.indenter, self.delta()
+        return [f.values.copy() for f in self.m.field.fields], self.indenter, self.delta(), self.pressure
 
     def restore(self, saved):
-        values, self.indenter, _ = saved
+        values, self.indenter, _, self.pressure = saved
         for f, v in zip(self.m.field.fields, values):
             f.values[...] = v
+
+    @property
+    def pressure(self):
+        """The pressure on the inner surface (mu), 0 without one."""
+        return 0.0 if self.m.pressure is None else self.m.pressure.P
+
+    @pressure.setter
+    def pressure(self, P):
+        if self.m.pressure is not None:
+            self.m.pressure.P = P
 
     @property
     def indenter(self):
@@ -118,7 +130,7 @@ class Newton:
 
     def delta(self):
         """The mid-surface pole's displacement, positive down."""
-        return -float(self.m.field[0].values[self.m.pole_mid, 0])
+        return self.pole0 - float(self.m.field[0].values[self.m.pole_mid, 0])
 
     def _remember(self):
         self.history = (self.history + [self.save()])[-3:]
@@ -138,15 +150,24 @@ class Newton:
             f.values[...] = x1 + t * (x1 - x0)
         if pole:
             self.indenter = h1[1] + t * (h1[1] - h0[1])
+        if self.V0 is not None:
+            self.pressure = h1[3] + t * (h1[3] - h0[3])
 
     # ------------------------------------------------------------ the system
     def residual(self):
-        """``(r, r_contact, K_contact, F)`` at the current state (full dofs)."""
+        """``(r, load, K_load, F)`` at the current state (full dofs): the residual, the norm of the
+        loads it is measured against (the contact's and the pressure's), their tangent and the
+        indenter's force.  (A rigid axial shift leaves the pressure's load unchanged: the pole
+        control's border is the contact's alone.)"""
         m = self.m
+        u = m.field[0].values.ravel()
         with np.errstate(invalid="ignore", divide="ignore", over="ignore"):  # trial states may invert
             r = np.asarray(m.solid.assemble.vector(m.field).todense()).ravel()
-        rc, Kc, F, _ = m.contact.evaluate(m.field[0].values.ravel())
-        return r + rc, rc, Kc, F
+        rc, Kc, F, _ = m.contact.evaluate(u)
+        if m.pressure is None:
+            return r + rc, np.linalg.norm(rc), Kc, F
+        rp, Kp = m.pressure.evaluate(u)
+        return r + rc + rp, np.linalg.norm(rc) + np.linalg.norm(rp), Kc + Kp, F
 
     def system(self, r, K):
         """``(K_reduced, r_reduced, J)``: the Newton system in the unknowns the rim leaves free
@@ -185,7 +206,7 @@ class Newton:
         self._predict(delta if pole else a, pole)
         if m.face is not None:
             m.face.project(m.field[0].values)  # the predictor extrapolates off the face's line
-        r, rc, Kc, F = self.residual()
+        r, load, K_load, F = self.residual()
         du = np.inf
         for it in range(self.max_iterations):
             rf = self.system(r, None)[1]
@@ -194,22 +215,17 @@ class Newton:
                 break
             # converged: the residual small against the contact force, or (at loads so small that
             # the residual meets rounding first) a full Newton step that moved nothing
-            if it > 0 and (norm <= self.tol * np.linalg.norm(rc) or du <= 1e-13) and self._on_target(delta):
+            if it > 0 and (norm <= self.tol * load or du <= 1e-13) and self._on_target(delta):
                 return self._converged(it, F)
-            K, rr, J = self.system(r, m.solid.assemble.matrix(m.field) + Kc)
+            K, rr, J = self.system(r, m.solid.assemble.matrix(m.field) + K_load)
             try:
                 lu = LinearSolve(K)
-                dq, da = lu.solve(-rr), 0.0
-                if pole:  # the indenter's step that puts the pole at delta
-                    b = Kc @ self.shift
-                    x2 = lu.solve(b[self.free] if J is None else J.T @ b)
-                    with np.errstate(divide="ignore", invalid="ignore"):  # no contact: no indenter step
-                        da = (dq[self.pole] + delta - self.delta()) / x2[self.pole]
-                        dq = dq - da * x2
-            except RuntimeError:  # singular: no equilibrium from here
+                dq = lu.solve(-rr)
+                dq, da, dP = self._bordered(lu, dq, K_load, J, delta)
+            except (RuntimeError, np.linalg.LinAlgError):  # singular: no equilibrium from here
                 break
             full = self._full(dq, J)
-            if not (np.all(np.isfinite(full)) and np.isfinite(da)) or np.max(np.abs(full[: m.contact.ndof_u])) > 0.5:
+            if not (np.all(np.isfinite(full)) and np.isfinite(da + dP)) or np.max(np.abs(full[: m.contact.ndof_u])) > 0.5:
                 break
             # backtracking on the residual's norm (a full step may raise it): contact enters and
             # leaves the active set
@@ -217,8 +233,8 @@ class Newton:
             base = self.save()
             for _ in range(8):
                 self.advance(dq, step)
-                self.indenter = base[1] + step * da
-                r, rc, Kc, F = self.residual()
+                self.indenter, self.pressure = base[1] + step * da, base[3] + step * dP
+                r, load, K_load, F = self.residual()
                 new = np.linalg.norm(self.system(r, None)[1])
                 if np.isfinite(new) and new <= (1 - 1e-4 * step) * norm * (GROW if step == 1.0 else 1.0):
                     du = np.max(np.abs(full[: m.contact.ndof_u])) if step == 1.0 else np.inf
@@ -226,17 +242,50 @@ class Newton:
                 self.restore(base)
                 step *= 0.5
             else:
-                r, rc, Kc, F = self.residual()
-                if norm <= STALL * np.linalg.norm(rc) and self._on_target(delta):  # stalled at rounding
+                r, load, K_load, F = self.residual()
+                if norm <= STALL * load and self._on_target(delta):  # stalled at rounding
                     return self._converged(it + 1, F)
                 self.advance(dq, step)  # no descent: take the short step and go on
-                self.indenter = base[1] + step * da
-                r, rc, Kc, F = self.residual()
+                self.indenter, self.pressure = base[1] + step * da, base[3] + step * dP
+                r, load, K_load, F = self.residual()
         self.restore(saved)
         return False
 
+    def _bordered(self, lu, dq, K_load, J, delta):
+        """``(dq, da, dP)``: the Newton step ``dq = K^-1 (-r)`` corrected for the bordered
+        unknowns -- the indenter's position under pole control (the pole at ``delta``), a sealed
+        shell's pressure (the volume at ``V0``) -- each with its linearised constraint (a Schur
+        complement of one or two rows)."""
+        cols, rows, rhs = [], [], []
+        reduced = (lambda v: v[self.free]) if J is None else (lambda v: J.T @ v)  # noqa: E731
+        if delta is not None:
+            cols.append(reduced(K_load @ self.shift))
+            row = np.zeros(dq.size)
+            row[self.pole] = 1.0
+            rows.append(row)
+            rhs.append(self.delta() - delta)
+        if self.V0 is not None:
+            u = self.m.field[0].values.ravel()
+            g = reduced(self.m.pressure.gradient(u))
+            cols.append(-g)
+            rows.append(g)
+            rhs.append(self.V0 - self.m.pressure.volume(u))
+        if not cols:
+            return dq, 0.0, 0.0
+        X = np.column_stack([lu.solve(c) for c in cols])
+        R = np.array(rows)
+        y = np.linalg.solve(R @ X, R @ dq - np.array(rhs))
+        return dq - X @ y, (y[0] if delta is not None else 0.0), (y[-1] if self.V0 is not None else 0.0)
+
+    def seal(self):
+        """From here on the volume below the inner surface is held (its pressure an unknown)."""
+        self.V0 = self.m.pressure.volume(self.m.field[0].values.ravel())
+        self.history = [self.save()]
+
     def _on_target(self, delta):
-        return delta is None or abs(self.delta() - delta) <= self._delta_tol(delta)
+        volume_held = self.V0 is None or abs(self.m.pressure.volume(self.m.field[0].values.ravel()) - self.V0) <= \
+            1e-10 * abs(self.V0)
+        return volume_held and (delta is None or abs(self.delta() - delta) <= self._delta_tol(delta))
 
     def _delta_tol(self, delta):
         return self.delta_tol * max(delta, self.m.eps)
@@ -245,6 +294,26 @@ class Newton:
         self.newton_iterations += iterations
         self.force = F
         self._remember()
+        return True
+
+    def inflate(self, first=0.25, smallest=1e-3):
+        """The pressure's load factor from 0 to 1 with the indenter away (steps grow after a
+        success and halve after a failure); the inflated state is then the path's start: first
+        touch on its surface, delta measured from its pole.  False where it is not reached."""
+        load, done, step = self.m.pressure, 0.0, first
+        self.indenter = -1.0  # the tip one R_L above the surface: no contact while inflating
+        while done < 1.0:
+            load.scale = min(1.0, done + step)
+            if self.solve(self.indenter):
+                done, step = load.scale, 1.5 * step
+            else:
+                load.scale, step = done, 0.5 * step
+                if step < smallest:
+                    return False
+        u = self.m.field[0].values
+        self.pole0 = float(u[self.m.pole_mid, 0])
+        self.m.contact.z0 = self.m.contact.apex = self.m.contact.first_touch(u.ravel())
+        self.history = [self.save()]
         return True
 
     def move(self, a, min_fraction=1e-3):

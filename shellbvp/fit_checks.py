@@ -10,8 +10,8 @@ import numpy as np
 from scipy import special
 
 __all__ = ["FIT_STATUS", "FIT_WARNINGS", "PLAUSIBLE_MU_H", "TREND_P", "RUNS_P", "RUNS_MIN_POINTS", "QUALITY_RULES",
-           "rank_trend", "runs_test", "runs_in_depth_order", "fit_diagnostics", "fit_quality", "diagnostics_lines",
-           "check_result"]
+           "CONTACT_MISFIT", "POOR_WARNINGS", "rank_trend", "runs_test", "runs_in_depth_order", "contact_misfit",
+           "fit_diagnostics", "fit_quality", "diagnostics_lines", "check_result"]
 
 
 #: Outcomes of a fit that ran (``FitResult.status``); ``success`` is ``status == 0``.
@@ -29,6 +29,8 @@ FIT_STATUS = {
 #: Kinds of warning (``FitResult.warning_codes``; the texts are in ``FitResult.warnings``).
 FIT_WARNINGS = {
     "residual_runs": "the residuals' signs form long runs (runs test): the model does not follow the data",
+    "contact_misfit": "where the model carries force (beyond the contact point) its residuals are systematic and "
+                      "large: the model misses the contact region (rated poor)",
     "implausible_mu_H": "mu*H is far outside the values of soft shells (PLAUSIBLE_MU_H): check the units",
     "search_range": "a shape parameter's interval or search reached the end of its range",
     "max_curves": "the number of model curves reached its limit",
@@ -53,6 +55,16 @@ RUNS_P = 1e-3
 
 
 RUNS_MIN_POINTS = 10
+
+
+#: A systematic residual in the contact region that rates a fit poor: the largest mean residual
+#: over a tenth of the rows where the model carries force (in depth order), as a fraction of the
+#: largest force the model carries there, when those rows' signs also fail the runs test.
+CONTACT_MISFIT = 0.05
+
+
+#: Warnings that rate a fit poor whatever its interval (:func:`fit_quality`).
+POOR_WARNINGS = ("contact_misfit",)
 
 
 def _average_ranks(x):
@@ -106,6 +118,22 @@ def runs_in_depth_order(resid, disp):
     return runs_test(resid[np.argsort(disp, kind="stable")])
 
 
+def contact_misfit(resid, disp, indentation):
+    """The residuals where the model carries force (``indentation > 0``: beyond the contact
+    point), in depth order: ``(runs, p, n, largest)`` with :func:`runs_test`'s runs and p on
+    those ``n`` rows and ``largest``, the largest mean residual over a tenth of them relative to
+    the largest ``indentation`` there (a misfit averages to a trend, noise to ~0); None for
+    fewer than :data:`RUNS_MIN_POINTS` such rows or a residual that is not finite there."""
+    carries = np.asarray(indentation, float) > 0
+    r = np.asarray(resid, float)[carries]
+    if r.size < RUNS_MIN_POINTS or not np.all(np.isfinite(r)):
+        return None
+    r = r[np.argsort(np.asarray(disp, float)[carries], kind="stable")]
+    runs, p = runs_test(r)
+    trend = max(abs(float(np.mean(b))) for b in np.array_split(r, 10))
+    return runs, p, int(r.size), trend / float(np.max(np.asarray(indentation, float)[carries]))
+
+
 def fit_diagnostics(cov, rss, n, k, weighted_resid, disp, runs) -> dict:
     """The fit's correlation matrix (order of ``fitted``), the noise scale, AIC and BIC and two
     residual diagnostics (the runs test's p, ``runs``, and the lag-1 autocorrelation in depth order)."""
@@ -137,8 +165,9 @@ QUALITY_RULES = {"good_halfwidth": 0.05, "fair_halfwidth": 0.20, "good_correlati
 def fit_quality(success, warning_codes, mu_H, mu_ci, correlation=None, fitted=(), model_error=None) -> str:
     """A transparent rating of one fit: ``good``, ``fair`` or ``poor``.
 
-    * poor: the fit failed its checks, mu*H's 95 % interval is wider than +-20 % of it, or the
-      model's own error (``model_error``, a fraction, where known) is larger than that
+    * poor: the fit failed its checks, a warning of :data:`POOR_WARNINGS` (the model misses the
+      contact region), mu*H's 95 % interval is wider than +-20 % of it, or the model's own error
+      (``model_error``, a fraction, where known) is larger than that
       interval: then the interval does not say how well mu*H is known;
     * good: succeeded without warnings, the interval within +-5 %, and mu*H not correlated with
       another fitted parameter beyond abs(r) = 0.98 (then the data cannot tell them apart);
@@ -146,7 +175,8 @@ def fit_quality(success, warning_codes, mu_H, mu_ci, correlation=None, fitted=()
 
     The rules are :data:`QUALITY_RULES`; nanite rates curves with a trained regressor instead.
     """
-    if not success or not (mu_H > 0) or not all(math.isfinite(v) for v in mu_ci):
+    if not success or not (mu_H > 0) or not all(math.isfinite(v) for v in mu_ci) or \
+            any(code in POOR_WARNINGS for code in warning_codes):
         return "poor"
     half = (mu_ci[1] - mu_ci[0]) / 2 / mu_H
     if half > QUALITY_RULES["fair_halfwidth"] or (model_error is not None and model_error > half):
@@ -182,8 +212,9 @@ def diagnostics_lines(quality, fitted, correlation, values, show_force=lambda v:
     return [f"quality = {quality} ({rules})", "diagnostics = " + ("; ".join(parts) if parts else "none")]
 
 
-def check_result(res_ok, mu_H, mu_ci, off_ci, resid_ok, n, runs):
-    """Status and warnings of a fitted result (see :data:`FIT_STATUS`, :data:`FIT_WARNINGS`)."""
+def check_result(res_ok, mu_H, mu_ci, off_ci, resid_ok, n, runs, contact=None):
+    """Status and warnings of a fitted result (see :data:`FIT_STATUS`, :data:`FIT_WARNINGS`);
+    ``contact``: :func:`contact_misfit` of the fit, or None."""
     warnings = []
     if not res_ok:
         status = 1
@@ -201,6 +232,14 @@ def check_result(res_ok, mu_H, mu_ci, off_ci, resid_ok, n, runs):
         warnings.append(("residual_runs", f"the residuals' signs form {runs[0]} runs over {n} points "
                          f"(runs test p = {runs[1]:.2g} < {RUNS_P:g}): a pattern the noise model does not explain; "
                          "the model (scene, contact point, weights) does not follow the data"))
+    if contact is not None and contact[1] < RUNS_P and contact[3] > CONTACT_MISFIT:
+        warnings.append(("contact_misfit", f"the model misses the contact region: where it carries force "
+                         f"({contact[2]} rows beyond the contact point) its residuals run in {contact[0]} runs "
+                         f"(p = {contact[1]:.2g}) "
+                         f"and their mean over a tenth of those rows reaches {100 * contact[3]:.0f} % of the force "
+                         "there (rated poor; mu*H does not describe these data); plot the fit (shellbvp plot), try "
+                         "another --weights, a fitting range (--max-depth), --baseline linear, and check the scene "
+                         "(indenter radius, rise, thickness) and the segment"))
     lo, hi = PLAUSIBLE_MU_H
     if status != 2 and math.isfinite(mu_H) and not lo <= mu_H <= hi:
         warnings.append(("implausible_mu_H", f"mu*H = {mu_H:.3g} N/m is far outside the range of soft shells "

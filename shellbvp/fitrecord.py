@@ -23,7 +23,8 @@ SI units, ``"1"`` nondimensional, ``""`` text)::
     /fit/parameters            NXparameters: mu_H (N/m), offset (m), baseline (N),
                                baseline_slope (N/m), R_L (m), residual_rms (N), n_points (1),
                                noise_sigma (N), aic, bic, runs_p, residual_autocorrelation, model_error
-                               (1: the shell model's error beside the interval; NaN: none), and every
+                               (1: the shell model's error beside the interval; NaN: none), max_depth
+                               (m: the fitting range's deepest depth; NaN: all data), and every
                                shape parameter and derived quantity of shellbvp.shape_parameters
                                (beta (1), alpha (1, NaN for other materials), pressure (1), pressure_Pa
                                (Pa, NaN unless fitted), ...) -- scalars; correlation (k, k); <name>_ci95
@@ -55,7 +56,7 @@ from pathlib import Path
 import numpy as np
 
 from .nexus import DIMENSIONLESS, number_dataset, string_dataset
-from .paths import atomic_file, check_output_path, open_hdf5
+from .paths import atomic_hdf5, check_output_path, open_hdf5
 from .shape_parameters import DERIVED, SHAPE_PARAMETERS
 from .version import __version__
 
@@ -67,7 +68,8 @@ FIT_FORMAT_VERSION = 1
 #: The fit's own scalar parameters in ``/fit/parameters`` with their units.
 _FIT_UNITS = {"mu_H": "N/m", "offset": "m", "baseline": "N", "baseline_slope": "N/m", "R_L": "m", "residual_rms": "N",
               "n_points": DIMENSIONLESS, "noise_sigma": "N", "aic": DIMENSIONLESS, "bic": DIMENSIONLESS,
-              "runs_p": DIMENSIONLESS, "residual_autocorrelation": DIMENSIONLESS, "model_error": DIMENSIONLESS}
+              "runs_p": DIMENSIONLESS, "residual_autocorrelation": DIMENSIONLESS, "model_error": DIMENSIONLESS,
+              "max_depth": "m"}
 #: Units of the scalar parameters in ``/fit/parameters``: the fit's own, every shape parameter's and
 #: every derived quantity's (:mod:`shellbvp.shape_parameters`).
 PARAMETER_UNITS = {**_FIT_UNITS, **{p.name: p.unit for p in SHAPE_PARAMETERS.values()},
@@ -169,88 +171,88 @@ def write_fit(path, result, record, used, *, segment="loading", overwrite=False)
     weight = np.full(d.size, np.nan)
     if result.point_weights is not None and np.sum(used) == result.point_weights.size:
         weight[used] = result.point_weights
-    with atomic_file(path) as tmp:
-        with h5py.File(tmp, "w") as h:
-            h.attrs.update({"format": FIT_FORMAT, "format_version": FIT_FORMAT_VERSION,
-                            "package_version": __version__, "NX_class": "NXroot", "default": "fit",
-                            "created": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds")})
-            e = h.create_group("fit")
-            e.attrs.update({"NX_class": "NXentry", "default": "data", "program_name": f"shellbvp {__version__}",
-                            "title": f"fit of mu*H to {Path(record.path).name}", "success": bool(result.success),
-                            "status": int(result.status), "message": result.message})
-            g = e.create_group("data")
-            g.attrs.update({"NX_class": "NXdata", "signal": "force",
-                            "axes": np.array(["displacement"], dtype=h5py.string_dtype()),
-                            "auxiliary_signals": np.array(["model_force"], dtype=h5py.string_dtype())})
-            number_dataset(g, "displacement", d, "m", "indenter displacement (as read)")
-            number_dataset(g, "force", f, "N", "force (as read)")
-            if record.time is not None:
-                number_dataset(g, "time", record.time, "s", "time")
-            number_dataset(g, "used", np.asarray(used, bool), DIMENSIONLESS, "row fitted")
-            string_dataset(g, "segment", [str(s) for s in record.segments], "segment of the record")
-            number_dataset(g, "line", np.asarray(record.line, int), DIMENSIONLESS, "line in the source file")
-            number_dataset(g, "model_force", model_force, "N", "fitted model force (baseline included)")
-            number_dataset(g, "residual", model_force - f, "N", "model - data")
-            number_dataset(g, "weight", weight, DIMENSIONLESS, "noise model weight 1/sigma (largest 1)")
-            m = e.create_group("model")
-            m.attrs.update({"NX_class": "NXdata", "signal": "force",
-                            "axes": np.array(["displacement"], dtype=h5py.string_dtype())})
-            c = result.curve
-            delta, F = np.r_[0.0, np.asarray(c.delta, float)], np.r_[0.0, np.asarray(c.force, float)]
-            x = result.offset + result.R_L * delta
-            number_dataset(m, "displacement", x, "m", "displacement: offset + R_L delta")
-            number_dataset(m, "force", result.model_force(x), "N", "model force: baseline + mu_H R_L F")
-            number_dataset(m, "delta", delta, DIMENSIONLESS, "indenter displacement / R_L (the 3D solid's)"
-                           if result.model == "solid" else "pole displacement / R_L")
-            number_dataset(m, "F", F, DIMENSIONLESS, "force / (mu H R_L)")
-            p = e.create_group("parameters")
-            p.attrs.update({"NX_class": "NXparameters", "baseline_model": result.baseline_model,
-                            "weights": result.weights, "segment": segment, "model": result.model,
-                            "model_note": result.model_note, "model_error_source": _error_source(result),
-                            "stability_verdict": getattr(result, "stability_verdict", "stability: not checked"),
-                            "fitted": np.array(list(result.fitted), dtype=h5py.string_dtype())})
-            values = {"mu_H": result.mu_H, "offset": result.offset, "baseline": result.baseline,
-                      "baseline_slope": result.baseline_slope, "R_L": result.R_L,
-                      "residual_rms": result.residual_rms, "n_points": result.n,
-                      "model_error": math.nan if result.model_error is None else result.model_error[0],
-                      **{k: getattr(result, k) for k in ("noise_sigma", "aic", "bic", "runs_p",
-                                                          "residual_autocorrelation")},
-                      **{k: np.nan if getattr(result, k) is None else getattr(result, k)
-                         for k in (*SHAPE_PARAMETERS, *DERIVED)}}
-            for name, v in values.items():
-                number_dataset(p, name, float(v), PARAMETER_UNITS[name])
-            if result.correlation is not None:
-                number_dataset(p, "correlation", np.asarray(result.correlation, float), DIMENSIONLESS,
-                               "correlation of the fitted parameters (rows and columns in the order of fitted)")
-            for name in _with_intervals(result):
-                number_dataset(p, f"{name}_ci95", np.asarray(getattr(result, f"{name}_ci95"), float),
-                               PARAMETER_UNITS[name], f"95 % interval of {name}")
-            first = getattr(result, "first_instability", None)
-            if first is not None:  # fit(stability=True) found the shell unstable within the fitted depths
-                number_dataset(p, "first_instability_delta", float(first.delta), DIMENSIONLESS,
-                               "where the axisymmetric shell first loses stability: pole displacement / R_L")
-                number_dataset(p, "first_instability_displacement", result.offset + result.R_L * float(first.delta),
-                               "m", "the same as a displacement of the data (offset + R_L delta)")
-                number_dataset(p, "first_instability_mode", int(first.mode), DIMENSIONLESS,
-                               "the Fourier mode n that goes unstable")
-            w = string_dataset(e, "warnings", list(result.warnings), "warnings of the fit")
-            w.attrs["codes"] = np.array(list(result.warning_codes), dtype=h5py.string_dtype())
-            s = e.create_group("sample")
-            s.attrs["NX_class"] = "NXsample"
-            scene = result.scene.to_dict()
-            s.attrs["scene"] = json.dumps(scene, sort_keys=True)
-            for k, v in scene.items():
-                if not isinstance(v, dict):
-                    s.attrs[f"scene_{k}"] = v
-            src = e.create_group("source")
-            src.attrs["NX_class"] = "NXnote"
-            string_dataset(src, "file_name", str(record.path))
-            string_dataset(src, "sha256", record.sha256)
-            string_dataset(src, "columns", json.dumps({k: str(v) for k, v in record.columns.items()}))
-            string_dataset(src, "units", json.dumps(record.units, ensure_ascii=False))
-            string_dataset(src, "inverted", json.dumps(list(getattr(record, "inverted", ()))))
-            string_dataset(src, "notes", json.dumps(list(getattr(record, "notes", ())), ensure_ascii=False),
-                           "what reading left out of the source file and why (JSON list of text)")
+    with atomic_hdf5(path) as h:  # built in memory: a full disk is one OSError naming the file
+        h.attrs.update({"format": FIT_FORMAT, "format_version": FIT_FORMAT_VERSION,
+                        "package_version": __version__, "NX_class": "NXroot", "default": "fit",
+                        "created": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds")})
+        e = h.create_group("fit")
+        e.attrs.update({"NX_class": "NXentry", "default": "data", "program_name": f"shellbvp {__version__}",
+                        "title": f"fit of mu*H to {Path(record.path).name}", "success": bool(result.success),
+                        "status": int(result.status), "message": result.message})
+        g = e.create_group("data")
+        g.attrs.update({"NX_class": "NXdata", "signal": "force",
+                        "axes": np.array(["displacement"], dtype=h5py.string_dtype()),
+                        "auxiliary_signals": np.array(["model_force"], dtype=h5py.string_dtype())})
+        number_dataset(g, "displacement", d, "m", "indenter displacement (as read)")
+        number_dataset(g, "force", f, "N", "force (as read)")
+        if record.time is not None:
+            number_dataset(g, "time", record.time, "s", "time")
+        number_dataset(g, "used", np.asarray(used, bool), DIMENSIONLESS, "row fitted")
+        string_dataset(g, "segment", [str(s) for s in record.segments], "segment of the record")
+        number_dataset(g, "line", np.asarray(record.line, int), DIMENSIONLESS, "line in the source file")
+        number_dataset(g, "model_force", model_force, "N", "fitted model force (baseline included)")
+        number_dataset(g, "residual", model_force - f, "N", "model - data")
+        number_dataset(g, "weight", weight, DIMENSIONLESS, "noise model weight 1/sigma (largest 1)")
+        m = e.create_group("model")
+        m.attrs.update({"NX_class": "NXdata", "signal": "force",
+                        "axes": np.array(["displacement"], dtype=h5py.string_dtype())})
+        c = result.curve
+        delta, F = np.r_[0.0, np.asarray(c.delta, float)], np.r_[0.0, np.asarray(c.force, float)]
+        x = result.offset + result.R_L * delta
+        number_dataset(m, "displacement", x, "m", "displacement: offset + R_L delta")
+        number_dataset(m, "force", result.model_force(x), "N", "model force: baseline + mu_H R_L F")
+        number_dataset(m, "delta", delta, DIMENSIONLESS, "indenter displacement / R_L (the 3D solid's)"
+                       if result.model == "solid" else "pole displacement / R_L")
+        number_dataset(m, "F", F, DIMENSIONLESS, "force / (mu H R_L)")
+        p = e.create_group("parameters")
+        p.attrs.update({"NX_class": "NXparameters", "baseline_model": result.baseline_model,
+                        "weights": result.weights, "segment": segment, "model": result.model,
+                        "model_note": result.model_note, "model_error_source": _error_source(result),
+                        "stability_verdict": getattr(result, "stability_verdict", "stability: not checked"),
+                        "fitted": np.array(list(result.fitted), dtype=h5py.string_dtype())})
+        values = {"mu_H": result.mu_H, "offset": result.offset, "baseline": result.baseline,
+                  "baseline_slope": result.baseline_slope, "R_L": result.R_L,
+                  "residual_rms": result.residual_rms, "n_points": result.n,
+                  "model_error": math.nan if result.model_error is None else result.model_error[0],
+                  "max_depth": math.nan if result.max_depth is None else result.max_depth,
+                  **{k: getattr(result, k) for k in ("noise_sigma", "aic", "bic", "runs_p",
+                                                      "residual_autocorrelation")},
+                  **{k: np.nan if getattr(result, k) is None else getattr(result, k)
+                     for k in (*SHAPE_PARAMETERS, *DERIVED)}}
+        for name, v in values.items():
+            number_dataset(p, name, float(v), PARAMETER_UNITS[name])
+        if result.correlation is not None:
+            number_dataset(p, "correlation", np.asarray(result.correlation, float), DIMENSIONLESS,
+                           "correlation of the fitted parameters (rows and columns in the order of fitted)")
+        for name in _with_intervals(result):
+            number_dataset(p, f"{name}_ci95", np.asarray(getattr(result, f"{name}_ci95"), float),
+                           PARAMETER_UNITS[name], f"95 % interval of {name}")
+        first = getattr(result, "first_instability", None)
+        if first is not None:  # fit(stability=True) found the shell unstable within the fitted depths
+            number_dataset(p, "first_instability_delta", float(first.delta), DIMENSIONLESS,
+                           "where the axisymmetric shell first loses stability: pole displacement / R_L")
+            number_dataset(p, "first_instability_displacement", result.offset + result.R_L * float(first.delta),
+                           "m", "the same as a displacement of the data (offset + R_L delta)")
+            number_dataset(p, "first_instability_mode", int(first.mode), DIMENSIONLESS,
+                           "the Fourier mode n that goes unstable")
+        w = string_dataset(e, "warnings", list(result.warnings), "warnings of the fit")
+        w.attrs["codes"] = np.array(list(result.warning_codes), dtype=h5py.string_dtype())
+        s = e.create_group("sample")
+        s.attrs["NX_class"] = "NXsample"
+        scene = result.scene.to_dict()
+        s.attrs["scene"] = json.dumps(scene, sort_keys=True)
+        for k, v in scene.items():
+            if not isinstance(v, dict):
+                s.attrs[f"scene_{k}"] = v
+        src = e.create_group("source")
+        src.attrs["NX_class"] = "NXnote"
+        string_dataset(src, "file_name", str(record.path))
+        string_dataset(src, "sha256", record.sha256)
+        string_dataset(src, "columns", json.dumps({k: str(v) for k, v in record.columns.items()}))
+        string_dataset(src, "units", json.dumps(record.units, ensure_ascii=False))
+        string_dataset(src, "inverted", json.dumps(list(getattr(record, "inverted", ()))))
+        string_dataset(src, "notes", json.dumps(list(getattr(record, "notes", ())), ensure_ascii=False),
+                       "what reading left out of the source file and why (JSON list of text)")
 
 
 def _error_source(result):

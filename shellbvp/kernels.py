@@ -157,6 +157,32 @@ def _import_kernels(src: Path, key: str):
     return mod
 
 
+def _discard_compiled(src: Path) -> None:
+    """Remove numba's cache files of ``src`` and its marker (they failed to load: damaged or
+    from another numba), so that the next compile rebuilds them and later runs read them as
+    not compiled rather than warn again."""
+    for f in [_marker(src), *(src.parent / "__pycache__").glob(src.stem + ".*.nb[ic]")]:
+        try:
+            f.unlink()
+        except FileNotFoundError:
+            pass
+
+
+def _load_compiled(src: Path, key: str, desc: dict):
+    """Import the compiled kernels of ``src``; where numba's cache of them fails to load (a
+    damaged file: UnpicklingError, EOFError, ...), one warning, the cache discarded and the
+    kernels compiled again.  ``(module, seconds compiling)``: 0 when loaded."""
+    if why := untrusted_reason(src) or _untrusted_cache(src):
+        raise ImportError(f"not loading compiled kernels: {why}")
+    try:
+        return _import_kernels(src, key), 0.0
+    except Exception as exc:  # numba's loader raises what unpickling a damaged file raises
+        log.warning("the compiled kernels of %s could not be loaded (%s: %s); compiling them again",
+                    src.name, type(exc).__name__, " ".join(str(exc).split())[:200])
+    _discard_compiled(src)
+    return _compile_here(src, key, desc)
+
+
 def _compile_here(src: Path, key: str, desc: dict):
     """Generate the source if need be, compile it in this process and mark it compiled."""
     if not holds_key(src, key):
@@ -371,7 +397,9 @@ class KernelSet:
                 mod, seconds = _compile_here(src, key, desc)
                 log.info("compiled kernels %s in %.1f s", src.name, seconds)
             else:
-                mod = _import_kernels(src, key)
+                mod, seconds = _load_compiled(src, key, desc)
+                if seconds:
+                    log.info("compiled kernels %s in %.1f s", src.name, seconds)
             self._use(mod)
             return
         if not _ready(src, key):
@@ -387,7 +415,14 @@ class KernelSet:
                 raise RuntimeError(f"the compile process failed (exit {rc}); its output: "
                                    f"{src.with_suffix('.log')}")
         t0 = time.perf_counter()
-        mod = _import_kernels(src, key)
+        try:
+            mod = _import_kernels(src, key)
+        except Exception as exc:  # a damaged cache: discarded, so later runs read "not compiled", no warning
+            if isinstance(exc, ImportError) and str(exc).startswith("not loading"):
+                raise
+            _discard_compiled(src)
+            raise RuntimeError(f"numba's cache of them failed to load ({type(exc).__name__}: {exc}); it is "
+                               f"discarded: `shellbvp compile` builds it again") from None
         self._use(mod)
         log.info("compiled kernels %s loaded in %.2f s; the solver uses them from now on", src.name,
                  time.perf_counter() - t0)
@@ -436,10 +471,20 @@ def compile_for(scene) -> tuple[str, float]:
     if _numba_version() is None:
         raise ImportError("compiled kernels need numba: pip install 'shellbvp[fast]'")
     model = scene.model()
-    fresh = not _ready(kernel_path(scene.structure()), model.KEY)
+    src = kernel_path(scene.structure())
+    marked = _marker_time(src)
     t0 = time.perf_counter()
     KernelSet(model, "numba").start(scene.structure)
-    return ("compiled" if fresh else "loaded"), time.perf_counter() - t0
+    compiled = marked is None or _marker_time(src) != marked  # a damaged cache is compiled again
+    return ("compiled" if compiled else "loaded"), time.perf_counter() - t0
+
+
+def _marker_time(src: Path) -> int | None:
+    """When the kernels of ``src`` were last marked compiled (None: not compiled)."""
+    try:
+        return _marker(src).stat().st_mtime_ns if _compiled(src) else None
+    except OSError:
+        return None
 
 
 def main(argv=None) -> int:

@@ -167,6 +167,9 @@ def write_atomic(path: Path, text: str) -> None:
             fh.write(text)
         os.chmod(tmp, 0o644)  # mkstemp makes 0600; never group- or world-writable
         os.replace(tmp, path)
+    except OSError as exc:  # a full disk: one error naming the file
+        Path(tmp).unlink(missing_ok=True)
+        raise OSError(exc.errno, f"cannot write {path}: {exc.strerror or exc}") from None
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise

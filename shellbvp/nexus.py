@@ -88,12 +88,13 @@ def string_dataset(group, name, values, long_name=None):
 
 
 def file_header(f, fmt: str, version: int) -> None:
-    """The root attributes every file of the package carries: format, format_version,
-    package_version and the time it was created (UTC)."""
+    """The root attributes every file of the package carries: NX_class (NXroot), format,
+    format_version, package_version and the time it was created (UTC)."""
     import datetime as _dt
 
     from .version import __version__
 
+    f.attrs["NX_class"] = "NXroot"
     f.attrs["format"] = fmt
     f.attrs["format_version"] = version
     f.attrs["package_version"] = __version__
@@ -107,16 +108,13 @@ def new_file(path, fmt: str, version: int, *, overwrite: bool = False):
     their units (:func:`label_units`) and the file replaces ``path``, on any error nothing does."""
     from pathlib import Path
 
-    import h5py
-
-    from .paths import atomic_file, check_output_path
+    from .paths import atomic_hdf5, check_output_path
 
     path = Path(path)
     if path.exists() and not overwrite:
         raise FileExistsError(f"{path} exists; pass overwrite=True (CLI: --overwrite) to replace it")
     check_output_path(path, overwrite=True)
-    with atomic_file(path) as tmp:
-        with h5py.File(tmp, "w") as f:
-            file_header(f, fmt, version)
-            yield f
-        label_units(tmp)  # every dataset says its unit (nondimensional: "1")
+    with atomic_hdf5(path) as f:  # built in memory: a full disk is one OSError naming the file
+        file_header(f, fmt, version)
+        yield f
+        label_units(f)  # every dataset says its unit (nondimensional: "1")

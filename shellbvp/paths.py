@@ -8,7 +8,8 @@ import tempfile
 from contextlib import contextmanager
 from pathlib import Path
 
-__all__ = ["check_output_path", "partial_path", "atomic_file", "open_hdf5", "read_input_bytes", "MAX_INPUT_BYTES"]
+__all__ = ["check_output_path", "partial_path", "atomic_file", "atomic_hdf5", "open_hdf5", "read_input_bytes",
+           "MAX_INPUT_BYTES"]
 
 #: The largest input file read whole (a measured curve is kilobytes to a few megabytes).
 MAX_INPUT_BYTES = 256 * 2**20
@@ -93,6 +94,31 @@ def atomic_file(path):
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise
+
+
+@contextmanager
+def atomic_hdf5(path):
+    """An HDF5 file built in memory (yielded open for writing), then written to ``path`` as
+    :func:`atomic_file` does.  Why in memory: HDF5 writing into a file on a full disk (ENOSPC,
+    EFBIG) fails while it flushes and closes, and h5py then prints a traceback per object
+    released and the process can crash at exit; plain file writes fail with one OSError, which
+    names ``path`` here.  A file of the package is kilobytes to a few megabytes."""
+    import io
+
+    import h5py
+
+    path = Path(path)
+    buffer = io.BytesIO()
+    with h5py.File(buffer, "w") as f:
+        yield f
+    image = buffer.getbuffer()
+    try:
+        with atomic_file(path) as tmp, open(tmp, "wb") as out:
+            out.write(image)
+            out.flush()
+            os.fsync(out.fileno())
+    except OSError as exc:
+        raise OSError(exc.errno, f"cannot write {path}: {exc.strerror or exc}") from None
 
 
 def partial_path(path) -> Path:

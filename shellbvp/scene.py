@@ -318,7 +318,7 @@ class Scene:
 
         >>> import shellbvp as sb
         >>> print(sb.Scene.preset("fit", thickness=0.05).describe(R_L=0.3e-3))
-        preset fit with thickness; shell: spheroid, rise 750 um (gamma 2.5) on a rim radius of 300 um; indenter: sphere of radius 100 um (rho 0.3333); thickness 15 um (eps 0.05, beta 0.0008333); Mooney-Rivlin alpha 0.1; smooth contact
+        preset fit with thickness; shell: spheroidal bowl (indented from inside), rise 750 um (gamma 2.5) on a rim radius of 300 um; indenter: sphere of radius 100 um (rho 0.3333); thickness 15 um (eps 0.05, beta 0.0008333); Mooney-Rivlin alpha 0.1; smooth contact
         """
         from .units import format_in
 
@@ -335,9 +335,8 @@ class Scene:
                  replace(self, transverse_shear=False)]
         parts = [f"preset {named[0]}" if named else f"preset {extra[0]} with thickness" if extra else "own scene"]
         if isinstance(self.shell, Spheroid):
-            side = "dome indented from its convex side, " if self.gamma < 0 else ""
             rise = f"rise {length(self.gamma)} (gamma {self.gamma:.4g})" if R_L else f"gamma {self.gamma:.4g}"
-            parts.append(f"shell: spheroid, {side}{rise}" + (f" on a rim radius of {length(1.0)}" if R_L else ""))
+            parts.append(f"shell: {self.shell_side()}, {rise}" + (f" on a rim radius of {length(1.0)}" if R_L else ""))
         else:
             parts.append("shell: user meridian" + (f" on a rim radius of {length(1.0)}" if R_L else ""))
         tip = "sphere" if isinstance(self.tip, SphereTip) else "user tip"
@@ -358,6 +357,20 @@ class Scene:
         if self.rim != "pinned":
             parts.append(f"{self.rim} rim")
         return "; ".join(parts)
+
+    def shell_side(self) -> str:
+        """Which shell the indenter meets, in words: a spheroid's ``gamma > 0`` is a bowl (pole below
+        the rim, indented from inside), ``gamma < 0`` a dome (indented from outside), 0 a flat disk.
+
+        >>> import shellbvp as sb
+        >>> sb.Scene.preset("fit").shell_side(), sb.Scene.preset("dome").shell_side()
+        ('spheroidal bowl (indented from inside)', 'spheroidal dome (indented from outside)')
+        """
+        if not isinstance(self.shell, Spheroid):
+            return "user meridian"
+        if self.gamma == 0:
+            return "flat disk"
+        return f"spheroidal {'bowl (indented from inside)' if self.gamma > 0 else 'dome (indented from outside)'}"
 
     def to_json(self) -> str:
         """:meth:`to_dict` as a JSON string (sorted keys)."""

@@ -10,10 +10,11 @@ from __future__ import annotations
 
 import json
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 
-__all__ = ["validate", "Validation", "default_depths", "shell_curve", "FORMAT"]
+__all__ = ["validate", "Validation", "ValidationFile", "read_validation", "default_depths", "shell_curve", "FORMAT"]
 
 FORMAT = "shellbvp-validation"
 FORMAT_VERSION = 1
@@ -39,6 +40,8 @@ class Validation:
         The shell model's curve at ``delta``.
     fe : FECurve
         The 3D reference at ``delta``.
+    R_L : float or None
+        The rim radius (m) when known: its file names the sample in lab units.
     delta, force_shell, force_fe, error : ndarray
         ``error = F_shell / F_FE - 1`` (NaN where either is missing).
 
@@ -54,6 +57,7 @@ class Validation:
     scene: object
     shell: object
     fe: object
+    R_L: float | None = None
 
     @property
     def delta(self):
@@ -82,20 +86,17 @@ class Validation:
 
     def table(self) -> str:
         """The comparison as aligned text, one depth a line."""
-        eps = self.scene.thickness
-        lines = [f"{'delta':>9} {'delta/H':>8} {'F_shell':>11} {'F_FE':>11} {'error':>8} {'FE mesh':>8}"]
-        for d, fs, ff, e, m in zip(self.delta, self.force_shell, self.force_fe, self.error, self.fe.mesh_error):
-            mesh = f"{100 * m:7.2f}%" if np.isfinite(m) else f"{'-':>8}"
-            err = f"{100 * e:+7.2f}%" if np.isfinite(e) else f"{'-':>8}"
-            lines.append(f"{d:9.4g} {d / eps:8.3g} {fs:11.5g} {ff:11.5g} {err} {mesh}")
-        return "\n".join(lines)
+        return _table(self.scene.thickness, self.delta, self.force_shell, self.force_fe, self.error,
+                      self.fe.mesh_error)
 
     def to_hdf5(self, path, *, overwrite: bool = False):
         """Both curves and the comparison in one NeXus file, written atomically.
 
-        Layout: ``/entry`` (NXentry) with ``comparison`` (NXdata: delta, force_shell, force_fe,
-        error; the default plot), ``shell`` (the shell model's curve as in a curve file) and
-        ``fe`` (NXdata: delta, force, indenter, contact_radius, mesh_error; the FE settings).
+        Layout: ``/`` (NXroot), ``/entry`` (NXentry) with ``comparison`` (NXdata: delta,
+        force_shell, force_fe, error; the default plot), ``shell`` (the shell model's curve as in a
+        curve file), ``fe`` (NXdata: delta, force, indenter, contact_radius, mesh_error; the FE
+        settings) and ``sample`` (NXsample: the scene in words; with ``R_L``, the datasets
+        ``R_L`` and ``thickness`` in m).  :func:`read_validation` reads it.
         """
         from .io import write_curve_group
         from .nexus import new_file, number_dataset
@@ -126,10 +127,15 @@ class Validation:
                            "radius of the outermost contact point / R_L")
             number_dataset(fe, "mesh_error", self.fe.mesh_error, "1",
                            "|F - F on a mesh with 2/3 the elements| / F")
+            sample = entry.create_group("sample")
+            sample.attrs.update({"NX_class": "NXsample", "description": self.scene.describe(self.R_L)})
+            if self.R_L is not None:
+                number_dataset(sample, "R_L", float(self.R_L), "m", "rim radius")
+                number_dataset(sample, "thickness", float(self.scene.thickness * self.R_L), "m", "shell thickness H")
 
 
 def validate(scene, thickness=None, deltas=None, *, delta_max=0.5, mesh_check=False, progress=None,
-             tol=1e-6, max_nodes=10000, max_dofs=None, **fe_settings) -> Validation:
+             tol=1e-6, max_nodes=10000, max_dofs=None, R_L=None, **fe_settings) -> Validation:
     """The shell model's error for ``scene`` at thickness ``eps``: both curves at the same depths.
 
     Parameters
@@ -149,6 +155,8 @@ def validate(scene, thickness=None, deltas=None, *, delta_max=0.5, mesh_check=Fa
     max_dofs : int, optional
         The largest 3D solid built, in unknowns (:func:`shellbvp.fe.fe_size`; a larger one is
         refused before any work); default ``sb.options``' ``max_fe_dofs`` (50,000).
+    R_L : float, optional
+        The rim radius (m): kept with the result, so that its file names the sample in lab units.
     **fe_settings
         :data:`shellbvp.fe.FE_DEFAULTS` overrides.
 
@@ -177,7 +185,8 @@ def validate(scene, thickness=None, deltas=None, *, delta_max=0.5, mesh_check=Fa
         deltas = default_depths(eps, delta_max)
     deltas = np.asarray(deltas, dtype=float)
     fe = fe_curve(scene, eps, deltas, mesh_check=mesh_check, progress=progress, max_dofs=max_dofs, **fe_settings)
-    return Validation(scene, shell_curve(scene, deltas, tol=tol, max_nodes=max_nodes), fe)
+    return Validation(scene, shell_curve(scene, deltas, tol=tol, max_nodes=max_nodes), fe,
+                      R_L=None if R_L is None else float(R_L))
 
 
 def shell_curve(scene, deltas, *, tol=1e-6, max_nodes=10000):
@@ -197,3 +206,147 @@ def shell_curve(scene, deltas, *, tol=1e-6, max_nodes=10000):
     if not shifted.size:
         return shell
     return curve(scene, deltas=np.unique(np.r_[deltas, shifted]), tol=tol, max_nodes=max_nodes, estimate_error=False)
+
+
+def _table(eps, delta, force_shell, force_fe, error, mesh_error) -> str:
+    lines = [f"{'delta':>9} {'delta/H':>8} {'F_shell':>11} {'F_FE':>11} {'error':>8} {'FE mesh':>8}"]
+    for d, fs, ff, e, m in zip(delta, force_shell, force_fe, error, mesh_error):
+        mesh = f"{100 * m:7.2f}%" if np.isfinite(m) else f"{'-':>8}"
+        err = f"{100 * e:+7.2f}%" if np.isfinite(e) else f"{'-':>8}"
+        lines.append(f"{d:9.4g} {d / eps:8.3g} {fs:11.5g} {ff:11.5g} {err} {mesh}")
+    return "\n".join(lines)
+
+
+@dataclass
+class ValidationFile:
+    """What a validation file (:meth:`Validation.to_hdf5`) holds, as :func:`read_validation` reads it.
+
+    Attributes
+    ----------
+    path : str
+    scene : Scene
+        The shell model's scene (its thickness eps = H/R_L set).
+    R_L : float or None
+        The rim radius (m), when the file has it (``shellbvp validate --radius``).
+    delta, force_shell, force_fe, error, mesh_error : ndarray
+        The comparison (nondimensional; ``error = F_shell / F_FE - 1``).
+    fe_success : bool
+    fe_message : str
+    """
+
+    path: str
+    scene: object
+    R_L: object
+    delta: np.ndarray
+    force_shell: np.ndarray
+    force_fe: np.ndarray
+    error: np.ndarray
+    mesh_error: np.ndarray
+    fe_success: bool
+    fe_message: str
+
+    def table(self) -> str:
+        """The comparison as aligned text, as ``shellbvp validate`` printed it."""
+        return _table(self.scene.thickness, self.delta, self.force_shell, self.force_fe, self.error,
+                      self.mesh_error)
+
+    def summary_lines(self) -> list:
+        """What ``shellbvp info`` prints."""
+        from .units import format_in
+
+        def length(x):
+            return format_in(x, "um" if x < 1e-3 else "mm", "length")
+
+        lab = "" if self.R_L is None else f", R_L = {length(self.R_L)}, H = {length(self.scene.thickness * self.R_L)}"
+        lines = [f"sample:    {self.scene.describe(self.R_L)}",
+                 f"compared:  the shell model and the 3D solid (FElupe) at {self.delta.size} pole displacements; "
+                 f"eps = H/R_L = {self.scene.thickness:.4g}{lab}"]
+        if not self.fe_success:
+            lines.append(f"FE:        {self.fe_message}")
+        return lines + self.table().splitlines()
+
+    def plot(self, out=None, dpi=150):
+        """F against delta of both models and the shell's error, side by side; saved to ``out``."""
+        from .plotting import require_matplotlib, save_figure
+
+        plt = require_matplotlib()
+        fig, (a, b) = plt.subplots(1, 2, figsize=(10, 4.2))
+        a.plot(self.delta, self.force_fe, "ko", label="3D solid (FElupe)")
+        a.plot(self.delta, self.force_shell, "C0.-", label="shell model")
+        a.set_xlabel("pole displacement delta / R_L")
+        a.set_ylabel("F / (mu H R_L)")
+        a.set_xlim(left=0)
+        a.set_ylim(bottom=0)
+        a.legend()
+        b.axhline(0, color="0.6", lw=0.8)
+        b.plot(self.delta, 100 * self.error, "C3o-")
+        b.set_xlabel("pole displacement delta / R_L")
+        b.set_ylabel("F_shell / F_FE - 1 (%)")
+        fig.suptitle(f"{Path(self.path).name}: eps = H/R_L = {self.scene.thickness:.3g}", fontsize=9)
+        fig.tight_layout()
+        if out is not None:
+            try:
+                save_figure(fig, out, dpi=dpi)
+            finally:
+                plt.close(fig)
+        return fig
+
+
+def read_validation(path) -> ValidationFile:
+    """Read a validation file (``shellbvp validate``, :meth:`Validation.to_hdf5`), every item checked.
+
+    Parameters
+    ----------
+    path : str or Path
+        An HDF5 file of format ``shellbvp-validation``.
+
+    Returns
+    -------
+    ValidationFile
+        The comparison, the scene, the rim radius (when the file has it) and the FE outcome.
+
+    Raises
+    ------
+    ValueError
+        Not a validation file, or an item missing or malformed (naming it).
+
+    Examples
+    --------
+    >>> import os, tempfile, shellbvp as sb
+    >>> v = sb.validate(sb.Scene.preset("base", material=sb.NeoHookean()), thickness=0.1, deltas=[0.1], R_L=1e-3)
+    >>> path = os.path.join(tempfile.mkdtemp(), "validate.h5")
+    >>> v.to_hdf5(path)
+    >>> back = sb.read_validation(path)
+    >>> back.R_L                                  # the rim radius (m), as validate was given it
+    0.001
+    >>> print(back.table())
+        delta  delta/H     F_shell        F_FE    error  FE mesh
+          0.1        1     0.10418    0.089085  +16.94%        -
+    """
+    from . import schema as sc
+    from .io import read_curve_group
+    from .paths import open_hdf5
+
+    with open_hdf5(path, fmt=FORMAT, group="entry/comparison", kind="validation") as h:
+        try:
+            sc.format_version(h, FORMAT_VERSION)
+            entry, fe = h["entry"], h["entry/fe"]
+            delta = sc.dataset(h["entry/comparison"], "delta")
+            columns = {k: sc.dataset(h["entry/comparison"], k, length=delta.size)
+                       for k in ("force_shell", "force_fe", "error")}
+            mesh_error = sc.dataset(fe, "mesh_error", length=delta.size)
+            scene = read_curve_group(entry["shell"]).scene
+            if scene.thickness is None:
+                raise ValueError("the shell's scene has no thickness")
+            sample = entry.get("sample")
+            R_L = None
+            if sample is not None and "R_L" in sample:
+                R_L = sc.scalar(sample, "R_L", low=0.0)
+                if not R_L > 0:
+                    raise ValueError(f"R_L must be > 0; got {R_L!r}")
+            success, message = sc.attr_bool(fe, "success"), sc.attr_text(fe, "message")
+        except (ValueError, KeyError, TypeError, OSError) as exc:
+            what = str(exc) if isinstance(exc, ValueError) else f"{type(exc).__name__}: {exc}"
+            raise ValueError(f"{path}: incomplete or corrupt validation file ({what})") from None
+    return ValidationFile(path=str(path), scene=scene, R_L=R_L, delta=delta, mesh_error=mesh_error,
+                          fe_success=success, fe_message=message, **columns)

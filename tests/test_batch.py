@@ -70,7 +70,7 @@ def test_batch_of_three_files_gives_a_table_of_three_rows(folder):
     assert sorted(p.name for p in (folder / "fits").iterdir()) == ["seed_a.h5", "seed_b.h5", "seed_c.h5"]
     assert "3 of 3 files fitted" in r.stdout
     # the batch names its sample in lab units, as a single fit does
-    assert "scene  = preset fit; shell: spheroid, rise 750 um (gamma 2.5) on a rim radius of 300 um" in r.stdout
+    assert "scene  = preset fit; shell: spheroidal bowl (indented from inside), rise 750 um (gamma 2.5) on a rim radius of 300 um" in r.stdout
 
 
 def test_a_broken_file_gets_its_row_and_the_others_are_fitted(folder):
@@ -107,6 +107,30 @@ def test_batch_outputs_are_checked_before_any_fit(folder):
     assert r.returncode == 2 and "must be a directory" in r.stderr
     r = run("fit", "nothing-*.csv", "--preset", "fit", "--radius", "0.3mm", cwd=folder)
     assert r.returncode == 2 and "no file matches" in r.stderr
+
+
+
+def test_a_given_thickness_fills_the_tables_thickness_mu_and_E(folder, tmp_path):
+    """Issue 56 item 7: with --thickness given (not fitted), the table carried mu*H only; the
+    thickness, mu = mu*H / H and E = 3 mu are known, so their columns are filled (no interval on H)."""
+    from shellbvp.batch import write_table
+
+    H = 5e-6
+    files = [str(folder / "data" / f"{name}.tsv") for name in ("seed_a", "seed_b")]
+    rows = fit_files(sb.Scene.preset("fit", thickness=H / R_L), files, R_L=R_L)
+    assert [r.status for r in rows] == ["ok", "ok"], [r.message for r in rows]
+    write_table(tmp_path / "t.csv", rows)
+    with open(tmp_path / "t.csv", newline="") as fh:
+        table = list(csv.DictReader(fh))
+    for row, r in zip(table, rows):
+        mu_H, low, high = (float(row[c]) for c in ("mu_H (N/m)", "mu_H 95% low (N/m)", "mu_H 95% high (N/m)"))
+        assert float(row["thickness (m)"]) == pytest.approx(H, rel=1e-6)
+        assert row["thickness 95% low (m)"] == row["thickness 95% high (m)"] == ""
+        assert float(row["mu (Pa)"]) == pytest.approx(mu_H / H, rel=1e-6)
+        assert float(row["mu 95% low (Pa)"]) == pytest.approx(low / H, rel=1e-6)
+        assert float(row["E (Pa)"]) == pytest.approx(3 * mu_H / H, rel=1e-6)
+        assert float(row["E 95% high (Pa)"]) == pytest.approx(3 * high / H, rel=1e-6)
+        assert r.result.E == pytest.approx(3 * r.result.mu) and r.result.to_dict()["E"] is not None
 
 
 # -- progress bars ----------------------------------------------------------------------------------

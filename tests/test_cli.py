@@ -165,10 +165,37 @@ def test_fit_names_its_sample_in_lab_units(capsys):
     assert main(["fit", "--example", "--radius", "0.3mm", "--preset", "fit", "--thickness", "15um", "--model",
                  "shell"]) == 0
     out = capsys.readouterr().out
-    assert "scene  = preset fit with thickness; shell: spheroid, rise 750 um (gamma 2.5)" in out
+    assert "scene  = preset fit with thickness; shell: spheroidal bowl (indented from inside), rise 750 um (gamma 2.5)" in out
     assert "indenter: sphere of radius 100 um" in out and "thickness 15 um" in out
     assert main(["solve", "--indenter-radius", "0.1mm"]) == 2
     assert "--indenter-radius 0.1 mm is a length: it needs --radius" in capsys.readouterr().err
+
+
+def test_a_dome_in_lab_units_by_a_negative_rise_or_dome(capsys, tmp_path):
+    """Issue 56 item 4: `--rise -5um` was an argparse error and a positive rise always a bowl.  A
+    negative rise (both spellings) and `--rise 5um --dome` give the dome gamma = -rise/R_L; the
+    summary says bowl or dome; contradictions are one-line errors."""
+    from shellbvp.cli import build_parser, main, scene_from_args
+
+    def scene(*options):
+        return scene_from_args(build_parser().parse_args(["solve", "--radius", "10um", "--indenter-radius", "2.5um",
+                                                          *options]))
+
+    for options in (["--rise", "-5um"], ["--rise=-5um"], ["--rise", "5um", "--dome"], ["--gamma", "-0.5"]):
+        assert scene(*options).gamma == pytest.approx(-0.5), options
+    assert scene("--rise", "5um").gamma == pytest.approx(0.5)
+    assert scene("--gamma", "-5e-1").gamma == pytest.approx(-0.5)  # a negative number in any spelling is a value
+    assert "dome (indented from outside), rise 5 um (gamma -0.5)" in scene("--rise", "-5um").describe(10e-6)
+    assert "bowl (indented from inside), rise 5 um (gamma 0.5)" in scene("--rise", "5um").describe(10e-6)
+    for options, says in ((["--rise", "-5um", "--dome"], "give the dome's height as a length > 0"),
+                          (["--gamma", "-0.5", "--dome"], "--dome goes with --rise")):
+        assert main(["solve", "--radius", "10um", "--muH", "1N/m", *options]) == 2
+        err = capsys.readouterr().err
+        assert err.startswith("shellbvp: error: ") and says in err and err.count("\n") == 1, err
+    assert main(["curve", "--radius", "10um", "--muH", "1N/m", "--indenter-radius", "2.5um", "--rise", "5um",
+                 "--dome", "--thickness", "0.5um", "--points", "2", "--delta-max", "0.02", "-o",
+                 str(tmp_path / "dome.h5"), "-q"]) == 0
+    assert "shell: spheroidal dome (indented from outside), rise 5 um (gamma -0.5)" in capsys.readouterr().out
 
 
 def test_every_option_has_help():

@@ -161,7 +161,7 @@ def test_validate_writes_both_curves(tmp_path, capsys):
 
 def test_fe_materials_map_to_the_shell_models(capsys):
     """Mooney-Rivlin through tensortrax with alpha = 0 is FElupe's own neo-Hooke; a user energy
-    of a sheet (no unique 3D form) and a pressure are refused before any work."""
+    of a sheet (no unique 3D form) is refused before any work."""
     scene = sb.Scene.preset("base", thickness=0.1)
     nh = sb.fe_curve(scene.replace(material=sb.NeoHookean()), 0.1, [0.05])
     mr = sb.fe_curve(scene.replace(material=sb.MooneyRivlin(0.0)), 0.1, [0.05])
@@ -170,8 +170,6 @@ def test_fe_materials_map_to_the_shell_models(capsys):
     user = scene.replace(material=sb.StrainEnergy("(lambda_s**2 + lambda_theta**2 + 1/(lambda_s*lambda_theta)**2 - 3)/2"))
     with pytest.raises(ValueError, match="no unique 3D form"):
         sb.fe_curve(user, 0.1, [0.05])
-    with pytest.raises(ValueError, match="pressure"):
-        sb.fe_curve(sb.Scene.preset("cell"), 0.05, [0.05])
     with pytest.raises(ValueError, match="thickness"):
         sb.fe_curve(scene, 0.7, [0.05])
     with pytest.raises(ValueError, match="deltas"):

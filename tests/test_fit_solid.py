@@ -25,7 +25,6 @@ def test_refusals_name_the_parameter_before_any_work():
              (SCENE, {"free": ("alpha",)}, "fitting alpha with the solid is not supported"),
              (SCENE.replace(transverse_shear=True), {}, "drop --transverse-shear"),
              (SCENE, {"stability": True}, "the stability check"),
-             (SCENE.replace(pressure=0.5), {}, "pressure"),
              (SCENE, {"model": "beam"}, "model must be one of")]
     for scene, extra, text in cases:
         with pytest.raises(ValueError, match=text):
@@ -38,7 +37,7 @@ def _fake_fe(calls):
     def fe_curve(scene, eps, grid, at, progress=None, **settings):
         calls.append(len(grid))
         g = np.asarray(grid, float)
-        return FECurve(scene, eps, 0.9 * g, g**1.5, g, 0.1 * g, np.full(g.size, np.nan), True, "done", (4, 2),
+        return FECurve(scene, eps, 0.9 * g, g**1.5, g, 0.1 * g, np.zeros(g.size), np.full(g.size, np.nan), True, "done", (4, 2),
                        settings={"at": at})
     return fe_curve
 

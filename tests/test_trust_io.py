@@ -395,3 +395,86 @@ def test_csv_numbers_that_overflow_in_si_units_name_their_line(tmp_path):
 def test_booleans_are_not_material_parameters(material):
     with pytest.raises(ValueError, match="alpha|Jm"):
         sb.Scene.preset("base", material=material())
+
+
+# -- a full disk, damaged compiled kernels (issue 59) ----------------------------------------------------
+
+def _limited(limit_bytes):
+    """A subprocess's preexec: files larger than ``limit_bytes`` cannot be written (EFBIG, as on
+    a full disk; SIGXFSZ ignored so that the write fails instead of the process)."""
+    import resource
+    import signal
+
+    def limit():
+        signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+        resource.setrlimit(resource.RLIMIT_FSIZE, (limit_bytes, limit_bytes))
+    return limit
+
+
+@pytest.mark.parametrize("json_out", [False, True])
+def test_fit_output_on_a_full_disk_prints_the_fit_then_one_error_line(tmp_path, json_out):
+    """Before: the result, then 16-28 h5py tracebacks and a segfault, a hidden .tmp left."""
+    sb.Scene.preset("fit").model()  # the generated code in the cache first: the limit is for the output
+    r = subprocess.run([sys.executable, "-m", "shellbvp", "fit", "--example", "--preset", "fit", "--radius", "0.3mm",
+                        "-o", "out.h5", *(["--json"] if json_out else [])], cwd=tmp_path, capture_output=True,
+                       text=True, env=dict(os.environ), timeout=300, preexec_fn=_limited(12000))
+    assert r.returncode == 2 and "Traceback" not in r.stderr, r.stderr
+    errors = [ln for ln in r.stderr.splitlines() if ln.startswith("shellbvp: error:")]
+    assert errors == ["shellbvp: error: cannot write out.h5: File too large"], r.stderr
+    if json_out:
+        out = json.loads(r.stdout)
+        assert out["exit_status"] == 2 and out["success"] and "out.h5" in out["write_error"]
+    else:
+        assert "mu*H   = " in r.stdout  # the result stands, printed before the file failed
+    assert list(tmp_path.iterdir()) == []  # neither out.h5 nor a hidden partial file
+
+
+def test_a_curve_file_on_a_full_disk_is_one_oserror_naming_it(tmp_path):
+    code = ("import resource, signal, sys, numpy as np, shellbvp as sb; "
+            "c = sb.curve(sb.Scene.preset('base'), deltas=np.linspace(0.05, 0.2, 4), estimate_error=False); "
+            "signal.signal(signal.SIGXFSZ, signal.SIG_IGN); resource.setrlimit(resource.RLIMIT_FSIZE, (6000, 6000))\n"
+            "try:\n    c.to_hdf5(sys.argv[1], profiles=True)\nexcept OSError as exc:\n    print(exc.strerror)")
+    r = subprocess.run([sys.executable, "-c", code, str(tmp_path / "c.h5")], capture_output=True, text=True,
+                       timeout=300)
+    assert r.returncode == 0 and "Traceback" not in r.stderr, r.stderr
+    assert r.stdout.strip() == f"cannot write {tmp_path / 'c.h5'}: File too large"
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_damaged_compiled_kernels_are_discarded_and_compiled_again(tmp_path, monkeypatch, caplog):
+    """numba's loader raises what unpickling a damaged cache file raises; `compile` (the
+    foreground load) warns once, removes that structure's cache files and compiles; a background
+    load removes them too, so later runs read the kernels as not compiled (no warning each run)."""
+    import pickle
+
+    from shellbvp import kernels as sk
+
+    src = tmp_path / "kernels_0123.py"
+    src.write_text("KEY = 'k'\n")
+    cache = tmp_path / "__pycache__"
+    cache.mkdir(mode=0o700)
+    files = [cache / "kernels_0123.rhs-12.py311.nbi", cache / "kernels_0123.rhs-12.py311.1.nbc",
+             src.with_suffix(".ready")]
+    other = cache / "kernels_9999.rhs-12.py311.nbi"  # another structure's: kept
+    for f in [*files, other]:
+        f.write_bytes(b"x")
+    calls = []
+
+    def damaged(path, key):
+        calls.append("import")
+        raise pickle.UnpicklingError("invalid load key, '\\xbb'.")
+
+    monkeypatch.setattr(sk, "_import_kernels", damaged)
+    monkeypatch.setattr(sk, "_compile_here", lambda path, key, desc: (calls.append("compile") or "module", 12.0))
+    with caplog.at_level("WARNING", logger="shellbvp.kernels"):
+        assert sk._load_compiled(src, "k", {}) == ("module", 12.0)
+    assert calls == ["import", "compile"] and not any(f.exists() for f in files) and other.exists()
+    assert len(caplog.records) == 1 and "UnpicklingError" in caplog.records[0].getMessage()
+    for f in files:
+        f.write_bytes(b"x")
+    monkeypatch.setattr(sk, "_ready", lambda path, key: True)
+    monkeypatch.setattr(sk, "kernel_path", lambda desc: src)
+    ks = sk.KernelSet(type("M", (), {"KEY": "k"})(), "auto")
+    with pytest.raises(RuntimeError, match="discarded: `shellbvp compile` builds it again"):
+        ks._load({}, foreground=False)
+    assert not any(f.exists() for f in files)

@@ -82,3 +82,9 @@ def _main(argv=None):
 
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 141
+    except OSError as exc:  # a file that cannot be written (a full disk): its partial file is removed
+        from ..textdata import printable
+        from .common import os_error_line
+
+        print(f"shellbvp: error: {printable(os_error_line(exc))}", file=sys.stderr)
+        return 2

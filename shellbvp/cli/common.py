@@ -6,6 +6,7 @@ import argparse
 import json
 import math
 import os
+import re
 from pathlib import Path
 
 
@@ -15,6 +16,12 @@ __all__ = ["Parser", "print_json_error", "plain_number", "plain_numbers", "quant
 
 class Parser(argparse.ArgumentParser):
     json_errors = False  # set by main when --json was asked for: errors are JSON on stdout too
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        # a value that starts like a negative number is a value, not an option: `--rise -5um`,
+        # `--gamma -1e-3` (argparse's own pattern takes only -5 and -0.5; no option here starts -<digit>)
+        self._negative_number_matcher = re.compile(r"^-\.?\d")
 
     def error(self, message):  # one line, exit 2 (argparse's own convention)
         if Parser.json_errors:
@@ -26,6 +33,12 @@ def print_json_error(message):
     """The one JSON document of a --json run that stopped on bad input (exit status 2)."""
     print(json.dumps({"success": False, "status": None, "exit_status": 2, "message": str(message),
                       "warnings": [], "warning_codes": []}))
+
+
+def os_error_line(exc: OSError) -> str:
+    """One line for a file that could not be written or read (a full disk, a read-only folder)."""
+    text = exc.strerror or str(exc)
+    return " ".join((f"{text}: {exc.filename}" if exc.filename else text).split())
 
 
 def plain_number(text):
@@ -45,14 +58,15 @@ def plain_numbers(text, name):
     return [plain_number(v, name) for v in text.split(",")]
 
 
-def quantity(kind):
-    """argparse type: a quantity with its unit (``0.3mm``, ``52N/m``), > 0; a bare number is an
-    error that says which unit to add.  Every subcommand takes dimensional options this way."""
+def quantity(kind, positive=True):
+    """argparse type: a quantity with its unit (``0.3mm``, ``52N/m``), > 0 (``positive``; else
+    any finite value, ``-5um``); a bare number is an error that says which unit to add.  Every
+    subcommand takes dimensional options this way."""
     from ..units import Quantity
 
     def parse(text):
         try:
-            return Quantity.parse(text, kind, "the value")  # argparse names the option
+            return Quantity.parse(text, kind, "the value", positive=positive)  # argparse names the option
         except ValueError as exc:
             raise argparse.ArgumentTypeError(str(exc)) from None
 
@@ -242,9 +256,13 @@ def add_scene_options(p, uncertain=False, preset_required=False, solver=("tol", 
     kind, note = (uncertain_value, "; VALUE+-U: with a standard uncertainty U") if uncertain else (plain_number, "")
     shape = g.add_mutually_exclusive_group()
     shape.add_argument("--gamma", type=kind, help=f"spheroid aspect parameter (< 1/rho; >0 bowl, <0 dome){note}")
-    shape.add_argument("--rise", type=quantity("length"),
-                       help="the shell's depth from its rim's plane to its pole, with its unit (with --radius): "
-                            "gamma = rise / R_L (a bowl indented from inside; a dome: --gamma < 0)")
+    shape.add_argument("--rise", type=quantity("length", positive=False),
+                       help="how far the pole lies below the rim's plane, with its unit (with --radius): gamma = "
+                            "rise / R_L; > 0 a bowl indented from inside (5um), < 0 a dome indented from outside "
+                            "(-5um, or 5um with --dome)")
+    g.add_argument("--dome", action="store_true", default=None,
+                   help="the shell is a dome indented from outside (its convex side): --rise is the pole's height "
+                        "above the rim's plane, gamma = -rise / R_L")
     tip = g.add_mutually_exclusive_group()
     tip.add_argument("--rho", type=kind, help=f"indenter radius / rim radius (> 0){note}")
     tip.add_argument("--indenter-radius", type=quantity("length"), dest="indenter_radius",
@@ -312,7 +330,20 @@ def scene_from_args(args):
     for name, length, what in (("rho", "indenter_radius", "--indenter-radius"), ("gamma", "rise", "--rise")):
         if getattr(args, length, None) is not None:
             over[name] = over_rim_radius(args, getattr(args, length), what)
+    if getattr(args, "dome", None):
+        over["gamma"] = -_dome_rise(args) / args.radius.si
     return sb.Scene.preset(args.preset or "base", **over)
+
+
+def _dome_rise(args):
+    """``--rise`` with ``--dome``: the dome's height above its rim (m), > 0."""
+    if args.rise is None:
+        raise ValueError("--dome goes with --rise, the dome's height above its rim (e.g. --rise 5um --dome); "
+                         "with --gamma give the sign itself (< 0: a dome)")
+    if not args.rise.si > 0:
+        raise ValueError(f"--rise {args.rise} with --dome: give the dome's height as a length > 0 (or drop --dome: "
+                         f"a negative --rise is a dome)")
+    return args.rise.si
 
 
 def over_rim_radius(args, length, option):

@@ -7,7 +7,7 @@ from .common import add_scene_options, scene_from_args
 __all__ = ["add_parser", "run"]
 
 #: Scene options whose presence means "this scene", not "every preset"
-_SCENE_KEYS = ("preset", "gamma", "rise", "rho", "indenter_radius", "beta", "thickness", "alpha", "gent_jm",
+_SCENE_KEYS = ("preset", "gamma", "rise", "dome", "rho", "indenter_radius", "beta", "thickness", "alpha", "gent_jm",
                "neo_hookean", "material", "xi", "pressure", "sealed", "contact", "bending", "bending_formula",
                "transverse_shear")
 

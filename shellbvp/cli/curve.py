@@ -140,7 +140,9 @@ def _assess(c, args):
 
 
 def _print_details(c, args, units):
-    """The lines under the summary: the range in lab units, the configurations, the stability note."""
+    """The lines under the summary: the scene (a bowl or a dome, lengths in lab units with --radius),
+    the range in lab units, the configurations, the stability note."""
+    print(f"  scene: {c.scene.describe(None if args.radius is None else args.radius.si)}")
     if units is not None and len(c):
         from ..units import force_unit_of, format_in
 

@@ -7,9 +7,10 @@ import sys
 from pathlib import Path
 
 from ..shape_parameters import SHAPE_PARAMETERS
+from ..textdata import printable
 from .common import (
-    add_limit_options, add_overwrite_option, add_scene_options, check_report_path, curve_bars, output_dir, progress_bar,
-    quantity, require_sample, say, scene_from_args, strict_json,
+    add_limit_options, add_overwrite_option, add_scene_options, check_report_path, curve_bars, number_or,
+    os_error_line, output_dir, progress_bar, quantity, require_sample, say, scene_from_args, strict_json,
 )
 
 __all__ = ["add_parser", "run"]
@@ -54,6 +55,9 @@ def add_parser(sub):
                    help="force baseline fitted with the contact point: auto (default: constant when the data "
                         "have an approach before contact, else none), none, constant, linear")
     f.add_argument("--no-offset", action="store_true", dest="no_offset", help="do not fit the contact point")
+    f.add_argument("--max-depth", dest="max_depth", type=number_or("length"),
+                   help="fitting range: leave out rows deeper than this beyond the contact point's first guess, "
+                        "a length (2um) or a plain number (a fraction of R_L, as the warnings give it)")
     for name, param in SHAPE_PARAMETERS.items():  # one of them at most
         f.add_argument(f"--fit-{name}", action="store_true", dest=f"fit_{name}", help=param.fit_help)
         f.add_argument(f"--{name}-range", dest=f"{name}_range", help=param.range_help)
@@ -155,8 +159,19 @@ def _fit_inputs(args, pixel_values=None):
 
         check_stability_size(scene)
     options = {"fit_offset": not args.no_offset, "free": free, "bounds": bounds, "weights": args.weights,
-               "tol": args.tol, "stability": args.stability, "model": args.model, "mesh_check": args.mesh_check}
+               "tol": args.tol, "stability": args.stability, "model": args.model, "mesh_check": args.mesh_check,
+               "max_depth": _max_depth(args.max_depth, args.radius.si)}
     return scene, args.radius.si, {"columns": columns, "units": units, "invert": tuple(args.invert or ())}, options
+
+
+def _max_depth(given, R_L):
+    """``--max-depth`` in m: a length as it is, a plain number as a fraction of R_L; None if not given."""
+    if given is None:
+        return None
+    depth = given.si if hasattr(given, "si") else given * R_L
+    if not depth > 0:
+        raise ValueError(f"--max-depth must be a depth > 0 (a length, or a fraction of R_L); got {given}")
+    return depth
 
 
 def _search_range(param, text, R_L):
@@ -245,6 +260,11 @@ def run(args):
         out["geometry"] = geometry.to_dict()
         out["success"] = ok
     out["exit_status"] = 0 if ok else 1
+    written = not (args.output or args.report) or not res.success
+    if args.json and not written:  # written first: the one JSON document says whether it was
+        written = _save_or_error(res, record, used, args)
+        if written is not True:
+            out.update(exit_status=2, write_error=written)
     if args.json:
         print(json.dumps(strict_json(out), allow_nan=False))
     else:
@@ -259,9 +279,22 @@ def run(args):
     if args.output or args.report:
         if not res.success:
             print(f"shellbvp: not writing {args.output or args.report}: the fit failed its checks", file=sys.stderr)
-        else:
-            _save_fit(res, record, used, args.output, args.report, args.segment, args.force, args.json)
+        elif written is not True:  # the result is printed; the file could not be written (a full disk)
+            written = written or _save_or_error(res, record, used, args)
+            if written is not True:
+                print(f"shellbvp: error: {printable(written)}", file=sys.stderr)
+                return 2
     return 0 if ok else 1
+
+
+def _save_or_error(res, record, used, args):
+    """True once the fit's record (and report) are written, else the one-line reason (a full
+    disk: the partial file is removed, the fit's result stands)."""
+    try:
+        _save_fit(res, record, used, args.output, args.report, args.segment, args.force, args.json)
+    except OSError as exc:
+        return os_error_line(exc)
+    return True
 
 
 def _fit_batch(args, files):
@@ -365,6 +398,9 @@ def _fit_map(args, path, curves, scene, R_L, reading, options, pixel_values=None
         say(f"scene  = {scene.describe(R_L)}" + ("" if pixel_values is None else
                                                  f"; in place of its {pixel_values.name}: the pixel table's"))
         say(f"map    = {fm.summary()}")
+        for code, (where, text) in fm.warning_counts().items():
+            cells = ", ".join(map(str, where[:8])) + (", ..." if len(where) > 8 else "")
+            say(f"warning: {len(where)} curve{'s' * (len(where) > 1)} ({cells}): {text}")
         for note in fm.notes:
             say(f"note: {note}")
         for w in wrote:
@@ -452,6 +488,9 @@ def _print_fit(res, record, used, args):
             for e in res.derived.values():
                 if e.of == name:
                     say(_estimate_line(e))
+    if res.max_depth is not None:
+        say(f"range  = depths up to {format_in(res.max_depth, du, 'length')} beyond the contact point's first guess "
+            f"(--max-depth; deeper rows left out)")
     say(f"rms residual = {format_in(res.residual_rms, fu, 'force')} over {res.n} points; R_L = "
           f"{args.radius}; {res.weights} weights")
     from ..fitting import diagnostics_lines

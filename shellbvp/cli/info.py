@@ -1,4 +1,4 @@
-"""The ``info`` command: what a curve, sweep, fit or force-map file holds."""
+"""The ``info`` command: what a curve, sweep, fit, force-map or validation file holds."""
 
 from __future__ import annotations
 
@@ -12,7 +12,7 @@ __all__ = ["add_parser", "run"]
 
 def add_parser(sub):
     """The ``info`` subcommand's arguments, on ``sub`` (the subparsers)."""
-    i = sub.add_parser("info", help="describe a curve, sweep, fit or force-map file")
+    i = sub.add_parser("info", help="describe a curve, sweep, fit, force-map or validation file")
     i.add_argument("file")
     i.set_defaults(func=run)
 
@@ -51,27 +51,35 @@ def _sweep_info(path):
 def run(args):
     import numpy as np
 
-    from ..fitrecord import is_fit_file, read_fit
+    from ..filekinds import file_kind
     from ..io import read_curve
-    from ..sweep import is_sweep_file
 
-    if is_fit_file(args.file):
+    kind = file_kind(args.file) if os.path.isfile(args.file) else None
+    if kind == "fit":
+        from ..fitrecord import read_fit
         from ..plotting import fit_summary_lines
 
         say(f"file:      {args.file} (a fit)")
         for line in fit_summary_lines(read_fit(args.file)):
             say(f"  {line}")
         return 0
-    from ..afm import is_map_file, read_map_file
+    if kind == "force-map":
+        from ..afm import read_map_file
 
-    if os.path.isfile(args.file) and is_map_file(args.file):
         say(f"file:      {args.file} (a force map fitted curve by curve)")
         for line in read_map_file(args.file).summary_lines():
             say(line)
         return 0
-    if os.path.isfile(args.file) and is_sweep_file(args.file):
+    if kind == "validation":
+        from ..validation import read_validation
+
+        say(f"file:      {args.file} (a validation: the shell model against the 3D solid)")
+        for line in read_validation(args.file).summary_lines():
+            say(line)
+        return 0
+    if kind == "sweep":
         return _sweep_info(args.file)
-    c = read_curve(args.file)
+    c = read_curve(args.file)  # a curve, its checkpoint, or the one-line reason it is neither
     s = c.scene
     mat = s.material
     say(f"file:      {args.file} (shellbvp {c.version})")
@@ -79,6 +87,7 @@ def run(args):
           f"material={mat!r} bending={s.bending!r} shell={s.shell!r} tip={s.tip!r}"
           + (f" pressure={s.pressure:g} (delta from the inflated pole)" if s.pressure else "")
           + (" sealed (volume control: the pressure is per point)" if s.sealed else ""))
+    say(f"sample:    {s.describe(None if c.units is None else c.units['R_L'])}")  # bowl or dome, lab lengths
     say(f"curve:     {c.summary()}")
     say(f"complete:  {c.complete}  interrupted: {c.interrupted}")
     from ..curve_stability import verdict

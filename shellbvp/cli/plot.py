@@ -1,4 +1,4 @@
-"""The ``plot`` command: figures of curve, sweep, fit and force-map files."""
+"""The ``plot`` command: figures of curve, sweep, fit, force-map and validation files."""
 
 from __future__ import annotations
 
@@ -14,53 +14,40 @@ def add_parser(sub):
     pl = sub.add_parser("plot", help="plot curves (and profiles) from HDF5 files (needs matplotlib)")
     pl.add_argument("files", nargs="+", help="curve files (`shellbvp curve`), sweep files (`shellbvp sweep`: one "
                     "curve per finished combination), fit files (`shellbvp fit -o`: data, model and residuals in "
-                    "SI units) or force-map files (`shellbvp fit MAP.jpk-force-map -o`: the image of mu*H)")
-    pl.add_argument("-o", "--output", help="PNG or PDF (default curves.png; for fit and force-map files <name>.png "
-                    "next to each); for several fit or force-map files a directory (one <name>.png each)")
+                    "SI units), force-map files (`shellbvp fit MAP.jpk-force-map -o`: the image of mu*H) or validation "
+                    "files (`shellbvp validate`: both models' F and the shell's error)")
+    pl.add_argument("-o", "--output", help="PNG or PDF (default curves.png; for fit, force-map and validation files <name>.png "
+                    "next to each); for several of those a directory (one <name>.png each)")
     pl.add_argument("--profiles", help="also draw the deformed shell of the first file at these depths, e.g. 0.1,0.3")
     pl.add_argument("--dpi", type=int, default=150, help="resolution of a PNG (default 150)")
     pl.set_defaults(func=run)
 
 
 def run(args):
-    from ..fitrecord import is_fit_file, read_fit
+    from ..filekinds import file_kind
     from ..io import read_curve
     from ..paths import check_output_path
-    from ..plotting import plot_curves, plot_fit_record, plot_profiles, require_matplotlib, save_figure, scene_label
-    from ..sweep import is_sweep_file, read_sweep
+    from ..plotting import plot_curves, plot_profiles, require_matplotlib, save_figure, scene_label
+    from ..sweep import read_sweep
 
-    from ..afm import is_map_file, read_map_file
-
-    maps = [f for f in args.files if is_map_file(f)]
-    if maps:  # a force map's file: its mu*H image, one figure each
-        if len(maps) != len(args.files):
-            raise ValueError("plot either force-map files or curve and fit files, not both in one call")
-        for name, out in zip(maps, _figure_paths(args.output, maps)):
-            check_output_path(out, overwrite=True)
-            read_map_file(name).plot(out, dpi=args.dpi)
-            print(f"wrote {out}")
-        return 0
-    fits = [f for f in args.files if is_fit_file(f)]
-    if fits:
-        if len(fits) != len(args.files):
-            raise ValueError("plot either curve files or fit files, not both in one call")
-        plt = require_matplotlib()
-        for name, out in zip(fits, _figure_paths(args.output, fits)):
-            check_output_path(out, overwrite=True)
-            ax, _ = plot_fit_record(read_fit(name))
-            ax.figure.tight_layout()
-            try:
-                save_figure(ax.figure, out, dpi=args.dpi)
-            finally:
-                plt.close(ax.figure)
+    kinds = [file_kind(f) for f in args.files]
+    single = [k for k in kinds if k in _ONE_FIGURE_EACH]
+    if single:  # fit, force-map and validation files: one figure each
+        if len(set(kinds)) != 1:
+            raise ValueError(f"plot files of one kind in one call: {single[0]} files, or curve and sweep files "
+                             f"(got {', '.join(sorted({str(k or 'other') for k in kinds}))})")
+        draw = _ONE_FIGURE_EACH[single[0]]
+        for name, out in zip(args.files, _figure_paths(args.output, args.files)):
+            check_output_path(out, overwrite=True)  # a figure is cheap to redraw: replaced
+            draw(name, out, args.dpi)
             print(f"wrote {out}")
         return 0
     args.output = "curves.png" if args.output is None else args.output
     check_output_path(args.output, overwrite=True)  # a figure is cheap to redraw: replaced
     plt = require_matplotlib()
     curves, labels = [], []
-    for name in args.files:
-        if is_sweep_file(name):  # a family: one curve per finished combination, labelled by its values
+    for name, kind in zip(args.files, kinds):
+        if kind == "sweep":  # a family: one curve per finished combination, labelled by its values
             sw = read_sweep(name)
             for i, c in sorted(sw.curves.items()):
                 curves.append(c)
@@ -83,6 +70,35 @@ def run(args):
     save_figure(fig, args.output, dpi=args.dpi)
     print(f"wrote {args.output}")
     return 0
+
+
+def _fit_figure(name, out, dpi):
+    from ..fitrecord import read_fit
+    from ..plotting import plot_fit_record, require_matplotlib, save_figure
+
+    plt = require_matplotlib()
+    ax, _ = plot_fit_record(read_fit(name))
+    ax.figure.tight_layout()
+    try:
+        save_figure(ax.figure, out, dpi=dpi)
+    finally:
+        plt.close(ax.figure)
+
+
+def _map_figure(name, out, dpi):
+    from ..afm import read_map_file
+
+    read_map_file(name).plot(out, dpi=dpi)
+
+
+def _validation_figure(name, out, dpi):
+    from ..validation import read_validation
+
+    read_validation(name).plot(out, dpi=dpi)
+
+
+#: The kinds of file drawn one figure each, and how.
+_ONE_FIGURE_EACH = {"fit": _fit_figure, "force-map": _map_figure, "validation": _validation_figure}
 
 
 def _figure_paths(output, names):

@@ -37,8 +37,9 @@ def run(args):
     args.delta_max = nondimensional(args, args.delta_max, "--delta-max")
     if scene.thickness is None:
         raise ValueError("validate needs --thickness (H/R_L, or with a unit and --radius)")
-    if scene.pressurised:
-        raise ValueError("validate: the 3D model has no internal pressure yet; use a scene without --pressure")
+    from ..fe import check_fe_size, check_solid_scene, fe_size
+
+    check_solid_scene(scene)
     if not (0 < args.delta_max <= 2):
         raise ValueError(f"--delta-max must be in (0, 2]; got {args.delta_max:g}")
     deltas = None
@@ -54,17 +55,16 @@ def run(args):
         import felupe  # noqa: F401
     except ImportError:
         raise ValueError("validate needs FElupe: pip install 'shellbvp[fe]'") from None
-    from ..fe import check_fe_size, fe_size
-
     size = fe_size(scene, scene.thickness)
     check_fe_size(size)  # before the shell's curve too: one line, no work
     t0 = time.perf_counter()
     shell = "with its transverse shear" if scene.transverse_shear else "Kirchhoff (no transverse shear)"
     print(f"scene: {args.preset or 'base'}, eps = H/R_L = {scene.thickness:.4g}, beta = {scene.beta:.4g}; "
           f"3D model (FElupe) and shell model, {shell}, at the same pole displacements", flush=True)
+    print(f"sample: {scene.describe(None if args.radius is None else args.radius.si)}", flush=True)
     print(f"3D model: {size.describe()} (estimated)", flush=True)
     result = validate(scene, deltas=deltas, delta_max=args.delta_max, mesh_check=args.mesh_check, tol=args.tol,
-                      max_nodes=args.max_nodes,
+                      R_L=None if args.radius is None else args.radius.si, max_nodes=args.max_nodes,
                       progress=lambda i, d, f: print(f"  FE: delta = {d:.4g}, F = {f:.5g}", flush=True))
     print(result.table())
     if not result.fe.success:

@@ -8,7 +8,10 @@ A curve kept on disk is a curve file (``read_curve`` reads it as data, checked) 
 of everything it depends on: the scene, the depths, the tolerance, the solver's options and the
 package's source (any edit of the code makes new keys).  A fit of a sample fitted before, in
 any process, then computes no curve (``FitResult.curves_computed`` counts the computed ones);
-``sb.options(model_curve_cache=False)`` turns the disk off."""
+``sb.options(model_curve_cache=False)`` turns the disk off.  A kept curve is data from disk
+(:mod:`shellbvp.fitting.kept`): used only when it is this user's, carries a checksum of its
+contents that matches, and holds the requested scene and depths with finite forces; a bad one
+is set aside with a warning and computed again."""
 
 from __future__ import annotations
 
@@ -22,6 +25,8 @@ from pathlib import Path
 
 import numpy as np
 from scipy.interpolate import CubicSpline, PchipInterpolator
+
+from .kept import keep, kept_folder, read_kept
 
 __all__ = ["N_DEPTHS", "ModelCurves", "clear_model_curves", "code_fingerprint"]
 
@@ -54,12 +59,12 @@ def _model_curve(scene, deltas, tol, counter=None, progress=None):
         _CACHE.move_to_end(key)
         return _CACHE[key]
     path, disk_key = _disk_place(scene, deltas, tol)
-    c = _read_kept(path, disk_key)
+    c = _read_kept(path, disk_key, scene, deltas)
     if c is None:
-        _check_model_start(scene, float(deltas[0]), tol)
+        first = _model_start(scene, deltas, tol)  # shallower depths: the point-load limit (ModelCurves)
         bar, callback = progress("model curve", float(deltas[-1])) if progress is not None else (None, None)
         try:
-            c = curve(scene, deltas=deltas, tol=tol, estimate_error=False, callback=callback)
+            c = curve(scene, deltas=deltas[first:], tol=tol, estimate_error=False, callback=callback)
         finally:
             if bar is not None:
                 bar.close()
@@ -87,10 +92,9 @@ def code_fingerprint() -> str:
 
 def _disk_place(scene, deltas, tol):
     """(path, key) of a model curve in the code cache's ``curves/`` folder, or (None, None)
-    where the disk cache is off, the scene does not describe itself as data, or the folder is
-    not trusted."""
+    where the disk cache is off, the scene does not describe itself as data, or the folder
+    cannot hold curves (:func:`shellbvp.fitting.kept.kept_folder`: one warning)."""
     from ..config import OPTIONS
-    from ..model import cache_dir, untrusted_reason
     from ..version import __version__
 
     if not OPTIONS.model_curve_cache:
@@ -103,8 +107,8 @@ def _disk_place(scene, deltas, tol):
     except (TypeError, ValueError, AttributeError):
         return None, None
     key = hashlib.sha256(payload.encode()).hexdigest()
-    folder = cache_dir() / "curves"
-    if folder.exists() and untrusted_reason(folder):
+    folder = kept_folder("curves", KEPT_WHAT)
+    if folder is None:
         return None, None
     return folder / f"curve_{key[:32]}.h5", key
 
@@ -113,32 +117,69 @@ def _disk_place(scene, deltas, tol):
 _NOT_NUMERICS = ("progress_seconds", "health_seconds", "compile_in_background", "model_curve_cache", "max_fe_dofs",
                  "max_stability_dofs")
 
+#: What the cache's warnings call a kept shell curve
+KEPT_WHAT = "model curves"
 
-def _read_kept(path, key):
-    """The kept curve at ``path`` if it is there and holds ``key``, else None."""
+#: A kept model curve larger than this is not read (40 depths take about 50 kB).
+MAX_KEPT_BYTES = 4 << 20
+
+
+def content_checksum(c) -> str:
+    """SHA-256 of everything a curve holds (scene, settings but this checksum, stop reason,
+    completeness, flags and every point field): a kept curve carries it in
+    ``settings["kept_sha256"]`` and is used only when it matches."""
+    head = {"scene": c.scene.to_dict(), "settings": {k: v for k, v in c.settings.items() if k != "kept_sha256"},
+            "stop_reason": str(c.stop_reason), "complete": bool(c.complete), "flags": [str(f) for f in c.flags]}
+    h = hashlib.sha256(json.dumps(head, sort_keys=True, default=str).encode())
+    for name in sorted(c.points):
+        values = np.asarray(c.points[name])
+        h.update(name.encode())
+        h.update(np.ascontiguousarray(values, float).tobytes() if values.dtype.kind in "fiub"
+                 else json.dumps([str(v) for v in values.tolist()]).encode())
+    return h.hexdigest()
+
+
+def _unsound(c, key, scene, deltas):
+    """Why the curve ``c`` read from the cache cannot serve as ``scene``'s at ``deltas``, or None."""
+    if c.settings.get("kept_sha256") != content_checksum(c):
+        return "its checksum does not match its contents (damaged or edited)"
+    if c.settings.get("model_curve_key") != key or not c.complete:
+        return "made for another scene, grid or version, or not complete"
+    if c.scene != scene:
+        return "its scene is not the requested one"
+    delta, force = np.asarray(c.delta, float), np.asarray(c.force, float)
+    if delta.shape != np.shape(deltas) or not np.array_equal(delta, np.asarray(deltas, float)):
+        return "its depths are not the requested ones"
+    if not (np.all(np.isfinite(force)) and np.all(np.diff(delta) > 0)):
+        return "a non-finite force or depths not increasing"
+    return None
+
+
+def _read_kept(path, key, scene, deltas):
+    """The kept curve at ``path`` when it is sound and holds ``key``, ``scene`` and ``deltas``,
+    else None (a bad one set aside with a warning)."""
     from ..io import read_curve
 
-    if path is None or not path.exists():
-        return None
-    try:
-        c = read_curve(path)
-    except (ValueError, OSError) as exc:
-        log.info("ignoring the kept model curve %s: %s", path.name, exc)
-        return None
-    return c if c.settings.get("model_curve_key") == key and c.complete else None
+    return read_kept(path, read_curve, lambda c: _unsound(c, key, scene, deltas), what="model curve",
+                     max_bytes=MAX_KEPT_BYTES)
 
 
 def _keep(c, path, key):
-    """Write the complete curve ``c`` to ``path`` (atomically); a cache that cannot be written is
-    skipped."""
+    """Write the complete curve ``c`` to ``path`` (atomically, read back and checked); a cache
+    that cannot be written is skipped with one warning."""
+    from ..io import read_curve, write_curve
+
     if path is None or not c.complete:
         return
     c.settings["model_curve_key"] = key
-    try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        c.to_hdf5(path, overwrite=True)
-    except OSError as exc:
-        log.info("model curve not kept (%s)", exc)
+    c.settings["kept_sha256"] = content_checksum(c)
+
+    def write(tmp):
+        write_curve(c, tmp, overwrite=True)
+        if (why := _unsound(read_curve(tmp), key, c.scene, c.delta)) is not None:
+            raise ValueError(f"the curve read back is not the one written: {why}")
+
+    keep(path, write, what=KEPT_WHAT)
 
 
 def _with_shear(c):
@@ -153,30 +194,56 @@ def _with_shear(c):
     return dataclasses.replace(c, points=points, flags=list(c.flags[:n]))
 
 
-def _check_model_start(scene, delta, tol):
-    """ValueError unless the model curve can start at its shallowest depth ``delta`` (one solve).
+#: The shallowest depths (indices of the curve's depths, doubling) a model curve may start from;
+#: beyond the last the data are refused as too shallow against R_L.
+START_TRIALS = (0, 1, 3, 7)
 
-    A curve at requested depths starts from a single contact cap; at depths where
-    the scene's contact is the point-load limit (far shallower than the shell's
-    size) it cannot start, so data that shallow are reported before the curve.
+
+def _model_start(scene, deltas, tol):
+    """The index of the first of ``deltas`` the model curve can start from (one solve per trial
+    of :data:`START_TRIALS`), or ValueError.
+
+    A curve at requested depths starts from a single contact cap; at depths where the scene's
+    contact is the point-load limit (the cap exponentially small) it cannot, and there the
+    point-load solution is the model's state (:func:`point_load_forces` gives its force).
+    Data whose depths are nearly all in that limit are refused before the curve.
     """
     from ..configurations import is_single_cap
     from ..state import solve
 
-    sol = solve(scene, delta=delta, tol=tol, estimate_error=False, topology="cap")
-    if not (sol.success and is_single_cap(sol)):
-        why = (sol.message if not sol.success else "the contact there is the point-load limit (the contact cap "
-               "is exponentially small), from which the model curve cannot start")
-        raise ValueError(f"the model curve cannot start at its shallowest depth delta = {delta:.3g} "
-                         f"(1/{N_DEPTHS} of delta_max = 1.2 x the deepest data depth / R_L): {why}. "
-                         f"Check the displacement units and the rim radius R_L (--radius): data this shallow "
-                         f"against R_L do not determine mu*H with this scene")
+    why = ""
+    for i in START_TRIALS:
+        if i >= len(deltas) - 2:
+            break
+        sol = solve(scene, delta=float(deltas[i]), tol=tol, estimate_error=False, topology="cap")
+        if sol.success and is_single_cap(sol):
+            return i
+        why = sol.message if not sol.success else "the contact there is the point-load limit (the contact cap is " \
+                                                   "exponentially small)"
+    raise ValueError(f"the model curve cannot start at its shallowest depths, up to delta = {deltas[i]:.3g} "
+                     f"({i + 1}/{len(deltas)} of delta_max = 1.2 x the deepest data depth / R_L): {why}. The data are "
+                     f"this shallow against R_L: check the displacement units and the rim radius R_L (--radius)")
+
+
+def point_load_forces(scene, deltas, tol):
+    """The model's nondimensional force at ``deltas`` shallower than its curve's first depth: the
+    point-load limit of the smooth contact (:func:`shellbvp.pointload.solve_point_load`), each
+    solved from the shallower one's state; NaN where a solve fails."""
+    from ..pointload import solve_point_load
+
+    out, prev = [], None
+    for d in deltas:
+        sol = solve_point_load(scene, float(d), tol=tol, guess=prev)
+        prev = sol if sol.success else None
+        out.append(float(sol.force) if sol.success else np.nan)
+    return np.array(out)
 
 
 def _beyond_message(c, need):
     return (f"the data reach delta = {need:.4g} (deepest displacement / R_L) but the model curve ends at "
             f"delta = {c.delta[-1]:.4g} ({c.stop_reason}): the model cannot explain the deepest points; "
-            f"fit the data up to delta = {c.delta[-1]:.4g} x R_L, or check the units and R_L (--radius)")
+            f"fit the data up to that depth (--max-depth {c.delta[-1]:.4g}, a fraction of R_L; fit(max_depth=...) in "
+            f"m), or check the units and R_L (--radius)")
 
 
 class ModelCurves:
@@ -197,6 +264,7 @@ class ModelCurves:
         # what computes a node's curve: the shell model's (default) or the solid's
         self.source = _model_curve if source is None else source
         self.nodes = {}  # theta -> curve
+        self.forces = {}  # theta -> F at the grid's depths (the point-load limit's below the curve's first)
         self._spline = None
 
     def add(self, theta):
@@ -210,6 +278,12 @@ class ModelCurves:
                 return False
             raise ValueError(_beyond_message(c, self.need))
         self.nodes[theta] = c
+        shallow = self.grid[self.grid < c.delta[0] * (1 - 1e-9)] if self.source is _model_curve else self.grid[:0]
+        F = np.r_[point_load_forces(self.scene_at(theta), shallow, self.tol), c.force]
+        if not np.all(np.isfinite(F[:shallow.size])):
+            raise ValueError(f"the point-load limit below the model curve's first depth delta = {c.delta[0]:.3g} "
+                             f"could not be solved: the data are too shallow for this scene")
+        self.forces[theta] = F
         self._spline = None
         return True
 
@@ -220,8 +294,8 @@ class ModelCurves:
     def _table(self):
         if self._spline is None:
             th = self.thetas
-            m = min(len(self.nodes[t]) for t in th)
-            rows = np.array([np.r_[0.0, self.nodes[t].force[:m]] for t in th])
+            m = min(len(self.forces[t]) for t in th)
+            rows = np.array([np.r_[0.0, self.forces[t][:m]] for t in th])
             self.top = float(self.grid[m - 1])
             self.x = np.r_[0.0, self.grid[:m]]
             self._spline = rows[0] if len(th) == 1 else CubicSpline(th, rows, axis=0)

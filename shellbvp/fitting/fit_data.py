@@ -72,9 +72,27 @@ def _check_data(d, f, k, origin=0.0):
     return d, f
 
 
+def _within_depth(d, f, keep, max_depth, origin, k):
+    """The rows (d, f, and ``keep``, the fitted rows of the input) no deeper than ``max_depth``
+    (m) beyond ``origin``, the contact point's first guess; ValueError for a range that is not a
+    length > 0 or that leaves too few rows to fit."""
+    if not (isinstance(max_depth, (int, float)) and math.isfinite(max_depth) and max_depth > 0):
+        raise ValueError(f"max_depth (the deepest depth fitted, m from the contact point) must be a finite number "
+                         f"> 0; got {max_depth!r}")
+    within = ~(d - origin > max_depth)  # NaN rows stay: the checks drop them
+    keep = keep & within
+    need = max(3, k + 2)
+    beyond = np.count_nonzero(np.isfinite(d) & (d > origin))
+    inside = np.count_nonzero(keep & (d > origin))
+    if np.count_nonzero(keep) < need or (beyond and inside < need):
+        raise ValueError(f"max_depth = {max_depth:.4g} m (--max-depth) leaves {inside} of {beyond} rows beyond the "
+                         f"contact point's first guess ({origin:.4g} m); need at least {need}: give a deeper range")
+    return d[within], f[within], keep
+
+
 def fit(scene, displacement, force, *, R_L, fit_offset=True, free=(), bounds=None, weights=None, floor=0.05,
         delta_max=None, tol=1e-6, loss="linear", baseline="none", contact_guess=None, progress=None, shared=None,
-        stability=False, model="auto", mesh_check=False, **aliases):
+        stability=False, model="auto", mesh_check=False, max_depth=None, **aliases):
     """Least-squares fit of mu*H (the displacement origin, and a shape parameter) to measured data.
 
     Parameters
@@ -110,6 +128,11 @@ def fit(scene, displacement, force, *, R_L, fit_offset=True, free=(), bounds=Non
         also a slope, ``b0 + b1 (d - d0)`` (a tilted baseline: drift or drag, continued
         through contact).  It needs data before the contact point (the approach) to be
         determined well.
+    max_depth : float, optional
+        A fitting range: the deepest depth fitted (m, > 0), measured from the contact point's
+        first guess (``contact_guess``; 0 without one); deeper rows are left out before the
+        fit (e.g. past the first instability, or where the model stops following the data).
+        Reported as ``FitResult.max_depth``.  Default: every row.
     contact_guess : float, optional
         A first guess of the contact point (m; e.g. :func:`shellbvp.instrument.estimate_contact`):
         the model curve is computed to 1.2 x the depth of the data beyond it.  Default 0
@@ -219,6 +242,8 @@ def fit(scene, displacement, force, *, R_L, fit_offset=True, free=(), bounds=Non
     f = np.asarray(force, float).ravel()
     keep = np.isfinite(d) & np.isfinite(f) if d.shape == f.shape else None
     k = 1 + bool(fit_offset) + len(free) + (baseline != "none") + (baseline == "linear")
+    if max_depth is not None and keep is not None:
+        d, f, keep = _within_depth(d, f, keep, max_depth, float(origin), k)
     d, f = _check_data(d, f, k, float(origin))
     if not (isinstance(R_L, (int, float)) and math.isfinite(R_L) and R_L > 0):
         raise ValueError(f"R_L (rim radius, m) must be a finite number > 0; got {R_L!r}")
@@ -236,7 +261,9 @@ def fit(scene, displacement, force, *, R_L, fit_offset=True, free=(), bounds=Non
         if stability:
             raise ValueError("stability is checked for one fit at a time, not per pixel of a map on shared curves "
                              "(each pixel would need a curve of its own)")
-        return _fit_on_shared(shared, scene, mdl, noise, depth, k, keep, weights, baseline)
+        res = _fit_on_shared(shared, scene, mdl, noise, depth, k, keep, weights, baseline)
+        res.max_depth = None if max_depth is None else float(max_depth)
+        return res
 
     def run(name, coarse=False):
         """The fit with model ``name`` (the solid on the mesh check's mesh with ``coarse``)."""
@@ -254,6 +281,7 @@ def fit(scene, displacement, force, *, R_L, fit_offset=True, free=(), bounds=Non
             fitted = search.run(noise, k)
             notes = search.notes
         res = result_of(fitted, mdl, sp, k, notes, keep, weights, baseline, counter[0], name)
+        res.max_depth = None if max_depth is None else float(max_depth)
         if stability and res.scene is not None and math.isfinite(res.offset):
             _check_axisymmetry(res, (float(np.max(d)) - res.offset) / R_L, tol, progress)
         return res
@@ -309,7 +337,8 @@ def _check_axisymmetry(res, deepest, tol, progress=None):
         res.warnings.append(
             f"the fitted depths reach delta = {deepest:.4g} but the axisymmetric shell loses stability at delta = "
             f"{first.delta:.4g} (mode n = {first.mode}, displacement {res.offset + first.delta * res.R_L:.4g} m): past "
-            f"it the shell is not axisymmetric and the model does not describe it; fit the data up to that depth")
+            f"it the shell is not axisymmetric and the model does not describe it; fit the data up to that depth "
+            f"(--max-depth {first.delta:.4g}, a fraction of R_L; fit(max_depth={first.delta * res.R_L:.4g}) in m)")
         res.warning_codes.append("unstable_depths")
 
 

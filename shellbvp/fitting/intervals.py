@@ -12,7 +12,7 @@ import math
 import numpy as np
 from scipy import special
 
-from ..fit_checks import FIT_STATUS, check_result, fit_diagnostics, runs_in_depth_order
+from ..fit_checks import FIT_STATUS, check_result, contact_misfit, fit_diagnostics, runs_in_depth_order
 from ..shape_parameters import SHAPE_PARAMETERS
 from .least_squares import MODEL_PARAMETERS, LeastSquaresModel
 from .result import Estimate, FitResult
@@ -68,8 +68,9 @@ def result_of(fitted, mdl, sp, k, notes, keep, weights, baseline, curves_compute
             derived[dq.name] = Estimate(value, interval, dq.unit, dq.label, dq.display_unit, dq.note, name)
     mu_ci = ci[0]
     runs = runs_in_depth_order(resid, d)
+    contact = contact_misfit(resid, d, model(d, mu_H, d0, 0.0, 0.0))
     status, checks = check_result(bool(res.success), mu_H, mu_ci, off_ci, bool(np.all(np.isfinite(resid))),
-                                   resid.size, runs)
+                                   resid.size, runs, contact)
     found = notes + checks
     for _, text in found:
         log.info("fit: warning: %s", text)
@@ -107,7 +108,8 @@ def _linearised(dq, x, dx_dtheta, mu_H, R_L, cov, t):
 
 
 def _given_thickness(scene, mu_H, mu_H_ci, R_L):
-    """``{"mu": Estimate}`` of a scene with a thickness (mu*H over H, H taken as exact), else {}."""
+    """``{"mu": Estimate, "E": Estimate}`` of a scene with a thickness (mu*H over H, H taken as
+    exact; E = 3 mu, incompressible), else {}: the same quantities a fitted thickness gives."""
     from ..units import format_in
 
     eps = getattr(scene, "thickness", None)
@@ -115,4 +117,6 @@ def _given_thickness(scene, mu_H, mu_H_ci, R_L):
         return {}
     H = eps * R_L
     return {"mu": Estimate(mu_H / H, (mu_H_ci[0] / H, mu_H_ci[1] / H), "Pa", "mu", "MPa",
-                           f"H = {format_in(H, 'um', 'length')}, eps = H/R_L = {eps:.3g}, beta = eps^2/3")}
+                           f"H = {format_in(H, 'um', 'length')}, eps = H/R_L = {eps:.3g}, beta = eps^2/3"),
+            "E": Estimate(3 * mu_H / H, (3 * mu_H_ci[0] / H, 3 * mu_H_ci[1] / H), "Pa", "E", "MPa",
+                          "E = 3 mu, incompressible")}

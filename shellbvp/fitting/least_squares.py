@@ -12,7 +12,7 @@ import numpy as np
 from scipy import optimize
 
 __all__ = ["BASELINES", "MODEL_PARAMETERS", "WEIGHTS", "DEFAULT_WEIGHTS", "LeastSquaresModel", "NoiseModel",
-           "Fitted"]
+           "Fitted", "local_scatter"]
 
 #: Force baselines of :func:`fit` (none; a constant b0; b0 + b1 (d - d0)).
 BASELINES = ("none", "constant", "linear")
@@ -131,7 +131,22 @@ class LeastSquaresModel:
         return res, float(np.dot(r, r)), jac(res.x)
 
 
-def _weights(kind, model_force, f, floor, w_prev):
+def local_scatter(resid, disp):
+    """Each row's squared noise estimated from the residuals' second differences in depth order,
+    ``(r_{i-1} - 2 r_i + r_{i+1})^2 / 6`` (its mean is sigma^2 for independent noise; the end
+    rows take their neighbour's).  A smooth misfit of the model cancels in the differences, so it
+    is not taken for noise."""
+    order = np.argsort(disp, kind="stable")
+    r = np.asarray(resid, float)[order]
+    if r.size < 3:
+        return np.asarray(resid, float) ** 2
+    second = (r[:-2] - 2 * r[1:-1] + r[2:]) ** 2 / 6
+    out = np.empty_like(r)
+    out[order] = np.r_[second[0], second, second[-1]]
+    return out
+
+
+def _weights(kind, model_force, f, floor, w_prev, disp):
     """Weights 1/sigma_i of the noise model, from the current model force (IRLS)."""
     if kind == "uniform":
         return np.ones_like(f)
@@ -139,9 +154,12 @@ def _weights(kind, model_force, f, floor, w_prev):
     fmax = np.max(np.abs(f))
     if kind == "relative":
         return 1.0 / np.maximum(m, floor * fmax)
-    # mixed: sigma^2 = a^2 + b^2 F^2, (a^2, b^2) >= 0 by least squares on the squared residuals
-    # (each row scaled by the previous sigma^2: squared residuals have variance ~ sigma^4)
-    r2 = (np.nan_to_num(model_force) - f) ** 2
+    # mixed: sigma^2 = a^2 + b^2 F^2, (a^2, b^2) >= 0 by least squares on each row's squared noise
+    # (each row scaled by the previous sigma^2: squared residuals have variance ~ sigma^4).  The
+    # noise is read from the residuals' local scatter, not from the residuals themselves: where the
+    # model misses the data (a real curve's contact region), squared residuals would be taken for
+    # a large relative noise, its rows weighted down and the misfit kept (issue 56).
+    r2 = local_scatter(np.nan_to_num(model_force) - f, disp)
     s2_prev = 1.0 / w_prev ** 2
     A = np.column_stack([np.ones_like(m), (m / fmax) ** 2]) / s2_prev[:, None]
     coef, _ = optimize.nnls(A, r2 / s2_prev)
@@ -160,7 +178,8 @@ class NoiseModel:
 
     def reweight(self, mdl, P, top, q, w):
         """(new weights, their largest relative change from ``w``)."""
-        w_new = _weights(self.kind, mdl.indentation(P, top, mdl.d, q), mdl.f - mdl.baseline(mdl.d, q), self.floor, w)
+        w_new = _weights(self.kind, mdl.indentation(P, top, mdl.d, q), mdl.f - mdl.baseline(mdl.d, q), self.floor, w,
+                         mdl.d)
         return w_new, np.max(np.abs(w_new / w - 1))
 
     def irls(self, mdl, P, dP, top):

@@ -75,7 +75,7 @@ class ProfileSearch:
         self.w = None
         if not shape.add(sp.theta0):
             raise ValueError(f"the model curve at the scene's {sp.name} ends before the deepest data point "
-                             f"(delta = {depth:.4g}): fit shallower data, or check the units and R_L")
+                             f"(delta = {depth:.4g}): fit shallower data (--max-depth), or check the units and R_L")
 
     def extend(self, side):
         """Add the next node beyond the nodes on side -1 (low) or +1 (high); False at the limit."""

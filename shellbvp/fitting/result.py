@@ -58,6 +58,9 @@ class FitResult:
         mu_H/R_L``; None unless the pressure was fitted); and mu of a given thickness (``mu``).
     fitted : tuple of str
         The fitted parameters ("mu_H", "offset", and a shape parameter's name).
+    max_depth : float or None
+        The fitting range (m): rows deeper than this beyond the contact point's first guess were
+        left out (``fit(max_depth=...)``); None: every row.
     weights : str
         The noise model, "uniform", "relative" or "mixed".
     residual_rms : float
@@ -189,6 +192,7 @@ class FitResult:
     model_note: str = ""
     measured_model_error: float = None
     mesh_error: float = None
+    max_depth: float = None
 
     @property
     def success(self):
@@ -267,7 +271,7 @@ class FitResult:
             shape[name], shape[f"{name}_ci95"] = num(getattr(self, name)), ci(getattr(self, f"{name}_ci95"))
         return {"mu_H": num(self.mu_H), "mu_H_ci95": ci(self.mu_H_ci95), "offset": num(self.offset),
                 "offset_ci95": ci(self.offset_ci95), **shape, "fitted": list(self.fitted),
-                "model": self.model, "model_note": self.model_note,
+                "model": self.model, "model_note": self.model_note, "max_depth": num(self.max_depth),
                 "measured_model_error": num(self.measured_model_error), "mesh_error": num(self.mesh_error),
                 "weights": self.weights, "residual": num(self.residual_rms), "residual_rms": num(self.residual_rms),
                 "n": self.n, "success": self.success, "status": self.status, "message": self.message,
@@ -288,7 +292,7 @@ class FitResult:
                 "stability_verdict": self.stability_verdict,
                 "model_error": None if self.model_error is None else num(self.model_error[0]),
                 "model_error_extrapolated": None if self.model_error is None else self.model_error[1],
-                "units": {"mu_H": "N/m (= um*MPa)", "offset": "m", "residual": "N (rms)",
+                "units": {"mu_H": "N/m (= um*MPa)", "offset": "m", "max_depth": "m", "residual": "N (rms)",
                           "residual_rms": "N", "R_L": "m",
                           **{p.name: p.unit_text or p.unit for p in SHAPE_PARAMETERS.values()},
                           **{d.name: d.unit for d in DERIVED.values()},

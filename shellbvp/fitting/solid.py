@@ -16,8 +16,9 @@ point and the baseline; it is kept on disk (:func:`solid_curve`) like a shell mo
 A kept solid curve is data from disk: a JSON file in the code cache's ``solid_curves/``
 folder, named by a hash of everything it depends on (scene, depths, the FE's settings, the
 package's source) and carrying a SHA-256 of its own contents.  It is used only when that
-checksum, its key, its depths and its finite forces all check; otherwise it is ignored and
-computed again.  A folder or file another user owns or may write is not read.
+checksum, its key, its depths and its finite forces all check; otherwise it is set aside with
+a warning and computed again (:mod:`shellbvp.fitting.kept`, as a shell model curve).  A folder
+or file another user owns or may write is not read.
 """
 
 from __future__ import annotations
@@ -35,10 +36,9 @@ import numpy as np
 
 from ..config import OPTIONS
 from ..fe import FE_DEFAULTS, check_fe_size, check_solid_scene, coarser, fe_curve, fe_size
-from ..model import cache_dir, untrusted_reason
-from ..paths import atomic_file
 from ..version import __version__
 from .curves import code_fingerprint
+from .kept import checksum, keep, kept_folder, read_kept
 
 __all__ = ["SolidCurve", "solid_curve", "clear_solid_curves", "check_solid_fit", "auto_model", "shell_or_solid",
            "FIT_MODELS", "AUTO_SOLID_EPS", "MAX_KEPT_BYTES"]
@@ -246,33 +246,30 @@ def _place(scene, grid, settings):
     except (TypeError, ValueError, AttributeError):
         return None, None
     key = hashlib.sha256(payload.encode()).hexdigest()
-    folder = cache_dir() / "solid_curves"
-    if folder.exists() and untrusted_reason(folder):
-        log.info("solid curves not kept: the folder %s is not trusted (%s)", folder, untrusted_reason(folder))
+    folder = kept_folder("solid_curves", KEPT_WHAT)
+    if folder is None:
         return None, None
     return folder / f"solid_{key[:32]}.json", key
 
 
+#: What the cache's warnings call a kept solid curve
+KEPT_WHAT = "solid curves"
+
+
 def _checksum(record):
-    body = {k: v for k, v in record.items() if k != "sha256"}
-    return hashlib.sha256(json.dumps(body, sort_keys=True).encode()).hexdigest()
+    return checksum({k: v for k, v in record.items() if k != "sha256"})
+
+
+def _read_json(path):
+    return json.loads(path.read_bytes().decode("utf-8"))
 
 
 def _read_kept(path, key, scene, grid, settings):
-    """The kept curve at ``path`` when it is sound and holds ``key`` and ``grid``, else None (why: logged)."""
-    if path is None or not path.is_file():
-        return None
-    why = untrusted_reason(path)
-    try:
-        if why is None and path.stat().st_size > MAX_KEPT_BYTES:
-            why = f"larger than {MAX_KEPT_BYTES} bytes"
-        record = None if why else json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, ValueError, UnicodeDecodeError) as exc:
-        why = f"unreadable ({type(exc).__name__})"
-    if why is None:
-        why = _unsound(record, key, grid)
-    if why is not None:
-        log.info("ignoring the kept solid curve %s: %s", path.name, why)
+    """The kept curve at ``path`` when it is sound and holds ``key`` and ``grid``, else None (a
+    bad one set aside with a warning)."""
+    record = read_kept(path, _read_json, lambda r: _unsound(r, key, grid), what="solid curve",
+                       max_bytes=MAX_KEPT_BYTES)
+    if record is None:
         return None
     return SolidCurve(scene, grid.copy(), np.array(record["force"], float), np.array(record["pole_delta"], float),
                       np.array(record["contact_radius"], float), True, record["stop_reason"][:200],
@@ -318,10 +315,10 @@ def _keep(c, path, key):
     if not all(math.isfinite(x) for x in record["force"]):
         return
     record["sha256"] = _checksum(record)
-    try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        with atomic_file(path) as tmp:
-            tmp.write_text(json.dumps(record, sort_keys=True), encoding="utf-8")
-    except OSError as exc:
-        log.info("solid curve not kept (%s)", exc)
 
+    def write(tmp):
+        tmp.write_text(json.dumps(record, sort_keys=True), encoding="utf-8")
+        if (why := _unsound(_read_json(tmp), key, np.asarray(record["grid"]))) is not None:
+            raise ValueError(f"the record read back is not the one written: {why}")
+
+    keep(path, write, what=KEPT_WHAT)

@@ -101,6 +101,7 @@ class Writer:
             debris.unlink(missing_ok=True)
 
         def edit(f):
+            f.attrs["NX_class"] = "NXroot"
             f.attrs["format"], f.attrs["format_version"] = FORMAT, FORMAT_VERSION
             f.attrs["package_version"] = __version__
             if "created" not in f.attrs:
