@@ -61,6 +61,7 @@ import sympy as sp
 
 import shellbvp as sb
 import trust_cache
+import trust_work  # issue 59: oversized work, dead options (its kinds join KINDS)
 
 ROOT = Path(__file__).resolve().parent.parent
 RESULTS = ROOT / "benchmarks" / "results"
@@ -128,6 +129,8 @@ KIND_NOTES = {**trust_cache.KIND_NOTES,
            "`plot` on non-files, unknown commands) in a temporary directory, timeout 120 s; with --json "
            "stdout must parse as one strict JSON document (no NaN) whose exit_status is the exit status.",
 }
+KINDS.update(trust_work.KINDS)
+KIND_NOTES.update(trust_work.KIND_NOTES)
 
 
 # -- recording and classifying ------------------------------------------------------------------------
@@ -1192,6 +1195,8 @@ def main(argv=None):
     dirty = ", ".join(f"`{d}/`" for d in dirty)
     funcs = {"formulas": kind_formulas, "hdf5": kind_hdf5, "csv": kind_csv, "scenes": kind_scenes, "cli": kind_cli,
              "fitrecords": kind_fitrecords, "sweepfiles": kind_sweepfiles, "inputs": kind_inputs, **trust_cache.FUNCS}
+    funcs.update(trust_work.FUNCS)
+    sizes = {**trust_work.SIZES, **sizes}
     records, kind_times = [], {}
     t0 = time.perf_counter()
     with tempfile.TemporaryDirectory(prefix="trust-tally-") as td:

@@ -182,7 +182,43 @@ def factorise(J, *args, **kwargs):
             return lu
         log.debug("collocation factors grew beyond %g times the matrix: SuperLU instead", OPTIONS.collocation_max_growth)
         J = J.tocsc()
-    return _ORIGINAL["splu"](J, *args, **kwargs)
+    with _c_output_discarded():
+        return _ORIGINAL["splu"](J, *args, **kwargs)
+
+
+_QUIET = threading.Lock()
+
+
+@contextlib.contextmanager
+def _c_output_discarded():
+    """SuperLU reports a failed allocation by printing from C ("Not enough memory to perform
+    factorization." on stdout, "malloc fails for local dworkptr[]." on stderr, no newline) before
+    Python sees the error, which the solve turns into a status: that text would break ``--json``'s
+    one document and the CLI's one-line error (issue 59).  File descriptors 1 and 2 point at
+    /dev/null meanwhile (a few microseconds; without usable descriptors, nothing changes)."""
+    import os
+    import sys
+
+    with _QUIET:
+        for stream in (sys.stdout, sys.stderr):
+            try:
+                stream.flush()
+            except (AttributeError, OSError, ValueError):
+                pass
+        try:
+            saved, null = (os.dup(1), os.dup(2)), os.open(os.devnull, os.O_WRONLY)
+        except OSError:
+            yield
+            return
+        try:
+            os.dup2(null, 1)
+            os.dup2(null, 2)
+            yield
+        finally:
+            os.dup2(saved[0], 1)
+            os.dup2(saved[1], 2)
+            for fd in (*saved, null):
+                os.close(fd)
 
 
 _CURRENT = threading.local()

@@ -91,6 +91,14 @@ class Options:
         A fit's model curves are kept in the code cache's ``curves/`` folder and read back by
         the next fit of the same scene and depths, in any process (:mod:`shellbvp.fitting.curves`);
         False: computed in every process.
+    max_fe_dofs : float
+        The largest 3D solid (:func:`shellbvp.fe_curve`, ``validate``, ``fit --model solid``)
+        built, in unknowns, estimated from the scene before the mesh is (:func:`shellbvp.fe.fe_size`):
+        50,000 is about 30 min and 330 MB on a 2-core machine.  Larger ones are refused in one line.
+    max_stability_dofs : float
+        The largest stability analysis of a state (:func:`shellbvp.stability`), in unknowns summed
+        over its modes (6 per node and mode): 300,000 is about 15 s, the hemisphere at beta ~ 1e-7
+        (the cost grows like 1/sqrt(beta)).  Larger ones are refused in one line.
 
     Examples
     --------
@@ -114,6 +122,8 @@ class Options:
     health_seconds: float = 10.0
     compile_in_background: bool = False
     model_curve_cache: bool = True
+    max_fe_dofs: float = 50_000
+    max_stability_dofs: float = 300_000
 
 
 #: The options in force

@@ -30,7 +30,7 @@ import numpy as np
 from .io import STABILITY_FIELDS, FirstInstability
 
 __all__ = ["STABILITY_CHOICES", "STABILITY_FIELDS", "FirstInstability", "check_choice", "point_stability",
-           "assess", "locate_zero"]
+           "assess", "locate_zero", "verdict"]
 
 #: What ``curve(stability=...)`` accepts
 STABILITY_CHOICES = ("off", "points", "locate")
@@ -92,7 +92,8 @@ def locate_zero(f, a, fa, b, fb, *, xtol, max_evals=MAX_REFINE):
     return a, fa, b, fb, n
 
 
-def assess(curve, choice: str = "points", *, delta_tol: float = 1e-4, samples: int = LOCATE_SAMPLES) -> None:
+def assess(curve, choice: str = "points", *, delta_tol: float = 1e-4, samples: int = LOCATE_SAMPLES,
+           progress=None) -> None:
     """Fill ``curve``'s stability fields and ``first_instability`` (see the module docstring).
 
     Parameters
@@ -105,6 +106,8 @@ def assess(curve, choice: str = "points", *, delta_tol: float = 1e-4, samples: i
         ``"locate"``: the width of the final bracket in delta.
     samples : int
         ``"locate"``: about how many states spread along the curve are analysed first.
+    progress : callable, optional
+        Called as ``progress(delta)`` after each state analysed (a bar's step).
     """
     choice = check_choice(choice)
     n = len(curve)
@@ -115,13 +118,18 @@ def assess(curve, choice: str = "points", *, delta_tol: float = 1e-4, samples: i
     curve.settings["stability"] = choice
     if choice == "off" or n == 0:
         return
+    from .modal_stability import default_modes
+
     t0 = time.perf_counter()
     notes = []
+    curve.settings["stability_modes"] = int(default_modes(curve.scene)[-1])
 
     def analyse(i):
         mins[i], modes[i], why = point_stability(curve.solutions[i])
         if why and why not in notes:
             notes.append(why)
+        if progress is not None:
+            progress(float(curve.points["delta"][i]))
         return mins[i] < 0
 
     try:
@@ -142,6 +150,25 @@ def assess(curve, choice: str = "points", *, delta_tol: float = 1e-4, samples: i
         notes.append("stability interrupted")
     curve.settings["stability_note"] = "; ".join(notes)
     curve.settings["stability_time"] = time.perf_counter() - t0
+
+
+def verdict(curve) -> str:
+    """One line: whether the states' stability was checked (:func:`assess`, also on a curve read
+    back from its file) and what it found -- a stable curve is said to be so, and to what depth."""
+    choice = curve.settings.get("stability", "off")
+    mins = np.asarray(curve.points.get("stability_min", ()), float)
+    checked = np.isfinite(mins)
+    if choice in (None, "off") or not len(curve):
+        return "stability: not checked"
+    if not checked.any():
+        return f"stability: not checked at any state ({curve.settings.get('stability_note') or 'none analysed'})"
+    top = curve.settings.get("stability_modes")
+    modes = f", modes n = 0..{int(top)}" if isinstance(top, (int, float)) and math.isfinite(top) else ""
+    analysed = f"{int(checked.sum())} of {len(curve)} states analysed{modes}"
+    if curve.first_instability is not None:
+        return f"stability: checked ({analysed}); {curve.first_instability.summary()}"
+    deepest = float(np.max(np.asarray(curve.points["delta"], float)[checked]))
+    return f"stability: checked, stable to delta = {deepest:.4g} ({analysed})"
 
 
 def _first(curve, i, mins, modes, choice, delta_tol):

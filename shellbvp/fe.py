@@ -37,13 +37,15 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .config import OPTIONS
 from .fe_contact import PenaltyContact, TipSurface
 from .fe_newton import Newton
 from .fe_pressure import FollowerPressure
 from .fe_rim import RIM_FACES, HingedFace
 from .materials import MATERIALS
 
-__all__ = ["fe_curve", "FECurve", "TipSurface", "FE_DEFAULTS", "check_solid_scene", "coarser"]
+__all__ = ["fe_curve", "FECurve", "TipSurface", "FE_DEFAULTS", "check_solid_scene", "coarser", "FESize", "fe_size",
+           "check_fe_size"]
 
 #: Mesh, material and contact settings of :func:`fe_curve` (all nondimensional).
 FE_DEFAULTS = {
@@ -58,6 +60,14 @@ FE_DEFAULTS = {
     "delta_tol": 1e-7,          # pole control: |delta - target| / max(target, H)
     "rim_face": "plane",        # the rim face held plane, turning about its mid-thickness point (RIM_FACES)
 }
+
+
+#: The cost model of :func:`fe_size`, measured (benchmarks/results/fe_speed-new-grow.md and the
+#: first touch of the hemisphere at eps 0.01, 0.004, 0.002): a curve of the hemisphere at eps 0.02
+#: (167 x 3 elements, 12 depths) took 52.5 s, and the time grows like the square of the elements
+#: (the Newton iterations grow with them); the peak memory was ~100 MB plus ~4.5 kB per unknown.
+_REFERENCE_ELEMENTS, _REFERENCE_SECONDS = 167 * 3, 52.5
+_BASE_MB, _MB_PER_DOF = 100.0, 4.5e-3
 
 
 def _felupe():
@@ -168,6 +178,67 @@ def _build(scene, eps, *, through_thickness, element_length, pole_refinement, bu
     return _Model(mesh, region, field, solid, contact, fixed, node(n_t, 0), eps, (n_s, n_t), face, pressure)
 
 
+@dataclass(frozen=True)
+class FESize:
+    """What a solid of :func:`fe_curve` costs, estimated from the scene before it is built.
+
+    Attributes
+    ----------
+    elements : tuple
+        Elements along the meridian and through the thickness.
+    dofs : int
+        Unknowns of the mixed fields (displacement, pressure, volume ratio).
+    memory_mb, seconds : float
+        Peak memory and wall time of a curve, by the measured cost model (:data:`_REFERENCE_SECONDS`):
+        an order of magnitude, not a promise.
+    """
+
+    elements: tuple
+    dofs: int
+    memory_mb: float
+    seconds: float
+
+    def describe(self) -> str:
+        minutes = self.seconds / 60
+        when = f"{self.seconds:.0f} s" if minutes < 2 else (f"{minutes:.0f} min" if minutes < 120
+                                                            else f"{minutes / 60:.0f} h")
+        return (f"{self.elements[0]}x{self.elements[1]} elements, {self.dofs:,} unknowns, "
+                f"~{self.memory_mb:,.0f} MB, about {when}")
+
+
+def fe_size(scene, thickness, **settings) -> FESize:
+    """The mesh :func:`fe_curve` would build for ``scene`` at ``thickness`` and its estimated cost,
+    without building it (``settings``: :data:`FE_DEFAULTS` overrides)."""
+    opts = {**FE_DEFAULTS, **settings}
+    eps = float(thickness)
+    total = _meridian(scene)[0][-1]
+    h = opts["element_length"] * eps
+    n_s = math.ceil(total / h)
+    if n_s < 100_000:  # exact (the loop is cheap); beyond, the uniform count is a lower bound
+        n_s = _node_positions(total, h, h / opts["pole_refinement"], 4 * eps).size - 1
+    n_t = int(opts["through_thickness"])
+    # quadratic displacement nodes, two components; pressure and volume ratio: 4 per element each
+    dofs = 2 * (2 * n_s + 1) * (2 * n_t + 1) + 2 * 4 * n_s * n_t
+    seconds = _REFERENCE_SECONDS * (n_s * n_t / _REFERENCE_ELEMENTS) ** 2
+    return FESize((n_s, n_t), dofs, _BASE_MB + _MB_PER_DOF * dofs, seconds)
+
+
+def check_fe_size(size: FESize, max_dofs=None) -> None:
+    """ValueError, in one line, where ``size`` exceeds ``max_dofs`` (default ``sb.options``'
+    ``max_fe_dofs``, 50,000: about 30 min and 330 MB, the hemisphere at eps ~ 0.0035; eps = 1e-4
+    would need 1.6 million unknowns, issue 59)."""
+    limit = int(OPTIONS.max_fe_dofs if max_dofs is None else max_dofs)
+    if size.dofs > limit:
+        raise ValueError(f"thickness: the 3D solid would need {size.describe()}, over the limit of {limit:,} "
+                         f"unknowns (max_dofs, --max-fe-dofs); a thicker shell, or a larger limit if the "
+                         f"machine allows it")
+
+
+def _check_max_dofs(max_dofs):
+    if max_dofs is not None and not (isinstance(max_dofs, (int, np.integer)) and max_dofs > 0):
+        raise ValueError(f"max_dofs must be a positive integer (unknowns of the 3D solid); got {max_dofs!r}")
+
+
 def coarser(settings):
     """The mesh of a mesh check: ``settings`` with 2/3 the elements each way."""
     return {**settings, "element_length": settings["element_length"] * 1.5,
@@ -254,7 +325,8 @@ class FECurve:
                 f"{self.elements[0]}x{self.elements[1]} elements, {self.wall_time:.1f} s; {self.message}")
 
 
-def fe_curve(scene, thickness, deltas, *, at="pole", mesh_check=False, progress=None, **settings) -> FECurve:
+def fe_curve(scene, thickness, deltas, *, at="pole", mesh_check=False, progress=None, max_dofs=None,
+             **settings) -> FECurve:
     """Indent the scene's shell as a 3D axisymmetric solid of thickness ``eps`` (FElupe).
 
     Parameters
@@ -279,6 +351,9 @@ def fe_curve(scene, thickness, deltas, *, at="pole", mesh_check=False, progress=
         (``mesh_error``).
     progress : callable, optional
         Called as ``progress(i, depth, force)`` after each depth.
+    max_dofs : int, optional
+        Refuse (ValueError, before the mesh is built) a solid of more unknowns than this
+        (:func:`fe_size`); default ``sb.options``' ``max_fe_dofs`` (50,000).
     **settings
         Override :data:`FE_DEFAULTS`.
 
@@ -311,6 +386,8 @@ def fe_curve(scene, thickness, deltas, *, at="pole", mesh_check=False, progress=
     opts = {**FE_DEFAULTS, **settings}
     if opts["rim_face"] not in RIM_FACES:
         raise ValueError(f"rim_face must be one of {RIM_FACES}; got {opts['rim_face']!r}")
+    _check_max_dofs(max_dofs)
+    check_fe_size(fe_size(scene, eps, **opts), max_dofs)
     path = _indenter_path if at == "indenter" else _pole_path
     out = path(scene, eps, deltas, opts, progress)
     err = np.full(deltas.size, np.nan)

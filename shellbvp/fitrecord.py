@@ -33,7 +33,8 @@ SI units, ``"1"`` nondimensional, ``""`` text)::
                                delta is, the mid-surface pole's or the indenter's displacement),
                                model_note (why that model, with model auto), model_error_source
                                (measured: on this scene by the solid; map: the mapped scenes' bound;
-                               mesh: the solid's own, by its mesh check)
+                               mesh: the solid's own, by its mesh check), stability_verdict
+                               (whether the fitted shell's stability was checked, and to what depth)
     /fit/warnings              (k,) the fit's warnings (text); attr codes
     /fit/sample                NXsample; attrs: scene (JSON, rebuilds the Scene), scene_<key>
     /fit/source                NXnote: file_name, sha256, columns (JSON), units (JSON), inverted
@@ -207,6 +208,7 @@ def write_fit(path, result, record, used, *, segment="loading", overwrite=False)
         p.attrs.update({"NX_class": "NXparameters", "baseline_model": result.baseline_model,
                         "weights": result.weights, "segment": segment, "model": result.model,
                         "model_note": result.model_note, "model_error_source": _error_source(result),
+                        "stability_verdict": getattr(result, "stability_verdict", "stability: not checked"),
                         "fitted": np.array(list(result.fitted), dtype=h5py.string_dtype())})
         values = {"mu_H": result.mu_H, "offset": result.offset, "baseline": result.baseline,
                   "baseline_slope": result.baseline_slope, "R_L": result.R_L,
@@ -390,7 +392,7 @@ def read_fit(path) -> FitRecord:
                                      f"{correlation.shape}")
             settings = {k: sc.attr_text(p, k) for k in ("baseline_model", "weights", "segment")}
             settings["model"] = sc.attr_text(p, "model") if "model" in p.attrs else "shell"  # files before it: shell
-            for k in ("model_note", "model_error_source"):
+            for k in ("model_note", "model_error_source", "stability_verdict"):
                 settings[k] = sc.attr_text(p, k) if k in p.attrs else ""
             if settings["model"] not in ("shell", "solid"):
                 raise ValueError(f"parameters.model must be 'shell' or 'solid'; got {settings['model']!r}")

@@ -116,14 +116,15 @@ class FirstInstability:
     message: str = ""
 
     def to_dict(self) -> dict:
+        """As JSON can hold it: an unknown end of the bracket (NaN) as None (null)."""
         d = asdict(self)
-        d["bracket"] = list(self.bracket)
+        d["bracket"] = [float(b) if math.isfinite(b) else None for b in self.bracket]
         return d
 
     @classmethod
     def from_dict(cls, d) -> "FirstInstability":
         return cls(delta=float(d["delta"]), force=float(d["force"]), mode=int(d["mode"]),
-                   located=bool(d["located"]), bracket=tuple(float(b) for b in d["bracket"]),
+                   located=bool(d["located"]), bracket=tuple(math.nan if b is None else float(b) for b in d["bracket"]),
                    message=str(d["message"]) if "message" in d else "")
 
     def summary(self) -> str:

@@ -261,6 +261,8 @@ def fit_summary_lines(record):
             lines.append(f"model: {record.settings['model_note']}")
         if record.settings.get("model", "shell") == "shell" and record.settings.get("model_error_source") != "measured":
             lines.append(model_error_line(s))
+        if record.settings.get("stability_verdict"):
+            lines.append(record.settings["stability_verdict"])
     lines.append(f"scene: {s.describe(p['R_L'])}")
     lines += [f"warning: {w}" for w in record.warnings] or ["warnings: none"]
     lines.append(f"shellbvp {record.version}; {record.message}")

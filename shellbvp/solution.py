@@ -135,6 +135,9 @@ def solve_bvp(fun, bc, x, y, p=None, *, fun_jac, bc_jac, max_jacobians=None, ker
     except _NonFinite as exc:
         return _failed_run(x, y, p, 2, f"the Jacobian ({exc}) overflowed to NaN/inf during Newton: the "
                                        f"iterate left the model's domain (no solve of the collocation system)")
+    except MemoryError:  # the refined mesh's collocation system outgrew the machine: a node budget too
+        return _failed_run(x, y, p, 1, f"{STATUS_MESSAGES[1]} (memory ran out on the refined mesh, from "
+                                       f"{xa.size} nodes)")
 
 
 

@@ -135,7 +135,7 @@ class Validation:
 
 
 def validate(scene, thickness=None, deltas=None, *, delta_max=0.5, mesh_check=False, progress=None,
-             tol=1e-6, R_L=None, **fe_settings) -> Validation:
+             tol=1e-6, max_nodes=10000, max_dofs=None, R_L=None, **fe_settings) -> Validation:
     """The shell model's error for ``scene`` at thickness ``eps``: both curves at the same depths.
 
     Parameters
@@ -150,8 +150,11 @@ def validate(scene, thickness=None, deltas=None, *, delta_max=0.5, mesh_check=Fa
         Also solve the 3D model on a coarser mesh (``FECurve.mesh_error``).
     progress : callable, optional
         ``progress(i, delta, F_FE)`` after each FE depth.
-    tol : float
-        The shell model's collocation tolerance.
+    tol, max_nodes : float, int
+        The shell model's collocation tolerance and largest mesh of a state.
+    max_dofs : int, optional
+        The largest 3D solid built, in unknowns (:func:`shellbvp.fe.fe_size`; a larger one is
+        refused before any work); default ``sb.options``' ``max_fe_dofs`` (50,000).
     R_L : float, optional
         The rim radius (m): kept with the result, so that its file names the sample in lab units.
     **fe_settings
@@ -181,18 +184,19 @@ def validate(scene, thickness=None, deltas=None, *, delta_max=0.5, mesh_check=Fa
             raise ValueError(f"delta_max must be in (0, 2]; got {delta_max!r}")
         deltas = default_depths(eps, delta_max)
     deltas = np.asarray(deltas, dtype=float)
-    fe = fe_curve(scene, eps, deltas, mesh_check=mesh_check, progress=progress, **fe_settings)
-    return Validation(scene, shell_curve(scene, deltas, tol=tol), fe, R_L=None if R_L is None else float(R_L))
+    fe = fe_curve(scene, eps, deltas, mesh_check=mesh_check, progress=progress, max_dofs=max_dofs, **fe_settings)
+    return Validation(scene, shell_curve(scene, deltas, tol=tol, max_nodes=max_nodes), fe,
+                      R_L=None if R_L is None else float(R_L))
 
 
-def shell_curve(scene, deltas, *, tol=1e-6):
+def shell_curve(scene, deltas, *, tol=1e-6, max_nodes=10000):
     """The shell model's curve at ``deltas``; with ``scene.transverse_shear`` also at ``deltas -
     shear_delta``, whose thick-shell depths ``delta + shear_delta`` fall next to ``deltas`` (then
     :meth:`Curve.force_at` interpolates locally)."""
     from .continuation import curve
 
     deltas = np.asarray(deltas, dtype=float)
-    shell = curve(scene, deltas=deltas, tol=tol, estimate_error=False)
+    shell = curve(scene, deltas=deltas, tol=tol, max_nodes=max_nodes, estimate_error=False)
     if not scene.transverse_shear:
         return shell
     d, sd = np.asarray(shell.points["delta"], float), np.asarray(shell.points["shear_delta"], float)
@@ -201,7 +205,7 @@ def shell_curve(scene, deltas, *, tol=1e-6):
     shifted = shifted[shifted > 0]
     if not shifted.size:
         return shell
-    return curve(scene, deltas=np.unique(np.r_[deltas, shifted]), tol=tol, estimate_error=False)
+    return curve(scene, deltas=np.unique(np.r_[deltas, shifted]), tol=tol, max_nodes=max_nodes, estimate_error=False)
 
 
 def _table(eps, delta, force_shell, force_fe, error, mesh_error) -> str:

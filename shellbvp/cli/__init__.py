@@ -23,7 +23,8 @@ import logging
 import sys
 
 from . import compile, convexity, curve, fit, info, plot, presets, report, solve, sweep, validate
-from .common import Parser, print_json_error, scene_from_args
+from ..config import options
+from .common import Parser, limits_of, print_json_error, scene_from_args
 
 __all__ = ["main", "build_parser", "scene_from_args"]
 
@@ -64,7 +65,8 @@ def _main(argv=None):
     logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING,
                         format="%(levelname)s %(name)s: %(message)s")
     try:
-        return args.func(args)
+        with options(**limits_of(args)):  # --max-fe-dofs, --max-stability-dofs
+            return args.func(args)
     except (ValueError, FileExistsError, ImportError) as exc:  # ImportError: an optional part missing or refused
         if getattr(args, "json", False):
             print_json_error(exc)

@@ -10,7 +10,8 @@ import re
 from pathlib import Path
 
 
-__all__ = ["Parser", "print_json_error", "plain_number", "plain_numbers", "quantity", "uncertain_value", "pressure_value", "say", "number_or", "thickness_value", "nondimensional", "add_radius_option", "add_mu_h_option", "material_spec", "material_help", "bending_families", "add_scene_options", "scene_from_args", "over_rim_radius", "require_sample", "nondimensional_thickness", "nondimensional_pressure", "checkpoint_seconds", "progress_bar", "curve_bars", "MAX_POINTS", "free_default_name", "strict_json", "output_dir", "check_report_path", "add_overwrite_option"]
+__all__ = ["Parser", "print_json_error", "plain_number", "plain_numbers", "quantity", "uncertain_value", "pressure_value", "say", "number_or", "thickness_value", "nondimensional", "add_radius_option", "add_mu_h_option", "material_spec", "material_help", "bending_families", "add_scene_options", "scene_from_args", "over_rim_radius", "require_sample", "nondimensional_thickness", "nondimensional_pressure", "checkpoint_seconds", "progress_bar", "curve_bars", "MAX_POINTS", "free_default_name", "strict_json", "output_dir", "check_report_path", "add_overwrite_option",
+           "NODE_BUDGET", "node_budget", "add_limit_options", "limits_of", "LIMIT_OPTIONS"]
 
 
 class Parser(argparse.ArgumentParser):
@@ -197,7 +198,56 @@ def bending_families() -> tuple:
     return tuple(f for f, c in BENDINGS.items() if c.cli)
 
 
-def add_scene_options(p, uncertain=False, preset_required=False):
+#: The collocation mesh a state may grow to (``--max-nodes``): fewer than the smallest start
+#: mesh fails every solve; more than a million outgrows the memory of a workstation.
+NODE_BUDGET = (100, 1_000_000)
+
+
+def node_budget(text):
+    """``--max-nodes``: an integer in :data:`NODE_BUDGET`."""
+    lo, hi = NODE_BUDGET
+    try:
+        value = int(text)
+    except ValueError:
+        value = None
+    if value is None or not lo <= value <= hi:
+        raise argparse.ArgumentTypeError(f"must be an integer in [{lo}, {hi:,}]; got {text!r}")
+    return value
+
+
+#: ``--max-fe-dofs`` and ``--max-stability-dofs``: the option of :func:`shellbvp.options` each sets.
+LIMIT_OPTIONS = {"fe": ("--max-fe-dofs", "max_fe_dofs",
+                        "largest 3D solid built, in unknowns (default 50000: ~30 min, ~330 MB); its size is "
+                        "estimated from the scene first and a larger one refused"),
+                 "stability": ("--max-stability-dofs", "max_stability_dofs",
+                               "largest stability analysis of a state, in unknowns over its modes (default 300000: "
+                               "~15 s a state, beta ~ 1e-7); estimated first and a larger one refused")}
+
+
+def positive_count(text):
+    try:
+        value = int(text)
+    except ValueError:
+        value = 0
+    if value <= 0:
+        raise argparse.ArgumentTypeError(f"must be a positive integer; got {text!r}")
+    return value
+
+
+def add_limit_options(p, *kinds):
+    """``--max-fe-dofs`` / ``--max-stability-dofs`` (:data:`LIMIT_OPTIONS`); :func:`shellbvp.cli.main`
+    runs the command with them in force."""
+    for kind in kinds:
+        flag, dest, text = LIMIT_OPTIONS[kind]
+        p.add_argument(flag, type=positive_count, dest=dest, help=text)
+
+
+def limits_of(args) -> dict:
+    """The ``sb.options`` the command's limit options set (those given)."""
+    return {dest: getattr(args, dest) for _, dest, _ in LIMIT_OPTIONS.values() if getattr(args, dest, None) is not None}
+
+
+def add_scene_options(p, uncertain=False, preset_required=False, solver=("tol", "max_nodes")):
     g = p.add_argument_group("scene (overrides of the preset)")
     g.add_argument("--preset", default=None,
                    help="built-in scene (see `shellbvp presets`); " + (
@@ -244,9 +294,14 @@ def add_scene_options(p, uncertain=False, preset_required=False):
     b.add_argument("--bending-formula", dest="bending_formula",
                    help="a user bending energy B per beta in lambda_s, lambda_theta, kappa_s, kappa_theta, "
                         "kappa_s0, kappa_theta0 (the reference curvatures)")
+    if not solver:  # a command that solves nothing: no solver options to ignore
+        return
     s = p.add_argument_group("solver")
-    s.add_argument("--tol", type=plain_number, default=1e-6, help="collocation tolerance (default 1e-6)")
-    s.add_argument("--max-nodes", type=int, default=10000, dest="max_nodes", help="largest collocation mesh of a state (default 10000)")
+    if "tol" in solver:
+        s.add_argument("--tol", type=plain_number, default=1e-6, help="collocation tolerance (default 1e-6)")
+    if "max_nodes" in solver:
+        s.add_argument("--max-nodes", type=node_budget, default=10000, dest="max_nodes",
+                       help=f"largest collocation mesh of a state (default 10000, in [{NODE_BUDGET[0]}, {NODE_BUDGET[1]}])")
 
 
 def scene_from_args(args):

@@ -16,7 +16,7 @@ def add_parser(sub):
     """The ``compile`` subcommand's arguments, on ``sub`` (the subparsers)."""
     c = sub.add_parser("compile", help="compile the solver's kernels with numba, once (the [fast] extra): every "
                                        "preset's, or the scene's given by the options")
-    add_scene_options(c)
+    add_scene_options(c, solver=())
     c.add_argument("--radius", "--rim-radius", help="rim radius with its unit, for lengths given in lab units")
     c.set_defaults(func=run)
 

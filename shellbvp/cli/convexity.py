@@ -12,7 +12,7 @@ def add_parser(sub):
     """The ``convexity`` subcommand's arguments, on ``sub`` (the subparsers)."""
     cv = sub.add_parser("convexity", help="where the scene's energy is convex in stretch and curvature "
                                           "(the Legendre condition; beyond it the contact edge becomes a corner)")
-    add_scene_options(cv)
+    add_scene_options(cv, solver=())
     cv.add_argument("--radius", "--rim-radius", type=quantity("length"),
                     help="rim radius with its unit, for the lengths of --indenter-radius, --rise, --thickness")
     cv.set_defaults(func=run)

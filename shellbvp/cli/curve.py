@@ -7,7 +7,7 @@ import sys
 import time
 
 from .common import (
-    MAX_POINTS, add_mu_h_option, add_overwrite_option, add_radius_option, add_scene_options, checkpoint_seconds,
+    MAX_POINTS, add_limit_options, add_mu_h_option, add_overwrite_option, add_radius_option, add_scene_options, checkpoint_seconds,
     free_default_name, nondimensional, number_or, plain_number, scene_from_args,
 )
 
@@ -38,6 +38,7 @@ def add_parser(sub):
     c.add_argument("--stability", choices=("off", "points", "locate"), default="off",
                    help="stability of the states against non-axisymmetric modes: off (default); points: at "
                         "every point; locate: and the first instability narrowed between two points")
+    add_limit_options(c, "stability")
     c.set_defaults(func=run)
 
 
@@ -57,6 +58,10 @@ def run(args):
                          f"it); use --overwrite to replace it")
     check_output_path(partial, overwrite=True)
     scene = scene_from_args(args)
+    if args.stability != "off":  # its cost per state, estimated before the curve is computed
+        from ..modal_stability import check_stability_size
+
+        check_stability_size(scene)
     units = None
     if (args.radius is None) != (args.mu_h is None):
         raise ValueError("--radius and --muH go together (rim radius, e.g. 0.3mm, and mu*H, e.g. 52N/m)")
@@ -96,10 +101,12 @@ def run(args):
     finally:
         bar.close()
     c = run.result()
-    if not c.interrupted:
+    if not c.interrupted and args.stability != "off":
+        _assess(c, args)
+    elif not c.interrupted:
         from ..curve_stability import assess
 
-        assess(c, args.stability)
+        assess(c, "off")
     if c.interrupted and out.exists():
         # Ctrl-C is as safe as kill -9: an earlier file stays; the finished points go to the checkpoint
         write_curve(c, partial, profiles=args.profiles, overwrite=True, units=units)
@@ -116,6 +123,22 @@ def run(args):
     return 0 if c.complete else 1
 
 
+def _assess(c, args):
+    """The states' stability, with a bar of its own: the curve's stays at 100 % meanwhile."""
+    from ..curve_stability import assess
+    from ..modal_stability import stability_size
+    from ..progress import progress_bar, wanted
+
+    seconds = stability_size(c.scene)[3]
+    total = len(c) if args.stability == "points" else None
+    bar = progress_bar(total, desc=f"stability (~{seconds:.2g} s a state)", unit="state",
+                       enabled=wanted(args.quiet))
+    try:
+        assess(c, args.stability, progress=lambda delta: (bar.update(1), bar.set_postfix_str(f"delta {delta:.4g}")))
+    finally:
+        bar.close()
+
+
 def _print_details(c, args, units):
     """The lines under the summary: the scene (a bowl or a dome, lengths in lab units with --radius),
     the range in lab units, the configurations, the stability note."""
@@ -130,5 +153,8 @@ def _print_details(c, args, units):
               f"{format_in(scale * float(min(c.force)), fu, 'force')} .. {format_in(scale * float(max(c.force)), fu, 'force')}")
     if len(c):
         print(f"  contact topologies along the curve: {c.topology_summary()}")
+    from ..curve_stability import verdict
+
+    print(f"  {verdict(c)}")
     if c.settings.get("stability_note"):
         print(f"  stability not computed where: {c.settings['stability_note']}")

@@ -9,8 +9,8 @@ from pathlib import Path
 from ..shape_parameters import SHAPE_PARAMETERS
 from ..textdata import printable
 from .common import (
-    add_overwrite_option, add_scene_options, check_report_path, curve_bars, number_or, os_error_line, output_dir,
-    progress_bar, quantity, require_sample, say, scene_from_args, strict_json,
+    add_limit_options, add_overwrite_option, add_scene_options, check_report_path, curve_bars, number_or,
+    os_error_line, output_dir, progress_bar, quantity, require_sample, say, scene_from_args, strict_json,
 )
 
 __all__ = ["add_parser", "run"]
@@ -29,7 +29,9 @@ def add_parser(sub):
                    "offset, baseline, residual, warnings, ...)")
     f.add_argument("--example", action="store_true",
                    help="use the synthetic Lepidium-like data shipped with shellbvp (README)")
-    add_scene_options(f, uncertain=True, preset_required=True)
+    # --max-nodes is not offered: the model curves keep the solver's node budget, which is part of
+    # the key of every kept model curve (issue 59)
+    add_scene_options(f, uncertain=True, preset_required=True, solver=("tol",))
     f.add_argument("--workers", type=int, help="with VALUE+-U parameters: local processes for their fits "
                                                "(default: all cores)")
     f.add_argument("--scheduler", help="with VALUE+-U parameters: run their fits on this Dask scheduler")
@@ -83,6 +85,7 @@ def add_parser(sub):
                    "(one <name>.pdf per file)")
     f.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
     add_overwrite_option(f, "replace an existing output file (record, report, table)")
+    add_limit_options(f, "fe", "stability")
     f.set_defaults(func=run)
 
 
@@ -151,6 +154,10 @@ def _fit_inputs(args, pixel_values=None):
         from ..fitting.solid import check_solid_fit
 
         check_solid_fit(scene, free)
+    if args.stability:
+        from ..modal_stability import check_stability_size
+
+        check_stability_size(scene)
     options = {"fit_offset": not args.no_offset, "free": free, "bounds": bounds, "weights": args.weights,
                "tol": args.tol, "stability": args.stability, "model": args.model, "mesh_check": args.mesh_check,
                "max_depth": _max_depth(args.max_depth, args.radius.si)}
@@ -495,6 +502,8 @@ def _print_fit(res, record, used, args):
         say(line)
     for text in res.warnings:
         say(f"warning: {text}")
+    if getattr(args, "stability", False):
+        say(res.stability_verdict)
     if res.stability_note:
         say(f"stability not analysed where: {res.stability_note}")
 

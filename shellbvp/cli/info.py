@@ -90,6 +90,9 @@ def run(args):
     say(f"sample:    {s.describe(None if c.units is None else c.units['R_L'])}")  # bowl or dome, lab lengths
     say(f"curve:     {c.summary()}")
     say(f"complete:  {c.complete}  interrupted: {c.interrupted}")
+    from ..curve_stability import verdict
+
+    say(verdict(c))
     res = c.energy_residual
     if np.any(np.isfinite(res)):
         say(f"energy identity: max |dE/ddelta - F| = {np.nanmax(np.abs(res)):.3g}")

@@ -7,7 +7,7 @@ import time
 
 from .common import (
     MAX_POINTS, add_mu_h_option, add_overwrite_option, add_radius_option, material_help, material_spec, nondimensional,
-    number_or, plain_number,
+    node_budget, number_or, plain_number,
 )
 
 __all__ = ["add_parser", "run"]
@@ -44,7 +44,8 @@ def add_parser(sub):
     add_mu_h_option(w, "with --radius, for --force-max with a unit")
     w.add_argument("--points", type=int, help="N equally spaced depths up to delta-max (default: adaptive)")
     w.add_argument("--tol", type=plain_number, default=1e-6, help="collocation tolerance (default 1e-6)")
-    w.add_argument("--max-nodes", type=int, default=10000, dest="max_nodes", help="largest collocation mesh of a state (default 10000)")
+    w.add_argument("--max-nodes", type=node_budget, default=10000, dest="max_nodes",
+                   help="largest collocation mesh of a state (default 10000, in [100, 1000000])")
     w.add_argument("--max-steps", type=int, default=400, dest="max_steps", help="most continuation steps of a curve (default 400)")
     w.add_argument("--topology", choices=("auto", "cap"), default="auto",
                    help="auto (default): lifted-off contact where the cap would pull the shell; cap: single cap only")

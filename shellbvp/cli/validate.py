@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from .common import (
-    add_overwrite_option, add_radius_option, add_scene_options, free_default_name, nondimensional, number_or,
+    add_limit_options, add_overwrite_option, add_radius_option, add_scene_options, free_default_name, nondimensional, number_or,
     plain_numbers, scene_from_args,
 )
 
@@ -24,6 +24,7 @@ def add_parser(sub):
                    help="also solve the 3D model on a coarser mesh and report the difference (~1.5x the time)")
     v.add_argument("-o", "--output", help="output file (default <preset>-validate.h5, or -2, ... if that exists)")
     add_overwrite_option(v, "replace an existing output file")
+    add_limit_options(v, "fe")
     v.set_defaults(func=run)
 
 
@@ -36,7 +37,7 @@ def run(args):
     args.delta_max = nondimensional(args, args.delta_max, "--delta-max")
     if scene.thickness is None:
         raise ValueError("validate needs --thickness (H/R_L, or with a unit and --radius)")
-    from ..fe import check_solid_scene
+    from ..fe import check_fe_size, check_solid_scene, fe_size
 
     check_solid_scene(scene)
     if not (0 < args.delta_max <= 2):
@@ -54,13 +55,16 @@ def run(args):
         import felupe  # noqa: F401
     except ImportError:
         raise ValueError("validate needs FElupe: pip install 'shellbvp[fe]'") from None
+    size = fe_size(scene, scene.thickness)
+    check_fe_size(size)  # before the shell's curve too: one line, no work
     t0 = time.perf_counter()
     shell = "with its transverse shear" if scene.transverse_shear else "Kirchhoff (no transverse shear)"
     print(f"scene: {args.preset or 'base'}, eps = H/R_L = {scene.thickness:.4g}, beta = {scene.beta:.4g}; "
           f"3D model (FElupe) and shell model, {shell}, at the same pole displacements", flush=True)
     print(f"sample: {scene.describe(None if args.radius is None else args.radius.si)}", flush=True)
+    print(f"3D model: {size.describe()} (estimated)", flush=True)
     result = validate(scene, deltas=deltas, delta_max=args.delta_max, mesh_check=args.mesh_check, tol=args.tol,
-                      R_L=None if args.radius is None else args.radius.si,
+                      R_L=None if args.radius is None else args.radius.si, max_nodes=args.max_nodes,
                       progress=lambda i, d, f: print(f"  FE: delta = {d:.4g}, F = {f:.5g}", flush=True))
     print(result.table())
     if not result.fe.success:

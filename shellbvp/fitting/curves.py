@@ -114,7 +114,8 @@ def _disk_place(scene, deltas, tol):
 
 
 #: Options that do not change a curve's numbers (not part of a kept curve's key)
-_NOT_NUMERICS = ("progress_seconds", "health_seconds", "compile_in_background", "model_curve_cache")
+_NOT_NUMERICS = ("progress_seconds", "health_seconds", "compile_in_background", "model_curve_cache", "max_fe_dofs",
+                 "max_stability_dofs")
 
 #: What the cache's warnings call a kept shell curve
 KEPT_WHAT = "model curves"

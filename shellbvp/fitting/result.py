@@ -116,6 +116,9 @@ class FitResult:
         With ``fit(..., stability=True)``: where the fitted scene's curve first loses
         axisymmetric stability, if within the fitted depths (:mod:`shellbvp.curve_stability`);
         ``stability_note`` says what was not analysed.
+    stability_verdict : str
+        One line: "stability: not checked" (the default), or checked and stable to which
+        depth, or where it is lost (:func:`shellbvp.curve_stability.verdict`).
     correlation : ndarray or None
         Correlation matrix of the fitted parameters (order of ``fitted``), from the linearised
         covariance.
@@ -184,6 +187,7 @@ class FitResult:
     residual_autocorrelation: float = float("nan")
     first_instability: object = None
     stability_note: str = ""
+    stability_verdict: str = "stability: not checked"
     model: str = "shell"
     model_note: str = ""
     measured_model_error: float = None
@@ -285,6 +289,7 @@ class FitResult:
                 [[num(v) for v in row] for row in np.asarray(self.correlation)],
                 "first_instability": None if self.first_instability is None else self.first_instability.to_dict(),
                 "stability_note": self.stability_note,
+                "stability_verdict": self.stability_verdict,
                 "model_error": None if self.model_error is None else num(self.model_error[0]),
                 "model_error_extrapolated": None if self.model_error is None else self.model_error[1],
                 "units": {"mu_H": "N/m (= um*MPa)", "offset": "m", "max_depth": "m", "residual": "N (rms)",

@@ -35,7 +35,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..config import OPTIONS
-from ..fe import FE_DEFAULTS, check_solid_scene, coarser, fe_curve
+from ..fe import FE_DEFAULTS, check_fe_size, check_solid_scene, coarser, fe_curve, fe_size
 from ..version import __version__
 from .curves import code_fingerprint
 from .kept import checksum, keep, kept_folder, read_kept
@@ -120,6 +120,7 @@ def check_solid_fit(scene, free=()):
         raise ValueError("transverse_shear is a correction of the shell model; the solid has its shear already: "
                          "drop --transverse-shear with --model solid")
     check_solid_scene(scene)
+    check_fe_size(fe_size(scene, scene.thickness, **FE_DEFAULTS))  # before the data are read
 
 
 #: How the summary names the shell model: what it takes the data's displacement to be.

@@ -249,16 +249,18 @@ import numpy as np
 from ..geometry import Spheroid
 from ..configurations import of
 from .contact import FRICTION, NOT_BUILT, Contact, check_friction, check_supported, contact_of, supported
-from .fem import END_CONDITIONS, Stability, default_elements, default_modes, mesh, spectrum
+from .fem import (
+    END_CONDITIONS, Stability, check_stability_size, default_elements, default_modes, mesh, spectrum, stability_size,
+)
 from .form import chain_base, form_functions, sphere_base, state_base
 
 __all__ = ["stability", "Stability", "spectrum", "state_base", "sphere_base", "mesh", "default_modes",
            "default_elements", "END_CONDITIONS", "sphere_stretch", "NOT_BUILT", "supported", "Contact", "check_supported",
-           "contact_of", "chain_base", "form_functions", "FRICTION"]
+           "contact_of", "chain_base", "form_functions", "FRICTION", "stability_size", "check_stability_size"]
 
 
 def stability(state, modes=None, *, elements: int | None = None, S0: float | None = None,
-              count: int = 2, vectors: bool = False, friction: str = "frictionless") -> Stability:
+              count: int = 2, vectors: bool = False, friction: str = "frictionless", max_dofs=None) -> Stability:
     """The smallest eigenvalues of the second variation of ``state`` per Fourier mode.
 
     Parameters
@@ -282,6 +284,10 @@ def stability(state, modes=None, *, elements: int | None = None, S0: float | Non
         no slip (``u = v = 0`` there, the pole held at a point included).  The two bound the
         stability of the state under any friction coefficient (module docstring, "Friction");
         no effect without contact.
+    max_dofs : int, optional
+        Refuse (ValueError, before anything is built) an analysis of more unknowns than this,
+        summed over the modes (:func:`stability_size`); default ``sb.options``'
+        ``max_stability_dofs`` (300,000: about 15 s, the hemisphere at beta ~ 1e-7).
 
     Returns
     -------
@@ -322,6 +328,8 @@ def stability(state, modes=None, *, elements: int | None = None, S0: float | Non
     t0 = time.perf_counter()
     check_friction(friction)
     check_supported(state)
+    modes = None if modes is None else [int(n) for n in modes]
+    check_stability_size(state.scene, modes, elements, max_dofs)
     sysm = state.system
     if of(state) is None:  # the inflated shell: no contact
         zeta = float(sysm.S_point(sysm.regions[0].start, None))
