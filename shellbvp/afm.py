@@ -24,7 +24,10 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["AFM_SUFFIXES", "AFMCurve", "ForceMap", "MapFile", "is_afm_file", "read_afm", "curves_from_afm",
+from .afm_files import AFMFileError
+from .textdata import printable
+
+__all__ = ["AFM_SUFFIXES", "AFMCurve", "ForceMap", "map_shape", "MapFile", "is_afm_file", "read_afm", "curves_from_afm",
            "refuse_text_options", "MAP_FORMAT", "is_map_file", "read_map_file", "draw_map"]
 
 #: File name endings read through afmformats (other text files go through shellbvp.instrument).
@@ -80,30 +83,30 @@ def _afmformats():
 def read_afm(path) -> list:
     """The curves of an AFM file (:data:`AFM_SUFFIXES`) as :class:`AFMCurve`, in file order.
 
+    The file's declared sizes are checked first (:func:`shellbvp.afm_files.check_afm_sizes`:
+    an archive's members and inflated sizes, an ``.ibw`` header's parts), then afmformats
+    reads it inside one error boundary (:func:`shellbvp.afm_files.afmformats_boundary`):
+    whatever fails while the file is decoded is one ``ValueError`` line.
+
     Raises
     ------
     ValueError
         afmformats is not installed, or cannot read the file, or a curve lacks the force,
-        a height or the spring constant.
+        a height or the spring constant, or the file declares sizes beyond the bounds.
     """
+    from .afm_files import afmformats_boundary, check_afm_sizes
     from .instrument import sha256_of
     from .paths import read_input_bytes
 
     afmformats = _afmformats()
-    read_input_bytes(path)  # a regular file of bounded size: never a FIFO, a device or a folder
-    from afmformats import errors, meta
-
-    # afmformats raises many kinds on a damaged or foreign file, some of them BaseExceptions
-    failures = (Exception, meta.MetaDataMissingError,
-                *(c for c in vars(errors).values() if isinstance(c, type) and issubclass(c, BaseException)
-                  and not issubclass(c, Exception)))
-    try:
+    size = len(read_input_bytes(path))  # a regular file of bounded size: never a FIFO, a device or a folder
+    check_afm_sizes(path, size)
+    with afmformats_boundary(path):
         datasets = afmformats.load_data(str(path))
-    except failures as exc:
-        raise ValueError(f"{path}: afmformats cannot read it ({type(exc).__name__}: {exc})") from None
-    if not datasets:
-        raise ValueError(f"{path}: afmformats found no force-distance curve in it")
-    return curves_from_afm(datasets, path, sha256=sha256_of(path))
+        if not datasets:
+            raise AFMFileError(f"{printable(path)}: afmformats found no force-distance curve in it")
+        # afmformats loads a curve's columns when they are first read: inside the boundary too
+        return curves_from_afm(datasets, path, sha256=sha256_of(path))
 
 
 def _meta(md, key):
@@ -119,9 +122,9 @@ def curves_from_afm(datasets, path, *, sha256=None) -> list:
     for i, ds in enumerate(datasets):
         columns = list(ds.columns)
         md = ds.metadata
-        where = f"{path}, curve {i}"
+        where = f"{printable(path)}, curve {i}"
         if "force" not in columns:
-            raise ValueError(f"{where}: no force column (columns: {', '.join(columns)})")
+            raise AFMFileError(f"{where}: no force column (columns: {printable(', '.join(map(str, columns)))})")
         force = np.asarray(ds["force"], float)
         if "tip position" in columns:
             tip, how = np.asarray(ds["tip position"], float), "-(tip position)"
@@ -129,13 +132,13 @@ def curves_from_afm(datasets, path, *, sha256=None) -> list:
             height = next((h for h in ("height (measured)", "height (piezo)") if h in columns), None)
             k = _meta(md, "spring constant")
             if height is None or k is None or not k > 0:
-                raise ValueError(f"{where}: needs a height column and the spring constant to place the tip "
-                                 f"(columns: {', '.join(columns)}; spring constant: {k})")
+                raise AFMFileError(f"{where}: needs a height column and the spring constant to place the tip "
+                                 f"(columns: {printable(', '.join(map(str, columns)))}; spring constant: {k})")
             tip, how = np.asarray(ds[height], float) + force / k, f"-({height} + force / spring constant)"
         time = np.asarray(ds["time"], float) if "time" in columns else None
         ok = np.isfinite(tip) & np.isfinite(force) & (np.isfinite(time) if time is not None else True)
         if ok.sum() < 3:
-            raise ValueError(f"{where}: fewer than 3 rows with numbers")
+            raise AFMFileError(f"{where}: fewer than 3 rows with numbers")
         record = record_from_arrays(path, -tip[ok], force[ok], None if time is None else time[ok],
                                     np.flatnonzero(ok), columns={"displacement": how, "force": "force",
                                                                  **({"time": "time"} if time is not None else {})},
@@ -152,6 +155,32 @@ def curves_from_afm(datasets, path, *, sha256=None) -> list:
                             grid_geometry=((geometry[0], geometry[1]), (geometry[2], geometry[3]))
                             if None not in geometry else None))
     return out
+
+
+def map_shape(curves, path="the map") -> tuple:
+    """``(nx, ny)``: the grid a force map's curves span (their largest grid indices + 1), or
+    ``(len(curves), 1)`` when they carry none.
+
+    Raises
+    ------
+    ValueError
+        The grid spans more than :data:`~shellbvp.afm_files.MAX_MAP_PIXELS` cells (a map's
+        images are allocated at this size): a header declaring a 100000 x 100000 grid for the
+        few curves present is refused before any curve is fitted.
+    """
+    from .afm_files import MAX_MAP_PIXELS
+
+    grids = [c.grid for c in curves if c.grid is not None]
+    if not grids:
+        return (len(curves), 1)
+    shape = (max(g[0] for g in grids) + 1, max(g[1] for g in grids) + 1)
+    if min(min(g) for g in grids) < 0:
+        raise ValueError(f"{printable(path)}: a curve has a negative grid index")
+    if shape[0] * shape[1] > MAX_MAP_PIXELS:
+        raise ValueError(f"{printable(path)}: its {len(curves)} curves' grid indices span a {shape[0]} x {shape[1]} "
+                         f"grid ({shape[0] * shape[1]} cells); a map has at most {MAX_MAP_PIXELS} cells "
+                         f"(MAX_MAP_PIXELS; the header's grid size or the curves' positions are wrong)")
+    return shape
 
 
 def mu_H_spread(mu, with_range=False) -> str:

@@ -308,14 +308,14 @@ def fit_map(scene, curves, *, R_L, path=None, segment="loading", baseline="auto"
     this map and scene (a pixel outside the grid, a value out of range, a map without grid
     indices) is a ``ValueError`` before any curve.
     """
-    from .afm import AFMCurve, ForceMap
+    from .afm import AFMCurve, ForceMap, map_shape
 
     if not curves:
         raise ValueError("fit_map: no curves")
     path = path or curves[0].record.path
     named = [(f"{path}#{c.index}", c.record) for c in curves]
     grids = [c.grid for c in curves if c.grid is not None]
-    shape = (max(g[0] for g in grids) + 1, max(g[1] for g in grids) + 1) if grids else (len(curves), 1)
+    shape = map_shape(curves, path)  # bounded before any curve is fitted
     settings = {"baseline": baseline, **{k: v for k, v in options.items() if k != "progress"}}
     if pixel_values is not None:
         return _fit_map_per_pixel(scene, curves, named, shape, pixel_values, R_L=R_L, path=path, segment=segment,

@@ -50,6 +50,9 @@ _NAMES = {
     "force": (("force", "load"), ("f",)),
     "time": (("time",), ("t",)),
 }
+#: Lines of header and comments a table bounded in rows (``read_table(max_rows=...)``) may add.
+MAX_PREAMBLE_LINES = 1000
+
 _KIND = {"displacement": "length", "force": "force", "time": "time"}
 
 _BOMS = ((codecs.BOM_UTF32_LE, "utf-32"), (codecs.BOM_UTF32_BE, "utf-32"), (codecs.BOM_UTF8, "utf-8-sig"),
@@ -162,7 +165,7 @@ class Table:
     delimiter: str
 
 
-def read_table(path) -> Table:
+def read_table(path, *, max_rows=None, what="table") -> Table:
     """Split a delimited text file into header rows and data rows.
 
     ``#`` and ``%`` start comment lines; blank lines are skipped; the delimiter
@@ -173,16 +176,24 @@ def read_table(path) -> Table:
     just above the data, as many cells as the data after an optional ``columns:`` or
     ``units:`` label (``# columns: height vDeflection`` / ``# units: m N``).
 
+    ``max_rows`` bounds the data rows (``what`` names the table in the message): a file with
+    more lines than that and :data:`MAX_PREAMBLE_LINES` is refused before it is split.
+
     Raises
     ------
     ValueError
-        The file cannot be read or decoded, or holds no data.
+        The file cannot be read or decoded, or holds no data, or more than ``max_rows`` rows.
     """
     from .paths import read_input_bytes
 
     raw = read_input_bytes(path)  # a regular file of bounded size: never a FIFO, a device or a folder
     text = _decode(raw, path)
+    del raw
+    if max_rows is not None and text.count("\n") > max_rows + MAX_PREAMBLE_LINES:
+        raise ValueError(f"{path}: {text.count(chr(10))} lines; a {what} has at most {max_rows} rows (and "
+                         f"{MAX_PREAMBLE_LINES} lines of header and comments)")
     all_lines = text.splitlines()
+    del text
     numbered = [(i, ln) for i, ln in enumerate(all_lines, start=1)
                 if ln.strip() and not ln.lstrip().startswith(("#", "%"))]
     if not numbered:
@@ -201,6 +212,8 @@ def read_table(path) -> Table:
     first = next((k for k, r in enumerate(rows) if r and all(_number(c) is not None for c in r)), len(rows))
     if first == len(rows):
         raise ValueError(f"{path}: fewer than 3 rows with numbers (no row is all numbers)")
+    if max_rows is not None and len(rows) - first > max_rows:
+        raise ValueError(f"{path}: {len(rows) - first} rows; a {what} has at most {max_rows}")
     heads = rows[:first]
     if not heads:  # no header among the data lines: one in the comment lines just above them
         heads = _commented_header(all_lines[:line_no[0] - 1], delim, len(rows[first]))
