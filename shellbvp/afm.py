@@ -9,7 +9,10 @@ cantilever's deflection ``force / spring constant`` (nanite's tip-sample separat
 sample is minus the tip's position: the package's signs, no ``--invert`` needed.
 
 * :func:`read_afm` -- the curves of a file as :class:`AFMCurve` (an
-  :class:`~shellbvp.instrument.InstrumentRecord` with its place on the map).
+  :class:`~shellbvp.instrument.InstrumentRecord` with its place on the map); the file's
+  declared sizes checked first and every failure of decoding one line
+  (:mod:`shellbvp.afm_read`).  AFM Workshop CSV and NT-MDT Nova text exports go through
+  afmformats too (:func:`afm_text_format`), with the cantilever's calibration given.
 * :class:`ForceMap` -- a force map fitted curve by curve (:func:`shellbvp.batch.fit_map`): the
   per-curve rows of a batch, images of mu*H and its interval, a NeXus file, a figure.
 * :func:`read_map_file` -- that NeXus file read back (:class:`MapFile`), for ``shellbvp info``
@@ -18,143 +21,21 @@ sample is minus the tip's position: the package's signs, no ``--invert`` needed.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
-from .afm_files import AFMFileError
+from .afm_read import (AFM_SUFFIXES, AFMCurve, afm_text_format, curves_from_afm, is_afm_file, read_afm,
+                       refuse_text_options, single_curve)
 from .textdata import printable
 
-__all__ = ["AFM_SUFFIXES", "AFMCurve", "ForceMap", "map_shape", "MapFile", "is_afm_file", "read_afm", "curves_from_afm",
-           "refuse_text_options", "MAP_FORMAT", "is_map_file", "read_map_file", "draw_map"]
+__all__ = ["AFM_SUFFIXES", "AFMCurve", "ForceMap", "MapFile", "is_afm_file", "afm_text_format", "read_afm",
+           "curves_from_afm", "single_curve", "refuse_text_options", "map_shape", "MAP_FORMAT", "is_map_file",
+           "read_map_file", "draw_map"]
 
-#: File name endings read through afmformats (other text files go through shellbvp.instrument).
-AFM_SUFFIXES = (".jpk-force", ".jpk-force-map", ".jpk-qi-data", ".jpk-qi-series", ".ibw")
 MAP_FORMAT = "shellbvp-force-map"
 MAP_FORMAT_VERSION = 1
-
-
-def is_afm_file(path) -> bool:
-    return str(path).lower().endswith(AFM_SUFFIXES)
-
-
-@dataclass
-class AFMCurve:
-    """One curve of an AFM file.
-
-    Attributes
-    ----------
-    record : InstrumentRecord
-        Displacement into the sample (m), force (N), time (s), segments, contact estimate.
-    index : int
-        The curve's number in the file (afmformats' ``enum``).
-    grid : tuple of int or None
-        ``(ix, iy)`` on a force map.
-    position : tuple of float or None
-        ``(x, y)`` of the curve on the sample (m), as the file gives it.
-    grid_geometry : tuple or None
-        ``((center x, center y), (size x, size y))`` of the map's grid (m).
-    """
-
-    record: object
-    index: int
-    grid: tuple = None
-    position: tuple = None
-    grid_geometry: tuple = None  # ((center x, center y), (size x, size y)) of the map's grid, m
-
-
-def refuse_text_options(path, columns=None, units=None, invert=()):
-    """ValueError when reading options of text exports are given for an AFM file."""
-    if columns or units or invert:
-        raise ValueError(f"{path}: an AFM file gives its own columns, units and signs: --columns, --units and "
-                         f"--invert are for text exports")
-
-
-def _afmformats():
-    try:
-        import afmformats
-    except ImportError:
-        raise ValueError("reading AFM files needs afmformats: pip install 'shellbvp[afm]'") from None
-    return afmformats
-
-
-def read_afm(path) -> list:
-    """The curves of an AFM file (:data:`AFM_SUFFIXES`) as :class:`AFMCurve`, in file order.
-
-    The file's declared sizes are checked first (:func:`shellbvp.afm_files.check_afm_sizes`:
-    an archive's members and inflated sizes, an ``.ibw`` header's parts), then afmformats
-    reads it inside one error boundary (:func:`shellbvp.afm_files.afmformats_boundary`):
-    whatever fails while the file is decoded is one ``ValueError`` line.
-
-    Raises
-    ------
-    ValueError
-        afmformats is not installed, or cannot read the file, or a curve lacks the force,
-        a height or the spring constant, or the file declares sizes beyond the bounds.
-    """
-    from .afm_files import afmformats_boundary, check_afm_sizes
-    from .instrument import sha256_of
-    from .paths import read_input_bytes
-
-    afmformats = _afmformats()
-    size = len(read_input_bytes(path))  # a regular file of bounded size: never a FIFO, a device or a folder
-    check_afm_sizes(path, size)
-    with afmformats_boundary(path):
-        datasets = afmformats.load_data(str(path))
-        if not datasets:
-            raise AFMFileError(f"{printable(path)}: afmformats found no force-distance curve in it")
-        # afmformats loads a curve's columns when they are first read: inside the boundary too
-        return curves_from_afm(datasets, path, sha256=sha256_of(path))
-
-
-def _meta(md, key):
-    v = dict.get(md, key) if isinstance(md, dict) else None  # MetaData[key] raises a BaseException
-    return v if isinstance(v, (int, float, np.integer, np.floating)) and math.isfinite(v) else None
-
-
-def curves_from_afm(datasets, path, *, sha256=None) -> list:
-    """:class:`AFMCurve` from afmformats' curves (``AFMForceDistance``) of the file ``path``."""
-    from .instrument import record_from_arrays
-
-    out = []
-    for i, ds in enumerate(datasets):
-        columns = list(ds.columns)
-        md = ds.metadata
-        where = f"{printable(path)}, curve {i}"
-        if "force" not in columns:
-            raise AFMFileError(f"{where}: no force column (columns: {printable(', '.join(map(str, columns)))})")
-        force = np.asarray(ds["force"], float)
-        if "tip position" in columns:
-            tip, how = np.asarray(ds["tip position"], float), "-(tip position)"
-        else:
-            height = next((h for h in ("height (measured)", "height (piezo)") if h in columns), None)
-            k = _meta(md, "spring constant")
-            if height is None or k is None or not k > 0:
-                raise AFMFileError(f"{where}: needs a height column and the spring constant to place the tip "
-                                 f"(columns: {printable(', '.join(map(str, columns)))}; spring constant: {k})")
-            tip, how = np.asarray(ds[height], float) + force / k, f"-({height} + force / spring constant)"
-        time = np.asarray(ds["time"], float) if "time" in columns else None
-        ok = np.isfinite(tip) & np.isfinite(force) & (np.isfinite(time) if time is not None else True)
-        if ok.sum() < 3:
-            raise AFMFileError(f"{where}: fewer than 3 rows with numbers")
-        record = record_from_arrays(path, -tip[ok], force[ok], None if time is None else time[ok],
-                                    np.flatnonzero(ok), columns={"displacement": how, "force": "force",
-                                                                 **({"time": "time"} if time is not None else {})},
-                                    units={"displacement": "m", "force": "N", **({"time": "s"} if time is not None
-                                                                               else {})},
-                                    header=columns, sha256=sha256)
-        ix, iy = _meta(md, "grid index x"), _meta(md, "grid index y")
-        x, y = _meta(md, "position x"), _meta(md, "position y")
-        index = _meta(md, "enum")
-        geometry = [_meta(md, f"grid {a} {b}") for a in ("center", "size") for b in "xy"]
-        out.append(AFMCurve(record=record, index=int(index) if index is not None else i,
-                            grid=(int(ix), int(iy)) if ix is not None and iy is not None else None,
-                            position=(float(x), float(y)) if x is not None and y is not None else None,
-                            grid_geometry=((geometry[0], geometry[1]), (geometry[2], geometry[3]))
-                            if None not in geometry else None))
-    return out
 
 
 def map_shape(curves, path="the map") -> tuple:
@@ -164,11 +45,11 @@ def map_shape(curves, path="the map") -> tuple:
     Raises
     ------
     ValueError
-        The grid spans more than :data:`~shellbvp.afm_files.MAX_MAP_PIXELS` cells (a map's
+        The grid spans more than :data:`~shellbvp.afm_read.MAX_MAP_PIXELS` cells (a map's
         images are allocated at this size): a header declaring a 100000 x 100000 grid for the
         few curves present is refused before any curve is fitted.
     """
-    from .afm_files import MAX_MAP_PIXELS
+    from .afm_read import MAX_MAP_PIXELS
 
     grids = [c.grid for c in curves if c.grid is not None]
     if not grids:
@@ -343,7 +224,6 @@ class ForceMap:
         import json
 
         from .nexus import new_file, number_dataset, string_dataset
-        from .textdata import printable
 
         x, y = self.axes()
         with new_file(out, MAP_FORMAT, MAP_FORMAT_VERSION, overwrite=overwrite) as f:

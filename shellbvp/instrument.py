@@ -207,6 +207,7 @@ def read_table(path, *, max_rows=None, what="table") -> Table:
             delim = csv.Sniffer().sniff("\n".join(lines[:20]), delimiters=",;\t").delimiter
         except csv.Error:
             delim = "\t" if "\t" in lines[-1] else (";" if ";" in lines[-1] else ",")
+    delim = _numeric_delimiter(sample, delim)
     rows = [_split(ln, delim) for ln in lines]
     line_no = [i for i, _ in numbered]
     first = next((k for k, r in enumerate(rows) if r and all(_number(c) is not None for c in r)), len(rows))
@@ -214,7 +215,7 @@ def read_table(path, *, max_rows=None, what="table") -> Table:
         raise ValueError(f"{path}: fewer than 3 rows with numbers (no row is all numbers)")
     if max_rows is not None and len(rows) - first > max_rows:
         raise ValueError(f"{path}: {len(rows) - first} rows; a {what} has at most {max_rows}")
-    heads = rows[:first]
+    heads = [_header_cells(ln, delim, len(rows[first])) for ln in lines[:first]]
     if not heads:  # no header among the data lines: one in the comment lines just above them
         heads = _commented_header(all_lines[:line_no[0] - 1], delim, len(rows[first]))
     header, header_units = [], None
@@ -227,6 +228,39 @@ def read_table(path, *, max_rows=None, what="table") -> Table:
         else:
             header = [c.strip() for c in heads[-1]]
     return Table(header=header, header_units=header_units, rows=rows[first:], line=line_no[first:], delimiter=delim)
+
+
+def _numeric_delimiter(sample, delim):
+    """``delim``, unless the data lines (``sample``, the last of the file) split by it are not
+    all numbers while another delimiter splits them into equal rows of numbers: a headerless
+    table with decimal commas (``0,5<TAB>1,5``) is tab-separated, not comma-separated."""
+    def numbers(d):
+        cells = [_split(ln, d) for ln in sample]
+        return len({len(c) for c in cells}) == 1 and len(cells[0]) >= 2 and \
+            all(x.strip() and _number(x) is not None for c in cells for x in c)
+
+    if numbers(delim):
+        return delim
+    return next((d for d in ("\t", ";", " ") if d != delim and numbers(d)), delim)
+
+
+def _header_cells(line, delim, width):
+    """The cells of a header line; in a whitespace-separated table, names with spaces or a unit
+    (``displacement (mm)   force (mN)``) are split at runs of two or more spaces or tabs, or
+    each ``(unit)``/``[unit]`` is joined to the name before it, when that gives ``width`` cells."""
+    cells = _split(line, delim)
+    if delim != " " or len(cells) == width:
+        return cells
+    wide = [c for c in re.split(r"\t|\s{2,}", line.strip()) if c]
+    if len(wide) == width:
+        return wide
+    joined = []
+    for c in cells:
+        if joined and c[:1] in "([":
+            joined[-1] += " " + c
+        else:
+            joined.append(c)
+    return joined if len(joined) == width else cells
 
 
 def _split(line, delim):
@@ -252,7 +286,7 @@ def _commented_header(comments, delim, width):
         body = body.lstrip("#%").strip()
         label, sep, rest = body.partition(":")
         labelled = sep and label.strip().lower().replace(" ", "") in _HEADER_LABELS
-        cells = [c.strip() for c in _split(rest if labelled else body, delim)]
+        cells = [c.strip() for c in _header_cells(rest if labelled else body, delim, width)]
         if len(cells) == width and all(cells):
             found.append((label.strip().lower() if labelled else "", cells))
     units = next((c for lab, c in found if all(unit_kind(x) for x in c)), None)
@@ -350,7 +384,8 @@ def read_instrument(path, *, columns=None, units=None, invert=()) -> InstrumentR
     Parameters
     ----------
     path : str or Path
-        Delimited text (see :func:`read_table`).
+        Delimited text (see :func:`read_table`); an AFM file (:data:`shellbvp.afm.AFM_SUFFIXES`)
+        is read through afmformats (:func:`shellbvp.afm.read_afm`), its one curve returned.
     columns : sequence, optional
         Displacement and force columns (and, third, time) by name or 0-based index.
         Default: found by unit (a length, a force, a time) and name (``Displacement``,
@@ -396,6 +431,10 @@ def read_instrument(path, *, columns=None, units=None, invert=()) -> InstrumentR
     >>> print(f"contact near {rec.contact_estimate * 1e6:.0f} um; first rows {rec.displacement[:2]} m")
     contact near 20 um; first rows [0.e+00 4.e-06] m
     """
+    from .afm import is_afm_file, single_curve
+
+    if is_afm_file(path):  # an AFM file: through afmformats, with the file's own units and signs
+        return single_curve(path, columns=columns, units=units, invert=invert)
     flip = _check_invert(invert)
     table = read_table(path)
     dcol, fcol, tcol = _pick_columns(table, columns, path)

@@ -99,7 +99,7 @@ def read_pixel_table(path) -> PixelTable:
         column, two geometry columns, an unknown unit, a pixel index that is not an integer
         >= 0, a value that is not a finite number > 0 (alpha: >= 0), a pixel given twice.
     """
-    from .afm_files import MAX_MAP_PIXELS
+    from .afm_read import MAX_MAP_PIXELS
     from .instrument import cell_number, header_name_and_unit, read_table
 
     # at most one row per cell of the largest map; checked against the map's own grid by fit_map
