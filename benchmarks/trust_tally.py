@@ -60,6 +60,7 @@ import numpy as np
 import sympy as sp
 
 import shellbvp as sb
+import trust_afm
 import trust_cache
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -128,6 +129,8 @@ KIND_NOTES = {**trust_cache.KIND_NOTES,
            "`plot` on non-files, unknown commands) in a temporary directory, timeout 120 s; with --json "
            "stdout must parse as one strict JSON document (no NaN) whose exit_status is the exit status.",
 }
+
+trust_afm.hook(KINDS, KIND_NOTES)  # issue 59: damaged and oversized AFM files (benchmarks/trust_afm.py)
 
 
 # -- recording and classifying ------------------------------------------------------------------------
@@ -1185,13 +1188,15 @@ def main(argv=None):
         sizes = {"formulas": 60, "hdf5": 15, "csv": 20, "scenes": 8, "cli": 10, "fitrecords": 15, "sweepfiles": 10,
                  "inputs": 20}
     sizes.update(trust_cache.sizes(args.quick))
+    sizes.update(trust_afm.sizes(args.quick))
     kinds = args.only.split(",") if args.only else list(KINDS)
     head = git("rev-parse", "--short", "HEAD")
     dirty = sorted({ln[3:].split("/")[0] for ln in git("status", "--porcelain").splitlines()
                     if ln[3:].startswith(("shellbvp/", "symbolic/"))})
     dirty = ", ".join(f"`{d}/`" for d in dirty)
     funcs = {"formulas": kind_formulas, "hdf5": kind_hdf5, "csv": kind_csv, "scenes": kind_scenes, "cli": kind_cli,
-             "fitrecords": kind_fitrecords, "sweepfiles": kind_sweepfiles, "inputs": kind_inputs, **trust_cache.FUNCS}
+             "fitrecords": kind_fitrecords, "sweepfiles": kind_sweepfiles, "inputs": kind_inputs, **trust_cache.FUNCS,
+             **trust_afm.functions()}
     records, kind_times = [], {}
     t0 = time.perf_counter()
     with tempfile.TemporaryDirectory(prefix="trust-tally-") as td:
