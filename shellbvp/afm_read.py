@@ -169,7 +169,7 @@ def read_afm(path, *, spring_constant=None, sensitivity=None) -> list:
         a height or the spring constant, or the file declares sizes beyond the bounds.
     """
     from .afm_read import afmformats_boundary, check_afm_sizes
-    from .instrument import sha256_of
+    from .instrument_record import sha256_of
     from .paths import read_input_bytes
 
     afmformats = _afmformats()
@@ -227,7 +227,7 @@ def _meta(md, key):
 
 def curves_from_afm(datasets, path, *, sha256=None) -> list:
     """:class:`AFMCurve` from afmformats' curves (``AFMForceDistance``) of the file ``path``."""
-    from .instrument import record_from_arrays
+    from .instrument_record import record_from_arrays
 
     out = []
     for i, ds in enumerate(datasets):

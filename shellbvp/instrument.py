@@ -27,14 +27,13 @@ from __future__ import annotations
 
 import codecs
 import csv
-import hashlib
 import math
 import re
 from dataclasses import dataclass
 
 import numpy as np
 
-from .instrument_record import InstrumentRecord
+from .instrument_record import InstrumentRecord, record_from_arrays, sha256_of
 from .segments import FIT_SEGMENTS, SEGMENTS, estimate_contact, segment, smoothed_slope
 from .units import PLAIN_NUMBER, normalize_unit, unit_factor, unit_kind
 
@@ -57,15 +56,6 @@ _KIND = {"displacement": "length", "force": "force", "time": "time"}
 
 _BOMS = ((codecs.BOM_UTF32_LE, "utf-32"), (codecs.BOM_UTF32_BE, "utf-32"), (codecs.BOM_UTF8, "utf-8-sig"),
          (codecs.BOM_UTF16_LE, "utf-16"), (codecs.BOM_UTF16_BE, "utf-16"))
-
-
-def sha256_of(path) -> str:
-    """Hex SHA-256 of a file's bytes (a fit record names the data it was made from)."""
-    h = hashlib.sha256()
-    with open(path, "rb") as fh:
-        for block in iter(lambda: fh.read(1 << 20), b""):
-            h.update(block)
-    return h.hexdigest()
 
 
 def _decode(raw, path):
@@ -431,7 +421,7 @@ def read_instrument(path, *, columns=None, units=None, invert=()) -> InstrumentR
     >>> print(f"contact near {rec.contact_estimate * 1e6:.0f} um; first rows {rec.displacement[:2]} m")
     contact near 20 um; first rows [0.e+00 4.e-06] m
     """
-    from .afm import is_afm_file, single_curve
+    from .afm_read import is_afm_file, single_curve
 
     if is_afm_file(path):  # an AFM file: through afmformats, with the file's own units and signs
         return single_curve(path, columns=columns, units=units, invert=invert)
@@ -500,30 +490,6 @@ def _dropped_time_note(table, col, unit, exc):
     name = table.header[col] if col < len(table.header) else col
     return printable(f"time column {name!r} not used: its unit {unit!r} is not a time ({exc}); the rows are "
                      f"in the file's order")
-
-
-def record_from_arrays(path, displacement, force, time, line, *, columns, units, header=(), inverted=(),
-                       sha256=None, notes=()) -> InstrumentRecord:
-    """An :class:`InstrumentRecord` from SI arrays in the package's signs (any row order with a
-    time column): sorted by time, segmented, the contact estimated.  ``line``: each row's line
-    in the file (or its index)."""
-    arr = {"displacement": np.asarray(displacement, float), "force": np.asarray(force, float)}
-    line = np.asarray(line)
-    t = None if time is None else np.asarray(time, float)
-    if t is not None:
-        order = np.argsort(t, kind="stable")  # rows in time order: the segments follow time
-        arr = {role: a[order] for role, a in arr.items()}
-        line, t = line[order], t[order]
-    labels = segment(arr["displacement"], t)
-    rec = InstrumentRecord(path=str(path), sha256=sha256 or sha256_of(path), displacement=arr["displacement"],
-                           force=arr["force"], time=t, line=line, segments=labels, columns=dict(columns),
-                           units=dict(units), header=list(header), inverted=tuple(inverted), notes=tuple(notes))
-    push = rec.mask("loading")
-    if push.sum() >= 3:
-        rec.contact_estimate = estimate_contact(rec.displacement[push], rec.force[push])
-        if rec.contact_estimate is not None:
-            rec.relabel(rec.contact_estimate)
-    return rec
 
 
 def _check_invert(invert):
