@@ -47,8 +47,8 @@ TIMEOUT = 300
 KINDS = {"afmdamaged": "13. damaged AFM data", "afmsizes": "14. oversized AFM archives, headers and tables"}
 KIND_NOTES = {
     "afmdamaged": "Seeded mutations of tests/data/afm/spot3-0192.jpk-force, of a 2 x 2 JPK force map made from "
-                  "it and of SiN_FD_plot.ibw, read by `read_afm` (a clear error or finite curves; afmformats must "
-                  "log nothing at WARNING or above); one in four also by `shellbvp fit FILE --json`; and "
+                  "it and of SiN_FD_plot.ibw, read by `read_afm` (a clear error or finite curves; afmformats and "
+                  "igor2 must log nothing at WARNING or above); one in four also by `shellbvp fit FILE --json`; and "
                   "batches of the good curve with damaged ones (`fit GOOD BAD... --json`).",
     "afmsizes": f"Each input fitted by `shellbvp fit` in a process limited to {CAP_BYTES / 2**30:.1f} GB of address "
                 f"space; the outcome's detail gives the peak resident memory (DEFECT above {RSS_LIMIT_MB} MB, or "
@@ -91,7 +91,7 @@ def rewrite(src, dst, edit=None, drop=(), extra=()):
             if info.filename in drop:
                 continue
             if edit and info.filename.endswith(".properties"):
-                data = edit(info.filename, data.decode("latin-1")).encode("latin-1")
+                data = edit(info.filename, data.decode("latin-1")).encode("utf-8")  # junk values: any text
             zo.writestr(info.filename, data)
         for name, data in extra:
             zo.writestr(name, data)
@@ -199,13 +199,15 @@ def judge_afm_read(path):
 
     tt = _tt()
     log = _AfmLog()
-    logging.getLogger("afmformats").addHandler(log)
+    for name in ("afmformats", "igor2"):
+        logging.getLogger(name).addHandler(log)
     try:
         out = tt.call(lambda: read_afm(path), limit=60)
     finally:
-        logging.getLogger("afmformats").removeHandler(log)
+        for name in ("afmformats", "igor2"):
+            logging.getLogger(name).removeHandler(log)
     if log.records:
-        return "DEFECT", f"afmformats logged: {log.records[0]}", out["seconds"]
+        return "DEFECT", f"a reader logged: {log.records[0]}", out["seconds"]
     if out["exc"] is not None:
         o, d = tt.judge_exception(out)
         if o == "clear error" and re.search(r"[\x00-\x08\x0b-\x1f\x7f\u202e]", str(out["exc"])):

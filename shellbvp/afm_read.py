@@ -6,12 +6,13 @@ A JPK file is a zip archive: a few megabytes can declare a gigabyte of inflated 
 its central directory alone can hold millions of entries.  An Asylum ``.ibw`` declares the sizes
 of its parts in a header that igor2 trusts: a mutated size is a read of gigabytes.  Both are
 checked here from the sizes the file declares, before anything is inflated or allocated
-(:func:`check_afm_sizes`), against the bounds below (stated in docs/afm.md).
+(:func:`check_afm_sizes`), against the bounds below (stated in docs/fitting.md).
 
 :func:`afmformats_boundary` turns every exception of afmformats, igor2, zipfile and numpy while a
 file is decoded into one ``ValueError`` line naming the file (its text escaped), and keeps
-afmformats' own log (a full traceback for each file it rejects) quiet unless asked for: a level
-set on the ``afmformats`` logger, or verbose logging (``shellbvp -v``).
+afmformats' own log (a full traceback for each file it rejects; igor2 logs a damaged wave's
+bytes) quiet unless asked for: a level set on the ``afmformats`` or ``igor2`` logger, or
+verbose logging (``shellbvp -v``).
 """
 
 from __future__ import annotations
@@ -30,10 +31,11 @@ import numpy as np
 from .textdata import printable
 
 __all__ = ["AFM_SUFFIXES", "AFMCurve", "is_afm_file", "afm_text_format", "read_afm", "curves_from_afm",
-           "single_curve", "refuse_text_options", "MAX_MAP_PIXELS", "MAX_ARCHIVE_MEMBERS", "MAX_CENTRAL_DIRECTORY_BYTES", "MAX_INFLATED_BYTES", "MAX_INFLATION_RATIO",
-           "INFLATION_ALLOWANCE_BYTES", "check_afm_sizes", "afmformats_boundary", "AFMFileError"]
+           "single_curve", "refuse_text_options", "check_afm_sizes", "afmformats_boundary", "AFMFileError",
+           "MAX_MAP_PIXELS", "MAX_ARCHIVE_MEMBERS", "MAX_CENTRAL_DIRECTORY_BYTES", "MAX_INFLATED_BYTES",
+           "MAX_INFLATION_RATIO", "INFLATION_ALLOWANCE_BYTES", "READER_LOGGERS"]
 
-#: The most members a JPK archive may hold (a 128 x 128 force map has about 250,000).
+#: The most members a JPK archive may hold (a 128 x 128 force map: about 330,000, 20 a curve).
 MAX_ARCHIVE_MEMBERS = 500_000
 #: The largest central directory (the archive's list of members) read: about 130 bytes a member.
 MAX_CENTRAL_DIRECTORY_BYTES = 64 * 2**20
@@ -55,6 +57,10 @@ _IBW_HEADERS = {
     5: ("h15l", ("wfmSize", "formulaSize", "noteSize", "dataEUnitsSize", *(f"dimEUnitsSize[{i}]" for i in range(4)),
                  *(f"dimLabelsSize[{i}]" for i in range(4)), "sIndicesSize", "optionsSize1", "optionsSize2")),
 }
+
+
+#: Loggers of the readers below afmformats, quiet while a file is read unless asked for.
+READER_LOGGERS = ("afmformats", "igor2")
 
 
 class AFMFileError(ValueError):
@@ -357,11 +363,12 @@ def _check_ibw(path, size):
 def afmformats_boundary(path):
     """Every exception of afmformats (and of igor2, zipfile, zlib, numpy below it) raised in
     the ``with`` block becomes one ``ValueError`` line naming ``path``; :class:`AFMFileError`
-    (shellbvp's own checks) passes unchanged; KeyboardInterrupt and SystemExit pass.  afmformats'
-    logger is quiet meanwhile unless asked for (module docstring)."""
-    logger = logging.getLogger("afmformats")
-    asked = logger.level != logging.NOTSET or logging.getLogger().getEffectiveLevel() <= logging.INFO
-    if not asked:
+    (shellbvp's own checks) passes unchanged; KeyboardInterrupt and SystemExit pass.  The loggers
+    of afmformats and igor2 (:data:`READER_LOGGERS`) are quiet meanwhile unless asked for (module
+    docstring)."""
+    verbose = logging.getLogger().getEffectiveLevel() <= logging.INFO
+    quieted = [lg for lg in map(logging.getLogger, READER_LOGGERS) if lg.level == logging.NOTSET and not verbose]
+    for logger in quieted:
         logger.setLevel(logging.CRITICAL + 1)
     try:
         yield
@@ -374,5 +381,5 @@ def afmformats_boundary(path):
         text = text if len(text) <= 300 else text[:297] + "..."
         raise ValueError(f"{printable(path)}: afmformats cannot read it ({type(exc).__name__}: {text})") from None
     finally:
-        if not asked:
+        for logger in quieted:
             logger.setLevel(logging.NOTSET)
