@@ -60,6 +60,7 @@ import numpy as np
 import sympy as sp
 
 import shellbvp as sb
+import trust_afm
 import trust_cache
 import trust_work  # issue 59: oversized work, dead options (its kinds join KINDS)
 
@@ -131,6 +132,8 @@ KIND_NOTES = {**trust_cache.KIND_NOTES,
 }
 KINDS.update(trust_work.KINDS)
 KIND_NOTES.update(trust_work.KIND_NOTES)
+
+trust_afm.hook(KINDS, KIND_NOTES)  # issue 59: damaged and oversized AFM files (benchmarks/trust_afm.py)
 
 
 # -- recording and classifying ------------------------------------------------------------------------
@@ -1188,13 +1191,15 @@ def main(argv=None):
         sizes = {"formulas": 60, "hdf5": 15, "csv": 20, "scenes": 8, "cli": 10, "fitrecords": 15, "sweepfiles": 10,
                  "inputs": 20}
     sizes.update(trust_cache.sizes(args.quick))
+    sizes.update(trust_afm.sizes(args.quick))
     kinds = args.only.split(",") if args.only else list(KINDS)
     head = git("rev-parse", "--short", "HEAD")
     dirty = sorted({ln[3:].split("/")[0] for ln in git("status", "--porcelain").splitlines()
                     if ln[3:].startswith(("shellbvp/", "symbolic/"))})
     dirty = ", ".join(f"`{d}/`" for d in dirty)
     funcs = {"formulas": kind_formulas, "hdf5": kind_hdf5, "csv": kind_csv, "scenes": kind_scenes, "cli": kind_cli,
-             "fitrecords": kind_fitrecords, "sweepfiles": kind_sweepfiles, "inputs": kind_inputs, **trust_cache.FUNCS}
+             "fitrecords": kind_fitrecords, "sweepfiles": kind_sweepfiles, "inputs": kind_inputs, **trust_cache.FUNCS,
+             **trust_afm.functions()}
     funcs.update(trust_work.FUNCS)
     sizes = {**trust_work.SIZES, **sizes}
     records, kind_times = [], {}

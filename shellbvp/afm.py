@@ -9,7 +9,10 @@ cantilever's deflection ``force / spring constant`` (nanite's tip-sample separat
 sample is minus the tip's position: the package's signs, no ``--invert`` needed.
 
 * :func:`read_afm` -- the curves of a file as :class:`AFMCurve` (an
-  :class:`~shellbvp.instrument.InstrumentRecord` with its place on the map).
+  :class:`~shellbvp.instrument.InstrumentRecord` with its place on the map); the file's
+  declared sizes checked first and every failure of decoding one line
+  (:mod:`shellbvp.afm_read`).  AFM Workshop CSV and NT-MDT Nova text exports go through
+  afmformats too (:func:`afm_text_format`), with the cantilever's calibration given.
 * :class:`ForceMap` -- a force map fitted curve by curve (:func:`shellbvp.batch.fit_map`): the
   per-curve rows of a batch, images of mu*H and its interval, a NeXus file, a figure.
 * :func:`read_map_file` -- that NeXus file read back (:class:`MapFile`), for ``shellbvp info``
@@ -18,140 +21,47 @@ sample is minus the tip's position: the package's signs, no ``--invert`` needed.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
-__all__ = ["AFM_SUFFIXES", "AFMCurve", "ForceMap", "MapFile", "is_afm_file", "read_afm", "curves_from_afm",
-           "refuse_text_options", "MAP_FORMAT", "is_map_file", "read_map_file", "draw_map"]
+from .afm_read import (AFM_SUFFIXES, AFMCurve, afm_text_format, curves_from_afm, is_afm_file, read_afm,
+                       refuse_text_options, single_curve)
+from .textdata import printable
 
-#: File name endings read through afmformats (other text files go through shellbvp.instrument).
-AFM_SUFFIXES = (".jpk-force", ".jpk-force-map", ".jpk-qi-data", ".jpk-qi-series", ".ibw")
+__all__ = ["AFM_SUFFIXES", "AFMCurve", "ForceMap", "MapFile", "is_afm_file", "afm_text_format", "read_afm",
+           "curves_from_afm", "single_curve", "refuse_text_options", "map_shape", "MAP_FORMAT", "is_map_file",
+           "read_map_file", "draw_map"]
+
 MAP_FORMAT = "shellbvp-force-map"
 MAP_FORMAT_VERSION = 1
 
 
-def is_afm_file(path) -> bool:
-    return str(path).lower().endswith(AFM_SUFFIXES)
-
-
-@dataclass
-class AFMCurve:
-    """One curve of an AFM file.
-
-    Attributes
-    ----------
-    record : InstrumentRecord
-        Displacement into the sample (m), force (N), time (s), segments, contact estimate.
-    index : int
-        The curve's number in the file (afmformats' ``enum``).
-    grid : tuple of int or None
-        ``(ix, iy)`` on a force map.
-    position : tuple of float or None
-        ``(x, y)`` of the curve on the sample (m), as the file gives it.
-    grid_geometry : tuple or None
-        ``((center x, center y), (size x, size y))`` of the map's grid (m).
-    """
-
-    record: object
-    index: int
-    grid: tuple = None
-    position: tuple = None
-    grid_geometry: tuple = None  # ((center x, center y), (size x, size y)) of the map's grid, m
-
-
-def refuse_text_options(path, columns=None, units=None, invert=()):
-    """ValueError when reading options of text exports are given for an AFM file."""
-    if columns or units or invert:
-        raise ValueError(f"{path}: an AFM file gives its own columns, units and signs: --columns, --units and "
-                         f"--invert are for text exports")
-
-
-def _afmformats():
-    try:
-        import afmformats
-    except ImportError:
-        raise ValueError("reading AFM files needs afmformats: pip install 'shellbvp[afm]'") from None
-    return afmformats
-
-
-def read_afm(path) -> list:
-    """The curves of an AFM file (:data:`AFM_SUFFIXES`) as :class:`AFMCurve`, in file order.
+def map_shape(curves, path="the map") -> tuple:
+    """``(nx, ny)``: the grid a force map's curves span (their largest grid indices + 1), or
+    ``(len(curves), 1)`` when they carry none.
 
     Raises
     ------
     ValueError
-        afmformats is not installed, or cannot read the file, or a curve lacks the force,
-        a height or the spring constant.
+        The grid spans more than :data:`~shellbvp.afm_read.MAX_MAP_PIXELS` cells (a map's
+        images are allocated at this size): a header declaring a 100000 x 100000 grid for the
+        few curves present is refused before any curve is fitted.
     """
-    from .instrument import sha256_of
-    from .paths import read_input_bytes
+    from .afm_read import MAX_MAP_PIXELS
 
-    afmformats = _afmformats()
-    read_input_bytes(path)  # a regular file of bounded size: never a FIFO, a device or a folder
-    from afmformats import errors, meta
-
-    # afmformats raises many kinds on a damaged or foreign file, some of them BaseExceptions
-    failures = (Exception, meta.MetaDataMissingError,
-                *(c for c in vars(errors).values() if isinstance(c, type) and issubclass(c, BaseException)
-                  and not issubclass(c, Exception)))
-    try:
-        datasets = afmformats.load_data(str(path))
-    except failures as exc:
-        raise ValueError(f"{path}: afmformats cannot read it ({type(exc).__name__}: {exc})") from None
-    if not datasets:
-        raise ValueError(f"{path}: afmformats found no force-distance curve in it")
-    return curves_from_afm(datasets, path, sha256=sha256_of(path))
-
-
-def _meta(md, key):
-    v = dict.get(md, key) if isinstance(md, dict) else None  # MetaData[key] raises a BaseException
-    return v if isinstance(v, (int, float, np.integer, np.floating)) and math.isfinite(v) else None
-
-
-def curves_from_afm(datasets, path, *, sha256=None) -> list:
-    """:class:`AFMCurve` from afmformats' curves (``AFMForceDistance``) of the file ``path``."""
-    from .instrument import record_from_arrays
-
-    out = []
-    for i, ds in enumerate(datasets):
-        columns = list(ds.columns)
-        md = ds.metadata
-        where = f"{path}, curve {i}"
-        if "force" not in columns:
-            raise ValueError(f"{where}: no force column (columns: {', '.join(columns)})")
-        force = np.asarray(ds["force"], float)
-        if "tip position" in columns:
-            tip, how = np.asarray(ds["tip position"], float), "-(tip position)"
-        else:
-            height = next((h for h in ("height (measured)", "height (piezo)") if h in columns), None)
-            k = _meta(md, "spring constant")
-            if height is None or k is None or not k > 0:
-                raise ValueError(f"{where}: needs a height column and the spring constant to place the tip "
-                                 f"(columns: {', '.join(columns)}; spring constant: {k})")
-            tip, how = np.asarray(ds[height], float) + force / k, f"-({height} + force / spring constant)"
-        time = np.asarray(ds["time"], float) if "time" in columns else None
-        ok = np.isfinite(tip) & np.isfinite(force) & (np.isfinite(time) if time is not None else True)
-        if ok.sum() < 3:
-            raise ValueError(f"{where}: fewer than 3 rows with numbers")
-        record = record_from_arrays(path, -tip[ok], force[ok], None if time is None else time[ok],
-                                    np.flatnonzero(ok), columns={"displacement": how, "force": "force",
-                                                                 **({"time": "time"} if time is not None else {})},
-                                    units={"displacement": "m", "force": "N", **({"time": "s"} if time is not None
-                                                                               else {})},
-                                    header=columns, sha256=sha256)
-        ix, iy = _meta(md, "grid index x"), _meta(md, "grid index y")
-        x, y = _meta(md, "position x"), _meta(md, "position y")
-        index = _meta(md, "enum")
-        geometry = [_meta(md, f"grid {a} {b}") for a in ("center", "size") for b in "xy"]
-        out.append(AFMCurve(record=record, index=int(index) if index is not None else i,
-                            grid=(int(ix), int(iy)) if ix is not None and iy is not None else None,
-                            position=(float(x), float(y)) if x is not None and y is not None else None,
-                            grid_geometry=((geometry[0], geometry[1]), (geometry[2], geometry[3]))
-                            if None not in geometry else None))
-    return out
+    grids = [c.grid for c in curves if c.grid is not None]
+    if not grids:
+        return (len(curves), 1)
+    shape = (max(g[0] for g in grids) + 1, max(g[1] for g in grids) + 1)
+    if min(min(g) for g in grids) < 0:
+        raise ValueError(f"{printable(path)}: a curve has a negative grid index")
+    if shape[0] * shape[1] > MAX_MAP_PIXELS:
+        raise ValueError(f"{printable(path)}: its {len(curves)} curves' grid indices span a {shape[0]} x {shape[1]} "
+                         f"grid ({shape[0] * shape[1]} cells); a map has at most {MAX_MAP_PIXELS} cells "
+                         f"(MAX_MAP_PIXELS; the header's grid size or the curves' positions are wrong)")
+    return shape
 
 
 def mu_H_spread(mu, with_range=False) -> str:
@@ -314,7 +224,6 @@ class ForceMap:
         import json
 
         from .nexus import new_file, number_dataset, string_dataset
-        from .textdata import printable
 
         x, y = self.axes()
         with new_file(out, MAP_FORMAT, MAP_FORMAT_VERSION, overwrite=overwrite) as f:

@@ -159,7 +159,7 @@ def expand_inputs(inputs) -> list:
 
 
 def fit_files(scene, paths, *, R_L, segment="loading", baseline="auto", columns=None, units=None,
-              invert=(), on_file=None, **options) -> list:
+              invert=(), spring_constant=None, sensitivity=None, on_file=None, **options) -> list:
     """Fit each file with the same scene and settings; one :class:`BatchRow` per file.
 
     Parameters
@@ -173,6 +173,8 @@ def fit_files(scene, paths, *, R_L, segment="loading", baseline="auto", columns=
         As :func:`shellbvp.fitting.fit_record`.
     columns, units, invert : sequence, optional
         As :func:`shellbvp.instrument.read_instrument`.
+    spring_constant, sensitivity : float, optional
+        AFM text exports' calibration (:func:`shellbvp.afm.read_afm`).
     on_file : callable, optional
         Called as ``on_file(row)`` after each file (a progress bar over files).
     **options
@@ -212,27 +214,28 @@ def fit_files(scene, paths, *, R_L, segment="loading", baseline="auto", columns=
     read = []
     for path in paths:  # read every file first: the common depth of the model curves
         try:
-            read.append((path, read_record(path, columns=columns, units=units, invert=invert)))
+            read.append((path, read_record(path, columns=columns, units=units, invert=invert,
+                                           spring_constant=spring_constant, sensitivity=sensitivity)))
         except ValueError as exc:
             read.append((path, exc))
     return fit_records(scene, read, R_L=R_L, segment=segment, baseline=baseline, on_file=on_file, **options)
 
 
-def read_record(path, *, columns=None, units=None, invert=()):
-    """One record from a file: an AFM curve through afmformats (:mod:`shellbvp.afm`), a text
-    export through :func:`shellbvp.instrument.read_instrument`.  A force map is refused here
-    (it is fitted on its own: :func:`fit_map`)."""
-    from .afm import is_afm_file, read_afm, refuse_text_options
+def read_record(path, *, columns=None, units=None, invert=(), spring_constant=None, sensitivity=None):
+    """One record from a file: an AFM curve through afmformats (:mod:`shellbvp.afm`; an AFM
+    text export with the cantilever's ``spring_constant`` and ``sensitivity``), a text export
+    through :func:`shellbvp.instrument.read_instrument`.  A force map is refused here (it is
+    fitted on its own: :func:`fit_map`)."""
+    from .afm import is_afm_file, single_curve
     from .instrument import read_instrument
 
-    if not is_afm_file(path):
-        return read_instrument(path, columns=columns, units=units, invert=invert)
-    refuse_text_options(path, columns, units, invert)
-    curves = read_afm(path)
-    if len(curves) > 1:
-        raise ValueError(f"{path}: a force map of {len(curves)} curves: fit it on its own "
-                         f"(shellbvp fit {Path(path).name} ... -o map.h5)")
-    return curves[0].record
+    if is_afm_file(path):
+        return single_curve(path, columns=columns, units=units, invert=invert, spring_constant=spring_constant,
+                            sensitivity=sensitivity)
+    if spring_constant is not None or sensitivity is not None:
+        raise ValueError(f"{path}: not an AFM file: --spring-constant and --sensitivity are for AFM text exports "
+                         f"(AFM Workshop, NT-MDT)")
+    return read_instrument(path, columns=columns, units=units, invert=invert)
 
 
 def fit_records(scene, named, *, R_L, segment="loading", baseline="auto", on_file=None, **options) -> list:
@@ -308,14 +311,14 @@ def fit_map(scene, curves, *, R_L, path=None, segment="loading", baseline="auto"
     this map and scene (a pixel outside the grid, a value out of range, a map without grid
     indices) is a ``ValueError`` before any curve.
     """
-    from .afm import AFMCurve, ForceMap
+    from .afm import AFMCurve, ForceMap, map_shape
 
     if not curves:
         raise ValueError("fit_map: no curves")
     path = path or curves[0].record.path
     named = [(f"{path}#{c.index}", c.record) for c in curves]
     grids = [c.grid for c in curves if c.grid is not None]
-    shape = (max(g[0] for g in grids) + 1, max(g[1] for g in grids) + 1) if grids else (len(curves), 1)
+    shape = map_shape(curves, path)  # bounded before any curve is fitted
     settings = {"baseline": baseline, **{k: v for k, v in options.items() if k != "progress"}}
     if pixel_values is not None:
         return _fit_map_per_pixel(scene, curves, named, shape, pixel_values, R_L=R_L, path=path, segment=segment,

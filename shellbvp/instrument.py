@@ -27,14 +27,13 @@ from __future__ import annotations
 
 import codecs
 import csv
-import hashlib
 import math
 import re
 from dataclasses import dataclass
 
 import numpy as np
 
-from .instrument_record import InstrumentRecord
+from .instrument_record import InstrumentRecord, record_from_arrays, sha256_of
 from .segments import FIT_SEGMENTS, SEGMENTS, estimate_contact, segment, smoothed_slope
 from .units import PLAIN_NUMBER, normalize_unit, unit_factor, unit_kind
 
@@ -50,19 +49,13 @@ _NAMES = {
     "force": (("force", "load"), ("f",)),
     "time": (("time",), ("t",)),
 }
+#: Lines of header and comments a table bounded in rows (``read_table(max_rows=...)``) may add.
+MAX_PREAMBLE_LINES = 1000
+
 _KIND = {"displacement": "length", "force": "force", "time": "time"}
 
 _BOMS = ((codecs.BOM_UTF32_LE, "utf-32"), (codecs.BOM_UTF32_BE, "utf-32"), (codecs.BOM_UTF8, "utf-8-sig"),
          (codecs.BOM_UTF16_LE, "utf-16"), (codecs.BOM_UTF16_BE, "utf-16"))
-
-
-def sha256_of(path) -> str:
-    """Hex SHA-256 of a file's bytes (a fit record names the data it was made from)."""
-    h = hashlib.sha256()
-    with open(path, "rb") as fh:
-        for block in iter(lambda: fh.read(1 << 20), b""):
-            h.update(block)
-    return h.hexdigest()
 
 
 def _decode(raw, path):
@@ -162,7 +155,7 @@ class Table:
     delimiter: str
 
 
-def read_table(path) -> Table:
+def read_table(path, *, max_rows=None, what="table") -> Table:
     """Split a delimited text file into header rows and data rows.
 
     ``#`` and ``%`` start comment lines; blank lines are skipped; the delimiter
@@ -173,16 +166,24 @@ def read_table(path) -> Table:
     just above the data, as many cells as the data after an optional ``columns:`` or
     ``units:`` label (``# columns: height vDeflection`` / ``# units: m N``).
 
+    ``max_rows`` bounds the data rows (``what`` names the table in the message): a file with
+    more lines than that and :data:`MAX_PREAMBLE_LINES` is refused before it is split.
+
     Raises
     ------
     ValueError
-        The file cannot be read or decoded, or holds no data.
+        The file cannot be read or decoded, or holds no data, or more than ``max_rows`` rows.
     """
     from .paths import read_input_bytes
 
     raw = read_input_bytes(path)  # a regular file of bounded size: never a FIFO, a device or a folder
     text = _decode(raw, path)
+    del raw
+    if max_rows is not None and text.count("\n") > max_rows + MAX_PREAMBLE_LINES:
+        raise ValueError(f"{path}: {text.count(chr(10))} lines; a {what} has at most {max_rows} rows (and "
+                         f"{MAX_PREAMBLE_LINES} lines of header and comments)")
     all_lines = text.splitlines()
+    del text
     numbered = [(i, ln) for i, ln in enumerate(all_lines, start=1)
                 if ln.strip() and not ln.lstrip().startswith(("#", "%"))]
     if not numbered:
@@ -196,12 +197,15 @@ def read_table(path) -> Table:
             delim = csv.Sniffer().sniff("\n".join(lines[:20]), delimiters=",;\t").delimiter
         except csv.Error:
             delim = "\t" if "\t" in lines[-1] else (";" if ";" in lines[-1] else ",")
+    delim = _numeric_delimiter(sample, delim)
     rows = [_split(ln, delim) for ln in lines]
     line_no = [i for i, _ in numbered]
     first = next((k for k, r in enumerate(rows) if r and all(_number(c) is not None for c in r)), len(rows))
     if first == len(rows):
         raise ValueError(f"{path}: fewer than 3 rows with numbers (no row is all numbers)")
-    heads = rows[:first]
+    if max_rows is not None and len(rows) - first > max_rows:
+        raise ValueError(f"{path}: {len(rows) - first} rows; a {what} has at most {max_rows}")
+    heads = [_header_cells(ln, delim, len(rows[first])) for ln in lines[:first]]
     if not heads:  # no header among the data lines: one in the comment lines just above them
         heads = _commented_header(all_lines[:line_no[0] - 1], delim, len(rows[first]))
     header, header_units = [], None
@@ -214,6 +218,39 @@ def read_table(path) -> Table:
         else:
             header = [c.strip() for c in heads[-1]]
     return Table(header=header, header_units=header_units, rows=rows[first:], line=line_no[first:], delimiter=delim)
+
+
+def _numeric_delimiter(sample, delim):
+    """``delim``, unless the data lines (``sample``, the last of the file) split by it are not
+    all numbers while another delimiter splits them into equal rows of numbers: a headerless
+    table with decimal commas (``0,5<TAB>1,5``) is tab-separated, not comma-separated."""
+    def numbers(d):
+        cells = [_split(ln, d) for ln in sample]
+        return len({len(c) for c in cells}) == 1 and len(cells[0]) >= 2 and \
+            all(x.strip() and _number(x) is not None for c in cells for x in c)
+
+    if numbers(delim):
+        return delim
+    return next((d for d in ("\t", ";", " ") if d != delim and numbers(d)), delim)
+
+
+def _header_cells(line, delim, width):
+    """The cells of a header line; in a whitespace-separated table, names with spaces or a unit
+    (``displacement (mm)   force (mN)``) are split at runs of two or more spaces or tabs, or
+    each ``(unit)``/``[unit]`` is joined to the name before it, when that gives ``width`` cells."""
+    cells = _split(line, delim)
+    if delim != " " or len(cells) == width:
+        return cells
+    wide = [c for c in re.split(r"\t|\s{2,}", line.strip()) if c]
+    if len(wide) == width:
+        return wide
+    joined = []
+    for c in cells:
+        if joined and c[:1] in "([":
+            joined[-1] += " " + c
+        else:
+            joined.append(c)
+    return joined if len(joined) == width else cells
 
 
 def _split(line, delim):
@@ -239,7 +276,7 @@ def _commented_header(comments, delim, width):
         body = body.lstrip("#%").strip()
         label, sep, rest = body.partition(":")
         labelled = sep and label.strip().lower().replace(" ", "") in _HEADER_LABELS
-        cells = [c.strip() for c in _split(rest if labelled else body, delim)]
+        cells = [c.strip() for c in _header_cells(rest if labelled else body, delim, width)]
         if len(cells) == width and all(cells):
             found.append((label.strip().lower() if labelled else "", cells))
     units = next((c for lab, c in found if all(unit_kind(x) for x in c)), None)
@@ -337,7 +374,8 @@ def read_instrument(path, *, columns=None, units=None, invert=()) -> InstrumentR
     Parameters
     ----------
     path : str or Path
-        Delimited text (see :func:`read_table`).
+        Delimited text (see :func:`read_table`); an AFM file (:data:`shellbvp.afm.AFM_SUFFIXES`)
+        is read through afmformats (:func:`shellbvp.afm.read_afm`), its one curve returned.
     columns : sequence, optional
         Displacement and force columns (and, third, time) by name or 0-based index.
         Default: found by unit (a length, a force, a time) and name (``Displacement``,
@@ -383,6 +421,10 @@ def read_instrument(path, *, columns=None, units=None, invert=()) -> InstrumentR
     >>> print(f"contact near {rec.contact_estimate * 1e6:.0f} um; first rows {rec.displacement[:2]} m")
     contact near 20 um; first rows [0.e+00 4.e-06] m
     """
+    from .afm_read import is_afm_file, single_curve
+
+    if is_afm_file(path):  # an AFM file: through afmformats, with the file's own units and signs
+        return single_curve(path, columns=columns, units=units, invert=invert)
     flip = _check_invert(invert)
     table = read_table(path)
     dcol, fcol, tcol = _pick_columns(table, columns, path)
@@ -448,30 +490,6 @@ def _dropped_time_note(table, col, unit, exc):
     name = table.header[col] if col < len(table.header) else col
     return printable(f"time column {name!r} not used: its unit {unit!r} is not a time ({exc}); the rows are "
                      f"in the file's order")
-
-
-def record_from_arrays(path, displacement, force, time, line, *, columns, units, header=(), inverted=(),
-                       sha256=None, notes=()) -> InstrumentRecord:
-    """An :class:`InstrumentRecord` from SI arrays in the package's signs (any row order with a
-    time column): sorted by time, segmented, the contact estimated.  ``line``: each row's line
-    in the file (or its index)."""
-    arr = {"displacement": np.asarray(displacement, float), "force": np.asarray(force, float)}
-    line = np.asarray(line)
-    t = None if time is None else np.asarray(time, float)
-    if t is not None:
-        order = np.argsort(t, kind="stable")  # rows in time order: the segments follow time
-        arr = {role: a[order] for role, a in arr.items()}
-        line, t = line[order], t[order]
-    labels = segment(arr["displacement"], t)
-    rec = InstrumentRecord(path=str(path), sha256=sha256 or sha256_of(path), displacement=arr["displacement"],
-                           force=arr["force"], time=t, line=line, segments=labels, columns=dict(columns),
-                           units=dict(units), header=list(header), inverted=tuple(inverted), notes=tuple(notes))
-    push = rec.mask("loading")
-    if push.sum() >= 3:
-        rec.contact_estimate = estimate_contact(rec.displacement[push], rec.force[push])
-        if rec.contact_estimate is not None:
-            rec.relabel(rec.contact_estimate)
-    return rec
 
 
 def _check_invert(invert):

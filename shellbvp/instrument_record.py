@@ -3,13 +3,14 @@ file (time) order with the segment of each (:mod:`shellbvp.segments`)."""
 
 from __future__ import annotations
 
+import hashlib
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from .segments import FIT_SEGMENTS, SEGMENTS
+from .segments import FIT_SEGMENTS, SEGMENTS, estimate_contact, segment
 
-__all__ = ["InstrumentRecord"]
+__all__ = ["InstrumentRecord", "record_from_arrays", "sha256_of"]
 
 
 @dataclass
@@ -104,3 +105,36 @@ class InstrumentRecord:
         """Split the pushing rows at the contact point ``contact`` (m): before it 'approach'."""
         push = np.isin(self.segments, ("approach", "loading"))
         self.segments = np.where(push, np.where(self.displacement < contact, "approach", "loading"), self.segments)
+
+
+def sha256_of(path) -> str:
+    """Hex SHA-256 of a file's bytes (a fit record names the data it was made from)."""
+    h = hashlib.sha256()
+    with open(path, "rb") as fh:
+        for block in iter(lambda: fh.read(1 << 20), b""):
+            h.update(block)
+    return h.hexdigest()
+
+
+def record_from_arrays(path, displacement, force, time, line, *, columns, units, header=(), inverted=(),
+                       sha256=None, notes=()) -> InstrumentRecord:
+    """An :class:`InstrumentRecord` from SI arrays in the package's signs (any row order with a
+    time column): sorted by time, segmented, the contact estimated.  ``line``: each row's line
+    in the file (or its index)."""
+    arr = {"displacement": np.asarray(displacement, float), "force": np.asarray(force, float)}
+    line = np.asarray(line)
+    t = None if time is None else np.asarray(time, float)
+    if t is not None:
+        order = np.argsort(t, kind="stable")  # rows in time order: the segments follow time
+        arr = {role: a[order] for role, a in arr.items()}
+        line, t = line[order], t[order]
+    labels = segment(arr["displacement"], t)
+    rec = InstrumentRecord(path=str(path), sha256=sha256 or sha256_of(path), displacement=arr["displacement"],
+                           force=arr["force"], time=t, line=line, segments=labels, columns=dict(columns),
+                           units=dict(units), header=list(header), inverted=tuple(inverted), notes=tuple(notes))
+    push = rec.mask("loading")
+    if push.sum() >= 3:
+        rec.contact_estimate = estimate_contact(rec.displacement[push], rec.force[push])
+        if rec.contact_estimate is not None:
+            rec.relabel(rec.contact_estimate)
+    return rec

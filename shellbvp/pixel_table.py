@@ -99,9 +99,11 @@ def read_pixel_table(path) -> PixelTable:
         column, two geometry columns, an unknown unit, a pixel index that is not an integer
         >= 0, a value that is not a finite number > 0 (alpha: >= 0), a pixel given twice.
     """
+    from .afm_read import MAX_MAP_PIXELS
     from .instrument import cell_number, header_name_and_unit, read_table
 
-    table = read_table(path)
+    # at most one row per cell of the largest map; checked against the map's own grid by fit_map
+    table = read_table(path, max_rows=MAX_MAP_PIXELS, what="pixel table (one row per pixel, MAX_MAP_PIXELS)")
     if not table.header:
         raise ValueError(f"{path}: no header row; the pixel table needs the columns ix, iy and one of "
                          f"{', '.join(PIXEL_PARAMETERS)} (e.g. thickness_um)")

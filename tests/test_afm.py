@@ -2,6 +2,7 @@
 signs, and a force map fitted curve by curve into a NeXus map whose values are known (made
 from the model at four moduli)."""
 
+import json
 from pathlib import Path
 
 import numpy as np
@@ -9,7 +10,7 @@ import pytest
 from scipy.interpolate import PchipInterpolator
 
 import shellbvp as sb
-from shellbvp.afm import curves_from_afm, read_afm
+from shellbvp.afm import AFMCurve, curves_from_afm, read_afm
 from shellbvp.batch import fit_map
 from shellbvp.cli import main
 
@@ -131,7 +132,7 @@ def test_cli_fits_a_map_into_a_table_a_file_and_a_figure(synthetic_map, tmp_path
     scene, curves = synthetic_map
     path = tmp_path / "cells.jpk-force-map"
     path.write_bytes(b"")  # the file the command names; its curves come from the fixture
-    monkeypatch.setattr(afm, "read_afm", lambda p: curves)
+    monkeypatch.setattr(afm, "read_afm", lambda p, **calibration: curves)
     argv = ["fit", str(path), "--preset", "fit", "--radius", "10um", "-o", str(tmp_path / "m.h5"),
             "--table", str(tmp_path / "m.csv"), "--report", str(tmp_path / "m.png")]
     assert main(argv) == 0
@@ -143,12 +144,12 @@ def test_cli_fits_a_map_into_a_table_a_file_and_a_figure(synthetic_map, tmp_path
 
 
 def test_a_force_map_in_a_batch_is_one_error_row(synthetic_map, tmp_path, monkeypatch):
-    import shellbvp.afm as afm
+    import shellbvp.afm_read as afm_read
 
     _, curves = synthetic_map
     path = tmp_path / "cells.jpk-force-map"
     path.write_bytes(b"")
-    monkeypatch.setattr(afm, "read_afm", lambda p: curves)
+    monkeypatch.setattr(afm_read, "read_afm", lambda p, **calibration: curves)
     (row,) = sb.fit_files(sb.Scene.preset("fit"), [str(path)], R_L=R_L)
     assert row.status == "error" and "a force map of 4 curves: fit it on its own" in row.message
 
@@ -195,3 +196,157 @@ def test_a_maps_spread_of_mu_H_reads_in_a_unit_of_its_size():
     assert mu_H_spread(np.array([39.9, 40.1, 52.0]), with_range=True) == \
         "median 40.1 N/m, quartiles 40..46.05 N/m, range 39.9..52 N/m"
     assert mu_H_spread(np.array([2e-7, 3e-7])).endswith("uN/m")
+
+
+# -- damaged and oversized AFM files (issue 59, items 4 and 5) --------------------------------------------
+SPOT = DATA / "spot3-0192.jpk-force"
+
+
+def _rewrite(dst, edit=None, drop=(), extra=()):
+    """A copy of SPOT, its property files passed through ``edit(text)``, members dropped or added."""
+    import zipfile
+
+    with zipfile.ZipFile(SPOT) as zi, zipfile.ZipFile(dst, "w", zipfile.ZIP_DEFLATED) as zo:
+        for info in zi.infolist():
+            if info.filename not in drop:
+                data = zi.read(info.filename)
+                if edit and info.filename.endswith(".properties"):
+                    data = edit(data.decode("latin-1")).encode("latin-1")
+                zo.writestr(info.filename, data)
+        for name, data in extra:
+            zo.writestr(name, data)
+    return dst
+
+
+def _bad_crc(dst, member="segments/0/channels/vDeflection.dat"):
+    """SPOT with the CRC of one member flipped in its local header and the central directory."""
+    import struct
+    import zipfile
+
+    raw = bytearray(SPOT.read_bytes())
+    with zipfile.ZipFile(SPOT) as z:
+        raw[z.getinfo(member).header_offset + 14] ^= 0xFF
+    at = raw.find(b"PK\x01\x02")
+    while at >= 0:
+        n = struct.unpack("<H", raw[at + 28:at + 30])[0]
+        if raw[at + 46:at + 46 + n] == member.encode():
+            raw[at + 16] ^= 0xFF
+        at = raw.find(b"PK\x01\x02", at + 4)
+    dst.write_bytes(bytes(raw))
+    return dst
+
+
+@pytest.mark.parametrize("damage, says", [
+    ("crc", "BadZipFile"),
+    ("no channel", "vDeflection"),
+    ("nan scaling", "vDeflection"),
+    ("unknown encoder", "\\x1b[2J"),   # the file's text, escaped
+])
+def test_a_damaged_jpk_archive_is_one_clean_line_and_afmformats_stays_quiet(tmp_path, damage, says, caplog):
+    path = tmp_path / "damaged.jpk-force"
+    if damage == "crc":
+        _bad_crc(path)
+    elif damage == "no channel":
+        _rewrite(path, drop=("segments/0/channels/vDeflection.dat",))
+    else:
+        key, value = {"nan scaling": ("vDeflection.data.encoder.scaling.multiplier", "NaN"),
+                      "unknown encoder": ("vDeflection.data.encoder.type", "\x1b[2Jfloat128")}[damage]
+        _rewrite(path, edit=lambda text: "\n".join(f"{ln.split('=')[0]}={value}" if ln.split("=")[0].endswith(key)
+                                                    else ln for ln in text.splitlines()))
+    with pytest.raises(ValueError) as info:
+        read_afm(path)
+    msg = str(info.value)
+    assert str(path) in msg and says in msg and "\n" not in msg and "\x1b" not in msg
+    assert not [r for r in caplog.records if r.name.startswith("afmformats")]  # no traceback logged
+
+
+def test_a_batch_keeps_the_good_files_row_beside_a_damaged_afm_file(tmp_path, capsys, closed_form):
+    from shellbvp.fitting import example_data_path
+
+    good, bad = str(example_data_path()), str(_bad_crc(tmp_path / "damaged.jpk-force"))
+    rows = sb.fit_files(sb.Scene.preset("fit"), [good, bad], R_L=0.3e-3)
+    assert [r.file for r in rows] == [good, bad]
+    assert rows[0].status != "error" and rows[0].result is not None   # fitted (the closed-form model)
+    assert rows[1].status == "error" and "BadZipFile" in rows[1].message and rows[1].result is None
+    code = main(["fit", good, bad, "--preset", "fit", "--radius", "0.3mm", "--json", "-q"])
+    doc = json.loads(capsys.readouterr().out)     # exactly one JSON document
+    assert code == doc["exit_status"] == 1 and [d["file"] for d in doc["files"]] == [good, bad]
+    assert "BadZipFile" in doc["files"][1]["message"] and "mu_H" in doc["files"][0]
+
+
+def test_an_archive_inflating_far_beyond_its_size_is_refused_before_inflating(tmp_path, capsys):
+    import zipfile
+
+    from shellbvp import afm_read
+
+    bomb = _rewrite(tmp_path / "bomb.jpk-force")
+    with zipfile.ZipFile(bomb, "a", zipfile.ZIP_DEFLATED) as z:     # 48 MiB of zeros in ~50 kB
+        z.writestr("segments/0/channels/big.dat", bytes(48 * 2**20))
+    with pytest.raises(ValueError, match=r"inflate to 48\.\d MiB from 0\.\d+ MiB .*'segments/0/channels/big.dat'"):
+        read_afm(bomb)
+    assert main(["fit", str(bomb), "--preset", "fit", "--radius", "10um", "--json"]) == 2
+    out, err = capsys.readouterr()
+    assert err.startswith("shellbvp: error:") and len(err.strip().splitlines()) == 1
+    assert "MiB" in json.loads(out)["message"]
+    many = _rewrite(tmp_path / "many.jpk-force", extra=[(f"junk/{i}", b"") for i in range(20)])
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(afm_read, "MAX_ARCHIVE_MEMBERS", 25)
+        with pytest.raises(ValueError, match="declares 32 members.*MAX_ARCHIVE_MEMBERS"):
+            read_afm(many)
+
+
+@pytest.mark.parametrize("offset, value, says", [(12, 0x7FFFFFF0, "noteSize = 2147483632"),
+                                                 (4, 0x7FFFFFF0, "wfmSize = 2147483632"),
+                                                 (12, -5, "negative sizes")])
+def test_an_ibw_header_declaring_huge_sizes_is_refused_before_allocation(tmp_path, offset, value, says):
+    import struct
+
+    good = DATA / "SiN_FD_plot.ibw"
+    assert len(read_afm(good)) == 1
+    raw = bytearray(good.read_bytes())
+    raw[offset:offset + 4] = struct.pack("<l", value)
+    bad = tmp_path / "bad.ibw"
+    bad.write_bytes(bytes(raw))
+    with pytest.raises(ValueError, match=f"Igor binary wave header declares .*{says}"):
+        read_afm(bad)
+    bad.write_bytes(good.read_bytes()[:5000])   # cut short: its parts do not fit
+    with pytest.raises(ValueError, match="declares .* in a file of 5000 bytes"):
+        read_afm(bad)
+
+
+def test_a_map_grid_far_larger_than_its_curves_is_refused_before_any_fit():
+    from shellbvp.afm import map_shape
+    from shellbvp.afm_read import MAX_MAP_PIXELS
+
+    curves = [AFMCurve(record=None, index=i, grid=g) for i, g in enumerate([(4999, 4999), (94977, 94967)])]
+    with pytest.raises(ValueError, match=r"94978 x 94968 grid .*MAX_MAP_PIXELS"):
+        fit_map(sb.Scene.preset("fit"), curves, R_L=R_L, path="m.jpk-force-map")
+    side = int(MAX_MAP_PIXELS ** 0.5)
+    assert map_shape([AFMCurve(None, 0, (side - 1, side - 1))]) == (side, side)
+
+
+def test_afm_text_exports_go_through_afmformats_with_their_calibration():
+    from shellbvp.afm import afm_text_format
+
+    nt, ws = DATA / "ntmdt-gel4.txt", DATA / "afm-workshop-single.csv"
+    assert (afm_text_format(nt), afm_text_format(ws), afm_text_format(SPOT)) == ("NT-MDT Nova", "AFM Workshop", None)
+    for path in (nt, ws):
+        with pytest.raises(ValueError, match="--spring-constant K --sensitivity S"):
+            sb.read_instrument(path)
+        (curve,) = read_afm(path, spring_constant=0.05, sensitivity=1e-7)
+        assert len(curve.record) > 500 and np.all(np.isfinite(curve.record.force))
+    with pytest.raises(ValueError, match="carries the cantilever's calibration"):
+        read_afm(SPOT, spring_constant=0.05, sensitivity=1e-7)
+
+
+def test_read_instrument_reads_an_afm_curve_and_points_a_map_to_its_reader(tmp_path, monkeypatch):
+    import shellbvp.afm_read as afm_read
+
+    rec = sb.read_instrument(SPOT)
+    np.testing.assert_array_equal(rec.displacement, read_afm(SPOT)[0].record.displacement)
+    with pytest.raises(ValueError, match="gives its own columns"):
+        sb.read_instrument(SPOT, units=("um", "uN"))
+    curves = [AFMCurve(record=None, index=i, grid=(i % 2, i // 2)) for i in range(4)]
+    monkeypatch.setattr(afm_read, "read_afm", lambda p, **calibration: curves)
+    with pytest.raises(ValueError, match="a force map of 4 curves.*shellbvp.batch.fit_map"):
+        sb.read_instrument(tmp_path / "m.jpk-force-map")

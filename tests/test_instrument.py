@@ -312,3 +312,44 @@ def test_a_time_column_whose_unit_is_not_a_time_is_dropped_and_the_record_says_s
     plain = tmp_path / "seconds.csv"
     plain.write_text("\n".join(["Time (s),Displacement (um),Force (uN)"] + lines[1:]) + "\n")
     assert read_instrument(plain).notes == () and read_instrument(plain).time is not None
+
+
+# -- readers (issue 56, item 3) ------------------------------------------------------------------------------
+@pytest.mark.parametrize("text, units", [
+    ("0,0\t0,0\n1,0\t0,5\n2,0\t1,5\n3,0\t3,0\n", ("um", "mN")),                       # headerless decimal commas
+    ("0,0;0,0\n1,0;0,5\n2,0;1,5\n3,0;3,0\n", ("um", "mN")),
+    ("# displacement (mm)   force (mN)\n0.0   0.0\n1.0   0.5\n2.0   1.5\n3.0   3.0\n", None),   # commented header
+    ("displacement (mm)   force (mN)\n0.0   0.0\n1.0   0.5\n2.0   1.5\n3.0   3.0\n", None),
+    ("# displacement [mm] force [mN]\n0.0 0.0\n1.0 0.5\n2.0 1.5\n3.0 3.0\n", None),
+])
+def test_whitespace_and_decimal_comma_tables_read_every_row_with_their_units(tmp_path, text, units):
+    path = tmp_path / "rec.txt"
+    path.write_text(text)
+    rec = sb.read_instrument(path, units=units)
+    scale = (1e-6, 1e-3) if units else (1e-3, 1e-3)
+    np.testing.assert_allclose(rec.displacement, np.array([0, 1, 2, 3]) * scale[0])
+    np.testing.assert_allclose(rec.force, np.array([0, 0.5, 1.5, 3]) * scale[1])
+    if units is None:
+        assert rec.units == {"displacement": "mm", "force": "mN"}
+
+
+def test_the_cli_fits_a_headerless_decimal_comma_file(tmp_path, capsys, closed_form):
+    from shellbvp.cli import main
+
+    (tmp_path / "dc.txt").write_text("0,0\t0,0\n1,0\t0,5\n2,0\t1,5\n3,0\t3,0\n")
+    main(["fit", str(tmp_path / "dc.txt"), "--preset", "fit", "--radius", "0.3mm", "--units", "um,mN", "-q"])
+    out = capsys.readouterr().out
+    assert "dc.txt: 4 rows" in out
+
+
+def test_a_table_bounded_in_rows_is_refused_before_it_is_split(tmp_path):
+    from shellbvp.instrument import MAX_PREAMBLE_LINES, read_table
+
+    path = tmp_path / "t.csv"
+    path.write_text("a,b\n" + "1,2\n" * (100 + MAX_PREAMBLE_LINES + 1))
+    with pytest.raises(ValueError, match=r"lines; a table has at most 100 rows"):
+        read_table(path, max_rows=100)
+    path.write_text("a,b\n" + "1,2\n" * 101)
+    with pytest.raises(ValueError, match=r"101 rows; a table has at most 100"):
+        read_table(path, max_rows=100)
+    assert len(read_table(path, max_rows=101).rows) == 101

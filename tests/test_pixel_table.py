@@ -212,3 +212,16 @@ def test_cli_refuses_a_bad_pixel_table_in_one_line(tmp_path, capsys):
     csv_file.write_text("d,f\n0,0\n1,1\n2,2\n")
     assert main(["fit", str(csv_file), "--preset", "fit", "--radius", "10um", "--pixel-table", str(good)]) == 2
     assert "--pixel-table is for one force map" in capsys.readouterr().err
+
+
+def test_a_pixel_table_has_at_most_a_row_per_cell_of_the_largest_map(tmp_path, monkeypatch):
+    """Bounded before its text is split (issue 59, item 5): a 100 MB table once peaked at 3.6 GB."""
+    from shellbvp import afm_read
+
+    monkeypatch.setattr(afm_read, "MAX_MAP_PIXELS", 16)
+    path = tmp_path / "pixels.csv"
+    path.write_text("ix,iy,thickness_um\n" + "".join(f"{i % 5},{i // 5},0.5\n" for i in range(17)))
+    with pytest.raises(ValueError, match=r"17 rows; a pixel table .*has at most 16"):
+        read_pixel_table(path)
+    path.write_text("ix,iy,thickness_um\n" + "".join(f"{i % 4},{i // 4},0.5\n" for i in range(16)))
+    assert len(read_pixel_table(path).values) == 16

@@ -127,3 +127,21 @@ def test_inputs_that_are_not_files_get_a_row_each_and_never_hang_the_batch(tmp_p
     assert "FIFO" in rows["pipe.csv"]["message"] and "directory" in rows["sub.csv"]["message"]
     assert "symbolic links" in rows["loop.csv"]["message"] and "character device" in rows["zero"]["message"]
     assert "1 of 5 files fitted" in out
+
+
+def test_the_afmformats_boundary_gives_one_escaped_line_for_any_exception():
+    from shellbvp.afm_read import AFMFileError, afmformats_boundary
+
+    for exc in (NotImplementedError("format '\x1b[2J'\nnot supported"), KeyError("x"), MemoryError()):
+        with pytest.raises(ValueError) as info:
+            with afmformats_boundary("a\x1b]0;x.jpk-force"):
+                raise exc
+        msg = str(info.value)
+        assert type(info.value) is ValueError and "\n" not in msg and "\x1b" not in msg
+        assert msg.startswith("a\\x1b]0;x.jpk-force: afmformats cannot read it (" + type(exc).__name__)
+    with pytest.raises(AFMFileError, match="ours"):
+        with afmformats_boundary("f.ibw"):
+            raise AFMFileError("ours")
+    with pytest.raises(KeyboardInterrupt):
+        with afmformats_boundary("f.ibw"):
+            raise KeyboardInterrupt

@@ -10,7 +10,7 @@ from ..shape_parameters import SHAPE_PARAMETERS
 from ..textdata import printable
 from .common import (
     add_limit_options, add_overwrite_option, add_scene_options, check_report_path, curve_bars, number_or,
-    os_error_line, output_dir, progress_bar, quantity, require_sample, say, scene_from_args, strict_json,
+    os_error_line, output_dir, plain_number, progress_bar, quantity, require_sample, say, scene_from_args, strict_json,
 )
 
 __all__ = ["add_parser", "run"]
@@ -47,6 +47,10 @@ def add_parser(sub):
     f.add_argument("--invert", action="append", choices=("displacement", "force"),
                    help="flip the sign of a column: an AFM height that falls as the tip goes in "
                         "(displacement), compression recorded as negative (force); may be given twice")
+    f.add_argument("--spring-constant", dest="spring_constant", type=positive_number, metavar="N/m",
+                   help="AFM text exports (AFM Workshop CSV, NT-MDT Nova .txt): the cantilever's spring constant")
+    f.add_argument("--sensitivity", type=positive_number, metavar="m/V",
+                   help="AFM text exports: the deflection sensitivity (NT-MDT: m/A)")
     f.add_argument("--segment", choices=("loading", "retraction", "all"), default="loading",
                    help="rows to fit: loading (default: the approach and the loading, up to the deepest point; "
                         "segments by the direction of the displacement over time), retraction, or all "
@@ -161,7 +165,23 @@ def _fit_inputs(args, pixel_values=None):
     options = {"fit_offset": not args.no_offset, "free": free, "bounds": bounds, "weights": args.weights,
                "tol": args.tol, "stability": args.stability, "model": args.model, "mesh_check": args.mesh_check,
                "max_depth": _max_depth(args.max_depth, args.radius.si)}
-    return scene, args.radius.si, {"columns": columns, "units": units, "invert": tuple(args.invert or ())}, options
+    reading = {"columns": columns, "units": units, "invert": tuple(args.invert or ()), **_calibration(args)}
+    return scene, args.radius.si, reading, options
+
+
+def _calibration(args):
+    """An AFM text export's calibration options, as :func:`shellbvp.afm.read_afm` takes them."""
+    return {"spring_constant": args.spring_constant, "sensitivity": args.sensitivity}
+
+
+def positive_number(text):
+    """argparse type of ``--spring-constant``/``--sensitivity``: a finite number > 0 (SI units)."""
+    import argparse
+
+    value = plain_number(text)
+    if not value > 0:
+        raise argparse.ArgumentTypeError(f"must be a number > 0 (SI units); got {text!r}")
+    return value
 
 
 def _max_depth(given, R_L):
@@ -220,7 +240,7 @@ def run(args):
     if len(files) == 1 and not folder and is_afm_file(files[0]):
         # its one-line error before the file is read
         require_sample(args, bending_per_pixel=_bending_per_pixel(pixel_values))
-        curves = read_afm(files[0])
+        curves = read_afm(files[0], **_calibration(args))
         if len(curves) > 1:  # a force map: every curve, into a map
             if uncertainty:
                 raise ValueError("VALUE+-U (the geometry's uncertainty) is for one curve, not a force map")
