@@ -28,7 +28,7 @@ import numpy as np
 
 import shellbvp as sb
 
-KINDS = {"work": "13. oversized work, memory and stability verdicts", "options": "14. accepted options read"}
+KINDS = {"work": "15. oversized work, memory and stability verdicts", "options": "16. accepted options read"}
 SIZES = {"work": 0, "options": 0}  # fixed lists: the sizes play no part
 KIND_NOTES = {
     "work": "Inputs: the 3D solid at eps 1e-4, 1e-3, 1e-7 and over a small max_dofs (fe_curve, validate, "
