@@ -33,7 +33,7 @@ from dataclasses import dataclass
 from typing import Callable
 
 from .. import chain as ch
-from ..inflation import system_parameters
+from ..inflation import enclosed_volume, system_parameters
 from ..solution import attach_tip_table
 
 __all__ = ["Configuration", "CONFIGURATIONS", "FAMILIES", "configuration", "names", "register", "family_of", "of",
@@ -114,11 +114,13 @@ class Configuration:
 
     def system(self, scene, control, value, eps, edge=None):
         """The ChainBVP of this configuration for ``scene`` with ``control`` = ``value``, its
-        tip tabulated for the admissibility checks."""
+        tip tabulated for the admissibility checks; a sealed scene's system holds the volume of
+        its inflated state (solved here, once per scene, not by the system)."""
         self.check(scene, control)
         model = scene.model()
         sysm = ch.ChainBVP(scene, self.chain(eps, scene.shell_length, edge or scene.contact), control, value,
-                           model=model, par=system_parameters(scene, model))
+                           model=model, par=system_parameters(scene, model),
+                           enclosed_volume=enclosed_volume(scene) if scene.sealed else None)
         attach_tip_table(sysm)
         return sysm
 
