@@ -207,15 +207,25 @@ def system_parameters(scene, model=None):
 
 def enclosed_volume(scene) -> float:
     """V0 of a sealed scene: the volume between the shell and its rim's plane in the inflated
-    state at ``scene.pressure`` (the reference volume at pressure 0); a ValueError if the
-    inflated state was not found.  What a sealed scene's systems hold the volume at.
+    state at ``scene.pressure`` (the reference volume at pressure 0).  What a sealed scene's
+    systems hold the volume at.
+
+    Parameters
+    ----------
+    scene : Scene
+        Its ``sealed`` flag is not read: the volume of the open shell at its pressure.
+
+    Returns
+    -------
+    float
+        V0 (units R_L^3); a ValueError if the inflated state was not found.
 
     Examples
     --------
     >>> import shellbvp as sb
     >>> scene = sb.Scene.preset("balloon", sealed=True)
-    >>> round(sb.enclosed_volume(scene) - scene.reference_volume(), 4)
-    0.0052
+    >>> round(sb.enclosed_volume(scene) - scene.reference_volume(), 4)  # the inflated state's volume change
+    0.088
     """
     if not scene.pressure:
         return scene.reference_volume()
