@@ -59,8 +59,9 @@ from .nexus import new_file
 from .paths import open_hdf5
 from .schema import MAX_DATASET_BYTES
 
-__all__ = ["Curve", "FirstInstability", "STABILITY_FIELDS", "POINT_FIELDS", "CAP_FIELD_DEFAULTS", "point_record",
-           "energy_residual", "write_curve", "read_curve", "write_curve_group", "read_curve_group", "FORMAT", "FORMAT_VERSION"]
+__all__ = ["Curve", "FirstInstability", "STABILITY_FIELDS", "POINT_FIELDS", "CAP_FIELD_DEFAULTS", "FORMAT",
+           "point_record", "energy_residual", "write_curve", "read_curve", "write_curve_group", "read_curve_group",
+           "FORMAT_VERSION"]
 
 FORMAT = "shellbvp-curve"
 FORMAT_VERSION = 4
@@ -521,14 +522,11 @@ def read_curve_group(g, version: str = ""):
     return Curve(scene=scene, points=points, flags=flags, stop_reason=_text_attr(g, "stop_reason"),
                  complete=_bool_attr(g, "complete"), interrupted=_bool_attr(g, "interrupted"),
                  settings=settings, version=version, units=units, first_instability=_first_instability(g),
-                 inflated=_inflated(g))
+                 inflated=_inflated(g["inflated"]) if "inflated" in g else None)
 
 
-def _inflated(g):
-    """The curve's inflated state (group ``inflated``: one number each of ``INFLATED_FIELDS``), or None."""
-    if "inflated" not in g:
-        return None
-    ig = g["inflated"]
+def _inflated(ig):
+    """The curve's inflated state from its group ``inflated`` (one number each of ``INFLATED_FIELDS``)."""
     values = {name: ig.get(name) if hasattr(ig, "keys") else None for name, _, _ in INFLATED_FIELDS}
     for name, d in values.items():
         if getattr(d, "shape", None) != () or d.dtype.kind not in "fiu":

@@ -26,12 +26,13 @@ Adding a configuration is one new module here and its tests: copy the module of 
 configuration of its family (``line.py`` for a lifted pole, ``cap_line_cylinder.py`` for the
 cylinder), give it a new name, ``ORDER`` and chain, set its traits (``askable``,
 ``inner_edge``, ``line_contact``, ``pole_branch_end``) and declare its switches; its family's
-searches (``shellbvp.state.AGAIN``, ``shellbvp.switches.MEASURED``) serve it.  The lifted-pole search (``shellbvp.liftoff``) tries every askable
-configuration of its family through :func:`names` and tells them apart by their traits, so
-a lifted configuration needs no other change (``tests/test_configurations.py`` adds a copy
-of ``line.py`` in a test and solves it).  A wall configuration also needs its guesses from
-its neighbours (``shellbvp.cylinder``, a table keyed by pairs of names), and a split one a
-search (``shellbvp.liftoff.second_zone_state`` looks for ``cap+line(tip)`` only).
+searches (``shellbvp.state.AGAIN``, ``shellbvp.switches.MEASURED``) serve it.  The lifted-pole
+search (``shellbvp.liftoff``) tries every askable configuration of its family through
+:func:`names` and tells them apart by their traits, so a lifted configuration needs no other
+change (``tests/test_configurations.py`` adds a copy of ``line.py`` in a test and solves it).
+A wall configuration also needs its guesses from its neighbours (``shellbvp.cylinder``, a
+table keyed by pairs of names), and a split one a search
+(``shellbvp.liftoff.second_zone_state`` looks for ``cap+line(tip)`` only).
 """
 
 from __future__ import annotations
