@@ -4,7 +4,9 @@
 
 Counts what issue 43 names: comparisons with configuration names, modules and functions
 by length, ``.get`` on results, places that build a ``Solution``, function-level
-imports, module flags that tests patch.  The numbers are what the redesign is judged by;
+imports, module flags that tests patch; and of issue 57, string hooks: ``"module:function"``
+strings that name a function of the package, resolved by name at run time (an upward path
+the import graph does not show).  The numbers are what the redesign is judged by;
 ``--markdown`` prints them as the table of benchmarks/results/architecture.md.  A ``.get`` is
 counted where its key is a result's field name; ``--verbose`` shows its receiver, which may
 be a dict of another kind.  ``--layers`` prints the package's modules by floor: a module
@@ -22,6 +24,8 @@ import sys
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 
+#: A string naming a function of the package, ``"shellbvp.module:function"``
+STRING_HOOK = re.compile(r"^shellbvp(\.\w+)+:\w+$")
 MODULE_LINES = 600
 FUNCTION_LINES = 80
 #: Module-level names that a result carries (a ``.get`` of one of them reads a result)
@@ -85,7 +89,7 @@ def _adapts_a_step(loop):
 def census(root=ROOT):
     names = configuration_names(root)
     out = {"step_loops": [], "name_comparisons": {}, "long_modules": {}, "long_functions": [], "result_gets": {},
-           "solution_builds": {}, "function_imports": {}, "lines": 0}
+           "solution_builds": {}, "function_imports": {}, "string_hooks": {}, "lines": 0}
     pkg = root / "shellbvp"
     for path in sorted(pkg.rglob("*.py")):  # subpackages (materials/, cli/) too
         text = path.read_text()
@@ -100,6 +104,8 @@ def census(root=ROOT):
                 hits = [s for side in [node.left, *node.comparators] for s in _strings(side) if s in names]
                 if hits:
                     out["name_comparisons"][mod] = out["name_comparisons"].get(mod, 0) + 1
+            elif isinstance(node, ast.Constant) and isinstance(node.value, str) and STRING_HOOK.match(node.value):
+                out["string_hooks"][mod] = out["string_hooks"].get(mod, 0) + 1
             elif isinstance(node, (ast.While, ast.For)) and _adapts_a_step(node):
                 out["step_loops"].append(f"{mod}:{node.lineno}")
             elif isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
@@ -194,6 +200,7 @@ def main(argv=None):
         ("places that build a Solution", total(c["solution_builds"]), c["solution_builds"]),
         ("imports inside functions", total(c["function_imports"]), c["function_imports"]),
         ("module flags patched by tests and benchmarks", len(c["patched_flags"]), c["patched_flags"]),
+        ('string hooks (`"module:function"` resolved by name)', total(c["string_hooks"]), c["string_hooks"]),
         ("lines of shellbvp/*.py", c["lines"], ""),
     ]
     if args.markdown:

@@ -38,7 +38,8 @@ H = 0.002
 
 def resolve(sol, delta, tol=1e-8):
     """The configuration of ``sol`` (same chain) solved at ``delta`` from ``sol``."""
-    sysm = ChainBVP(sol.scene, sol.system.chain, "delta", delta, model=sol.system.model, par=sol.system.par)
+    sysm = ChainBVP(sol.scene, sol.system.chain, "delta", delta, model=sol.system.model, par=sol.system.par,
+                    enclosed_volume=sol.system.enclosed_volume)
     attach_tip_table(sysm)
     named = dict(zip(sol.system.unknowns, sol.p))
     out = solve_from(sysm, (sol.x, sol.y[:sysm.n], sysm.pack(**named)), tol=tol, max_nodes=50000)

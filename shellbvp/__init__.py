@@ -25,7 +25,7 @@ _LAZY = {"curve": "continuation", "iter_curve": "continuation", "CurveRun": "con
          "read_instrument": "instrument", "fit_files": "batch", "read_fit": "fitrecord",
          "sweep": "sweep", "read_sweep": "sweep", "Sweep": "sweep",
          "fit_with_geometry": "uncertainty", "GeometryFit": "uncertainty", "convexity_limits": "convexity",
-         "inflate": "inflation", "stability": "modal_stability", "hoop_indicator": "wrinkling", "HoopIndicator": "wrinkling", "Stability": "modal_stability", "options": "config", "Options": "config", "fe_curve": "fe", "FECurve": "fe", "validate": "validation",
+         "inflate": "inflation", "enclosed_volume": "inflation", "stability": "modal_stability", "hoop_indicator": "wrinkling", "HoopIndicator": "wrinkling", "Stability": "modal_stability", "options": "config", "Options": "config", "fe_curve": "fe", "FECurve": "fe", "validate": "validation",
          "Validation": "validation", "read_validation": "validation"}
 
 
@@ -49,6 +49,7 @@ __all__ = [
     "solve",
     "delta_bounds",
     "inflate",
+    "enclosed_volume",
     "stability",
     "Stability",
     "hoop_indicator",

@@ -27,6 +27,7 @@ from .configurations import is_single_cap, names
 from .corner import edge_model
 from .curve_stability import assess, check_choice
 from .cylinder import best_wall_state, wall_contact_suspected
+from .inflation import inflated_start
 from .io import POINT_FIELDS, Curve
 from .kernels import LONG_CURVE_POINTS, kernel_set
 from .legs import Stop, adaptive, natural
@@ -262,6 +263,7 @@ class CurveRun:
         if self.deltas is None or self.deltas.size >= LONG_CURVE_POINTS:  # long enough to repay compiled kernels
             kernel_set(scene.model(), scene.structure).start_now()
         self.t0 = time.perf_counter()
+        self.out.inflated = inflated_start(scene)  # the first step under pressure, passed on to the curve's file
         legs = natural(scene, self.deltas, self.branch, st) if self.deltas is not None else \
             adaptive(scene, self.branch, st)
         while True:

@@ -33,7 +33,8 @@ from .diagnosis import diagnose
 from .march import Steps, march
 from .solution import Solution, attach_tip_table
 
-__all__ = ["inflate", "InflatedState", "inflated_chain", "inflated_pole_rise", "start_shape", "system_parameters"]
+__all__ = ["inflate", "InflatedState", "inflated_chain", "inflated_pole_rise", "start_shape", "system_parameters",
+           "enclosed_volume", "InflatedStart", "INFLATED_FIELDS", "inflated_start"]
 
 #: Pole start of the inflated state, ``zeta = EPS * L`` (the free pole's truncation error
 #: is O(zeta^2): 1e-8 relative, below the inflation's tolerance).
@@ -52,6 +53,34 @@ class InflatedState(Solution):
     pole_stretch: float = math.nan
     volume_change: float = math.nan
     rim_hoop_tension: float = math.nan
+
+
+#: The inflated state's numbers that a curve carries and its file keeps: (name, units, what it is)
+INFLATED_FIELDS = (("pole_rise", "1 (R_L)", "height of the inflated pole above the reference pole"),
+                   ("pole_stretch", "1", "stretch at the inflated pole"),
+                   ("volume_change", "1 (R_L^3)", "V - V_ref, V between the shell and its rim's plane"),
+                   ("rim_hoop_tension", "1 (mu H)", "tau_theta at the rim"))
+
+
+@dataclass(frozen=True)
+class InflatedStart:
+    """Where a curve under pressure starts: the numbers of its inflated state (:func:`inflate`),
+    which the curve carries (``Curve.inflated``) and its file keeps.  NaN where the state was
+    not found."""
+
+    pole_rise: float
+    pole_stretch: float
+    volume_change: float
+    rim_hoop_tension: float
+
+
+def inflated_start(scene) -> InflatedStart | None:
+    """The inflated state's numbers of a scene under pressure (:func:`inflate`, solved once per
+    scene), None without pressure: a step of the continuation, passed on to the curve's file."""
+    if not scene.pressure:
+        return None
+    state = inflate(scene)
+    return InflatedStart(**{name: float(getattr(state, name)) for name, _, _ in INFLATED_FIELDS})
 
 
 def inflated_chain(L: float) -> Chain:
@@ -174,6 +203,37 @@ def system_parameters(scene, model=None):
     """The run-time parameters of a system of ``scene``: with the inflated state's pole rise
     (:func:`inflate`, solved once per scene) where the scene is under pressure."""
     return scene.parameters(model, pole_rise=inflated_pole_rise(scene) if scene.pressure else 0.0)
+
+
+def enclosed_volume(scene) -> float:
+    """V0 of a sealed scene: the volume between the shell and its rim's plane in the inflated
+    state at ``scene.pressure`` (the reference volume at pressure 0).  What a sealed scene's
+    systems hold the volume at.
+
+    Parameters
+    ----------
+    scene : Scene
+        Its ``sealed`` flag is not read: the volume of the open shell at its pressure.
+
+    Returns
+    -------
+    float
+        V0 (units R_L^3); a ValueError if the inflated state was not found.
+
+    Examples
+    --------
+    >>> import shellbvp as sb
+    >>> scene = sb.Scene.preset("balloon", sealed=True)
+    >>> round(sb.enclosed_volume(scene) - scene.reference_volume(), 4)  # the inflated state's volume change
+    0.088
+    """
+    if not scene.pressure:
+        return scene.reference_volume()
+    state = inflate(scene.replace(sealed=False))
+    if not state.success:
+        raise ValueError(f"the inflated state at pressure {scene.pressure:g} was not found "
+                         f"({state.message}): no enclosed volume for the sealed shell")
+    return scene.reference_volume() + state.volume_change
 
 
 def inflated_pole_rise(scene) -> float:

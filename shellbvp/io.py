@@ -54,12 +54,13 @@ from pathlib import Path
 import numpy as np
 
 from .configurations import CONFIGURATION_NAMES, is_point_load
+from .inflation import INFLATED_FIELDS, InflatedStart
 from .nexus import new_file
 from .paths import open_hdf5
 from .schema import MAX_DATASET_BYTES
 
-__all__ = ["Curve", "FirstInstability", "STABILITY_FIELDS", "POINT_FIELDS", "CAP_FIELD_DEFAULTS", "point_record", "energy_residual", "write_curve",
-           "read_curve", "write_curve_group", "read_curve_group", "FORMAT",
+__all__ = ["Curve", "FirstInstability", "STABILITY_FIELDS", "POINT_FIELDS", "CAP_FIELD_DEFAULTS", "FORMAT",
+           "point_record", "energy_residual", "write_curve", "read_curve", "write_curve_group", "read_curve_group",
            "FORMAT_VERSION"]
 
 FORMAT = "shellbvp-curve"
@@ -132,8 +133,6 @@ class FirstInstability:
         return f"loses axisymmetric stability at delta = {self.delta:.6g} (n = {self.mode}{how})"
 
 
-
-
 @dataclass
 class Curve:
     """A force–displacement curve: per-point arrays and how it was made.
@@ -183,6 +182,9 @@ class Curve:
     units: dict = None  # {"R_L": m, "mu_H": N/m} when the file had SI columns (to_hdf5(units=...))
     #: the first unstable depth (:class:`FirstInstability`, shellbvp.curve_stability), None if none was found
     first_instability: object = None
+    #: under pressure, where the curve starts (:class:`shellbvp.inflation.InflatedStart`): the
+    #: continuation's first step, which the file keeps; None without pressure
+    inflated: object = None
 
     def __getattr__(self, name):
         points = self.__dict__.get("points", {})
@@ -316,8 +318,8 @@ def write_curve_group(g, curve, *, profiles=False, units=None):
         if first is not None:
             g.attrs["first_instability_delta_m"] = R_L * first.delta
             g.attrs["first_instability_force_N"] = mu_H * R_L * first.force
-    if curve.scene.pressure:
-        _write_inflated(g.create_group("inflated"), curve.scene)
+    if curve.inflated is not None:
+        _write_inflated(g.create_group("inflated"), curve.inflated)
     if profiles:
         pg = g.create_group("profiles")
         for i, sol in enumerate(curve.solutions):
@@ -328,18 +330,12 @@ def write_curve_group(g, curve, *, profiles=False, units=None):
                 sg.create_dataset(k, data=v)
 
 
-def _write_inflated(ig, scene):
-    """The inflated state of a pressurised scene, where its curve starts (``sb.inflate``)."""
-    from .inflation import inflate
-
-    state = inflate(scene)
+def _write_inflated(ig, inflated):
+    """The inflated state of a pressurised scene, where its curve starts (``Curve.inflated``)."""
     ig.attrs["NX_class"] = "NXnote"
     ig.attrs["long_name"] = "the shell under its pressure before indentation: delta is measured from its pole"
-    for name, units, what in (("pole_rise", "1 (R_L)", "height of the inflated pole above the reference pole"),
-                              ("pole_stretch", "1", "stretch at the inflated pole"),
-                              ("volume_change", "1 (R_L^3)", "V - V_ref, V between the shell and its rim's plane"),
-                              ("rim_hoop_tension", "1 (mu H)", "tau_theta at the rim")):
-        d = ig.create_dataset(name, data=float(getattr(state, name)))
+    for name, units, what in INFLATED_FIELDS:
+        d = ig.create_dataset(name, data=getattr(inflated, name))
         d.attrs["units"], d.attrs["long_name"] = units, what
 
 
@@ -526,7 +522,17 @@ def read_curve_group(g, version: str = ""):
         units = {"R_L": units[0], "mu_H": units[1]}
     return Curve(scene=scene, points=points, flags=flags, stop_reason=_text_attr(g, "stop_reason"),
                  complete=_bool_attr(g, "complete"), interrupted=_bool_attr(g, "interrupted"),
-                 settings=settings, version=version, units=units, first_instability=_first_instability(g))
+                 settings=settings, version=version, units=units, first_instability=_first_instability(g),
+                 inflated=_inflated(g["inflated"]) if "inflated" in g else None)
+
+
+def _inflated(ig):
+    """The curve's inflated state from its group ``inflated`` (one number each of ``INFLATED_FIELDS``)."""
+    values = {name: ig.get(name) if hasattr(ig, "keys") else None for name, _, _ in INFLATED_FIELDS}
+    for name, d in values.items():
+        if getattr(d, "shape", None) != () or d.dtype.kind not in "fiu":
+            raise ValueError(f"inflated/{name} must be one number")
+    return InflatedStart(**{name: float(d[()]) for name, d in values.items()})
 
 
 def _first_instability(g):

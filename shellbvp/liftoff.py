@@ -461,7 +461,8 @@ def _continue_in_delta(sysm, previous, before, delta, *, tol, max_nodes, bc_tol)
 
     def solve_at(target, states):
         previous, before = states[-1], (states[-2] if len(states) > 1 else None)
-        stepper = ChainBVP(sysm.scene, sysm.chain, "delta", target, model=sysm.model, par=sysm.par)
+        stepper = ChainBVP(sysm.scene, sysm.chain, "delta", target, model=sysm.model, par=sysm.par,
+                           enclosed_volume=sysm.enclosed_volume)
         stepper.tip_A, stepper.tip_B = sysm.tip_A, sysm.tip_B
         secant = before if before is not None and abs(target - previous.delta) <= abs(previous.delta - before.delta) \
             else None
@@ -491,7 +492,8 @@ def split_state_from(guess: Solution, control: str, value: float, *, tol=1e-6, m
     under force or lambda0 by one solve from it (diagnosed, valid or not)."""
     if guess.topology not in names("split"):
         raise ValueError(f"guess must be a {' or '.join(names('split'))} state; got {guess.topology!r}")
-    sysm = ChainBVP(guess.scene, guess.system.chain, control, value, model=guess.system.model, par=guess.system.par)
+    sysm = ChainBVP(guess.scene, guess.system.chain, control, value, model=guess.system.model, par=guess.system.par,
+                    enclosed_volume=guess.system.enclosed_volume)
     attach_tip_table(sysm)
     if control == "delta":
         return _continue_in_delta(sysm, guess, None, value, tol=tol, max_nodes=max_nodes, bc_tol=bc_tol)

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import functools
 import math
+import warnings
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -414,17 +415,15 @@ class Scene:
         return np.array([v[name] for name in model.PARAMS], dtype=float)
 
     def enclosed_volume(self) -> float:
-        """V0 of a sealed scene: the volume between the shell and its rim's plane in the
-        inflated state at ``pressure`` (the reference volume at pressure 0)."""
-        if not self.pressure:
-            return self.reference_volume()
-        from .inflation import inflate
+        """Deprecated: use ``sb.enclosed_volume(scene)`` (:func:`shellbvp.inflation.enclosed_volume`).
 
-        state = inflate(self.replace(sealed=False))
-        if not state.success:
-            raise ValueError(f"the inflated state at pressure {self.pressure:g} was not found "
-                             f"({state.message}): no enclosed volume for the sealed shell")
-        return self.reference_volume() + state.volume_change
+        V0 of a sealed scene, which solves the inflated state: a scene itself solves nothing,
+        so this method goes in the next version."""
+        warnings.warn("Scene.enclosed_volume() is deprecated: use shellbvp.enclosed_volume(scene)",
+                      DeprecationWarning, stacklevel=2)
+        from .inflation import enclosed_volume  # the scene's floor is below inflation's
+
+        return enclosed_volume(self)
 
     def reference_volume(self) -> float:
         """V of the undeformed shell, ``-pi Int R^2 Z' dS``: the volume between it and its rim's

@@ -15,10 +15,12 @@ import time
 import numpy as np
 
 from .chain import FREE_STATES, ChainBVP
-from .configurations import ASKED, CAP_REPLACEMENTS, asked, configuration, is_point_load, is_single_cap, of, resolve
+from .configurations import ASKED, asked, configuration, is_point_load, is_single_cap, of
 from .corner import edge_model, edge_null_jump, is_corner, limit_estimate, near_limit, other_edge_root
+from .cylinder import cap_onto_wall, wall_again
 from .diagnosis import as_failure, diagnose
 from .inflation import start_shape
+from .liftoff import POINT_LIMIT_SC, cap_lifted_off, lifted_again, split_again
 from .bounds import check_delta, check_tol, delta_bounds
 from .march import Steps, march
 from .pointload import SC_POINT, solve_point_load
@@ -33,9 +35,19 @@ from .solution import (
 )
 
 __all__ = ["solve", "solve_from", "make_system", "system_like", "cross_convexity_limit", "warm_guess", "delta_bounds", "check_delta", "check_tol",
-           "TOPOLOGIES"]
+           "TOPOLOGIES", "AGAIN", "CAP_REPLACEMENTS"]
 
 log = logging.getLogger(__name__)
+
+#: How ``solve(guess=...)`` solves a state of each family again from itself:
+#: ``again(guess, control, value, *, topology, tol, max_nodes, eps, bc_tol, estimate_error)``
+#: returns the finished state, or None to fall back to the single cap.  The cap and the point
+#: load have none: the cap's own warm start serves them.
+AGAIN = {"lifted": lifted_again, "split": split_again, "wall": wall_again}
+#: How a single cap is replaced where a state of another family is suspected, in the order tried:
+#: ``replace(cap, topology, kw)`` returns the replacement or the cap (with what was tried in its flags)
+CAP_REPLACEMENTS = (("wall", cap_onto_wall), ("lifted", cap_lifted_off))
+
 
 def _undeformed_guess(sysm: ChainBVP, ln_Sc, lambda0, delta, n=41):
     """Crude start: the shell before indentation (the reference shell, or the inflated one
@@ -289,10 +301,10 @@ def solve(scene, *, delta=None, lambda0=None, force=None, tol=1e-6, max_nodes=10
         check_delta("delta", value, scene, tol)
     if topology != "auto":
         configuration(topology).check_contact(scene)
-    again = of(guess).again if guess is not None and of(guess) is not None else None
+    again = AGAIN.get(of(guess).family) if guess is not None and of(guess) is not None else None
     if again is not None:  # a lifted, split or wall state: its configuration solved again from it
-        res = resolve(again)(guess, control, value, topology=topology, tol=tol, max_nodes=max_nodes, eps=eps,
-                             bc_tol=bc_tol, estimate_error=estimate_error)
+        res = again(guess, control, value, topology=topology, tol=tol, max_nodes=max_nodes, eps=eps,
+                    bc_tol=bc_tol, estimate_error=estimate_error)
         if res is not None:
             return res
         guess = None  # back to the cap
@@ -317,7 +329,7 @@ def solve(scene, *, delta=None, lambda0=None, force=None, tol=1e-6, max_nodes=10
         res = _cold_other(scene, make_system(scene, control, value, eps), control, value, eps, **kw)
     for family, replace in CAP_REPLACEMENTS:
         if is_single_cap(res) and (topology == "auto" or configuration(topology).family == family):
-            res = resolve(replace)(res, topology, kw)
+            res = replace(res, topology, kw)
     if res.success and estimate_error:
         richardson_error(res.system, res, tol, bc_tol)
     else:
@@ -394,8 +406,6 @@ def _point_route(sysm, delta, near_point=None, **kw):
     point state at ``_SC_FROM_POINT`` finds it, and it is returned instead (the caller
     replaces an invalid cap by its lift-off state as for any cap).
     """
-    from .liftoff import POINT_LIMIT_SC
-
     scene = sysm.scene
     pkw = dict(tol=kw["tol"], max_nodes=kw["max_nodes"], bc_tol=kw["bc_tol"])
     point = solve_point_load(scene, delta, guess=near_point, **pkw)

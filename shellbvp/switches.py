@@ -10,7 +10,7 @@ import math
 
 import numpy as np
 
-from .configurations import configuration, is_single_cap, names, resolve, switch_between
+from .configurations import configuration, is_single_cap, names, switch_between
 from .corner import edge_model, is_corner, limit_estimate
 from .cylinder import wall_state
 from .liftoff import liftoff_state, pole_clearance, solve_liftoff
@@ -18,7 +18,7 @@ from .state import cross_convexity_limit, solve_from, system_like, warm_guess
 from .steps import solve_at_delta, step_nodes
 
 __all__ = ["locate_switches", "locate_corner_switch", "regula_falsi", "cap_of", "line_state_at", "cap_state_at",
-           "cap_solved_at", "wall_state_at", "wall_solved_at", "lifted_solved_at"]
+           "cap_solved_at", "wall_state_at", "wall_solved_at", "lifted_solved_at", "MEASURED"]
 
 log = logging.getLogger(__name__)
 
@@ -106,10 +106,10 @@ def locate_switches(builder, st):
         return (sol, sol.tip_end_margin) if sol.status in (0, 4) else (None, None)
 
     def state_of(on, s):  # the measured configuration's state at a recorded point's depth
-        return resolve(configuration(on).measured[0])(s, on, st)
+        return MEASURED[configuration(on).family][0](s, on, st)
 
     def solve_on(on):  # ... and solved at another depth from a neighbour
-        solve = resolve(configuration(on).measured[1])
+        solve = MEASURED[configuration(on).family][1]
         return lambda d, near: solve(scene, on, d, near, st)
 
     for (k1, _, _, s1), (k2, _, _, s2) in zip(rows[:-1], rows[1:]):
@@ -227,7 +227,7 @@ def locate_corner_switch(smooth, corner, st, h=0.003):
             "jump_ls_after": float(corner.edge_jump_ls)}
 
 
-# -- how a switch criterion is measured on a configuration (``Configuration.measured``) ---------
+# -- how a switch criterion is measured on a configuration of each family (``MEASURED``) ---------
 def cap_state_at(sol, topology, st):
     """The single cap at a recorded point's depth (itself, or the cap it replaced)."""
     return cap_of(sol)
@@ -279,7 +279,8 @@ def line_state_at(sol, topology, st):
     """The line state (``topology``) at a lift-off point's delta (the one its search converged,
     else from its cap), or None."""
     line = sol.line_state
-    if line is not None and line.success and not math.isnan(line.curvature_excess) and line.delta == sol.delta:
+    if line is not None and line.topology == topology and line.success and not math.isnan(line.curvature_excess) \
+            and line.delta == sol.delta:
         return line
     cap = cap_of(sol)
     if cap is None:
@@ -302,3 +303,11 @@ def _add_switch(builder, st, switches, best, frm, to, k1, k2, criterion):
     already = any(abs(r[3].delta - best.delta) <= 1e-12 * (1 + best.delta) for r in builder.rows)
     if st["mode"] == "adaptive" and not already:  # a curve at requested depths keeps exactly those
         builder.add(best, 0.5 * (k1 + k2))
+
+
+#: How a switch criterion is measured on a configuration of each family (``Switch.measured_on``):
+#: ``state_at(recorded, name, settings)``, its state at a recorded point's depth (None if there is
+#: none), and ``solved_at(scene, name, delta, near, settings)``, its state at another depth from a
+#: neighbour.  Every switch is measured on a configuration of one of these families (a test checks it).
+MEASURED = {"cap": (cap_state_at, cap_solved_at), "lifted": (line_state_at, lifted_solved_at),
+            "wall": (wall_state_at, wall_solved_at)}

@@ -269,5 +269,7 @@ def test_the_structure_census_holds_what_the_redesign_reached():
     assert receivers <= {"sc", "s", "settings", "p"}, receivers
     # configuration names are compared in the registry only, and the census knows every name
     assert set(census["name_comparisons"]) <= {"configurations.registry"}, census["name_comparisons"]
+    # no function of the package named in a "module:function" string (issue 57: 16 at 011499a)
+    assert census["string_hooks"] == {}, census["string_hooks"]
     from shellbvp.configurations import CONFIGURATION_NAMES
     assert _load("architecture").configuration_names(BENCH.parent) == set(CONFIGURATION_NAMES)

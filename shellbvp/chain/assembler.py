@@ -43,11 +43,16 @@ class ChainBVP(BoundaryConditions):
         under pressure they carry the inflated state's pole rise
         (``shellbvp.inflation.system_parameters``), which a configuration's system passes.
     volume_control : bool, optional
-        The pressure as an unknown with the enclosed volume held at ``scene.enclosed_volume()``
+        The pressure as an unknown with the enclosed volume held at ``enclosed_volume``
         (default: ``scene.sealed``).
+    enclosed_volume : float, optional
+        V0, the volume a sealed shell holds; needed under volume control
+        (``shellbvp.inflation.enclosed_volume``, which a configuration's system passes): the
+        system solves nothing to find it.
     """
 
-    def __init__(self, scene, chain: Chain, control: str, value, model=None, par=None, volume_control=None):
+    def __init__(self, scene, chain: Chain, control: str, value, model=None, par=None, volume_control=None,
+                 enclosed_volume=None):
         if control not in CONTROLS:
             raise ValueError(f"control must be one of {CONTROLS}; got {control!r}")
         self.scene, self.chain, self.control = scene, chain, control
@@ -63,6 +68,7 @@ class ChainBVP(BoundaryConditions):
         self.offsets = np.cumsum([0, *self.sizes])[:-1].tolist()
         self.n_shell = int(sum(self.sizes))  # the regions' states; then the volume state
         self.volume_control = bool(scene.sealed if volume_control is None else volume_control)
+        self.enclosed_volume = None
         self.n = self.n_shell + self.volume_control
         kinds = {type(j) for j in chain.junctions}
         self.has_contact_pole = ContactPole in kinds
@@ -80,8 +86,11 @@ class ChainBVP(BoundaryConditions):
         if self.volume_control:
             if "pressure" not in mod.PARAMS:
                 raise ValueError("volume control needs a pressurised structure (Scene.sealed)")
+            if enclosed_volume is None:
+                raise ValueError("enclosed_volume is needed under volume control: V0 of the sealed shell "
+                                 "(shellbvp.inflation.enclosed_volume; a configuration's system passes it)")
             names.append("pressure")
-            self.enclosed_volume = scene.enclosed_volume()
+            self.enclosed_volume = float(enclosed_volume)
         self.unknowns = tuple(names)
         self.k = len(names)
         self.col = {name: i for i, name in enumerate(names)}

@@ -25,26 +25,27 @@ can stand between two others.
 Adding a configuration is one new module here and its tests: copy the module of a
 configuration of its family (``line.py`` for a lifted pole, ``cap_line_cylinder.py`` for the
 cylinder), give it a new name, ``ORDER`` and chain, set its traits (``askable``,
-``inner_edge``, ``line_contact``, ``pole_branch_end``, ``again``, ``measured``) and declare
-its switches.  The lifted-pole search (``shellbvp.liftoff``) tries every askable
-configuration of its family through :func:`names` and tells them apart by their traits, so
-a lifted configuration needs no other change (``tests/test_configurations.py`` adds a copy
-of ``line.py`` in a test and solves it).  A wall configuration also needs its guesses from
-its neighbours (``shellbvp.cylinder``, a table keyed by pairs of names), and a split one a
-search (``shellbvp.liftoff.second_zone_state`` looks for ``cap+line(tip)`` only).
+``inner_edge``, ``line_contact``, ``pole_branch_end``) and declare its switches; its family's
+searches (``shellbvp.state.AGAIN``, ``shellbvp.switches.MEASURED``) serve it.  The lifted-pole
+search (``shellbvp.liftoff``) tries every askable configuration of its family through
+:func:`names` and tells them apart by their traits, so a lifted configuration needs no other
+change (``tests/test_configurations.py`` adds a copy of ``line.py`` in a test and solves it).
+A wall configuration also needs its guesses from its neighbours (``shellbvp.cylinder``, a
+table keyed by pairs of names), and a split one a search
+(``shellbvp.liftoff.second_zone_state`` looks for ``cap+line(tip)`` only).
 """
 
 from __future__ import annotations
 
 import sys
 
-from .registry import (CAP_REPLACEMENTS, CONFIGURATIONS, FAMILIES, SWITCHES, Configuration, Switch, asked,
+from .registry import (CONFIGURATIONS, FAMILIES, SWITCHES, Configuration, Switch, asked,
                        configuration, discover, family_of, install, is_point_load, is_single_cap, names, of, register,
-                       register_switch, resolve, switch_between, without_edge_model)
+                       register_switch, switch_between, without_edge_model)
 from .point import POINT_S0  # the point-load state's s0, which shellbvp.pointload reads
 
 __all__ = ["Configuration", "CONFIGURATIONS", "CONFIGURATION_NAMES", "FAMILIES", "configuration", "names",
-           "register", "family_of", "of", "is_single_cap", "is_point_load", "resolve", "CAP_REPLACEMENTS", "ASKED",
+           "register", "family_of", "of", "is_single_cap", "is_point_load", "ASKED",
            "Switch", "SWITCHES", "switch_between", "register_switch", "without_edge_model", "discover", "install",
            "asked", "POINT_S0"]
 

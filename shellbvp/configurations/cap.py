@@ -25,6 +25,5 @@ def cap_chain(eps: float, L: float, model: str = "smooth") -> Chain:
 
 
 CONFIGURATIONS = (
-    Configuration("cap", "cap", cap_chain, controls=("delta", "force", "lambda0", "arclength"), askable=True,
-                  measured=("shellbvp.switches:cap_state_at", "shellbvp.switches:cap_solved_at")),
+    Configuration("cap", "cap", cap_chain, controls=("delta", "force", "lambda0", "arclength"), askable=True),
 )

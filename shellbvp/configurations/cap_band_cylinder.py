@@ -25,7 +25,7 @@ def cap_band_cylinder_chain(eps: float, L: float, model: str = "smooth") -> Chai
 
 CONFIGURATIONS = (
     Configuration("cap+band(cylinder)", "wall", cap_band_cylinder_chain, contacts=("smooth",), askable=True,
-                  needs_tip_end=True, again="shellbvp.cylinder:wall_again"),
+                  needs_tip_end=True),
 )
 SWITCHES = (
     # the free shell reaches the cylinder (or the contact the tip's end)

@@ -23,6 +23,5 @@ def cap_band_tip_chain(eps: float, L: float) -> Chain:
 
 
 CONFIGURATIONS = (
-    Configuration("cap+band(tip)", "split", without_edge_model(cap_band_tip_chain), contacts=("smooth",),
-                  again="shellbvp.liftoff:split_again"),
+    Configuration("cap+band(tip)", "split", without_edge_model(cap_band_tip_chain), contacts=("smooth",)),
 )

@@ -23,8 +23,7 @@ def cylinder_chain(eps: float, L: float, model: str = "smooth") -> Chain:
 
 
 CONFIGURATIONS = (
-    Configuration("cap+cylinder", "wall", cylinder_chain, askable=True, needs_tip_end=True,
-                  again="shellbvp.cylinder:wall_again"),
+    Configuration("cap+cylinder", "wall", cylinder_chain, askable=True, needs_tip_end=True),
 )
 SWITCHES = (
     # the free shell reaches the cylinder (or the contact the tip's end)

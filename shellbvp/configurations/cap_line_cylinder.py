@@ -24,8 +24,7 @@ def cap_line_cylinder_chain(eps: float, L: float, model: str = "smooth") -> Chai
 
 CONFIGURATIONS = (
     Configuration("cap+line(cylinder)", "wall", cap_line_cylinder_chain, contacts=("smooth",), askable=True,
-                  needs_tip_end=True, again="shellbvp.cylinder:wall_again",
-                  measured=("shellbvp.switches:wall_state_at", "shellbvp.switches:wall_solved_at")),
+                  needs_tip_end=True),
 )
 SWITCHES = (
     # the free shell reaches the cylinder (or the contact the tip's end)

@@ -22,8 +22,7 @@ def cap_line_tip_chain(eps: float, L: float) -> Chain:
 
 
 CONFIGURATIONS = (
-    Configuration("cap+line(tip)", "split", without_edge_model(cap_line_tip_chain), contacts=("smooth",),
-                  again="shellbvp.liftoff:split_again"),
+    Configuration("cap+line(tip)", "split", without_edge_model(cap_line_tip_chain), contacts=("smooth",)),
 )
 SWITCHES = (
     # the cap's contact pressure at its edge: where the shell lifts off between two zones

@@ -23,8 +23,7 @@ def line_chain(eps: float, L: float) -> Chain:
 
 CONFIGURATIONS = (
     Configuration("line", "lifted", without_edge_model(line_chain), contacts=("smooth",), askable=True,
-                  again="shellbvp.liftoff:lifted_again", line_contact=True, pole_branch_end=True,
-                  measured=("shellbvp.switches:line_state_at", "shellbvp.switches:lifted_solved_at")),
+                  line_contact=True, pole_branch_end=True),
 )
 SWITCHES = (
     # the cap's contact pressure at its edge: where the pole lifts off

@@ -23,6 +23,5 @@ def line_kink_chain(eps: float, L: float) -> Chain:
 
 
 CONFIGURATIONS = (
-    Configuration("line+corner", "lifted", without_edge_model(line_kink_chain), contacts=("smooth",),
-                  again="shellbvp.liftoff:lifted_again"),
+    Configuration("line+corner", "lifted", without_edge_model(line_kink_chain), contacts=("smooth",)),
 )

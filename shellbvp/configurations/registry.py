@@ -16,6 +16,13 @@ Families:
     a cap and, beyond a lifted gap, a second zone on the tip;
 ``wall``
     contact on the indenter's cylinder beyond the tip's end.
+
+A family's searches are functions of the modules above this registry that know it
+(:mod:`shellbvp.liftoff`, :mod:`shellbvp.cylinder`), held by the modules that call them, by
+family: how ``solve(guess=...)`` solves a state again (``shellbvp.state.AGAIN``), how a single
+cap is replaced by a state of another family (``shellbvp.state.CAP_REPLACEMENTS``) and how a
+switch criterion is measured on a configuration (``shellbvp.switches.MEASURED``).  The
+registry names no module above it.
 """
 
 from __future__ import annotations
@@ -26,11 +33,11 @@ from dataclasses import dataclass
 from typing import Callable
 
 from .. import chain as ch
-from ..inflation import system_parameters
+from ..inflation import enclosed_volume, system_parameters
 from ..solution import attach_tip_table
 
 __all__ = ["Configuration", "CONFIGURATIONS", "FAMILIES", "configuration", "names", "register", "family_of", "of",
-           "is_single_cap", "is_point_load", "resolve", "CAP_REPLACEMENTS", "Switch", "SWITCHES", "switch_between",
+           "is_single_cap", "is_point_load", "Switch", "SWITCHES", "switch_between",
            "register_switch", "without_edge_model", "discover", "install", "asked"]
 
 FAMILIES = ("cap", "point", "lifted", "split", "wall")
@@ -58,22 +65,12 @@ class Configuration:
         :mod:`shellbvp.liftoff` searches).
     needs_tip_end : bool
         Whether it needs a tip that ends on a cylinder (``model.OMEGA_MAX``).
-    again : str or None
-        ``"module:function"`` that solves this configuration again from one of its states
-        (``solve(guess=...)``): ``again(guess, control, value, *, topology, tol, max_nodes,
-        eps, bc_tol, estimate_error)`` returns the finished state, or None to fall back to
-        the single cap.  None: the cap's own warm start serves.
     inner_edge : bool
         Its contact zone has an inner edge ``S1`` besides ``Sc`` (the annulus): guessed with
         the edge near the cap's middle, refused once the edge runs to the pole.
     line_contact : bool
         Its outer contact on the tip is one circle carrying a ring force (zero width), whose
         ``curvature_excess`` says when it opens into a band.
-    measured : (str, str) or None
-        Where a switch criterion is measured on this configuration (``SWITCHES``), how to get
-        its state: ``"module:function"`` of ``state_at(recorded, name, settings)``, its state
-        at a recorded point's depth (None if there is none), and of ``solved_at(scene, name,
-        delta, near, settings)``, its state at another depth from a neighbour.
     pole_branch_end : bool
         A smooth lifted pole whose branch may end where its Legendre determinant vanishes
         (:mod:`shellbvp.lifted_ends`).
@@ -86,11 +83,9 @@ class Configuration:
     controls: tuple = ("delta", "force", "lambda0")
     askable: bool = False
     needs_tip_end: bool = False
-    again: str | None = None
     inner_edge: bool = False
     line_contact: bool = False
     pole_branch_end: bool = False
-    measured: tuple | None = None
 
     @property
     def single_cap(self) -> bool:
@@ -119,11 +114,13 @@ class Configuration:
 
     def system(self, scene, control, value, eps, edge=None):
         """The ChainBVP of this configuration for ``scene`` with ``control`` = ``value``, its
-        tip tabulated for the admissibility checks."""
+        tip tabulated for the admissibility checks; a sealed scene's system holds the volume of
+        its inflated state (solved here, once per scene, not by the system)."""
         self.check(scene, control)
         model = scene.model()
         sysm = ch.ChainBVP(scene, self.chain(eps, scene.shell_length, edge or scene.contact), control, value,
-                           model=model, par=system_parameters(scene, model))
+                           model=model, par=system_parameters(scene, model),
+                           enclosed_volume=enclosed_volume(scene) if scene.sealed else None)
         attach_tip_table(sysm)
         return sysm
 
@@ -183,18 +180,6 @@ def is_single_cap(state) -> bool:
 def is_point_load(state) -> bool:
     conf = of(state)
     return conf is not None and conf.point_load
-
-
-def resolve(path: str) -> Callable:
-    """The function a ``"module:function"`` path names (imported when first asked for: a
-    configuration's numerics live in its family's module, which imports this registry)."""
-    module, _, name = path.partition(":")
-    return getattr(importlib.import_module(module), name)
-
-
-#: How a single cap is replaced where a state of another family is suspected, in the order tried:
-#: ``replace(cap, topology, kw)`` returns the replacement or the cap (with what was tried in its flags)
-CAP_REPLACEMENTS = (("wall", "shellbvp.cylinder:cap_onto_wall"), ("lifted", "shellbvp.liftoff:cap_lifted_off"))
 
 
 @dataclass(frozen=True)

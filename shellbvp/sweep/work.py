@@ -35,13 +35,13 @@ def run_curve(index: int, scene, delta_max: float, settings: dict) -> dict:
     return {"index": index, "status": "complete" if c.complete else "stopped", "message": "",
             "stop_reason": c.stop_reason, "complete": c.complete, "interrupted": c.interrupted,
             "points": {k: np.asarray(v) for k, v in c.points.items()}, "flags": list(c.flags),
-            "settings": c.settings, "version": c.version, "wall_time": time.perf_counter() - t0}
+            "settings": c.settings, "version": c.version, "inflated": c.inflated, "wall_time": time.perf_counter() - t0}
 
 
 def curve_of(record, scene) -> Curve:
     return Curve(scene=scene, points=record["points"], flags=record["flags"], stop_reason=record["stop_reason"],
                  complete=record["complete"], interrupted=record["interrupted"], settings=record["settings"],
-                 version=record.get("version", ""))
+                 version=record.get("version", ""), inflated=record.get("inflated"))
 
 
 def _executor_gone(executor) -> bool:
