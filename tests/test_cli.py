@@ -145,6 +145,21 @@ def test_version(capsys):
     assert exc.value.code == 0 and capsys.readouterr().out.strip() == f"shellbvp {sb.__version__}"
 
 
+@pytest.mark.parametrize("argv, words", [
+    (["fit", "--frobnicate"], "unrecognized arguments: --frobnicate"),  # not "--radius is required"
+    (["fit", "--example", "--frobnicate", "--json"], "unrecognized arguments: --frobnicate"),
+    (["sweep", "--frobnicate"], "unrecognized arguments: --frobnicate"),
+    (["fit", "--example"], "the following arguments are required: --radius/--rim-radius"),
+    (["plot"], "the following arguments are required: files")])
+def test_an_unknown_option_is_reported_before_a_missing_one(argv, words, capsys):
+    from shellbvp.cli import main
+
+    with pytest.raises(SystemExit) as exc:
+        main(argv)
+    err = capsys.readouterr().err
+    assert exc.value.code == 2 and err == f"shellbvp: error: {words}\n"
+
+
 def test_fit_names_its_sample_in_lab_units(capsys):
     """No silent default scene: fit needs a preset or the geometry; lengths in lab units give the
     same scene as the ratios, and the summary names it in those units."""

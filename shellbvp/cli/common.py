@@ -23,6 +23,27 @@ class Parser(argparse.ArgumentParser):
         # `--gamma -1e-3` (argparse's own pattern takes only -5 and -0.5; no option here starts -<digit>)
         self._negative_number_matcher = re.compile(r"^-\.?\d")
 
+    def parse_known_args(self, args=None, namespace=None):
+        # argparse checks a subcommand's required options before its caller reports the unknown
+        # ones, so `fit --frobnicate` said only "--radius is required": unknown options first
+        required = [a for a in self._actions if a.required]
+        if not required:
+            return super().parse_known_args(args, namespace)
+        for action in required:
+            action.required = False
+        try:
+            namespace, extras = super().parse_known_args(args, namespace)
+        finally:
+            for action in required:
+                action.required = True
+        if extras:
+            self.error(f"unrecognized arguments: {' '.join(extras)}")
+        missing = [a for a in required if getattr(namespace, a.dest, None) is None]
+        if missing:
+            names = ", ".join("/".join(a.option_strings) or a.metavar or a.dest for a in missing)
+            self.error(f"the following arguments are required: {names}")
+        return namespace, extras
+
     def error(self, message):  # one line, exit 2 (argparse's own convention)
         if Parser.json_errors:
             print_json_error(message)
