@@ -271,3 +271,19 @@ def test_sweep_takes_its_depth_and_force_in_lab_units_as_curve_does(tmp_path):
     for curve in grid.curves.values():
         assert curve.force[-1] >= 5e-3 / (52 * 0.3e-3) > curve.force[-2]
         assert "force_max" in curve.stop_reason
+
+
+def test_data_in_bare_si_is_printed_in_units_that_suit_its_size(tmp_path):
+    # AFM files come in m and N: a fit of a 2 um, 3 nN curve prints um and nN (files keep SI)
+    from shellbvp.cli.fit import _shown_units
+    from shellbvp.units import readable_unit
+
+    assert [readable_unit(v, "length") for v in (0.3, 2e-3, 2e-6, 1.5e-7, 1e-12, 0.0)] == ["mm", "mm", "um", "nm",
+                                                                                        "nm", "m"]
+    assert [readable_unit(v, "force") for v in (2.0, 3e-9, -4e-11)] == ["N", "nN", "pN"]
+    si, mm = tmp_path / "si.csv", tmp_path / "mm.csv"
+    si.write_text("displacement (m),force (N)\n" + "".join(f"{i * 2e-7:.3e},{i * i * 3e-11:.3e}\n"
+                                                            for i in range(11)))
+    mm.write_text("displacement (mm),force (N)\n0,0\n0.001,1e-9\n0.002,3e-9\n0.003,6e-9\n")
+    assert _shown_units(sb.read_instrument(si)) == ("um", "nN")
+    assert _shown_units(sb.read_instrument(mm)) == ("mm", "nN")  # the data's own unit where it has one
