@@ -287,3 +287,31 @@ def test_data_in_bare_si_is_printed_in_units_that_suit_its_size(tmp_path):
     mm.write_text("displacement (mm),force (N)\n0,0\n0.001,1e-9\n0.002,3e-9\n0.003,6e-9\n")
     assert _shown_units(sb.read_instrument(si)) == ("um", "nN")
     assert _shown_units(sb.read_instrument(mm)) == ("mm", "nN")  # the data's own unit where it has one
+
+
+def test_code_generation_is_announced_on_a_terminal_only(capsys, monkeypatch):
+    # the first run of a structure waits 5-25 s for its code: a terminal is told why
+    import argparse
+    import io
+    import logging
+
+    from shellbvp.cli.common import show_code_generation
+
+    class Terminal(io.StringIO):
+        def isatty(self):
+            return True
+
+    log = logging.getLogger("shellbvp.model")
+    monkeypatch.setattr(log, "handlers", [])
+    monkeypatch.setattr(log, "propagate", log.propagate)
+    level = log.level
+    try:
+        for quiet, stream in ((True, Terminal()), (False, io.StringIO())):  # -q, or stderr a file: nothing
+            show_code_generation(argparse.Namespace(verbose=False, quiet=quiet), stream)
+            assert log.handlers == []
+        show_code_generation(argparse.Namespace(verbose=False, quiet=False), Terminal())
+        log.info("deriving %s", "x")
+        log.debug("not shown")
+        assert capsys.readouterr().err == "shellbvp: deriving x\n"
+    finally:
+        log.setLevel(level)  # setLevel, not the attribute: it clears logging's cache
