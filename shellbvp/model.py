@@ -240,6 +240,8 @@ def _cached_or_generated(path: Path, key: str, generate, regenerate=False, write
         except Exception as exc:  # corrupt or foreign file: derive again
             log.warning("ignoring unusable cached module %s (%s); regenerating", path, exc)
     t0 = time.perf_counter()
+    log.info("deriving the equations of a new structure and generating their code, once (%s in %s) ...",
+             path.name, path.parent)
     src, extra = generate()
     log.info("derived and generated %s in %.2f s", path.name, time.perf_counter() - t0)
     try:

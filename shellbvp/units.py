@@ -17,7 +17,8 @@ from dataclasses import dataclass
 
 __all__ = ["Dimensions", "parse_quantity", "unit_factor", "unit_kind", "normalize_unit", "format_in",
            "beta_from_thickness", "plain_number", "PLAIN_NUMBER", "LENGTH_UNITS", "FORCE_UNITS", "TIME_UNITS",
-           "MU_H_UNITS", "PRESSURE_UNITS", "UNIT_TABLES", "SI_UNITS", "split_quantity", "Quantity", "force_unit_of"]
+           "MU_H_UNITS", "PRESSURE_UNITS", "UNIT_TABLES", "SI_UNITS", "split_quantity", "Quantity", "force_unit_of",
+           "readable_unit"]
 
 #: A number as a person or a CSV writes it: ASCII digits, optional sign, decimal point and
 #: exponent.  Python's float() also takes "5_0", "inf", "nan", "1e999" and non-ASCII digits.
@@ -123,6 +124,21 @@ def unit_factor(unit: str, kind: str) -> float:
 def format_in(value: float, unit: str, kind: str, digits: int = 4) -> str:
     """``value`` (SI) written in ``unit``, e.g. ``format_in(1e-5, "um", "length") == "10 um"``."""
     return f"{value / unit_factor(unit, kind):.{digits}g} {normalize_unit(unit)}"
+
+
+#: the units a value is shown in when its data came in bare SI (AFM files: m and N), largest first
+READABLE_UNITS = {"length": ("m", "mm", "um", "nm"), "force": ("N", "mN", "uN", "nN", "pN")}
+
+
+def readable_unit(scale: float, kind: str) -> str:
+    """The largest unit of ``READABLE_UNITS[kind]`` in which ``scale`` (SI) is at least 1, e.g.
+    ``readable_unit(2e-7, "length") == "nm"``, ``readable_unit(3e-9, "force") == "nN"``; the
+    smallest for a smaller scale, the SI unit for a scale that is 0 or not finite."""
+    units = READABLE_UNITS[kind]
+    scale = abs(float(scale))
+    if not math.isfinite(scale) or scale == 0:
+        return units[0]
+    return next((u for u in units if scale >= UNIT_TABLES[kind][u]), units[-1])
 
 
 def plain_number(text: str, name: str = "value") -> float:

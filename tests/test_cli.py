@@ -145,6 +145,21 @@ def test_version(capsys):
     assert exc.value.code == 0 and capsys.readouterr().out.strip() == f"shellbvp {sb.__version__}"
 
 
+@pytest.mark.parametrize("argv, words", [
+    (["fit", "--frobnicate"], "unrecognized arguments: --frobnicate"),  # not "--radius is required"
+    (["fit", "--example", "--frobnicate", "--json"], "unrecognized arguments: --frobnicate"),
+    (["sweep", "--frobnicate"], "unrecognized arguments: --frobnicate"),
+    (["fit", "--example"], "the following arguments are required: --radius/--rim-radius"),
+    (["plot"], "the following arguments are required: files")])
+def test_an_unknown_option_is_reported_before_a_missing_one(argv, words, capsys):
+    from shellbvp.cli import main
+
+    with pytest.raises(SystemExit) as exc:
+        main(argv)
+    err = capsys.readouterr().err
+    assert exc.value.code == 2 and err == f"shellbvp: error: {words}\n"
+
+
 def test_fit_names_its_sample_in_lab_units(capsys):
     """No silent default scene: fit needs a preset or the geometry; lengths in lab units give the
     same scene as the ratios, and the summary names it in those units."""
@@ -256,3 +271,47 @@ def test_sweep_takes_its_depth_and_force_in_lab_units_as_curve_does(tmp_path):
     for curve in grid.curves.values():
         assert curve.force[-1] >= 5e-3 / (52 * 0.3e-3) > curve.force[-2]
         assert "force_max" in curve.stop_reason
+
+
+def test_data_in_bare_si_is_printed_in_units_that_suit_its_size(tmp_path):
+    # AFM files come in m and N: a fit of a 2 um, 3 nN curve prints um and nN (files keep SI)
+    from shellbvp.cli.fit import _shown_units
+    from shellbvp.units import readable_unit
+
+    assert [readable_unit(v, "length") for v in (0.3, 2e-3, 2e-6, 1.5e-7, 1e-12, 0.0)] == ["mm", "mm", "um", "nm",
+                                                                                        "nm", "m"]
+    assert [readable_unit(v, "force") for v in (2.0, 3e-9, -4e-11)] == ["N", "nN", "pN"]
+    si, mm = tmp_path / "si.csv", tmp_path / "mm.csv"
+    si.write_text("displacement (m),force (N)\n" + "".join(f"{i * 2e-7:.3e},{i * i * 3e-11:.3e}\n"
+                                                            for i in range(11)))
+    mm.write_text("displacement (mm),force (N)\n0,0\n0.001,1e-9\n0.002,3e-9\n0.003,6e-9\n")
+    assert _shown_units(sb.read_instrument(si)) == ("um", "nN")
+    assert _shown_units(sb.read_instrument(mm)) == ("mm", "nN")  # the data's own unit where it has one
+
+
+def test_code_generation_is_announced_on_a_terminal_only(capsys, monkeypatch):
+    # the first run of a structure waits 5-25 s for its code: a terminal is told why
+    import argparse
+    import io
+    import logging
+
+    from shellbvp.cli.common import show_code_generation
+
+    class Terminal(io.StringIO):
+        def isatty(self):
+            return True
+
+    log = logging.getLogger("shellbvp.model")
+    monkeypatch.setattr(log, "handlers", [])
+    monkeypatch.setattr(log, "propagate", log.propagate)
+    level = log.level
+    try:
+        for quiet, stream in ((True, Terminal()), (False, io.StringIO())):  # -q, or stderr a file: nothing
+            show_code_generation(argparse.Namespace(verbose=False, quiet=quiet), stream)
+            assert log.handlers == []
+        show_code_generation(argparse.Namespace(verbose=False, quiet=False), Terminal())
+        log.info("deriving %s", "x")
+        log.debug("not shown")
+        assert capsys.readouterr().err == "shellbvp: deriving x\n"
+    finally:
+        log.setLevel(level)  # setLevel, not the attribute: it clears logging's cache

@@ -24,7 +24,7 @@ import sys
 
 from . import compile, convexity, curve, fit, info, plot, presets, report, solve, sweep, validate
 from ..config import options
-from .common import Parser, limits_of, print_json_error, scene_from_args
+from .common import Parser, limits_of, print_json_error, scene_from_args, show_code_generation
 
 __all__ = ["main", "build_parser", "scene_from_args"]
 
@@ -64,6 +64,7 @@ def _main(argv=None):
         args = parser.parse_args(["curve", *argv])
     logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING,
                         format="%(levelname)s %(name)s: %(message)s")
+    show_code_generation(args)
     try:
         with options(**limits_of(args)):  # --max-fe-dofs, --max-stability-dofs
             return args.func(args)

@@ -4,13 +4,15 @@ from __future__ import annotations
 
 import argparse
 import json
+import logging
 import math
 import os
 import re
+import sys
 from pathlib import Path
 
 
-__all__ = ["Parser", "print_json_error", "plain_number", "plain_numbers", "quantity", "uncertain_value", "pressure_value", "say", "number_or", "thickness_value", "nondimensional", "add_radius_option", "add_mu_h_option", "material_spec", "material_help", "bending_families", "add_scene_options", "scene_from_args", "over_rim_radius", "require_sample", "nondimensional_thickness", "nondimensional_pressure", "checkpoint_seconds", "progress_bar", "curve_bars", "MAX_POINTS", "free_default_name", "strict_json", "output_dir", "check_report_path", "add_overwrite_option",
+__all__ = ["Parser", "print_json_error", "show_code_generation", "plain_number", "plain_numbers", "quantity", "uncertain_value", "pressure_value", "say", "number_or", "thickness_value", "nondimensional", "add_radius_option", "add_mu_h_option", "material_spec", "material_help", "bending_families", "add_scene_options", "scene_from_args", "over_rim_radius", "require_sample", "nondimensional_thickness", "nondimensional_pressure", "checkpoint_seconds", "progress_bar", "curve_bars", "MAX_POINTS", "free_default_name", "strict_json", "output_dir", "check_report_path", "add_overwrite_option",
            "NODE_BUDGET", "node_budget", "add_limit_options", "limits_of", "LIMIT_OPTIONS"]
 
 
@@ -23,10 +25,58 @@ class Parser(argparse.ArgumentParser):
         # `--gamma -1e-3` (argparse's own pattern takes only -5 and -0.5; no option here starts -<digit>)
         self._negative_number_matcher = re.compile(r"^-\.?\d")
 
+    def parse_known_args(self, args=None, namespace=None):
+        # argparse checks a subcommand's required options before its caller reports the unknown
+        # ones, so `fit --frobnicate` said only "--radius is required": unknown options first
+        required = [a for a in self._actions if a.required]
+        if not required:
+            return super().parse_known_args(args, namespace)
+        for action in required:
+            action.required = False
+        try:
+            namespace, extras = super().parse_known_args(args, namespace)
+        finally:
+            for action in required:
+                action.required = True
+        if extras:
+            self.error(f"unrecognized arguments: {' '.join(extras)}")
+        missing = [a for a in required if getattr(namespace, a.dest, None) is None]
+        if missing:
+            names = ", ".join("/".join(a.option_strings) or a.metavar or a.dest for a in missing)
+            self.error(f"the following arguments are required: {names}")
+        return namespace, extras
+
     def error(self, message):  # one line, exit 2 (argparse's own convention)
         if Parser.json_errors:
             print_json_error(message)
         self.exit(2, f"shellbvp: error: {message}\n")
+
+
+class _CodeGenerationNotes(logging.Handler):
+    """The model's INFO lines (code generation: 5-25 s the first time a structure is met) on a
+    terminal's stderr, above a progress bar if one is drawn."""
+
+    def emit(self, record):
+        line = (f"shellbvp: {record.getMessage()}" if record.levelno == logging.INFO else
+                f"{record.levelname} {record.name}: {record.getMessage()}")  # as the root logger's
+        tqdm = sys.modules.get("tqdm")
+        if tqdm is not None:
+            tqdm.tqdm.write(line, file=sys.stderr)
+        else:
+            print(line, file=sys.stderr, flush=True)
+
+
+def show_code_generation(args, stream=None):
+    """Say on stderr when the equations are derived and their code generated (the wait of a
+    first run), unless -v (the log says it), -q, or stderr is not a terminal (logs, tests)."""
+    stream = sys.stderr if stream is None else stream
+    if getattr(args, "verbose", False) or getattr(args, "quiet", False) or not stream.isatty():
+        return
+    log = logging.getLogger("shellbvp.model")
+    if not any(isinstance(h, _CodeGenerationNotes) for h in log.handlers):
+        log.addHandler(_CodeGenerationNotes(logging.INFO))
+    log.setLevel(logging.INFO)
+    log.propagate = False  # its warnings are written by the handler above, once
 
 
 def print_json_error(message):

@@ -459,7 +459,7 @@ def _print_fit(res, record, used, args):
     """The fit in words, in the data's own units (and mu*H in N/m)."""
     from ..units import format_in
 
-    du, fu = record.units["displacement"], record.units["force"]
+    du, fu = _shown_units(record)
     if not res.success:
         say(f"fit failed (status {res.status}): {res.message}")
     counts = ", ".join(f"{k} {v}" for k, v in record.counts().items())
@@ -526,6 +526,21 @@ def _print_fit(res, record, used, args):
         say(res.stability_verdict)
     if res.stability_note:
         say(f"stability not analysed where: {res.stability_note}")
+
+
+def _shown_units(record):
+    """The units the fit is printed in: the data's own, or for data in bare SI (AFM files, in m
+    and N) the unit that suits its size (um or nm, nN or pN); files keep SI."""
+    import numpy as np
+
+    from ..units import readable_unit
+
+    du, fu = record.units["displacement"], record.units["force"]
+    if du == "m" and np.isfinite(record.displacement).any():
+        du = readable_unit(np.nanmax(record.displacement) - np.nanmin(record.displacement), "length")
+    if fu == "N" and np.isfinite(record.force).any():
+        fu = readable_unit(np.nanmax(np.abs(record.force)), "force")
+    return du, fu
 
 
 def _solid_line(c, mesh_error):
