@@ -212,6 +212,7 @@ def solve_from(sysm, guess, *, tol=1e-6, max_nodes=10000, bc_tol=None):
 #: the package registers them; ``solve`` asks the registry, which one registered later joins)
 TOPOLOGIES = ASKED
 
+
 def solve(scene, *, delta=None, lambda0=None, force=None, tol=1e-6, max_nodes=10000, guess=None,
           eps=None, bc_tol=1e-10, estimate_error=True, topology="auto"):
     """Solve one indentation state.

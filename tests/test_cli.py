@@ -315,3 +315,14 @@ def test_code_generation_is_announced_on_a_terminal_only(capsys, monkeypatch):
         assert capsys.readouterr().err == "shellbvp: deriving x\n"
     finally:
         log.setLevel(level)  # setLevel, not the attribute: it clears logging's cache
+
+
+def test_solve_offers_every_configuration_the_registry_lets_be_asked_for(capsys):
+    """`solve --topology` takes its choices from the registry (issue 57), not from a list of its own."""
+    from shellbvp.cli import main
+    from shellbvp.configurations import asked
+
+    with pytest.raises(SystemExit):
+        main(["solve", "--topology", "no-such-configuration"])
+    err = capsys.readouterr().err
+    assert all(name in err for name in asked()) and len(asked()) > 4
