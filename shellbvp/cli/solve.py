@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import json
 
-from ..configurations import asked
 from .common import (
     add_scene_options, nondimensional, number_or, plain_number, quantity, scene_from_args, strict_json,
 )
@@ -27,9 +26,9 @@ def add_parser(sub):
     s.add_argument("--muH", type=quantity("mu_H"), dest="mu_h", help="mu*H with its unit, e.g. 52N/m")
     s.add_argument("--profiles", action="store_true", help="print the fields over S")
     s.add_argument("--json", action="store_true", help="print JSON")
-    s.add_argument("--topology", choices=asked(), default="auto",
-                   help="configuration of the contact, one of the registry's that may be asked for (default auto: "
-                        "the cap, or a valid lifted-off state where the cap would pull the shell)")
+    s.add_argument("--topology", default="auto",
+                   help="configuration of the contact, one the registry lets be asked for (an unknown one lists "
+                        "them; default auto: the cap, or a valid lifted-off state where the cap would pull the shell)")
     s.set_defaults(func=run)
 
 
