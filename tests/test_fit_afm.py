@@ -103,7 +103,9 @@ def test_a_shallow_afm_curve_fits_from_the_point_load_limit():
 
     pytest.importorskip("afmformats")
     (curve,) = read_afm(DATA / "spot3-0192.jpk-force")
-    res, used = fit_record(sb.Scene.preset("base", **AFM_SCENE), curve.record, R_L=10e-6, model="shell")
+    # its weightings disagree (tests/test_fit_range.py): the shallow fit itself is what is tested here
+    res, used = fit_record(sb.Scene.preset("base", **AFM_SCENE), curve.record, R_L=10e-6, model="shell",
+                           weights_check=False)
     assert res.success and 0.05 < res.mu_H < 0.5
     depth = curve.record.displacement[used].max() - res.offset
     assert 100e-9 < depth < 250e-9
