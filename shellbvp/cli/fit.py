@@ -6,7 +6,6 @@ import json
 import sys
 from pathlib import Path
 
-from ..fit_checks import weights_check_line
 from ..shape_parameters import SHAPE_PARAMETERS
 from ..textdata import printable
 from .common import (
@@ -522,6 +521,8 @@ def _print_fit(res, record, used, args):
         say(f"range  = forces up to {format_in(res.max_force, fu, 'force')} (--force-max; rows above left out)")
     say(f"rms residual = {format_in(res.residual_rms, fu, 'force')} over {res.n} points; R_L = "
           f"{args.radius}; {res.weights} weights")
+    from ..fit_checks import weights_check_line
+
     say(weights_check_line(res.weights, res.weights_check))
     from ..fitting import diagnostics_lines
 
