@@ -1,10 +1,10 @@
-"""Fits checked against another weighting, a fitting range in force and the apparent modulus
+"""Fits checked against another weighting (a real AFM curve whose weightings disagree: in
+tests/test_fit_afm.py, beside the same curve's other fit), a fitting range in force and the apparent modulus
 against depth, E(delta) (issue 56, item 1): a fit whose weightings' intervals of mu*H do not
 overlap is not a success (its numbers kept), --force-max leaves out the rows above a force, and
 E(delta) is flat where the model follows the data's shape."""
 
 import json
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -13,10 +13,8 @@ import shellbvp as sb
 from shellbvp.cli import main
 from shellbvp.fit_checks import FIT_STATUS, WEIGHTS_DISAGREE, other_weights, weights_disagreement
 from shellbvp.fitrecord import read_fit
-from shellbvp.fitting import example_data_path, fit_record
+from shellbvp.fitting import example_data_path
 
-DATA = Path(__file__).parent / "data" / "afm"
-AFM_SCENE = dict(gamma=0.5, rho=0.25, thickness=0.05)
 
 
 @pytest.fixture(scope="module")
@@ -50,23 +48,6 @@ def test_a_synthetic_fit_passes_its_weights_check(example):
     assert res.to_dict()["weights_check"]["agree"] is True
     unchecked = sb.fit(scene, d, F, R_L=0.3e-3, weights_check=False)
     assert unchecked.weights_check is None and unchecked.mu_H == pytest.approx(res.mu_H, rel=1e-12)
-
-
-def test_a_real_afm_curve_whose_weightings_disagree_is_not_a_success():
-    """spot3 (161 nm deep): mixed weights 0.125 N/m, uniform 0.161 N/m, intervals +-2 %:
-    the model misses the data's shape, and the fit says so; its numbers are kept."""
-    from shellbvp.afm import read_afm
-
-    pytest.importorskip("afmformats")
-    (curve,) = read_afm(DATA / "spot3-0192.jpk-force")
-    res, _ = fit_record(sb.Scene.preset("base", **AFM_SCENE), curve.record, R_L=10e-6, model="shell")
-    assert res.status == WEIGHTS_DISAGREE and not res.success and res.quality == "poor"
-    check = res.weights_check
-    assert not check["agree"] and check["weights"] == "uniform"
-    lo, hi = res.mu_H_ci95
-    assert np.isfinite([res.mu_H, lo, hi]).all() and lo < res.mu_H < hi
-    assert check["mu_H_ci95"][0] > hi                       # no overlap
-    assert f"{res.mu_H:.4g}" in res.message and f"{check['mu_H']:.4g}" in res.message
 
 
 def test_max_force_leaves_out_the_rows_above_it(example):
