@@ -10,7 +10,7 @@ import numpy as np
 from scipy import special
 
 __all__ = ["FIT_STATUS", "FIT_WARNINGS", "PLAUSIBLE_MU_H", "TREND_P", "RUNS_P", "RUNS_MIN_POINTS", "QUALITY_RULES",
-           "CONTACT_MISFIT", "POOR_WARNINGS", "rank_trend", "runs_test", "runs_in_depth_order", "contact_misfit",
+           "CONTACT_MISFIT", "POOR_WARNINGS", "WEIGHTS_DISAGREE", "other_weights", "weights_disagreement", "weights_check_line", "rank_trend", "runs_test", "runs_in_depth_order", "contact_misfit",
            "fit_diagnostics", "fit_quality", "diagnostics_lines", "check_result"]
 
 
@@ -23,7 +23,12 @@ FIT_STATUS = {
     3: "the model force is not finite at every data point",
     4: "a 95 % interval (mu*H or the offset) is not finite",
     5: "the 95 % interval of mu*H is wider than mu*H itself: the data do not determine mu*H",
+    6: "weights_disagree: refitted with another noise model, mu*H's 95 % interval does not overlap the fit's (the "
+       "model misses the data's shape where the weightings stress them differently)",
 }
+
+#: The status of a fit whose weightings disagree (:func:`weights_disagreement`).
+WEIGHTS_DISAGREE = 6
 
 
 #: Kinds of warning (``FitResult.warning_codes``; the texts are in ``FitResult.warnings``).
@@ -210,6 +215,39 @@ def diagnostics_lines(quality, fitted, correlation, values, show_force=lambda v:
         parts += [f"corr({a}, {b}) = {c[i, j]:+.2f}" for i, a in enumerate(fitted) for j, b in enumerate(fitted)
                   if i < j]
     return [f"quality = {quality} ({rules})", "diagnostics = " + ("; ".join(parts) if parts else "none")]
+
+
+def other_weights(kind):
+    """The noise model a fit with weights ``kind`` is checked against: uniform, or for a uniform
+    fit the default's (mixed)."""
+    return "mixed" if kind == "uniform" else "uniform"
+
+
+def weights_disagreement(kind, mu_H, mu_ci, other):
+    """The message's detail when the fit's mu*H (weights ``kind``, 95 % interval ``mu_ci``) and
+    ``other`` (``{"weights", "mu_H", "mu_H_ci95"}``: the same model refitted with another noise
+    model) lie further apart than the sum of their 95 % half-widths (the intervals do not
+    overlap); None when they agree or cannot be compared (a value that is not finite)."""
+    if other is None:
+        return None
+    a, b = other["mu_H_ci95"]
+    values = (mu_H, *mu_ci, other["mu_H"], a, b)
+    if not all(math.isfinite(v) for v in values) or abs(mu_H - other["mu_H"]) <= (mu_ci[1] - mu_ci[0] + b - a) / 2:
+        return None
+    return (f"{kind} weights give mu*H = {mu_H:.4g} N/m [{mu_ci[0]:.4g}, {mu_ci[1]:.4g}], {other['weights']} weights "
+            f"{other['mu_H']:.4g} N/m [{a:.4g}, {b:.4g}]; plot the fit, fit a range where the model follows "
+            "the data (--max-depth, --force-max), try --baseline linear and check the scene (indenter radius, "
+            "rise, thickness); --no-weights-check reports the fit without this check")
+
+
+def weights_check_line(kind, check):
+    """One line of a fit's summary: what its weights check found (``FitResult.weights_check``)."""
+    if check is None:
+        return f"weights = {kind}; not checked against another noise model"
+    a, b = check["mu_H_ci95"]
+    verdict = "the intervals overlap" if check["agree"] else "the intervals do not overlap: not a success"
+    return (f"weights = {kind}; checked: {check['weights']} weights give mu*H = {check['mu_H']:.4g} N/m "
+            f"[{a:.4g}, {b:.4g}] ({verdict})")
 
 
 def check_result(res_ok, mu_H, mu_ci, off_ci, resid_ok, n, runs, contact=None):

@@ -24,7 +24,8 @@ SI units, ``"1"`` nondimensional, ``""`` text)::
                                baseline_slope (N/m), R_L (m), residual_rms (N), n_points (1),
                                noise_sigma (N), aic, bic, runs_p, residual_autocorrelation, model_error
                                (1: the shell model's error beside the interval; NaN: none), max_depth
-                               (m: the fitting range's deepest depth; NaN: all data), and every
+                               (m: the fitting range's deepest depth; NaN: all data), max_force (N: the
+                               fitting range's largest force; NaN: all data), and every
                                shape parameter and derived quantity of shellbvp.shape_parameters
                                (beta (1), alpha (1, NaN for other materials), pressure (1), pressure_Pa
                                (Pa, NaN unless fitted), ...) -- scalars; correlation (k, k); <name>_ci95
@@ -34,7 +35,9 @@ SI units, ``"1"`` nondimensional, ``""`` text)::
                                model_note (why that model, with model auto), model_error_source
                                (measured: on this scene by the solid; map: the mapped scenes' bound;
                                mesh: the solid's own, by its mesh check), stability_verdict
-                               (whether the fitted shell's stability was checked, and to what depth)
+                               (whether the fitted shell's stability was checked, and to what depth),
+                               weights_check (one line: mu*H refitted with another noise model, or
+                               not checked)
     /fit/warnings              (k,) the fit's warnings (text); attr codes
     /fit/sample                NXsample; attrs: scene (JSON, rebuilds the Scene), scene_<key>
     /fit/source                NXnote: file_name, sha256, columns (JSON), units (JSON), inverted
@@ -55,6 +58,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .fit_checks import weights_check_line
 from .nexus import DIMENSIONLESS, number_dataset, string_dataset
 from .paths import atomic_hdf5, check_output_path, open_hdf5
 from .shape_parameters import DERIVED, SHAPE_PARAMETERS
@@ -69,7 +73,7 @@ FIT_FORMAT_VERSION = 1
 _FIT_UNITS = {"mu_H": "N/m", "offset": "m", "baseline": "N", "baseline_slope": "N/m", "R_L": "m", "residual_rms": "N",
               "n_points": DIMENSIONLESS, "noise_sigma": "N", "aic": DIMENSIONLESS, "bic": DIMENSIONLESS,
               "runs_p": DIMENSIONLESS, "residual_autocorrelation": DIMENSIONLESS, "model_error": DIMENSIONLESS,
-              "max_depth": "m"}
+              "max_depth": "m", "max_force": "N"}
 #: Units of the scalar parameters in ``/fit/parameters``: the fit's own, every shape parameter's and
 #: every derived quantity's (:mod:`shellbvp.shape_parameters`).
 PARAMETER_UNITS = {**_FIT_UNITS, **{p.name: p.unit for p in SHAPE_PARAMETERS.values()},
@@ -209,12 +213,14 @@ def write_fit(path, result, record, used, *, segment="loading", overwrite=False)
                         "weights": result.weights, "segment": segment, "model": result.model,
                         "model_note": result.model_note, "model_error_source": _error_source(result),
                         "stability_verdict": getattr(result, "stability_verdict", "stability: not checked"),
+                        "weights_check": weights_check_line(result.weights, getattr(result, "weights_check", None)),
                         "fitted": np.array(list(result.fitted), dtype=h5py.string_dtype())})
         values = {"mu_H": result.mu_H, "offset": result.offset, "baseline": result.baseline,
                   "baseline_slope": result.baseline_slope, "R_L": result.R_L,
                   "residual_rms": result.residual_rms, "n_points": result.n,
                   "model_error": math.nan if result.model_error is None else result.model_error[0],
                   "max_depth": math.nan if result.max_depth is None else result.max_depth,
+                  "max_force": math.nan if getattr(result, "max_force", None) is None else result.max_force,
                   **{k: getattr(result, k) for k in ("noise_sigma", "aic", "bic", "runs_p",
                                                       "residual_autocorrelation")},
                   **{k: np.nan if getattr(result, k) is None else getattr(result, k)
@@ -392,7 +398,7 @@ def read_fit(path) -> FitRecord:
                                      f"{correlation.shape}")
             settings = {k: sc.attr_text(p, k) for k in ("baseline_model", "weights", "segment")}
             settings["model"] = sc.attr_text(p, "model") if "model" in p.attrs else "shell"  # files before it: shell
-            for k in ("model_note", "model_error_source", "stability_verdict"):
+            for k in ("model_note", "model_error_source", "stability_verdict", "weights_check"):
                 settings[k] = sc.attr_text(p, k) if k in p.attrs else ""
             if settings["model"] not in ("shell", "solid"):
                 raise ValueError(f"parameters.model must be 'shell' or 'solid'; got {settings['model']!r}")

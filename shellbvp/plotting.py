@@ -13,9 +13,10 @@ import numpy as np
 from .textdata import printable
 from .fitrecord import PARAMETER_UNITS
 from .fitting import diagnostics_lines
+from .fitting.apparent import apparent_modulus
 from .thickness import model_error_line
 
-__all__ = ["plot_curves", "plot_profiles", "plot_fit", "plot_fit_record", "fit_report", "fit_summary_lines",
+__all__ = ["plot_curves", "plot_profiles", "plot_fit", "plot_fit_record", "plot_apparent_modulus", "record_apparent_modulus", "fit_report", "fit_summary_lines",
            "require_matplotlib", "scene_label", "save_figure"]
 
 
@@ -198,6 +199,52 @@ def plot_fit_record(record, axes=None):
     return ax, axr
 
 
+def record_apparent_modulus(record):
+    """E(delta) of a fit file's fitted rows (:func:`shellbvp.fitting.apparent.apparent_modulus`), the
+    model from its curve (linear between the curve's depths), the thickness given or fitted."""
+    p, m, used = record.parameters, record.model, record.data["used"]
+    R_L, offset = p["R_L"], p["offset"]
+    delta, F = np.asarray(m["delta"], float), np.asarray(m["F"], float)
+    return apparent_modulus(record.data["displacement"][used], record.data["force"][used],
+                            lambda x: R_L * np.interp((x - offset) / R_L, delta, F, right=np.nan),
+                            offset=offset, baseline=p["baseline"], baseline_slope=p["baseline_slope"],
+                            thickness=_thickness(record))
+
+
+def _thickness(record):
+    """The shell's thickness H (m) of a fit file: fitted, else the scene's, else None."""
+    fitted = record.parameters.get("thickness", np.nan)
+    if np.isfinite(fitted):
+        return float(fitted)
+    return None if record.scene.thickness is None else record.scene.thickness * record.parameters["R_L"]
+
+
+def plot_apparent_modulus(record, ax):
+    """E(delta) of a fit file on ``ax`` (mu*H(delta) without a thickness): each fitted point's
+    apparent modulus against its depth beyond the contact point, the fitted value and its 95 %
+    interval as a band.  Flat: the model follows the data's shape."""
+    am = record_apparent_modulus(record)
+    p = record.parameters
+    lo, hi = record.intervals.get("mu_H", (np.nan, np.nan))
+    H = _thickness(record)
+    scale, unit, name = (1.0, "N/m", "mu*H") if H is None else (3.0 / H, "Pa", "E")
+    values = am.mu_H if am.E is None else am.E
+    ax.plot(am.depth, values, "k.", ms=2, label=f"apparent {name}: the model through each point alone")
+    ax.axhline(scale * p["mu_H"], color="C3", lw=1, label=f"fitted {name}")
+    if np.isfinite(lo) and np.isfinite(hi):
+        ax.axhspan(scale * lo, scale * hi, color="C3", alpha=0.2, lw=0)
+    if values.size:
+        a, b = np.nanpercentile(values, [2, 98])
+        pad = 0.1 * (b - a) or 0.1 * abs(b) or 1.0
+        ax.set_ylim(min(a, scale * p["mu_H"]) - pad, max(b, scale * p["mu_H"]) + pad)
+    _si_axis(ax, "x", "m")
+    _si_axis(ax, "y", unit)
+    ax.set_xlabel("depth beyond the contact point")
+    ax.set_ylabel(f"{name}(depth)")
+    ax.legend(fontsize=6, loc="best")
+    return ax
+
+
 def _display(record):
     """``show(value, si_unit) -> (number text, unit)``: lengths and forces in the units of the data's
     file (as the fit command prints them), everything else as stored."""
@@ -248,6 +295,12 @@ def fit_summary_lines(record):
     lines += [line(name, " (linearised)") for name in iv if name not in record.fitted]  # a shape parameter's derived
     rms, R_L = show(p["residual_rms"], "N"), show(p["R_L"], "m")
     lines.append(f"rms residual = {rms[0]} {rms[1]}; R_L = {R_L[0]} {R_L[1]}")
+    if record.settings.get("weights_check"):
+        lines.append(record.settings["weights_check"])
+    for name, what in (("max_depth", "depths up to {} beyond the contact point's first guess"),
+                       ("max_force", "forces up to {}")):
+        if np.isfinite(p.get(name, np.nan)):
+            lines.append("range: " + what.format(" ".join(show(p[name], PARAMETER_UNITS[name]))))
     lines += diagnostics_lines(record.quality, record.fitted, record.correlation, p,
                                lambda v: " ".join(show(v, "N")))
     s = record.scene
@@ -271,14 +324,16 @@ def fit_summary_lines(record):
 
 def fit_report(record, path):
     """A one-page summary of a fit (PNG or PDF by the name's suffix): the figure of
-    :func:`plot_fit_record` and the numbers, for a lab notebook."""
+    :func:`plot_fit_record`, the apparent modulus against depth (:func:`plot_apparent_modulus`)
+    and the numbers, for a lab notebook."""
     import textwrap
 
     plt = require_matplotlib()
     fig = plt.figure(figsize=(8.27, 11.69))  # A4 portrait
-    ax = fig.add_axes([0.12, 0.50, 0.8, 0.38])
-    axr = fig.add_axes([0.12, 0.36, 0.8, 0.12], sharex=ax)
+    ax = fig.add_axes([0.12, 0.62, 0.8, 0.28])
+    axr = fig.add_axes([0.12, 0.525, 0.8, 0.09], sharex=ax)
     plot_fit_record(record, (ax, axr))
+    plot_apparent_modulus(record, fig.add_axes([0.12, 0.355, 0.8, 0.12]))
     plt.setp(ax.get_xticklabels(), visible=False)
     fig.suptitle("shellbvp fit report", fontsize=13, y=0.95)
     text = "\n".join(textwrap.fill(ln, 110, subsequent_indent="    ") for ln in fit_summary_lines(record))

@@ -103,7 +103,9 @@ def test_a_shallow_afm_curve_fits_from_the_point_load_limit():
 
     pytest.importorskip("afmformats")
     (curve,) = read_afm(DATA / "spot3-0192.jpk-force")
-    res, used = fit_record(sb.Scene.preset("base", **AFM_SCENE), curve.record, R_L=10e-6, model="shell")
+    # its weightings disagree (the next test): the shallow fit itself is what is tested here
+    res, used = fit_record(sb.Scene.preset("base", **AFM_SCENE), curve.record, R_L=10e-6, model="shell",
+                           weights_check=False)
     assert res.success and 0.05 < res.mu_H < 0.5
     depth = curve.record.displacement[used].max() - res.offset
     assert 100e-9 < depth < 250e-9
@@ -141,3 +143,20 @@ def test_cli_max_depth_in_lab_units_or_a_fraction_of_R_L(tmp_path, capsys):
     assert json.loads(doc)["max_depth"] == pytest.approx(30e-6)
     assert main(["fit", "--example", "--preset", "fit", "--radius", "0.3mm", "--max-depth", "0", "-q"]) == 2
     assert "--max-depth" in capsys.readouterr().err
+
+
+def test_a_real_afm_curve_whose_weightings_disagree_is_not_a_success():
+    """spot3 (161 nm deep): mixed weights 0.125 N/m, uniform 0.161 N/m, intervals +-2 %:
+    the model misses the data's shape, and the fit says so; its numbers are kept."""
+    from shellbvp.afm import read_afm
+
+    pytest.importorskip("afmformats")
+    (curve,) = read_afm(DATA / "spot3-0192.jpk-force")
+    res, _ = fit_record(sb.Scene.preset("base", **AFM_SCENE), curve.record, R_L=10e-6, model="shell")
+    assert res.status == 6 and not res.success and res.quality == "poor"
+    check = res.weights_check
+    assert not check["agree"] and check["weights"] == "uniform"
+    lo, hi = res.mu_H_ci95
+    assert np.isfinite([res.mu_H, lo, hi]).all() and lo < res.mu_H < hi
+    assert check["mu_H_ci95"][0] > hi                       # no overlap
+    assert f"{res.mu_H:.4g}" in res.message and f"{check['mu_H']:.4g}" in res.message

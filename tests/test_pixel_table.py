@@ -35,6 +35,10 @@ def _map(n, thickness_um, mu_h, force_of, noise=0.01, seed=5):
             s = scene.replace(thickness=thickness_um[iy, ix] * 1e-6 / R_L)
             x = np.clip((depth - CONTACT) / R_L, 0, None)
             force = mu_h[iy, ix] * R_L * force_of(s, x) * (1 + noise * rng.standard_normal(depth.size))
+            # an instrument's additive noise too (0.1 % of the largest force): approach rows of exactly
+            # zero noise bias the mixed weights (mu*H +0.6 %, its interval covering the truth in 0 of 64
+            # pixels; uniform 58 of 64), and the weights check fails those fits
+            force += 1e-3 * np.max(force) * rng.standard_normal(depth.size)
             rec = record_from_arrays("map.jpk-force-map", depth, force, 0.01 * np.arange(depth.size),
                                      np.arange(depth.size), columns={"displacement": "d", "force": "f"},
                                      units={"displacement": "m", "force": "N"}, sha256="0" * 64)

@@ -62,6 +62,11 @@ def add_parser(sub):
     f.add_argument("--max-depth", dest="max_depth", type=number_or("length"),
                    help="fitting range: leave out rows deeper than this beyond the contact point's first guess, "
                         "a length (2um) or a plain number (a fraction of R_L, as the warnings give it)")
+    f.add_argument("--force-max", dest="max_force", type=quantity("force"),
+                   help="fitting range: leave out rows whose force is above this, with its unit (5nN, 2mN)")
+    f.add_argument("--no-weights-check", action="store_false", dest="weights_check",
+                   help="do not refit with another noise model (uniform; mixed for --weights uniform) to check "
+                        "the fit: by default a fit whose two mu*H intervals do not overlap fails (status 6)")
     for name, param in SHAPE_PARAMETERS.items():  # one of them at most
         f.add_argument(f"--fit-{name}", action="store_true", dest=f"fit_{name}", help=param.fit_help)
         f.add_argument(f"--{name}-range", dest=f"{name}_range", help=param.range_help)
@@ -164,7 +169,8 @@ def _fit_inputs(args, pixel_values=None):
         check_stability_size(scene)
     options = {"fit_offset": not args.no_offset, "free": free, "bounds": bounds, "weights": args.weights,
                "tol": args.tol, "stability": args.stability, "model": args.model, "mesh_check": args.mesh_check,
-               "max_depth": _max_depth(args.max_depth, args.radius.si)}
+               "max_depth": _max_depth(args.max_depth, args.radius.si),
+               "max_force": None if args.max_force is None else args.max_force.si, "weights_check": args.weights_check}
     reading = {"columns": columns, "units": units, "invert": tuple(args.invert or ()), **_calibration(args)}
     return scene, args.radius.si, reading, options
 
@@ -511,8 +517,13 @@ def _print_fit(res, record, used, args):
     if res.max_depth is not None:
         say(f"range  = depths up to {format_in(res.max_depth, du, 'length')} beyond the contact point's first guess "
             f"(--max-depth; deeper rows left out)")
+    if res.max_force is not None:
+        say(f"range  = forces up to {format_in(res.max_force, fu, 'force')} (--force-max; rows above left out)")
     say(f"rms residual = {format_in(res.residual_rms, fu, 'force')} over {res.n} points; R_L = "
           f"{args.radius}; {res.weights} weights")
+    from ..fit_checks import weights_check_line
+
+    say(weights_check_line(res.weights, res.weights_check))
     from ..fitting import diagnostics_lines
 
     for line in diagnostics_lines(res.quality, res.fitted, res.correlation,

@@ -11,7 +11,7 @@ import math
 
 import numpy as np
 
-from ..fit_checks import TREND_P, rank_trend
+from ..fit_checks import TREND_P, other_weights, rank_trend
 from ..instrument import estimate_contact
 from ..shape_parameters import SHAPE_PARAMETERS, shape_parameter
 from .curves import N_DEPTHS, ModelCurves
@@ -90,9 +90,24 @@ def _within_depth(d, f, keep, max_depth, origin, k):
     return d[within], f[within], keep
 
 
+def _below_force(d, f, keep, max_force, k):
+    """The rows (d, f, and ``keep``) whose force is at most ``max_force`` (N); ValueError for a
+    bound that is not a force > 0 or that leaves too few rows to fit."""
+    if not (isinstance(max_force, (int, float)) and math.isfinite(max_force) and max_force > 0):
+        raise ValueError(f"max_force (the largest force fitted, N) must be a finite number > 0; got {max_force!r}")
+    within = ~(f > max_force)  # NaN rows stay: the checks drop them
+    keep = keep & within
+    need = max(3, k + 2)
+    if np.count_nonzero(keep) < need:
+        raise ValueError(f"max_force = {max_force:.4g} N (--force-max) leaves {np.count_nonzero(keep)} of "
+                         f"{np.count_nonzero(np.isfinite(f))} rows; need at least {need}: give a larger force")
+    return d[within], f[within], keep
+
+
 def fit(scene, displacement, force, *, R_L, fit_offset=True, free=(), bounds=None, weights=None, floor=0.05,
         delta_max=None, tol=1e-6, loss="linear", baseline="none", contact_guess=None, progress=None, shared=None,
-        stability=False, model="auto", mesh_check=False, max_depth=None, **aliases):
+        stability=False, model="auto", mesh_check=False, max_depth=None, max_force=None, weights_check=True,
+        **aliases):
     """Least-squares fit of mu*H (the displacement origin, and a shape parameter) to measured data.
 
     Parameters
@@ -133,6 +148,15 @@ def fit(scene, displacement, force, *, R_L, fit_offset=True, free=(), bounds=Non
         first guess (``contact_guess``; 0 without one); deeper rows are left out before the
         fit (e.g. past the first instability, or where the model stops following the data).
         Reported as ``FitResult.max_depth``.  Default: every row.
+    max_force : float, optional
+        A fitting range in force: rows whose force (N, as measured, baseline included) is above
+        this are left out before the fit.  Reported as ``FitResult.max_force``.  Default: every row.
+    weights_check : bool
+        Refit mu*H with another noise model (uniform weights; mixed for a uniform fit) at the
+        fitted shape, from the fit's solution (one more least-squares fit, no model curve): when
+        the two 95 % intervals of mu*H do not overlap, the fit fails with status 6
+        (``weights_disagree``; its numbers are kept).  ``FitResult.weights_check`` holds the
+        other fit.  Default True.
     contact_guess : float, optional
         A first guess of the contact point (m; e.g. :func:`shellbvp.instrument.estimate_contact`):
         the model curve is computed to 1.2 x the depth of the data beyond it.  Default 0
@@ -244,6 +268,8 @@ def fit(scene, displacement, force, *, R_L, fit_offset=True, free=(), bounds=Non
     k = 1 + bool(fit_offset) + len(free) + (baseline != "none") + (baseline == "linear")
     if max_depth is not None and keep is not None:
         d, f, keep = _within_depth(d, f, keep, max_depth, float(origin), k)
+    if max_force is not None and keep is not None:
+        d, f, keep = _below_force(d, f, keep, max_force, k)
     d, f = _check_data(d, f, k, float(origin))
     if not (isinstance(R_L, (int, float)) and math.isfinite(R_L) and R_L > 0):
         raise ValueError(f"R_L (rim radius, m) must be a finite number > 0; got {R_L!r}")
@@ -255,15 +281,17 @@ def fit(scene, displacement, force, *, R_L, fit_offset=True, free=(), bounds=Non
     grid = dm * np.arange(1, N_DEPTHS + 1) / N_DEPTHS
     mdl = LeastSquaresModel(d, f, R_L, fit_offset, baseline, loss)
     noise = NoiseModel(weights, floor)
+    check = NoiseModel(other_weights(weights), floor) if weights_check else None
+    ranges = {"max_depth": None if max_depth is None else float(max_depth),
+              "max_force": None if max_force is None else float(max_force)}
     if shared is not None:
         if sp is not None:
             raise ValueError(f"{sp.name} is given per pixel: it cannot also be fitted")
         if stability:
             raise ValueError("stability is checked for one fit at a time, not per pixel of a map on shared curves "
                              "(each pixel would need a curve of its own)")
-        res = _fit_on_shared(shared, scene, mdl, noise, depth, k, keep, weights, baseline)
-        res.max_depth = None if max_depth is None else float(max_depth)
-        return res
+        res = _fit_on_shared(shared, scene, mdl, noise, depth, k, keep, weights, baseline, check)
+        return dataclasses.replace(res, **ranges)
 
     def run(name, coarse=False):
         """The fit with model ``name`` (the solid on the mesh check's mesh with ``coarse``)."""
@@ -274,14 +302,14 @@ def fit(scene, displacement, force, *, R_L, fit_offset=True, free=(), bounds=Non
             shape.add(None)
             P, dP, top = shape.at(None)
             res, rss, J, w = noise.irls(mdl, P, dP, top)
-            fitted = Fitted(res, rss, J, w, scene, shape.nodes[None], P, top)
+            fitted = Fitted(res, rss, J, w, scene, shape.nodes[None], P, top, dP=dP)
             notes = []
         else:
             search = ProfileSearch(sp, ModelCurves(sp.scene_at, grid, tol, depth, counter, progress), mdl, depth)
             fitted = search.run(noise, k)
             notes = search.notes
-        res = result_of(fitted, mdl, sp, k, notes, keep, weights, baseline, counter[0], name)
-        res.max_depth = None if max_depth is None else float(max_depth)
+        res = dataclasses.replace(result_of(fitted, mdl, sp, k, notes, keep, weights, baseline, counter[0], name,
+                                            check), **ranges)
         if stability and res.scene is not None and math.isfinite(res.offset):
             _check_axisymmetry(res, (float(np.max(d)) - res.offset) / R_L, tol, progress)
         return res
@@ -342,7 +370,7 @@ def _check_axisymmetry(res, deepest, tol, progress=None):
         res.warning_codes.append("unstable_depths")
 
 
-def _fit_on_shared(shared, scene, mdl, noise, depth, k, keep, weights, baseline):
+def _fit_on_shared(shared, scene, mdl, noise, depth, k, keep, weights, baseline, check=None):
     """:func:`fit` on the curve interpolated at ``theta`` across shared node curves (no curve computed)."""
     curves, theta = shared
     P, dP, top = curves.at(theta)
@@ -352,8 +380,8 @@ def _fit_on_shared(shared, scene, mdl, noise, depth, k, keep, weights, baseline)
     res, rss, J, w = noise.irls(mdl, P, dP, top)
     near = min(curves.thetas, key=lambda t: abs(t - theta))
     fitted = Fitted(res, rss, J, w, scene, curves.nodes[near], P, top,
-                    interpolation_error=getattr(curves, "interpolation_error", None))
-    return result_of(fitted, mdl, None, k, [], keep, weights, baseline, 0)
+                    interpolation_error=getattr(curves, "interpolation_error", None), dP=dP)
+    return result_of(fitted, mdl, None, k, [], keep, weights, baseline, 0, check=check)
 
 
 def free_parameters(free=(), bounds=None, aliases=None):

@@ -12,7 +12,8 @@ import math
 import numpy as np
 from scipy import special
 
-from ..fit_checks import FIT_STATUS, check_result, contact_misfit, fit_diagnostics, runs_in_depth_order
+from ..fit_checks import (FIT_STATUS, WEIGHTS_DISAGREE, check_result, contact_misfit, fit_diagnostics,
+                          runs_in_depth_order, weights_disagreement)
 from ..shape_parameters import SHAPE_PARAMETERS
 from .least_squares import MODEL_PARAMETERS, LeastSquaresModel
 from .result import Estimate, FitResult
@@ -22,9 +23,11 @@ log = logging.getLogger(__name__)
 __all__ = ["result_of"]
 
 
-def result_of(fitted, mdl, sp, k, notes, keep, weights, baseline, curves_computed, fit_model="shell"):
+def result_of(fitted, mdl, sp, k, notes, keep, weights, baseline, curves_computed, fit_model="shell", check=None):
     """The :class:`FitResult` of what a fit found: Wald (t) intervals of the free parameters
-    from the weighted Jacobian, the shape parameter's profile interval, status and warnings."""
+    from the weighted Jacobian, the shape parameter's profile interval, status and warnings;
+    ``check``: the :class:`~shellbvp.fitting.least_squares.NoiseModel` the fit's mu*H is checked
+    against (refitted at the fitted shape from the fit's solution), or None."""
     res, rss, J, w, P, top, R_L = fitted.res, fitted.rss, fitted.J, fitted.w, fitted.P, fitted.top, mdl.R_L
     d, f = mdl.d, mdl.f
     n = d.size
@@ -74,7 +77,13 @@ def result_of(fitted, mdl, sp, k, notes, keep, weights, baseline, curves_compute
     found = notes + checks
     for _, text in found:
         log.info("fit: warning: %s", text)
-    message = f"{FIT_STATUS[status]} (least squares: {res.message})"
+    other = None if check is None or fitted.dP is None else _refit_weighted(fitted, mdl, check, dof)
+    detail = weights_disagreement(weights, mu_H, mu_ci, other) if status == 0 else None
+    if detail is not None:
+        status = WEIGHTS_DISAGREE
+    if other is not None:
+        other["agree"] = detail is None
+    message = FIT_STATUS[status] + (f": {detail}" if detail else "") + f" (least squares: {res.message})"
     point_weights = np.full(keep.size, np.nan)
     point_weights[keep] = w / np.max(w)
     diagnostics = fit_diagnostics(cov, rss, n, J.shape[1], w * resid, d, runs)
@@ -86,7 +95,19 @@ def result_of(fitted, mdl, sp, k, notes, keep, weights, baseline, curves_compute
                      interpolation_error=fitted.interpolation_error, warnings=[t for _, t in found],
                      warning_codes=[code for code, _ in found], baseline_model=baseline, baseline=b0,
                      baseline_ci95=ci[2], baseline_slope=b1, baseline_slope_ci95=ci[3],
-                     point_weights=point_weights, model=fit_model, **diagnostics)
+                     point_weights=point_weights, model=fit_model, weights_check=other, **diagnostics)
+
+
+def _refit_weighted(fitted, mdl, noise, dof):
+    """``{"weights", "mu_H", "mu_H_ci95"}``: mu*H and its 95 % (Wald, t) interval refitted with
+    the noise model ``noise`` at the fitted shape, from the fit's solution (no model curve)."""
+    res, rss, J, _ = noise.irls(mdl, fitted.P, fitted.dP, fitted.top, start=fitted.res.x)
+    mu_H = float(mdl.full(res.x)[0])
+    try:
+        half = float(special.stdtrit(dof, 0.975) * math.sqrt(np.linalg.inv(J.T @ J)[0, 0] * rss / dof))
+    except (np.linalg.LinAlgError, ValueError):
+        half = math.nan
+    return {"weights": noise.kind, "mu_H": mu_H, "mu_H_ci95": (mu_H - half, mu_H + half)}
 
 
 def _linearised(dq, x, dx_dtheta, mu_H, R_L, cov, t):

@@ -111,6 +111,10 @@ class LeastSquaresModel:
         weighted Jacobian); ``result.x`` holds the free parameters (see :meth:`full`)."""
         d, f, R_L = self.d, self.f, self.R_L
 
+        # the solver sees residuals in units of the largest force: its gradient tolerance is absolute,
+        # and with AFM forces (nN: a cost of ~1e-18 N^2) it stopped at the start, unrefined
+        unit = self.fscale
+
         def residual(p):
             r = self.force(P, top, d, self.full(p)) - f
             return w * np.nan_to_num(r, nan=self.big)
@@ -125,8 +129,8 @@ class LeastSquaresModel:
 
         start = self.start(P, top, w) if start is None else np.asarray(start, float)
         scale = np.array([abs(start[0]) or 1.0, 0.01 * R_L, 0.01 * self.fscale, 0.01 * self.fscale / R_L])
-        res = optimize.least_squares(residual, start, jac=jac, x_scale=scale[self.free], loss=self.loss,
-                                     method="trf")
+        res = optimize.least_squares(lambda p: residual(p) / unit, start, jac=lambda p: jac(p) / unit,
+                                     x_scale=scale[self.free], loss=self.loss, f_scale=1.0 / unit, method="trf")
         r = residual(res.x)
         return res, float(np.dot(r, r)), jac(res.x)
 
@@ -182,10 +186,11 @@ class NoiseModel:
                          mdl.d)
         return w_new, np.max(np.abs(w_new / w - 1))
 
-    def irls(self, mdl, P, dP, top):
-        """Fit at a fixed shape, iteratively reweighted: (result, RSS, Jacobian, weights)."""
+    def irls(self, mdl, P, dP, top, start=None):
+        """Fit at a fixed shape, iteratively reweighted: (result, RSS, Jacobian, weights);
+        ``start``: the free parameters to start from (default: :meth:`LeastSquaresModel.start`)."""
         w = np.ones_like(mdl.f)
-        res, rss, J = mdl.fit(P, dP, top, w)
+        res, rss, J = mdl.fit(P, dP, top, w, start=start)
         for it in range(8):
             if self.kind == "uniform":
                 break
@@ -201,7 +206,8 @@ class NoiseModel:
 class Fitted:
     """What a fit found: the least-squares result at the fitted shape, its weighted RSS and
     Jacobian (a column for the shape parameter too), the weights, the scene and model curve
-    reported, the shape F(delta) fitted, and the shape parameter's estimate and interval."""
+    reported, the shape F(delta) fitted (and its derivative), and the shape parameter's estimate
+    and interval."""
     res: object
     rss: float
     J: np.ndarray
@@ -213,3 +219,4 @@ class Fitted:
     theta: float | None = None
     theta_ci: tuple | None = None
     interpolation_error: float | None = None
+    dP: object = None  # the shape's derivative (the weights check refits at this shape)

@@ -201,7 +201,7 @@ class ProfileSearch:
         col = self.w * np.nan_to_num((Fp[1] - Fp[0]) / (ths[1] - ths[0]))
         near = min(shape.thetas, key=lambda t: abs(t - theta_hat))
         return Fitted(res, rss, np.column_stack([J, col]), self.w, shape.scene_at(near), shape.nodes[near], P, top,
-                      theta_hat, (c_lo, c_hi), interp_err)
+                      theta_hat, (c_lo, c_hi), interp_err, dP=dP)
 
 
 def _drop(pdt):

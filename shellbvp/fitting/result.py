@@ -11,6 +11,7 @@ import numpy as np
 
 from ..fit_checks import fit_quality
 from ..shape_parameters import DERIVED, SHAPE_PARAMETERS
+from .apparent import apparent_modulus
 from .least_squares import DEFAULT_WEIGHTS
 
 __all__ = ["Estimate", "FitResult"]
@@ -61,8 +62,17 @@ class FitResult:
     max_depth : float or None
         The fitting range (m): rows deeper than this beyond the contact point's first guess were
         left out (``fit(max_depth=...)``); None: every row.
+    max_force : float or None
+        The fitting range (N): rows whose force is above this were left out (``fit(max_force=...)``);
+        None: every row.
     weights : str
         The noise model, "uniform", "relative" or "mixed".
+    weights_check : dict or None
+        With ``fit(..., weights_check=True)`` (the default): the same model refitted with another
+        noise model (uniform; mixed for a uniform fit) at the fitted shape from the fit's
+        solution: ``{"weights", "mu_H", "mu_H_ci95", "agree"}``.  When the two intervals of mu*H
+        do not overlap the fit fails (status 6, ``weights_disagree``; the numbers are kept).  None:
+        not checked.
     residual_rms : float
         Root-mean-square force residual, N (unweighted).
     n : int
@@ -193,6 +203,8 @@ class FitResult:
     measured_model_error: float = None
     mesh_error: float = None
     max_depth: float = None
+    max_force: float = None
+    weights_check: dict = None
 
     @property
     def success(self):
@@ -260,6 +272,16 @@ class FitResult:
         that mu*H (e.g. an end of ``mu_H_ci95``), offset and baseline as fitted."""
         return self._model(np.asarray(displacement, float), self.mu_H if mu_H is None else float(mu_H), self.offset)
 
+    def apparent_modulus(self, displacement, force):
+        """E(delta), the apparent modulus against depth (:func:`shellbvp.fitting.apparent.apparent_modulus`):
+        for each point of the data (m, N) beyond the fitted contact point, the mu*H (and E =
+        3 mu*H / H with a thickness) that the model would need to pass through it alone; flat over
+        depth when the model follows the data's shape."""
+        return apparent_modulus(displacement, force,
+                                lambda x: self._model(x, 1.0, self.offset) - self._model(x, 0.0, self.offset),
+                                offset=self.offset, baseline=self.baseline, baseline_slope=self.baseline_slope,
+                                thickness=self.thickness)
+
     def to_dict(self):
         """A JSON-ready dict (non-finite numbers as None, so the JSON is strict)."""
         def num(v):
@@ -272,6 +294,9 @@ class FitResult:
         return {"mu_H": num(self.mu_H), "mu_H_ci95": ci(self.mu_H_ci95), "offset": num(self.offset),
                 "offset_ci95": ci(self.offset_ci95), **shape, "fitted": list(self.fitted),
                 "model": self.model, "model_note": self.model_note, "max_depth": num(self.max_depth),
+                "max_force": num(self.max_force), "weights_check": None if self.weights_check is None else
+                {**self.weights_check, "mu_H": num(self.weights_check["mu_H"]),
+                 "mu_H_ci95": ci(self.weights_check["mu_H_ci95"])},
                 "measured_model_error": num(self.measured_model_error), "mesh_error": num(self.mesh_error),
                 "weights": self.weights, "residual": num(self.residual_rms), "residual_rms": num(self.residual_rms),
                 "n": self.n, "success": self.success, "status": self.status, "message": self.message,
@@ -292,7 +317,8 @@ class FitResult:
                 "stability_verdict": self.stability_verdict,
                 "model_error": None if self.model_error is None else num(self.model_error[0]),
                 "model_error_extrapolated": None if self.model_error is None else self.model_error[1],
-                "units": {"mu_H": "N/m (= um*MPa)", "offset": "m", "max_depth": "m", "residual": "N (rms)",
+                "units": {"mu_H": "N/m (= um*MPa)", "offset": "m", "max_depth": "m", "max_force": "N",
+                          "residual": "N (rms)",
                           "residual_rms": "N", "R_L": "m",
                           **{p.name: p.unit_text or p.unit for p in SHAPE_PARAMETERS.values()},
                           **{d.name: d.unit for d in DERIVED.values()},
