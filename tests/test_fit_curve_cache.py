@@ -204,3 +204,19 @@ def test_keeping_a_curve_on_a_full_disk_warns_and_leaves_no_partial_file(kept_cu
     assert r.returncode == 0 and r.stdout.strip() == "done", r.stderr
     assert "Traceback" not in r.stderr and "cannot keep model curves" in r.stderr, r.stderr
     assert sorted(p.name for p in path.parent.iterdir()) == [path.name + ".src"]  # no .tmp left
+
+
+def test_a_kept_curve_that_starts_deeper_than_its_grid_is_read_back(tmp_path, monkeypatch, caplog):
+    """A shallow record's model curve starts at the first depth with a contact cap (the rest of
+    the grid is the point-load limit's): kept, it is read back, not set aside as damaged."""
+    monkeypatch.setenv("SHELLBVP_CACHE_DIR", str(tmp_path))
+    kept_records.forget_warnings()
+    scene, grid = sb.Scene.preset("base"), np.r_[1e-3, GRID]  # at 1e-3 the contact is the point-load limit
+    with sb.options(model_curve_cache=True):
+        clear_model_curves()
+        computed = curves._model_curve(scene, grid, 1e-6)
+        path, key = curves._disk_place(scene, grid, 1e-6)
+        assert computed.delta[0] > grid[0] and path.is_file()
+        again = curves._read_kept(path, key, scene, grid)
+    assert again is not None and np.array_equal(again.force, computed.force)
+    assert not list(tmp_path.rglob("*.bad")) and "set aside" not in caplog.text
