@@ -12,7 +12,7 @@ convert at that boundary, so files written before this record read as before.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, fields
+from dataclasses import MISSING, dataclass, fields
 
 __all__ = ["CurveSettings"]
 
@@ -75,14 +75,15 @@ class CurveSettings:
     @classmethod
     def from_dict(cls, d: dict) -> CurveSettings:
         """The record of a curve file's settings (``Curve.settings``); the keys of what the run
-        learned (switches, stability, times) are left out.
+        learned (switches, stability, times) are left out, and a field with a default that an
+        older file lacks takes its default.
 
         Raises
         ------
         ValueError
-            If a setting is missing.
+            If a setting without a default is missing.
         """
-        missing = [f.name for f in fields(cls) if f.name not in d]
+        missing = [f.name for f in fields(cls) if f.name not in d and f.default is MISSING]
         if missing:
             raise ValueError(f"curve settings lack {', '.join(missing)}")
-        return cls(**{f.name: d[f.name] for f in fields(cls)})
+        return cls(**{f.name: d[f.name] for f in fields(cls) if f.name in d})
