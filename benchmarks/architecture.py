@@ -6,7 +6,10 @@ Counts what issue 43 names: comparisons with configuration names, modules and fu
 by length, ``.get`` on results, places that build a ``Solution``, function-level
 imports, module flags that tests patch; and of issue 57, string hooks: ``"module:function"``
 strings that name a function of the package, resolved by name at run time (an upward path
-the import graph does not show).  The numbers are what the redesign is judged by;
+the import graph does not show), and writes of a curve's settings below their owner (a
+subscript stored or deleted, ``setdefault``/``update``/... called, on ``settings``, ``st`` or
+``<x>.settings`` in a module on a floor below ``continuation``, which builds them; ``io``, whose
+``Curve.learned`` records beside them what a step learned, excepted).  The numbers are what the redesign is judged by;
 ``--markdown`` prints them as the table of benchmarks/results/architecture.md.  A ``.get`` is
 counted where its key is a result's field name; ``--verbose`` shows its receiver, which may
 be a dict of another kind.  ``--layers`` prints the package's modules by floor: a module
@@ -26,6 +29,12 @@ ROOT = pathlib.Path(__file__).resolve().parents[1]
 
 #: A string naming a function of the package, ``"shellbvp.module:function"``
 STRING_HOOK = re.compile(r"^shellbvp(\.\w+)+:\w+$")
+#: Names under which a curve's settings are passed (``settings``, ``st``, ``curve.settings`` ...)
+SETTINGS_RECEIVER = re.compile(r"^(st|settings|[\w.]+\.settings)$")
+#: Methods that change a dict (or a list held in it) in place
+MUTATORS = {"setdefault", "update", "pop", "popitem", "clear", "append", "extend"}
+#: Where a curve's settings are built (the owner) and where the curve records what it learned
+SETTINGS_OWNERS = ("continuation", "io")
 MODULE_LINES = 600
 FUNCTION_LINES = 80
 #: Module-level names that a result carries (a ``.get`` of one of them reads a result)
@@ -86,10 +95,42 @@ def _adapts_a_step(loop):
     return grows and halves
 
 
+def _settings_write(node):
+    """Whether ``node`` changes a curve's settings: ``st[k] = ...``, ``del settings[k]``,
+    ``curve.settings.update(...)``, ``st["topology_switches"].append(...)``, ``st.x = ...``."""
+    def settings(expr):
+        return bool(SETTINGS_RECEIVER.match(ast.unparse(expr)))
+
+    if isinstance(node, (ast.Subscript, ast.Attribute)) and isinstance(node.ctx, (ast.Store, ast.Del)):
+        return settings(node.value)
+    if isinstance(node, ast.Call) and isinstance(node.func, ast.Attribute) and node.func.attr in MUTATORS:
+        receiver = node.func.value
+        return settings(receiver.value if isinstance(receiver, ast.Subscript) else receiver)
+    return False
+
+
+def settings_writes(root, found):
+    """{module: writes} of ``found`` (census's ``settings_writes``) in the modules below the
+    settings' owner (``continuation``): a module stands on the floor of its top-level module or
+    subpackage (:func:`layers`)."""
+    floor = {mod: f for f, mods in layers(root).items() for mod in mods}
+    owner = floor.get("continuation")
+    if owner is None:
+        return {}
+    out = {}
+    for mod, n in found.items():
+        top = mod.split(".")[0]
+        where = floor.get(top, floor.get(top + "/"))
+        if where is not None and where < owner and top not in SETTINGS_OWNERS:
+            out[mod] = n
+    return out
+
+
 def census(root=ROOT):
     names = configuration_names(root)
     out = {"step_loops": [], "name_comparisons": {}, "long_modules": {}, "long_functions": [], "result_gets": {},
-           "solution_builds": {}, "function_imports": {}, "string_hooks": {}, "lines": 0}
+           "solution_builds": {}, "function_imports": {}, "string_hooks": {}, "settings_writes": {},
+           "lines": 0}
     pkg = root / "shellbvp"
     for path in sorted(pkg.rglob("*.py")):  # subpackages (materials/, cli/) too
         text = path.read_text()
@@ -106,6 +147,8 @@ def census(root=ROOT):
                     out["name_comparisons"][mod] = out["name_comparisons"].get(mod, 0) + 1
             elif isinstance(node, ast.Constant) and isinstance(node.value, str) and STRING_HOOK.match(node.value):
                 out["string_hooks"][mod] = out["string_hooks"].get(mod, 0) + 1
+            elif _settings_write(node):
+                out["settings_writes"][mod] = out["settings_writes"].get(mod, 0) + 1
             elif isinstance(node, (ast.While, ast.For)) and _adapts_a_step(node):
                 out["step_loops"].append(f"{mod}:{node.lineno}")
             elif isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
@@ -130,6 +173,7 @@ def census(root=ROOT):
         for m in re.finditer(r"monkeypatch\.setattr\(\s*([\w.]+)\s*,\s*\"(_?[A-Z_]+)\"", path.read_text()):
             patched.add(f"{m.group(1)}.{m.group(2)}")
     out["patched_flags"] = sorted(patched)
+    out["settings_writes"] = settings_writes(root, out["settings_writes"])
     return out
 
 
@@ -201,6 +245,8 @@ def main(argv=None):
         ("imports inside functions", total(c["function_imports"]), c["function_imports"]),
         ("module flags patched by tests and benchmarks", len(c["patched_flags"]), c["patched_flags"]),
         ('string hooks (`"module:function"` resolved by name)', total(c["string_hooks"]), c["string_hooks"]),
+        ("writes of a curve's settings below their owner (continuation)", total(c["settings_writes"]),
+         c["settings_writes"]),
         ("lines of shellbvp/*.py", c["lines"], ""),
     ]
     if args.markdown:

@@ -25,6 +25,7 @@ import numpy as np
 
 from .configurations import is_single_cap, names
 from .corner import edge_model
+from .curve_settings import CurveSettings
 from .curve_stability import assess, check_choice
 from .cylinder import best_wall_state, wall_contact_suspected
 from .inflation import inflated_start
@@ -194,11 +195,11 @@ estimate_error, topology
         raise ValueError(f"topology must be 'auto' or 'cap' for a curve; got {topology!r}")
     estimate_error = _error_mode(estimate_error)
 
-    settings = dict(tol=tol, max_nodes=max_nodes, delta_max=delta_max, force_max=force_max,
-                    lambda0_max=lambda0_max, max_steps=max_steps, delta_start=delta_start,
-                    delta_min=delta_min, ds_max=ds_max, estimate_error=estimate_error,
-                    mode="deltas" if deltas is not None else "adaptive", eps=default_eps(tol),
-                    bc_tol=1e-10, topology=topology)
+    settings = CurveSettings(tol=tol, max_nodes=max_nodes, delta_max=delta_max, force_max=force_max,
+                             lambda0_max=lambda0_max, max_steps=max_steps, delta_start=delta_start,
+                             delta_min=delta_min, ds_max=ds_max, estimate_error=estimate_error,
+                             mode="deltas" if deltas is not None else "adaptive", eps=default_eps(tol),
+                             bc_tol=1e-10, topology=topology)
     return CurveRun(scene, settings, deltas)
 
 
@@ -221,11 +222,12 @@ class CurveRun:
     (True, 'interrupted', True)
     """
 
-    def __init__(self, scene, settings, deltas=None):
-        self.scene, self.settings, self.deltas = scene, settings, deltas
+    def __init__(self, scene, settings: CurveSettings, deltas=None):
+        self.scene, self.settings, self.deltas = scene, settings, deltas  # settings: read, never written
+        # the curve's file record: the settings, and beside them what the run learns
         self.out = Curve(scene=scene, points={k: [] for k in POINT_FIELDS}, flags=[], stop_reason="",
-                         complete=False, interrupted=False, settings=settings, version=VERSION)
-        self.recorder = Recorder(self.out, settings["estimate_error"], settings)
+                         complete=False, interrupted=False, settings=settings.to_dict(), version=VERSION)
+        self.recorder = Recorder(self.out, settings.estimate_error, settings)
         self.branch = _Branch(settings)
         self.stop = None  # the Stop of the continuation, once it has ended
         self._states = None
@@ -248,11 +250,15 @@ class CurveRun:
         if shown is not None:
             self._pending.append(shown)
 
+    def switch_located(self, switch: dict):
+        """Record a switch the switch search located (``settings["topology_switches"]`` of the curve)."""
+        self.out.settings["topology_switches"].append(switch)
+
     def _accept(self, sol, key):
         """(Stop or None, the recorded state or None) for a leg's state ``sol``."""
         shown = self.recorder.estimated(self.branch.shown(sol))
         end = self.branch.end
-        if end and self.settings["mode"] != "adaptive":  # requested depths only
+        if end and self.settings.mode != "adaptive":  # requested depths only
             return Stop(end, complete=True), None
         self.recorder.record(shown, key)
         self.branch.last_shown = shown
@@ -281,8 +287,9 @@ class CurveRun:
                 break
         self.out.stop_reason, self.out.complete = self.stop.reason, self.stop.complete
         # what the stop cost: failed attempts after the last accepted point (issue 14: <= 2 s)
-        st["after_last_point_s"] = time.perf_counter() - (self.recorder.last_accepted or self.t0)
-        if st["topology"] == "auto":
+        self.out.learned(after_last_point_s=time.perf_counter() - (self.recorder.last_accepted or self.t0))
+        if st.topology == "auto":
+            self.out.learned(topology_switches=[])  # filled as they are located (kept if interrupted)
             locate_switches(self, st)
             yield from self._pending
             self._pending = []
@@ -300,8 +307,8 @@ class CurveRun:
         self.out.interrupted = True
         if self.stop is None:
             self.out.stop_reason = "interrupted"
-            self.settings["after_last_point_s"] = time.perf_counter() - (
-                self.recorder.last_accepted or self.t0 or time.perf_counter())
+            self.out.learned(after_last_point_s=time.perf_counter() - (
+                self.recorder.last_accepted or self.t0 or time.perf_counter()))
         self._finish()
 
     def result(self) -> Curve:
@@ -316,8 +323,8 @@ class CurveRun:
             return
         self._finished = True
         self.recorder.finish()
-        self.settings["wall_time"] = time.perf_counter() - (self.t0 or time.perf_counter())
-        log.info("curve: %s in %.2f s", self.out.summary(), self.settings["wall_time"])
+        self.out.learned(wall_time=time.perf_counter() - (self.t0 or time.perf_counter()))
+        log.info("curve: %s in %.2f s", self.out.summary(), self.out.settings["wall_time"])
 
 
 def _check_positive(name, v):
@@ -362,9 +369,9 @@ class _Branch:
         """The state the curve records at ``sol``'s depth: ``sol``, or the configuration that
         replaces it there."""
         st = self.settings
-        if st["topology"] != "auto":
+        if st.topology != "auto":
             return sol
-        kw = dict(tol=st["tol"], max_nodes=st["max_nodes"], bc_tol=st["bc_tol"])
+        kw = dict(tol=st.tol, max_nodes=st.max_nodes, bc_tol=st.bc_tol)
         shown = sol
         if sol.scene.contact == "smooth":
             last = self.last_shown  # the point computed before this one

@@ -115,14 +115,14 @@ def assess(curve, choice: str = "points", *, delta_tol: float = 1e-4, samples: i
     modes = np.full(n, -1, dtype=int)
     curve.points["stability_min"], curve.points["critical_mode"] = mins, modes
     curve.first_instability = None
-    curve.settings["stability"] = choice
+    curve.learned(stability=choice)
     if choice == "off" or n == 0:
         return
     from .modal_stability import default_modes
 
     t0 = time.perf_counter()
     notes = []
-    curve.settings["stability_modes"] = int(default_modes(curve.scene)[-1])
+    curve.learned(stability_modes=int(default_modes(curve.scene)[-1]))
 
     def analyse(i):
         mins[i], modes[i], why = point_stability(curve.solutions[i])
@@ -148,8 +148,7 @@ def assess(curve, choice: str = "points", *, delta_tol: float = 1e-4, samples: i
             curve.first_instability = _first(curve, first, mins, modes, choice, delta_tol)
     except KeyboardInterrupt:  # the curve is finished work: keep it, with what was assessed
         notes.append("stability interrupted")
-    curve.settings["stability_note"] = "; ".join(notes)
-    curve.settings["stability_time"] = time.perf_counter() - t0
+    curve.learned(stability_note="; ".join(notes), stability_time=time.perf_counter() - t0)
 
 
 def verdict(curve) -> str:

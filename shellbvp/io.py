@@ -1,6 +1,5 @@
-"""Curves as records: the per-point schema, :class:`Curve`, and its HDF5 file
-(atomic writes, a documented self-describing layout).  The continuation
-algorithm (``shellbvp.continuation``) fills a Curve; this module owns its shape.
+"""Curves as records: the per-point schema, :class:`Curve`, and its HDF5 file (atomic writes, a documented
+self-describing layout).  The continuation (``shellbvp.continuation``) fills a Curve; this module owns its shape.
 
 Layout (format ``shellbvp-curve``, version 4, NeXus; versions 1-3 kept the same group at
 ``/curve``, under the root, and read as before; version 1 lacked topology, S1 and
@@ -46,6 +45,7 @@ replaced unless ``overwrite=True``.
 
 from __future__ import annotations
 
+import itertools
 import json
 import math
 from dataclasses import asdict, dataclass, field
@@ -154,7 +154,7 @@ class Curve:
         The stopping rule was reached (False: failure or interruption).
     interrupted : bool
     settings : dict
-        Solver and continuation settings.
+        Its :class:`~shellbvp.curve_settings.CurveSettings` as a dict, and what was learned (:meth:`learned`).
     solutions : list of Solution
         In memory only (profiles); not stored unless ``to_hdf5(profiles=True)``.
 
@@ -212,10 +212,12 @@ class Curve:
         the lab scales it was read with, if any."""
         write_curve(self, path, profiles=profiles, overwrite=overwrite, units=units or self.units)
 
+    def learned(self, **facts):
+        """Record beside the settings what a step learned (``topology_switches``, ``wall_time``, ...)."""
+        self.settings.update(facts)
+
     def topology_summary(self) -> str:
         """Runs of contact topology along the curve, e.g. 'point x2, line x6, cap x27'."""
-        import itertools
-
         runs = [f"{k} x{len(list(g))}" for k, g in itertools.groupby(self.points["topology"])]
         switches = self.settings.get("topology_switches") or []
         where = "; ".join(f"{s['from']} -> {s['to']} at delta = {s['delta']:.6g}"

@@ -46,7 +46,7 @@ def _X(sol):
 
 def _first_point(scene, delta, settings):
     """The curve's first state (the single cap: the branch followed is the cap's), or a Stop."""
-    sol = solve(scene, delta=delta, tol=settings["tol"], max_nodes=settings["max_nodes"],
+    sol = solve(scene, delta=delta, tol=settings.tol, max_nodes=settings.max_nodes,
                 estimate_error=False, topology="cap")
     if not sol.success:
         return Stop(f"no solution at the first point delta = {delta:g}: {sol.message}")
@@ -86,10 +86,10 @@ def gent_lock_ratio(sol) -> float:
 
 
 def _stop_rule(sol, settings):
-    if settings["force_max"] is not None and sol.force >= settings["force_max"]:
-        return f"force_max = {settings['force_max']:g} reached"
-    if settings["lambda0_max"] is not None and sol.lambda0 >= settings["lambda0_max"]:
-        return f"lambda0_max = {settings['lambda0_max']:g} reached"
+    if settings.force_max is not None and sol.force >= settings.force_max:
+        return f"force_max = {settings.force_max:g} reached"
+    if settings.lambda0_max is not None and sol.lambda0 >= settings.lambda0_max:
+        return f"lambda0_max = {settings.lambda0_max:g} reached"
     return None
 
 
@@ -162,8 +162,8 @@ def _wall_leg(scene, branch, st, last_cap, key, *, reason, deltas=None):
     lowest energy at each depth, from the last such state), to delta_max or through the
     remaining ``deltas``.  Yields ``(state, order key)``; returns the Stop, with ``reason`` if no
     wall state is found."""
-    kw = dict(tol=st["tol"], max_nodes=st["max_nodes"], bc_tol=st["bc_tol"])
-    if st["topology"] != "auto" or scene.model().OMEGA_MAX is None:
+    kw = dict(tol=st.tol, max_nodes=st.max_nodes, bc_tol=st.bc_tol)
+    if st.topology != "auto" or scene.model().OMEGA_MAX is None:
         return Stop(reason, complete=True)  # the cap's branch ends at the tip's end: the end asked for
     tried = []
     targets = list(deltas) if deltas is not None else None
@@ -182,7 +182,7 @@ def _wall_leg(scene, branch, st, last_cap, key, *, reason, deltas=None):
         if targets is None or any(abs(prev.delta - t) < 1e-12 for t in targets):  # (a requested depth)
             key += 1
             yield prev, key
-    d_end = st["delta_max"] if targets is None else (targets[-1] if targets else prev.delta)
+    d_end = st.delta_max if targets is None else (targets[-1] if targets else prev.delta)
 
     def advance(u, step, t):
         return min(t, u + step) if targets is None else min(min(d for d in targets if d > u), u + step)
@@ -213,7 +213,7 @@ def _wall_leg(scene, branch, st, last_cap, key, *, reason, deltas=None):
         return Stop(f"no valid contact configuration beyond delta = {m.at:.6g} ({'; '.join(tried)})")
     if m.reason:  # a stop rule
         return Stop(m.reason, complete=True)
-    return Stop(f"delta_max = {st['delta_max']:g} reached" if targets is None else "all requested deltas computed",
+    return Stop(f"delta_max = {st.delta_max:g} reached" if targets is None else "all requested deltas computed",
                 complete=True)
 
 
@@ -226,9 +226,9 @@ def _pinned_state(scene, start, delta, st, tried):
     shell: at a hemispherical tip's end it is radial and carries no axial force); xi = 0: from
     delta 0.9295, where the free cap's edge reaches the end, to delta 1, where no cap+cylinder
     state exists (its band on the cylinder would have a negative length)."""
-    sysm = make_system(scene, "delta", delta, st["eps"], edge="pinned")
-    sol = solve_from(sysm, warm_guess(sysm, start), tol=st["tol"], max_nodes=step_nodes(start, st),
-                     bc_tol=st["bc_tol"])
+    sysm = make_system(scene, "delta", delta, st.eps, edge="pinned")
+    sol = solve_from(sysm, warm_guess(sysm, start), tol=st.tol, max_nodes=step_nodes(start, st),
+                     bc_tol=st.bc_tol)
     if sol.success and sol.valid:
         return sol
     tried.append(f"cap held at the tip's end: {sol.message if not sol.success else '; '.join(sol.flags)}")
@@ -237,8 +237,8 @@ def _pinned_state(scene, start, delta, st, tried):
 
 def _cross(cur, prev, delta, st):
     """The corner cap at ``delta`` past the smooth cap's convexity limit (or None)."""
-    sol = cross_convexity_limit(cur, prev, delta, eps=st["eps"], tol=st["tol"], max_nodes=step_nodes(cur, st),
-                                bc_tol=st["bc_tol"], exact=False)
+    sol = cross_convexity_limit(cur, prev, delta, eps=st.eps, tol=st.tol, max_nodes=step_nodes(cur, st),
+                                bc_tol=st.bc_tol, exact=False)
     if sol is not None:
         log.info("past the convexity limit near delta = %.6g: corner at the contact edge", cur.delta)
     return sol
@@ -262,7 +262,7 @@ def _wall_state_deeper(scene, last_cap, st, kw, tried):
     they may help (:func:`_room_may_help`).  The switch itself is located afterwards
     (``locate_switches``)."""
     for dd in (0.01, 0.02, 0.04, 0.08):
-        if last_cap.delta + dd > st["delta_max"]:
+        if last_cap.delta + dd > st.delta_max:
             break
         deeper = solve_at_delta(scene, last_cap.delta + dd, last_cap, None, st)
         if deeper.status not in (0, 4):  # converged, possibly past the tip's end
@@ -280,10 +280,10 @@ def _wall_state_deeper(scene, last_cap, st, kw, tried):
 def _land_on_delta_max(scene, cur, prev, st, key):
     """Delta-controlled solve at delta_max from the current point: yields it where it converges;
     returns (the state, the Stop that ends the curve there or None)."""
-    sol = solve_at_delta(scene, st["delta_max"], cur, prev, st)
+    sol = solve_at_delta(scene, st.delta_max, cur, prev, st)
     if sol.success:
         yield sol, key
-        return sol, Stop(f"delta_max = {st['delta_max']:g} reached", complete=True)
+        return sol, Stop(f"delta_max = {st.delta_max:g} reached", complete=True)
     return sol, None
 
 
@@ -316,7 +316,7 @@ def _angle(cosine):
 def adaptive(scene, branch, settings):
     """The adaptive curve: yields ``(state, order key)``, returns the Stop."""
     st = settings
-    first = _first_point(scene, st["delta_start"], st)
+    first = _first_point(scene, st.delta_start, st)
     if isinstance(first, Stop):
         return first
     yield first, 0
@@ -325,15 +325,15 @@ def adaptive(scene, branch, settings):
     prev, prev2, below = first, None, None
     d = first.delta
     factor = 0.6
-    while d > st["delta_min"] and steps < st["max_steps"]:
-        nd = max(st["delta_min"], d * factor)
+    while d > st.delta_min and steps < st.max_steps:
+        nd = max(st.delta_min, d * factor)
         if is_point_load(prev):
-            sol = solve_point_load(scene, nd, tol=st["tol"], max_nodes=st["max_nodes"], guess=prev)
+            sol = solve_point_load(scene, nd, tol=st.tol, max_nodes=st.max_nodes, guess=prev)
         else:
             sol = solve_at_delta(scene, nd, prev, prev2, st)
             if scene.contact == "smooth" and prev.Sc < 1e-8 and (not sol.success or sol.Sc < SC_POINT):
                 # the cap is leaving double precision: continue with its point-load limit
-                point = solve_point_load(scene, nd, tol=st["tol"], max_nodes=st["max_nodes"], guess=prev)
+                point = solve_point_load(scene, nd, tol=st.tol, max_nodes=st.max_nodes, guess=prev)
                 sol = point if point.success else sol
         steps += 1
         if sol.success:
@@ -349,9 +349,9 @@ def adaptive(scene, branch, settings):
     if is_point_load(first):
         # the cap is below double precision there: no (delta, lambda0, F) branch to follow
         # until it comes back; natural continuation in delta instead (point-load limit or cap)
-        grid = np.linspace(first.delta, st["delta_max"], 11)
+        grid = np.linspace(first.delta, st.delta_max, 11)
         stop = yield from natural(scene, grid, branch, st, first=first, key0=steps)
-        return Stop(f"delta_max = {st['delta_max']:g} reached", complete=True) if stop is None else stop
+        return Stop(f"delta_max = {st.delta_max:g} reached", complete=True) if stop is None else stop
     scale = np.array([1.0, 1.0, 1.0])
     cur = first
     if below is not None and below.topology != first.topology:
@@ -361,14 +361,14 @@ def adaptive(scene, branch, settings):
         if not below.success:
             return Stop(f"no second point near delta = {first.delta:g}: {below.message}")
     prev = below
-    ds = min(st["ds_max"], OPTIONS.first_step * np.linalg.norm((_X(cur) - _X(prev)) / scale))
+    ds = min(st.ds_max, OPTIONS.first_step * np.linalg.norm((_X(cur) - _X(prev)) / scale))
     ds_min = 1e-4  # in (delta, lambda0, F): below this the branch is taken to end here
     force_scale = max(abs(cur.force), abs(prev.force))
     tangent = None
     crossed_from = None  # the smooth cap from which the corner was last tried
     while True:
-        if steps >= st["max_steps"]:
-            return Stop(f"max_steps = {st['max_steps']} reached")
+        if steps >= st.max_steps:
+            return Stop(f"max_steps = {st.max_steps} reached")
         rule = _stop_rule(cur, st)
         if rule:
             return Stop(rule, complete=True)
@@ -383,14 +383,14 @@ def adaptive(scene, branch, settings):
         turn = 0.0 if tangent is None else _angle(np.dot(new_tangent, tangent))
         tangent = new_tangent
         Xhat = _X(cur) + ds * tangent * scale
-        if Xhat[0] >= st["delta_max"]:
+        if Xhat[0] >= st.delta_max:
             steps += 1
             sol, stop = yield from _land_on_delta_max(scene, cur, prev, st, steps)
             if stop:
                 return stop
             ds /= 2
             if ds < ds_min:
-                return Stop(f"no solution at delta_max = {st['delta_max']:g}: {sol.message}")
+                return Stop(f"no solution at delta_max = {st.delta_max:g}: {sol.message}")
             continue
         sol = None
         crossing = near_limit(cur) and crossed_from is not cur  # the corner is tried once from each state
@@ -400,12 +400,12 @@ def adaptive(scene, branch, settings):
                 sol = _cross(cur, prev, Xhat[0], st)
                 crossed_from = cur
         if sol is None:
-            sysm = system_like(cur, "arclength", (Xhat, tangent, scale), st["eps"])
+            sysm = system_like(cur, "arclength", (Xhat, tangent, scale), st.eps)
             # no secant across a change of configuration (e.g. the smooth edge to the corner:
             # the states' difference is the jump forming, not the branch's direction)
             a = ds / max(norm, 1e-300) if configuration_key(cur) == configuration_key(prev) else 0.0
             guess = secant_guess(sysm, cur, prev, a)
-            sol = solve_from(sysm, guess, tol=st["tol"], max_nodes=step_nodes(cur, st), bc_tol=st["bc_tol"])
+            sol = solve_from(sysm, guess, tol=st.tol, max_nodes=step_nodes(cur, st), bc_tol=st.bc_tol)
             if not sol.success and crossing and crossed_from is not cur:
                 sol = _cross(cur, prev, Xhat[0], st) or sol
                 crossed_from = cur
@@ -415,7 +415,7 @@ def adaptive(scene, branch, settings):
                             f"the contact edge (Legendre determinant at Sc+ down to {cur.edge_legendre:.2g} of "
                             f"its mid-region value) and no corner state was found past it ({sol.message})")
         steps += 1
-        if sol.success and sol.delta > st["delta_max"]:  # overshot: land from the current point
+        if sol.success and sol.delta > st.delta_max:  # overshot: land from the current point
             steps += 1
             _, stop = yield from _land_on_delta_max(scene, cur, prev, st, steps)
             if stop:
@@ -427,8 +427,8 @@ def adaptive(scene, branch, settings):
                                          reason=f"the contact reached the end of the tip (the indenter's "
                                                 f"cylinder) just after delta = {cur.delta:.6g}"))
         if sol.success and sol.delta > 0:
-            if ds > PLOT_TURN_MIN_DS * st["ds_max"] \
-                    and plot_turn(prev, cur, sol, st["delta_max"], force_scale) > MAX_PLOT_TURN:
+            if ds > PLOT_TURN_MIN_DS * st.ds_max \
+                    and plot_turn(prev, cur, sol, st.delta_max, force_scale) > MAX_PLOT_TURN:
                 ds /= 2  # the force-displacement curve would bend too much in one step: a shorter one
                 continue
             yield sol, steps
@@ -443,7 +443,7 @@ def adaptive(scene, branch, settings):
                 grow = min(grow, 0.5)
             elif turn > 0.1:
                 grow = min(grow, 1.0)
-            ds = min(st["ds_max"], ds * grow)
+            ds = min(st.ds_max, ds * grow)
         else:
             ds /= 2
             if ds < ds_min:

@@ -49,7 +49,7 @@ class Recorder:
     def __init__(self, out: Curve, estimate_error, settings):
         self.out, self.estimate_error = out, estimate_error
         self.settings = settings
-        self.tol = settings["tol"]
+        self.tol = settings.tol
         self.rows = []  # (order key, row, flags, solution)
         self.since_richardson = None  # points added since the last Richardson estimate
         self.last_configuration = None
@@ -121,11 +121,11 @@ class Recorder:
         does not converge to a state of the same configuration and validity."""
         st = self.settings
         if is_point_load(sol):
-            fine = solve_point_load(sol.scene, sol.delta, tol=tol, max_nodes=st["max_nodes"], guess=sol,
-                                    bc_tol=st["bc_tol"])
+            fine = solve_point_load(sol.scene, sol.delta, tol=tol, max_nodes=st.max_nodes, guess=sol,
+                                    bc_tol=st.bc_tol)
         else:
-            fine = solve_from(sol.system, (sol.x, sol.y, sol.p), tol=tol, max_nodes=st["max_nodes"],
-                              bc_tol=st["bc_tol"])
+            fine = solve_from(sol.system, (sol.x, sol.y, sol.p), tol=tol, max_nodes=st.max_nodes,
+                              bc_tol=st.bc_tol)
         if not (fine.success and fine.valid == sol.valid
                 and configuration_key(fine) == configuration_key(sol)):
             return None

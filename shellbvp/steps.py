@@ -28,7 +28,7 @@ def solve_at_delta(scene, delta, prev, prev2, settings, prev3=None):
     prev, prev2 and prev3 where it applies, else the secant through prev and prev2."""
     if is_point_load(prev):
         return step_from_point(scene, delta, prev, settings)
-    sysm = system_like(prev, "delta", delta, settings["eps"])
+    sysm = system_like(prev, "delta", delta, settings.eps)
     guess = None
     a = secant_ratio(delta, prev, prev2)
     if a is not None and not is_point_load(prev2) and edge_model(prev2) == edge_model(prev) \
@@ -36,10 +36,10 @@ def solve_at_delta(scene, delta, prev, prev2, settings, prev3=None):
         guess = quadratic_guess(sysm, (prev, prev2, prev3), delta) or secant_guess(sysm, prev, prev2, a)
     if guess is None:
         guess = warm_guess(sysm, prev)
-    kw = dict(tol=settings["tol"], max_nodes=step_nodes(prev, settings), bc_tol=settings["bc_tol"])
+    kw = dict(tol=settings.tol, max_nodes=step_nodes(prev, settings), bc_tol=settings.bc_tol)
     sol = solve_from(sysm, guess, **kw)
     if not sol.success and delta > prev.delta and near_limit(prev):
-        sol = cross_convexity_limit(prev, prev2, delta, eps=settings["eps"], **kw) or sol
+        sol = cross_convexity_limit(prev, prev2, delta, eps=settings.eps, **kw) or sol
     return sol
 
 
@@ -48,15 +48,15 @@ def step_from_point(scene, delta, prev, settings):
     come back within double precision: a cold solve finds the cap there, or the point-load
     limit again; shallower, the point-load limit from ``prev``."""
     if delta > prev.delta:  # (solve takes a point-load guess for its point-load limit only)
-        return solve(scene, delta=delta, guess=prev, tol=settings["tol"], max_nodes=settings["max_nodes"],
-                     bc_tol=settings["bc_tol"], estimate_error=False, topology="cap")
-    return solve_point_load(scene, delta, tol=settings["tol"], max_nodes=settings["max_nodes"], guess=prev)
+        return solve(scene, delta=delta, guess=prev, tol=settings.tol, max_nodes=settings.max_nodes,
+                     bc_tol=settings.bc_tol, estimate_error=False, topology="cap")
+    return solve_point_load(scene, delta, tol=settings.tol, max_nodes=settings.max_nodes, guess=prev)
 
 
 def step_nodes(prev, settings):
     """Node budget of one continuation step: a few times the previous mesh, so that a
     step towards a singularity (e.g. a boundary layer forming) fails fast and is halved."""
-    return int(min(settings["max_nodes"], max(2000, 4 * prev.nodes)))
+    return int(min(settings.max_nodes, max(2000, 4 * prev.nodes)))
 
 
 def quadratic_guess(sysm, states, at):

@@ -91,11 +91,11 @@ def locate_switches(builder, st):
     the indenter; cap <-> contact on the cylinder: the free shell's gap to the cylinder, or the
     contact's margin to the tip's end).  The root is found by regula falsi (Illinois) on that
     configuration's states; the point is added to an adaptive curve, and every switch is
-    listed in ``settings["topology_switches"]``.  The corner edge and the paper cap held at the
-    tip's end are located from the caps' edge models.
+    handed to ``builder.switch_located`` (the curve lists them in ``settings["topology_switches"]``;
+    ``st``, the :class:`~shellbvp.curve_settings.CurveSettings`, is only read).  The corner edge and
+    the paper cap held at the tip's end are located from the caps' edge models.
     """
     scene = builder.out.scene
-    switches = st.setdefault("topology_switches", [])
     rows = sorted(builder.rows, key=lambda r: r[0])
 
     def cap_at(d, near):
@@ -116,7 +116,7 @@ def locate_switches(builder, st):
         c1, c2 = cap_of(s1), cap_of(s2)
         if c1 is not None and c2 is not None and c1.success and c2.success \
                 and (edge_model(c1), edge_model(c2)) == ("smooth", "corner"):
-            switches.append(locate_corner_switch(c1, c2, st))
+            builder.switch_located(locate_corner_switch(c1, c2, st))
             continue
         if s1.valid and s2.valid and (edge_model(s1), edge_model(s2)) == ("paper", "pinned"):
             # the free cap's edge reaches the tip's end: from the caps either side of it
@@ -124,7 +124,7 @@ def locate_switches(builder, st):
             if ends[1] is not None and ends[1].status in (0, 4) and ends[0].tip_end_margin > 0 > ends[1].tip_end_margin:
                 best = regula_falsi(ends[0].delta, ends[0].tip_end_margin, ends[0], ends[1].delta,
                                      ends[1].tip_end_margin, ends[1], cap_end_at)
-                _add_switch(builder, st, switches, best, "cap", "cap (pinned at the tip's end)", k1, k2,
+                _add_switch(builder, st, best, "cap", "cap (pinned at the tip's end)", k1, k2,
                             "tip_end_margin")
             continue
         frm, to = s1.topology, s2.topology
@@ -162,7 +162,7 @@ def locate_switches(builder, st):
             return sol, sign * _criterion_value(sol, criterion)
 
         best = regula_falsi(e1.delta, f1, e1, e2.delta, f2, e2, solve_at)
-        _add_switch(builder, st, switches, best, frm, to, k1, k2, criterion)
+        _add_switch(builder, st, best, frm, to, k1, k2, criterion)
 
 
 def locate_corner_switch(smooth, corner, st, h=0.003):
@@ -176,25 +176,25 @@ def locate_corner_switch(smooth, corner, st, h=0.003):
     out of the smooth branch (a continuous switch); F and E extrapolated from each side give
     their jumps at the switch.
     """
-    kw = dict(tol=st["tol"], max_nodes=step_nodes(smooth, st), bc_tol=st["bc_tol"])  # fail fast
-    sysm = system_like(smooth, "delta", 0.98 * smooth.delta, st["eps"])
+    kw = dict(tol=st.tol, max_nodes=step_nodes(smooth, st), bc_tol=st.bc_tol)  # fail fast
+    sysm = system_like(smooth, "delta", 0.98 * smooth.delta, st.eps)
     d0 = limit_estimate(solve_from(sysm, warm_guess(sysm, smooth), **kw), smooth)
     d0 = d0 if d0 is not None and smooth.delta < d0 < corner.delta else 0.5 * (smooth.delta + corner.delta)
     lo = [smooth]
     for d in sorted((d0 - k * h for k in (1, 2, 3)), key=lambda d: abs(d - smooth.delta)):
-        sysm = system_like(lo[-1], "delta", d, st["eps"])
+        sysm = system_like(lo[-1], "delta", d, st.eps)
         s = solve_from(sysm, warm_guess(sysm, lo[-1]), **kw)
         if s.success and edge_model(s) == "smooth":
             lo.append(s)
     lo = sorted(lo[1:], key=lambda s: s.delta)
-    first = cross_convexity_limit(lo[-1], lo[0] if len(lo) > 1 else None, d0 + h, eps=st["eps"], exact=False,
+    first = cross_convexity_limit(lo[-1], lo[0] if len(lo) > 1 else None, d0 + h, eps=st.eps, exact=False,
                                   **kw) if lo else None
-    hi = [first] if first is not None and is_corner(first, st["tol"]) else []
+    hi = [first] if first is not None and is_corner(first, st.tol) else []
     for k in (1, 2):
         if hi:
-            sysm = system_like(hi[-1], "delta", hi[0].delta + k * h, st["eps"])
+            sysm = system_like(hi[-1], "delta", hi[0].delta + k * h, st.eps)
             s = solve_from(sysm, warm_guess(sysm, hi[-1]), **kw)
-            if is_corner(s, st["tol"]):
+            if is_corner(s, st.tol):
                 hi.append(s)
 
     def root(states, key):
@@ -239,18 +239,18 @@ def cap_solved_at(scene, topology, d, near, st):
 
 def wall_state_at(sol, topology, st):
     """The ``topology`` wall state at a recorded wall point's delta (from it), or None."""
-    line = wall_state(sol, topology, tol=st["tol"], max_nodes=st["max_nodes"], bc_tol=st["bc_tol"])
+    line = wall_state(sol, topology, tol=st.tol, max_nodes=st.max_nodes, bc_tol=st.bc_tol)
     return line if line.success and not math.isnan(line.curvature_excess) else None
 
 
 def wall_solved_at(scene, topology, d, near, st):
-    return wall_state(near, topology, control="delta", value=d, tol=st["tol"], max_nodes=st["max_nodes"],
-                      bc_tol=st["bc_tol"])
+    return wall_state(near, topology, control="delta", value=d, tol=st.tol, max_nodes=st.max_nodes,
+                      bc_tol=st.bc_tol)
 
 
 def lifted_solved_at(scene, topology, d, near, st):
-    return solve_liftoff(scene, topology, delta=d, guess=near, tol=st["tol"], max_nodes=st["max_nodes"],
-                         bc_tol=st["bc_tol"])
+    return solve_liftoff(scene, topology, delta=d, guess=near, tol=st.tol, max_nodes=st.max_nodes,
+                         bc_tol=st.bc_tol)
 
 
 def _touchdown_bracket(states, delta):
@@ -285,7 +285,7 @@ def line_state_at(sol, topology, st):
     cap = cap_of(sol)
     if cap is None:
         return None
-    line = liftoff_state(cap, topology, tol=st["tol"], max_nodes=st["max_nodes"], bc_tol=st["bc_tol"])
+    line = liftoff_state(cap, topology, tol=st.tol, max_nodes=st.max_nodes, bc_tol=st.bc_tol)
     return line if line.success and not math.isnan(line.curvature_excess) else None
 
 
@@ -296,12 +296,12 @@ def _criterion_value(state, criterion):
     return min(value, 1.0) if criterion == "wall_gap" else value
 
 
-def _add_switch(builder, st, switches, best, frm, to, k1, k2, criterion):
-    switches.append({"delta": float(best.delta), "force": float(best.force), "from": frm, "to": to,
-                     "criterion": criterion, "value": float(getattr(best, criterion))})
+def _add_switch(builder, st, best, frm, to, k1, k2, criterion):
+    builder.switch_located({"delta": float(best.delta), "force": float(best.force), "from": frm, "to": to,
+                            "criterion": criterion, "value": float(getattr(best, criterion))})
     log.info("topology switch %s -> %s at delta = %.6g", frm, to, best.delta)
     already = any(abs(r[3].delta - best.delta) <= 1e-12 * (1 + best.delta) for r in builder.rows)
-    if st["mode"] == "adaptive" and not already:  # a curve at requested depths keeps exactly those
+    if st.mode == "adaptive" and not already:  # a curve at requested depths keeps exactly those
         builder.add(best, 0.5 * (k1 + k2))
 
 

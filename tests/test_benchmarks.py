@@ -271,5 +271,12 @@ def test_the_structure_census_holds_what_the_redesign_reached():
     assert set(census["name_comparisons"]) <= {"configurations.registry"}, census["name_comparisons"]
     # no function of the package named in a "module:function" string (issue 57: 16 at 011499a)
     assert census["string_hooks"] == {}, census["string_hooks"]
+    # a curve's settings are written by their owner only (issue 57: 5 writes below continuation at 8e0f2e3)
+    assert census["settings_writes"] == {}, census["settings_writes"]
+    import ast
+    seen = _load("architecture")._settings_write
+    writes = ['st["x"] = 1', 'del curve.settings["x"]', 'st.setdefault("x", [])', 'settings["x"].append(1)']
+    assert all(any(seen(n) for n in ast.walk(ast.parse(w))) for w in writes)
+    assert not any(seen(n) for n in ast.walk(ast.parse('y = st["x"] + settings.get("x", 0)')))
     from shellbvp.configurations import CONFIGURATION_NAMES
     assert _load("architecture").configuration_names(BENCH.parent) == set(CONFIGURATION_NAMES)

@@ -200,6 +200,25 @@ def test_hdf5_round_trip(base_curve, tmp_path):
     assert not list(tmp_path.glob(".*.tmp"))  # no temporary files left behind
 
 
+def test_curve_settings_are_a_frozen_record_and_the_file_keeps_them(base_curve, tmp_path):
+    """The curve's settings are read from a frozen record; the curve (and its file) keeps them as
+    one dict, with what the run learned beside them (issue 57)."""
+    import dataclasses
+
+    from shellbvp.curve_settings import CurveSettings
+
+    st = CurveSettings.from_dict(base_curve.settings)
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        st.tol = 1e-3
+    assert st.mode == "adaptive" and st.solver == dict(tol=st.tol, max_nodes=st.max_nodes, bc_tol=1e-10)
+    assert {k: base_curve.settings[k] for k in st.to_dict()} == st.to_dict()
+    assert {"wall_time", "after_last_point_s", "topology_switches"} <= set(base_curve.settings) - set(st.to_dict())
+    base_curve.to_hdf5(tmp_path / "c.h5")
+    assert CurveSettings.from_dict(sb.read_curve(tmp_path / "c.h5").settings) == st
+    with pytest.raises(ValueError, match="lack tol"):
+        CurveSettings.from_dict({k: v for k, v in st.to_dict().items() if k != "tol"})
+
+
 def test_user_scene_round_trips_through_hdf5(tmp_path):
     scene = sb.Scene.preset("base", material=sb.StrainEnergy(
         "(lambda_s**2 + lambda_theta**2 + 1/(lambda_s*lambda_theta)**2 - 3)/2"))
