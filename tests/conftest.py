@@ -35,11 +35,22 @@ def pytest_collection_modifyitems(config, items):
 os.environ.setdefault("SHELLBVP_KERNELS", "numpy")
 
 
+def _run_code_cache(tmp_path_factory):
+    """A fresh code cache for this run, one for all its xdist workers: each structure is derived
+    once per run rather than once per worker (the cache writes atomically, so two workers
+    deriving the same structure at once both write a whole module)."""
+    if not os.environ.get("PYTEST_XDIST_WORKER"):
+        return tmp_path_factory.mktemp("codecache")
+    shared = tmp_path_factory.getbasetemp().parent / "codecache"  # the run's root, beside popen-gw*
+    shared.mkdir(mode=0o700, exist_ok=True)
+    return shared
+
+
 @pytest.fixture(scope="session", autouse=True)
 def _fresh_code_cache(tmp_path_factory):
-    """Generate code into a private cache: the tests exercise the derivation."""
+    """Generate code into a fresh cache: the tests exercise the derivation."""
     old = os.environ.get("SHELLBVP_CACHE_DIR")
-    os.environ["SHELLBVP_CACHE_DIR"] = str(tmp_path_factory.mktemp("codecache"))
+    os.environ["SHELLBVP_CACHE_DIR"] = str(_run_code_cache(tmp_path_factory))
     yield
     if old is None:
         os.environ.pop("SHELLBVP_CACHE_DIR", None)

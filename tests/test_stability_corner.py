@@ -34,6 +34,19 @@ def base_scene():
     return sb.Scene.preset("base")
 
 
+#: The depths the tests analyse, solved once along one curve: a cold solve past the convexity
+#: limit costs ~8 s of CPU, the curve through all of them ~2 s (the same states to 1e-9 in F).
+DEPTHS = (0.3, 0.6, 0.61, 0.62, 0.7, 0.8, 0.9)
+
+
+@pytest.fixture(scope="module")
+def state_at(base_scene):
+    """The base scene's state at one of DEPTHS (the tests read the state, not its error estimate)."""
+    c = sb.curve(base_scene, deltas=DEPTHS, estimate_error=False)
+    assert c.complete and list(c.delta) == list(DEPTHS), c.stop_reason
+    return dict(zip(DEPTHS, c.solutions)).__getitem__
+
+
 def _exact_and_form(state, d=0.05, slopes=(3.0, -2.0), w2=4.0, elements=640):
     """(exact, form): the eta^2 coefficient of the energy along a path at n = 0, exactly and
     from the discrete form (pi q^T K q at n = 0, module docstring).
@@ -136,19 +149,19 @@ def _exact_and_form(state, d=0.05, slopes=(3.0, -2.0), w2=4.0, elements=640):
 
 
 @pytest.mark.parametrize("delta", [0.7, 0.9])
-def test_the_corner_term_gives_the_exact_energy(base_scene, delta):
+def test_the_corner_term_gives_the_exact_energy(state_at, delta):
     """Measured: 7e-7 (delta 0.7) and 5e-6 (0.9) relative; the smooth edge's own check at delta 0.6
     gives 1.3e-4 (the edge's motion, O(eta^3), in the difference quotient)."""
-    state = sb.solve(base_scene, delta=delta)
+    state = state_at(delta)
     assert state.contact_edge == "corner" and abs(state.edge_jump_ls) > 0.1
     exact, form = _exact_and_form(state)
     assert abs(form - exact) < 3e-5 * abs(exact)
 
 
-def test_without_the_corner_term_the_energy_is_wrong(base_scene, monkeypatch):
+def test_without_the_corner_term_the_energy_is_wrong(state_at, monkeypatch):
     """The check can fail: without the term the form misses 25 % at delta 0.8, with the free side's
     moment on both sides 0.4 %."""
-    state = sb.solve(base_scene, delta=0.8)
+    state = state_at(0.8)
     exact, _ = _exact_and_form(state, elements=160)
     corner_energy = fem.corner_energy
     monkeypatch.setattr(fem, "corner_energy", lambda c, i, n, hs: (corner_energy(c, i, n, hs)[0], np.zeros((8, 8))))
@@ -158,10 +171,10 @@ def test_without_the_corner_term_the_energy_is_wrong(base_scene, monkeypatch):
     assert abs(_exact_and_form(state, elements=160)[1] - exact) > 1e-3 * exact
 
 
-def test_cornered_caps_converge_in_the_mesh(base_scene, monkeypatch):
+def test_cornered_caps_converge_in_the_mesh(state_at, monkeypatch):
     """n = 0..5 at delta 0.8 with 40 and 160 elements within 1e-4; without the corner's term the
     smallest eigenvalue was -4.6 at 80 elements and -90 at 160 (measured)."""
-    state = sb.solve(base_scene, delta=0.8)
+    state = state_at(0.8)
     coarse = st.stability(state, modes=range(6), elements=40)
     fine = st.stability(state, modes=range(6), elements=160)
     assert coarse.stable and fine.stable
@@ -175,24 +188,24 @@ def test_cornered_caps_converge_in_the_mesh(base_scene, monkeypatch):
     assert without.minimum < -10
 
 
-def test_the_corner_joins_the_smooth_edge(base_scene):
+def test_the_corner_joins_the_smooth_edge(state_at):
     """Where the corner is born (delta 0.61 smooth, 0.62 corner with a jump of 0.011) the n = 0, 2, 3
     eigenvalues step as they did along the smooth branch from 0.60 to 0.61 (measured: 2.8e-4,
     0.0259, 0.0347 against 3.7e-4, 0.0260, 0.0341; n = 1 has a layer at the edge that needs more
     elements there)."""
-    states = [sb.solve(base_scene, delta=d) for d in (0.60, 0.61, 0.62)]
+    states = [state_at(d) for d in (0.60, 0.61, 0.62)]
     assert [s.contact_edge for s in states] == ["smooth", "smooth", "corner"]
     a, b, c = (st.stability(s, modes=[0, 2, 3], elements=160).smallest for s in states)
     assert np.all(np.abs(c - b) < 1.5 * np.abs(b - a))
 
 
 # -- the pole's rounding floor --------------------------------------------------------------------
-def test_a_negative_eigenvalue_that_moves_with_the_mesh_start_is_refused(base_scene, monkeypatch):
+def test_a_negative_eigenvalue_that_moves_with_the_mesh_start_is_refused(state_at, monkeypatch):
     """A negative eigenvalue is recomputed with the mesh starting 10 times further from the pole:
     one that keeps its sign and value (the cap at delta 0.3 with a negative shift standing in for a
     genuine instability) is reported; one that changes sign (the pole's floor, as on a thick shell's
     lifted pole near its fold) is refused in one line."""
-    state = sb.solve(base_scene, delta=0.3)
+    state = state_at(0.3)
     spectrum = st.spectrum
 
     def shifted(depends_on_S0):
@@ -210,11 +223,11 @@ def test_a_negative_eigenvalue_that_moves_with_the_mesh_start_is_refused(base_sc
         st.stability(state, modes=[0, 1], elements=40)
 
 
-def test_a_negative_eigenvalue_is_recomputed_on_a_finer_mesh(monkeypatch):
+def test_a_negative_eigenvalue_is_recomputed_on_a_finer_mesh(state_at, monkeypatch):
     """Next to the convexity limit the default mesh does not resolve the edge's layer (measured on
     the grid's gamma = 2 at delta 0.739: n = 1 at -1.66, 0.418, 0.933 with 40, 160, 640 elements):
     a negative eigenvalue is recomputed with 4 times the elements and the finer one kept."""
-    state = sb.solve(sb.Scene.preset("base"), delta=0.3)
+    state = state_at(0.3)
     spectrum = st.spectrum
 
     def coarse_is_wrong(scene, base_of, S0, L, modes=None, elements=None, **kw):
