@@ -37,6 +37,14 @@ from make_force_map import write_map  # noqa: E402  (a script beside this one)
 COMMAND = ["fit", "{map}", "--preset", "fit", "--radius", "10um", "-o", "{out}"]
 
 
+def commit_of(checkout) -> str:
+    """The checkout's short commit, with ``+`` when it has changes not committed."""
+    def git(*a):
+        return subprocess.run(["git", "-C", str(checkout), *a], capture_output=True, text=True).stdout.strip()
+
+    return (git("rev-parse", "--short", "HEAD") or "?") + ("+" if git("status", "--porcelain", "--", "shellbvp") else "")
+
+
 def run(argv, env, cwd):
     """(wall s, CPU s, peak RSS MiB, exit status) of one ``python -m shellbvp`` process; SystemExit
     unless it wrote its map (exit 0, or 1: some curve failed its checks)."""
@@ -84,7 +92,8 @@ def main(argv=None):
             rows.setdefault(side, {})[n] = {"cold": cold, "warm": warm}
             print(f"{side} {n} x {n}: cold {cold[0]:.1f} s (CPU {cold[1]:.1f} s), warm {warm[0]:.1f} s "
                   f"(CPU {warm[1]:.1f} s), peak {max(cold[2], warm[2]):.0f} MiB", flush=True)
-    result = {"sizes": sizes, "command": " ".join(COMMAND), "rows": rows, "load": os.getloadavg()}
+    result = {"sizes": sizes, "command": " ".join(COMMAND), "rows": rows, "load": os.getloadavg(),
+              "commits": {side: commit_of(path) for side, path in sides.items()}}
     out = Path(args.out_dir)
     out.mkdir(parents=True, exist_ok=True)
     stem = "map_scaling-large" if args.large else "map_scaling"
@@ -99,6 +108,7 @@ def report(res) -> str:
     lines = [f"# Force maps of n x n curves: `shellbvp {res['command']}`", "",
              "Wall and CPU (user + system) seconds; ratio: to the 16 x 16 map of the same side, cache and run "
              f"(target: 64 x 64 within 6x); exit 1: the map was written, some curve failed its checks. Load average at the end: {res['load'][0]:.1f}.", "",
+             "Packages: " + ", ".join(f"{side} {c}" for side, c in res["commits"].items()) + ".", "",
              "| package | map | cache | wall (s) | CPU (s) | peak (MiB) | wall ratio | CPU ratio | curves ratio | exit |",
              "|---|---|---|---|---|---|---|---|---|---|"]
     for side, by_n in res["rows"].items():

@@ -36,8 +36,15 @@ _SEGMENT_FOLDER = re.compile(r"^(.*?segments/\d+/)")
 
 
 def _reader_class():
+    """:class:`ArchiveReader`, or None when afmformats' reader is not built as this one expects
+    (another version: its own loader is used)."""
     from afmformats.formats.fmt_jpk import jpk_data
     from afmformats.formats.fmt_jpk.jpk_reader import ArchiveCache, JPKReader
+
+    if not (hasattr(getattr(JPKReader.files, "fget", None), "__wrapped__")
+            and hasattr(JPKReader._get_index_segment_properties, "__wrapped__")
+            and hasattr(JPKReader.get_metadata, "cache_clear")):
+        return None
 
     class Members(list):
         """The archive's sorted member names, with O(1) membership and members per segment folder."""
@@ -107,16 +114,18 @@ def _reader_class():
 def jpk_datasets(path, meta_override=None):
     """afmformats' curves (``AFMForceDistance``) of a JPK archive, one at a time, or None when the
     file is no force-distance measurement (creep compliance, stress relaxation: left to
-    ``afmformats.load_data``).  Read each curve's columns before taking the next."""
+    ``afmformats.load_data``), as when afmformats' reader is not the one this module extends.
+    Read each curve's columns before taking the next."""
     from afmformats.formats import formats_by_suffix
     from afmformats.lazy_loader import LazyData
     from afmformats.meta import LazyMetaValue
     from afmformats.mod_force_distance import AFMForceDistance
 
     recipes = formats_by_suffix.get(Path(path).suffix)
-    if not recipes:
+    reader_class = _reader_class()
+    if not recipes or reader_class is None:
         return None
-    reader = _reader_class()(str(path))
+    reader = reader_class(str(path))
     reader.set_metadata(dict(meta_override or {}))
     if reader.get_imaging_mode() != "force-distance":
         return None
