@@ -45,3 +45,17 @@ def test_each_property_file_is_parsed_once(monkeypatch):
     per_segment = [p for p in parsed if p.endswith("segment-header.properties")]
     assert len(curves) == 4
     assert len(per_segment) == len(set(per_segment)) == 4 * 2, sorted(per_segment)
+
+
+def test_another_afmformats_reader_falls_back_to_its_own_loader(monkeypatch):
+    """When afmformats' reader is not built as shellbvp.afm_jpk expects (another version), the
+    file is read by afmformats.load_data: the same curves."""
+    from shellbvp import afm_jpk
+
+    ours = read_afm(QI)
+    monkeypatch.setattr(afm_jpk, "_reader_class", lambda: None)
+    assert afm_jpk.jpk_datasets(QI) is None
+    theirs = read_afm(QI)
+    assert [c.grid for c in theirs] == [c.grid for c in ours]
+    for a, b in zip(ours, theirs):
+        np.testing.assert_array_equal(a.record.force, b.record.force)
