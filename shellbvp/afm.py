@@ -206,14 +206,15 @@ class ForceMap:
     def warning_counts(self) -> dict:
         """``{code: (grid cells or indices of the curves with that warning, its first text)}``
         over the curves fitted (codes of :data:`shellbvp.fit_checks.FIT_WARNINGS`)."""
-        out = {}
+        out, seen = {}, set()  # seen: (code, cell), so that a map's cells are not searched per curve
         for c, row in zip(self.curves, self.rows):
             if row.result is None or row.status == "error":
                 continue
             cell = c.grid if c.grid is not None else c.index
             for code, text in zip(row.result.warning_codes, row.result.warnings):
                 where, _ = out.setdefault(code, ([], text))
-                if cell not in where:
+                if (code, cell) not in seen:
+                    seen.add((code, cell))
                     where.append(cell)
         return out
 

@@ -28,6 +28,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .afm_jpk import JPK_SUFFIXES, jpk_datasets
 from .textdata import printable
 
 __all__ = ["AFM_SUFFIXES", "AFMCurve", "is_afm_file", "afm_text_format", "read_afm", "curves_from_afm",
@@ -183,11 +184,15 @@ def read_afm(path, *, spring_constant=None, sensitivity=None) -> list:
     check_afm_sizes(path, size)
     override = _calibration(path, spring_constant, sensitivity)
     with afmformats_boundary(path):
-        datasets = afmformats.load_data(str(path), meta_override=override)
-        if not datasets:
-            raise AFMFileError(f"{printable(path)}: afmformats found no force-distance curve in it")
+        # a JPK archive curve by curve (time linear in its curves: shellbvp.afm_jpk)
+        datasets = jpk_datasets(path, override) if str(path).endswith(JPK_SUFFIXES) else None
+        if datasets is None:
+            datasets = afmformats.load_data(str(path), meta_override=override)
         # afmformats loads a curve's columns when they are first read: inside the boundary too
-        return curves_from_afm(datasets, path, sha256=sha256_of(path))
+        curves = curves_from_afm(datasets, path, sha256=sha256_of(path))
+        if not curves:
+            raise AFMFileError(f"{printable(path)}: afmformats found no force-distance curve in it")
+        return curves
 
 
 def _calibration(path, spring_constant, sensitivity):
