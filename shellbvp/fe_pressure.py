@@ -70,25 +70,24 @@ class FollowerPressure:
 
     def gradient(self, u):
         """``dV/du`` (full size)."""
-        scale, P = self.scale, self.P
-        self.scale, self.P = 1.0, -1.0
-        try:
-            return self.evaluate(u, False)[0]
-        finally:
-            self.scale, self.P = scale, P
+        return self._times_gradient(u, 1.0, False)[0]
 
     def evaluate(self, u, with_matrix=True):
-        """``(r, K)``: the residual's part ``-scale f`` (full size) and its derivative (sparse, or
-        None) at the displacement ``u`` (the displacement field's values, flat)."""
+        """``(r, K)``: the residual's part ``-scale P dV/du`` (full size) and its derivative
+        (sparse, or None) at the displacement ``u`` (the displacement field's values, flat)."""
+        return self._times_gradient(u, -self.scale * self.P, with_matrix)
+
+    def _times_gradient(self, u, factor, with_matrix):
+        """``factor * dV/du`` and, with ``with_matrix``, ``factor`` times V's Hessian."""
         x, rq, dx = self._surface(u)                                                   # rq: (e, g)
         m = np.stack([dx[..., 1], -dx[..., 0]], axis=-1)                               # n ds / dxi
-        c = -self.scale * self.P * 2 * np.pi * self.w[None, :]                         # the residual's sign
+        c = factor * 2 * np.pi * self.w[None, :]
         vec = np.einsum("eg,ga,egi->eai", c * rq, self.N, m)                          # (e, 3, 2)
         r = np.zeros(self.ndof)
         np.add.at(r, self.dof.ravel(), vec.ravel())
         # the closing cylinder: d(pi r_e^2 (z_e - z_e0)) less the surface's end term pi r_e^2 dz_e
         z_e, r_e = np.asarray(u)[2 * self.end: 2 * self.end + 2] + self.X[self.end]
-        ce = -self.scale * self.P * 2 * np.pi
+        ce = factor * 2 * np.pi
         r[2 * self.end + 1] += ce * r_e * (z_e - self.z_end)
         if not with_matrix:
             return r, None
@@ -100,9 +99,9 @@ class FollowerPressure:
         blk[:, :, 0, :, 1] += np.einsum("eg,ga,gb->eab", c * rq, self.N, self.dN)
         blk[:, :, 1, :, 0] -= np.einsum("eg,ga,gb->eab", c * rq, self.N, self.dN)
         full = blk.reshape(e, 6, 6)
-        rows = np.r_[np.broadcast_to(self.dof[:, :, None], full.shape).ravel(), [2 * self.end + 1] * 3]
-        cols = np.r_[np.broadcast_to(self.dof[:, None, :], full.shape).ravel(),
-                     2 * self.end + 1, 2 * self.end, 2 * self.end + 1]
-        vals = np.r_[full.ravel(), ce * (z_e - self.z_end), ce * r_e, 0.0]  # d/dr_e, d/dz_e of the end term
+        end_r, end_z = 2 * self.end + 1, 2 * self.end
+        rows = np.r_[np.broadcast_to(self.dof[:, :, None], full.shape).ravel(), end_r, end_r]
+        cols = np.r_[np.broadcast_to(self.dof[:, None, :], full.shape).ravel(), end_r, end_z]
+        vals = np.r_[full.ravel(), ce * (z_e - self.z_end), ce * r_e]  # d/dr_e, d/dz_e of the end term
         K = coo_matrix((vals, (rows, cols)), shape=(self.ndof, self.ndof)).tocsr()
         return r, K
