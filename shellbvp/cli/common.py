@@ -317,6 +317,14 @@ def add_scene_options(p, uncertain=False, preset_required=False, solver=("tol", 
     tip.add_argument("--rho", type=kind, help=f"indenter radius / rim radius (> 0){note}")
     tip.add_argument("--indenter-radius", type=quantity("length"), dest="indenter_radius",
                      help="the indenter's tip radius with its unit (with --radius): rho = it / R_L")
+    tip.add_argument("--flat-tip", action="store_true", default=None, dest="flat_tip",
+                     help="the indenter is a flat plate (FlatTip: no radius)")
+    g.add_argument("--closed", action="store_true", default=None,
+                   help="a complete spheroid (a cell, capsule or pollen grain) instead of a shell held on its rim: "
+                        "--radius is its equatorial radius, --gamma (or --rise) its polar semi-axis over it")
+    g.add_argument("--support", choices=("substrate", "plates"),
+                   help="with --closed: resting on a rigid plane (default) or compressed between two plates; "
+                        "both under a flat plate (--flat-tip) for now")
     g.add_argument("--beta", type=kind, help=f"bending stiffness B/(mu R_L^2) (> 0){note}")
     g.add_argument("--thickness", type=thickness_value,
                    help="shell thickness: H/R_L in (0, 0.5], or with a unit (50um) together with --radius; "
@@ -357,8 +365,11 @@ def add_scene_options(p, uncertain=False, preset_required=False, solver=("tol", 
 def scene_from_args(args):
     import shellbvp as sb
 
-    over = {k: getattr(args, k) for k in ("gamma", "rho", "beta", "xi", "contact", "sealed", "transverse_shear")
+    over = {k: getattr(args, k) for k in ("gamma", "rho", "beta", "xi", "contact", "sealed", "transverse_shear",
+                                          "closed", "support")
             if getattr(args, k, None) is not None}
+    if getattr(args, "flat_tip", None):
+        over["tip"] = sb.FlatTip()
     if args.alpha is not None:
         over["material"] = sb.MooneyRivlin(args.alpha)
     elif args.gent_jm is not None:
