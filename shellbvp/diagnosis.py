@@ -14,7 +14,7 @@ import math
 
 import numpy as np
 
-from .chain import FREE_STATES, ContactPole, Edge, FreePole, Line, PointPole, TipEnd
+from .chain import FREE_STATES, ContactPole, Edge, FreePole, Line, PointPole, Seam, TipEnd
 from .solution import STATE_NUMBERS, Solution, penetration, set_status, wall_gap
 from .thickness import shear_delta
 
@@ -24,9 +24,13 @@ _LS, _LT = FREE_STATES.index("ls"), FREE_STATES.index("lt")
 
 
 def _edges(sysm):
-    """(S point, inner region, outer region) of each contact edge and line, pole to rim."""
+    """(S point, inner region, outer region) of each contact edge and line, pole to rim (of a
+    closed shell on a substrate: its upper half's, on the tip)."""
     out = []
+    upper = set(_halves(sysm)[0])
     for j in sysm.junctions:
+        if isinstance(j, (Edge, Line)) and (j.kc if isinstance(j, Edge) else j.k) not in upper:
+            continue
         if isinstance(j, Edge):
             inner, outer = min(j.kc, j.kf), max(j.kc, j.kf)
             out.append((sysm.regions[inner].end, inner, outer))
@@ -135,7 +139,9 @@ def diagnose(sysm, bvp, tol, converged_note: str = "", result: type = Solution) 
     ya, yb = bvp.y[:, 0], bvp.y[:, -1]
     force, delta = sysm.end_values(ya, yb, p)
     par = sysm.par
-    first = sysm.chain.junctions[0]
+    # the upper pole (a closed shell on a substrate declares its lower half's junctions first)
+    first = next((j for j in sysm.chain.junctions if isinstance(j, (ContactPole, FreePole, PointPole)) and j.k == 0),
+                 sysm.chain.junctions[0])
     lambda0 = (q["lambda0"] if isinstance(first, ContactPole)
                else ya[sysm.rows(0)][_LS] if isinstance(first, FreePole) else nan)
     edges = _edges(sysm)
@@ -159,9 +165,10 @@ def diagnose(sysm, bvp, tol, converged_note: str = "", result: type = Solution) 
     if not finite:
         flags.append("non-finite state")
     elif bvp.status == 0:
-        bounds = [sysm.S_point(r.start, p) for r in sysm.regions] + [sysm.L]
-        if not (bounds[0] > 0 and np.all(np.diff(bounds) > 0)):
-            flags.append("region boundaries not ordered inside (0, L): " + ", ".join(f"{b:.3g}" for b in bounds))
+        for half in _halves(sysm):  # each half of a closed shell on a substrate from its own pole
+            bounds = [sysm.S_point(sysm.regions[k].start, p) for k in half] + [sysm.L]
+            if not (bounds[0] > 0 and np.all(np.diff(bounds) > 0)):
+                flags.append("region boundaries not ordered inside (0, L): " + ", ".join(f"{b:.3g}" for b in bounds))
         stretches = [bvp.y[sysm.offsets[k] + (_LS if r.kind == "free" else 1)] for k, r in enumerate(sysm.regions)]
         stretches += [bvp.y[sysm.offsets[k] + _LT] for k, r in enumerate(sysm.regions) if r.kind == "free"]
         if (math.isfinite(lambda0) and lambda0 <= 0) or any(np.any(s <= 0) for s in stretches):
@@ -199,8 +206,10 @@ def diagnose(sysm, bvp, tol, converged_note: str = "", result: type = Solution) 
         ref = 0.0 if (k == 0 and isinstance(first, FreePole)) else G[0]
         defect = max(defect, float(np.max(np.abs(G - ref))))
     res.force_defect = defect
-    res.penetration = max(penetration(sysm, f["r"], f["z"], res.z_tip) for _, f in free)
-    res.wall_gap = min(wall_gap(sysm, f["r"], f["z"], res.z_tip) for _, f in free)
+    below = set(_halves(sysm)[1]) if len(_halves(sysm)) > 1 else set()  # the half on the substrate
+    res.penetration = max(float(np.max(f["z"])) - sysm.pole_height if k in below
+                          else penetration(sysm, f["r"], f["z"], res.z_tip) for k, f in free)
+    res.wall_gap = min(wall_gap(sysm, f["r"], f["z"], res.z_tip) for k, f in free if k not in below)
     last = len(sysm.regions) - 1
     t_leg = np.array([0.0, 0.5])
     leg = sysm.kernels.active.free_legendre(sysm.S(last, t_leg, p), bvp.sol(t_leg)[sysm.rows(last)], par)[0]
@@ -225,7 +234,7 @@ def diagnose(sysm, bvp, tol, converged_note: str = "", result: type = Solution) 
             admissible.append("the contact on the cylinder runs back onto the tip")
     for j in sysm.junctions:
         if isinstance(j, Line):
-            w = q["chi1"] * sysm.S_point(sysm.regions[j.k].end, p) / sysm.scene.rho
+            w = q[j.chi] * sysm.S_point(sysm.regions[j.k].end, p) / sysm.scene.rho
             if j.on == "contact" and w > omega_max * (1 + 1e-9):
                 admissible.append("the contact has passed the end of the tip (the indenter's cylinder)")
                 past_end = True
@@ -239,7 +248,7 @@ def diagnose(sysm, bvp, tol, converged_note: str = "", result: type = Solution) 
         vflags.append(f"negative point force ({force:.3g})")
     scale = 10 * tol * (1 + abs(force))
     for k, f in contact:
-        where = "the cylinder" if sysm.regions[k].kind == "cylinder" else "the tip"
+        where = {"cylinder": "the cylinder", "plane": "the substrate"}.get(sysm.regions[k].kind, "the tip")
         if float(np.min(f["P"])) < -scale:
             vflags.append(f"negative contact pressure on {where} (min P = {float(np.min(f['P'])):.3g})")
     for (pt, _, _), N in zip(edges, normal):
@@ -257,7 +266,7 @@ def diagnose(sysm, bvp, tol, converged_note: str = "", result: type = Solution) 
             # (else it passes through it next to the line: the contact is a band)
             S = sysm.S_point(sysm.regions[j.k].end, p)
             yin = yb[sysm.rows(j.k)]
-            on = _at(sysm, j.on, S, np.array([q["chi1"], yin[_LS]]))
+            on = _at(sysm, j.on, S, np.array([q[j.chi], yin[_LS]]))
             res.curvature_excess = float(yin[FREE_STATES.index("ks")] - on["kappa_s"][0])
             if res.curvature_excess > 10 * tol * max(1.0, abs(float(on["kappa_s"][0]))):
                 vflags.append(f"the shell bends more tightly than the indenter at the contact line "
@@ -266,6 +275,14 @@ def diagnose(sysm, bvp, tol, converged_note: str = "", result: type = Solution) 
     res.flags = flags + vflags
     res.valid = res.success and not vflags
     return _without_iterate_numbers(res)
+
+
+def _halves(sysm) -> list:
+    """The regions' indices by the pole they run from: one list, or a closed shell's two halves
+    on a substrate (upper, lower; :class:`~shellbvp.chain.Seam`)."""
+    seam = next((j for j in sysm.junctions if isinstance(j, Seam)), None)
+    n = len(sysm.regions)
+    return [list(range(n))] if seam is None else [list(range(seam.ku + 1)), list(range(seam.ku + 1, n))]
 
 
 def _without_iterate_numbers(res):

@@ -331,7 +331,8 @@ def adaptive(scene, branch, settings):
             sol = solve_point_load(scene, nd, tol=st.tol, max_nodes=st.max_nodes, guess=prev)
         else:
             sol = solve_at_delta(scene, nd, prev, prev2, st)
-            if scene.contact == "smooth" and prev.Sc < 1e-8 and (not sol.success or sol.Sc < SC_POINT):
+            if scene.contact == "smooth" and not scene.two_contacts and prev.Sc < 1e-8 and \
+                    (not sol.success or sol.Sc < SC_POINT):
                 # the cap is leaving double precision: continue with its point-load limit
                 point = solve_point_load(scene, nd, tol=st.tol, max_nodes=st.max_nodes, guess=prev)
                 sol = point if point.success else sol
@@ -346,9 +347,10 @@ def adaptive(scene, branch, settings):
                 log.info("small-delta leg stopped at delta = %.4g: %s", d, sol.message)
                 break
     # Leg 2: pseudo-arclength upwards from the first point.
-    if is_point_load(first):
+    if is_point_load(first) or scene.two_contacts:
         # the cap is below double precision there: no (delta, lambda0, F) branch to follow
-        # until it comes back; natural continuation in delta instead (point-load limit or cap)
+        # until it comes back; natural continuation in delta instead (point-load limit or cap).
+        # A closed shell on a substrate: natural continuation (shellbvp.closed)
         grid = np.linspace(first.delta, st.delta_max, 11)
         stop = yield from natural(scene, grid, branch, st, first=first, key0=steps)
         return Stop(f"delta_max = {st.delta_max:g} reached", complete=True) if stop is None else stop

@@ -69,10 +69,11 @@ def _code_inputs() -> tuple[str, str]:
     return source_fingerprint(Path(__file__).parent / "materials"), importlib.metadata.version("sympy")
 
 
-def structure_description(material, xi: int, shell, tip, bending=None, pressurised=False) -> dict:
+def structure_description(material, xi: int, shell, tip, bending=None, pressurised=False, substrate=False) -> dict:
     """Everything the generated code depends on, as JSON-able data (``pressurised``: the
-    pressure's terms and parameters are generated; descriptions without it are unchanged)."""
-    return {**({"pressurised": True} if pressurised else {}),
+    pressure's terms and parameters are generated; ``substrate``: a closed shell's contact with
+    the plane it rests on; descriptions without them are unchanged)."""
+    return {**({"pressurised": True} if pressurised else {}), **({"substrate": True} if substrate else {}),
         "bending": bending.description() if bending is not None else {"family": "trace"},
         "codegen": CODEGEN_VERSION,
         "source": _code_inputs()[0],

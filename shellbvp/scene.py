@@ -102,10 +102,11 @@ class Scene:
         in units of its equatorial radius (``R_L``).  Default False.
     support : {"substrate", "plates"}, optional
         What a closed shell rests on (default ``"substrate"``, a rigid frictionless plane) or
-        ``"plates"`` (compressed between two parallel plates); delta is the approach of the
-        indenter and the support.  Both are solved on the half above the equator (symmetry:
-        the equator stays vertical, free to move out, and moves by delta/2), which needs a
-        ``FlatTip()`` on top; a curved tip on a substrate is not offered yet.
+        ``"plates"`` (compressed between two parallel plates: ``tip=FlatTip()``; with a curved
+        tip, between two such indenters); delta is the approach of the indenter and the
+        support.  Between plates, or on a substrate under a flat plate, the half above the
+        equator is solved (symmetry: the equator stays vertical, free to move out, and moves
+        by delta/2); under a curved tip on a substrate both halves are, with a contact each.
 
     Raises
     ------
@@ -398,7 +399,9 @@ class Scene:
         ('spheroidal bowl (indented from inside)', 'spheroidal dome (indented from outside)')
         """
         if self.closed:
-            return f"closed spheroid {'between plates' if self.support == 'plates' else 'on a substrate'}"
+            if self.support == "plates":
+                return "closed spheroid between " + ("plates" if isinstance(self.tip, FlatTip) else "two indenters")
+            return "closed spheroid on a substrate"
         if not isinstance(self.shell, Spheroid):
             return "user meridian"
         if self.gamma == 0:
@@ -415,7 +418,18 @@ class Scene:
     def structure(self) -> dict:
         """The structural choices the generated code is specialised on."""
         return structure_description(self.material, self.xi, self.shell, self.tip, self.bending,
-                                     pressurised=self.pressurised)
+                                     pressurised=self.pressurised, substrate=self.two_contacts)
+
+    @property
+    def halved(self) -> bool:
+        """A closed shell solved on the half above its equator: between two plates (or two
+        identical tips), or on a substrate under a flat plate (the same problem)."""
+        return self.closed and (self.support == "plates" or isinstance(self.tip, FlatTip))
+
+    @property
+    def two_contacts(self) -> bool:
+        """A closed shell on a substrate under a curved tip: both halves solved, two contacts."""
+        return self.closed and not self.halved
 
     @property
     def pressurised(self) -> bool:
@@ -495,9 +509,6 @@ def _support(scene, gamma) -> str:
         raise ValueError(f"gamma (polar / equatorial semi-axis of a closed spheroid) must be > 0; got {gamma!r}")
     if scene.rim != "pinned":
         raise ValueError(f"rim={scene.rim!r} holds a rim; a closed shell has none")
-    if not isinstance(scene.tip, FlatTip):
-        raise ValueError(f"a closed shell on support={support!r} is offered under a flat plate only (tip=FlatTip()): "
-                         "a curved tip on a substrate (two different contacts) is not offered yet")
     return support
 
 

@@ -15,6 +15,7 @@ import time
 import numpy as np
 
 from .chain import FREE_STATES, ChainBVP
+from .closed import closed_again, closed_cold
 from .configurations import ASKED, asked, configuration, is_point_load, is_single_cap, of
 from .corner import edge_model, edge_null_jump, is_corner, limit_estimate, near_limit, other_edge_root
 from .cylinder import cap_onto_wall, wall_again
@@ -43,7 +44,7 @@ log = logging.getLogger(__name__)
 #: ``again(guess, control, value, *, topology, tol, max_nodes, eps, bc_tol, estimate_error)``
 #: returns the finished state, or None to fall back to the single cap.  The cap and the point
 #: load have none: the cap's own warm start serves them.
-AGAIN = {"lifted": lifted_again, "split": split_again, "wall": wall_again}
+AGAIN = {"lifted": lifted_again, "split": split_again, "wall": wall_again, "closed": closed_again}
 #: How a single cap is replaced where a state of another family is suspected, in the order tried:
 #: ``replace(cap, topology, kw)`` returns the replacement or the cap (with what was tried in its flags)
 CAP_REPLACEMENTS = (("wall", cap_onto_wall), ("lifted", cap_lifted_off))
@@ -318,6 +319,12 @@ def solve(scene, *, delta=None, lambda0=None, force=None, tol=1e-6, max_nodes=10
 
     t0 = time.perf_counter()
     kw = dict(tol=tol, max_nodes=max_nodes, bc_tol=bc_tol)
+    if scene.two_contacts:  # a closed shell on a substrate: its own configuration, from the flat plate's
+        res = closed_cold(scene, control, value, solve_half=solve, eps=eps, **kw)
+        if res.success and estimate_error:
+            richardson_error(res.system, res, tol, bc_tol)
+        res.wall_time = time.perf_counter() - t0
+        return res
     if guess is not None:
         sysm = system_like(guess, control, value, eps)
         res = solve_from(sysm, warm_guess(sysm, guess, tol=tol), **kw)

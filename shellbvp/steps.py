@@ -25,7 +25,12 @@ def configuration_key(sol):
 
 def solve_at_delta(scene, delta, prev, prev2, settings, prev3=None):
     """Delta-controlled solve warm-started from prev: with the quadratic predictor through
-    prev, prev2 and prev3 where it applies, else the secant through prev and prev2."""
+    prev, prev2 and prev3 where it applies, else the secant through prev and prev2.  A closed
+    shell on a substrate: :func:`shellbvp.state.solve` from prev (its configuration again, or
+    a cold start where that is not valid)."""
+    if scene.two_contacts:
+        return solve(scene, delta=delta, guess=prev, tol=settings.tol, max_nodes=step_nodes(prev, settings),
+                     bc_tol=settings.bc_tol, eps=settings.eps, estimate_error=False)
     if is_point_load(prev):
         return step_from_point(scene, delta, prev, settings)
     sysm = system_like(prev, "delta", delta, settings.eps)

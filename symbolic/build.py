@@ -41,7 +41,7 @@ def structure_from_description(desc: dict) -> Structure:
         tip = geometry.user_tip(_expr(tp["A"], "A(omega)", geometry.OMEGA), _expr(tp["B"], "B(omega)", geometry.OMEGA))
     B = energies.bending_energy(desc.get("bending", {"family": "trace"}))
     return Structure(W=W, material_params=mpar, shell=shell, tip=tip, xi=int(desc["xi"]), B=B,
-                     pressurised=bool(desc.get("pressurised", False)))
+                     pressurised=bool(desc.get("pressurised", False)), substrate=bool(desc.get("substrate", False)))
 
 
 def generate_source(desc: dict) -> str:

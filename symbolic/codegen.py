@@ -199,6 +199,8 @@ def function_specs(d: Derivation) -> list[FunctionSpec]:
                ("contact", d.contact, d.contact_states, d.contact_rhs, d.contact_profile)]
     if d.has_cylinder:
         regions.append(("cylinder", d.cylinder, d.cylinder_states, d.cylinder_rhs, d.cylinder_profile))
+    if d.has_plane:
+        regions.append(("plane", d.plane, d.plane_states, d.plane_rhs, d.plane_profile))
     for region, prog, states, rhs, profile in regions:
         n = len(states)
         args = [("S", (sp.Symbol("S"),)), ("y", states), ("par", par)]
@@ -257,6 +259,18 @@ def function_specs(d: Derivation) -> list[FunctionSpec]:
     if pressurised:
         specs.append(FunctionSpec("pole_jac_par", d.pole, pargs, [("dres", d.pole.jacobian(d.pole_res, par))],
                                   f"Pole conditions: d/dpar (2, {len(par)})."))
+    if d.has_plane:  # the lower pole of a closed shell on a substrate
+        specs += [
+            FunctionSpec("plane_pole_res", d.plane_pole, pargs, [("res", d.plane_pole_res)],
+                         "Lower pole on the substrate (2,)."),
+            FunctionSpec("plane_pole_jac", d.plane_pole, pargs,
+                         [("dres", d.plane_pole.jacobian(d.plane_pole_res, [chi, ls, LAMBDA0]))],
+                         "Lower pole on the substrate: d/d(chi, ls, lambda0), (2, 3)."),
+        ]
+        if pressurised:
+            specs.append(FunctionSpec("plane_pole_jac_par", d.plane_pole, pargs,
+                                      [("dres", d.plane_pole.jacobian(d.plane_pole_res, par))],
+                                      f"Lower pole on the substrate: d/dpar (2, {len(par)})."))
     # rim (S = L)
     Ssym = d.free.inputs[0]
     rargs = [("S", (Ssym,)), ("y", d.free_states), ("par", par)]
@@ -272,6 +286,9 @@ def function_specs(d: Derivation) -> list[FunctionSpec]:
     if d.has_cylinder:
         edges.append(("cyl_", "cylinder", d.cyl_junction, d.cyl_junction_inputs, d.cyl_junction_res,
                       d.cyl_force_res))
+    if d.has_plane:
+        edges.append(("plane_", "plane", d.plane_junction, d.plane_junction_inputs, d.plane_junction_res,
+                      d.plane_force_res))
     for prefix, where, J, inputs, residuals, force_res in edges:
         Sc, yc, yf = inputs[0], inputs[1:3], inputs[3:]
         jargs = [("Sc", (Sc,)), ("yc", yc), ("yf", yf), ("delta", (DELTA,)), ("F", (FORCE,)), ("par", par)]

@@ -52,7 +52,7 @@ import sympy as sp
 
 from . import bending
 from .dag import Program
-from .geometry import OMEGA, S, ShellGeometry, TipGeometry, cylinder_of
+from .geometry import OMEGA, S, ShellGeometry, TipGeometry, cylinder_of, flat_tip
 from .materials import LS, LT
 
 __all__ = [
@@ -92,6 +92,7 @@ class Structure:
     xi: int
     B: sp.Expr | None = None
     pressurised: bool = False
+    substrate: bool = False  # a closed shell on a rigid plane: its lower half's contact ("plane")
 
     @property
     def params(self) -> tuple:
@@ -184,6 +185,19 @@ class Derivation:
             (self.cyl_junction, self.cyl_junction_inputs, self.cyl_junction_res,
              self.cyl_force_res) = self._edge(self.cylinder, self.cylinder_profile, self.cylinder_phys_out)
             self._build_tip_end()
+        # A closed shell on a substrate: its lower half, from the lower pole, touches a rigid
+        # plane (a flat tip that does not move: its edges are evaluated at delta = 0).
+        self.has_plane = st.substrate
+        if self.has_plane:
+            self.plane_phys, self.plane_phys_out = self._contact_physical(flat_tip())
+            self.plane, self.plane_states, self.plane_rhs, self.plane_profile = self._contact_scaled(
+                self.plane_phys, self.plane_phys_out)
+            (self.plane_junction, self.plane_junction_inputs, self.plane_junction_res,
+             self.plane_force_res) = self._edge(self.plane, self.plane_profile, self.plane_phys_out)
+            chi0, ls0 = self.pole_states
+            dR0 = sp.diff(st.shell.R, S).subs(S, 0)
+            self.plane_pole = Pp = Program([chi0, ls0, LAMBDA0, *self.params])
+            self.plane_pole_res = [Pp.let("res_chi", chi0 - LAMBDA0 * dR0), Pp.let("res_ls", ls0 - LAMBDA0)]
         self._build_geometry()
         self._build_point_load()
         self._build_free_pole()

@@ -52,9 +52,9 @@ The package's modules: :mod:`shellbvp.chain.blocks` (the declarations),
 
 from .assembler import CONTROLS, ChainBVP
 from .blocks import (CONTACT_KINDS, CONTACT_STATES, FREE_STATES, REGION_CODES, SIZES, Chain, ContactPole, Edge,
-                     FreePole, Kink, Line, Point, PointPole, Region, Rim, TipEnd)
+                     FreePole, Kink, Line, Point, PointPole, Region, Rim, Seam, TipEnd)
 
-__all__ = ["Point", "Region", "ContactPole", "FreePole", "PointPole", "Edge", "TipEnd", "Line", "Kink", "Rim",
+__all__ = ["Point", "Region", "ContactPole", "FreePole", "PointPole", "Edge", "TipEnd", "Line", "Kink", "Rim", "Seam",
            "Chain",
            "ChainBVP", "CONTROLS",
            "SIZES", "FREE_STATES", "CONTACT_STATES", "CONTACT_KINDS", "REGION_CODES"]

@@ -8,7 +8,7 @@ import numpy as np
 
 from ..kernels import kernel_set
 from ..quadrature import gauss_points
-from .blocks import CONTACT_KINDS, REGION_CODES, SIZES, Chain, ContactPole, Edge, FreePole, Line, Point, Rim
+from .blocks import CONTACT_KINDS, REGION_CODES, SIZES, Chain, ContactPole, Edge, FreePole, Line, Point, Rim, Seam
 from .conditions import BoundaryConditions
 
 __all__ = ["ChainBVP", "CONTROLS"]
@@ -71,7 +71,7 @@ class ChainBVP(BoundaryConditions):
         self.enclosed_volume = None
         self.n = self.n_shell + self.volume_control
         kinds = {type(j) for j in chain.junctions}
-        self.has_contact_pole = ContactPole in kinds
+        self.has_contact_pole = any(isinstance(j, ContactPole) and j.stretch == "lambda0" for j in chain.junctions)
         if control == "arclength" and not self.has_contact_pole:
             raise ValueError(f"arclength control needs a contact cap at the pole; {chain.name} has none")
         if control in ("force", "arclength") and not any(isinstance(j, (Edge, Line)) for j in chain.junctions):
@@ -81,6 +81,8 @@ class ChainBVP(BoundaryConditions):
         names = list(chain.unknowns)
         if self.has_contact_pole and control != "lambda0":
             names.append("lambda0")
+        # a closed shell's lower pole on its substrate has a stretch of its own
+        names += [j.stretch for j in chain.junctions if isinstance(j, ContactPole) and j.stretch != "lambda0"]
         if control != "delta":
             names.append("delta")
         if self.volume_control:
@@ -107,6 +109,8 @@ class ChainBVP(BoundaryConditions):
         self.n_conditions = (sum(j.rows for j in self.junctions) + (self.extra is not None)
                              + (2 if self.volume_control else 0))
         self.rim_slope = self._clamped_rim_slope()
+        # a closed shell solved on the half above its equator (its mirror image the other half)
+        self.mirrored = scene.closed and any(isinstance(j, Rim) for j in self.junctions)
 
     def _clamped_rim_slope(self):
         """``Phi(L)/L``, the reference slope over L that a clamped rim or a closed shell's equator
@@ -385,7 +389,8 @@ class ChainBVP(BoundaryConditions):
     def end_values(self, ya, yb, p=None):
         """(F, delta): F is the axial force at the start of the region that ends at the rim
         (a first integral of a free region, so the indenter's force)."""
-        k = len(self.regions) - 1
+        seam = next((j for j in self.junctions if isinstance(j, Seam)), None)
+        k = len(self.regions) - 1 if seam is None else seam.ku  # a closed shell's: its upper half's
         S = self.S_point(self.regions[k].start, p)
         G = self.kernels.active.free_profile(np.array([S]), ya[self.rows(k), None],
                                              self.par_at(p))["axial_force_2pi"][0]
@@ -447,9 +452,10 @@ class ChainBVP(BoundaryConditions):
         each pole disc ``[0, zeta]``) and the pressure's potential (``shellbvp.inflation``).
         Under volume control the pressure does no work (V is held): E is the elastic energy."""
         elastic = self._elastic_energy(sol, x, p)
-        if not (self.volume_control or not self.pressure):
-            elastic -= self.pressure * (self.volume(sol, x, p) - self.scene.reference_volume())
-        return 2 * elastic if self.scene.closed else elastic  # a closed shell: both halves
+        if not (self.volume_control or not self.pressure):  # V_ref: of the half a closed shell's inflation solves
+            reference = self.scene.reference_volume() * (2 if self.scene.two_contacts and not self.mirrored else 1)
+            elastic -= self.pressure * (self.volume(sol, x, p) - reference)
+        return 2 * elastic if self.mirrored else elastic
 
     def volume(self, sol, x, p) -> float:
         """``V = Int dV/dS dS`` over every region (Gauss-Legendre on the mesh): the volume between

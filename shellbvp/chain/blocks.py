@@ -7,14 +7,17 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 __all__ = ["Point", "Region", "ContactPole", "FreePole", "PointPole", "Edge", "TipEnd", "Line", "Kink", "Rim",
-           "Chain", "SIZES", "FREE_STATES", "CONTACT_STATES", "CONTACT_KINDS", "REGION_CODES"]
+           "Seam", "Chain", "SIZES", "FREE_STATES", "CONTACT_STATES", "CONTACT_KINDS", "REGION_CODES"]
 
 FREE_STATES = ("lt", "phiS", "ls", "ks", "rQ", "z")
 CONTACT_STATES = ("chi", "ls")
-SIZES = {"free": len(FREE_STATES), "contact": len(CONTACT_STATES), "cylinder": len(CONTACT_STATES)}
-CONTACT_KINDS = ("contact", "cylinder")  # the shell on the tip; on the indenter's cylinder r = rho A(omega_max)
-#: ``region`` codes of profiles: 0 on the tip, 1 free, 2 on the cylinder
-REGION_CODES = {"contact": 0, "free": 1, "cylinder": 2}
+SIZES = {"free": len(FREE_STATES), "contact": len(CONTACT_STATES), "cylinder": len(CONTACT_STATES),
+         "plane": len(CONTACT_STATES)}
+#: the shell on the tip; on the indenter's cylinder r = rho A(omega_max); a closed shell's lower
+#: half on the plane it rests on
+CONTACT_KINDS = ("contact", "cylinder", "plane")
+#: ``region`` codes of profiles: 0 on the tip, 1 free, 2 on the cylinder, 3 on the substrate
+REGION_CODES = {"contact": 0, "free": 1, "cylinder": 2, "plane": 3}
 
 
 @dataclass(frozen=True)
@@ -35,9 +38,12 @@ class Region:
 
 @dataclass(frozen=True)
 class ContactPole:
-    """Regular pole of a contact cap (region ``k`` starts at zeta): 2 rows, uses lambda0."""
+    """Regular pole of a contact cap (region ``k`` starts at zeta): 2 rows, uses its stretch
+    (``lambda0``; a closed shell's lower pole on the substrate, region kind ``plane``: its own,
+    ``lambda0_b``)."""
 
     k: int
+    stretch: str = "lambda0"
     rows = 2
 
 
@@ -51,9 +57,11 @@ class FreePole:
 
 @dataclass(frozen=True)
 class PointPole:
-    """Point-load pole of the free region ``k`` at its start s0: 3 rows, uses delta."""
+    """Point-load pole of the free region ``k`` at its start s0: 3 rows, uses delta (a closed
+    shell's lower pole on its substrate, which does not move: ``moving=False``, delta 0)."""
 
     k: int
+    moving: bool = True
     rows = 3
 
 
@@ -87,12 +95,14 @@ class Line:
     """Line contact between free regions ``k`` and ``k + 1`` at the indenter point ``chi1``: 8 rows.
 
     r, phi, z on the indenter (3 rows, the smooth junction's first three; ``on`` the tip,
-    ``"contact"``, or the cylinder, ``"cylinder"``); lt, phiS, ls, ks, z continuous (5);
+    ``"contact"``, the cylinder, ``"cylinder"``, or a closed shell's substrate, ``"plane"``);
+    lt, phiS, ls, ks, z continuous (5);
     rQ jumps (the ring force).
     """
 
     k: int
     on: str = "contact"
+    chi: str = "chi1"  # its unknown (a closed shell's lower ring on the plane: ``chi1_b``)
     rows = 8
 
 
@@ -115,6 +125,19 @@ class Rim:
 
     k: int
     rows = 3
+
+
+@dataclass(frozen=True)
+class Seam:
+    """A closed shell's equator, where the end of its upper half's free region ``ku`` meets the
+    end of its lower half's ``kl`` (each half running from its own pole, the lower in the
+    mirror image z -> -z): r, z, the slope, lambda_s, kappa_s and the shear force continuous,
+    6 rows, linear in the states (``lt``, ``ls``, ``ks`` equal; ``z``, ``rQ`` and the slopes'
+    departures from the reference opposite)."""
+
+    ku: int
+    kl: int
+    rows = 6
 
 
 @dataclass(frozen=True)

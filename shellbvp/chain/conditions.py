@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .blocks import FREE_STATES, ContactPole, Edge, FreePole, Kink, Line, PointPole, Rim, TipEnd
+from .blocks import FREE_STATES, ContactPole, Edge, FreePole, Kink, Line, PointPole, Rim, Seam, TipEnd
 
 __all__ = ["BoundaryConditions"]
 
@@ -17,6 +17,9 @@ _LINE_CONTINUOUS = [FREE_STATES.index(s) for s in ("lt", "phiS", "ls", "ks", "z"
 # states continuous across an interior corner (ls, ks jump)
 _KINK_CONTINUOUS = [FREE_STATES.index(s) for s in ("lt", "phiS", "rQ", "z")]
 _PHIS, _RQ, _Z = (FREE_STATES.index(s) for s in ("phiS", "rQ", "z"))
+# a closed shell's equator (Seam): states equal across it, and states opposite in the mirror image
+_SEAM_EQUAL = [FREE_STATES.index(s) for s in ("lt", "ls", "ks")]
+_SEAM_OPPOSITE = [FREE_STATES.index(s) for s in ("rQ", "z")]
 # the generated rim rows are (lt - 1, the moment's m, z); a clamped rim holds its slope instead
 # of M_s = 0: phi/S - Phi(L)/L, linear in the states and free of the run-time parameters.  A
 # closed shell's equator (the half above it solved, symmetric about it) holds its slope too (the
@@ -31,8 +34,21 @@ class BoundaryConditions:
 
     @staticmethod
     def _prefix(kind):
-        """Generated names of cylinder edges carry ``cyl_`` (``junction_cyl_smooth_res``)."""
-        return "cyl_" if kind == "cylinder" else ""
+        """Generated names of cylinder edges carry ``cyl_`` (``junction_cyl_smooth_res``), of a
+        closed shell's edge on its substrate ``plane_``."""
+        return {"cylinder": "cyl_", "plane": "plane_"}.get(kind, "")
+
+    def _edge_delta(self, j, q):
+        """The indenter's delta at an edge: the substrate's plane does not move (0)."""
+        return 0.0 if self.regions[j.kc].kind == "plane" else q["delta"]
+
+    @staticmethod
+    def _line_delta(j, q):
+        """The indenter's delta at a line contact: the substrate's plane does not move (0)."""
+        return 0.0 if j.on == "plane" else q["delta"]
+
+    def _pole_function(self, j, what):
+        return getattr(self.model, f"{self._prefix(self.regions[j.k].kind)}pole_{what}")
 
     def _edge_function(self, j, what):
         """junction_[cyl_]<model>_<what> of an edge, by its contact region's kind."""
@@ -48,7 +64,7 @@ class BoundaryConditions:
 
     def _line_states(self, j: Line, ya, yb, q):
         yin = yb[self.rows(j.k)]
-        return self.regions[j.k].end, np.array([q["chi1"], yin[_LS]]), yin, ya[self.rows(j.k + 1)]
+        return self.regions[j.k].end, np.array([q[j.chi], yin[_LS]]), yin, ya[self.rows(j.k + 1)]
 
     def bc(self, ya, yb, p=None):
         mod, par = self.model, self.par_at(p)
@@ -57,26 +73,31 @@ class BoundaryConditions:
         for j in self.junctions:
             if isinstance(j, ContactPole):
                 y0 = ya[self.rows(j.k)]
-                parts.append(mod.pole_res(y0[0], y0[1], q["lambda0"], par))
+                parts.append(self._pole_function(j, "res")(y0[0], y0[1], q[j.stretch], par))
             elif isinstance(j, FreePole):
                 parts.append(mod.free_pole_res(self.S_point(self.regions[j.k].start, p), ya[self.rows(j.k)], par))
             elif isinstance(j, PointPole):
                 parts.append(mod.point_load_res(self.S_point(self.regions[j.k].start, p), ya[self.rows(j.k)],
-                                                q["delta"], par))
+                                                q["delta"] if j.moving else 0.0, par))
             elif isinstance(j, Edge):
                 point, yc, yf, _, _ = self._edge_states(j, ya, yb)
-                parts.append(self._edge_function(j, "res")(self.S_point(point, p), yc, yf, q["delta"], q["F"], par))
+                parts.append(self._edge_function(j, "res")(self.S_point(point, p), yc, yf, self._edge_delta(j, q),
+                                                           q["F"], par))
             elif isinstance(j, TipEnd):
                 parts.append(mod.tip_end_res(self.S_point(self.regions[j.k].end, p), yb[self.rows(j.k)],
                                              ya[self.rows(j.k + 1)], par))
             elif isinstance(j, Line):
                 point, yc, yin, yout = self._line_states(j, ya, yb, q)
-                on_tip = self._line_function(j, "res")(self.S_point(point, p), yc, yin, q["delta"], q["F"], par)[:3]
+                on_tip = self._line_function(j, "res")(self.S_point(point, p), yc, yin, self._line_delta(j, q), q["F"],
+                                                       par)[:3]
                 parts += [on_tip, (yout - yin)[_LINE_CONTINUOUS]]
             elif isinstance(j, Kink):
                 yl, yr = yb[self.rows(j.k)], ya[self.rows(j.k + 1)]
                 parts += [mod.kink_res(self.S_point(self.regions[j.k].end, p), yl, yr, par),
                           (yr - yl)[_KINK_CONTINUOUS]]
+            elif isinstance(j, Seam):
+                yu, yl = yb[self.rows(j.ku)], yb[self.rows(j.kl)]
+                parts += [(yu - yl)[_SEAM_EQUAL], (yu + yl)[_SEAM_OPPOSITE], [yu[_PHIS] + yl[_PHIS] - 2 * self.rim_slope]]
             elif isinstance(j, Rim):
                 parts.append(self._rim_res(self.S_point(self.regions[j.k].end, p), yb[self.rows(j.k)], par,
                                            q.get("delta", 0.0)))
@@ -161,11 +182,11 @@ class BoundaryConditions:
             if isinstance(j, ContactPole):
                 o = self.offsets[j.k]
                 y0 = ya[self.rows(j.k)]
-                pj = mod.pole_jac(y0[0], y0[1], q["lambda0"], par)  # d/d(chi, ls, lambda0)
+                pj = self._pole_function(j, "jac")(y0[0], y0[1], q[j.stretch], par)  # d/d(chi, ls, lambda0)
                 A[rows, o:o + 2] = pj[:, :2]
-                self._add_p(P, rows, "lambda0", pj[:, 2])
+                self._add_p(P, rows, j.stretch, pj[:, 2])
                 if vc:
-                    self._pressure_column(P, rows, mod.pole_jac_par(y0[0], y0[1], q["lambda0"], par))
+                    self._pressure_column(P, rows, self._pole_function(j, "jac_par")(y0[0], y0[1], q[j.stretch], par))
             elif isinstance(j, (FreePole, PointPole)):
                 point = self.regions[j.k].start
                 S = self.S_point(point, p)
@@ -175,32 +196,37 @@ class BoundaryConditions:
                     if vc:
                         self._pressure_column(P, rows, mod.free_pole_jac_par(S, ya[self.rows(j.k)], par))
                 else:
-                    pj = mod.point_load_jac(S, ya[self.rows(j.k)], q["delta"], par)  # d/d(y, delta)
-                    self._add_p(P, rows, "delta", pj[:, 6])
+                    delta = q["delta"] if j.moving else 0.0
+                    pj = mod.point_load_jac(S, ya[self.rows(j.k)], delta, par)  # d/d(y, delta)
+                    if j.moving:
+                        self._add_p(P, rows, "delta", pj[:, 6])
                     if vc:
-                        self._pressure_column(P, rows, mod.point_load_jac_par(S, ya[self.rows(j.k)], q["delta"], par))
+                        self._pressure_column(P, rows, mod.point_load_jac_par(S, ya[self.rows(j.k)], delta, par))
                 A[rows, self.rows(j.k)] = pj[:, :6]
             elif isinstance(j, Edge):
                 point, yc, yf, c_at_a, f_at_a = self._edge_states(j, ya, yb)
                 S = self.S_point(point, p)
-                jj = self._edge_function(j, "jac")(S, yc, yf, q["delta"], q["F"], par)
+                delta = self._edge_delta(j, q)
+                jj = self._edge_function(j, "jac")(S, yc, yf, delta, q["F"], par)
                 (A if c_at_a else B)[rows, self.rows(j.kc)] = jj[:, 1:3]
                 (A if f_at_a else B)[rows, self.rows(j.kf)] = jj[:, 3:9]
                 self._add_p(P, rows, point.unknown, jj[:, 0] * S)
-                self._add_p(P, rows, "delta", jj[:, 9])
+                if self.regions[j.kc].kind != "plane":
+                    self._add_p(P, rows, "delta", jj[:, 9])
                 if vc:
-                    dpar = self._edge_function(j, "jac_par")(S, yc, yf, q["delta"], q["F"], par)
+                    dpar = self._edge_function(j, "jac_par")(S, yc, yf, delta, q["F"], par)
                     self._pressure_column(P, rows, dpar)
             elif isinstance(j, Line):
                 point, yc, yin, yout = self._line_states(j, ya, yb, q)
                 S = self.S_point(point, p)
                 on = slice(r, r + 3)
-                jj = self._line_function(j, "jac")(S, yc, yin, q["delta"], q["F"], par)[:3]
+                jj = self._line_function(j, "jac")(S, yc, yin, self._line_delta(j, q), q["F"], par)[:3]
                 self._add_p(P, on, point.unknown, jj[:, 0] * S)
-                self._add_p(P, on, "chi1", jj[:, 1])
-                self._add_p(P, on, "delta", jj[:, 9])
+                self._add_p(P, on, j.chi, jj[:, 1])
+                if j.on != "plane":
+                    self._add_p(P, on, "delta", jj[:, 9])
                 if vc:
-                    self._pressure_column(P, on, self._line_function(j, "jac_par")(S, yc, yin, q["delta"], q["F"],
+                    self._pressure_column(P, on, self._line_function(j, "jac_par")(S, yc, yin, self._line_delta(j, q), q["F"],
                                                                                  par)[:3])
                 i0, o0 = self.offsets[j.k], self.offsets[j.k + 1]
                 B[on, i0:i0 + 6] = jj[:, 3:9]
@@ -233,6 +259,11 @@ class BoundaryConditions:
                 for row, c in enumerate(_KINK_CONTINUOUS, start=r + 3):
                     A[row, r0 + c] = 1.0
                     B[row, l0 + c] = -1.0
+            elif isinstance(j, Seam):
+                ou, ol = self.offsets[j.ku], self.offsets[j.kl]
+                for row, c in enumerate(_SEAM_EQUAL + _SEAM_OPPOSITE + [_PHIS], start=r):
+                    B[row, ou + c] = 1.0
+                    B[row, ol + c] = -1.0 if c in _SEAM_EQUAL else 1.0
             elif isinstance(j, Rim):
                 S = self.S_point(self.regions[j.k].end, p)
                 B[rows, self.rows(j.k)] = self._rim_jac(S, yb[self.rows(j.k)], par)

@@ -15,7 +15,10 @@ Families:
 ``split``
     a cap and, beyond a lifted gap, a second zone on the tip;
 ``wall``
-    contact on the indenter's cylinder beyond the tip's end.
+    contact on the indenter's cylinder beyond the tip's end;
+``closed``
+    a closed shell on a substrate: a cap on the tip and a cap on the plane below
+    (:mod:`shellbvp.closed` solves them).
 
 A family's searches are functions of the modules above this registry that know it
 (:mod:`shellbvp.liftoff`, :mod:`shellbvp.cylinder`), held by the modules that call them, by
@@ -40,7 +43,7 @@ __all__ = ["Configuration", "CONFIGURATIONS", "FAMILIES", "configuration", "name
            "is_single_cap", "is_point_load", "Switch", "SWITCHES", "switch_between",
            "register_switch", "without_edge_model", "discover", "install", "asked"]
 
-FAMILIES = ("cap", "point", "lifted", "split", "wall")
+FAMILIES = ("cap", "point", "lifted", "split", "wall", "closed")
 
 
 @dataclass(frozen=True)
@@ -112,6 +115,12 @@ class Configuration:
                              f"single cap only" + (", which may run onto the cylinder ('cap+cylinder')"
                                                    if self.family == "wall" else ""))
 
+    @staticmethod
+    def enclosed_volume(scene) -> float:
+        """V0 a sealed scene's system holds: its inflated state's, solved on the half above the
+        equator of a closed shell, so both halves' where both are solved."""
+        return enclosed_volume(scene) * (2 if scene.two_contacts else 1)
+
     def system(self, scene, control, value, eps, edge=None):
         """The ChainBVP of this configuration for ``scene`` with ``control`` = ``value``, its
         tip tabulated for the admissibility checks; a sealed scene's system holds the volume of
@@ -120,7 +129,7 @@ class Configuration:
         model = scene.model()
         sysm = ch.ChainBVP(scene, self.chain(eps, scene.shell_length, edge or scene.contact), control, value,
                            model=model, par=system_parameters(scene, model),
-                           enclosed_volume=enclosed_volume(scene) if scene.sealed else None)
+                           enclosed_volume=self.enclosed_volume(scene) if scene.sealed else None)
         attach_tip_table(sysm)
         return sysm
 

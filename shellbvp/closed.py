@@ -1,0 +1,165 @@
+"""A closed shell on a substrate under a curved tip (family ``closed``): both halves as one BVP,
+each touching its indenter -- the tip above, the plane below -- with a cap or a ring
+(:mod:`shellbvp.configurations.closed`).
+
+A cold start begins from two problems the package solves as rimmed shells: the same shell
+squeezed between two such tips, and between two plates, each symmetric about its equator
+(``Scene.halved``).  Every horizontal section of a closed shell carries the same force, so
+the state on the substrate is near the upper half of the first at an approach ``du`` and the
+lower half of the second at ``dl``, where both carry the same force and ``(du + dl)/2`` is
+the prescribed delta (each half's pole moves by half its problem's approach).  Those halves,
+joined at the equator, are the guess; their contacts (cap or ring) choose the configuration.
+A state of a curve is solved again from its neighbour (``solve(guess=...)``,
+:func:`closed_again`), and cold where that fails or is not valid.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.optimize import brentq
+
+from .configurations import configuration
+from .configurations.closed import CONTACTS, LOWER_NAMES, closed_name
+from .cylinder import solve_chain_from
+from .geometry import FlatTip
+from .solution import failure, richardson_error, warm_mesh
+
+__all__ = ["closed_again", "closed_cold", "symmetric_scenes"]
+
+#: States of each symmetric problem computed up to twice the depth, to match their forces.
+HALF_POINTS = 8
+_Z = 5  # z in a free region's states
+
+
+def symmetric_scenes(scene):
+    """The shell squeezed between two of its tips, and between two plates."""
+    return scene.replace(support="plates"), scene.replace(support="plates", tip=FlatTip())
+
+
+def _system(scene, name, control, value, eps):
+    return configuration(name).system(scene, control, value, eps)
+
+
+def _unknowns(state) -> dict:
+    """A state's unknowns by name (with delta and the pressure of its solution)."""
+    named = dict(zip(state.system.unknowns, state.p))
+    named.setdefault("delta", state.delta)
+    return named
+
+
+def _walk(scene, depth, solve_half, kw):
+    """States of a symmetric problem at HALF_POINTS depths up to ``depth`` (warm-started)."""
+    states, prev = [], None
+    for d in depth * (np.arange(1, HALF_POINTS + 1) / HALF_POINTS) ** 1.5:
+        s = solve_half(scene, delta=float(d), guess=prev, estimate_error=False, **kw)
+        if s.success:
+            states.append(s)
+            prev = s
+    return states
+
+
+def _matched(scene, delta, solve_half, kw):
+    """The two symmetric halves at equal force with (du + dl)/2 = delta, or a reason why not."""
+    halves = []
+    for sym in symmetric_scenes(scene):
+        walk = _walk(sym, 2 * delta, solve_half, kw)
+        if len(walk) < 2:
+            return None, f"the shell between two {'plates' if sym.tip == FlatTip() else 'tips'} was not solved"
+        halves.append(walk)
+    curves = [(np.r_[0.0, [s.delta for s in w]], np.r_[0.0, [s.force for s in w]]) for w in halves]
+
+    def mismatch(du):
+        return np.interp(du, *curves[0]) - np.interp(2 * delta - du, *curves[1])
+
+    try:
+        du = brentq(mismatch, 0.0, 2 * delta, xtol=1e-12 * delta)
+    except ValueError:
+        return None, "the two symmetric problems' forces do not cross below twice the depth"
+    states = []
+    for walk, d in zip(halves, (du, 2 * delta - du)):
+        near = min(walk, key=lambda s: abs(s.delta - d))
+        s = solve_half(near.scene, delta=float(d), guess=near, estimate_error=False, **kw)
+        if not s.success or s.topology not in CONTACTS:
+            return None, f"a symmetric half at delta {d:.4g} gave {s.topology} ({s.message})"
+        states.append(s)
+    return states, ""
+
+
+def _joined(sysm, upper, lower, delta):
+    """(x, y, p) of ``sysm`` from the two symmetric halves: the upper half's states moved so its
+    tip is at the scene's, the lower half's so its plate is the substrate (z + dl)."""
+    x = np.union1d(upper.x, lower.x)
+    parts = []
+    for half, shift in ((upper, upper.delta - delta), (lower, lower.delta)):
+        y = half.sol(x)[:half.system.n_shell].copy()
+        for k, reg in enumerate(half.system.regions):
+            if reg.kind == "free":
+                y[half.system.offsets[k] + _Z] += shift
+        parts.append(y)
+    named = _unknowns(upper)
+    named.update({LOWER_NAMES[k]: v for k, v in _unknowns(lower).items() if k in LOWER_NAMES})
+    named.update(delta=delta, pressure=0.5 * (upper.pressure + lower.pressure))
+    return x, np.vstack(parts), sysm.pack(**named)
+
+
+def closed_cold(scene, control, value, *, solve_half, eps, tol, max_nodes, bc_tol):
+    """A state of a closed shell on a substrate at ``control = value`` (delta only), from the
+    two symmetric problems (``solve_half``: :func:`shellbvp.state.solve`)."""
+    def failed(message):
+        return failure(5, f"closed shell on a substrate: {message}", scene=scene, control=control, value=value,
+                       topology=closed_name("cap", "cap"))
+
+    if control != "delta":
+        return failed(f"solved cold at a given delta; {control} control needs a neighbouring state (guess=)")
+    kw = dict(eps=eps, tol=tol, max_nodes=max_nodes, bc_tol=bc_tol)
+    halves, why = _matched(scene, value, solve_half, kw)
+    if halves is None:
+        return failed(why)
+    res = None
+    for upper, lower in _contacts_tried(halves, solve_half, kw):
+        name = closed_name(upper.topology, lower.topology)
+        sysm = _system(scene, name, control, value, eps)
+        res = solve_chain_from(sysm, _joined(sysm, upper, lower, value), tol=tol, max_nodes=max_nodes, bc_tol=bc_tol)
+        if res.success and res.valid:
+            return res
+    if not res.success:
+        return failed(f"the {res.topology} state from the symmetric halves did not converge ({res.message})")
+    return res  # converged, not valid: its flags say why
+
+
+def _contacts_tried(halves, solve_half, kw):
+    """The symmetric halves as found, then, where a half touches on a ring (which near its
+    switches the joined state may refuse: the shell bending more tightly than the indenter
+    there), with that ring closed into a cap or opened into an annulus: the lower's, the
+    upper's, both."""
+    yield halves
+    others = []
+    for half in halves:
+        found = []
+        if half.topology == "line":
+            for topology in ("cap", "annulus"):
+                other = solve_half(half.scene, delta=half.delta, topology=topology, guess=half, estimate_error=False,
+                                   **kw)
+                if other.success:
+                    found.append(other)
+        others.append(found)
+    upper, lower = halves
+    yield from ((upper, other) for other in others[1])
+    yield from ((other, lower) for other in others[0])
+    yield from ((u, l) for u in others[0] for l in others[1])
+
+
+def closed_again(guess, control, value, *, topology, tol, max_nodes, eps, bc_tol, estimate_error):
+    """``solve(guess=...)`` of a closed shell on a substrate: its configuration from ``guess``;
+    None (a cold start) where that does not converge or is not valid (a contact that pulls
+    asks for the other configuration)."""
+    sysm = _system(guess.scene, guess.topology, control, value, eps)
+    x = warm_mesh(guess, tol)
+    res = solve_chain_from(sysm, (x, guess.sol(x)[:sysm.n_shell], sysm.pack(**_unknowns(guess))), tol=tol,
+                           max_nodes=max_nodes, bc_tol=bc_tol)
+    if not (res.success and res.valid):
+        return None
+    if estimate_error:
+        richardson_error(res.system, res, tol, bc_tol)
+    return res
+
