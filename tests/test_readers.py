@@ -67,7 +67,7 @@ def test_an_afm_file_given_as_a_table_says_what_it_is_and_how_it_is_read(tmp_pat
         read_pixel_table(DATA / "afm-workshop-single.csv")
 
 
-def test_a_new_reader_is_one_declaration(tmp_path, monkeypatch):
+def test_a_new_reader_is_one_declaration(tmp_path):
     """A format of its own (``.fdx``: rows of force in nN and depth in nm, no header) declared as
     one Reader: read_instrument, a folder's batch and the command line take it."""
     def read(path, *, invert=()):
@@ -75,17 +75,20 @@ def test_a_new_reader_is_one_declaration(tmp_path, monkeypatch):
         rec.columns["displacement"], rec.columns["force"] = "depth", "force"
         return rec
 
-    monkeypatch.setattr(registry, "READERS", list(registry.READERS))
-    registry.register(registry.Reader(name="FDX", order=50, suffixes=(".fdx",), folder_suffixes=(".fdx",),
-                                      what="an FDX record", hint="`shellbvp fit FILE` reads it",
-                                      options=("invert",), read=read))
-    rows = [(0.5 * max(d - 200, 0) ** 1.5, d) for d in range(0, 2000, 50)]
-    path = tmp_path / "seed.fdx"
-    path.write_text("".join(f"{f:.6g} {d}\n" for f, d in rows))
-    rec = sb.read_instrument(path)
-    assert rec.units == {"displacement": "nm", "force": "nN"}
-    np.testing.assert_allclose(rec.displacement[:3], [0, 50e-9, 100e-9])
-    with pytest.raises(ValueError, match="FDX record takes no --units"):
-        sb.read_instrument(path, units=("um", "uN"))
-    assert expand_inputs([str(tmp_path)]) == [str(path)]
-    assert main(["fit", str(path), "--preset", "fit", "--radius", "10um", "--units", "um,uN"]) == 2
+    fdx = registry.register(registry.Reader(name="FDX", order=50, suffixes=(".fdx",), folder_suffixes=(".fdx",),
+                                            what="an FDX record", hint="`shellbvp fit FILE` reads it",
+                                            options=("invert",), read=read))
+    try:
+        rows = [(0.5 * max(d - 200, 0) ** 1.5, d) for d in range(0, 2000, 50)]
+        path = tmp_path / "seed.fdx"
+        path.write_text("".join(f"{f:.6g} {d}\n" for f, d in rows))
+        rec = sb.read_instrument(path)
+        assert rec.units == {"displacement": "nm", "force": "nN"}
+        np.testing.assert_allclose(rec.displacement[:3], [0, 50e-9, 100e-9])
+        with pytest.raises(ValueError, match="FDX record takes no --units"):
+            sb.read_instrument(path, units=("um", "uN"))
+        assert expand_inputs([str(tmp_path)]) == [str(path)]
+        assert main(["fit", str(path), "--preset", "fit", "--radius", "10um", "--units", "um,uN"]) == 2
+    finally:
+        registry.READERS.remove(fdx)
+    assert readers.reader_for(tmp_path / "seed.fdx").name == "text table"
