@@ -26,13 +26,70 @@ from pathlib import Path
 
 import numpy as np
 
-from .afm_read import (AFM_SUFFIXES, AFMCurve, afm_text_format, curves_from_afm, is_afm_file, read_afm,
-                       refuse_text_options, single_curve)
+from . import readers
+from .afm_read import AFMCurve, curves_from_afm
 from .textdata import printable
 
 __all__ = ["AFM_SUFFIXES", "AFMCurve", "ForceMap", "MapFile", "is_afm_file", "afm_text_format", "read_afm",
            "curves_from_afm", "single_curve", "refuse_text_options", "map_shape", "MAP_FORMAT", "is_map_file",
            "read_map_file", "draw_map"]
+
+#: File name endings of the files read for their curves (:mod:`shellbvp.readers`: JPK, Asylum)
+AFM_SUFFIXES = readers.curve_suffixes()
+
+
+def is_afm_file(path) -> bool:
+    """True for a file read for its curves (an AFM file: :mod:`shellbvp.readers` recognises it by
+    its name or its first bytes), False for a text table."""
+    return readers.reader_for(path).curves
+
+
+def afm_text_format(path):
+    """The name of the AFM text export ``path`` is (``"AFM Workshop"``, ``"NT-MDT Nova"``: read with
+    the cantilever's calibration given), or None.  Only the first bytes of a regular file are read."""
+    found = readers.reader_for(path)
+    return found.name if found.curves and "spring_constant" in found.requires else None
+
+
+def read_afm(path, *, spring_constant=None, sensitivity=None) -> list:
+    """The curves of an AFM file as :class:`AFMCurve`, in file order, read by its reader
+    (:func:`shellbvp.readers.read_curves`; a file no reader recognises through afmformats' own
+    loader).
+
+    The file's declared sizes are checked first (an archive's members and inflated sizes, an
+    ``.ibw`` header's parts), then afmformats reads it inside one error boundary
+    (:func:`shellbvp.afm_read.afmformats_boundary`): whatever fails while the file is decoded is
+    one ``ValueError`` line.
+
+    Parameters
+    ----------
+    spring_constant, sensitivity : float, optional
+        The cantilever's spring constant (N/m) and deflection sensitivity (m/V; for NT-MDT
+        m/A), for the text exports that do not carry them (:func:`afm_text_format`); JPK and
+        Asylum files carry their own.
+
+    Raises
+    ------
+    ValueError
+        afmformats is not installed, or cannot read the file, or a curve lacks the force,
+        a height or the spring constant, or the file declares sizes beyond the bounds.
+    """
+    return readers.read_curves(path, spring_constant=spring_constant, sensitivity=sensitivity)
+
+
+def single_curve(path, *, columns=None, units=None, invert=(), spring_constant=None, sensitivity=None):
+    """The record of an AFM file's one curve (:func:`read_afm`); a force map is refused, pointing
+    to :func:`read_afm` and :func:`shellbvp.batch.fit_map`, as reading options of text exports."""
+    return readers.read_record(path, columns=columns, units=units, invert=invert, spring_constant=spring_constant,
+                               sensitivity=sensitivity, curves=True)
+
+
+def refuse_text_options(path, columns=None, units=None, invert=(), spring_constant=None, sensitivity=None):
+    """ValueError when reading options of text exports are given for an AFM file (the
+    calibration options are the AFM reader's: accepted)."""
+    readers.check_options(readers.reader_for(path, curves=True), path,
+                          {"columns": columns, "units": units, "invert": invert})
+
 
 MAP_FORMAT = "shellbvp-force-map"
 MAP_FORMAT_VERSION = 1

@@ -20,6 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
+from . import readers
 from .shape_parameters import DERIVED, SHAPE_PARAMETERS
 from .textdata import table_cell
 
@@ -28,8 +29,9 @@ log = logging.getLogger(__name__)
 __all__ = ["BatchRow", "fit_files", "fit_records", "fit_map", "shared_curves", "read_record", "expand_inputs", "write_table",
            "TABLE_COLUMNS", "DATA_SUFFIXES"]
 
-#: File names a directory given as input contributes (instrument exports are text tables).
-DATA_SUFFIXES = (".csv", ".tsv", ".txt", ".dat", ".jpk-force", ".ibw")  # AFM single curves: shellbvp.afm
+#: The file name endings a directory given as input contributes: each reader's
+#: (:mod:`shellbvp.readers`; text tables, AFM single curves)
+DATA_SUFFIXES = readers.folder_suffixes()
 
 
 def _with_unit(name, unit):
@@ -123,8 +125,9 @@ def _num(v):
 
 
 def expand_inputs(inputs) -> list:
-    """File names from files, directories (their files ending in :data:`DATA_SUFFIXES`,
-    sorted) and glob patterns (for shells that do not expand them); order kept, no repeats.
+    """File names from files, directories (their files ending as the readers take them in a folder,
+    :func:`shellbvp.readers.folder_suffixes`, sorted) and glob patterns (for shells that do not
+    expand them); order kept, no repeats.
 
     Raises
     ------
@@ -137,9 +140,10 @@ def expand_inputs(inputs) -> list:
         if p.is_dir():
             # every entry named like data, files or not: a FIFO, a folder named x.csv or a
             # symlink loop gets its own row saying why it was not read, instead of vanishing
-            found = sorted(q for q in p.iterdir() if q.suffix.lower() in DATA_SUFFIXES)
+            taken = readers.folder_suffixes()
+            found = sorted(q for q in p.iterdir() if q.suffix.lower() in taken)
             if not found:
-                raise ValueError(f"{item}: a directory without data files ({', '.join(DATA_SUFFIXES)})")
+                raise ValueError(f"{item}: a directory without data files ({', '.join(taken)})")
             out += [str(q) for q in found]
         elif p.exists():
             out.append(str(p))
@@ -222,20 +226,13 @@ def fit_files(scene, paths, *, R_L, segment="loading", baseline="auto", columns=
 
 
 def read_record(path, *, columns=None, units=None, invert=(), spring_constant=None, sensitivity=None):
-    """One record from a file: an AFM curve through afmformats (:mod:`shellbvp.afm`; an AFM
-    text export with the cantilever's ``spring_constant`` and ``sensitivity``), a text export
-    through :func:`shellbvp.instrument.read_instrument`.  A force map is refused here (it is
+    """One record from a file, read by its reader (:func:`shellbvp.readers.read_record`): an AFM
+    curve through afmformats (:mod:`shellbvp.afm`; an AFM text export with the cantilever's
+    ``spring_constant`` and ``sensitivity``), a text export as
+    :func:`shellbvp.instrument.read_instrument` reads it.  A force map is refused here (it is
     fitted on its own: :func:`fit_map`)."""
-    from .afm import is_afm_file, single_curve
-    from .instrument import read_instrument
-
-    if is_afm_file(path):
-        return single_curve(path, columns=columns, units=units, invert=invert, spring_constant=spring_constant,
-                            sensitivity=sensitivity)
-    if spring_constant is not None or sensitivity is not None:
-        raise ValueError(f"{path}: not an AFM file: --spring-constant and --sensitivity are for AFM text exports "
-                         f"(AFM Workshop, NT-MDT)")
-    return read_instrument(path, columns=columns, units=units, invert=invert)
+    return readers.read_record(path, columns=columns, units=units, invert=invert, spring_constant=spring_constant,
+                               sensitivity=sensitivity)
 
 
 def fit_records(scene, named, *, R_L, segment="loading", baseline="auto", on_file=None, **options) -> list:

@@ -100,7 +100,8 @@ def read_pixel_table(path) -> PixelTable:
         >= 0, a value that is not a finite number > 0 (alpha: >= 0), a pixel given twice.
     """
     from .afm_read import MAX_MAP_PIXELS
-    from .instrument import cell_number, header_name_and_unit, read_table
+    from .readers import read_table
+    from .readers.text_table import cell_number, header_name_and_unit
 
     # at most one row per cell of the largest map; checked against the map's own grid by fit_map
     table = read_table(path, max_rows=MAX_MAP_PIXELS, what="pixel table (one row per pixel, MAX_MAP_PIXELS)")

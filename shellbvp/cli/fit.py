@@ -123,10 +123,10 @@ def _pixel_table(args, files, folder):
     """``--pixel-table``'s table read and checked (before the map is read), or None."""
     if args.pixel_table is None:
         return None
-    from ..afm import is_afm_file
     from ..pixel_table import read_pixel_table
+    from ..readers import reader_for
 
-    if len(files) != 1 or folder or not is_afm_file(files[0]):
+    if len(files) != 1 or folder or not reader_for(files[0]).curves:
         raise ValueError("--pixel-table is for one force map (an AFM file such as .jpk-force-map)")
     table = read_pixel_table(args.pixel_table)
     given = {"thickness": ("--thickness", "--beta"), "beta": ("--thickness", "--beta"), "alpha": ("--alpha",)}
@@ -232,10 +232,11 @@ def run(args):
         raise ValueError("give data files (or a directory) or --example (one of them)")
     if len(args.data) == 1 and not any(ch in args.data[0] for ch in "*?[") and not Path(args.data[0]).exists():
         raise ValueError(f"{args.data[0]}: no such file or directory")  # before the numerics are imported
-    from ..afm import is_afm_file, read_afm
+    from ..afm import read_afm
     from ..batch import expand_inputs, read_record
     from ..fitting import example_data_path, fit_record
     from ..paths import check_output_path
+    from ..readers import reader_for
 
     inputs = [str(example_data_path())] if args.example else args.data
     files = expand_inputs(inputs)
@@ -243,7 +244,7 @@ def run(args):
     folder = any(Path(x).is_dir() for x in inputs)
     pixel_values = _pixel_table(args, files, folder)
     map_curves = None
-    if len(files) == 1 and not folder and is_afm_file(files[0]):
+    if len(files) == 1 and not folder and reader_for(files[0]).curves:  # a file of curves: a force map?
         # its one-line error before the file is read
         require_sample(args, bending_per_pixel=_bending_per_pixel(pixel_values))
         curves = read_afm(files[0], **_calibration(args))
@@ -381,11 +382,11 @@ def _fit_map(args, path, curves, scene, R_L, reading, options, pixel_values=None
     """``shellbvp fit MAP.jpk-force-map [-o map.h5] [--table map.csv] [--report map.png]
     [--pixel-table geometry.csv]``: every curve with the same scene (or with the table's geometry
     per pixel); exit 0 when every curve was fitted, 1 otherwise."""
-    from ..afm import refuse_text_options
     from ..batch import fit_map, write_table
     from ..paths import check_output_path
+    from ..readers import check_options, reader_for
 
-    refuse_text_options(path, **reading)
+    check_options(reader_for(path), path, reading)
     if args.table is not None:
         check_output_path(args.table, overwrite=args.force)
     options = dict(options, progress=curve_bars(args, leave=False))
