@@ -16,7 +16,8 @@ sample is minus the tip's position: the package's signs, no ``--invert`` needed.
 * :class:`ForceMap` -- a force map fitted curve by curve (:func:`shellbvp.batch.fit_map`): the
   per-curve rows of a batch, images of mu*H and its interval, a NeXus file, a figure.
 * :func:`read_map_file` -- that NeXus file read back (:class:`MapFile`), for ``shellbvp info``
-  and ``shellbvp plot``.
+  and ``shellbvp plot``; one pixel's data against its fitted model from it
+  (:meth:`MapFile.plot_pixel`, ``shellbvp plot map.h5 --pixel IX,IY``; :mod:`shellbvp.map_pixels`).
 """
 
 from __future__ import annotations
