@@ -320,8 +320,13 @@ def locate(grid, shape, ix, iy) -> int:
 def read_curves(h, shape, path="", source="") -> MapCurves:
     """``/entry/curves`` (and ``/entry/curve_data`` where present) of an open map file, every
     item checked (:mod:`shellbvp.schema`; ValueError naming it)."""
+    import h5py
+
     from . import schema as sc
 
+    for name in ("entry/curves", "entry/curve_data"):
+        if name in h and not isinstance(h[name], h5py.Group):
+            raise ValueError(f"{name.split('/')[-1]} must be a group")
     c = h["entry/curves"]
     index = sc.dataset(c, "index", kind="int")
     n = index.size

@@ -220,6 +220,11 @@ def test_damaged_curve_data_is_one_line_naming_it(fitted, tmp_path):
         start[1] = start[2] + 5
     with pytest.raises(ValueError, match=r"incomplete or corrupt force-map file \(curve_data: start must rise"):
         read_map_file(bad)
+    with h5py.File(bad, "a") as f:
+        del f["entry/curve_data"]
+        f["entry/curve_data"] = 1.0
+    with pytest.raises(ValueError, match=r"incomplete or corrupt force-map file \(curve_data must be a group\)$"):
+        read_map_file(bad)
 
 
 def test_thinning_keeps_the_contact_and_bounds_the_rows(fitted, tmp_path):
