@@ -166,6 +166,8 @@ def test_the_force_map_example_runs_from_the_real_file_to_the_map_and_a_pixels_f
         # what the example's text says of these fits
         assert [r.result.quality for r in fm.rows] == ["poor"] * 4, "update the example's text"
         assert [r.status for r in fm.rows] == ["failed", "failed", "failed", "ok"], "update the example's text"
+        mu = [r.result.mu_H for r in fm.rows]
+        assert max(mu) / min(mu) > 20, "update the example's text"
         np.testing.assert_array_equal(mf.mu_H, fm.image("mu_H"))
         shown = mf.pixel(0, 9)
         assert shown.status == "ok" and shown.displacement.size == 1000 and shown.rows_fitted == 4157

@@ -8,7 +8,8 @@ pixel's rating and warnings, and one pixel's data against its fitted model.
 
 The file is afmformats' test map ``fmt-jpk-fd_map2x2_extracted.jpk-force-map`` (MIT
 licence, (c) 2019 Paul Müller; ``docs/examples/data/``): four curves, at the corners of a
-10 x 10 grid over 600 um x 600 um, each pushed to about 1.6 nN with a cantilever of 0.0155 N/m.
+10 x 10 grid over 600 um x 600 um, each pushed until the force read 1.5-1.6 nN, with a
+cantilever of 0.0155 N/m.
 The file does not say what was measured.  **The geometry below is assumed for illustration:**
 a free-standing film 90 nm thick spanning a round opening 6 um across (rim radius R_L = 3 um),
 indented by a sphere of radius 0.9 um.  A film over a hole is the shape of the package's flat
@@ -104,7 +105,7 @@ for code, (where, text) in fm.warning_counts().items():
 # pixels a fit with another noise model gives another mu*H (status ``failed``,
 # ``weights_disagree``).  Their 95 % intervals then do not say how well mu*H is known: the
 # assumed film does not describe these curves well enough, and the spread of mu*H over the
-# map (a factor 25) is no measurement of the sample's variation.
+# map (more than a factor 20) is no measurement of the sample's variation.
 #
 # The map of mu*H
 # ---------------
