@@ -11,6 +11,8 @@ import re
 import sys
 from pathlib import Path
 
+from ..materials import material_class
+from ..scene_parameters import scene_parameter, scene_parameters
 
 __all__ = ["Parser", "print_json_error", "show_code_generation", "plain_number", "plain_numbers", "quantity", "uncertain_value", "pressure_value", "say", "number_or", "thickness_value", "nondimensional", "add_radius_option", "add_mu_h_option", "material_spec", "material_help", "material_options", "bending_families", "add_scene_options", "scene_from_args", "over_rim_radius", "require_sample", "nondimensional_thickness", "nondimensional_pressure", "checkpoint_seconds", "progress_bar", "curve_bars", "MAX_POINTS", "free_default_name", "strict_json", "output_dir", "check_report_path", "add_overwrite_option",
            "NODE_BUDGET", "node_budget", "add_limit_options", "limits_of", "LIMIT_OPTIONS"]
@@ -303,18 +305,16 @@ def add_scene_options(p, uncertain=False, preset_required=False, solver=("tol", 
                    help="built-in scene (see `shellbvp presets`); " + (
                        "give it, or the sample's geometry: --indenter-radius (or --rho) and --rise (or --gamma) "
                        "and --thickness (or --beta)" if preset_required else "default base"))
-    from ..scene_parameters import scene_parameters
-
     params = scene_parameters()
 
-    def kind(name):  # VALUE+-U where the registry lets the parameter carry an uncertainty
+    def kind(name):  # (type, the help's end): VALUE+-U where the registry lets it carry an uncertainty
         if uncertain and params[name].uncertainty:
-            return {"type": uncertain_value, "help": "; VALUE+-U: with a standard uncertainty U"}
-        return {"type": plain_number, "help": ""}
+            return uncertain_value, "; VALUE+-U: with a standard uncertainty U"
+        return plain_number, ""
 
     shape = g.add_mutually_exclusive_group()
-    shape.add_argument("--gamma", type=kind("gamma")["type"],
-                       help=f"spheroid aspect parameter (< 1/rho; >0 bowl, <0 dome){kind('gamma')['help']}")
+    kind_of, note = kind("gamma")
+    shape.add_argument("--gamma", type=kind_of, help=f"spheroid aspect parameter (< 1/rho; >0 bowl, <0 dome){note}")
     shape.add_argument("--rise", type=quantity("length", positive=False),
                        help="how far the pole lies below the rim's plane, with its unit (with --radius): gamma = "
                             "rise / R_L; > 0 a bowl indented from inside (5um), < 0 a dome indented from outside "
@@ -323,10 +323,12 @@ def add_scene_options(p, uncertain=False, preset_required=False, solver=("tol", 
                    help="the shell is a dome indented from outside (its convex side): --rise is the pole's height "
                         "above the rim's plane, gamma = -rise / R_L")
     tip = g.add_mutually_exclusive_group()
-    tip.add_argument("--rho", type=kind("rho")["type"], help=f"indenter radius / rim radius (> 0){kind('rho')['help']}")
+    kind_of, note = kind("rho")
+    tip.add_argument("--rho", type=kind_of, help=f"indenter radius / rim radius (> 0){note}")
     tip.add_argument("--indenter-radius", type=quantity("length"), dest="indenter_radius",
                      help="the indenter's tip radius with its unit (with --radius): rho = it / R_L")
-    g.add_argument("--beta", type=kind("beta")["type"], help=f"bending stiffness B/(mu R_L^2) (> 0){kind('beta')['help']}")
+    kind_of, note = kind("beta")
+    g.add_argument("--beta", type=kind_of, help=f"bending stiffness B/(mu R_L^2) (> 0){note}")
     g.add_argument("--thickness", type=thickness_value,
                    help="shell thickness: H/R_L in (0, 0.5], or with a unit (50um) together with --radius; "
                         "sets beta = (H/R_L)^2/3, the bending stiffness of a 3D plate")
@@ -335,8 +337,8 @@ def add_scene_options(p, uncertain=False, preset_required=False, solver=("tol", 
                         "shell's depth; removes most of the model's O(H/R_L) error, see docs/accuracy.md)")
     m = g.add_mutually_exclusive_group()
     for param in material_options():  # --alpha, --gent-jm: each selects its material
-        m.add_argument(param.option, dest=param.dest, type=kind(param.name)["type"],
-                       help=param.option_help + kind(param.name)["help"])
+        kind_of, note = kind(param.name)
+        m.add_argument(param.option, dest=param.dest, type=kind_of, help=param.option_help + note)
     m.add_argument("--neo-hookean", action="store_true", help="neo-Hookean material")
     m.add_argument("--material", type=material_spec, metavar="FAMILY[:NAME=VALUE,...]",
                    help=material_help())
@@ -368,15 +370,11 @@ def add_scene_options(p, uncertain=False, preset_required=False, solver=("tol", 
 def material_options() -> list:
     """The materials' parameters with an option of their own (``--alpha``, ``--gent-jm``), from
     the registry (:mod:`shellbvp.scene_parameters`)."""
-    from ..scene_parameters import scene_parameters
-
     return [p for p in scene_parameters().values() if p.material and p.option]
 
 
 def scene_from_args(args):
     import shellbvp as sb
-
-    from ..materials import material_class
 
     over = {k: getattr(args, k) for k in ("gamma", "rho", "beta", "xi", "contact", "sealed", "transverse_shear")
             if getattr(args, k, None) is not None}
@@ -418,8 +416,6 @@ def _dome_rise(args):
 
 def over_rim_radius(args, length, option):
     """A lab length of the sample over the rim radius ``--radius``: the nondimensional number."""
-    from ..scene_parameters import scene_parameter
-
     radius = getattr(args, "radius", None)
     if radius is None:
         raise ValueError(f"{option} {length} is a length: it needs --radius (the rim radius R_L), or give "
@@ -445,7 +441,6 @@ def require_sample(args, bending_per_pixel=False):
 
 def nondimensional_thickness(args):
     """``--thickness`` as ``H / R_L``: a plain number as it is, a length through ``--radius``."""
-    from ..scene_parameters import scene_parameter
     from ..units import Quantity
 
     if not isinstance(args.thickness, Quantity):
@@ -460,7 +455,6 @@ def nondimensional_thickness(args):
 def nondimensional_pressure(args):
     """``--pressure`` as ``p R_L/(mu H)``: a plain number as it is, a pressure with a unit through
     ``--radius`` and ``--muH``."""
-    from ..scene_parameters import scene_parameter
     from ..units import Quantity
 
     if not isinstance(args.pressure, Quantity):
