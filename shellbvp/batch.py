@@ -21,6 +21,7 @@ from pathlib import Path
 import numpy as np
 
 from . import readers
+from .scene_parameters import LiveNames
 from .shape_parameters import DERIVED, SHAPE_PARAMETERS
 from .textdata import table_cell
 
@@ -44,12 +45,13 @@ def _estimate_columns(name, unit):
 
 #: Columns of the results table, with their units: a shape parameter's and its derived
 #: quantities' (:mod:`shellbvp.shape_parameters`) are filled where it was fitted.
-TABLE_COLUMNS = ("file", "status", "quality", "model", "model error (1)", "mu_H (N/m)", "mu_H 95% low (N/m)", "mu_H 95% high (N/m)", "offset (m)",
-                 "offset 95% low (m)", "offset 95% high (m)", "baseline (N)", "baseline 95% low (N)",
-                 "baseline 95% high (N)", "baseline slope (N/m)", "baseline model",
-                 *(c for p in SHAPE_PARAMETERS.values() for c in _estimate_columns(p.name, p.unit)),
-                 *(c for d in DERIVED.values() for c in _estimate_columns(d.name, d.unit)),
-                 "residual rms (N)", "points", "segment", "warnings", "message", "sha256")
+TABLE_COLUMNS = LiveNames(lambda: (
+    "file", "status", "quality", "model", "model error (1)", "mu_H (N/m)", "mu_H 95% low (N/m)", "mu_H 95% high (N/m)",
+    "offset (m)", "offset 95% low (m)", "offset 95% high (m)", "baseline (N)", "baseline 95% low (N)",
+    "baseline 95% high (N)", "baseline slope (N/m)", "baseline model",
+    *(c for p in SHAPE_PARAMETERS.values() for c in _estimate_columns(p.name, p.unit)),
+    *(c for d in DERIVED.values() for c in _estimate_columns(d.name, d.unit)),
+    "residual rms (N)", "points", "segment", "warnings", "message", "sha256"))
 
 
 @dataclass
@@ -106,8 +108,8 @@ class BatchRow:
         for name, p in SHAPE_PARAMETERS.items():
             if name in r.fitted:
                 put(name, r.shape_values[name], r.shape_ci95[name], p.unit)
-        if "thickness" not in r.fitted and r.thickness is not None:
-            put("thickness", r.thickness, None, "m")  # given: exact, no interval
+        if "thickness" not in r.fitted and r.thickness is not None:  # given: exact, no interval; H in m
+            put("thickness", r.thickness, None, SHAPE_PARAMETERS["thickness"].unit)
         for name, e in r.derived.items():  # a fitted parameter's, and mu and E of a given thickness
             put(name, e.value, e.ci95, e.unit)
         row["quality"] = r.quality
@@ -334,9 +336,8 @@ MAX_PIXEL_CURVES = 40
 def _pixel_values_checked(scene, curves, shape, table, R_L, options):
     """``{(ix, iy): x}``: the table's nondimensional values, each checked against the scene and
     the map (ValueError naming the table's line otherwise)."""
-    from .shape_parameters import shape_parameter
-
-    from .shape_parameters import SHAPE_PARAMETERS
+    from .scene_parameters import scene_parameter
+    from .shape_parameters import SHAPE_PARAMETERS, shape_parameter
 
     if options.get("free") or any(options.get(f"fit_{name}") for name in SHAPE_PARAMETERS):
         raise ValueError(f"a map with {table.name} per pixel fits mu*H, the offset and the baseline on the "
@@ -346,8 +347,8 @@ def _pixel_values_checked(scene, curves, shape, table, R_L, options):
         raise ValueError(f"curve {missing_grid[0]} of the map has no grid index: a pixel table needs every "
                          f"curve's (ix, iy)")
     nx, ny = shape
-    param = shape_parameter(table.name)
-    if table.name != "thickness":  # a given thickness needs no start value in the scene
+    param, declared = shape_parameter(table.name), scene_parameter(table.name)
+    if declared.material:  # the scene's material must have it (a given thickness needs no start value)
         why = param.unavailable(scene)
         if why:
             raise ValueError(f"{table.path}: {why}")
@@ -358,7 +359,7 @@ def _pixel_values_checked(scene, curves, shape, table, R_L, options):
         given = f"{table.column} = {table.values[pixel]:g}"
         if not (math.isfinite(x) and param.low_ok(x) and param.high_ok(x)):
             raise ValueError(f"{table.where(pixel)}: {given} is out of the range of {param.description}"
-                             + (f" (H/R_L = {x:.4g}, R_L = {R_L:g} m)" if table.unit else ""))
+                             + (f" ({declared.symbol} = {x:.4g}, R_L = {R_L:g} m)" if table.unit else ""))
         try:
             param.set(scene, x)
         except ValueError as exc:
