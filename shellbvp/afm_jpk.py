@@ -24,10 +24,8 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["JPK_SUFFIXES", "jpk_datasets"]
+__all__ = ["jpk_datasets"]
 
-#: File name endings of JPK archives (afmformats' JPK recipes)
-JPK_SUFFIXES = (".jpk-force", ".jpk-force-map", ".jpk-qi-data", ".jpk-qi-series")
 #: The columns afmformats' ``load_jpk`` offers
 _COLUMNS = ("force", "height (measured)", "height (piezo)", "segment", "time")
 #: Property sets kept: a curve's segments (afmformats' own cache holds 128 of every curve's)

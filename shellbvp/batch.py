@@ -20,6 +20,8 @@ from pathlib import Path
 
 import numpy as np
 
+from . import readers
+from .scene_parameters import LiveNames
 from .shape_parameters import DERIVED, SHAPE_PARAMETERS
 from .textdata import table_cell
 
@@ -28,8 +30,9 @@ log = logging.getLogger(__name__)
 __all__ = ["BatchRow", "fit_files", "fit_records", "fit_map", "shared_curves", "read_record", "expand_inputs", "write_table",
            "TABLE_COLUMNS", "DATA_SUFFIXES"]
 
-#: File names a directory given as input contributes (instrument exports are text tables).
-DATA_SUFFIXES = (".csv", ".tsv", ".txt", ".dat", ".jpk-force", ".ibw")  # AFM single curves: shellbvp.afm
+#: The file name endings a directory given as input contributes: each reader's
+#: (:mod:`shellbvp.readers`; text tables, AFM single curves)
+DATA_SUFFIXES = readers.folder_suffixes()
 
 
 def _with_unit(name, unit):
@@ -42,12 +45,13 @@ def _estimate_columns(name, unit):
 
 #: Columns of the results table, with their units: a shape parameter's and its derived
 #: quantities' (:mod:`shellbvp.shape_parameters`) are filled where it was fitted.
-TABLE_COLUMNS = ("file", "status", "quality", "model", "model error (1)", "mu_H (N/m)", "mu_H 95% low (N/m)", "mu_H 95% high (N/m)", "offset (m)",
-                 "offset 95% low (m)", "offset 95% high (m)", "baseline (N)", "baseline 95% low (N)",
-                 "baseline 95% high (N)", "baseline slope (N/m)", "baseline model",
-                 *(c for p in SHAPE_PARAMETERS.values() for c in _estimate_columns(p.name, p.unit)),
-                 *(c for d in DERIVED.values() for c in _estimate_columns(d.name, d.unit)),
-                 "residual rms (N)", "points", "segment", "warnings", "message", "sha256")
+TABLE_COLUMNS = LiveNames(lambda: (
+    "file", "status", "quality", "model", "model error (1)", "mu_H (N/m)", "mu_H 95% low (N/m)", "mu_H 95% high (N/m)",
+    "offset (m)", "offset 95% low (m)", "offset 95% high (m)", "baseline (N)", "baseline 95% low (N)",
+    "baseline 95% high (N)", "baseline slope (N/m)", "baseline model",
+    *(c for p in SHAPE_PARAMETERS.values() for c in _estimate_columns(p.name, p.unit)),
+    *(c for d in DERIVED.values() for c in _estimate_columns(d.name, d.unit)),
+    "residual rms (N)", "points", "segment", "warnings", "message", "sha256"))
 
 
 @dataclass
@@ -104,8 +108,8 @@ class BatchRow:
         for name, p in SHAPE_PARAMETERS.items():
             if name in r.fitted:
                 put(name, r.shape_values[name], r.shape_ci95[name], p.unit)
-        if "thickness" not in r.fitted and r.thickness is not None:
-            put("thickness", r.thickness, None, "m")  # given: exact, no interval
+        if "thickness" not in r.fitted and r.thickness is not None:  # given: exact, no interval; H in m
+            put("thickness", r.thickness, None, SHAPE_PARAMETERS["thickness"].unit)
         for name, e in r.derived.items():  # a fitted parameter's, and mu and E of a given thickness
             put(name, e.value, e.ci95, e.unit)
         row["quality"] = r.quality
@@ -123,8 +127,9 @@ def _num(v):
 
 
 def expand_inputs(inputs) -> list:
-    """File names from files, directories (their files ending in :data:`DATA_SUFFIXES`,
-    sorted) and glob patterns (for shells that do not expand them); order kept, no repeats.
+    """File names from files, directories (their files ending as the readers take them in a folder,
+    :func:`shellbvp.readers.folder_suffixes`, sorted) and glob patterns (for shells that do not
+    expand them); order kept, no repeats.
 
     Raises
     ------
@@ -137,9 +142,10 @@ def expand_inputs(inputs) -> list:
         if p.is_dir():
             # every entry named like data, files or not: a FIFO, a folder named x.csv or a
             # symlink loop gets its own row saying why it was not read, instead of vanishing
-            found = sorted(q for q in p.iterdir() if q.suffix.lower() in DATA_SUFFIXES)
+            taken = readers.folder_suffixes()
+            found = sorted(q for q in p.iterdir() if q.suffix.lower() in taken)
             if not found:
-                raise ValueError(f"{item}: a directory without data files ({', '.join(DATA_SUFFIXES)})")
+                raise ValueError(f"{item}: a directory without data files ({', '.join(taken)})")
             out += [str(q) for q in found]
         elif p.exists():
             out.append(str(p))
@@ -222,20 +228,13 @@ def fit_files(scene, paths, *, R_L, segment="loading", baseline="auto", columns=
 
 
 def read_record(path, *, columns=None, units=None, invert=(), spring_constant=None, sensitivity=None):
-    """One record from a file: an AFM curve through afmformats (:mod:`shellbvp.afm`; an AFM
-    text export with the cantilever's ``spring_constant`` and ``sensitivity``), a text export
-    through :func:`shellbvp.instrument.read_instrument`.  A force map is refused here (it is
+    """One record from a file, read by its reader (:func:`shellbvp.readers.read_record`): an AFM
+    curve through afmformats (:mod:`shellbvp.afm`; an AFM text export with the cantilever's
+    ``spring_constant`` and ``sensitivity``), a text export as
+    :func:`shellbvp.instrument.read_instrument` reads it.  A force map is refused here (it is
     fitted on its own: :func:`fit_map`)."""
-    from .afm import is_afm_file, single_curve
-    from .instrument import read_instrument
-
-    if is_afm_file(path):
-        return single_curve(path, columns=columns, units=units, invert=invert, spring_constant=spring_constant,
-                            sensitivity=sensitivity)
-    if spring_constant is not None or sensitivity is not None:
-        raise ValueError(f"{path}: not an AFM file: --spring-constant and --sensitivity are for AFM text exports "
-                         f"(AFM Workshop, NT-MDT)")
-    return read_instrument(path, columns=columns, units=units, invert=invert)
+    return readers.read_record(path, columns=columns, units=units, invert=invert, spring_constant=spring_constant,
+                               sensitivity=sensitivity)
 
 
 def fit_records(scene, named, *, R_L, segment="loading", baseline="auto", on_file=None, **options) -> list:
@@ -337,9 +336,8 @@ MAX_PIXEL_CURVES = 40
 def _pixel_values_checked(scene, curves, shape, table, R_L, options):
     """``{(ix, iy): x}``: the table's nondimensional values, each checked against the scene and
     the map (ValueError naming the table's line otherwise)."""
-    from .shape_parameters import shape_parameter
-
-    from .shape_parameters import SHAPE_PARAMETERS
+    from .scene_parameters import scene_parameter
+    from .shape_parameters import SHAPE_PARAMETERS, shape_parameter
 
     if options.get("free") or any(options.get(f"fit_{name}") for name in SHAPE_PARAMETERS):
         raise ValueError(f"a map with {table.name} per pixel fits mu*H, the offset and the baseline on the "
@@ -349,8 +347,8 @@ def _pixel_values_checked(scene, curves, shape, table, R_L, options):
         raise ValueError(f"curve {missing_grid[0]} of the map has no grid index: a pixel table needs every "
                          f"curve's (ix, iy)")
     nx, ny = shape
-    param = shape_parameter(table.name)
-    if table.name != "thickness":  # a given thickness needs no start value in the scene
+    param, declared = shape_parameter(table.name), scene_parameter(table.name)
+    if declared.material:  # the scene's material must have it (a given thickness needs no start value)
         why = param.unavailable(scene)
         if why:
             raise ValueError(f"{table.path}: {why}")
@@ -361,7 +359,7 @@ def _pixel_values_checked(scene, curves, shape, table, R_L, options):
         given = f"{table.column} = {table.values[pixel]:g}"
         if not (math.isfinite(x) and param.low_ok(x) and param.high_ok(x)):
             raise ValueError(f"{table.where(pixel)}: {given} is out of the range of {param.description}"
-                             + (f" (H/R_L = {x:.4g}, R_L = {R_L:g} m)" if table.unit else ""))
+                             + (f" ({declared.symbol} = {x:.4g}, R_L = {R_L:g} m)" if table.unit else ""))
         try:
             param.set(scene, x)
         except ValueError as exc:

@@ -17,6 +17,7 @@ import numpy as np
 from .geometry import FlatTip, SphereTip, Spheroid, UserShell, UserTip
 from .materials import MATERIALS, Bending, Gent, Material, MooneyRivlin, TraceBending
 from .model import load_module, structure_description
+from .scene_parameters import scene_parameter
 
 __all__ = ["Scene", "PRESETS", "CONTACT_MODELS", "RIMS", "SUPPORTS"]
 
@@ -151,17 +152,16 @@ class Scene:
     support: str = None
 
     def __post_init__(self):
+        # the ranges and their errors are the registry's (shellbvp.scene_parameters)
         rho = _finite("rho", self.rho)
-        if rho <= 0:
-            raise ValueError(f"rho (indenter radius / rim radius) must be > 0; got {self.rho!r}")
+        scene_parameter("rho").check(rho, shown=self.rho)
         if not isinstance(self.bending, Bending):
             raise ValueError(f"bending must be TraceBending(), RotationBending() or BendingEnergy(...); "
                              f"got {self.bending!r}")
         beta = self.beta
         if self.thickness is not None:
-            eps = _finite("thickness", self.thickness)
-            if not 0 < eps <= 0.5:
-                raise ValueError(f"thickness (H / R_L) must be in (0, 0.5]; got {self.thickness!r}")
+            eps = _finite("thickness", self.thickness)  # H / R_L: the scene's unit (its lab form H = eps R_L)
+            scene_parameter("thickness").check(eps, shown=self.thickness)
             from .units import beta_from_thickness
 
             from_eps = beta_from_thickness(eps, 1.0, self.bending)
@@ -171,8 +171,7 @@ class Scene:
             beta = from_eps
             object.__setattr__(self, "thickness", eps)
         beta = _finite("beta", 0.01 if beta is None else beta)
-        if beta <= 0:
-            raise ValueError(f"beta (bending stiffness) must be > 0; got {self.beta!r}")
+        scene_parameter("beta").check(beta, shown=self.beta)
         gamma = _finite("gamma", self.gamma)
         if self.xi not in (0, 1) or isinstance(self.xi, bool):
             raise ValueError(f"xi must be 0 or 1; got {self.xi!r}")
