@@ -19,7 +19,7 @@ import numpy as np
 from scipy.optimize import brentq
 
 from .configurations import configuration
-from .configurations.closed import CONTACTS, LOWER_NAMES, closed_name
+from .configurations.closed import LOWER_NAMES, closed_name
 from .cylinder import solve_chain_from
 from .geometry import FlatTip
 from .solution import failure, richardson_error, warm_mesh
@@ -34,6 +34,12 @@ _Z = 5  # z in a free region's states
 def symmetric_scenes(scene):
     """The shell squeezed between two of its tips, and between two plates."""
     return scene.replace(support="plates"), scene.replace(support="plates", tip=FlatTip())
+
+
+def _half(state):
+    """How a symmetric problem's state touches its indenter, as a closed shell's half (None for
+    a configuration no half has)."""
+    return configuration(state.topology).half if state.topology else None
 
 
 def _system(scene, name, control, value, eps):
@@ -79,7 +85,7 @@ def _matched(scene, delta, solve_half, kw):
     for walk, d in zip(halves, (du, 2 * delta - du)):
         near = min(walk, key=lambda s: abs(s.delta - d))
         s = solve_half(near.scene, delta=float(d), guess=near, estimate_error=False, **kw)
-        if not s.success or s.topology not in CONTACTS:
+        if not s.success or _half(s) is None:
             return None, f"a symmetric half at delta {d:.4g} gave {s.topology} ({s.message})"
         states.append(s)
     return states, ""
@@ -117,7 +123,7 @@ def closed_cold(scene, control, value, *, solve_half, eps, tol, max_nodes, bc_to
         return failed(why)
     res = None
     for upper, lower in _contacts_tried(halves, solve_half, kw):
-        name = closed_name(upper.topology, lower.topology)
+        name = closed_name(_half(upper), _half(lower))
         sysm = _system(scene, name, control, value, eps)
         res = solve_chain_from(sysm, _joined(sysm, upper, lower, value), tol=tol, max_nodes=max_nodes, bc_tol=bc_tol)
         if res.success and res.valid:
@@ -136,7 +142,7 @@ def _contacts_tried(halves, solve_half, kw):
     others = []
     for half in halves:
         found = []
-        if half.topology == "line":
+        if configuration(half.topology).line_contact:
             for topology in ("cap", "annulus"):
                 other = solve_half(half.scene, delta=half.delta, topology=topology, guess=half, estimate_error=False,
                                    **kw)

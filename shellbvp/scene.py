@@ -506,6 +506,9 @@ def _support(scene, gamma) -> str:
         raise ValueError("closed=True needs the built-in spheroid (a user meridian from pole to pole is not offered yet)")
     if not gamma > 0:
         raise ValueError(f"gamma (polar / equatorial semi-axis of a closed spheroid) must be > 0; got {gamma!r}")
+    if support == "substrate" and not isinstance(scene.tip, FlatTip) and scene.contact != "smooth":
+        raise ValueError(f"contact={scene.contact!r}: a closed shell on a substrate under a curved tip has the smooth "
+                         "(variational) contact model only")
     if scene.rim != "pinned":
         raise ValueError(f"rim={scene.rim!r} holds a rim; a closed shell has none")
     return support
@@ -553,6 +556,15 @@ PRESETS = {
                        "indenting, under volume control (the pressure rises as it is indented)",
                 "scene": dict(shell=("sin(S)", "cos(S)", "4*pi/5"), rho=0.34, beta=1.55e-3,
                               material=MooneyRivlin(0.1), xi=1, sealed=True)},
+    "cell-glass": {"doc": "walled cell with turgor resting on glass under a colloidal probe: a complete sphere, wall "
+                          "eps = H/R = 0.04 (beta 5.3e-4), probe rho 0.34, pressure 0.15 (yeast-like: radius 2.5 um, "
+                          "wall 0.1 um, probe 0.85 um, mu H 3.3 N/m, turgor 0.2 MPa)",
+                   "scene": dict(closed=True, support="substrate", tip=SphereTip(), gamma=1.0, rho=0.34,
+                                 beta=0.04**2 / 3, material=MooneyRivlin(0.1), xi=1, pressure=0.15)},
+    "pollen": {"doc": "dry pollen grain on a substrate under a colloidal probe: a complete sphere of radius 25 um, "
+                      "wall 1 um (eps 0.04, beta 5.3e-4), probe radius 2 um (rho 0.08), no pressure",
+               "scene": dict(closed=True, support="substrate", tip=SphereTip(), gamma=1.0, rho=0.08,
+                             beta=0.04**2 / 3, material=MooneyRivlin(0.1), xi=1)},
     "capsule-plates": {"doc": "sealed liquid-filled capsule compressed between two plates: a complete sphere, wall "
                               "eps = H/R = 0.02 (beta 1.33e-4), no pressure before compressing (volume control)",
                        "scene": dict(closed=True, support="plates", tip=FlatTip(), gamma=1.0, rho=1.0,

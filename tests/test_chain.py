@@ -261,13 +261,18 @@ def test_every_configuration_is_registered_once_with_its_system():
     (the chain it declares, the tip tabulated) and refuses what it does not allow in one line."""
     from shellbvp import configurations as cf
 
-    assert cf.CONFIGURATION_NAMES == tuple(cf.CONFIGURATIONS) and len(set(cf.CONFIGURATION_NAMES)) == 10
+    assert cf.CONFIGURATION_NAMES == tuple(cf.CONFIGURATIONS) and len(set(cf.CONFIGURATION_NAMES)) == 10 + 16
     assert set(cf.names("wall")) == {"cap+line(cylinder)", "cap+band(cylinder)", "cap+cylinder"}
     assert cf.ASKED[0] == "auto" and "cap+line(tip)" not in cf.ASKED
     scene = sb.Scene.preset("base")
+    closed = sb.Scene(closed=True, tip=sb.SphereTip(), rho=0.5, beta=1e-2)  # on a substrate: two contacts
     for name, conf in cf.CONFIGURATIONS.items():
-        sysm = conf.system(scene, "delta", 0.2, EPS)
+        sysm = conf.system(closed if conf.family == "closed" else scene, "delta", 0.2, EPS)
         assert sysm.topology == name and sysm.tip_A.size > 0
+    with pytest.raises(ValueError, match="a closed shell's on a substrate"):
+        cf.configuration("closed-cap-cap").system(scene, "delta", 0.2, EPS)
+    with pytest.raises(ValueError, match="a rimmed shell's"):
+        cf.configuration("cap").system(closed, "delta", 0.2, EPS)
     with pytest.raises(ValueError, match="topology must be one of"):
         cf.configuration("cap+line(tipp)")
     with pytest.raises(ValueError, match="registered already"):

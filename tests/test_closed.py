@@ -169,11 +169,27 @@ def test_a_pressurised_closed_shell_on_a_substrate_has_its_force_from_its_energy
     assert (s.pressure > 0.1) == sealed  # a sealed shell's pressure rises as it is squeezed
 
 
-def test_what_a_closed_shell_does_not_have_yet_is_refused():
+def test_a_sphere_between_plates_is_checked_on_both_sides_of_its_equator():
+    # the half's modes symmetric and antisymmetric about the equator; n = 1 (sliding on the
+    # frictionless plates, zero) is left out by default
     s = sb.solve(plates(1e-3), delta=0.05)
-    with pytest.raises(ValueError, match="closed shell is not supported yet"):
-        sb.stability(s)
+    res = sb.stability(s, elements=40)
+    assert 1 not in res.modes and 0 in res.modes and 2 in res.modes
+    assert res.stable
+    from shellbvp.modal_stability import either_side
+    from shellbvp.modal_stability.fem import Stability
+
+    a = Stability(modes=np.array([2, 3]), eigenvalues=np.array([[1.0, 2.0], [5.0, 6.0]]), elements=1, S0=0.0)
+    b = Stability(modes=np.array([2, 3]), eigenvalues=np.array([[0.5, 3.0], [7.0, 8.0]]), elements=1, S0=0.0)
+    assert either_side([a, b]).eigenvalues.tolist() == [[0.5, 1.0], [5.0, 6.0]]
+
+
+def test_what_a_closed_shell_does_not_have_yet_is_refused():
+    with pytest.raises(ValueError, match="on a substrate under a curved tip is not supported yet"):
+        sb.stability(sb.solve(on_substrate(), delta=0.1))
     from shellbvp.fe import check_solid_scene
 
     with pytest.raises(ValueError, match="closed shell"):
         check_solid_scene(plates(1e-3))
+    with pytest.raises(ValueError, match="smooth"):
+        on_substrate(contact="paper")

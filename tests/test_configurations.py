@@ -14,7 +14,8 @@ from shellbvp.configurations import registry
 
 #: The registration order: names() lists candidates, curves and files in it
 ORDER = ("cap", "point", "line", "annulus", "cap+line(tip)", "cap+band(tip)", "cap+line(cylinder)",
-         "cap+band(cylinder)", "cap+cylinder", "line+corner")
+         "cap+band(cylinder)", "cap+cylinder", "line+corner") + tuple(
+    f"closed-{u}-{l}" for u in ("point", "cap", "line", "annulus") for l in ("point", "cap", "line", "annulus"))
 
 
 @pytest.fixture

@@ -4,7 +4,7 @@ in :mod:`shellbvp.chain`)."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 
 __all__ = ["Point", "Region", "ContactPole", "FreePole", "PointPole", "Edge", "TipEnd", "Line", "Kink", "Rim",
            "Seam", "Chain", "SIZES", "FREE_STATES", "CONTACT_STATES", "CONTACT_KINDS", "REGION_CODES"]
@@ -168,4 +168,7 @@ class Chain:
 
 
 def _fields(j):
-    return "(" + ", ".join(f"{k}={v!r}" for k, v in j.__dict__.items()) + ")"
+    """A junction's fields, those at their defaults left out (the layouts of rimmed shells' chains
+    read as before the fields closed shells added)."""
+    shown = [f for f in fields(j) if getattr(j, f.name) != f.default]
+    return "(" + ", ".join(f"{f.name}={getattr(j, f.name)!r}" for f in shown) + ")"

@@ -100,7 +100,7 @@ class BoundaryConditions:
                 parts += [(yu - yl)[_SEAM_EQUAL], (yu + yl)[_SEAM_OPPOSITE], [yu[_PHIS] + yl[_PHIS] - 2 * self.rim_slope]]
             elif isinstance(j, Rim):
                 parts.append(self._rim_res(self.S_point(self.regions[j.k].end, p), yb[self.rows(j.k)], par,
-                                           q.get("delta", 0.0)))
+                                           q["delta"] if "delta" in q else 0.0))
         if self.extra == "force":
             _, S, yc, yf, _, _ = self._force_args(ya, yb, p, q)
             parts.append(self._force_function("res")(S, yc, yf, q["delta"], q["F"], par))

@@ -24,7 +24,7 @@ def annulus_chain(eps: float, L: float) -> Chain:
 
 CONFIGURATIONS = (
     Configuration("annulus", "lifted", without_edge_model(annulus_chain), contacts=("smooth",), askable=True,
-                  inner_edge=True, pole_branch_end=True),
+                  inner_edge=True, pole_branch_end=True, half="annulus"),
 )
 SWITCHES = (
     # the cap's contact pressure at its edge: where the pole lifts off

@@ -25,5 +25,6 @@ def cap_chain(eps: float, L: float, model: str = "smooth") -> Chain:
 
 
 CONFIGURATIONS = (
-    Configuration("cap", "cap", cap_chain, controls=("delta", "force", "lambda0", "arclength"), askable=True),
+    Configuration("cap", "cap", cap_chain, controls=("delta", "force", "lambda0", "arclength"), askable=True,
+                  half="cap"),
 )

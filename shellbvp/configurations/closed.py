@@ -21,12 +21,10 @@ from ..chain import Chain, ContactPole, Edge, FreePole, Line, Point, PointPole, 
 from .point import POINT_S0
 from .registry import Configuration, without_edge_model
 
-__all__ = ["closed_chain", "closed_name", "CONTACTS", "LOWER_NAMES"]
+__all__ = ["closed_chain", "closed_name", "CONTACTS", "HALVES", "LOWER_NAMES"]
 
 ORDER = 110
 
-#: How each half touches its indenter (the topology of its rimmed counterpart)
-CONTACTS = ("point", "cap", "line", "annulus")
 #: A lower half's unknowns by their rimmed counterpart's names
 LOWER_NAMES = {"ln_Sc": "ln_Sb", "lambda0": "lambda0_b", "ln_S1": "ln_S1_b", "chi1": "chi1_b", "ln_S2": "ln_S2_b"}
 
@@ -40,22 +38,37 @@ def _name(name, lower):
     return LOWER_NAMES[name] if lower else name
 
 
-def _half(contact, k, on, end, eps, lower):
-    """(regions, junctions, unknowns) of one half from its pole (its first region ``k``)."""
-    if contact == "point":
-        return (Region("free", Point("s0", None, math.log(POINT_S0)), end),), (PointPole(k, not lower),), ()
-    if contact == "cap":
-        Sc = Point("Sc", _name("ln_Sc", lower))
-        return ((Region(on, Point("zeta", Sc.unknown, math.log(eps)), Sc), Region("free", Sc, end)),
-                (ContactPole(k, _name("lambda0", lower)), Edge(k, k + 1)), (Sc.unknown,))
+def _point(k, on, end, eps, lower):
+    """The point-load limit: the free shell from its pole (the substrate's pole does not move)."""
+    return (Region("free", Point("s0", None, math.log(POINT_S0)), end),), (PointPole(k, not lower),), ()
+
+
+def _cap(k, on, end, eps, lower):
+    """A cap on the indenter from the pole, the free shell beyond it."""
+    Sc = Point("Sc", _name("ln_Sc", lower))
+    return ((Region(on, Point("zeta", Sc.unknown, math.log(eps)), Sc), Region("free", Sc, end)),
+            (ContactPole(k, _name("lambda0", lower)), Edge(k, k + 1)), (Sc.unknown,))
+
+
+def _line(k, on, end, eps, lower):
+    """The pole lifted, a ring on the indenter carrying a ring force."""
     S1 = Point("S1", _name("ln_S1", lower))
-    pole = Point("zeta", S1.unknown, math.log(eps))
-    if contact == "line":
-        return ((Region("free", pole, S1), Region("free", S1, end)),
-                (FreePole(k), Line(k, on, _name("chi1", lower))), (S1.unknown, _name("chi1", lower)))
-    S2 = Point("S2", _name("ln_S2", lower))
-    return ((Region("free", pole, S1), Region(on, S1, S2), Region("free", S2, end)),
-            (FreePole(k), Edge(k + 1, k), Edge(k + 1, k + 2)), (S1.unknown, S2.unknown))
+    return ((Region("free", Point("zeta", S1.unknown, math.log(eps)), S1), Region("free", S1, end)),
+            (FreePole(k), Line(k, on, _name("chi1", lower))), (S1.unknown, _name("chi1", lower)))
+
+
+def _annulus(k, on, end, eps, lower):
+    """The pole lifted, an annulus on the indenter."""
+    S1, S2 = Point("S1", _name("ln_S1", lower)), Point("S2", _name("ln_S2", lower))
+    return ((Region("free", Point("zeta", S1.unknown, math.log(eps)), S1), Region(on, S1, S2),
+             Region("free", S2, end)), (FreePole(k), Edge(k + 1, k), Edge(k + 1, k + 2)), (S1.unknown, S2.unknown))
+
+
+#: Each half's regions, junctions and unknowns from its pole, by how it touches its indenter (the
+#: ``half`` of the rimmed configuration it matches); a half at a point has no force condition
+HALVES = {"point": _point, "cap": _cap, "line": _line, "annulus": _annulus}
+CONTACTS = tuple(HALVES)
+_DELTA_ONLY = frozenset({"point"})
 
 
 def closed_chain(upper: str, lower: str):
@@ -63,14 +76,35 @@ def closed_chain(upper: str, lower: str):
     half the plane by ``lower``."""
     def chain(eps: float, L: float) -> Chain:
         end = Point("L", None, math.log(L))
-        ru, ju, uu = _half(upper, 0, "contact", end, eps, False)
-        rl, jl, ul = _half(lower, len(ru), "plane", end, eps, True)
+        ru, ju, uu = HALVES[upper](0, "contact", end, eps, False)
+        rl, jl, ul = HALVES[lower](len(ru), "plane", end, eps, True)
         seam = Seam(len(ru) - 1, len(ru) + len(rl) - 1)
         return Chain(closed_name(upper, lower), ru + rl, jl + ju + (seam,), uu + ul, eps)
     return chain
 
 
-CONFIGURATIONS = tuple(
-    Configuration(closed_name(u, l), "closed", without_edge_model(closed_chain(u, l)), contacts=("smooth",),
-                  controls=("delta",) if u == "point" else ("delta", "force"))
-    for u in CONTACTS for l in CONTACTS)
+def _parts(upper, lower):
+    """(chain, contacts, controls) of the configuration touching by ``upper`` and ``lower``."""
+    return (without_edge_model(closed_chain(upper, lower)), ("smooth",),
+            ("delta",) if upper in _DELTA_ONLY else ("delta", "force"))
+
+
+# every name written out, as the registry's other modules declare theirs (closed_name(u, l))
+CONFIGURATIONS = (
+    Configuration("closed-point-point", "closed", *_parts("point", "point")),
+    Configuration("closed-point-cap", "closed", *_parts("point", "cap")),
+    Configuration("closed-point-line", "closed", *_parts("point", "line")),
+    Configuration("closed-point-annulus", "closed", *_parts("point", "annulus")),
+    Configuration("closed-cap-point", "closed", *_parts("cap", "point")),
+    Configuration("closed-cap-cap", "closed", *_parts("cap", "cap")),
+    Configuration("closed-cap-line", "closed", *_parts("cap", "line")),
+    Configuration("closed-cap-annulus", "closed", *_parts("cap", "annulus")),
+    Configuration("closed-line-point", "closed", *_parts("line", "point")),
+    Configuration("closed-line-cap", "closed", *_parts("line", "cap")),
+    Configuration("closed-line-line", "closed", *_parts("line", "line")),
+    Configuration("closed-line-annulus", "closed", *_parts("line", "annulus")),
+    Configuration("closed-annulus-point", "closed", *_parts("annulus", "point")),
+    Configuration("closed-annulus-cap", "closed", *_parts("annulus", "cap")),
+    Configuration("closed-annulus-line", "closed", *_parts("annulus", "line")),
+    Configuration("closed-annulus-annulus", "closed", *_parts("annulus", "annulus")),
+)

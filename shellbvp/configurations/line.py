@@ -23,7 +23,7 @@ def line_chain(eps: float, L: float) -> Chain:
 
 CONFIGURATIONS = (
     Configuration("line", "lifted", without_edge_model(line_chain), contacts=("smooth",), askable=True,
-                  line_contact=True, pole_branch_end=True),
+                  line_contact=True, pole_branch_end=True, half="line"),
 )
 SWITCHES = (
     # the cap's contact pressure at its edge: where the pole lifts off

@@ -22,5 +22,5 @@ def point_chain(s0: float, L: float) -> Chain:
 
 
 CONFIGURATIONS = (
-    Configuration("point", "point", lambda eps, L, edge: point_chain(POINT_S0, L), controls=("delta",)),
+    Configuration("point", "point", lambda eps, L, edge: point_chain(POINT_S0, L), controls=("delta",), half="point"),
 )

@@ -77,6 +77,10 @@ class Configuration:
     pole_branch_end : bool
         A smooth lifted pole whose branch may end where its Legendre determinant vanishes
         (:mod:`shellbvp.lifted_ends`).
+    half : str or None
+        How each half of a closed shell on a substrate touches its indenter where this
+        configuration is that of a rimmed shell (``"point"``, ``"cap"``, ``"line"``,
+        ``"annulus"``; :mod:`shellbvp.configurations.closed`), else None.
     """
 
     name: str
@@ -89,6 +93,7 @@ class Configuration:
     inner_edge: bool = False
     line_contact: bool = False
     pole_branch_end: bool = False
+    half: str = None
 
     @property
     def single_cap(self) -> bool:
@@ -102,6 +107,9 @@ class Configuration:
 
     def check(self, scene, control):
         """A clear ValueError where ``scene`` or ``control`` does not allow this configuration."""
+        if (self.family == "closed") != scene.two_contacts:
+            raise ValueError(f"topology={self.name!r} is " + ("a closed shell's on a substrate under a curved tip"
+                             if self.family == "closed" else "a rimmed shell's (or a closed shell's half)"))
         if self.needs_tip_end and scene.model().OMEGA_MAX is None:
             raise ValueError("this tip has no end where it meets a cylinder (A' never vanishes): no wall contact")
         self.check_contact(scene)

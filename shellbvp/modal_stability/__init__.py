@@ -250,7 +250,8 @@ from ..geometry import Spheroid
 from ..configurations import of
 from .contact import FRICTION, NOT_BUILT, Contact, check_friction, check_supported, contact_of, supported
 from .fem import (
-    END_CONDITIONS, Stability, check_stability_size, default_elements, default_modes, mesh, spectrum, stability_size,
+    END_CONDITIONS, Stability, check_stability_size, default_elements, default_modes, either_side, mesh, spectrum,
+    stability_size,
 )
 from .form import chain_base, form_functions, sphere_base, state_base
 
@@ -331,18 +332,25 @@ def stability(state, modes=None, *, elements: int | None = None, S0: float | Non
     modes = None if modes is None else [int(n) for n in modes]
     check_stability_size(state.scene, modes, elements, max_dofs)
     sysm = state.system
+    if modes is None and state.scene.closed:  # n = 1 slides the shell on frictionless plates (zero)
+        modes = [n for n in default_modes(state.scene) if n != 1]
     if of(state) is None:  # the inflated shell: no contact
         zeta = float(sysm.S_point(sysm.regions[0].start, None))
         S0 = zeta if S0 is None else max(float(S0), zeta)
 
-        def solve(modes, S0, elements=elements, **kw):
+        def solve_end(modes, S0, end, elements=elements, **kw):
             return spectrum(state.scene, state_base(state), S0, float(sysm.L), modes, elements=elements,
-                            end=state.scene.rim, **kw)
+                            end=end, **kw)
     else:
-        def solve(modes, S0, elements=elements, **kw):
+        def solve_end(modes, S0, end, elements=elements, **kw):
             contact = contact_of(state, S0, friction)
             return spectrum(state.scene, contact.base, contact.S0, float(sysm.L), modes, elements=elements,
-                            contact=contact, **kw)
+                            contact=contact, end=end, **kw)
+
+    def solve(modes, S0, **kw):
+        # a closed shell's half: the modes symmetric and antisymmetric about its equator
+        ends = ("symmetric", "antisymmetric") if state.scene.closed else (state.scene.rim,)
+        return either_side([solve_end(modes, S0, end, **kw) for end in ends])
     out = solve(modes, S0, count=count, vectors=vectors)
     _refine_negative(out, solve)
     _check_pole_floor(out, solve)

@@ -93,6 +93,23 @@ class Stability:
                 f"stable={self.stable}, modes={self.modes[0]}..{self.modes[-1]}, elements={self.elements})")
 
 
+def either_side(results: list) -> "Stability":
+    """One :class:`Stability` of the spectra of the same state under other end conditions (a
+    closed shell's half: modes symmetric and antisymmetric about its equator): per mode the
+    smallest eigenvalues of all, with the eigenvector of the smallest."""
+    first = results[0]
+    if len(results) == 1:
+        return first
+    count = first.eigenvalues.shape[1]
+    both = np.hstack([r.eigenvalues for r in results])
+    owner = np.argmin(np.stack([r.smallest for r in results]), axis=0)
+    vectors = {int(n): results[owner[i]].vectors[int(n)] for i, n in enumerate(first.modes)
+               if int(n) in results[owner[i]].vectors}
+    return Stability(modes=first.modes, eigenvalues=np.sort(both, axis=1)[:, :count], elements=first.elements,
+                     S0=first.S0, vectors=vectors, wall_time=sum(r.wall_time for r in results),
+                     held_corners=first.held_corners)
+
+
 def _hermite(xi, h):
     """Values, first and second S-derivatives of the four cubic Hermite shape functions on an
     element of length h at reference points xi in [0, 1] (dofs: f(a), f'(a), f(b), f'(b))."""
