@@ -61,7 +61,13 @@ def test_public_docstring_is_numpydoc_with_examples(name):
         assert "Returns" in sections, f"{name}: no Returns section"
 
 
-@pytest.mark.parametrize("name", [n for n, _ in _public()])
+#: Docstrings whose examples cost a minute of CPU (the stability of a buckling hemisphere and a
+#: state on the tip): run with --runslow; tests/test_stability.py covers the same calls
+SLOW_EXAMPLES = {"stability"}
+
+
+@pytest.mark.parametrize("name", [pytest.param(n, marks=pytest.mark.slow) if n in SLOW_EXAMPLES else n
+                                  for n, _ in _public()])
 def test_public_docstring_examples_run(name, tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)  # examples that write files write them here
     obj = getattr(sb, name)

@@ -159,6 +159,7 @@ def test_a_table_invalid_for_the_map_is_refused_before_any_curve(closed_form, tm
                 pixel_values=PixelTable("alpha", {(0, 0): 0.1}))
 
 
+@pytest.mark.slow  # 25-55 s: a JPK map fitted pixel by pixel with its own thickness; the text-table cases stay
 def test_a_jpk_map_with_its_own_thickness_per_pixel_recovers_every_mu_h(tmp_path, capsys):
     """benchmarks/make_force_map.py with a thickness per pixel: each pixel's curve from its own
     scene (the full model), read by afmformats; `shellbvp fit --pixel-table` recovers every

@@ -99,6 +99,7 @@ def test_solve_dome_paper_at_delta_5_is_refused_at_once():
         sb.solve(scene, delta=1e-300)
 
 
+@pytest.mark.slow  # 35-70 s: a whole curve from point-load states; the cold start from one stays below
 def test_curve_from_point_load_states_goes_up_without_index_error():
     """delta_max = 1e-3 on the base scene: every state is the point-load limit (the cap is
     below 1e-30), so the upward leg cannot follow a cap branch; it used to fail with an
