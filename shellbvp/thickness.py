@@ -141,8 +141,8 @@ def _loglog(eps, xs, ys):
 def model_error(scene):
     """``(error, extrapolated)``: the shell model's error to stand beside a fit's interval at
     ``scene.thickness`` (a fraction), or None where there is no such measurement (no thickness,
-    a pressure, a user bending energy, the paper's contact with transverse shear or rotation
-    bending).
+    a pressure, a closed shell, a user bending energy, the paper's contact with transverse
+    shear or rotation bending).
 
     The larger of two measurements against 3D elasticity: its largest error in F at equal
     pole displacement over the mapped scenes (:data:`MEASURED_MODEL_ERROR`) and, for the
@@ -153,7 +153,7 @@ def model_error(scene):
     ``fit(..., model="auto")`` measures that with the solid from eps 0.05 up.
     """
     eps = getattr(scene, "thickness", None)
-    if eps is None or scene.pressure or scene.sealed:
+    if eps is None or scene.pressure or scene.sealed or scene.closed:  # the map holds rimmed shells only
         return None
     row = MEASURED_MODEL_ERROR.get((scene.contact, scene.bending.family, bool(scene.transverse_shear)))
     if row is None:

@@ -139,3 +139,14 @@ def test_cli_bending_choice_and_convexity_report(capsys):
     doc = json.loads(capsys.readouterr().out)
     api = sb.solve(sb.Scene.preset("base", bending=sb.RotationBending()), delta=0.3, estimate_error=False)
     assert doc["force"] == pytest.approx(api.force, rel=1e-8)
+
+
+def test_a_bending_energy_without_its_plate_limit_is_refused_at_registration():
+    # beta from a thickness divides by the plate limit: no silent default of the trace's 1.0
+    from shellbvp.materials.base import Bending, register_bending
+
+    class Forgetful(Bending):
+        family = "forgetful"
+
+    with pytest.raises(ValueError, match="declares no small-strain plate limit"):
+        register_bending(Forgetful)

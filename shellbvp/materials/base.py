@@ -150,10 +150,14 @@ class Bending:
 
     #: the name in descriptions, files and ``--bending``
     family: str = ""
-    plate_stiffness: float = 1.0
-    plate_poisson: float = 1.0
+    #: declared by every bending energy (a class value, or set from its formula): None here so
+    #: that one without them is refused at registration, not given the trace's silently
+    plate_stiffness: float = None
+    plate_poisson: float = None
     #: chosen on the command line by ``--bending FAMILY``
     cli: bool = True
+    #: the plate limit is derived from each instance's formula (a user bending energy)
+    formula_sets_plate_limit: bool = False
 
     def description(self) -> dict:
         """The structural choice (family, a user formula): what generated code is keyed on."""
@@ -185,6 +189,9 @@ def register_bending(cls):
     """Class decorator: ``cls`` becomes the bending energy of ``cls.family``."""
     if BENDINGS.get(cls.family, cls) is not cls:
         raise ValueError(f"bending family {cls.family!r} is registered twice")
+    if not cls.formula_sets_plate_limit and (cls.plate_stiffness is None or cls.plate_poisson is None):
+        raise ValueError(f"bending family {cls.family!r} declares no small-strain plate limit (plate_stiffness, "
+                         f"plate_poisson: symbolic.bending.plate_limit of its B)")
     BENDINGS[cls.family] = cls
     register_bending_energy(cls.family, cls.bending_energy)
     return cls

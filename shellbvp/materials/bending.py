@@ -26,6 +26,7 @@ class TraceBending(Bending):
     """
 
     family = "trace"
+    plate_stiffness, plate_poisson = 1.0, 1.0  # symbolic.bending.plate_limit (tests/test_fe.py derives them)
 
     @staticmethod
     def bending_energy(description):
@@ -49,6 +50,7 @@ class RotationBending(Bending):
     """
 
     family = "rotation"
+    plate_stiffness, plate_poisson = 1.0, 1.0
 
     @staticmethod
     def bending_energy(description):
@@ -84,6 +86,7 @@ class BendingEnergy(Bending):
     """
 
     family = "user"
+    formula_sets_plate_limit = True
     cli = False  # given by --bending-formula
 
     def __init__(self, B, name: str = "user", *, legacy_srepr: bool = False):
