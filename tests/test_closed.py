@@ -193,3 +193,27 @@ def test_what_a_closed_shell_does_not_have_yet_is_refused():
         check_solid_scene(plates(1e-3))
     with pytest.raises(ValueError, match="smooth"):
         on_substrate(contact="paper")
+
+
+def _record(scene, R_L, mu_H, depths, noise, seed):
+    """A record made of the model's own states at the depths (lab units), with relative noise."""
+    force = np.array([sb.solve(scene, delta=d, estimate_error=False).force for d in depths])
+    rng = np.random.default_rng(seed)
+    return depths * R_L, force * mu_H * R_L * (1 + noise * rng.standard_normal(depths.size))
+
+
+def test_a_capsule_between_plates_is_fitted():
+    scene = sb.Scene.preset("capsule-plates")
+    disp, force = _record(scene, 30e-6, 0.5, np.linspace(0.02, 0.2, 12), 0.005, 3)
+    res = sb.fit(scene, disp, force, R_L=30e-6)
+    assert res.success, res.message
+    assert res.mu_H_ci95[0] < 0.5 < res.mu_H_ci95[1]
+
+
+@pytest.mark.slow  # a model curve of two contacts (~20 s of CPU)
+def test_a_pollen_grain_on_a_substrate_is_fitted():
+    scene = sb.Scene.preset("pollen")
+    disp, force = _record(scene, 25e-6, 2.0, np.linspace(0.01, 0.1, 10), 0.005, 4)
+    res = sb.fit(scene, disp, force, R_L=25e-6)
+    assert res.success, res.message
+    assert res.mu_H_ci95[0] < 2.0 < res.mu_H_ci95[1]

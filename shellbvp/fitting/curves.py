@@ -208,11 +208,14 @@ def _model_start(scene, deltas, tol):
     A curve at requested depths starts from a single contact cap; at depths where the scene's
     contact is the point-load limit (the cap exponentially small) it cannot, and there the
     point-load solution is the model's state (:func:`point_load_forces` gives its force).
-    Data whose depths are nearly all in that limit are refused before the curve.
+    Data whose depths are nearly all in that limit are refused before the curve.  A closed shell
+    on a substrate starts at the first depth: its configurations include the point loads.
     """
     from ..configurations import is_single_cap
     from ..state import solve
 
+    if scene.two_contacts:  # a closed shell on a substrate has its point-load states in its own curve
+        return 0
     why = ""
     for i in START_TRIALS:
         if i >= len(deltas) - 2:
