@@ -332,7 +332,9 @@ def stability(state, modes=None, *, elements: int | None = None, S0: float | Non
     modes = None if modes is None else [int(n) for n in modes]
     check_stability_size(state.scene, modes, elements, max_dofs)
     sysm = state.system
-    if modes is None and state.scene.closed:  # n = 1 slides the shell on frictionless plates (zero)
+    # a closed shell on frictionless plates: n = 1 slides it sideways and turns it about a horizontal
+    # axis at no cost (left out); its spin about the axis (n = 0) is held at the equator (fem)
+    if modes is None and state.scene.closed:
         modes = [n for n in default_modes(state.scene) if n != 1]
     if of(state) is None:  # the inflated shell: no contact
         zeta = float(sysm.S_point(sysm.regions[0].start, None))
@@ -349,7 +351,7 @@ def stability(state, modes=None, *, elements: int | None = None, S0: float | Non
 
     def solve(modes, S0, **kw):
         # a closed shell's half: the modes symmetric and antisymmetric about its equator
-        ends = ("symmetric", "antisymmetric") if state.scene.closed else (state.scene.rim,)
+        ends = ("held-symmetric", "antisymmetric") if state.scene.closed else (state.scene.rim,)
         return either_side([solve_end(modes, S0, end, **kw) for end in ends])
     out = solve(modes, S0, count=count, vectors=vectors)
     _refine_negative(out, solve)

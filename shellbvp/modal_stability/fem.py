@@ -228,8 +228,10 @@ def _element_basis(xg, h, hs):
 #: Dofs (of u, u', v, v', w, w') held at the end S = L: the held rim, pinned (``w'`` free:
 #: M_s = 0) or clamped (``w'`` held too: the slope is), named as ``Scene.rim``; or the equator of
 #: a complete sphere for modes symmetric (u = 0, w' = 0; Q and the in-plane shear vanish
-#: naturally) or antisymmetric (v = w = 0; w'' = 0 naturally) about it.
-END_CONDITIONS = {"pinned": (0, 2, 4), "clamped": (0, 2, 4, 5), "symmetric": (0, 5), "antisymmetric": (2, 4)}
+#: naturally) or antisymmetric (v = w = 0; w'' = 0 naturally) about it; ``held-symmetric``: a closed
+#: shell between plates, symmetric, its spin about the axis (n = 0, v) held at the equator.
+END_CONDITIONS = {"pinned": (0, 2, 4), "clamped": (0, 2, 4, 5), "symmetric": (0, 5), "antisymmetric": (2, 4),
+                  "held-symmetric": (0, 5)}
 
 
 def _constraints(n, m, end="pinned", S0_over_hs=0.0, held=(), pole_held=False, lines=(), stuck=(),
@@ -247,6 +249,8 @@ def _constraints(n, m, end="pinned", S0_over_hs=0.0, held=(), pole_held=False, l
     :func:`corner_ties`; n = 1's pole), dropped with the dofs it is given by where it is held."""
     ndof = 6 * m
     fixed = {6 * (m - 1) + k for k in END_CONDITIONS[end]}
+    if n == 0 and end == "held-symmetric":  # a closed shell's spin about its axis: no plate resists it
+        fixed.add(6 * (m - 1) + 2)
     fixed |= {6 * i + k for i in held for k in (4, 5)}
     fixed |= {6 * i + 4 for i in lines}
     fixed |= {6 * i + k for i in stuck for k in (0, 1, 2, 3)}
