@@ -217,3 +217,22 @@ def test_a_pollen_grain_on_a_substrate_is_fitted():
     res = sb.fit(scene, disp, force, R_L=25e-6)
     assert res.success, res.message
     assert res.mu_H_ci95[0] < 2.0 < res.mu_H_ci95[1]
+
+
+@pytest.mark.parametrize("name,preset,radius,truth", [
+    ("capsule_plates_synthetic.csv", "capsule-plates", "30um", 0.5),
+    pytest.param("cell_glass_synthetic.csv", "cell-glass", "2.5um", 3.3, marks=pytest.mark.slow),
+])
+def test_the_shipped_closed_shell_records_fit_as_docs_closed_md_shows(name, preset, radius, truth):
+    import json
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    data = Path(sb.__file__).parent / "data" / name
+    r = subprocess.run([sys.executable, "-m", "shellbvp", "fit", str(data), "--preset", preset, "--radius", radius,
+                        "--json"], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    out = json.loads(r.stdout)
+    lo, hi = out["mu_H_ci95"]
+    assert lo < truth < hi and out["quality"] == "good"
