@@ -13,8 +13,9 @@ sample is minus the tip's position: the package's signs, no ``--invert`` needed.
   declared sizes checked first and every failure of decoding one line
   (:mod:`shellbvp.afm_read`).  AFM Workshop CSV and NT-MDT Nova text exports go through
   afmformats too (:func:`afm_text_format`), with the cantilever's calibration given.
-* :class:`ForceMap` -- a force map fitted curve by curve (:func:`shellbvp.batch.fit_map`): the
-  per-curve rows of a batch, images of mu*H and its interval, a NeXus file, a figure.
+* :class:`ForceMap` -- a force map fitted (:func:`shellbvp.batch.fit_map`): the per-curve rows
+  of a batch (each fit's numbers; the curves are not kept), images of mu*H and its interval, a
+  NeXus file, a figure.
 * :func:`read_map_file` -- that NeXus file read back (:class:`MapFile`), for ``shellbvp info``
   and ``shellbvp plot``.
 """
@@ -26,11 +27,11 @@ from pathlib import Path
 
 import numpy as np
 
-from .afm_read import (AFM_SUFFIXES, AFMCurve, afm_text_format, curves_from_afm, is_afm_file, read_afm,
+from .afm_read import (AFM_SUFFIXES, AFMCurve, afm_text_format, curves_from_afm, is_afm_file, iter_afm, read_afm,
                        refuse_text_options, single_curve)
 from .textdata import printable
 
-__all__ = ["AFM_SUFFIXES", "AFMCurve", "ForceMap", "MapFile", "is_afm_file", "afm_text_format", "read_afm",
+__all__ = ["AFM_SUFFIXES", "AFMCurve", "ForceMap", "MapFile", "is_afm_file", "afm_text_format", "read_afm", "iter_afm",
            "curves_from_afm", "single_curve", "refuse_text_options", "map_shape", "MAP_FORMAT", "is_map_file",
            "read_map_file", "draw_map"]
 
@@ -101,6 +102,8 @@ class ForceMap:
         With ``pixel_values``: the largest ``max |F_interp - F| / max |F|`` at the curves
         checked between nodes (:func:`shellbvp.batch.shared_curves`).
     notes : list of str
+    sha256 : str
+        The map file's checksum (else its first curve's record's, where it has one).
     """
 
     path: str
@@ -116,6 +119,7 @@ class ForceMap:
     curves_computed: object = None
     interpolation_error: object = None
     notes: list = field(default_factory=list)
+    sha256: str = ""
 
     def pixel_image(self) -> np.ndarray:
         """``(ny, nx)`` image of the per-pixel geometry value in its unit (the thickness in m,
@@ -288,7 +292,8 @@ class ForceMap:
             src = entry.create_group("source")
             src.attrs["NX_class"] = "NXnote"
             string_dataset(src, "file_name", str(self.path))
-            string_dataset(src, "sha256", self.curves[0].record.sha256 if self.curves else "")
+            first = self.curves[0].record if self.curves else None
+            string_dataset(src, "sha256", self.sha256 or (first.sha256 if first is not None else ""))
             string_dataset(src, "settings", json.dumps({"segment": self.segment, **self.settings}, default=str))
 
     def plot(self, out=None, ax=None):

@@ -25,7 +25,7 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["JPK_SUFFIXES", "METADATA_KEYS", "jpk_datasets", "parse_properties", "read_properties", "LightCurve"]
+__all__ = ["JPK_SUFFIXES", "METADATA_KEYS", "jpk_datasets", "parse_properties", "read_properties", "LightCurve", "Curves"]
 
 #: File name endings of JPK archives (afmformats' JPK recipes)
 JPK_SUFFIXES = (".jpk-force", ".jpk-force-map", ".jpk-qi-data", ".jpk-qi-series")
@@ -330,7 +330,7 @@ def jpk_datasets(path, meta_override=None):
             for index in range(len(reader)):
                 yield LightCurve(reader, index, reader.curve_metadata(index))
 
-        return light()
+        return Curves(len(reader), light())
 
     def curves():
         for index in range(len(reader)):
@@ -342,7 +342,21 @@ def jpk_datasets(path, meta_override=None):
             metadata["format"] = label
             yield AFMForceDistance(data=data, metadata=metadata)
 
-    return curves()
+    return Curves(len(reader), curves())
+
+
+class Curves:
+    """The curves of an archive, one at a time, and how many there are (``len``: from the
+    archive's list of members, before any curve is read)."""
+
+    def __init__(self, count, curves):
+        self._count, self._curves = count, curves
+
+    def __len__(self):
+        return self._count
+
+    def __iter__(self):
+        return self._curves
 
 
 def _same_metadata(reader) -> bool:

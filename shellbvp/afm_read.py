@@ -33,7 +33,7 @@ from .textdata import printable
 
 __all__ = ["AFM_SUFFIXES", "AFMCurve", "is_afm_file", "afm_text_format", "read_afm", "curves_from_afm",
            "single_curve", "refuse_text_options", "check_afm_sizes", "afmformats_boundary", "AFMFileError",
-           "MAX_MAP_PIXELS", "MAX_ARCHIVE_MEMBERS", "MAX_CENTRAL_DIRECTORY_BYTES", "MAX_INFLATED_BYTES",
+           "iter_afm", "curve_from_afm", "MAX_MAP_CURVES", "MAX_MAP_PIXELS", "MAX_ARCHIVE_MEMBERS", "MAX_CENTRAL_DIRECTORY_BYTES", "MAX_INFLATED_BYTES",
            "MAX_INFLATION_RATIO", "INFLATION_ALLOWANCE_BYTES", "READER_LOGGERS"]
 
 #: The most members a JPK archive may hold (a 128 x 128 force map: about 330,000, 20 a curve).
@@ -49,6 +49,9 @@ INFLATION_ALLOWANCE_BYTES = 16 * 2**20
 
 #: The most cells of a force map's grid (its images: 8 MiB each) and rows of a pixel table.
 MAX_MAP_PIXELS = 1024 * 1024
+#: The most curves of an AFM file read (a 256 x 256 map): a map keeps each curve's results
+#: (a few kB) until it is written; a JPK archive declaring more is refused before its first curve.
+MAX_MAP_CURVES = 256 * 256
 
 #: Asylum (Igor) binary wave headers: version -> (struct layout after the version, names)
 _IBW_HEADERS = {
@@ -175,7 +178,17 @@ def read_afm(path, *, spring_constant=None, sensitivity=None) -> list:
         afmformats is not installed, or cannot read the file, or a curve lacks the force,
         a height or the spring constant, or the file declares sizes beyond the bounds.
     """
-    from .afm_read import afmformats_boundary, check_afm_sizes
+    curves = list(iter_afm(path, spring_constant=spring_constant, sensitivity=sensitivity))
+    if not curves:
+        raise AFMFileError(f"{printable(path)}: afmformats found no force-distance curve in it")
+    return curves
+
+
+def iter_afm(path, *, spring_constant=None, sensitivity=None):
+    """:func:`read_afm` one curve at a time (a force map's curves are never all in memory): the
+    file's sizes are checked and a JPK archive's curve count bounded by :data:`MAX_MAP_CURVES`
+    before the first curve is read; every failure while the file is decoded is one
+    ``ValueError`` line, raised when the curve is asked for."""
     from .instrument_record import sha256_of
     from .paths import read_input_bytes
 
@@ -183,16 +196,18 @@ def read_afm(path, *, spring_constant=None, sensitivity=None) -> list:
     size = len(read_input_bytes(path))  # a regular file of bounded size: never a FIFO, a device or a folder
     check_afm_sizes(path, size)
     override = _calibration(path, spring_constant, sensitivity)
+    sha256 = sha256_of(path)
     with afmformats_boundary(path):
         # a JPK archive curve by curve (time linear in its curves: shellbvp.afm_jpk)
         datasets = jpk_datasets(path, override) if str(path).endswith(JPK_SUFFIXES) else None
         if datasets is None:
             datasets = afmformats.load_data(str(path), meta_override=override)
+        if len(datasets) > MAX_MAP_CURVES:  # a JPK archive's count from its list of members
+            raise AFMFileError(f"{printable(path)}: {len(datasets)} curves; shellbvp fits at most {MAX_MAP_CURVES} "
+                               f"curves of a map (MAX_MAP_CURVES): cut the map into parts")
         # afmformats loads a curve's columns when they are first read: inside the boundary too
-        curves = curves_from_afm(datasets, path, sha256=sha256_of(path))
-        if not curves:
-            raise AFMFileError(f"{printable(path)}: afmformats found no force-distance curve in it")
-        return curves
+        for i, ds in enumerate(datasets):
+            yield curve_from_afm(ds, i, path, sha256=sha256)
 
 
 def _calibration(path, spring_constant, sensitivity):
@@ -238,45 +253,47 @@ def _meta(md, key):
 
 def curves_from_afm(datasets, path, *, sha256=None) -> list:
     """:class:`AFMCurve` from afmformats' curves (``AFMForceDistance``) of the file ``path``."""
+    return [curve_from_afm(ds, i, path, sha256=sha256) for i, ds in enumerate(datasets)]
+
+
+def curve_from_afm(ds, i, path, *, sha256=None) -> AFMCurve:
+    """The :class:`AFMCurve` of afmformats' curve ``ds``, the ``i``-th of the file ``path``."""
     from .instrument_record import record_from_arrays
 
-    out = []
-    for i, ds in enumerate(datasets):
-        columns = list(ds.columns)
-        md = ds.metadata
-        where = f"{printable(path)}, curve {i}"
-        if "force" not in columns:
-            raise AFMFileError(f"{where}: no force column (columns: {printable(', '.join(map(str, columns)))})")
-        force = np.asarray(ds["force"], float)
-        if "tip position" in columns:
-            tip, how = np.asarray(ds["tip position"], float), "-(tip position)"
-        else:
-            height = next((h for h in ("height (measured)", "height (piezo)") if h in columns), None)
-            k = _meta(md, "spring constant")
-            if height is None or k is None or not k > 0:
-                raise AFMFileError(f"{where}: needs a height column and the spring constant to place the tip "
-                                 f"(columns: {printable(', '.join(map(str, columns)))}; spring constant: {k})")
-            tip, how = np.asarray(ds[height], float) + force / k, f"-({height} + force / spring constant)"
-        time = np.asarray(ds["time"], float) if "time" in columns else None
-        ok = np.isfinite(tip) & np.isfinite(force) & (np.isfinite(time) if time is not None else True)
-        if ok.sum() < 3:
-            raise AFMFileError(f"{where}: fewer than 3 rows with numbers")
-        record = record_from_arrays(path, -tip[ok], force[ok], None if time is None else time[ok],
-                                    np.flatnonzero(ok), columns={"displacement": how, "force": "force",
-                                                                 **({"time": "time"} if time is not None else {})},
-                                    units={"displacement": "m", "force": "N", **({"time": "s"} if time is not None
-                                                                               else {})},
-                                    header=columns, sha256=sha256)
-        ix, iy = _meta(md, "grid index x"), _meta(md, "grid index y")
-        x, y = _meta(md, "position x"), _meta(md, "position y")
-        index = _meta(md, "enum")
-        geometry = [_meta(md, f"grid {a} {b}") for a in ("center", "size") for b in "xy"]
-        out.append(AFMCurve(record=record, index=int(index) if index is not None else i,
-                            grid=(int(ix), int(iy)) if ix is not None and iy is not None else None,
-                            position=(float(x), float(y)) if x is not None and y is not None else None,
-                            grid_geometry=((geometry[0], geometry[1]), (geometry[2], geometry[3]))
-                            if None not in geometry else None))
-    return out
+    columns = list(ds.columns)
+    md = ds.metadata
+    where = f"{printable(path)}, curve {i}"
+    if "force" not in columns:
+        raise AFMFileError(f"{where}: no force column (columns: {printable(', '.join(map(str, columns)))})")
+    force = np.asarray(ds["force"], float)
+    if "tip position" in columns:
+        tip, how = np.asarray(ds["tip position"], float), "-(tip position)"
+    else:
+        height = next((h for h in ("height (measured)", "height (piezo)") if h in columns), None)
+        k = _meta(md, "spring constant")
+        if height is None or k is None or not k > 0:
+            raise AFMFileError(f"{where}: needs a height column and the spring constant to place the tip "
+                               f"(columns: {printable(', '.join(map(str, columns)))}; spring constant: {k})")
+        tip, how = np.asarray(ds[height], float) + force / k, f"-({height} + force / spring constant)"
+    time = np.asarray(ds["time"], float) if "time" in columns else None
+    ok = np.isfinite(tip) & np.isfinite(force) & (np.isfinite(time) if time is not None else True)
+    if ok.sum() < 3:
+        raise AFMFileError(f"{where}: fewer than 3 rows with numbers")
+    record = record_from_arrays(path, -tip[ok], force[ok], None if time is None else time[ok],
+                                np.flatnonzero(ok), columns={"displacement": how, "force": "force",
+                                                             **({"time": "time"} if time is not None else {})},
+                                units={"displacement": "m", "force": "N", **({"time": "s"} if time is not None
+                                                                           else {})},
+                                header=columns, sha256=sha256)
+    ix, iy = _meta(md, "grid index x"), _meta(md, "grid index y")
+    x, y = _meta(md, "position x"), _meta(md, "position y")
+    index = _meta(md, "enum")
+    geometry = [_meta(md, f"grid {a} {b}") for a in ("center", "size") for b in "xy"]
+    return AFMCurve(record=record, index=int(index) if index is not None else i,
+                    grid=(int(ix), int(iy)) if ix is not None and iy is not None else None,
+                    position=(float(x), float(y)) if x is not None and y is not None else None,
+                    grid_geometry=((geometry[0], geometry[1]), (geometry[2], geometry[3]))
+                    if None not in geometry else None)
 
 
 def check_afm_sizes(path, size) -> None:
