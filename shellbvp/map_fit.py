@@ -96,12 +96,19 @@ def read_pixels(curves, path, *, R_L, segment="loading", baseline="auto", fit_of
     for c in curves:
         rec = c.record
         px = Pixel(name=f"{path or getattr(rec, 'path', '')}#{c.index}",
-                   curve=AFMCurve(None, c.index, c.grid, c.position, c.grid_geometry),
-                   depth=None if rec is None else record_depth(rec, segment, R_L), sha256=getattr(rec, "sha256", ""))
+                   curve=AFMCurve(None, c.index, c.grid, c.position, c.grid_geometry), sha256=getattr(rec, "sha256", ""))
         try:
             if rec is None:
                 raise ValueError(f"{px.name}: the curve has no record")
-            rows = record_rows(rec, segment, baseline, fit_offset)
+            # a loading segment's contact estimate is the record's own (made when it was read)
+            known = segment == "loading" and np.count_nonzero(rec.mask(segment)) >= 3
+            if known:
+                est = rec.contact_estimate
+                d = rec.displacement[rec.mask(segment)]
+                px.depth = (np.max(d) - (est if est is not None else min(0.0, np.min(d)))) / R_L
+            else:
+                px.depth = record_depth(rec, segment, R_L)
+            rows = record_rows(rec, segment, baseline, fit_offset, rec.contact_estimate if known else "find")
             px.rows = store.add(rows.d, rows.f)
             px.baseline, px.guess = rows.baseline, rows.guess
             px.warnings = segment_warnings(rec, segment, rows.used)
@@ -130,13 +137,13 @@ def fit_pixels(scene, pixels, store, *, R_L, chunk=CHUNK, **options):
     weights dropped."""
     dms = pixel_delta_max(pixels, options.pop("delta_max", None))
     todo = [(p, dm) for p, dm in zip(pixels, dms) if p.rows is not None]
-    together = batchable(scene, options)
+    together, curves = batchable(scene, options), {}
     for lo in range(0, len(todo), chunk):
         part = todo[lo:lo + chunk]
         data = [store.get(p.rows) for p, _ in part]
         if together:
             results = fit_batch(scene, [(d, f, p.baseline, p.guess, dm) for (p, dm), (d, f) in zip(part, data)],
-                                R_L=R_L, **options)
+                                R_L=R_L, curves=curves, **options)
         else:
             results = []
             for (p, dm), (d, f) in zip(part, data):

@@ -42,7 +42,7 @@ START_TRIALS = 160
 MAX_ITERATIONS = 200
 #: Options of :func:`shellbvp.fitting.fit` a batch takes (with a shell model, no shape parameter,
 #: the linear loss and no stability check; others: one fit per pixel)
-_OPTIONS = {"fit_offset", "weights", "floor", "delta_max", "tol", "loss", "model", "max_depth", "max_force",
+_OPTIONS = {"fit_offset", "weights", "floor", "delta_max", "tol", "loss", "model", "max_depth", "max_force", "bounds",
             "weights_check", "progress", "free", "stability", "mesh_check"}
 
 
@@ -270,7 +270,7 @@ class Stack:
         fp = f - sum(np.einsum("bn,bn->b", f, q)[:, None] * q for q in basis) if basis else f.copy()
         ff = np.einsum("bn,bn->b", fp, fp)
         rss = np.full((B, START_TRIALS), np.inf)
-        step = max(1, 2 ** 21 // (START_TRIALS * N))
+        step = max(1, 2 ** 18 // (START_TRIALS * N))  # about 2 MB a temporary array
         for lo in range(0, B, step):
             sl = slice(lo, min(B, lo + step))
             S = R_L * self.shape((d[sl, None, :] - trials[sl, :, None]) / R_L)
@@ -323,12 +323,13 @@ class _Rows(Stack):
         self.big, self.fscale, self.order = stack.big[rows], stack.fscale[rows], stack.order[rows]
 
 
-def fit_batch(scene, pixels, *, R_L, tol=1e-6, progress=None, chunk=256, **options) -> list:
+def fit_batch(scene, pixels, *, R_L, tol=1e-6, progress=None, chunk=256, curves=None, **options) -> list:
     """:func:`shellbvp.fitting.fit` of each pixel ``(displacement, force, baseline,
     contact_guess, delta_max)`` with one scene and ``options`` (:func:`batchable`), the pixels of
     one model curve (the same ``delta_max``) fitted together in chunks of ``chunk``: a list of
     :class:`FitResult`, or the ``ValueError`` that ``fit`` raises for that pixel, in the order
-    of ``pixels``."""
+    of ``pixels``.  ``curves``: a dict in which the model curves are kept for the next call
+    (a map fitted in parts)."""
     if not batchable(scene, options):
         raise ValueError(f"fit_batch: these options fit one pixel at a time ({sorted(options)})")
     out, groups = [None] * len(pixels), {}
@@ -343,17 +344,21 @@ def fit_batch(scene, pixels, *, R_L, tol=1e-6, progress=None, chunk=256, **optio
             out[i] = exc
             continue
         groups.setdefault((inputs.grid.tobytes(), tuple(inputs.mdl.free)), []).append((i, inputs))
-    for members in groups.values():
+    kept = {} if curves is None else curves
+    for key, members in groups.items():
         counter = [0]
-        curves = ModelCurves(lambda th: scene, members[0][1].grid, tol, 0.0, counter, progress)
-        try:
-            curves.add(None)
-        except ValueError as exc:
+        if key[0] not in kept:
+            node = ModelCurves(lambda th: scene, members[0][1].grid, tol, 0.0, counter, progress)
+            try:
+                node.add(None)
+                kept[key[0]] = (node.nodes[None], node.at(None))
+            except ValueError as exc:
+                kept[key[0]] = exc
+        if isinstance(kept[key[0]], Exception):
             for i, _ in members:
-                out[i] = exc
+                out[i] = kept[key[0]]
             continue
-        c = curves.nodes[None]
-        P, dP, top = curves.at(None)
+        c, (P, dP, top) = kept[key[0]]
         fits = []
         for i, inputs in members:
             if c.delta[-1] < inputs.depth * (1 - 1e-12):

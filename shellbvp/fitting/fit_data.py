@@ -535,9 +535,11 @@ class RecordRows:
     guess: float
 
 
-def record_rows(record, segment="loading", baseline="auto", fit_offset=True) -> RecordRows:
+def record_rows(record, segment="loading", baseline="auto", fit_offset=True, estimate="find") -> RecordRows:
     """The rows of ``record``'s ``segment`` that :func:`fit_record` fits, its baseline and contact
-    guess (ValueError: an unknown baseline, a segment of fewer than 3 rows)."""
+    guess (ValueError: an unknown baseline, a segment of fewer than 3 rows); ``estimate``: the
+    contact estimate of those rows when known (:func:`shellbvp.instrument.estimate_contact`;
+    ``"find"``: found here)."""
     if baseline not in ("auto",) + BASELINES:
         raise ValueError(f"baseline must be one of {('auto',) + BASELINES}; got {baseline!r}")
     used = record.mask(segment)
@@ -547,7 +549,8 @@ def record_rows(record, segment="loading", baseline="auto", fit_offset=True) -> 
                          f"{' and time' if record.time is not None else ''}); choose another with --segment "
                          f"(one of loading, retraction, all)")
     d, f = record.displacement[used], record.force[used]
-    estimate = estimate_contact(d, f)
+    if isinstance(estimate, str):
+        estimate = estimate_contact(d, f)
     if baseline == "auto":
         baseline = "constant" if estimate is not None else "none"
     return RecordRows(used, d, f, baseline, _contact_guess(d, estimate, fit_offset))
