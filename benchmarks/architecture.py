@@ -4,12 +4,26 @@
 
 Counts what issue 43 names: comparisons with configuration names, modules and functions
 by length, ``.get`` on results, places that build a ``Solution``, function-level
-imports, module flags that tests patch; and of issue 57, string hooks: ``"module:function"``
-strings that name a function of the package, resolved by name at run time (an upward path
-the import graph does not show), and writes of a curve's settings below their owner (a
-subscript stored or deleted, ``setdefault``/``update``/... called, on ``settings``, ``st`` or
-``<x>.settings`` in a module on a floor below ``continuation``, which builds them; ``io``, whose
-``Curve.learned`` records beside them what a step learned, excepted).  The numbers are what the redesign is judged by;
+imports, module flags that tests patch; and of issue 57:
+
+* string hooks: ``"module:function"`` strings that name a function of the package (``shellbvp.``
+  or not), resolved by name at run time (an upward path the import graph does not show);
+* writes of a curve's settings below their owner (a subscript stored or deleted,
+  ``setdefault``/``update``/... called, on ``settings``, ``st`` or ``<x>.settings`` in a module on
+  a floor below ``continuation``, which builds them; ``io``, whose ``Curve.learned`` records beside
+  them what a step learned, excepted);
+* writes of a ``Solution``'s fields outside ``solution`` and ``diagnosis`` (``x.field = ...`` or
+  ``setattr(x, "field", ...)`` of a field of the dataclass, ``self`` excepted; a field that a class
+  the module defines or imports also has is left out: there ``x`` may be that class's);
+* parallel parameter lists: a literal tuple, list, set or dict of two or more of the scene's
+  parameter names (the ``Scene``'s float fields, the fitted parameters, the materials'
+  parameters) outside the one registry (:data:`PARAMETER_REGISTRIES`);
+* function-level imports of the package itself, and separately of optional dependencies (the
+  extras of pyproject.toml but ``test`` and ``docs``);
+* instrument formats named outside the readers' registry (``shellbvp/readers/``): a string that
+  is a reader's file name ending (``".jpk-force"``, ``".ibw"``), or a reader's name compared.
+
+The numbers are what the redesign is judged by;
 ``--markdown`` prints them as the table of benchmarks/results/architecture.md.  A ``.get`` is
 counted where its key is a result's field name; ``--verbose`` shows its receiver, which may
 be a dict of another kind.  ``--layers`` prints the package's modules by floor: a module
@@ -28,13 +42,22 @@ import sys
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 
 #: A string naming a function of the package, ``"shellbvp.module:function"``
-STRING_HOOK = re.compile(r"^shellbvp(\.\w+)+:\w+$")
+STRING_HOOK = re.compile(r"^(?:shellbvp)?\.*(\w+(?:\.\w+)*):\w+$")
 #: Names under which a curve's settings are passed (``settings``, ``st``, ``curve.settings`` ...)
 SETTINGS_RECEIVER = re.compile(r"^(st|settings|[\w.]+\.settings)$")
 #: Methods that change a dict (or a list held in it) in place
 MUTATORS = {"setdefault", "update", "pop", "popitem", "clear", "append", "extend"}
 #: Where a curve's settings are built (the owner) and where the curve records what it learned
 SETTINGS_OWNERS = ("continuation", "io")
+#: Where a Solution is built and its fields set
+SOLUTION_OWNERS = ("solution", "diagnosis")
+#: The registry of the parameters of a scene that a fit, a sweep or a table handles (issue 57:
+#: the one registry of scene parameters replaces the shape parameters' when it lands)
+PARAMETER_REGISTRIES = ("shape_parameters", "scene_parameters")
+#: The readers' registry: the one place that names instrument formats
+READERS_PACKAGE = "readers"
+#: Extras of pyproject.toml that are tools, not optional dependencies of the package
+TOOL_EXTRAS = ("test", "docs")
 MODULE_LINES = 600
 FUNCTION_LINES = 80
 #: Module-level names that a result carries (a ``.get`` of one of them reads a result)
@@ -126,18 +149,168 @@ def settings_writes(root, found):
     return out
 
 
+def _parse_all(pkg):
+    """{module: (path, tree)} of every module of the package (subpackages' modules dotted)."""
+    return {".".join(p.relative_to(pkg).with_suffix("").parts): (p, ast.parse(p.read_text()))
+            for p in sorted(pkg.rglob("*.py"))}
+
+
+def _class_fields(tree, name):
+    """The annotated fields of the class ``name`` in ``tree`` (empty when there is none)."""
+    cls = next((n for n in ast.walk(tree) if isinstance(n, ast.ClassDef) and n.name == name), None)
+    return set() if cls is None else {n.target.id for n in cls.body
+                                      if isinstance(n, ast.AnnAssign) and isinstance(n.target, ast.Name)}
+
+
+def _attributes(cls):
+    """A class's attributes: its annotated fields and what its methods store on ``self``."""
+    out = {n.target.id for n in cls.body if isinstance(n, ast.AnnAssign) and isinstance(n.target, ast.Name)}
+    out |= {n.attr for n in ast.walk(cls) if isinstance(n, ast.Attribute) and isinstance(n.ctx, ast.Store)
+            and isinstance(n.value, ast.Name) and n.value.id == "self"}
+    return out
+
+
+def solution_writes(trees) -> dict:
+    """{module: writes of a Solution's fields} outside :data:`SOLUTION_OWNERS` (module docstring)."""
+    fields = _class_fields(trees["solution"][1], "Solution") if "solution" in trees else set()
+    others = {}
+    for _, tree in trees.values():
+        for cls in (n for n in ast.walk(tree) if isinstance(n, ast.ClassDef) and n.name != "Solution"):
+            others.setdefault(cls.name, set()).update(_attributes(cls))
+    out = {}
+    for mod, (_, tree) in trees.items():
+        if mod in SOLUTION_OWNERS or not fields:
+            continue
+        known = {n.name for n in ast.walk(tree) if isinstance(n, ast.ClassDef)}
+        known |= {a.asname or a.name for n in ast.walk(tree) if isinstance(n, ast.ImportFrom) for a in n.names}
+        shared = set().union(*(others[c] for c in known if c in others))
+        for n in ast.walk(tree):
+            if isinstance(n, ast.Attribute) and isinstance(n.ctx, (ast.Store, ast.Del)):
+                target, name = n.value, n.attr
+            elif isinstance(n, ast.Call) and ast.unparse(n.func) in ("setattr", "object.__setattr__") \
+                    and len(n.args) >= 2 and isinstance(n.args[1], ast.Constant):
+                target, name = n.args[0], n.args[1].value
+            else:
+                continue
+            if name in fields and name not in shared and not (isinstance(target, ast.Name) and target.id == "self"):
+                out[mod] = out.get(mod, 0) + 1
+    return out
+
+
+def scene_parameter_names(root) -> set:
+    """The scene's parameter names: its float fields, the fitted (shape) parameters, the
+    materials' parameters."""
+    pkg = root / "shellbvp"
+    scene = next(c for c in ast.walk(ast.parse((pkg / "scene.py").read_text()))
+                 if isinstance(c, ast.ClassDef) and c.name == "Scene")
+    names = {n.target.id for n in scene.body if isinstance(n, ast.AnnAssign) and isinstance(n.target, ast.Name)
+             and ast.unparse(n.annotation) == "float"}
+    for path in [pkg / "shape_parameters.py", *sorted((pkg / "materials").glob("*.py"))]:
+        if path.exists():
+            names |= set(re.findall(r'(?:ShapeParameter|Parameter)\(\s*"(\w+)"', path.read_text()))
+    return names
+
+
+def parameter_tables(trees, names) -> dict:
+    """{module: literal collections of two or more scene parameter names} outside the registry."""
+    out = {}
+    for mod, (_, tree) in trees.items():
+        if mod.split(".")[0] in PARAMETER_REGISTRIES:
+            continue
+        for n in ast.walk(tree):
+            if isinstance(n, (ast.Tuple, ast.List, ast.Set)):
+                items = n.elts
+            elif isinstance(n, ast.Dict):
+                items = [k for k in n.keys if k is not None]
+            else:
+                continue
+            found = {e.value for e in items if isinstance(e, ast.Constant) and isinstance(e.value, str)} & names
+            if len(found) >= 2:
+                out[mod] = out.get(mod, 0) + 1
+    return out
+
+
+def optional_dependencies(root) -> set:
+    """The import names of the optional dependencies: the extras of pyproject.toml but
+    :data:`TOOL_EXTRAS`."""
+    text = (root / "pyproject.toml").read_text()
+    block = re.search(r"^\[project\.optional-dependencies\]\n(.*?)(?=^\[)", text, re.S | re.M)
+    out = set()
+    for m in re.finditer(r"^(\w+)\s*=\s*\[(.*?)\]", block.group(1) if block else "", re.S | re.M):
+        if m.group(1) not in TOOL_EXTRAS:
+            out |= {d.replace("-", "_").lower() for d in re.findall(r'"([A-Za-z0-9_.-]+)', m.group(2))}
+    return out
+
+
+def _function_imports(tree):
+    """The import statements of ``tree`` inside functions (not at module level)."""
+    top = {id(n) for n in _module_level(tree)}
+    return [n for n in ast.walk(tree) if isinstance(n, (ast.Import, ast.ImportFrom)) and id(n) not in top]
+
+
+def _imports_package(node) -> bool:
+    if isinstance(node, ast.ImportFrom):
+        return node.level >= 1 or (node.module or "").split(".")[0] == "shellbvp"
+    return any(a.name.split(".")[0] == "shellbvp" for a in node.names)
+
+
+def _imported_tops(node) -> set:
+    if isinstance(node, ast.ImportFrom):
+        return set() if node.level else {(node.module or "").split(".")[0]}
+    return {a.name.split(".")[0] for a in node.names}
+
+
+def reader_formats(root):
+    """(the readers' file name endings, their names) as ``shellbvp/readers/`` declares them."""
+    suffixes, names = set(), set()
+    for path in sorted((root / "shellbvp" / READERS_PACKAGE).glob("*.py")):
+        text = path.read_text()
+        for tup in re.findall(r"SUFFIXES = \((.*?)\)|suffixes=\((.*?)\)", text, re.S):
+            suffixes |= set(re.findall(r'"(\.[\w.-]+)"', " ".join(tup)))
+        names |= set(re.findall(r'Reader\(\s*name="([^"]+)"', text))
+    return suffixes, names
+
+
+def _docstrings(tree):
+    """The ids of the docstring constants of ``tree``."""
+    out = set()
+    for n in ast.walk(tree):
+        if isinstance(n, (ast.Module, ast.ClassDef, ast.FunctionDef, ast.AsyncFunctionDef)) and n.body and \
+                isinstance(n.body[0], ast.Expr) and isinstance(n.body[0].value, ast.Constant):
+            out.add(id(n.body[0].value))
+    return out
+
+
+def format_names(trees, suffixes, names) -> dict:
+    """{module: instrument formats named} outside the readers' registry (module docstring)."""
+    out = {}
+    for mod, (_, tree) in trees.items():
+        if mod.split(".")[0] == READERS_PACKAGE:
+            continue
+        docs = _docstrings(tree)
+        for n in ast.walk(tree):
+            hit = isinstance(n, ast.Constant) and isinstance(n.value, str) and id(n) not in docs and \
+                n.value.lower() in suffixes
+            if isinstance(n, ast.Compare):
+                hit = any(s in names for side in [n.left, *n.comparators] for s in _strings(side))
+            if hit:
+                out[mod] = out.get(mod, 0) + 1
+    return out
+
+
 def census(root=ROOT):
     names = configuration_names(root)
     out = {"step_loops": [], "name_comparisons": {}, "long_modules": {}, "long_functions": [], "result_gets": {},
            "solution_builds": {}, "function_imports": {}, "string_hooks": {}, "settings_writes": {},
-           "lines": 0}
+           "function_imports_package": {}, "function_imports_optional": {}, "lines": 0}
     pkg = root / "shellbvp"
-    for path in sorted(pkg.rglob("*.py")):  # subpackages (materials/, cli/) too
+    trees = _parse_all(pkg)
+    modules = set(trees) | {m.rsplit(".", 1)[0] for m in trees if m.endswith(".__init__")}
+    optional = optional_dependencies(root)
+    for mod, (path, tree) in trees.items():  # subpackages (materials/, cli/) too
         text = path.read_text()
-        tree = ast.parse(text)
         nlines = text.count("\n")
         out["lines"] += nlines
-        mod = ".".join(path.relative_to(pkg).with_suffix("").parts)
         if nlines > MODULE_LINES:
             out["long_modules"][mod] = nlines
         for node in ast.walk(tree):
@@ -145,7 +318,8 @@ def census(root=ROOT):
                 hits = [s for side in [node.left, *node.comparators] for s in _strings(side) if s in names]
                 if hits:
                     out["name_comparisons"][mod] = out["name_comparisons"].get(mod, 0) + 1
-            elif isinstance(node, ast.Constant) and isinstance(node.value, str) and STRING_HOOK.match(node.value):
+            elif isinstance(node, ast.Constant) and isinstance(node.value, str) and STRING_HOOK.match(node.value) \
+                    and STRING_HOOK.match(node.value).group(1) in modules:
                 out["string_hooks"][mod] = out["string_hooks"].get(mod, 0) + 1
             elif _settings_write(node):
                 out["settings_writes"][mod] = out["settings_writes"].get(mod, 0) + 1
@@ -164,16 +338,21 @@ def census(root=ROOT):
                 # the diagnosis builds a Solution or a subclass, passed as ``result``
                 if isinstance(f, ast.Name) and f.id in ("Solution", "result"):
                     out["solution_builds"][mod] = out["solution_builds"].get(mod, 0) + 1
-        n_imports = sum(isinstance(n, (ast.Import, ast.ImportFrom)) for n in ast.walk(tree)) \
-            - sum(isinstance(n, (ast.Import, ast.ImportFrom)) for n in _module_level(tree))
-        if n_imports:
-            out["function_imports"][mod] = n_imports
+        late = _function_imports(tree)
+        for key, n in (("function_imports", len(late)),
+                       ("function_imports_package", sum(_imports_package(i) for i in late)),
+                       ("function_imports_optional", sum(bool(_imported_tops(i) & optional) for i in late))):
+            if n:
+                out[key][mod] = n
     patched = set()
     for path in sorted((root / "tests").glob("*.py")) + sorted((root / "benchmarks").glob("*.py")):
         for m in re.finditer(r"monkeypatch\.setattr\(\s*([\w.]+)\s*,\s*\"(_?[A-Z_]+)\"", path.read_text()):
             patched.add(f"{m.group(1)}.{m.group(2)}")
     out["patched_flags"] = sorted(patched)
     out["settings_writes"] = settings_writes(root, out["settings_writes"])
+    out["solution_writes"] = solution_writes(trees)
+    out["parameter_tables"] = parameter_tables(trees, scene_parameter_names(root))
+    out["format_names"] = format_names(trees, *reader_formats(root)) if (pkg / READERS_PACKAGE).is_dir() else {}
     return out
 
 
@@ -242,11 +421,18 @@ def main(argv=None):
          dict(sorted(c["long_functions"], key=lambda t: -t[1]))),
         ("`.get` of a result's field", total(c["result_gets"]), c["result_gets"] if args.verbose else gets),
         ("places that build a Solution", total(c["solution_builds"]), c["solution_builds"]),
-        ("imports inside functions", total(c["function_imports"]), c["function_imports"]),
+        ("imports inside functions", total(c["function_imports"]), c["function_imports"] if args.verbose else ""),
+        ("... of the package itself", total(c["function_imports_package"]), c["function_imports_package"]),
+        ("... of optional dependencies", total(c["function_imports_optional"]), c["function_imports_optional"]),
         ("module flags patched by tests and benchmarks", len(c["patched_flags"]), c["patched_flags"]),
         ('string hooks (`"module:function"` resolved by name)', total(c["string_hooks"]), c["string_hooks"]),
         ("writes of a curve's settings below their owner (continuation)", total(c["settings_writes"]),
          c["settings_writes"]),
+        ("writes of a Solution's fields outside solution and diagnosis", total(c["solution_writes"]),
+         c["solution_writes"]),
+        ("parallel parameter lists (scene parameter names tabled outside the registry)",
+         total(c["parameter_tables"]), c["parameter_tables"]),
+        ("instrument formats named outside the readers' registry", total(c["format_names"]), c["format_names"]),
         ("lines of shellbvp/*.py", c["lines"], ""),
     ]
     if args.markdown:

@@ -15,7 +15,7 @@ from .version import __version__  # noqa: F401  (sb.__version__)
 # Every public name is imported on first use (PEP 562): `import shellbvp` and the command line's
 # parser cost next to nothing, so bad input is refused before numpy and SciPy load and Ctrl-C
 # finds the CLI's handler in place.
-_LAZY = {"curve": "continuation", "iter_curve": "continuation", "CurveRun": "continuation", "SphereTip": "geometry", "Spheroid": "geometry", "UserShell": "geometry",
+_LAZY = {"curve": "continuation", "iter_curve": "continuation", "CurveRun": "continuation", "SphereTip": "geometry", "FlatTip": "geometry", "Spheroid": "geometry", "UserShell": "geometry",
          "UserTip": "geometry", "Curve": "io", "read_curve": "io", "BendingEnergy": "materials", "Gent": "materials",
          "MooneyRivlin": "materials", "NeoHookean": "materials", "RotationBending": "materials",
          "StrainEnergy": "materials", "TraceBending": "materials", "PRESETS": "scene", "Scene": "scene",
@@ -94,6 +94,7 @@ __all__ = [
     "convexity_limits",
     "Spheroid",
     "SphereTip",
+    "FlatTip",
     "UserShell",
     "UserTip",
 ]

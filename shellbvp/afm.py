@@ -9,15 +9,16 @@ cantilever's deflection ``force / spring constant`` (nanite's tip-sample separat
 sample is minus the tip's position: the package's signs, no ``--invert`` needed.
 
 * :func:`read_afm` -- the curves of a file as :class:`AFMCurve` (an
-  :class:`~shellbvp.instrument.InstrumentRecord` with its place on the map); the file's
-  declared sizes checked first and every failure of decoding one line
-  (:mod:`shellbvp.afm_read`).  AFM Workshop CSV and NT-MDT Nova text exports go through
+  :class:`~shellbvp.instrument.InstrumentRecord` with its place on the map), by its reader
+  (:mod:`shellbvp.readers`); :func:`iter_afm` one at a time.  The file's declared sizes are
+  checked first and every failure of decoding is one line (:mod:`shellbvp.afm_read`).  AFM Workshop CSV and NT-MDT Nova text exports go through
   afmformats too (:func:`afm_text_format`), with the cantilever's calibration given.
 * :class:`ForceMap` -- a force map fitted (:func:`shellbvp.batch.fit_map`): the per-curve rows
-  of a batch (each fit's numbers; the curves are not kept), images of mu*H and its interval, a
-  NeXus file, a figure.
+  of a batch (each fit's numbers and its fitted rows thinned with the model, not the records),
+  images of mu*H and its interval, a NeXus file, a figure.
 * :func:`read_map_file` -- that NeXus file read back (:class:`MapFile`), for ``shellbvp info``
-  and ``shellbvp plot``.
+  and ``shellbvp plot``; one pixel's data against its fitted model from it
+  (:meth:`MapFile.plot_pixel`, ``shellbvp plot map.h5 --pixel IX,IY``; :mod:`shellbvp.map_pixels`).
 """
 
 from __future__ import annotations
@@ -27,13 +28,79 @@ from pathlib import Path
 
 import numpy as np
 
-from .afm_read import (AFM_SUFFIXES, AFMCurve, afm_text_format, curves_from_afm, is_afm_file, iter_afm, read_afm,
-                       refuse_text_options, single_curve)
+from . import readers
+from .afm_read import AFMCurve, curves_from_afm
+from .map_pixels import MapPixel, locate, pixel_of_row, read_curves, write_curve_data
 from .textdata import printable
 
 __all__ = ["AFM_SUFFIXES", "AFMCurve", "ForceMap", "MapFile", "is_afm_file", "afm_text_format", "read_afm", "iter_afm",
            "curves_from_afm", "single_curve", "refuse_text_options", "map_shape", "MAP_FORMAT", "is_map_file",
-           "read_map_file", "draw_map"]
+           "read_map_file", "draw_map", "draw_pixel"]
+
+#: File name endings of the files read for their curves (:mod:`shellbvp.readers`: JPK, Asylum)
+AFM_SUFFIXES = readers.curve_suffixes()
+
+
+def is_afm_file(path) -> bool:
+    """True for a file read for its curves (an AFM file: :mod:`shellbvp.readers` recognises it by
+    its name or its first bytes), False for a text table."""
+    return readers.reader_for(path).curves
+
+
+def afm_text_format(path):
+    """The name of the AFM text export ``path`` is (``"AFM Workshop"``, ``"NT-MDT Nova"``: read with
+    the cantilever's calibration given), or None.  Only the first bytes of a regular file are read."""
+    found = readers.reader_for(path)
+    return found.name if found.curves and "spring_constant" in found.requires else None
+
+
+def read_afm(path, *, spring_constant=None, sensitivity=None) -> list:
+    """The curves of an AFM file as :class:`AFMCurve`, in file order, read by its reader
+    (:func:`shellbvp.readers.read_curves`; a file no reader recognises through afmformats' own
+    loader).
+
+    The file's declared sizes are checked first (an archive's members and inflated sizes, an
+    ``.ibw`` header's parts), then afmformats reads it inside one error boundary
+    (:func:`shellbvp.afm_read.afmformats_boundary`): whatever fails while the file is decoded is
+    one ``ValueError`` line.
+
+    Parameters
+    ----------
+    spring_constant, sensitivity : float, optional
+        The cantilever's spring constant (N/m) and deflection sensitivity (m/V; for NT-MDT
+        m/A), for the text exports that do not carry them (:func:`afm_text_format`); JPK and
+        Asylum files carry their own.
+
+    Raises
+    ------
+    ValueError
+        afmformats is not installed, or cannot read the file, or a curve lacks the force,
+        a height or the spring constant, or the file declares sizes beyond the bounds.
+    """
+    return readers.read_curves(path, spring_constant=spring_constant, sensitivity=sensitivity)
+
+
+def iter_afm(path, *, spring_constant=None, sensitivity=None):
+    """:func:`read_afm` one curve at a time (:func:`shellbvp.readers.iter_curves`): a force map's
+    curves are never all in memory (:func:`shellbvp.batch.fit_map` takes them so).  The options
+    are checked at once; the file's sizes, and its curve count against
+    :data:`~shellbvp.afm_read.MAX_MAP_CURVES`, before its first curve is read."""
+    return readers.iter_curves(path, spring_constant=spring_constant, sensitivity=sensitivity)
+
+
+def single_curve(path, *, columns=None, units=None, invert=(), spring_constant=None, sensitivity=None):
+    """The record of an AFM file's one curve (:func:`read_afm`); a force map is refused, pointing
+    to :func:`read_afm` and :func:`shellbvp.batch.fit_map`, as reading options of text exports."""
+    return readers.read_record(path, columns=columns, units=units, invert=invert, spring_constant=spring_constant,
+                               sensitivity=sensitivity, curves=True)
+
+
+def refuse_text_options(path, columns=None, units=None, invert=(), spring_constant=None, sensitivity=None):
+    """ValueError when reading options of text exports are given for an AFM file (the
+    calibration options are the AFM reader's: accepted)."""
+    readers.check_options(readers.reader_for(path, curves=True), path,
+                          {"columns": columns, "units": units, "invert": invert})
+
 
 MAP_FORMAT = "shellbvp-force-map"
 MAP_FORMAT_VERSION = 1
@@ -84,8 +151,11 @@ class ForceMap:
     path : str
         The map's file.
     curves : list of AFMCurve
+        Each curve's place on the map (from :func:`~shellbvp.batch.fit_map` without its record).
     rows : list of BatchRow
-        One per curve, in the same order (status ``ok``, ``failed`` or ``error``).
+        One per curve, in the same order (status ``ok``, ``failed`` or ``error``; from
+        :func:`~shellbvp.batch.fit_map` with its fitted rows thinned, ``BatchRow.curve_rows``,
+        for :meth:`pixel`).
     shape : tuple of int
         ``(nx, ny)``: the grid's size (from the curves' indices).
     scene : Scene
@@ -282,6 +352,7 @@ class ForceMap:
                                "largest max|F_interpolated - F|/max|F| at curves checked between nodes")
             string_dataset(c, "status", [r.status for r in self.rows], "ok, failed (its checks) or error")
             string_dataset(c, "message", [printable(r.message) for r in self.rows], "the fit's message")
+            write_curve_data(entry, self.rows, self.segment)  # ratings, warnings, each curve's rows and model
             s = entry.create_group("sample")
             s.attrs.update({"NX_class": "NXsample", "scene": self.scene.to_json(),
                             "description": self.scene.describe(self.R_L)
@@ -302,6 +373,42 @@ class ForceMap:
         title = (f"{Path(self.path).name}: {sum(r.status == 'ok' for r in self.rows)} of {len(self.rows)} "
                  "curves fitted")
         return draw_map(self.image("mu_H"), x, y, title, out=out, ax=ax)
+
+    def pixel(self, ix, iy) -> MapPixel:
+        """The curve at grid index ``(ix, iy)`` as a :class:`~shellbvp.map_pixels.MapPixel`: its
+        fit's numbers and its fitted rows with the model at them, thinned as the map file keeps
+        them; ValueError (one line, the valid range) outside the grid or where no curve is."""
+        i = locate([c.grid if c.grid is not None else (-1, -1) for c in self.curves], self.shape, ix, iy)
+        return pixel_of_row(self.curves[i], self.rows[i], len(self.rows), self.segment, source=str(self.path))
+
+    def plot_pixel(self, ix, iy, out=None, axes=None, dpi=150):
+        """One pixel's data, model and residuals (:func:`shellbvp.plotting.plot_map_pixel`; its
+        2 x 2 axes returned), saved to ``out`` when given."""
+        return draw_pixel(self.pixel(ix, iy), out=out, axes=axes, dpi=dpi)
+
+
+def draw_pixel(pixel, out=None, axes=None, dpi=150):
+    """:func:`shellbvp.plotting.plot_map_pixel` of ``pixel`` with its message and warnings
+    under it (on a figure of its own), saved to ``out`` (atomically) and closed when given;
+    ValueError when the pixel has no rows to draw."""
+    from .plotting import map_pixel_notes, plot_map_pixel, require_matplotlib, save_figure
+
+    if pixel.displacement is None or pixel.displacement.size == 0:
+        raise ValueError(f"pixel {pixel.grid}: no rows to draw ({pixel.status}: {printable(pixel.message)})")
+    plt = require_matplotlib()
+    axes = plot_map_pixel(pixel, axes)
+    fig = axes[0, 0].figure
+    notes = map_pixel_notes(pixel)
+    if notes and len(fig.axes) == 4:  # a figure of its own: the notes below the axes
+        lines = notes.count("\n") + 1
+        fig.subplots_adjust(left=0.09, right=0.98, top=0.93, hspace=0.08, wspace=0.22, bottom=0.1 + 0.022 * lines)
+        fig.text(0.01, 0.01, notes, fontsize=7, va="bottom", ha="left", family="monospace")
+    if out is not None:
+        try:
+            save_figure(fig, out, dpi=dpi)
+        finally:
+            plt.close(fig)
+    return axes
 
 
 def draw_map(img, x, y, title, out=None, ax=None, dpi=150):
@@ -349,6 +456,9 @@ class MapFile:
         The scene in lab units, as the fit described it.
     source : str
         The AFM file fitted.
+    curves : MapCurves or None
+        Each curve's numbers and, in a file written since the per-curve view, its fitted rows
+        and model (:mod:`shellbvp.map_pixels`); None where the file has no ``/entry/curves``.
     """
 
     path: str
@@ -360,6 +470,7 @@ class MapFile:
     y: object
     sample: str
     source: str
+    curves: object = None
 
     def summary_lines(self) -> list:
         """What ``shellbvp info`` prints."""
@@ -374,12 +485,38 @@ class MapFile:
         if self.x is not None:
             lines.append(f"area:      x {self.x.min() * 1e6:.4g}..{self.x.max() * 1e6:.4g} um, "
                          f"y {self.y.min() * 1e6:.4g}..{self.y.max() * 1e6:.4g} um (cell centres)")
+        if self.curves is not None:
+            lines += self.curves.summary_lines()
         return lines
 
     def plot(self, out=None, ax=None, dpi=150):
         fitted = int(np.sum(self.status == 0))
         title = f"{Path(self.source).name}: {fitted} of {int(np.sum(self.status >= 0))} curves fitted"
         return draw_map(self.mu_H, self.x, self.y, title, out=out, ax=ax, dpi=dpi)
+
+    def pixel(self, ix, iy) -> MapPixel:
+        """The curve at grid index ``(ix, iy)`` (:class:`~shellbvp.map_pixels.MapPixel`; its rows
+        None in a file written before the per-curve view); ValueError (one line, the valid
+        range) outside the grid or where no curve was measured."""
+        if self.curves is None:
+            raise ValueError(f"{self.path}: no per-curve rows (/entry/curves)")
+        return self.curves.pixel(ix, iy)
+
+    def plot_pixel(self, ix, iy, out=None, axes=None, dpi=150):
+        """One pixel's data, model and residuals (``shellbvp plot map.h5 --pixel IX,IY``), saved
+        to ``out`` when given; ValueError for a file that stores no curve data (what it can
+        show instead) and for a pixel off the grid."""
+        pixel = self.pixel(ix, iy)
+        if not self.curves.has_data:
+            raise ValueError(self.curves.no_data_reason())
+        return draw_pixel(pixel, out=out, axes=axes, dpi=dpi)
+
+    def pixels(self, which="all") -> list:
+        """Grid indices ``(ix, iy)`` of every curve (``"all"``) or of those whose fit did not
+        succeed (``"failed"``: failed its checks, or an error)."""
+        if self.curves is None:
+            raise ValueError(f"{self.path}: no per-curve rows (/entry/curves)")
+        return self.curves.select(which)
 
 
 def is_map_file(path) -> bool:
@@ -420,7 +557,9 @@ def read_map_file(path) -> MapFile:
                 x, y = sc.dataset(m, "x", length=nx), sc.dataset(m, "y", length=ny)
             sample = sc.attr_text(h["entry/sample"], "description") if "entry/sample" in h else ""
             source = sc.text_dataset(h["entry/source"], "file_name", ndim=0) if "entry/source" in h else ""
+            curves = read_curves(h, (nx, ny), path, printable(source)) if "entry/curves" in h else None
         except (ValueError, KeyError, TypeError, OSError) as exc:
             what = str(exc) if isinstance(exc, ValueError) else f"{type(exc).__name__}: {exc}"
             raise ValueError(f"{path}: incomplete or corrupt force-map file ({what})") from None
-    return MapFile(path=str(path), **images, status=status.astype(int), x=x, y=y, sample=sample, source=source)
+    return MapFile(path=str(path), **images, status=status.astype(int), x=x, y=y, sample=sample, source=source,
+                   curves=curves)

@@ -25,10 +25,8 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["JPK_SUFFIXES", "METADATA_KEYS", "jpk_datasets", "parse_properties", "read_properties", "LightCurve", "Curves"]
+__all__ = ["METADATA_KEYS", "jpk_datasets", "parse_properties", "read_properties", "LightCurve", "Curves"]
 
-#: File name endings of JPK archives (afmformats' JPK recipes)
-JPK_SUFFIXES = (".jpk-force", ".jpk-force-map", ".jpk-qi-data", ".jpk-qi-series")
 #: The columns afmformats' ``load_jpk`` offers
 _COLUMNS = ("force", "height (measured)", "height (piezo)", "segment", "time")
 #: Property sets kept: a curve's segments (afmformats' own cache holds 128 of every curve's)

@@ -1,12 +1,14 @@
 """AFM files read through afmformats: checked before it reads them, read inside one error boundary.
 
-:func:`read_afm` (re-exported by :mod:`shellbvp.afm`) gives a file's curves as :class:`AFMCurve`.
+:func:`read_afm` gives a file's curves as :class:`AFMCurve`, loaded by the loader of its reader
+(:mod:`shellbvp.readers`: which format a file is, which sizes it checks and which calibration it
+needs are the readers' own; :func:`shellbvp.afm.read_afm` asks them).
 
-A JPK file is a zip archive: a few megabytes can declare a gigabyte of inflated members, and
-its central directory alone can hold millions of entries.  An Asylum ``.ibw`` declares the sizes
-of its parts in a header that igor2 trusts: a mutated size is a read of gigabytes.  Both are
-checked here from the sizes the file declares, before anything is inflated or allocated
-(:func:`check_afm_sizes`), against the bounds below (stated in docs/fitting.md).
+A JPK file (or an AFM Workshop map) is a zip archive: a few megabytes can declare a gigabyte of
+inflated members, and its central directory alone can hold millions of entries.  An archive is
+checked here from the sizes it declares, before anything is inflated (:func:`check_archive`),
+against the bounds below (stated in docs/fitting.md); an Asylum ``.ibw``'s header by its reader
+(:mod:`shellbvp.readers.afmformats`).
 
 :func:`afmformats_boundary` turns every exception of afmformats, igor2, zipfile and numpy while a
 file is decoded into one ``ValueError`` line naming the file (its text escaped), and keeps
@@ -19,22 +21,21 @@ from __future__ import annotations
 
 import logging
 import math
-import re
 import struct
 import zipfile
 from contextlib import contextmanager
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 
-from .afm_jpk import JPK_SUFFIXES, jpk_datasets
+from .instrument_record import record_from_arrays, sha256_of
+from .paths import read_input_bytes
 from .textdata import printable
 
-__all__ = ["AFM_SUFFIXES", "AFMCurve", "is_afm_file", "afm_text_format", "read_afm", "curves_from_afm",
-           "single_curve", "refuse_text_options", "check_afm_sizes", "afmformats_boundary", "AFMFileError",
-           "iter_afm", "curve_from_afm", "MAX_MAP_CURVES", "MAX_MAP_PIXELS", "MAX_ARCHIVE_MEMBERS", "MAX_CENTRAL_DIRECTORY_BYTES", "MAX_INFLATED_BYTES",
-           "MAX_INFLATION_RATIO", "INFLATION_ALLOWANCE_BYTES", "READER_LOGGERS"]
+__all__ = ["AFMCurve", "read_afm", "iter_afm", "load_with_afmformats", "curves_from_afm", "curve_from_afm",
+           "check_archive", "afmformats_boundary", "AFMFileError", "AFM_REFUSALS", "MAX_MAP_CURVES", "MAX_MAP_PIXELS",
+           "MAX_ARCHIVE_MEMBERS", "MAX_CENTRAL_DIRECTORY_BYTES", "MAX_INFLATED_BYTES", "MAX_INFLATION_RATIO",
+           "INFLATION_ALLOWANCE_BYTES", "READER_LOGGERS"]
 
 #: The most members a JPK archive may hold (a 128 x 128 force map: about 330,000, 20 a curve).
 MAX_ARCHIVE_MEMBERS = 500_000
@@ -50,70 +51,25 @@ INFLATION_ALLOWANCE_BYTES = 16 * 2**20
 #: The most cells of a force map's grid (its images: 8 MiB each) and rows of a pixel table.
 MAX_MAP_PIXELS = 1024 * 1024
 #: The most curves of an AFM file read (a 256 x 256 map): a map keeps each curve's results
-#: (a few kB) until it is written; a JPK archive declaring more is refused before its first curve.
+#: (a few kB) until it is written; a file declaring more (a JPK archive's count from its list
+#: of members) is refused before its first curve.
 MAX_MAP_CURVES = 256 * 256
-
-#: Asylum (Igor) binary wave headers: version -> (struct layout after the version, names)
-_IBW_HEADERS = {
-    1: ("lh", ("wfmSize",)),
-    2: ("lllh", ("wfmSize", "noteSize", "pictSize")),
-    3: ("llllh", ("wfmSize", "noteSize", "formulaSize", "pictSize")),
-    5: ("h15l", ("wfmSize", "formulaSize", "noteSize", "dataEUnitsSize", *(f"dimEUnitsSize[{i}]" for i in range(4)),
-                 *(f"dimLabelsSize[{i}]" for i in range(4)), "sIndicesSize", "optionsSize1", "optionsSize2")),
-}
-
 
 #: Loggers of the readers below afmformats, quiet while a file is read unless asked for.
 READER_LOGGERS = ("afmformats", "igor2")
 
 
+#: What a reader of AFM files (:mod:`shellbvp.readers`) says of the reading options it does not take
+AFM_REFUSALS = {
+    "text": "an AFM file gives its own columns, units and signs: --columns, --units and --invert are for text "
+            "exports",
+    "calibration": "its file carries the cantilever's calibration: --spring-constant and --sensitivity are for "
+                   "AFM text exports ({takers})",
+}
+
+
 class AFMFileError(ValueError):
     """A file refused by shellbvp's own checks (its message is already one line, naming the file)."""
-
-
-#: File name endings read through afmformats (other text files go through shellbvp.instrument).
-AFM_SUFFIXES = (".jpk-force", ".jpk-force-map", ".jpk-qi-data", ".jpk-qi-series", ".ibw")
-
-
-def is_afm_file(path) -> bool:
-    """True for an AFM file afmformats reads: by its name (:data:`AFM_SUFFIXES`), or a text
-    export of an AFM (:func:`afm_text_format`)."""
-    return str(path).lower().endswith(AFM_SUFFIXES) or afm_text_format(path) is not None
-
-
-def afm_text_format(path):
-    """``"AFM Workshop"`` (a ``.csv`` whose first line is ``Force-Distance Curve``, or a ``.zip``
-    of them: a map), ``"NT-MDT Nova"`` (a ``.txt`` of three tab-separated columns of numbers with
-    decimal commas and no header: height, deflection approaching, deflection retracting) or
-    None.  Only the first bytes of a regular file are read."""
-    import stat
-    import zipfile
-
-    name = str(path).lower()
-    if not name.endswith((".csv", ".txt", ".zip")):
-        return None
-    try:
-        if not stat.S_ISREG(Path(path).stat().st_mode):
-            return None  # a FIFO is never opened here: it could block
-        if name.endswith(".zip"):
-            with zipfile.ZipFile(path) as z:
-                first = next((i for i in z.infolist() if i.filename.lower().endswith(".csv")), None)
-                if first is None:
-                    return None
-                with z.open(first) as fh:
-                    head = fh.read(4096)
-        else:
-            with open(path, "rb") as fh:
-                head = fh.read(4096)
-    except (OSError, ValueError, zipfile.BadZipFile, EOFError):
-        return None
-    if head.lstrip(b"\xef\xbb\xbf").startswith(b"Force-Distance Curve"):
-        return "AFM Workshop"
-    lines = head.splitlines()[:10] if name.endswith(".txt") else []
-    if len(lines) >= 3 and all(re.fullmatch(rb"\s*-?\d+(,\d+)?\t-?\d+(,\d+)?\t-?\d+(,\d+)?\s*", ln)
-                               for ln in lines[:-1]) and any(b"," in ln for ln in lines):
-        return "NT-MDT Nova"
-    return None
 
 
 @dataclass
@@ -141,14 +97,6 @@ class AFMCurve:
     grid_geometry: tuple = None  # ((center x, center y), (size x, size y)) of the map's grid, m
 
 
-def refuse_text_options(path, columns=None, units=None, invert=(), spring_constant=None, sensitivity=None):
-    """ValueError when reading options of text exports are given for an AFM file (the
-    calibration options are the AFM reader's: accepted)."""
-    if columns or units or invert:
-        raise ValueError(f"{path}: an AFM file gives its own columns, units and signs: --columns, --units and "
-                         f"--invert are for text exports")
-
-
 def _afmformats():
     try:
         import afmformats
@@ -157,20 +105,16 @@ def _afmformats():
     return afmformats
 
 
-def read_afm(path, *, spring_constant=None, sensitivity=None) -> list:
-    """The curves of an AFM file (:data:`AFM_SUFFIXES`) as :class:`AFMCurve`, in file order.
+def read_afm(path, *, load, check_sizes=None, meta_override=None) -> list:
+    """The curves of an AFM file as :class:`AFMCurve`, in file order, loaded by ``load``.
 
-    The file's declared sizes are checked first (:func:`shellbvp.afm_read.check_afm_sizes`:
-    an archive's members and inflated sizes, an ``.ibw`` header's parts), then afmformats
-    reads it inside one error boundary (:func:`shellbvp.afm_read.afmformats_boundary`):
-    whatever fails while the file is decoded is one ``ValueError`` line.
-
-    Parameters
-    ----------
-    spring_constant, sensitivity : float, optional
-        The cantilever's spring constant (N/m) and deflection sensitivity (m/V; for NT-MDT
-        m/A), for the text exports that do not carry them (:func:`afm_text_format`); JPK and
-        Asylum files carry their own.
+    The file is read whole once (a regular file of bounded size: never a FIFO, a device or a
+    folder) and its declared sizes checked (``check_sizes(path, size)``, its reader's), then
+    ``load(path, meta_override)`` (afmformats' curves, ``AFMForceDistance``) runs inside one error
+    boundary (:func:`afmformats_boundary`): whatever fails while the file is decoded is one
+    ``ValueError`` line.  Which loader, which checks and which calibration (``meta_override``:
+    afmformats' ``{"spring constant": ..., "sensitivity": ...}``) a file gets is its reader's
+    (:mod:`shellbvp.readers`); :func:`shellbvp.afm.read_afm` asks them.
 
     Raises
     ------
@@ -178,72 +122,43 @@ def read_afm(path, *, spring_constant=None, sensitivity=None) -> list:
         afmformats is not installed, or cannot read the file, or a curve lacks the force,
         a height or the spring constant, or the file declares sizes beyond the bounds.
     """
-    curves = list(iter_afm(path, spring_constant=spring_constant, sensitivity=sensitivity))
+    curves = list(iter_afm(path, load=load, check_sizes=check_sizes, meta_override=meta_override))
     if not curves:
         raise AFMFileError(f"{printable(path)}: afmformats found no force-distance curve in it")
     return curves
 
 
-def iter_afm(path, *, spring_constant=None, sensitivity=None):
-    """:func:`read_afm` one curve at a time (a force map's curves are never all in memory): the
-    file's sizes are checked and a JPK archive's curve count bounded by :data:`MAX_MAP_CURVES`
-    before the first curve is read; every failure while the file is decoded is one
-    ``ValueError`` line, raised when the curve is asked for."""
-    from .instrument_record import sha256_of
-    from .paths import read_input_bytes
-
-    afmformats = _afmformats()
+def iter_afm(path, *, load, check_sizes=None, meta_override=None):
+    """:func:`read_afm` one curve at a time (a force map's curves are never all in memory; a
+    JPK archive's are decoded one at a time too, :mod:`shellbvp.afm_jpk`): the file's sizes are
+    checked and its curve count bounded by :data:`MAX_MAP_CURVES` before the first curve is
+    read; every failure while the file is decoded is one ``ValueError`` line, raised when the
+    curve is asked for.  A file without curves yields none."""
+    _afmformats()
     size = len(read_input_bytes(path))  # a regular file of bounded size: never a FIFO, a device or a folder
-    check_afm_sizes(path, size)
-    override = _calibration(path, spring_constant, sensitivity)
+    if check_sizes is not None:
+        check_sizes(path, size)
     sha256 = sha256_of(path)
     with afmformats_boundary(path):
-        # a JPK archive curve by curve (time linear in its curves: shellbvp.afm_jpk)
-        datasets = jpk_datasets(path, override) if str(path).endswith(JPK_SUFFIXES) else None
-        if datasets is None:
-            datasets = afmformats.load_data(str(path), meta_override=override)
-        if len(datasets) > MAX_MAP_CURVES:  # a JPK archive's count from its list of members
-            raise AFMFileError(f"{printable(path)}: {len(datasets)} curves; shellbvp fits at most {MAX_MAP_CURVES} "
-                               f"curves of a map (MAX_MAP_CURVES): cut the map into parts")
-        # afmformats loads a curve's columns when they are first read: inside the boundary too
-        for i, ds in enumerate(datasets):
+        datasets = load(path, meta_override)
+        # a JPK archive's count from its list of members, before its first curve; any other as it is read
+        declared = len(datasets) if hasattr(datasets, "__len__") else None
+        over = declared is not None and declared > MAX_MAP_CURVES
+        for i, ds in enumerate(() if over else datasets):
+            if i >= MAX_MAP_CURVES:
+                over = True
+                break
+            # afmformats loads a curve's columns when they are first read: inside the boundary too
             yield curve_from_afm(ds, i, path, sha256=sha256)
+        if over:
+            count = declared if declared is not None and declared > MAX_MAP_CURVES else f"more than {MAX_MAP_CURVES}"
+            raise AFMFileError(f"{printable(path)}: {count} curves; shellbvp fits at most {MAX_MAP_CURVES} curves "
+                               f"of a map (MAX_MAP_CURVES): cut the map into parts")
 
 
-def _calibration(path, spring_constant, sensitivity):
-    """afmformats' ``meta_override`` for a text export: the calibration it needs, checked."""
-    given = {"spring constant": spring_constant, "sensitivity": sensitivity}
-    given = {k: v for k, v in given.items() if v is not None}
-    for key, value in given.items():
-        if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
-            raise ValueError(f"the {key} must be a finite number > 0; got {value!r}")
-    fmt = afm_text_format(path)
-    if fmt is None:
-        if given:
-            raise ValueError(f"{printable(path)}: its file carries the cantilever's calibration: "
-                             f"--spring-constant and --sensitivity are for AFM text exports (AFM Workshop, NT-MDT)")
-        return None
-    if len(given) < 2:
-        what = ("an NT-MDT Nova export (height in nm, deflection in nA)" if fmt == "NT-MDT Nova" else
-                "an AFM Workshop export")
-        unit = "m/A" if fmt == "NT-MDT Nova" else "m/V"
-        raise AFMFileError(f"{printable(path)}: {what} without the cantilever's calibration: give its spring "
-                           f"constant (N/m) and sensitivity ({unit}): --spring-constant K --sensitivity S"
-                           + (" (if it is no such export, give it a header row naming its columns and their units)"
-                              if fmt == "NT-MDT Nova" else ""))
-    return given
-
-
-def single_curve(path, *, columns=None, units=None, invert=(), spring_constant=None, sensitivity=None):
-    """The record of an AFM file's one curve (:func:`read_afm`); a force map is refused, pointing
-    to :func:`read_afm` and :func:`shellbvp.batch.fit_map`, as reading options of text exports."""
-    refuse_text_options(printable(path), columns, units, invert)
-    curves = read_afm(path, spring_constant=spring_constant, sensitivity=sensitivity)
-    if len(curves) > 1:
-        raise ValueError(f"{printable(path)}: a force map of {len(curves)} curves: fit it on its own "
-                         f"(shellbvp fit {printable(Path(path).name)} ... -o map.h5; in Python "
-                         f"shellbvp.afm.read_afm and shellbvp.batch.fit_map)")
-    return curves[0].record
+def load_with_afmformats(path, meta_override=None):
+    """afmformats' own loader (``afmformats.load_data``): the curves of any file it knows."""
+    return _afmformats().load_data(str(path), meta_override=meta_override)
 
 
 def _meta(md, key):
@@ -258,8 +173,6 @@ def curves_from_afm(datasets, path, *, sha256=None) -> list:
 
 def curve_from_afm(ds, i, path, *, sha256=None) -> AFMCurve:
     """The :class:`AFMCurve` of afmformats' curve ``ds``, the ``i``-th of the file ``path``."""
-    from .instrument_record import record_from_arrays
-
     columns = list(ds.columns)
     md = ds.metadata
     where = f"{printable(path)}, curve {i}"
@@ -296,17 +209,10 @@ def curve_from_afm(ds, i, path, *, sha256=None) -> AFMCurve:
                     if None not in geometry else None)
 
 
-def check_afm_sizes(path, size) -> None:
-    """AFMFileError when the file's declared sizes exceed the bounds of this module: a zip
-    archive's member count, central directory, inflated sizes; an ``.ibw`` header's part sizes
-    against the file's own ``size`` (bytes).  Nothing is inflated."""
-    if str(path).lower().endswith(".ibw"):
-        _check_ibw(path, size)
-    elif zipfile.is_zipfile(path):
-        _check_archive(path, size)
-
-
-def _check_archive(path, size):
+def check_archive(path, size) -> None:
+    """AFMFileError when the zip archive ``path`` (``size`` bytes) declares more members, a larger
+    central directory or more inflated bytes than the bounds of this module.  Nothing is
+    inflated."""
     count, cd_size = _central_directory(path)
     if count > MAX_ARCHIVE_MEMBERS or cd_size > MAX_CENTRAL_DIRECTORY_BYTES:
         raise AFMFileError(f"{path}: the archive declares {count} members in a {cd_size} byte directory; "
@@ -352,33 +258,6 @@ def _central_directory(path):
         if record[:4] == b"PK\x06\x06" and len(record) == 56:
             count, cd_size = struct.unpack("<QQ", record[32:48])
     return count, cd_size
-
-
-def _check_ibw(path, size):
-    with open(path, "rb") as fh:
-        head = fh.read(64)
-    if len(head) < 2:
-        raise AFMFileError(f"{path}: not an Igor binary wave (the file holds {len(head)} bytes)")
-    for order in "<>":
-        version = struct.unpack(order + "h", head[:2])[0]
-        if version in _IBW_HEADERS:
-            break
-    else:
-        raise AFMFileError(f"{path}: not an Igor binary wave (version field {head[:2].hex()}; known: 1, 2, 3, 5)")
-    layout, names = _IBW_HEADERS[version]
-    fmt = order + layout
-    need = 2 + struct.calcsize(fmt)
-    if len(head) < need:
-        raise AFMFileError(f"{path}: an Igor binary wave header of {need} bytes cut short at {len(head)} bytes")
-    fields = struct.unpack(fmt, head[2:need])
-    sizes = dict(zip(names, fields[1:] if version == 5 else fields))
-    bad = {k: v for k, v in sizes.items() if v < 0}
-    declared = sum(v for v in sizes.values() if v > 0)
-    if bad or need + declared > size:
-        what = (f"negative sizes ({', '.join(f'{k} = {v}' for k, v in bad.items())})" if bad else
-                f"{declared} bytes of parts ({', '.join(f'{k} = {v}' for k, v in sizes.items() if v)})")
-        raise AFMFileError(f"{path}: the Igor binary wave header declares {what} in a file of {size} bytes: "
-                           f"damaged, not read")
 
 
 @contextmanager

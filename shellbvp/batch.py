@@ -11,7 +11,6 @@ writes one row per file (CSV, units in the header, written atomically).
 from __future__ import annotations
 
 import csv
-import dataclasses
 import glob
 import io
 import logging
@@ -21,8 +20,11 @@ from pathlib import Path
 
 import numpy as np
 
+from . import readers
 from .afm_read import AFMCurve
-from .map_fit import fit_pixels, read_pixels, record_depth
+from .map_fit import finish, fit_pixels, read_pixels, record_depth
+from .map_pixels import curve_rows, rows_per_curve
+from .scene_parameters import LiveNames
 from .shape_parameters import DERIVED, SHAPE_PARAMETERS
 from .textdata import table_cell
 
@@ -31,8 +33,9 @@ log = logging.getLogger(__name__)
 __all__ = ["BatchRow", "fit_files", "fit_records", "fit_map", "shared_curves", "read_record", "expand_inputs", "write_table",
            "TABLE_COLUMNS", "DATA_SUFFIXES"]
 
-#: File names a directory given as input contributes (instrument exports are text tables).
-DATA_SUFFIXES = (".csv", ".tsv", ".txt", ".dat", ".jpk-force", ".ibw")  # AFM single curves: shellbvp.afm
+#: The file name endings a directory given as input contributes: each reader's
+#: (:mod:`shellbvp.readers`; text tables, AFM single curves)
+DATA_SUFFIXES = readers.folder_suffixes()
 
 
 def _with_unit(name, unit):
@@ -45,12 +48,13 @@ def _estimate_columns(name, unit):
 
 #: Columns of the results table, with their units: a shape parameter's and its derived
 #: quantities' (:mod:`shellbvp.shape_parameters`) are filled where it was fitted.
-TABLE_COLUMNS = ("file", "status", "quality", "model", "model error (1)", "mu_H (N/m)", "mu_H 95% low (N/m)", "mu_H 95% high (N/m)", "offset (m)",
-                 "offset 95% low (m)", "offset 95% high (m)", "baseline (N)", "baseline 95% low (N)",
-                 "baseline 95% high (N)", "baseline slope (N/m)", "baseline model",
-                 *(c for p in SHAPE_PARAMETERS.values() for c in _estimate_columns(p.name, p.unit)),
-                 *(c for d in DERIVED.values() for c in _estimate_columns(d.name, d.unit)),
-                 "residual rms (N)", "points", "segment", "warnings", "message", "sha256")
+TABLE_COLUMNS = LiveNames(lambda: (
+    "file", "status", "quality", "model", "model error (1)", "mu_H (N/m)", "mu_H 95% low (N/m)", "mu_H 95% high (N/m)",
+    "offset (m)", "offset 95% low (m)", "offset 95% high (m)", "baseline (N)", "baseline 95% low (N)",
+    "baseline 95% high (N)", "baseline slope (N/m)", "baseline model",
+    *(c for p in SHAPE_PARAMETERS.values() for c in _estimate_columns(p.name, p.unit)),
+    *(c for d in DERIVED.values() for c in _estimate_columns(d.name, d.unit)),
+    "residual rms (N)", "points", "segment", "warnings", "message", "sha256"))
 
 
 @dataclass
@@ -68,6 +72,11 @@ class BatchRow:
     used : ndarray of bool or None
         The rows fitted.
     message : str
+    extra : dict
+        More columns of its table row (a map's: the file's ``sha256``, a pixel table's value).
+    curve_rows : CurveRows or None
+        A force map's row (:func:`fit_map`, which keeps no ``record``): the rows fitted, thinned,
+        with the model at them (:class:`shellbvp.map_pixels.CurveRows`), for the pixel's view.
     """
 
     file: str
@@ -77,6 +86,7 @@ class BatchRow:
     used: object = None
     message: str = ""
     extra: dict = field(default_factory=dict)
+    curve_rows: object = None
 
     def table_row(self, segment: str) -> dict:
         """This file's row of the results table (:data:`TABLE_COLUMNS`)."""
@@ -107,8 +117,8 @@ class BatchRow:
         for name, p in SHAPE_PARAMETERS.items():
             if name in r.fitted:
                 put(name, r.shape_values[name], r.shape_ci95[name], p.unit)
-        if "thickness" not in r.fitted and r.thickness is not None:
-            put("thickness", r.thickness, None, "m")  # given: exact, no interval
+        if "thickness" not in r.fitted and r.thickness is not None:  # given: exact, no interval; H in m
+            put("thickness", r.thickness, None, SHAPE_PARAMETERS["thickness"].unit)
         for name, e in r.derived.items():  # a fitted parameter's, and mu and E of a given thickness
             put(name, e.value, e.ci95, e.unit)
         row["quality"] = r.quality
@@ -126,8 +136,9 @@ def _num(v):
 
 
 def expand_inputs(inputs) -> list:
-    """File names from files, directories (their files ending in :data:`DATA_SUFFIXES`,
-    sorted) and glob patterns (for shells that do not expand them); order kept, no repeats.
+    """File names from files, directories (their files ending as the readers take them in a folder,
+    :func:`shellbvp.readers.folder_suffixes`, sorted) and glob patterns (for shells that do not
+    expand them); order kept, no repeats.
 
     Raises
     ------
@@ -140,9 +151,10 @@ def expand_inputs(inputs) -> list:
         if p.is_dir():
             # every entry named like data, files or not: a FIFO, a folder named x.csv or a
             # symlink loop gets its own row saying why it was not read, instead of vanishing
-            found = sorted(q for q in p.iterdir() if q.suffix.lower() in DATA_SUFFIXES)
+            taken = readers.folder_suffixes()
+            found = sorted(q for q in p.iterdir() if q.suffix.lower() in taken)
             if not found:
-                raise ValueError(f"{item}: a directory without data files ({', '.join(DATA_SUFFIXES)})")
+                raise ValueError(f"{item}: a directory without data files ({', '.join(taken)})")
             out += [str(q) for q in found]
         elif p.exists():
             out.append(str(p))
@@ -225,20 +237,13 @@ def fit_files(scene, paths, *, R_L, segment="loading", baseline="auto", columns=
 
 
 def read_record(path, *, columns=None, units=None, invert=(), spring_constant=None, sensitivity=None):
-    """One record from a file: an AFM curve through afmformats (:mod:`shellbvp.afm`; an AFM
-    text export with the cantilever's ``spring_constant`` and ``sensitivity``), a text export
-    through :func:`shellbvp.instrument.read_instrument`.  A force map is refused here (it is
+    """One record from a file, read by its reader (:func:`shellbvp.readers.read_record`): an AFM
+    curve through afmformats (:mod:`shellbvp.afm`; an AFM text export with the cantilever's
+    ``spring_constant`` and ``sensitivity``), a text export as
+    :func:`shellbvp.instrument.read_instrument` reads it.  A force map is refused here (it is
     fitted on its own: :func:`fit_map`)."""
-    from .afm import is_afm_file, single_curve
-    from .instrument import read_instrument
-
-    if is_afm_file(path):
-        return single_curve(path, columns=columns, units=units, invert=invert, spring_constant=spring_constant,
-                            sensitivity=sensitivity)
-    if spring_constant is not None or sensitivity is not None:
-        raise ValueError(f"{path}: not an AFM file: --spring-constant and --sensitivity are for AFM text exports "
-                         f"(AFM Workshop, NT-MDT)")
-    return read_instrument(path, columns=columns, units=units, invert=invert)
+    return readers.read_record(path, columns=columns, units=units, invert=invert, spring_constant=spring_constant,
+                               sensitivity=sensitivity)
 
 
 def fit_records(scene, named, *, R_L, segment="loading", baseline="auto", on_file=None, **options) -> list:
@@ -297,8 +302,10 @@ def fit_map(scene, curves, *, R_L, path=None, segment="loading", baseline="auto"
     depth share one model curve (as :func:`fit_records`), and their fits run together on it in
     chunks (:func:`shellbvp.map_fit.fit_pixels`, :mod:`shellbvp.fitting.batched`): a map costs
     about one model curve plus a cheap least-squares fit per curve, its results per curve the
-    same as one :func:`shellbvp.fitting.fit_record` each.  The rows keep each fit's numbers, not
-    the records (``BatchRow.record`` and ``used`` are None; the file's checksum is in ``extra``).
+    same as one :func:`shellbvp.fitting.fit_record` each.  The rows keep each fit's numbers and
+    its fitted rows thinned with the model at them (``BatchRow.curve_rows``: what the map file
+    keeps for a pixel's view, :mod:`shellbvp.map_pixels`), not the records (``BatchRow.record``
+    and ``used`` are None; the file's checksum is in ``extra``).
 
     With ``pixel_values`` (a :class:`shellbvp.pixel_table.PixelTable`: a shape parameter per
     pixel, e.g. the thickness from :func:`shellbvp.pixel_table.read_pixel_table`) each pixel's
@@ -325,8 +332,10 @@ def fit_map(scene, curves, *, R_L, path=None, segment="loading", baseline="auto"
             return _fit_map_per_pixel(scene, pixels, store, shape, pixel_values, R_L=R_L, path=path,
                                       segment=segment, on_curve=on_curve, settings=settings, **options)
         fitted, rows = fit_pixels(scene, pixels, store, R_L=R_L, **options), []
-        for p in pixels:  # the fits come in the pixels' order
-            rows.append(_map_row(p, next(fitted)[1] if p.rows is not None else None))
+        budget = rows_per_curve(len(pixels))
+        for p in pixels:  # the fits come in the pixels' order, with their rows
+            res, data = next(fitted)[1:] if p.rows is not None else (None, None)
+            rows.append(_map_row(p, res, data, budget))
             if on_curve is not None:
                 on_curve(rows[-1])
     finally:
@@ -337,17 +346,20 @@ def fit_map(scene, curves, *, R_L, path=None, segment="loading", baseline="auto"
                     settings=settings, sha256=sha)
 
 
-def _map_row(pixel, res, extra=None):
+def _map_row(pixel, res, data, budget, extra=None, message=None):
     """A map's :class:`BatchRow` of ``pixel`` and its fit (a FitResult or the ValueError; None:
-    its segment could not be read, ``pixel.error``)."""
+    its segment could not be read, ``pixel.error``, or ``message`` says why it was not fitted),
+    with its fitted rows ``data`` (``(d, f)``, or None) thinned to ``budget`` rows."""
     extra = {"sha256": pixel.sha256, **(extra or {})}
     if res is None:
-        row = BatchRow(file=pixel.name, status="error", message=pixel.error, extra=extra)
+        row = BatchRow(file=pixel.name, status="error", message=message or pixel.error, extra=extra)
     elif isinstance(res, Exception):
         row = BatchRow(file=pixel.name, status="error", message=" ".join(str(res).split()), extra=extra)
     else:
         row = BatchRow(file=pixel.name, status="ok" if res.success else "failed", result=res, message=res.message,
                        extra=extra)
+    if data is not None:
+        row.curve_rows = curve_rows(*data, res if row.status != "error" else None, budget)
     log.info("map: %s: %s", pixel.name, row.status)
     return row
 
@@ -359,9 +371,8 @@ MAX_PIXEL_CURVES = 40
 def _pixel_values_checked(scene, curves, shape, table, R_L, options):
     """``{(ix, iy): x}``: the table's nondimensional values, each checked against the scene and
     the map (ValueError naming the table's line otherwise)."""
-    from .shape_parameters import shape_parameter
-
-    from .shape_parameters import SHAPE_PARAMETERS
+    from .scene_parameters import scene_parameter
+    from .shape_parameters import SHAPE_PARAMETERS, shape_parameter
 
     if options.get("free") or any(options.get(f"fit_{name}") for name in SHAPE_PARAMETERS):
         raise ValueError(f"a map with {table.name} per pixel fits mu*H, the offset and the baseline on the "
@@ -371,8 +382,8 @@ def _pixel_values_checked(scene, curves, shape, table, R_L, options):
         raise ValueError(f"curve {missing_grid[0]} of the map has no grid index: a pixel table needs every "
                          f"curve's (ix, iy)")
     nx, ny = shape
-    param = shape_parameter(table.name)
-    if table.name != "thickness":  # a given thickness needs no start value in the scene
+    param, declared = shape_parameter(table.name), scene_parameter(table.name)
+    if declared.material:  # the scene's material must have it (a given thickness needs no start value)
         why = param.unavailable(scene)
         if why:
             raise ValueError(f"{table.path}: {why}")
@@ -383,7 +394,7 @@ def _pixel_values_checked(scene, curves, shape, table, R_L, options):
         given = f"{table.column} = {table.values[pixel]:g}"
         if not (math.isfinite(x) and param.low_ok(x) and param.high_ok(x)):
             raise ValueError(f"{table.where(pixel)}: {given} is out of the range of {param.description}"
-                             + (f" (H/R_L = {x:.4g}, R_L = {R_L:g} m)" if table.unit else ""))
+                             + (f" ({declared.symbol} = {x:.4g}, R_L = {R_L:g} m)" if table.unit else ""))
         try:
             param.set(scene, x)
         except ValueError as exc:
@@ -474,27 +485,25 @@ def _fit_map_per_pixel(scene, pixels, store, shape, table, *, R_L, path, segment
         grid = dm * np.arange(1, N_DEPTHS + 1) / N_DEPTHS
         shared = shared_curves(scene, table.name, [xs[p.curve.grid] for p in inside], grid, need, tol,
                                progress=progress)
-    out = []
+    out, budget = [], rows_per_curve(len(pixels))
     for p in pixels:
         grid_at = p.curve.grid
+        data = store.get(p.rows) if p.rows is not None else None
         if grid_at not in xs:
-            row = BatchRow(file=p.name, status="error", message=f"pixel {grid_at} is not in the pixel table "
-                           f"{table.path}", extra={"sha256": p.sha256})
+            row = _map_row(p, None, data, budget, message=f"pixel {grid_at} is not in the pixel table {table.path}")
         else:
             x = xs[grid_at]
             res = None
-            if p.rows is not None:
+            if data is not None:
                 try:
                     if shared is None:
                         raise ValueError("no depth of indentation could be read from any curve of the map")
-                    d, f = store.get(p.rows)
-                    res = fit(param.set(scene, x), d, f, R_L=R_L, baseline=p.baseline, contact_guess=p.guess,
+                    res = fit(param.set(scene, x), *data, R_L=R_L, baseline=p.baseline, contact_guess=p.guess,
                               shared=(shared, param.to_theta(x)), tol=tol, **options)
-                    res = dataclasses.replace(res, point_weights=None, warnings=res.warnings + [t for _, t in p.warnings],
-                                              warning_codes=res.warning_codes + [c for c, _ in p.warnings])
+                    res = finish(res, p)
                 except ValueError as exc:
                     res = exc
-            row = _map_row(p, res, {_pixel_column(param): _num(param.reported(x, R_L))})
+            row = _map_row(p, res, data, budget, {_pixel_column(param): _num(param.reported(x, R_L))})
         out.append(row)
         if on_curve is not None:
             on_curve(row)

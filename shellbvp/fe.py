@@ -247,7 +247,10 @@ def coarser(settings):
 
 def check_solid_scene(scene):
     """ValueError, in one line, where the scene has no solid here (before any work): a material
-    without a 3D form."""
+    without a 3D form, a closed shell."""
+    if scene.closed:
+        raise ValueError("the 3D reference holds a shell on its rim; a closed shell (support=substrate/plates) "
+                         "has no solid yet")
     _check_material(scene)
 
 

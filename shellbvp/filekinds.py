@@ -18,7 +18,8 @@ _READ_BY = {
     "curve": "`shellbvp info` lists its points, `shellbvp plot` draws it",
     "sweep": "`shellbvp info` lists its curves, `shellbvp plot` draws them",
     "fit": "`shellbvp info`, `shellbvp plot` and `shellbvp report` read it",
-    "force-map": "`shellbvp info` summarises it, `shellbvp plot` and `shellbvp report` draw its image of mu*H",
+    "force-map": "`shellbvp info` summarises it, `shellbvp plot` and `shellbvp report` draw its image of mu*H, "
+                 "`shellbvp plot --pixel IX,IY` one pixel's fit",
     "validation": "`shellbvp info` prints its comparison, `shellbvp plot` and `shellbvp report` draw it",
 }
 

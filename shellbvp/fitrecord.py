@@ -61,6 +61,7 @@ import numpy as np
 from .fit_checks import weights_check_line
 from .nexus import DIMENSIONLESS, number_dataset, string_dataset
 from .paths import atomic_hdf5, check_output_path, open_hdf5
+from .scene_parameters import LiveMapping
 from .shape_parameters import DERIVED, SHAPE_PARAMETERS
 from .version import __version__
 
@@ -76,8 +77,8 @@ _FIT_UNITS = {"mu_H": "N/m", "offset": "m", "baseline": "N", "baseline_slope": "
               "max_depth": "m", "max_force": "N"}
 #: Units of the scalar parameters in ``/fit/parameters``: the fit's own, every shape parameter's and
 #: every derived quantity's (:mod:`shellbvp.shape_parameters`).
-PARAMETER_UNITS = {**_FIT_UNITS, **{p.name: p.unit for p in SHAPE_PARAMETERS.values()},
-                   **{d.name: d.unit for d in DERIVED.values()}}
+PARAMETER_UNITS = LiveMapping(lambda: {**_FIT_UNITS, **{p.name: p.unit for p in SHAPE_PARAMETERS.values()},
+                                       **{d.name: d.unit for d in DERIVED.values()}})
 #: Parameters every file of format version 1 holds; the others (later additions) read as NaN when absent.
 _REQUIRED_PARAMETERS = ("mu_H", "offset", "baseline", "baseline_slope", "beta", "alpha", "R_L", "residual_rms",
                         "n_points")

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import math
 
-__all__ = ["Spheroid", "SphereTip", "UserShell", "UserTip"]
+__all__ = ["Spheroid", "SphereTip", "FlatTip", "UserShell", "UserTip"]
 
 
 class Spheroid:
@@ -76,6 +76,45 @@ class SphereTip:
 
     def __hash__(self):
         return hash("sphere")
+
+
+class FlatTip:
+    """A flat rigid plate ``A = omega``, ``B = 0``: an indenter wider than the contact, or the
+    plates a closed shell is compressed between (``Scene(closed=True, support="plates")``).
+
+    It has no radius: a scene with a flat tip holds ``rho = 1`` (the plate's length scale,
+    ``r = rho omega``), and it meets a shell at the pole first only where the shell is a dome
+    (a closed shell, or ``gamma < 0``).  It has no end (no wall contact); it is followed up to
+    ``r = 2 pi``, six times the shell's radius.
+
+    Examples
+    --------
+    >>> import shellbvp as sb
+    >>> scene = sb.Scene(closed=True, gamma=1.0, tip=sb.FlatTip(), support="plates", beta=1e-4)
+    >>> scene.rho, sb.FlatTip().apex_curvature()
+    (1.0, 0.0)
+    """
+
+    kind = "flat"
+    # a plate has no end; tabulated, like a user tip without one, up to omega = 2 pi (r = 2 pi rho)
+    omega_max = 2 * math.pi
+
+    def description(self):
+        """The structural choice, as files store it."""
+        return {"kind": "flat"}
+
+    def apex_curvature(self):
+        """B''(0)/A'(0)^2: 0, a plane."""
+        return 0.0
+
+    def __repr__(self):
+        return "FlatTip()"
+
+    def __eq__(self, other):
+        return isinstance(other, FlatTip)
+
+    def __hash__(self):
+        return hash("flat")
 
 
 class UserShell:

@@ -25,7 +25,7 @@ from .fitting.batched import batchable, fit_batch
 from .fitting.fit_data import record_rows, segment_warnings
 from .instrument import estimate_contact
 
-__all__ = ["CHUNK", "Pixel", "RowStore", "read_pixels", "fit_pixels", "record_depth", "pixel_delta_max"]
+__all__ = ["CHUNK", "Pixel", "RowStore", "read_pixels", "fit_pixels", "finish", "record_depth", "pixel_delta_max"]
 
 #: Pixels fitted together (and the most whose rows are in memory at once)
 CHUNK = 256
@@ -100,15 +100,14 @@ def read_pixels(curves, path, *, R_L, segment="loading", baseline="auto", fit_of
         try:
             if rec is None:
                 raise ValueError(f"{px.name}: the curve has no record")
-            # a loading segment's contact estimate is the record's own (made when it was read)
-            known = segment == "loading" and np.count_nonzero(rec.mask(segment)) >= 3
-            if known:
-                est = rec.contact_estimate
-                d = rec.displacement[rec.mask(segment)]
+            # the contact estimated once from the segment's rows, as fit_record estimates it (not
+            # the record's own estimate: a record whose force was changed keeps its old one)
+            used = rec.mask(segment)
+            d = rec.displacement[used]
+            est = estimate_contact(d, rec.force[used]) if d.size >= 3 else None
+            if d.size:
                 px.depth = (np.max(d) - (est if est is not None else min(0.0, np.min(d)))) / R_L
-            else:
-                px.depth = record_depth(rec, segment, R_L)
-            rows = record_rows(rec, segment, baseline, fit_offset, rec.contact_estimate if known else "find")
+            rows = record_rows(rec, segment, baseline, fit_offset, est)
             px.rows = store.add(rows.d, rows.f)
             px.baseline, px.guess = rows.baseline, rows.guess
             px.warnings = segment_warnings(rec, segment, rows.used)
@@ -131,7 +130,8 @@ def pixel_delta_max(pixels, delta_max=None) -> list:
 
 
 def fit_pixels(scene, pixels, store, *, R_L, chunk=CHUNK, **options):
-    """``(pixel, FitResult or ValueError)`` for every pixel with rows, in order, fitted in chunks
+    """``(pixel, FitResult or ValueError, (d, f))`` for every pixel with rows (``d``, ``f``: its
+    fitted rows, m and N), in order, fitted in chunks
     of ``chunk``: together where :func:`~shellbvp.fitting.batched.batchable`, else one
     :func:`~shellbvp.fitting.fit` each; the result's segment warnings added and its per-point
     weights dropped."""
@@ -152,8 +152,11 @@ def fit_pixels(scene, pixels, store, *, R_L, chunk=CHUNK, **options):
                                        delta_max=dm, **options))
                 except ValueError as exc:
                     results.append(exc)
-        for (p, _), res in zip(part, results):
-            if not isinstance(res, Exception):
-                res = dataclasses.replace(res, point_weights=None, warnings=res.warnings + [t for _, t in p.warnings],
-                                          warning_codes=res.warning_codes + [c for c, _ in p.warnings])
-            yield p, res
+        for (p, _), res, rows in zip(part, results, data):
+            yield p, res if isinstance(res, Exception) else finish(res, p), rows
+
+
+def finish(res, pixel):
+    """A map's FitResult of ``pixel``: its segment warnings added, its per-point weights dropped."""
+    return dataclasses.replace(res, point_weights=None, warnings=res.warnings + [t for _, t in pixel.warnings],
+                               warning_codes=res.warning_codes + [c for c, _ in pixel.warnings])

@@ -1,11 +1,13 @@
 """A force map's geometry per pixel, from a table (issue 46, item 3).
 
 A CSV (or any table :func:`shellbvp.instrument.read_table` reads) with the columns ``ix`` and
-``iy`` (the pixel on the map's grid, integers from 0) and ONE geometry column, named by a shape
-parameter of :data:`PIXEL_PARAMETERS` with its unit the way the package's tables write units:
+``iy`` (the pixel on the map's grid, integers from 0) and ONE geometry column, named by a
+parameter of :data:`PIXEL_PARAMETERS` (those of :mod:`shellbvp.scene_parameters` flagged
+``per_pixel``) with its unit the way the package's tables write units:
 
 * ``thickness_um``, ``thickness (um)``, ``thickness [nm]`` ... -- the shell's thickness H, any
-  length unit; a bare ``thickness`` is the nondimensional ``H / R_L`` (as ``--thickness 0.05``);
+  length unit; a bare ``thickness`` is the nondimensional ``H / R_L`` (as ``--thickness 0.05``):
+  a parameter with a lab form over R_L may carry a unit of its kind;
 * ``beta`` -- the bending stiffness ``B/(mu R_L^2)`` (nondimensional);
 * ``alpha`` -- the Mooney-Rivlin alpha (nondimensional; needs a Mooney-Rivlin scene).
 
@@ -21,11 +23,20 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
+from .scene_parameters import LiveMapping, parameters_that, scene_parameter
+
 __all__ = ["PIXEL_PARAMETERS", "PixelTable", "read_pixel_table"]
 
+
+def _unit_kind(p) -> str:
+    """The kind of unit a column of ``p`` may carry: its lab form's when that is a multiple of
+    R_L (a length), else "" (nondimensional only)."""
+    return p.lab.kind if p.lab is not None and p.lab.scale == "R_L" else ""
+
+
 #: Shape parameters a pixel table may give, with the kind of unit their column may carry
-#: ("" : nondimensional only).
-PIXEL_PARAMETERS = {"thickness": "length", "beta": "", "alpha": ""}
+#: ("" : nondimensional only); the registry's, in its order (live).
+PIXEL_PARAMETERS = LiveMapping(lambda: {p.name: _unit_kind(p) for p in parameters_that("per_pixel")})
 
 
 @dataclass
@@ -86,7 +97,8 @@ class PixelTable:
         """``{(ix, iy): x}``: the scene's nondimensional value of every pixel (a length over R_L)."""
         if self._factor is None:
             return dict(self.values)
-        return {p: v * self._factor / R_L for p, v in self.values.items()}
+        param = scene_parameter(self.name)  # a lab value (SI) over its scale, R_L
+        return {p: param.from_lab(v * self._factor, R_L) for p, v in self.values.items()}
 
 
 def read_pixel_table(path) -> PixelTable:
@@ -100,7 +112,8 @@ def read_pixel_table(path) -> PixelTable:
         >= 0, a value that is not a finite number > 0 (alpha: >= 0), a pixel given twice.
     """
     from .afm_read import MAX_MAP_PIXELS
-    from .instrument import cell_number, header_name_and_unit, read_table
+    from .readers import read_table
+    from .readers.text_table import cell_number, header_name_and_unit
 
     # at most one row per cell of the largest map; checked against the map's own grid by fit_map
     table = read_table(path, max_rows=MAX_MAP_PIXELS, what="pixel table (one row per pixel, MAX_MAP_PIXELS)")
@@ -127,6 +140,7 @@ def read_pixel_table(path) -> PixelTable:
     if unit == "1":
         unit = ""
     kind = PIXEL_PARAMETERS[name]
+    param = scene_parameter(name)
     if unit:
         from .units import unit_kind
 
@@ -149,9 +163,9 @@ def read_pixel_table(path) -> PixelTable:
             pixel.append(int(v))
         pixel = tuple(pixel)
         v = cell_number(cells[g])
-        if v is None or not math.isfinite(v) or not (v >= 0 if name == "alpha" else v > 0):
-            raise ValueError(f"{where}: column {table.header[g]!r} must be a finite number "
-                             f"{'>= 0' if name == 'alpha' else '> 0'}; got {cells[g]!r}")
+        if v is None or not math.isfinite(v) or not param.low_ok(v):  # the upper bound: against R_L (fit_map)
+            bound = "" if param.low == -math.inf else f" {'>' if param.low_open else '>='} {param.low:g}"
+            raise ValueError(f"{where}: column {table.header[g]!r} must be a finite number{bound}; got {cells[g]!r}")
         if pixel in values:
             raise ValueError(f"{where}: pixel {pixel} again (first on line {lines[pixel]})")
         values[pixel], lines[pixel] = v, line

@@ -3,7 +3,8 @@
 * :func:`plot_curves` -- force against displacement, several curves overlaid;
 * :func:`plot_profiles` -- deformed meridians r(z) at chosen depths with the
   indenter and the undeformed shell dashed (as in the paper's figures);
-* :func:`plot_fit` -- measured data, the fitted model and its 95 % band.
+* :func:`plot_fit` -- measured data, the fitted model and its 95 % band;
+* :func:`plot_map_pixel` -- one pixel of a force map: its data, model and residuals.
 """
 
 from __future__ import annotations
@@ -16,7 +17,7 @@ from .fitting import diagnostics_lines
 from .fitting.apparent import apparent_modulus
 from .thickness import model_error_line
 
-__all__ = ["plot_curves", "plot_profiles", "plot_fit", "plot_fit_record", "plot_apparent_modulus", "record_apparent_modulus", "fit_report", "fit_summary_lines",
+__all__ = ["plot_curves", "plot_profiles", "plot_fit", "plot_fit_record", "plot_map_pixel", "map_pixel_notes", "plot_apparent_modulus", "record_apparent_modulus", "fit_report", "fit_summary_lines",
            "require_matplotlib", "scene_label", "save_figure"]
 
 
@@ -197,6 +198,78 @@ def plot_fit_record(record, axes=None):
     axr.set_ylabel("model - data")
     axr.set_xlabel("displacement")
     return ax, axr
+
+
+def plot_map_pixel(pixel, axes=None):
+    """One pixel of a force map (:class:`shellbvp.map_pixels.MapPixel`) in SI units: on the left
+    its fitted rows and the fitted model at them, on the right the same around the contact
+    (from one contact depth before the fitted contact point to the deepest row), below each the
+    residuals (model - data); the right's abscissa is the depth beyond the fitted contact point
+    (the displacement where there is no fit).  The title gives the pixel, the fit's status and rating, the legend
+    mu*H and its 95 % interval; :func:`map_pixel_notes` the message and warnings.
+
+    Parameters
+    ----------
+    pixel : MapPixel
+        With its rows (``displacement`` not None).
+    axes : 2 x 2 array of Axes, optional
+        ``[[data, data near contact], [residuals, residuals near contact]]`` (default: a new figure).
+
+    Returns
+    -------
+    ndarray of Axes, shape (2, 2)
+    """
+    plt = require_matplotlib()
+    from matplotlib.ticker import MaxNLocator
+
+    if axes is None:
+        _, axes = plt.subplots(2, 2, figsize=(10, 6.2), sharex="col", gridspec_kw={"height_ratios": [3, 1]})
+    axes = np.asarray(axes).reshape(2, 2)
+    d, f, m = pixel.displacement, pixel.force, pixel.model_force
+    order = np.argsort(d, kind="stable")
+    fitted = np.isfinite(m)
+    shown = f"{d.size} of {pixel.rows_fitted} rows" if d.size < (pixel.rows_fitted or 0) else f"{d.size} rows"
+    depth = np.max(d) - pixel.offset if np.isfinite(pixel.offset) else np.nan
+    near = (d >= pixel.offset - depth) if np.isfinite(depth) and depth > 0 else np.ones(d.size, bool)
+    zero = pixel.offset if np.isfinite(depth) else 0.0  # the right: depth beyond the fitted contact point
+    for col, (keep, x) in enumerate(((np.ones(d.size, bool), d), (near, d - zero))):
+        ax, axr = axes[0, col], axes[1, col]
+        ax.plot(x[keep], f[keep], "k.", ms=2, label=f"data ({shown} fitted)" if col == 0 else None)
+        line = order[keep[order] & fitted[order]]
+        if line.size:
+            lo, hi = pixel.mu_H_ci95
+            ax.plot(x[line], m[line], "-", color="C3",
+                    label=f"model: mu*H = {pixel.mu_H:.4g} N/m, 95% CI [{lo:.4g}, {hi:.4g}]" if col == 0 else None)
+            ax.axvline(pixel.offset - (zero if col else 0.0), color="0.5", lw=0.6, ls=":",
+                       label="contact point" if col == 0 else None)
+            axr.axhline(0, color="0.6", lw=0.6)
+            axr.plot(x[keep & fitted], (m - f)[keep & fitted], "k.", ms=2)
+        _si_axis(ax, "y", "N")
+        _si_axis(axr, "y", "N")
+        _si_axis(axr, "x", "m")
+        axr.xaxis.set_major_locator(MaxNLocator(5))
+    axes[1, 0].set_xlabel("displacement")
+    axes[1, 1].set_xlabel("depth beyond the fitted contact point" if np.isfinite(depth) else "displacement")
+    axes[0, 0].set_ylabel("force")
+    axes[1, 0].set_ylabel("model - data")
+    axes[0, 0].legend(fontsize=7, loc="upper left")
+    verdict = {"ok": "fit", "failed": "FAILED fit", "error": "no fit (error)"}.get(pixel.status, pixel.status)
+    rating = f", quality {pixel.quality}" if pixel.quality else ""
+    axes[0, 0].figure.suptitle(f"{printable(str(pixel.source).split('/')[-1])}: pixel {pixel.grid} (curve "
+                               f"{pixel.index}): {verdict}{rating}", fontsize=10)
+    return axes
+
+
+def map_pixel_notes(pixel, width=120) -> str:
+    """The lines under a pixel's figure: its fit's message (where it did not succeed) and the kinds
+    of its warnings, wrapped to ``width`` characters (text from the file escaped)."""
+    import textwrap
+
+    lines = [] if pixel.status == "ok" else [f"{pixel.status}: {printable(pixel.message)}"]
+    if pixel.warning_codes:
+        lines.append("warnings: " + ", ".join(printable(c) for c in pixel.warning_codes)
+                     + " (shellbvp.fit_checks.FIT_WARNINGS)")
+    return "\n".join(textwrap.fill(ln, width) for ln in lines)
 
 
 def record_apparent_modulus(record):

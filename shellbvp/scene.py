@@ -14,17 +14,21 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from .geometry import SphereTip, Spheroid, UserShell, UserTip
+from .geometry import FlatTip, SphereTip, Spheroid, UserShell, UserTip
 from .materials import MATERIALS, Bending, Gent, Material, MooneyRivlin, TraceBending
 from .model import load_module, structure_description
+from .scene_parameters import scene_parameter
 
-__all__ = ["Scene", "PRESETS", "CONTACT_MODELS", "RIMS"]
+__all__ = ["Scene", "PRESETS", "CONTACT_MODELS", "RIMS", "SUPPORTS"]
 
 CONTACT_MODELS = ("smooth", "paper")
 #: What is held at the rim S = L besides its circle (lambda_theta = 1, z = 0): ``pinned``
 #: leaves the rotation free (M_s = 0), ``clamped`` holds the slope at the reference's,
 #: phi(L) = Phi(L).
 RIMS = ("pinned", "clamped")
+#: What a closed shell rests on: a rigid plane below it (``substrate``) or a second plate,
+#: moving towards the first (``plates``); a shell held on its rim has support ``rim``.
+SUPPORTS = ("substrate", "plates")
 
 
 def _finite(name, value):
@@ -93,6 +97,16 @@ class Scene:
         reference's, ``phi(L) = Phi(L)``).  Clamped is offered for the shell under pressure
         before contact (:func:`shellbvp.inflate` and its :func:`shellbvp.stability`); a solve in
         contact refuses it.
+    closed : bool
+        A complete spheroid instead of a shell held on its rim (a cell, a capsule, a pollen
+        grain): ``gamma`` is then its polar over its equatorial semi-axis (> 0) and lengths are
+        in units of its equatorial radius (``R_L``).  Default False.
+    support : {"substrate", "plates"}, optional
+        What a closed shell rests on (default ``"substrate"``, a rigid frictionless plane) or
+        ``"plates"`` (compressed between two parallel plates); delta is the approach of the
+        indenter and the support.  Both are solved on the half above the equator (symmetry:
+        the equator stays vertical, free to move out, and moves by delta/2), which needs a
+        ``FlatTip()`` on top; a curved tip on a substrate is not offered yet.
 
     Raises
     ------
@@ -133,19 +147,20 @@ class Scene:
     thickness: float = None
     transverse_shear: bool = False
     rim: str = "pinned"
+    closed: bool = False
+    support: str = None
 
     def __post_init__(self):
+        # the ranges and their errors are the registry's (shellbvp.scene_parameters)
         rho = _finite("rho", self.rho)
-        if rho <= 0:
-            raise ValueError(f"rho (indenter radius / rim radius) must be > 0; got {self.rho!r}")
+        scene_parameter("rho").check(rho, shown=self.rho)
         if not isinstance(self.bending, Bending):
             raise ValueError(f"bending must be TraceBending(), RotationBending() or BendingEnergy(...); "
                              f"got {self.bending!r}")
         beta = self.beta
         if self.thickness is not None:
-            eps = _finite("thickness", self.thickness)
-            if not 0 < eps <= 0.5:
-                raise ValueError(f"thickness (H / R_L) must be in (0, 0.5]; got {self.thickness!r}")
+            eps = _finite("thickness", self.thickness)  # H / R_L: the scene's unit (its lab form H = eps R_L)
+            scene_parameter("thickness").check(eps, shown=self.thickness)
             from .units import beta_from_thickness
 
             from_eps = beta_from_thickness(eps, 1.0, self.bending)
@@ -155,8 +170,7 @@ class Scene:
             beta = from_eps
             object.__setattr__(self, "thickness", eps)
         beta = _finite("beta", 0.01 if beta is None else beta)
-        if beta <= 0:
-            raise ValueError(f"beta (bending stiffness) must be > 0; got {self.beta!r}")
+        scene_parameter("beta").check(beta, shown=self.beta)
         gamma = _finite("gamma", self.gamma)
         if self.xi not in (0, 1) or isinstance(self.xi, bool):
             raise ValueError(f"xi must be 0 or 1; got {self.xi!r}")
@@ -168,10 +182,13 @@ class Scene:
         self.material.validate()
         if not isinstance(self.shell, (Spheroid, UserShell)):
             raise ValueError(f"shell must be Spheroid() or UserShell(...); got {self.shell!r}")
-        if not isinstance(self.tip, (SphereTip, UserTip)):
-            raise ValueError(f"tip must be SphereTip() or UserTip(...); got {self.tip!r}")
+        if not isinstance(self.tip, (SphereTip, FlatTip, UserTip)):
+            raise ValueError(f"tip must be SphereTip(), FlatTip() or UserTip(...); got {self.tip!r}")
+        if isinstance(self.tip, FlatTip):
+            rho = 1.0  # a plate has no radius: rho is its length scale
+        object.__setattr__(self, "support", _support(self, gamma))
         # First contact at the pole: kappa_theta^R(0) < B''(0)/(rho A'(0)^2).
-        k_shell = self.shell.pole_curvature({"gamma": gamma})
+        k_shell = self.shell.pole_curvature({"gamma": -gamma if self.closed else gamma})
         k_tip = self.tip.apex_curvature() / rho
         if not k_shell < k_tip:
             what = "gamma" if isinstance(self.shell, Spheroid) else "the shell's pole curvature"
@@ -255,6 +272,7 @@ class Scene:
             **({"thickness": self.thickness} if self.thickness is not None else {}),
             **({"transverse_shear": True} if self.transverse_shear else {}),
             **({"rim": self.rim} if self.rim != "pinned" else {}),
+            **({"closed": True, "support": self.support} if self.closed else {}),
         }
 
     @classmethod
@@ -298,6 +316,8 @@ class Scene:
         kind = field(tp, "kind", text, "tip.")
         if kind == "sphere":
             tip = SphereTip()
+        elif kind == "flat":
+            tip = FlatTip()
         elif kind == "user":
             tip = UserTip(*(field(tp, k, text, "tip.") for k in "AB"), legacy_srepr=True)
         else:
@@ -312,7 +332,9 @@ class Scene:
                    thickness=field(d, "thickness", number, "") if "thickness" in d else None,
                    transverse_shear=field(d, "transverse_shear", (bool,), "") if "transverse_shear" in d
                    else False,
-                   rim=field(d, "rim", text, "") if "rim" in d else "pinned")
+                   rim=field(d, "rim", text, "") if "rim" in d else "pinned",
+                   closed=field(d, "closed", (bool,), "") if "closed" in d else False,
+                   support=field(d, "support", text, "") if "support" in d else None)
 
     def describe(self, R_L: float | None = None) -> str:
         """The scene in words, one line; with the rim radius ``R_L`` (m) its lengths in lab units.
@@ -337,12 +359,19 @@ class Scene:
         parts = [f"preset {named[0]}" if named else f"preset {extra[0]} with thickness" if extra else "own scene"]
         if isinstance(self.shell, Spheroid):
             rise = f"rise {length(self.gamma)} (gamma {self.gamma:.4g})" if R_L else f"gamma {self.gamma:.4g}"
-            parts.append(f"shell: {self.shell_side()}, {rise}" + (f" on a rim radius of {length(1.0)}" if R_L else ""))
+            if self.closed:
+                rise = (f"polar semi-axis {length(self.gamma)} (gamma {self.gamma:.4g}) on an equatorial radius of "
+                        f"{length(1.0)}" if R_L else f"gamma {self.gamma:.4g} (polar / equatorial semi-axis)")
+            parts.append(f"shell: {self.shell_side()}, {rise}" + (f" on a rim radius of {length(1.0)}"
+                                                                   if R_L and not self.closed else ""))
         else:
             parts.append("shell: user meridian" + (f" on a rim radius of {length(1.0)}" if R_L else ""))
         tip = "sphere" if isinstance(self.tip, SphereTip) else "user tip"
-        parts.append(f"indenter: {tip} of radius {length(self.rho)} (rho {self.rho:.4g})" if R_L
-                     else f"indenter: {tip}, rho {self.rho:.4g}")
+        if isinstance(self.tip, FlatTip):
+            parts.append("indenter: flat plate")
+        else:
+            parts.append(f"indenter: {tip} of radius {length(self.rho)} (rho {self.rho:.4g})" if R_L
+                         else f"indenter: {tip}, rho {self.rho:.4g}")
         if self.thickness is not None:
             parts.append(f"thickness {length(self.thickness) + ' (eps ' if R_L else 'eps '}{self.thickness:.4g}, "
                          f"beta {self.beta:.4g}{')' if R_L else ''}"
@@ -367,6 +396,8 @@ class Scene:
         >>> sb.Scene.preset("fit").shell_side(), sb.Scene.preset("dome").shell_side()
         ('spheroidal bowl (indented from inside)', 'spheroidal dome (indented from outside)')
         """
+        if self.closed:
+            return f"closed spheroid {'between plates' if self.support == 'plates' else 'on a substrate'}"
         if not isinstance(self.shell, Spheroid):
             return "user meridian"
         if self.gamma == 0:
@@ -395,8 +426,10 @@ class Scene:
         return load_module(self.structure())
 
     def values(self) -> dict:
-        """Continuous (run-time) parameters by name."""
-        v = {"beta": self.beta, "rho": self.rho, "gamma": self.gamma, "pressure": self.pressure,
+        """Continuous (run-time) parameters by name (a closed shell's upper half is the dome
+        ``Z = gamma cos S``: its meridian's gamma is ``-gamma``)."""
+        v = {"beta": self.beta, "rho": self.rho, "gamma": -self.gamma if self.closed else self.gamma,
+             "pressure": self.pressure,
              "pole_rise": 0.0}
         v.update(self.material.values())
         return v
@@ -443,6 +476,30 @@ class Scene:
         return float(self.shell.geometry.L)
 
 
+def _support(scene, gamma) -> str:
+    """``Scene.support`` checked: ``rim`` for a shell held on its rim, else one of SUPPORTS."""
+    if not isinstance(scene.closed, (bool, np.bool_)):
+        raise ValueError(f"closed must be True (a complete shell) or False (held on its rim); got {scene.closed!r}")
+    object.__setattr__(scene, "closed", bool(scene.closed))
+    if not scene.closed:
+        if scene.support not in (None, "rim"):
+            raise ValueError(f"support={scene.support!r} needs closed=True; a shell held on its rim has support 'rim'")
+        return "rim"
+    support = "substrate" if scene.support is None else scene.support
+    if support not in SUPPORTS:
+        raise ValueError(f"support must be one of {SUPPORTS} for a closed shell; got {support!r}")
+    if not isinstance(scene.shell, Spheroid):
+        raise ValueError("closed=True needs the built-in spheroid (a user meridian from pole to pole is not offered yet)")
+    if not gamma > 0:
+        raise ValueError(f"gamma (polar / equatorial semi-axis of a closed spheroid) must be > 0; got {gamma!r}")
+    if scene.rim != "pinned":
+        raise ValueError(f"rim={scene.rim!r} holds a rim; a closed shell has none")
+    if not isinstance(scene.tip, FlatTip):
+        raise ValueError(f"a closed shell on support={support!r} is offered under a flat plate only (tip=FlatTip()): "
+                         "a curved tip on a substrate (two different contacts) is not offered yet")
+    return support
+
+
 @functools.lru_cache(maxsize=64)
 def _reference_volume(scene) -> float:
     from scipy.integrate import quad
@@ -485,4 +542,8 @@ PRESETS = {
                        "indenting, under volume control (the pressure rises as it is indented)",
                 "scene": dict(shell=("sin(S)", "cos(S)", "4*pi/5"), rho=0.34, beta=1.55e-3,
                               material=MooneyRivlin(0.1), xi=1, sealed=True)},
+    "capsule-plates": {"doc": "sealed liquid-filled capsule compressed between two plates: a complete sphere, wall "
+                              "eps = H/R = 0.02 (beta 1.33e-4), no pressure before compressing (volume control)",
+                       "scene": dict(closed=True, support="plates", tip=FlatTip(), gamma=1.0, rho=1.0,
+                                     beta=0.02**2 / 3, material=MooneyRivlin(0.1), xi=1, sealed=True)},
 }

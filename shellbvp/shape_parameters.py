@@ -1,4 +1,5 @@
-"""What a fit may fit besides mu*H: the shape parameters, each declared once.
+"""What a fit may fit besides mu*H: the shape parameters, the fit's view of the registry of
+scene parameters (:mod:`shellbvp.scene_parameters`).
 
 mu*H only scales the nondimensional curve F(delta); a shape parameter changes its shape
 (the bending stiffness beta, the Mooney-Rivlin alpha, the pressure below the shell, the
@@ -8,54 +9,24 @@ parameter -- the fit's search, ``FitResult`` and its JSON, the CLI's ``--fit-NAM
 ``--NAME-range``, the batch table, the fit file and its report, the uncertainty of the
 geometry -- iterates over :data:`SHAPE_PARAMETERS`.
 
-To add one: declare a :class:`ShapeParameter` below (how it reads and sets the scene, its
-default search range, its search scale, how it is reported) and add it to the registry;
-then test it.  Its lab-unit quantities that also depend on mu*H (the pressure in Pa) are
-:class:`Derived` quantities, reported with a linearised interval from the fit's covariance.
+To add one: give its :class:`~shellbvp.scene_parameters.SceneParameter` a
+:class:`~shellbvp.scene_parameters.FitSearch` (a scene field's, in
+``shellbvp/scene_parameters.py``), or set ``fit=True`` on a material's
+:class:`~shellbvp.materials.Parameter` (searched over its range); then test it.  Its lab-unit
+quantities that also depend on mu*H (the pressure in Pa) are :class:`Derived` quantities,
+reported with a linearised interval from the fit's covariance.
 """
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 from typing import Callable
 
+from .scene_parameters import Derived, LiveMapping, SceneParameter, parameters_that, scene_with
+
 __all__ = ["ShapeParameter", "Derived", "SHAPE_PARAMETERS", "DERIVED", "shape_parameter"]
-
-
-@dataclass(frozen=True)
-class Derived:
-    """A lab quantity of a fitted shape parameter that depends on mu*H too.
-
-    Its 95 % interval is linearised: the gradient in (mu_H, theta) against the fit's
-    covariance of (mu_H, ..., theta), Student's t (as the Wald intervals of mu*H); with
-    ``log_interval`` the gradient of its logarithm, and the interval ``value * exp(-+ half)``
-    (positive, for a quantity that cannot change sign, such as a ratio).
-
-    Attributes
-    ----------
-    name : str
-        Its key in ``FitResult`` (``res.<name>``, ``res.<name>_ci95``), JSON, the fit file.
-    unit : str
-        SI unit.
-    label, display_unit, note : str
-        How the CLI shows it: ``label = value display_unit   95% CI [..] (note)``.
-    value : callable
-        ``value(x, mu_H, R_L)``: x the parameter's nondimensional value.
-    gradient : callable
-        ``gradient(x, mu_H, R_L) -> (d value / d mu_H, d value / d x)``.
-    log_interval : bool
-        Linearise its logarithm (a positive interval).
-    """
-
-    name: str
-    unit: str
-    label: str
-    display_unit: str
-    note: str
-    value: Callable
-    gradient: Callable
-    log_interval: bool = False
 
 
 @dataclass(frozen=True)
@@ -151,103 +122,31 @@ class ShapeParameter:
         return x if scale == 1.0 else x * scale
 
 
-def _mooney_rivlin():
-    from .materials import MooneyRivlin
+@functools.lru_cache(maxsize=None)
+def _of(p: SceneParameter) -> ShapeParameter:
+    """The fit's declaration of a registered parameter with a :class:`FitSearch`."""
+    f = p.fit
 
-    return MooneyRivlin
+    def set_(scene, x):
+        if f.clamp:
+            x = min(max(x, p.low), p.high)
+        return scene_with(scene, {p.name: float(x)})
 
-
-def _pressure_Pa():
-    return Derived("pressure_Pa", "Pa", "p", "kPa", "p mu_H/R_L; linearised",
-                   value=lambda p, mu_H, R_L: p * mu_H / R_L,
-                   gradient=lambda p, mu_H, R_L: (p / R_L, mu_H / R_L))
-
-
-def _pressure_scale(scene):
-    return 4 * math.sqrt(3 * scene.beta)  # tau = 1 at a pole of unit curvature
-
-
-BETA = ShapeParameter(
-    "beta", "bending stiffness B/(mu R_L^2)",
-    get=lambda scene: float(scene.beta),
-    set=lambda scene, x: scene.replace(beta=x),
-    default_bounds=lambda scene: (1e-4, 1.0),
-    low_ok=lambda v: v > 0, log_scale=True, unit_text="1 (B/(mu R_L^2))",
-    step=lambda scene: math.log(2.0),  # trial values a factor 2 apart
-    fit_help="also fit beta (starting from the scene's; a few more model curves)",
-    range_help="search range of --fit-beta, LOW,HIGH (default 1e-4,1)",
-    sets=("beta",))
-
-ALPHA = ShapeParameter(
-    "alpha", "Mooney-Rivlin alpha",
-    get=lambda scene: float(scene.material.alpha) if isinstance(scene.material, _mooney_rivlin()) else None,
-    set=lambda scene, x: scene.replace(material=_mooney_rivlin()(float(min(max(x, 0.0), 1.0)))),
-    unavailable=lambda scene: None if isinstance(scene.material, _mooney_rivlin()) else (
-        f"fit_alpha needs a Mooney-Rivlin material (alpha); the scene's material is {scene.material.family}"),
-    default_bounds=lambda scene: (0.0, 1.0),
-    low_ok=lambda v: v >= 0, high_ok=lambda v: v <= 1,
-    step=lambda scene: 0.2,
-    fit_help="also fit the Mooney-Rivlin alpha (starting from the scene's)",
-    range_help="search range of --fit-alpha, LOW,HIGH (default 0,1)",
-    sets=("alpha",))
-
-PRESSURE = ShapeParameter(
-    "pressure", "pressure below the shell p R_L/(mu H)",
-    get=lambda scene: float(scene.pressure),
-    set=lambda scene, x: scene.replace(pressure=float(x)),
-    default_bounds=lambda scene: (0.0, max(4 * abs(float(scene.pressure)), 10 * _pressure_scale(scene))),
-    step=lambda scene: max(0.25 * abs(float(scene.pressure)), 0.5 * _pressure_scale(scene)),
-    note="; nondimensional p R_L/(mu H)", unit_text="1 (p R_L/(mu H))",
-    fit_help="also fit the pressure below the shell (turgor, inflation): mu*H and the pressure in Pa "
-             "from one curve; --pressure (nondimensional p R_L/(mu H)) is the start",
-    range_help="search range of --fit-pressure, nondimensional LOW,HIGH (default 0 to the larger of 4x "
-               "the start and 40 sqrt(3 beta))",
-    sets=("pressure",), derived=(_pressure_Pa(),))
+    return ShapeParameter(
+        p.name, f.description or " ".join(t for t in (p.label, p.symbol) if t), get=p.get, set=set_,
+        default_bounds=f.default_bounds, step=f.step, fit_help=f.fit_help, range_help=f.range_help,
+        unavailable=f.unavailable or (lambda scene: None), low_ok=p.low_ok, high_ok=p.high_ok, log_scale=f.log_scale,
+        unit=p.lab.unit if f.report_lab else "1", unit_text="" if f.report_lab or not p.symbol else p.unit_text,
+        report_scale=p.lab.factor if f.report_lab else (lambda R_L: 1.0),
+        display_unit=f.display_unit, unit_kind=p.lab.kind if f.report_lab else "", note=f.note, sets=p.sets,
+        derived=f.derived)
 
 
-def _eps_of_beta(beta, bending):
-    """eps = H/R_L of a bending stiffness, by the package's map (beta is eps^2 times its value at eps = 1)."""
-    from .units import beta_from_thickness
-
-    return math.sqrt(beta / beta_from_thickness(1.0, 1.0, bending))
-
-
-def _modulus(name, factor, note):
-    """``factor * mu*H / H`` (Pa) of a fitted thickness: mu (factor 1) or E = 3 mu (incompressible)."""
-    return Derived(name, "Pa", name, "MPa", note,
-                   value=lambda eps, mu_H, R_L: factor * mu_H / (eps * R_L),
-                   gradient=lambda eps, mu_H, R_L: (factor / (eps * R_L), -factor * mu_H / (eps ** 2 * R_L)),
-                   log_interval=True)
-
-
-# Fitting the thickness is fitting beta through the trace-bending map beta(eps) of
-# shellbvp.units.beta_from_thickness (the scene applies it): the same curves at the same trial
-# values (beta ~ eps^2, so a factor sqrt(2) in eps is beta's factor 2), reported as H = eps R_L,
-# and mu*H splits into the modulus, mu = mu*H / H, E = 3 mu.
-THICKNESS = ShapeParameter(
-    "thickness", "shell thickness H (beta = (H/R_L)^2/3)",
-    get=lambda scene: scene.thickness,
-    set=lambda scene, eps: scene.replace(thickness=eps),
-    unavailable=lambda scene: None if scene.thickness is not None else (
-        "fit_thickness starts from the scene's thickness: give one (Scene(thickness=H/R_L); the CLI's --thickness)"),
-    default_bounds=lambda scene: (_eps_of_beta(BETA.default_bounds(scene)[0], scene.bending), 0.5),
-    low_ok=lambda v: v > 0, high_ok=lambda v: v <= 0.5, log_scale=True,
-    step=lambda scene: 0.5 * math.log(2.0),
-    unit="m", report_scale=lambda R_L: R_L, display_unit="um", unit_kind="length",
-    note="; beta = (H/R_L)^2/3",
-    fit_help="also fit the shell's thickness H (beta = (H/R_L)^2/3, a 3D plate's bending), which gives the "
-             "modulus mu = mu*H / H and E = 3 mu; --thickness is the start",
-    range_help="search range of --fit-thickness, LOW,HIGH as H/R_L or lengths with --radius (e.g. 10um,100um; "
-               "default from beta = 1e-4 to H/R_L = 0.5)",
-    sets=("thickness", "beta"),
-    derived=(_modulus("mu", 1.0, "mu*H / H; linearised in ln mu, with H's uncertainty"),
-             _modulus("E", 3.0, "E = 3 mu, incompressible; linearised in ln E")))
-
-
-#: The shape parameters by name, in the order of the batch table's and the file's columns.
-SHAPE_PARAMETERS = {p.name: p for p in (BETA, ALPHA, PRESSURE, THICKNESS)}
+#: The shape parameters by name, in the order of the batch table's and the file's columns (the
+#: registry's; live: a material registered later joins it).
+SHAPE_PARAMETERS = LiveMapping(lambda: {p.name: _of(p) for p in parameters_that("fit")})
 #: The derived quantities of all of them by name.
-DERIVED = {d.name: d for p in SHAPE_PARAMETERS.values() for d in p.derived}
+DERIVED = LiveMapping(lambda: {d.name: d for p in SHAPE_PARAMETERS.values() for d in p.derived})
 
 
 def shape_parameter(name) -> ShapeParameter:

@@ -1,7 +1,8 @@
 """mu*H with the uncertainty of the geometry: how sure is the modulus, given that the shell's
 shape and the indenter were measured with some error?
 
-The scene's parameters (gamma, rho, beta, the Mooney-Rivlin alpha) are known as ``x +- u``,
+The scene's parameters (those flagged ``uncertainty`` in :mod:`shellbvp.scene_parameters`: beta,
+rho, gamma, the Mooney-Rivlin alpha) are known as ``x +- u``,
 ``u`` a standard uncertainty (one standard deviation, as in the GUM).  The fit of mu*H is
 repeated with each parameter at ``x - u`` and ``x + u`` (the others nominal; every fit its own
 model curve, all of them through one ``concurrent.futures`` executor), which gives the
@@ -24,15 +25,16 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .materials import MooneyRivlin
+from .scene_parameters import LiveNames, parameters_that, scene_parameter, scene_with
 from .shape_parameters import SHAPE_PARAMETERS
 
 log = logging.getLogger(__name__)
 
 __all__ = ["UNCERTAIN_PARAMETERS", "GeometryFit", "fit_with_geometry", "parse_uncertain", "Z95"]
 
-#: Scene parameters that may carry an uncertainty.
-UNCERTAIN_PARAMETERS = ("gamma", "rho", "beta", "alpha")
+#: Scene parameters that may carry an uncertainty: those of the registry
+#: (:mod:`shellbvp.scene_parameters`) flagged ``uncertainty``, in its order.
+UNCERTAIN_PARAMETERS = LiveNames(lambda: [p.name for p in parameters_that("uncertainty")])
 #: Coverage factor of a 95 % interval of a normal quantity.
 Z95 = 1.959963984540054
 _PLUS_MINUS = re.compile(r"\+-|\+/-|±")
@@ -58,13 +60,11 @@ def parse_uncertain(text: str, name: str = "value") -> tuple[float, float | None
 
 
 def _perturbed(scene, name, value):
-    if name == "alpha":
-        return scene.replace(material=MooneyRivlin(value))
-    return scene.replace(**{name: value})
+    return scene_with(scene, {name: value})
 
 
 def _nominal(scene, name):
-    return float(scene.material.alpha) if name == "alpha" else float(getattr(scene, name))
+    return scene_parameter(name).get(scene)
 
 
 def _check_uncertainty(scene, uncertainty, fit_kwargs):
@@ -82,8 +82,9 @@ def _check_uncertainty(scene, uncertainty, fit_kwargs):
         if name not in UNCERTAIN_PARAMETERS:
             raise ValueError(f"uncertainty: {name!r} is not a scene parameter with an uncertainty; choose from "
                              f"{UNCERTAIN_PARAMETERS}")
-        if name == "alpha" and not isinstance(scene.material, MooneyRivlin):
-            raise ValueError(f"uncertainty: alpha needs a Mooney-Rivlin scene; its material is {scene.material!r}")
+        why = scene_parameter(name).needs(scene)
+        if why:
+            raise ValueError(f"uncertainty: {why}")
         if name in fitted:
             raise ValueError(f"uncertainty: {name} is fitted (fit_{fitted[name]}=True); its uncertainty comes from "
                              f"the fit")

@@ -35,6 +35,8 @@ def structure_from_description(desc: dict) -> Structure:
     tp = desc["tip"]
     if tp["kind"] == "sphere":
         tip = geometry.sphere_tip()
+    elif tp["kind"] == "flat":
+        tip = geometry.flat_tip()
     else:
         tip = geometry.user_tip(_expr(tp["A"], "A(omega)", geometry.OMEGA), _expr(tp["B"], "B(omega)", geometry.OMEGA))
     B = energies.bending_energy(desc.get("bending", {"family": "trace"}))

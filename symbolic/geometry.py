@@ -19,7 +19,7 @@ import sympy as sp
 from .formula import parse_formula
 
 __all__ = ["S", "OMEGA", "GAMMA", "ShellGeometry", "TipGeometry", "spheroid", "user_shell",
-           "sphere_tip", "user_tip"]
+           "sphere_tip", "flat_tip", "user_tip"]
 
 S = sp.Symbol("S", positive=True)
 OMEGA = sp.Symbol("omega", positive=True)
@@ -113,6 +113,11 @@ def user_shell(R, Z, L, *, legacy_srepr: bool = False) -> ShellGeometry:
 def sphere_tip() -> TipGeometry:
     """Sphere of radius rho: ``A = sin omega``, ``B = 1 - cos omega``, phi = omega."""
     return TipGeometry(A=sp.sin(OMEGA), B=1 - sp.cos(OMEGA), phi=OMEGA, omega_max=sp.pi / 2)
+
+
+def flat_tip() -> TipGeometry:
+    """A flat plate: ``A = omega``, ``B = 0``, phi = 0; it has no end (no cylinder)."""
+    return TipGeometry(A=OMEGA, B=sp.S.Zero, phi=sp.S.Zero, omega_max=None)
 
 
 def user_tip(A, B, *, legacy_srepr: bool = False) -> TipGeometry:

@@ -280,3 +280,40 @@ def test_the_structure_census_holds_what_the_redesign_reached():
     assert not any(seen(n) for n in ast.walk(ast.parse('y = st["x"] + settings.get("x", 0)')))
     from shellbvp.configurations import CONFIGURATION_NAMES
     assert _load("architecture").configuration_names(BENCH.parent) == set(CONFIGURATION_NAMES)
+
+
+def test_the_census_counts_that_are_zero_stay_zero():
+    """benchmarks/architecture.py on this checkout (issue 57): no string hook, no write of a
+    curve's settings below their owner, no instrument format named outside shellbvp/readers/
+    (23 at 971ae76: afm_read 13, batch 6, afm_jpk 4), no module over 600 lines, no
+    natural-continuation loop written out."""
+    census = _load("architecture").census()
+    for key in ("string_hooks", "settings_writes", "format_names", "long_modules", "step_loops"):
+        assert not census[key], (key, census[key])
+
+
+def test_the_census_sees_what_it_counts(tmp_path):
+    """Each count of issue 57 on a checkout made to hold one of each: a string hook, a write of a
+    Solution's field, a table of scene parameters, late imports of the package and of an optional
+    dependency, and a reader's file name ending outside the readers."""
+    pkg = tmp_path / "shellbvp"
+    (pkg / "configurations").mkdir(parents=True)
+    (pkg / "readers").mkdir()
+    (pkg / "configurations" / "cap.py").write_text('X = Configuration("cap")\n')
+    (pkg / "scene.py").write_text("class Scene:\n    gamma: float = 1.0\n    rho: float = 0.2\n    xi: int = 1\n")
+    (pkg / "solution.py").write_text("class Solution:\n    force: float = 0.0\n    wall_time: float = 0.0\n")
+    (pkg / "readers" / "jpk.py").write_text('SUFFIXES = (".jpk-force",)\nREADERS = (Reader(name="JPK"),)\n')
+    (pkg / "state.py").write_text("def solve():\n    pass\n")
+    (pkg / "bad.py").write_text(
+        'HOOK = "state:solve"\nNAMES = ("gamma", "rho")\nENDING = ".jpk-force"\n'
+        'def f(sol, self):\n    import afmformats\n    from . import state\n    sol.force = 1.0\n'
+        '    setattr(sol, "wall_time", 2.0)\n    self.force = 3.0\n    return ENDING == "JPK"\n')
+    (tmp_path / "pyproject.toml").write_text('[project.optional-dependencies]\nafm = ["afmformats>=0.18"]\n'
+                                             'test = ["pytest>=7"]\n[tool.x]\n')
+    census = _load("architecture").census(tmp_path)
+    assert census["string_hooks"] == {"bad": 1}
+    assert census["solution_writes"] == {"bad": 2}        # self.force is another class's
+    assert census["parameter_tables"] == {"bad": 1}
+    assert census["function_imports_package"] == {"bad": 1}
+    assert census["function_imports_optional"] == {"bad": 1}
+    assert census["format_names"] == {"bad": 2}           # the ending, and the reader's name compared

@@ -18,6 +18,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 import shellbvp as sb
@@ -121,3 +122,56 @@ def test_docs_build_without_warnings(tmp_path):
         if "-quick" not in md.stem:
             assert (out / "benchmarks" / f"{md.stem}.html").exists(), md.name
     assert (out / "auto_examples" / "index.html").exists()
+
+
+EXAMPLES = DOCS / "examples"
+#: The real AFM file the force-map example fits, as afmformats ships it (tests/data of
+#: AFM-analysis/afmformats at 731b5ad, MIT licence)
+AFM_EXAMPLE = EXAMPLES / "data" / "fmt-jpk-fd_map2x2_extracted.jpk-force-map"
+AFM_EXAMPLE_SHA256 = "562cac58f63f47fefa59e13307ebc2979b2190861669498e100844728d675b06"
+
+
+def test_the_force_map_examples_file_is_afmformats_own_small_and_credited():
+    import hashlib
+
+    data = AFM_EXAMPLE.read_bytes()
+    assert len(data) < 2**20, f"{AFM_EXAMPLE.name}: {len(data)} bytes; the docs ship files under 1 MiB"
+    assert hashlib.sha256(data).hexdigest() == AFM_EXAMPLE_SHA256  # copied unchanged
+    assert "Paul Müller" in (EXAMPLES / "data" / "LICENSE-afmformats.txt").read_text()
+    assert AFM_EXAMPLE.name in (EXAMPLES / "README.txt").read_text()  # the attribution line
+
+
+def test_the_force_map_example_runs_from_the_real_file_to_the_map_and_a_pixels_fit(tmp_path, monkeypatch):
+    """docs/examples/plot_7_afm_map.py, as the gallery runs it (the docs build in
+    test_docs_build_without_warnings skips the gallery's scripts): the real JPK map read, fitted
+    and written, one pixel's fit drawn from the map file.  Its text says what the fits found;
+    when they change, so must the text."""
+    import runpy
+    import warnings
+
+    pytest.importorskip("afmformats")
+    pytest.importorskip("matplotlib")
+    monkeypatch.setenv("MPLBACKEND", "Agg")
+    monkeypatch.chdir(tmp_path)
+    import matplotlib.pyplot as plt
+
+    before = set(plt.get_fignums())
+    with warnings.catch_warnings():
+        warnings.filterwarnings("ignore", message=".*non-interactive.*")  # plt.show() on Agg
+        ns = runpy.run_path(str(EXAMPLES / "plot_7_afm_map.py"), run_name="__main__")
+    try:
+        fm, mf = ns["fm"], ns["mf"]
+        assert fm.shape == (10, 10) and len(fm.rows) == 4
+        assert [c.grid for c in fm.curves] == [(0, 0), (9, 0), (9, 9), (0, 9)]
+        # what the example's text says of these fits
+        assert [r.result.quality for r in fm.rows] == ["poor"] * 4, "update the example's text"
+        assert [r.status for r in fm.rows] == ["failed", "failed", "failed", "ok"], "update the example's text"
+        mu = [r.result.mu_H for r in fm.rows]
+        assert max(mu) / min(mu) > 20, "update the example's text"
+        np.testing.assert_array_equal(mf.mu_H, fm.image("mu_H"))
+        shown = mf.pixel(0, 9)
+        assert shown.status == "ok" and shown.displacement.size == 1000 and shown.rows_fitted == 4157
+        assert len(set(plt.get_fignums()) - before) == 3  # the map with the status, two pixels
+    finally:
+        for n in set(plt.get_fignums()) - before:
+            plt.close(n)

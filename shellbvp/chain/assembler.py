@@ -109,11 +109,12 @@ class ChainBVP(BoundaryConditions):
         self.rim_slope = self._clamped_rim_slope()
 
     def _clamped_rim_slope(self):
-        """``Phi(L)/L``, the reference slope over L that a clamped rim holds (``phiS`` at the rim),
-        or None for the pinned rim.  Clamped is offered before contact only (a pole and a rim)."""
-        if self.scene.rim == "pinned":
+        """``Phi(L)/L``, the reference slope over L that a clamped rim or a closed shell's equator
+        holds (``phiS`` at the rim), or None for the pinned rim.  Clamped is offered before
+        contact only (a pole and a rim)."""
+        if self.scene.rim == "pinned" and not self.scene.closed:
             return None
-        if any(not isinstance(j, (FreePole, Rim)) for j in self.chain.junctions):
+        if not self.scene.closed and any(not isinstance(j, (FreePole, Rim)) for j in self.chain.junctions):
             raise ValueError(f"rim={self.scene.rim!r} is offered for the shell under pressure before contact "
                              f"(sb.inflate) only; the {self.chain.name} configuration touches the indenter")
         L = self.L
@@ -440,14 +441,15 @@ class ChainBVP(BoundaryConditions):
         return h
 
     def energy(self, sol, x, p) -> float:
-        """``E = 2 pi Int U R Psi dS - p (V - V_ref)``: the elastic energy over every region
+        """``E = 2 pi Int U R Psi dS - p (V - V_ref)``, twice that for a closed shell (the half
+        above its equator is solved): the elastic energy over every region
         (Gauss-Legendre on each mesh interval, plus the leading term ``zeta U(zeta)/2`` of
         each pole disc ``[0, zeta]``) and the pressure's potential (``shellbvp.inflation``).
         Under volume control the pressure does no work (V is held): E is the elastic energy."""
         elastic = self._elastic_energy(sol, x, p)
-        if self.volume_control or not self.pressure:
-            return elastic
-        return elastic - self.pressure * (self.volume(sol, x, p) - self.scene.reference_volume())
+        if not (self.volume_control or not self.pressure):
+            elastic -= self.pressure * (self.volume(sol, x, p) - self.scene.reference_volume())
+        return 2 * elastic if self.scene.closed else elastic  # a closed shell: both halves
 
     def volume(self, sol, x, p) -> float:
         """``V = Int dV/dS dS`` over every region (Gauss-Legendre on the mesh): the volume between

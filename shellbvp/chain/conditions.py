@@ -16,10 +16,13 @@ _LS = FREE_STATES.index("ls")
 _LINE_CONTINUOUS = [FREE_STATES.index(s) for s in ("lt", "phiS", "ls", "ks", "z")]
 # states continuous across an interior corner (ls, ks jump)
 _KINK_CONTINUOUS = [FREE_STATES.index(s) for s in ("lt", "phiS", "rQ", "z")]
-_PHIS = FREE_STATES.index("phiS")
+_PHIS, _RQ, _Z = (FREE_STATES.index(s) for s in ("phiS", "rQ", "z"))
 # the generated rim rows are (lt - 1, the moment's m, z); a clamped rim holds its slope instead
-# of M_s = 0: phi/S - Phi(L)/L, linear in the states and free of the run-time parameters
-_RIM_MOMENT_ROW = 1
+# of M_s = 0: phi/S - Phi(L)/L, linear in the states and free of the run-time parameters.  A
+# closed shell's equator (the half above it solved, symmetric about it) holds its slope too (the
+# tangent vertical), moves out freely (no horizontal force: r Q = 0) and moves by delta/2 towards
+# the indenter (z = -delta/2), so that delta is the approach of the indenter and the support.
+_RIM_CIRCLE_ROW, _RIM_MOMENT_ROW, _RIM_Z_ROW = 0, 1, 2
 
 
 class BoundaryConditions:
@@ -75,7 +78,8 @@ class BoundaryConditions:
                 parts += [mod.kink_res(self.S_point(self.regions[j.k].end, p), yl, yr, par),
                           (yr - yl)[_KINK_CONTINUOUS]]
             elif isinstance(j, Rim):
-                parts.append(self._rim_res(self.S_point(self.regions[j.k].end, p), yb[self.rows(j.k)], par))
+                parts.append(self._rim_res(self.S_point(self.regions[j.k].end, p), yb[self.rows(j.k)], par,
+                                           q.get("delta", 0.0)))
         if self.extra == "force":
             _, S, yc, yf, _, _ = self._force_args(ya, yb, p, q)
             parts.append(self._force_function("res")(S, yc, yf, q["delta"], q["F"], par))
@@ -90,12 +94,15 @@ class BoundaryConditions:
             parts += [[ya[self.n_shell]], [yb[self.n_shell] - self.enclosed_volume]]
         return np.concatenate(parts)
 
-    def _rim_res(self, S, y, par):
+    def _rim_res(self, S, y, par, delta):
         res = self.model.rim_res(S, y, par)
         if self.rim_slope is None:
             return res
         res = np.array(res, float)
         res[_RIM_MOMENT_ROW] = y[_PHIS] - self.rim_slope
+        if self.scene.closed:
+            res[_RIM_CIRCLE_ROW] = y[_RQ]
+            res[_RIM_Z_ROW] = y[_Z] + 0.5 * delta
         return res
 
     def _rim_jac(self, S, y, par, what="jac"):
@@ -104,9 +111,12 @@ class BoundaryConditions:
         if self.rim_slope is None:
             return dres
         dres = np.array(dres, float)
-        dres[_RIM_MOMENT_ROW] = 0.0
+        rows = [_RIM_MOMENT_ROW, _RIM_CIRCLE_ROW] if self.scene.closed else [_RIM_MOMENT_ROW]
+        dres[rows] = 0.0
         if what == "jac":
             dres[_RIM_MOMENT_ROW, _PHIS] = 1.0
+            if self.scene.closed:
+                dres[_RIM_CIRCLE_ROW, _RQ] = 1.0
         return dres
 
     def _line_function(self, j, what):
@@ -226,6 +236,8 @@ class BoundaryConditions:
             elif isinstance(j, Rim):
                 S = self.S_point(self.regions[j.k].end, p)
                 B[rows, self.rows(j.k)] = self._rim_jac(S, yb[self.rows(j.k)], par)
+                if self.scene.closed:
+                    self._add_p(P, r + _RIM_Z_ROW, "delta", 0.5)
                 if vc:
                     self._pressure_column(P, rows, self._rim_jac(S, yb[self.rows(j.k)], par, "jac_par"))
             r += j.rows

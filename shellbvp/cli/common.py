@@ -11,8 +11,10 @@ import re
 import sys
 from pathlib import Path
 
+from ..materials import material_class
+from ..scene_parameters import scene_parameter, scene_parameters
 
-__all__ = ["Parser", "print_json_error", "show_code_generation", "plain_number", "plain_numbers", "quantity", "uncertain_value", "pressure_value", "say", "number_or", "thickness_value", "nondimensional", "add_radius_option", "add_mu_h_option", "material_spec", "material_help", "bending_families", "add_scene_options", "scene_from_args", "over_rim_radius", "require_sample", "nondimensional_thickness", "nondimensional_pressure", "checkpoint_seconds", "progress_bar", "curve_bars", "MAX_POINTS", "free_default_name", "strict_json", "output_dir", "check_report_path", "add_overwrite_option",
+__all__ = ["Parser", "print_json_error", "show_code_generation", "plain_number", "plain_numbers", "quantity", "uncertain_value", "pressure_value", "say", "number_or", "thickness_value", "nondimensional", "add_radius_option", "add_mu_h_option", "material_spec", "material_help", "material_options", "bending_families", "add_scene_options", "scene_from_args", "over_rim_radius", "require_sample", "nondimensional_thickness", "nondimensional_pressure", "checkpoint_seconds", "progress_bar", "curve_bars", "MAX_POINTS", "free_default_name", "strict_json", "output_dir", "check_report_path", "add_overwrite_option",
            "NODE_BUDGET", "node_budget", "add_limit_options", "limits_of", "LIMIT_OPTIONS"]
 
 
@@ -303,9 +305,16 @@ def add_scene_options(p, uncertain=False, preset_required=False, solver=("tol", 
                    help="built-in scene (see `shellbvp presets`); " + (
                        "give it, or the sample's geometry: --indenter-radius (or --rho) and --rise (or --gamma) "
                        "and --thickness (or --beta)" if preset_required else "default base"))
-    kind, note = (uncertain_value, "; VALUE+-U: with a standard uncertainty U") if uncertain else (plain_number, "")
+    params = scene_parameters()
+
+    def kind(name):  # (type, the help's end): VALUE+-U where the registry lets it carry an uncertainty
+        if uncertain and params[name].uncertainty:
+            return uncertain_value, "; VALUE+-U: with a standard uncertainty U"
+        return plain_number, ""
+
     shape = g.add_mutually_exclusive_group()
-    shape.add_argument("--gamma", type=kind, help=f"spheroid aspect parameter (< 1/rho; >0 bowl, <0 dome){note}")
+    kind_of, note = kind("gamma")
+    shape.add_argument("--gamma", type=kind_of, help=f"spheroid aspect parameter (< 1/rho; >0 bowl, <0 dome){note}")
     shape.add_argument("--rise", type=quantity("length", positive=False),
                        help="how far the pole lies below the rim's plane, with its unit (with --radius): gamma = "
                             "rise / R_L; > 0 a bowl indented from inside (5um), < 0 a dome indented from outside "
@@ -314,10 +323,20 @@ def add_scene_options(p, uncertain=False, preset_required=False, solver=("tol", 
                    help="the shell is a dome indented from outside (its convex side): --rise is the pole's height "
                         "above the rim's plane, gamma = -rise / R_L")
     tip = g.add_mutually_exclusive_group()
-    tip.add_argument("--rho", type=kind, help=f"indenter radius / rim radius (> 0){note}")
+    kind_of, note = kind("rho")
+    tip.add_argument("--rho", type=kind_of, help=f"indenter radius / rim radius (> 0){note}")
     tip.add_argument("--indenter-radius", type=quantity("length"), dest="indenter_radius",
                      help="the indenter's tip radius with its unit (with --radius): rho = it / R_L")
-    g.add_argument("--beta", type=kind, help=f"bending stiffness B/(mu R_L^2) (> 0){note}")
+    tip.add_argument("--flat-tip", action="store_true", default=None, dest="flat_tip",
+                     help="the indenter is a flat plate (FlatTip: no radius)")
+    g.add_argument("--closed", action="store_true", default=None,
+                   help="a complete spheroid (a cell, capsule or pollen grain) instead of a shell held on its rim: "
+                        "--radius is its equatorial radius, --gamma (or --rise) its polar semi-axis over it")
+    g.add_argument("--support", choices=("substrate", "plates"),
+                   help="with --closed: resting on a rigid plane (default) or compressed between two plates; "
+                        "both under a flat plate (--flat-tip) for now")
+    kind_of, note = kind("beta")
+    g.add_argument("--beta", type=kind_of, help=f"bending stiffness B/(mu R_L^2) (> 0){note}")
     g.add_argument("--thickness", type=thickness_value,
                    help="shell thickness: H/R_L in (0, 0.5], or with a unit (50um) together with --radius; "
                         "sets beta = (H/R_L)^2/3, the bending stiffness of a 3D plate")
@@ -325,8 +344,9 @@ def add_scene_options(p, uncertain=False, preset_required=False, solver=("tol", 
                    help="with --thickness: add the shell's transverse shear compliance (forces at the thick "
                         "shell's depth; removes most of the model's O(H/R_L) error, see docs/accuracy.md)")
     m = g.add_mutually_exclusive_group()
-    m.add_argument("--alpha", type=kind, help=f"Mooney-Rivlin alpha in [0, 1]{note}")
-    m.add_argument("--gent-jm", type=plain_number, dest="gent_jm", help="Gent model with this Jm (> 0)")
+    for param in material_options():  # --alpha, --gent-jm: each selects its material
+        kind_of, note = kind(param.name)
+        m.add_argument(param.option, dest=param.dest, type=kind_of, help=param.option_help + note)
     m.add_argument("--neo-hookean", action="store_true", help="neo-Hookean material")
     m.add_argument("--material", type=material_spec, metavar="FAMILY[:NAME=VALUE,...]",
                    help=material_help())
@@ -345,24 +365,33 @@ def add_scene_options(p, uncertain=False, preset_required=False, solver=("tol", 
                    help="a user bending energy B per beta in lambda_s, lambda_theta, kappa_s, kappa_theta, "
                         "kappa_s0, kappa_theta0 (the reference curvatures)")
     if not solver:  # a command that solves nothing: no solver options to ignore
-        return
+        return g
     s = p.add_argument_group("solver")
     if "tol" in solver:
         s.add_argument("--tol", type=plain_number, default=1e-6, help="collocation tolerance (default 1e-6)")
     if "max_nodes" in solver:
         s.add_argument("--max-nodes", type=node_budget, default=10000, dest="max_nodes",
                        help=f"largest collocation mesh of a state (default 10000, in [{NODE_BUDGET[0]}, {NODE_BUDGET[1]}])")
+    return g
+
+
+def material_options() -> list:
+    """The materials' parameters with an option of their own (``--alpha``, ``--gent-jm``), from
+    the registry (:mod:`shellbvp.scene_parameters`)."""
+    return [p for p in scene_parameters().values() if p.material and p.option]
 
 
 def scene_from_args(args):
     import shellbvp as sb
 
-    over = {k: getattr(args, k) for k in ("gamma", "rho", "beta", "xi", "contact", "sealed", "transverse_shear")
+    over = {k: getattr(args, k) for k in ("gamma", "rho", "beta", "xi", "contact", "sealed", "transverse_shear",
+                                          "closed", "support")
             if getattr(args, k, None) is not None}
-    if args.alpha is not None:
-        over["material"] = sb.MooneyRivlin(args.alpha)
-    elif args.gent_jm is not None:
-        over["material"] = sb.Gent(args.gent_jm)
+    if getattr(args, "flat_tip", None):
+        over["tip"] = sb.FlatTip()
+    chosen = [p for p in material_options() if getattr(args, p.dest, None) is not None]
+    if chosen:  # its material (the options exclude each other)
+        over["material"] = material_class(chosen[0].material)(**{chosen[0].name: getattr(args, chosen[0].dest)})
     elif args.neo_hookean:
         over["material"] = sb.NeoHookean()
     elif args.material is not None:
@@ -402,7 +431,7 @@ def over_rim_radius(args, length, option):
     if radius is None:
         raise ValueError(f"{option} {length} is a length: it needs --radius (the rim radius R_L), or give "
                          f"the ratio itself ({'--rho' if option == '--indenter-radius' else '--gamma'})")
-    return length.si / radius.si
+    return scene_parameter("rho" if option == "--indenter-radius" else "gamma").from_lab(length.si, radius.si)
 
 
 def require_sample(args, bending_per_pixel=False):
@@ -431,13 +460,13 @@ def nondimensional_thickness(args):
     if radius is None:
         raise ValueError(f"--thickness {args.thickness} has a unit: it needs --radius (the nondimensional "
                          f"thickness is H / R_L); or give that number itself")
-    return args.thickness.si / radius.si
+    return scene_parameter("thickness").from_lab(args.thickness.si, radius.si)  # H (m) -> H / R_L
 
 
 def nondimensional_pressure(args):
     """``--pressure`` as ``p R_L/(mu H)``: a plain number as it is, a pressure with a unit through
     ``--radius`` and ``--muH``."""
-    from ..units import Dimensions, Quantity
+    from ..units import Quantity
 
     if not isinstance(args.pressure, Quantity):
         return args.pressure
@@ -449,7 +478,7 @@ def nondimensional_pressure(args):
     if radius is None or mu_h is None:
         raise ValueError(f"--pressure {args.pressure} has a unit: it needs --radius and --muH (the nondimensional "
                          f"pressure is p R_L/(mu H)); or give that number itself")
-    return Dimensions(R_L=radius.si, mu_H=mu_h.si).p(args.pressure.si)
+    return scene_parameter("pressure").from_lab(args.pressure.si, radius.si, mu_h.si)  # Pa -> p R_L/(mu H)
 
 
 def checkpoint_seconds():

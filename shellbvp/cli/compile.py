@@ -6,26 +6,21 @@ from .common import add_scene_options, scene_from_args
 
 __all__ = ["add_parser", "run"]
 
-#: Scene options whose presence means "this scene", not "every preset"
-_SCENE_KEYS = ("preset", "gamma", "rise", "dome", "rho", "indenter_radius", "beta", "thickness", "alpha", "gent_jm",
-               "neo_hookean", "material", "xi", "pressure", "sealed", "contact", "bending", "bending_formula",
-               "transverse_shear")
-
-
 def add_parser(sub):
     """The ``compile`` subcommand's arguments, on ``sub`` (the subparsers)."""
     c = sub.add_parser("compile", help="compile the solver's kernels with numba, once (the [fast] extra): every "
                                        "preset's, or the scene's given by the options")
-    add_scene_options(c, solver=())
+    scene = add_scene_options(c, solver=())
     c.add_argument("--radius", "--rim-radius", help="rim radius with its unit, for lengths given in lab units")
-    c.set_defaults(func=run)
+    # the scene's options: given, they mean "this scene", not "every preset"
+    c.set_defaults(func=run, scene_keys=tuple(a.dest for a in scene._group_actions))
 
 
 def run(args):
     from ..kernels import compile_for
     from ..scene import PRESETS, Scene
 
-    given = any(getattr(args, k, None) not in (None, False) for k in _SCENE_KEYS)
+    given = any(getattr(args, k, None) not in (None, False) for k in args.scene_keys)
     if given:
         if args.radius is not None:
             from .common import quantity

@@ -7,6 +7,7 @@ import json
 import sys
 from pathlib import Path
 
+from ..scene_parameters import parameters_that, scene_parameter, scene_parameters
 from ..shape_parameters import SHAPE_PARAMETERS
 from ..textdata import printable
 from .common import (
@@ -40,9 +41,8 @@ def add_parser(sub):
                    help="rim radius R_L of the sample with its unit, e.g. 0.3mm")
     f.add_argument("--pixel-table", dest="pixel_table", metavar="CSV",
                    help="a force map: the shell's geometry per pixel, a table with the columns ix, iy and one of "
-                        "thickness (with its unit: thickness_um, 'thickness (nm)'; bare: H/R_L), beta, alpha; "
-                        "each pixel fitted with its value fixed (model curves at a few values spanning the "
-                        "table's range, interpolated)")
+                        f"{_pixel_columns()}; each pixel fitted with its value fixed (model curves at a few values "
+                        "spanning the table's range, interpolated)")
     f.add_argument("--columns", help="displacement,force columns by name or 0-based index (default 0,1)")
     f.add_argument("--units", help="units of the two columns, e.g. mm,mN (default: from the header)")
     f.add_argument("--invert", action="append", choices=("displacement", "force"),
@@ -99,15 +99,21 @@ def add_parser(sub):
     f.set_defaults(func=run)
 
 
+def _pixel_columns() -> str:
+    """The geometry columns a pixel table may have, from the registry (in words, for --help)."""
+    return ", ".join(f"{p.name} (with its unit: {p.name}_um, '{p.name} (nm)'; bare: {p.symbol})"
+                     if p.lab is not None and p.lab.scale == "R_L" else p.name for p in parameters_that("per_pixel"))
+
+
 def _split_uncertain(args):
     """``VALUE+-U`` options of ``fit``: the values go to the scene; returns {name: U}."""
     uncertainty = {}
-    for name in ("gamma", "rho", "beta", "alpha"):
-        given = getattr(args, name)
+    for param in parameters_that("uncertainty"):  # the registry's, in its order
+        given = getattr(args, param.dest, None)
         if isinstance(given, tuple):
-            setattr(args, name, given[0])
+            setattr(args, param.dest, given[0])
             if given[1] is not None:
-                uncertainty[name] = given[1]
+                uncertainty[param.name] = given[1]
     if (args.workers is not None or args.scheduler) and not uncertainty:
         raise ValueError("--workers and --scheduler run the fits of an uncertain geometry: give a parameter "
                          "as VALUE+-U (e.g. --rho 0.333+-0.02)")
@@ -117,21 +123,23 @@ def _split_uncertain(args):
 
 
 def _bending_per_pixel(pixel_values):
-    return pixel_values is not None and pixel_values.name in ("thickness", "beta")
+    return pixel_values is not None and "beta" in scene_parameter(pixel_values.name).sets
 
 
 def _pixel_table(args, files, folder):
     """``--pixel-table``'s table read and checked (before the map is read), or None."""
     if args.pixel_table is None:
         return None
-    from ..afm import is_afm_file
     from ..pixel_table import read_pixel_table
+    from ..readers import reader_for
 
-    if len(files) != 1 or folder or not is_afm_file(files[0]):
+    if len(files) != 1 or folder or not reader_for(files[0]).curves:
         raise ValueError("--pixel-table is for one force map (an AFM file such as .jpk-force-map)")
     table = read_pixel_table(args.pixel_table)
-    given = {"thickness": ("--thickness", "--beta"), "beta": ("--thickness", "--beta"), "alpha": ("--alpha",)}
-    clash = [o for o in given[table.name] if getattr(args, o[2:]) is not None]
+    # the options that set what the table sets (the thickness sets beta too)
+    sets = set(scene_parameter(table.name).sets)
+    clash = [p.option for p in scene_parameters().values()
+             if p.option and sets & set(p.sets) and getattr(args, p.dest, None) is not None]
     if clash:
         raise ValueError(f"{args.pixel_table} gives the {table.name} per pixel: leave out {', '.join(clash)}")
     return table
@@ -233,10 +241,11 @@ def run(args):
         raise ValueError("give data files (or a directory) or --example (one of them)")
     if len(args.data) == 1 and not any(ch in args.data[0] for ch in "*?[") and not Path(args.data[0]).exists():
         raise ValueError(f"{args.data[0]}: no such file or directory")  # before the numerics are imported
-    from ..afm import is_afm_file, iter_afm
+    from ..afm import iter_afm
     from ..batch import expand_inputs, read_record
     from ..fitting import example_data_path, fit_record
     from ..paths import check_output_path
+    from ..readers import reader_for
 
     inputs = [str(example_data_path())] if args.example else args.data
     files = expand_inputs(inputs)
@@ -244,7 +253,7 @@ def run(args):
     folder = any(Path(x).is_dir() for x in inputs)
     pixel_values = _pixel_table(args, files, folder)
     map_curves = None
-    if len(files) == 1 and not folder and is_afm_file(files[0]):
+    if len(files) == 1 and not folder and reader_for(files[0]).curves:  # a file of curves: a force map?
         # its one-line error before the file is read
         require_sample(args, bending_per_pixel=_bending_per_pixel(pixel_values))
         curves = iter_afm(files[0], **_calibration(args))  # one at a time: a map is never all in memory
@@ -385,11 +394,11 @@ def _fit_map(args, path, curves, scene, R_L, reading, options, pixel_values=None
     """``shellbvp fit MAP.jpk-force-map [-o map.h5] [--table map.csv] [--report map.png]
     [--pixel-table geometry.csv]``: every curve with the same scene (or with the table's geometry
     per pixel); exit 0 when every curve was fitted, 1 otherwise."""
-    from ..afm import refuse_text_options
     from ..batch import fit_map, write_table
     from ..paths import check_output_path
+    from ..readers import check_options, reader_for
 
-    refuse_text_options(path, **reading)
+    check_options(reader_for(path), path, reading)
     if args.table is not None:
         check_output_path(args.table, overwrite=args.force)
     options = dict(options, progress=curve_bars(args, leave=False))

@@ -1,4 +1,5 @@
-"""The ``plot`` command: figures of curve, sweep, fit, force-map and validation files."""
+"""The ``plot`` command: figures of curve, sweep, fit, force-map and validation files; one
+pixel of a force map (``--pixel IX,IY``) or one figure per pixel (``--pixels all|failed -o DIR``)."""
 
 from __future__ import annotations
 
@@ -6,7 +7,10 @@ from pathlib import Path
 
 from .common import output_dir, plain_numbers
 
-__all__ = ["add_parser", "run"]
+__all__ = ["add_parser", "run", "MAX_PIXEL_FIGURES"]
+
+#: ``--pixels`` writes at most this many figures unless ``--max-figures`` says more
+MAX_PIXEL_FIGURES = 100
 
 
 def add_parser(sub):
@@ -20,6 +24,16 @@ def add_parser(sub):
                     "next to each); for several of those a directory (one <name>.png each)")
     pl.add_argument("--profiles", help="also draw the deformed shell of the first file at these depths, e.g. 0.1,0.3")
     pl.add_argument("--dpi", type=int, default=150, help="resolution of a PNG (default 150)")
+    px = pl.add_mutually_exclusive_group()
+    px.add_argument("--pixel", metavar="IX,IY",
+                    help="a force-map file: one pixel's fitted rows against its model, and the residuals (the grid "
+                         "index as the map's warnings name pixels, e.g. 9,0; default -o <name>_pixel_IX_IY.png)")
+    px.add_argument("--pixels", choices=("all", "failed"),
+                    help="a force-map file: one such figure per pixel into the directory -o (every curve's, or those "
+                         "whose fit failed its checks or could not run); at most --max-figures")
+    pl.add_argument("--max-figures", type=int, default=MAX_PIXEL_FIGURES, metavar="N",
+                    help=f"--pixels: refuse to write more than N figures (default {MAX_PIXEL_FIGURES}; say how many "
+                         f"you want)")
     pl.set_defaults(func=run)
 
 
@@ -31,6 +45,8 @@ def run(args):
     from ..sweep import read_sweep
 
     kinds = [file_kind(f) for f in args.files]
+    if args.pixel is not None or args.pixels is not None:
+        return _pixel_figures(args, kinds)
     single = [k for k in kinds if k in _ONE_FIGURE_EACH]
     if single:  # fit, force-map and validation files: one figure each
         if len(set(kinds)) != 1:
@@ -83,6 +99,63 @@ def _fit_figure(name, out, dpi):
         save_figure(ax.figure, out, dpi=dpi)
     finally:
         plt.close(ax.figure)
+
+
+def _pixel_figures(args, kinds):
+    """``--pixel IX,IY``: one pixel's figure; ``--pixels all|failed -o DIR``: one per pixel, their
+    number said first and bounded by ``--max-figures``."""
+    from ..afm import read_map_file
+    from ..map_pixels import parse_pixel
+    from ..paths import check_output_path
+    from ..textdata import printable
+
+    option = "--pixel" if args.pixel is not None else "--pixels"
+    if len(args.files) != 1 or kinds[0] != "force-map":
+        what = (f"{len(args.files)} files" if len(args.files) != 1 else f"{args.files[0]}, a {kinds[0]} file"
+                if kinds[0] else f"{args.files[0]}, not a file shellbvp writes")
+        raise ValueError(f"{option} is for one force-map file (`shellbvp fit MAP -o map.h5`); got {what}")
+    name = args.files[0]
+    if args.pixel is not None:
+        ix, iy = parse_pixel(args.pixel)
+        out = Path(args.output) if args.output else Path(name).with_name(f"{Path(name).stem}_pixel_{ix}_{iy}.png")
+        check_output_path(out, overwrite=True)  # a figure is cheap to redraw: replaced
+        try:
+            read_map_file(name).plot_pixel(ix, iy, out, dpi=args.dpi)
+        except ValueError as exc:
+            raise ValueError(f"--pixel {ix},{iy}: {exc}") from None
+        print(f"wrote {out}")
+        return 0
+    if args.max_figures < 1:
+        raise ValueError(f"--max-figures must be >= 1; got {args.max_figures}")
+    if args.output is None or (Path(args.output).exists() and not Path(args.output).is_dir()):
+        raise ValueError("--pixels writes one figure per pixel: give a directory with -o DIR")
+    mf = read_map_file(name)
+    pixels = mf.pixels(args.pixels)
+    if not mf.curves.has_data:
+        raise ValueError(mf.curves.no_data_reason())
+    which = "every curve's" if args.pixels == "all" else "the pixels whose fit did not succeed"
+    if len(pixels) > args.max_figures:
+        raise ValueError(f"--pixels {args.pixels} would write {len(pixels)} figures ({which}) into {args.output}; "
+                         f"at most --max-figures {args.max_figures}: give --max-figures {len(pixels)} to write them")
+    outdir = Path(args.output)
+    if not outdir.exists():
+        if not outdir.parent.is_dir():
+            raise ValueError(f"-o {args.output}: its parent directory does not exist")
+        outdir.mkdir()
+    paths = {p: outdir / f"{Path(name).stem}_pixel_{p[0]}_{p[1]}.png" for p in pixels}
+    for path in paths.values():
+        check_output_path(path, overwrite=True)
+    print(f"{name}: {len(pixels)} figures ({which}) into {outdir}")
+    written = 0
+    for (ix, iy), path in paths.items():
+        pixel = mf.pixel(ix, iy)
+        if pixel.displacement is None or pixel.displacement.size == 0:
+            print(f"pixel {(ix, iy)}: no rows to draw ({pixel.status}: {printable(pixel.message)})")
+            continue
+        mf.plot_pixel(ix, iy, path, dpi=args.dpi)
+        written += 1
+    print(f"wrote {written} figures ({Path(name).stem}_pixel_IX_IY.png) into {outdir}")
+    return 0
 
 
 def _map_figure(name, out, dpi):

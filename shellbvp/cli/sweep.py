@@ -5,6 +5,8 @@ from __future__ import annotations
 import sys
 import time
 
+from ..materials import material_class
+from ..scene_parameters import parameters_that
 from .common import (
     MAX_POINTS, add_mu_h_option, add_overwrite_option, add_radius_option, material_help, material_spec, nondimensional,
     node_budget, number_or, plain_number,
@@ -24,16 +26,16 @@ def add_parser(sub):
                        "(see `shellbvp info`); 2 bad input; 130 interrupted.")
     g = w.add_argument_group("scene (the preset, with the swept parameters replaced)")
     g.add_argument("--preset", default="base", help="built-in scene (see `shellbvp presets`; default base)")
-    for name, what in (("gamma", "spheroid aspect parameter"), ("rho", "indenter radius / rim radius"),
-                       ("beta", "bending stiffness B/(mu R_L^2)")):
-        g.add_argument(f"--{name}", help=f"{what}: values to sweep")
-    m = g.add_mutually_exclusive_group()
-    m.add_argument("--alpha", help="Mooney-Rivlin alpha: values to sweep")
-    m.add_argument("--gent-jm", dest="gent_jm", help="Gent material, Jm values to sweep")
-    m.add_argument("--neo-hookean", action="store_true", help="neo-Hookean material")
-    m.add_argument("--material", type=material_spec, metavar="FAMILY[:NAME=VALUE,...]",
-                   help=material_help() + " (the base scene's; not swept)")
-    g.add_argument("--pressure", help="pressure below the shell, nondimensional p R_L/(mu H): values to sweep")
+    m = g.add_mutually_exclusive_group()  # a material's parameter selects its material
+    chosen = False  # --neo-hookean and --material added (after the materials' parameters: one group)
+    for p in parameters_that("sweep"):  # the registry's (shellbvp.scene_parameters), in its order
+        if not p.material and m._group_actions and not chosen:
+            _material_choices(m)
+            chosen = True
+        what = " ".join(t for t in (p.label, p.symbol) if t)
+        (m if p.material else g).add_argument(p.option, dest=p.dest, help=f"{what}: values to sweep")
+    if not chosen:
+        _material_choices(m)
     g.add_argument("--xi", type=int, choices=(0, 1), help="1: full generalised tensions; 0: first approximation")
     g.add_argument("--contact", choices=("smooth", "paper"), help="contact-line model (default smooth)")
     w.add_argument("--delta-max", type=number_or("length"), default=0.5, dest="delta_max",
@@ -59,6 +61,13 @@ def add_parser(sub):
     add_overwrite_option(w, "start the file anew (its curves are discarded once the new file is first written)")
     w.add_argument("-q", "--quiet", action="store_true", help="no line per finished curve")
     w.set_defaults(func=run)
+
+
+def _material_choices(m):
+    """The material options that are not swept, in the materials' group."""
+    m.add_argument("--neo-hookean", action="store_true", help="neo-Hookean material")
+    m.add_argument("--material", type=material_spec, metavar="FAMILY[:NAME=VALUE,...]",
+                   help=material_help() + " (the base scene's; not swept)")
 
 
 MAX_SWEEP_VALUES = 10_000  # values of one swept parameter: more is a typo, not a grid
@@ -94,21 +103,22 @@ def run(args):
 
     from ..sweep import check_grid, dask_executor, sweep
 
-    grid = {}
-    for name, text in (("beta", args.beta), ("rho", args.rho), ("gamma", args.gamma), ("alpha", args.alpha),
-                       ("Jm", args.gent_jm), ("pressure", args.pressure)):  # the grid's axes in this order
+    grid, swept = {}, parameters_that("sweep")
+    for p in swept:  # the grid's axes in the registry's order
+        text = getattr(args, p.dest, None)
         if text is not None:
-            grid[name] = _sweep_values(text, f"--{'gent-jm' if name == 'Jm' else name}")
+            grid[p.name] = _sweep_values(text, p.option)
     if not grid:
-        raise ValueError("give at least one of --gamma, --rho, --beta, --alpha, --gent-jm, --pressure to sweep")
+        raise ValueError(f"give at least one of {', '.join(p.option for p in swept)} to sweep")
     over = {k: getattr(args, k) for k in ("xi", "contact") if getattr(args, k) is not None}
-    if args.gent_jm is not None:
-        over["material"] = sb.Gent(grid["Jm"][0])
-    elif args.neo_hookean:
+    if args.neo_hookean:
         over["material"] = sb.NeoHookean()
     elif args.material is not None:
         over["material"] = args.material
     base = sb.Scene.preset(args.preset, **over)
+    for p in swept:  # a swept material parameter: the preset's material if of its family, else that family's
+        if p.material and p.name in grid and base.material.family != p.material:
+            base = base.replace(material=material_class(p.material)(**{p.name: grid[p.name][0]}))
     args.delta_max = nondimensional(args, args.delta_max, "--delta-max")
     args.force_max = nondimensional(args, args.force_max, "--force-max")
     check_grid(base, grid, args.max_cells)  # before a scheduler is asked for anything

@@ -14,6 +14,7 @@ from scipy import special
 
 from ..fit_checks import (FIT_STATUS, WEIGHTS_DISAGREE, check_result, contact_misfit, fit_diagnostics,
                           runs_in_depth_order, weights_disagreement)
+from ..scene_parameters import scene_parameter
 from ..shape_parameters import SHAPE_PARAMETERS
 from .least_squares import MODEL_PARAMETERS, LeastSquaresModel
 from .result import Estimate, FitResult
@@ -141,10 +142,10 @@ def _given_thickness(scene, mu_H, mu_H_ci, R_L):
     exact; E = 3 mu, incompressible), else {}: the same quantities a fitted thickness gives."""
     from ..units import format_in
 
-    eps = getattr(scene, "thickness", None)
+    eps = getattr(scene, "thickness", None)  # H / R_L
     if eps is None:
         return {}
-    H = eps * R_L
+    H = scene_parameter("thickness").to_lab(eps, R_L)  # m
     return {"mu": Estimate(mu_H / H, (mu_H_ci[0] / H, mu_H_ci[1] / H), "Pa", "mu", "MPa",
                            f"H = {format_in(H, 'um', 'length')}, eps = H/R_L = {eps:.3g}, beta = eps^2/3"),
             "E": Estimate(3 * mu_H / H, (3 * mu_H_ci[0] / H, 3 * mu_H_ci[1] / H), "Pa", "E", "MPa",

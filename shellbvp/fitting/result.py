@@ -10,6 +10,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..fit_checks import fit_quality
+from ..scene_parameters import scene_parameter
 from ..shape_parameters import DERIVED, SHAPE_PARAMETERS
 from .apparent import apparent_modulus
 from .least_squares import DEFAULT_WEIGHTS
@@ -224,13 +225,14 @@ class FitResult:
 
     @property
     def thickness(self):
-        """The shell's thickness H (m) when the scene was given one (``Scene(thickness=H/R_L)``,
-        ``--thickness``) or a fit estimated it: then beta is the 3D plate's and mu follows from
-        mu*H; None otherwise."""
+        """The shell's thickness H in m -- its lab form, where ``Scene.thickness`` is H / R_L
+        (:mod:`shellbvp.scene_parameters`) -- when the scene was given one
+        (``Scene(thickness=H/R_L)``, ``--thickness``) or a fit estimated it: then beta is the 3D
+        plate's and mu follows from mu*H; None otherwise."""
         if self.shape_values.get("thickness") is not None:
-            return self.shape_values["thickness"]
+            return self.shape_values["thickness"]  # reported in m
         eps = getattr(self.scene, "thickness", None)
-        return None if eps is None else eps * self.R_L
+        return None if eps is None else scene_parameter("thickness").to_lab(eps, self.R_L)
 
     @property
     def mu(self):
@@ -322,7 +324,8 @@ class FitResult:
                           "residual_rms": "N", "R_L": "m",
                           **{p.name: p.unit_text or p.unit for p in SHAPE_PARAMETERS.values()},
                           **{d.name: d.unit for d in DERIVED.values()},
-                          "baseline": "N", "baseline_slope": "N/m", "thickness": "m", "mu": "Pa",
+                          "baseline": "N", "baseline_slope": "N/m", "thickness": scene_parameter("thickness").lab.unit,
+                          "mu": "Pa",
                           "model_error": "1 (fraction of F)", "noise_sigma": "N (of the most weighted point)",
                           "aic": "1", "bic": "1", "runs_p": "1", "residual_autocorrelation": "1",
                           "correlation": "1 (order of fitted)"}}

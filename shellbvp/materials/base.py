@@ -33,7 +33,14 @@ BENDINGS: dict = {}
 class Parameter:
     """A material's run-time parameter: its name (the generated code's, the files' and
     ``--material``'s) and its valid range ``low < value`` (``low_open``) or ``low <= value``,
-    and ``value <= high``."""
+    and ``value <= high``.
+
+    It is also the parameter's entry in the registry of scene parameters
+    (:mod:`shellbvp.scene_parameters`), which lists every registered material's parameters:
+    the flags below say what the package may do with it.  A flag is all it takes: the sweep's
+    grid, the geometry's uncertainty, the pixel tables, the fit and the command line read them
+    there.
+    """
 
     name: str
     low: float = -math.inf
@@ -42,6 +49,18 @@ class Parameter:
     help: str = ""
     #: the SymPy assumption of its symbol in the derivation ("positive" or "nonnegative")
     assumption: str = "positive"
+    #: its own option of the scene's command-line options (``"--alpha"``; it selects the family;
+    #: default ``--NAME`` for a parameter swept or given an uncertainty, else none: then
+    #: ``--material FAMILY:NAME=VALUE`` gives it), and that option's help (default: the label, the
+    #: name and the range)
+    option: str = ""
+    option_help: str = ""
+    #: ``fit(free=(name,))`` may fit it (searched over its range: it needs a finite one)
+    fit: bool = False
+    #: a sweep may vary it; it may be given an uncertainty; a pixel table may give it per pixel
+    sweep: bool = False
+    uncertainty: bool = False
+    per_pixel: bool = False
 
     def range_text(self) -> str:
         if self.high == math.inf:

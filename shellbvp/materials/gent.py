@@ -29,7 +29,8 @@ class Gent(Material):
     Jm: float = 97.2
     family = "gent"
     label, short_label = "Gent", "Gent"
-    parameters = (Parameter("Jm", 0.0, low_open=True, help="the limit of I1 - 3"),)
+    parameters = (Parameter("Jm", 0.0, low_open=True, help="the limit of I1 - 3", option="--gent-jm",
+                            option_help="Gent model with this Jm (> 0)", sweep=True),)
 
     @staticmethod
     def energy(Jm):

@@ -34,7 +34,8 @@ class MooneyRivlin(Material):
     alpha: float = 0.1
     family = "mooney-rivlin"
     label, short_label = "Mooney-Rivlin", "MR"
-    parameters = (Parameter("alpha", 0.0, 1.0, help="weight of the second invariant"),)
+    parameters = (Parameter("alpha", 0.0, 1.0, help="weight of the second invariant", option="--alpha", fit=True,
+                            sweep=True, uncertainty=True, per_pixel=True),)
 
     @staticmethod
     def energy(alpha):

@@ -44,6 +44,9 @@ def check_supported(state):
         raise ValueError(f"stability: topology {state.topology!r} is not supported (only the inflated shell and "
                          f"{built}: the contact running over the tip's end onto the indenter's cylinder and interior "
                          f"corners are not built)")
+    if state.scene is not None and state.scene.closed:
+        raise ValueError("stability: a closed shell is not supported yet (its modes symmetric and antisymmetric "
+                         "about the equator are not assembled)")
     if conf is None:
         return
     scene = state.scene

@@ -11,25 +11,22 @@ import math
 import numpy as np
 
 from ..continuation import curve
-from ..materials import Gent, MooneyRivlin
+from ..scene_parameters import LiveNames, parameters_that, scene_parameter, scene_with
 
 __all__ = ["SWEEP_PARAMETERS", "MAX_CELLS", "scene_at", "check_grid", "combinations", "check_settings",
            "check_scenes"]
 
-#: Parameters a sweep may vary (run-time parameters of the generated code: no new derivation).
-SWEEP_PARAMETERS = ("beta", "rho", "gamma", "alpha", "Jm", "pressure")
+#: Parameters a sweep may vary (run-time parameters of the generated code: no new derivation):
+#: those of the registry (:mod:`shellbvp.scene_parameters`) flagged ``sweep``, in its order.
+SWEEP_PARAMETERS = LiveNames(lambda: [p.name for p in parameters_that("sweep")])
 #: Settings of :func:`shellbvp.curve` a sweep passes on (the rest are fixed by the sweep).
 _CURVE_SETTINGS = tuple(k for k in inspect.signature(curve).parameters if k not in ("scene", "delta_max", "callback"))
 
 
 def scene_at(base_scene, values: dict):
-    """``base_scene`` with the swept parameters set (``alpha``: Mooney-Rivlin, ``Jm``: Gent)."""
-    changes = {k: v for k, v in values.items() if k in ("beta", "rho", "gamma", "pressure")}
-    if "alpha" in values:
-        changes["material"] = MooneyRivlin(values["alpha"])
-    if "Jm" in values:
-        changes["material"] = Gent(values["Jm"])
-    return base_scene.replace(**changes)
+    """``base_scene`` with the swept parameters set (a material's: that material's,
+    :func:`shellbvp.scene_parameters.scene_with`)."""
+    return scene_with(base_scene, values)
 
 
 #: The most combinations a sweep takes unless told otherwise (``max_cells``, ``--max-cells``): a
@@ -59,10 +56,9 @@ def check_grid(base_scene, grid, max_cells=MAX_CELLS) -> dict:
     for name, values in grid.items():
         if name not in SWEEP_PARAMETERS:
             raise ValueError(f"grid: {name!r} is not a parameter a sweep varies; choose from {SWEEP_PARAMETERS}")
-        if name == "alpha" and not isinstance(base_scene.material, MooneyRivlin):
-            raise ValueError(f"grid: alpha needs a Mooney-Rivlin base scene; its material is {base_scene.material!r}")
-        if name == "Jm" and not isinstance(base_scene.material, Gent):
-            raise ValueError(f"grid: Jm needs a Gent base scene; its material is {base_scene.material!r}")
+        why = scene_parameter(name).needs(base_scene, "base scene")
+        if why:
+            raise ValueError(f"grid: {why}")
         try:
             vals = tuple(float(v) for v in np.atleast_1d(values))
         except (TypeError, ValueError):
@@ -72,8 +68,10 @@ def check_grid(base_scene, grid, max_cells=MAX_CELLS) -> dict:
         if len(set(vals)) != len(vals):
             raise ValueError(f"grid: {name} lists a value twice: {list(vals)}")
         out[name] = vals
-    if "alpha" in out and "Jm" in out:
-        raise ValueError("grid: alpha (Mooney-Rivlin) and Jm (Gent) belong to different materials")
+    families = {scene_parameter(n).material for n in out} - {""}
+    if len(families) > 1:  # (each is the base scene's: kept for a base scene checked elsewhere)
+        raise ValueError("grid: " + " and ".join(f"{n} ({scene_parameter(n).material_label()})" for n in out
+                                                 if scene_parameter(n).material) + " belong to different materials")
     return out
 
 
