@@ -122,24 +122,25 @@ def curve_rows(d, f, result, budget=MAX_ROWS_PER_CURVE) -> CurveRows:
 def _row_arrays(row, result, segment, budget):
     """``(displacement, force, model_force, rows fitted)`` of one curve of a map (its
     :class:`~shellbvp.batch.BatchRow`: its kept :class:`CurveRows`, else its record's rows),
-    thinned (empty arrays when its rows cannot be read)."""
-    empty = np.empty(0)
+    thinned, float32 (empty arrays when its rows cannot be read)."""
+    empty = np.empty(0, np.float32)
     kept = getattr(row, "curve_rows", None)
-    if kept is not None:
-        keep = thin_rows(np.arange(kept.displacement.size), kept.displacement, kept.offset, budget)
-        return (*(np.asarray(a[keep], float) for a in (kept.displacement, kept.force, kept.model_force)),
-                kept.rows_fitted)
-    record, used = row.record, row.used
-    if record is None:
-        return empty, empty, empty, 0
-    if used is None:  # an error row: the segment's rows, if they can be read
-        try:
-            used = record.mask(segment)
-        except ValueError:
+    if kept is None:
+        record, used = row.record, row.used
+        if record is None:
             return empty, empty, empty, 0
-    rows = np.flatnonzero(np.asarray(used, bool))
-    kept = curve_rows(record.displacement[rows], record.force[rows], result, budget)
-    return (*(np.asarray(a, float) for a in (kept.displacement, kept.force, kept.model_force)), kept.rows_fitted)
+        if used is None:  # an error row: the segment's rows, if they can be read
+            try:
+                used = record.mask(segment)
+            except ValueError:
+                return empty, empty, empty, 0
+        rows = np.flatnonzero(np.asarray(used, bool))
+        kept = curve_rows(record.displacement[rows], record.force[rows], result, budget)
+    arrays = (kept.displacement, kept.force, kept.model_force)
+    if kept.displacement.size > budget:  # kept for a larger budget: thinned again
+        keep = thin_rows(np.arange(kept.displacement.size), kept.displacement, kept.offset, budget)
+        arrays = tuple(a[keep] for a in arrays)
+    return (*arrays, kept.rows_fitted)
 
 
 def rows_per_curve(n_curves, max_rows=MAX_STORED_ROWS) -> int:
@@ -181,7 +182,8 @@ def write_curve_data(entry, rows, segment="loading", max_rows=MAX_STORED_ROWS):
                                              ("force", "N", "force as read, the fitted rows (thinned)"),
                                              ("model_force", "N", "fitted model at those rows, baseline included; "
                                               "NaN: no fit"))):
-        data = np.concatenate([p[k] for p in parts]).astype(np.float32) if parts else np.empty(0, np.float32)
+        data = np.concatenate([p[k] for p in parts]).astype(np.float32, copy=False) if parts else \
+            np.empty(0, np.float32)
         ds = g.create_dataset(name, data=data, compression="gzip" if data.size else None,
                               shuffle=bool(data.size))
         ds.attrs.update({"units": unit, "long_name": what})
@@ -252,7 +254,8 @@ def pixel_of_row(curve, row, n_curves, segment="loading", source="") -> MapPixel
     """The :class:`MapPixel` of one curve of an in-memory map (``curve``, its ``row``), thinned
     as :func:`write_curve_data` stores it for a map of ``n_curves`` curves."""
     res = row.result if row.status in ("ok", "failed") else None
-    d, f, m, n = _row_arrays(row, res, segment, rows_per_curve(n_curves))
+    *arrays, n = _row_arrays(row, res, segment, rows_per_curve(n_curves))
+    d, f, m = (np.asarray(a, float) for a in arrays)
     nan = math.nan
     return MapPixel(grid=tuple(curve.grid), index=int(curve.index), status=row.status, message=row.message,
                     mu_H=nan if res is None else float(res.mu_H),

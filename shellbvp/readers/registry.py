@@ -1,9 +1,9 @@
 """The registry of instrument readers: :class:`Reader`, how the package finds its reader
 modules (:func:`discover`, :func:`install`) and the look-ups every caller asks
 (:func:`reader_for`, :func:`read_record`, :func:`read_curves`, :func:`iter_curves`,
-:func:`read_table`, :func:`check_options`).  The readers themselves are declared in the other modules of
-:mod:`shellbvp.readers`, one module per format; nothing outside this package compares a
-file's name or first bytes with a format.
+:func:`read_table`, :func:`check_options`).  The readers themselves are declared in the other
+modules of :mod:`shellbvp.readers`, one module per format; nothing outside this package
+compares a file's name or first bytes with a format.
 """
 
 from __future__ import annotations
