@@ -9,12 +9,13 @@ cantilever's deflection ``force / spring constant`` (nanite's tip-sample separat
 sample is minus the tip's position: the package's signs, no ``--invert`` needed.
 
 * :func:`read_afm` -- the curves of a file as :class:`AFMCurve` (an
-  :class:`~shellbvp.instrument.InstrumentRecord` with its place on the map); the file's
-  declared sizes checked first and every failure of decoding one line
-  (:mod:`shellbvp.afm_read`).  AFM Workshop CSV and NT-MDT Nova text exports go through
+  :class:`~shellbvp.instrument.InstrumentRecord` with its place on the map), by its reader
+  (:mod:`shellbvp.readers`); :func:`iter_afm` one at a time.  The file's declared sizes are
+  checked first and every failure of decoding is one line (:mod:`shellbvp.afm_read`).  AFM Workshop CSV and NT-MDT Nova text exports go through
   afmformats too (:func:`afm_text_format`), with the cantilever's calibration given.
-* :class:`ForceMap` -- a force map fitted curve by curve (:func:`shellbvp.batch.fit_map`): the
-  per-curve rows of a batch, images of mu*H and its interval, a NeXus file, a figure.
+* :class:`ForceMap` -- a force map fitted (:func:`shellbvp.batch.fit_map`): the per-curve rows
+  of a batch (each fit's numbers and its fitted rows thinned with the model, not the records),
+  images of mu*H and its interval, a NeXus file, a figure.
 * :func:`read_map_file` -- that NeXus file read back (:class:`MapFile`), for ``shellbvp info``
   and ``shellbvp plot``; one pixel's data against its fitted model from it
   (:meth:`MapFile.plot_pixel`, ``shellbvp plot map.h5 --pixel IX,IY``; :mod:`shellbvp.map_pixels`).
@@ -32,7 +33,7 @@ from .afm_read import AFMCurve, curves_from_afm
 from .map_pixels import MapPixel, locate, pixel_of_row, read_curves, write_curve_data
 from .textdata import printable
 
-__all__ = ["AFM_SUFFIXES", "AFMCurve", "ForceMap", "MapFile", "is_afm_file", "afm_text_format", "read_afm",
+__all__ = ["AFM_SUFFIXES", "AFMCurve", "ForceMap", "MapFile", "is_afm_file", "afm_text_format", "read_afm", "iter_afm",
            "curves_from_afm", "single_curve", "refuse_text_options", "map_shape", "MAP_FORMAT", "is_map_file",
            "read_map_file", "draw_map", "draw_pixel"]
 
@@ -77,6 +78,14 @@ def read_afm(path, *, spring_constant=None, sensitivity=None) -> list:
         a height or the spring constant, or the file declares sizes beyond the bounds.
     """
     return readers.read_curves(path, spring_constant=spring_constant, sensitivity=sensitivity)
+
+
+def iter_afm(path, *, spring_constant=None, sensitivity=None):
+    """:func:`read_afm` one curve at a time (:func:`shellbvp.readers.iter_curves`): a force map's
+    curves are never all in memory (:func:`shellbvp.batch.fit_map` takes them so).  The options
+    are checked at once; the file's sizes, and its curve count against
+    :data:`~shellbvp.afm_read.MAX_MAP_CURVES`, before its first curve is read."""
+    return readers.iter_curves(path, spring_constant=spring_constant, sensitivity=sensitivity)
 
 
 def single_curve(path, *, columns=None, units=None, invert=(), spring_constant=None, sensitivity=None):
@@ -142,8 +151,11 @@ class ForceMap:
     path : str
         The map's file.
     curves : list of AFMCurve
+        Each curve's place on the map (from :func:`~shellbvp.batch.fit_map` without its record).
     rows : list of BatchRow
-        One per curve, in the same order (status ``ok``, ``failed`` or ``error``).
+        One per curve, in the same order (status ``ok``, ``failed`` or ``error``; from
+        :func:`~shellbvp.batch.fit_map` with its fitted rows thinned, ``BatchRow.curve_rows``,
+        for :meth:`pixel`).
     shape : tuple of int
         ``(nx, ny)``: the grid's size (from the curves' indices).
     scene : Scene
@@ -160,6 +172,8 @@ class ForceMap:
         With ``pixel_values``: the largest ``max |F_interp - F| / max |F|`` at the curves
         checked between nodes (:func:`shellbvp.batch.shared_curves`).
     notes : list of str
+    sha256 : str
+        The map file's checksum (else its first curve's record's, where it has one).
     """
 
     path: str
@@ -175,6 +189,7 @@ class ForceMap:
     curves_computed: object = None
     interpolation_error: object = None
     notes: list = field(default_factory=list)
+    sha256: str = ""
 
     def pixel_image(self) -> np.ndarray:
         """``(ny, nx)`` image of the per-pixel geometry value in its unit (the thickness in m,
@@ -348,7 +363,8 @@ class ForceMap:
             src = entry.create_group("source")
             src.attrs["NX_class"] = "NXnote"
             string_dataset(src, "file_name", str(self.path))
-            string_dataset(src, "sha256", self.curves[0].record.sha256 if self.curves else "")
+            first = self.curves[0].record if self.curves else None
+            string_dataset(src, "sha256", self.sha256 or (first.sha256 if first is not None else ""))
             string_dataset(src, "settings", json.dumps({"segment": self.segment, **self.settings}, default=str))
 
     def plot(self, out=None, ax=None):

@@ -32,9 +32,10 @@ from .instrument_record import record_from_arrays, sha256_of
 from .paths import read_input_bytes
 from .textdata import printable
 
-__all__ = ["AFMCurve", "read_afm", "load_with_afmformats", "curves_from_afm", "check_archive", "afmformats_boundary",
-           "AFMFileError", "AFM_REFUSALS", "MAX_MAP_PIXELS", "MAX_ARCHIVE_MEMBERS", "MAX_CENTRAL_DIRECTORY_BYTES",
-           "MAX_INFLATED_BYTES", "MAX_INFLATION_RATIO", "INFLATION_ALLOWANCE_BYTES", "READER_LOGGERS"]
+__all__ = ["AFMCurve", "read_afm", "iter_afm", "load_with_afmformats", "curves_from_afm", "curve_from_afm",
+           "check_archive", "afmformats_boundary", "AFMFileError", "AFM_REFUSALS", "MAX_MAP_CURVES", "MAX_MAP_PIXELS",
+           "MAX_ARCHIVE_MEMBERS", "MAX_CENTRAL_DIRECTORY_BYTES", "MAX_INFLATED_BYTES", "MAX_INFLATION_RATIO",
+           "INFLATION_ALLOWANCE_BYTES", "READER_LOGGERS"]
 
 #: The most members a JPK archive may hold (a 128 x 128 force map: about 330,000, 20 a curve).
 MAX_ARCHIVE_MEMBERS = 500_000
@@ -49,6 +50,10 @@ INFLATION_ALLOWANCE_BYTES = 16 * 2**20
 
 #: The most cells of a force map's grid (its images: 8 MiB each) and rows of a pixel table.
 MAX_MAP_PIXELS = 1024 * 1024
+#: The most curves of an AFM file read (a 256 x 256 map): a map keeps each curve's results
+#: (a few kB) until it is written; a file declaring more (a JPK archive's count from its list
+#: of members) is refused before its first curve.
+MAX_MAP_CURVES = 256 * 256
 
 #: Loggers of the readers below afmformats, quiet while a file is read unless asked for.
 READER_LOGGERS = ("afmformats", "igor2")
@@ -117,17 +122,38 @@ def read_afm(path, *, load, check_sizes=None, meta_override=None) -> list:
         afmformats is not installed, or cannot read the file, or a curve lacks the force,
         a height or the spring constant, or the file declares sizes beyond the bounds.
     """
+    curves = list(iter_afm(path, load=load, check_sizes=check_sizes, meta_override=meta_override))
+    if not curves:
+        raise AFMFileError(f"{printable(path)}: afmformats found no force-distance curve in it")
+    return curves
+
+
+def iter_afm(path, *, load, check_sizes=None, meta_override=None):
+    """:func:`read_afm` one curve at a time (a force map's curves are never all in memory; a
+    JPK archive's are decoded one at a time too, :mod:`shellbvp.afm_jpk`): the file's sizes are
+    checked and its curve count bounded by :data:`MAX_MAP_CURVES` before the first curve is
+    read; every failure while the file is decoded is one ``ValueError`` line, raised when the
+    curve is asked for.  A file without curves yields none."""
     _afmformats()
-    size = len(read_input_bytes(path))
+    size = len(read_input_bytes(path))  # a regular file of bounded size: never a FIFO, a device or a folder
     if check_sizes is not None:
         check_sizes(path, size)
+    sha256 = sha256_of(path)
     with afmformats_boundary(path):
         datasets = load(path, meta_override)
-        # afmformats loads a curve's columns when they are first read: inside the boundary too
-        curves = curves_from_afm(datasets, path, sha256=sha256_of(path))
-        if not curves:
-            raise AFMFileError(f"{printable(path)}: afmformats found no force-distance curve in it")
-        return curves
+        # a JPK archive's count from its list of members, before its first curve; any other as it is read
+        declared = len(datasets) if hasattr(datasets, "__len__") else None
+        over = declared is not None and declared > MAX_MAP_CURVES
+        for i, ds in enumerate(() if over else datasets):
+            if i >= MAX_MAP_CURVES:
+                over = True
+                break
+            # afmformats loads a curve's columns when they are first read: inside the boundary too
+            yield curve_from_afm(ds, i, path, sha256=sha256)
+        if over:
+            count = declared if declared is not None and declared > MAX_MAP_CURVES else f"more than {MAX_MAP_CURVES}"
+            raise AFMFileError(f"{printable(path)}: {count} curves; shellbvp fits at most {MAX_MAP_CURVES} curves "
+                               f"of a map (MAX_MAP_CURVES): cut the map into parts")
 
 
 def load_with_afmformats(path, meta_override=None):
@@ -142,43 +168,45 @@ def _meta(md, key):
 
 def curves_from_afm(datasets, path, *, sha256=None) -> list:
     """:class:`AFMCurve` from afmformats' curves (``AFMForceDistance``) of the file ``path``."""
-    out = []
-    for i, ds in enumerate(datasets):
-        columns = list(ds.columns)
-        md = ds.metadata
-        where = f"{printable(path)}, curve {i}"
-        if "force" not in columns:
-            raise AFMFileError(f"{where}: no force column (columns: {printable(', '.join(map(str, columns)))})")
-        force = np.asarray(ds["force"], float)
-        if "tip position" in columns:
-            tip, how = np.asarray(ds["tip position"], float), "-(tip position)"
-        else:
-            height = next((h for h in ("height (measured)", "height (piezo)") if h in columns), None)
-            k = _meta(md, "spring constant")
-            if height is None or k is None or not k > 0:
-                raise AFMFileError(f"{where}: needs a height column and the spring constant to place the tip "
-                                 f"(columns: {printable(', '.join(map(str, columns)))}; spring constant: {k})")
-            tip, how = np.asarray(ds[height], float) + force / k, f"-({height} + force / spring constant)"
-        time = np.asarray(ds["time"], float) if "time" in columns else None
-        ok = np.isfinite(tip) & np.isfinite(force) & (np.isfinite(time) if time is not None else True)
-        if ok.sum() < 3:
-            raise AFMFileError(f"{where}: fewer than 3 rows with numbers")
-        record = record_from_arrays(path, -tip[ok], force[ok], None if time is None else time[ok],
-                                    np.flatnonzero(ok), columns={"displacement": how, "force": "force",
-                                                                 **({"time": "time"} if time is not None else {})},
-                                    units={"displacement": "m", "force": "N", **({"time": "s"} if time is not None
-                                                                               else {})},
-                                    header=columns, sha256=sha256)
-        ix, iy = _meta(md, "grid index x"), _meta(md, "grid index y")
-        x, y = _meta(md, "position x"), _meta(md, "position y")
-        index = _meta(md, "enum")
-        geometry = [_meta(md, f"grid {a} {b}") for a in ("center", "size") for b in "xy"]
-        out.append(AFMCurve(record=record, index=int(index) if index is not None else i,
-                            grid=(int(ix), int(iy)) if ix is not None and iy is not None else None,
-                            position=(float(x), float(y)) if x is not None and y is not None else None,
-                            grid_geometry=((geometry[0], geometry[1]), (geometry[2], geometry[3]))
-                            if None not in geometry else None))
-    return out
+    return [curve_from_afm(ds, i, path, sha256=sha256) for i, ds in enumerate(datasets)]
+
+
+def curve_from_afm(ds, i, path, *, sha256=None) -> AFMCurve:
+    """The :class:`AFMCurve` of afmformats' curve ``ds``, the ``i``-th of the file ``path``."""
+    columns = list(ds.columns)
+    md = ds.metadata
+    where = f"{printable(path)}, curve {i}"
+    if "force" not in columns:
+        raise AFMFileError(f"{where}: no force column (columns: {printable(', '.join(map(str, columns)))})")
+    force = np.asarray(ds["force"], float)
+    if "tip position" in columns:
+        tip, how = np.asarray(ds["tip position"], float), "-(tip position)"
+    else:
+        height = next((h for h in ("height (measured)", "height (piezo)") if h in columns), None)
+        k = _meta(md, "spring constant")
+        if height is None or k is None or not k > 0:
+            raise AFMFileError(f"{where}: needs a height column and the spring constant to place the tip "
+                               f"(columns: {printable(', '.join(map(str, columns)))}; spring constant: {k})")
+        tip, how = np.asarray(ds[height], float) + force / k, f"-({height} + force / spring constant)"
+    time = np.asarray(ds["time"], float) if "time" in columns else None
+    ok = np.isfinite(tip) & np.isfinite(force) & (np.isfinite(time) if time is not None else True)
+    if ok.sum() < 3:
+        raise AFMFileError(f"{where}: fewer than 3 rows with numbers")
+    record = record_from_arrays(path, -tip[ok], force[ok], None if time is None else time[ok],
+                                np.flatnonzero(ok), columns={"displacement": how, "force": "force",
+                                                             **({"time": "time"} if time is not None else {})},
+                                units={"displacement": "m", "force": "N", **({"time": "s"} if time is not None
+                                                                           else {})},
+                                header=columns, sha256=sha256)
+    ix, iy = _meta(md, "grid index x"), _meta(md, "grid index y")
+    x, y = _meta(md, "position x"), _meta(md, "position y")
+    index = _meta(md, "enum")
+    geometry = [_meta(md, f"grid {a} {b}") for a in ("center", "size") for b in "xy"]
+    return AFMCurve(record=record, index=int(index) if index is not None else i,
+                    grid=(int(ix), int(iy)) if ix is not None and iy is not None else None,
+                    position=(float(x), float(y)) if x is not None and y is not None else None,
+                    grid_geometry=((geometry[0], geometry[1]), (geometry[2], geometry[3]))
+                    if None not in geometry else None)
 
 
 def check_archive(path, size) -> None:

@@ -21,6 +21,9 @@ from pathlib import Path
 import numpy as np
 
 from . import readers
+from .afm_read import AFMCurve
+from .map_fit import finish, fit_pixels, read_pixels, record_depth
+from .map_pixels import curve_rows, rows_per_curve
 from .scene_parameters import LiveNames
 from .shape_parameters import DERIVED, SHAPE_PARAMETERS
 from .textdata import table_cell
@@ -69,6 +72,11 @@ class BatchRow:
     used : ndarray of bool or None
         The rows fitted.
     message : str
+    extra : dict
+        More columns of its table row (a map's: the file's ``sha256``, a pixel table's value).
+    curve_rows : CurveRows or None
+        A force map's row (:func:`fit_map`, which keeps no ``record``): the rows fitted, thinned,
+        with the model at them (:class:`shellbvp.map_pixels.CurveRows`), for the pixel's view.
     """
 
     file: str
@@ -78,6 +86,7 @@ class BatchRow:
     used: object = None
     message: str = ""
     extra: dict = field(default_factory=dict)
+    curve_rows: object = None
 
     def table_row(self, segment: str) -> dict:
         """This file's row of the results table (:data:`TABLE_COLUMNS`)."""
@@ -279,27 +288,24 @@ def fit_records(scene, named, *, R_L, segment="loading", baseline="auto", on_fil
 def _depths(records, segment, R_L) -> dict:
     """``{name: deepest datum's delta}`` of each record's ``segment`` beyond its contact estimate
     (records whose segment cannot be read are left out: their fits say why)."""
-    from .instrument import estimate_contact
-
-    depths = {}
-    for path, rec in records.items():
-        try:
-            m = rec.mask(segment)
-            d, f = rec.displacement[m], rec.force[m]
-            guess = estimate_contact(d, f)
-            depths[path] = (np.max(d) - (guess if guess is not None else min(0.0, np.min(d)))) / R_L
-        except ValueError:
-            pass
-    return depths
+    depths = {path: record_depth(rec, segment, R_L) for path, rec in records.items()}
+    return {path: v for path, v in depths.items() if v is not None}
 
 
 def fit_map(scene, curves, *, R_L, path=None, segment="loading", baseline="auto", on_curve=None,
             pixel_values=None, **options):
-    """Fit every curve of a force map (:func:`shellbvp.afm.read_afm`) with one scene: a
-    :class:`shellbvp.afm.ForceMap`.
+    """Fit every curve of a force map (:func:`shellbvp.afm.read_afm`, or one at a time
+    :func:`shellbvp.afm_read.iter_afm`) with one scene: a :class:`shellbvp.afm.ForceMap`.
 
-    Curves of comparable depth share one model curve (:func:`fit_records`), so a
-    map costs about one model curve plus a cheap least-squares fit per curve.
+    The curves are taken once, in order: of each only the rows fitted are kept (in a temporary
+    file) and its place on the map (:func:`shellbvp.map_fit.read_pixels`).  Curves of comparable
+    depth share one model curve (as :func:`fit_records`), and their fits run together on it in
+    chunks (:func:`shellbvp.map_fit.fit_pixels`, :mod:`shellbvp.fitting.batched`): a map costs
+    about one model curve plus a cheap least-squares fit per curve, its results per curve the
+    same as one :func:`shellbvp.fitting.fit_record` each.  The rows keep each fit's numbers and
+    its fitted rows thinned with the model at them (``BatchRow.curve_rows``: what the map file
+    keeps for a pixel's view, :mod:`shellbvp.map_pixels`), not the records (``BatchRow.record``
+    and ``used`` are None; the file's checksum is in ``extra``).
 
     With ``pixel_values`` (a :class:`shellbvp.pixel_table.PixelTable`: a shape parameter per
     pixel, e.g. the thickness from :func:`shellbvp.pixel_table.read_pixel_table`) each pixel's
@@ -310,23 +316,52 @@ def fit_map(scene, curves, *, R_L, path=None, segment="loading", baseline="auto"
     this map and scene (a pixel outside the grid, a value out of range, a map without grid
     indices) is a ``ValueError`` before any curve.
     """
-    from .afm import AFMCurve, ForceMap, map_shape
+    from .afm import ForceMap, map_shape
 
-    if not curves:
-        raise ValueError("fit_map: no curves")
-    path = path or curves[0].record.path
-    named = [(f"{path}#{c.index}", c.record) for c in curves]
-    grids = [c.grid for c in curves if c.grid is not None]
-    shape = map_shape(curves, path)  # bounded before any curve is fitted
-    settings = {"baseline": baseline, **{k: v for k, v in options.items() if k != "progress"}}
-    if pixel_values is not None:
-        return _fit_map_per_pixel(scene, curves, named, shape, pixel_values, R_L=R_L, path=path, segment=segment,
-                                  baseline=baseline, on_curve=on_curve, settings=settings, **options)
-    rows = fit_records(scene, named, R_L=R_L, segment=segment, baseline=baseline, on_file=on_curve, **options)
-    if not grids:  # no grid in the file: one row in file order
-        curves = [AFMCurve(c.record, c.index, (i, 0), c.position, c.grid_geometry) for i, c in enumerate(curves)]
-    return ForceMap(path=str(path), curves=curves, rows=rows, shape=shape, scene=scene, R_L=R_L, segment=segment,
-                    settings=settings)
+    pixels, store = read_pixels(curves, path, R_L=R_L, segment=segment, baseline=baseline,
+                                fit_offset=options.get("fit_offset", True))
+    try:
+        if not pixels:
+            raise ValueError("fit_map: no curves")
+        path = path or pixels[0].name.rsplit("#", 1)[0]
+        light = [p.curve for p in pixels]
+        shape = map_shape(light, path)  # bounded before any curve is fitted
+        settings = {"baseline": baseline, **{k: v for k, v in options.items() if k != "progress"}}
+        sha = pixels[0].sha256
+        if pixel_values is not None:
+            return _fit_map_per_pixel(scene, pixels, store, shape, pixel_values, R_L=R_L, path=path,
+                                      segment=segment, on_curve=on_curve, settings=settings, **options)
+        fitted, rows = fit_pixels(scene, pixels, store, R_L=R_L, **options), []
+        budget = rows_per_curve(len(pixels))
+        for p in pixels:  # the fits come in the pixels' order, with their rows
+            res, data = next(fitted)[1:] if p.rows is not None else (None, None)
+            rows.append(_map_row(p, res, data, budget))
+            if on_curve is not None:
+                on_curve(rows[-1])
+    finally:
+        store.close()
+    if not any(c.grid is not None for c in light):  # no grid in the file: one row in file order
+        light = [AFMCurve(None, c.index, (i, 0), c.position, c.grid_geometry) for i, c in enumerate(light)]
+    return ForceMap(path=str(path), curves=light, rows=rows, shape=shape, scene=scene, R_L=R_L, segment=segment,
+                    settings=settings, sha256=sha)
+
+
+def _map_row(pixel, res, data, budget, extra=None, message=None):
+    """A map's :class:`BatchRow` of ``pixel`` and its fit (a FitResult or the ValueError; None:
+    its segment could not be read, ``pixel.error``, or ``message`` says why it was not fitted),
+    with its fitted rows ``data`` (``(d, f)``, or None) thinned to ``budget`` rows."""
+    extra = {"sha256": pixel.sha256, **(extra or {})}
+    if res is None:
+        row = BatchRow(file=pixel.name, status="error", message=message or pixel.error, extra=extra)
+    elif isinstance(res, Exception):
+        row = BatchRow(file=pixel.name, status="error", message=" ".join(str(res).split()), extra=extra)
+    else:
+        row = BatchRow(file=pixel.name, status="ok" if res.success else "failed", result=res, message=res.message,
+                       extra=extra)
+    if data is not None:
+        row.curve_rows = curve_rows(*data, res if row.status != "error" else None, budget)
+    log.info("map: %s: %s", pixel.name, row.status)
+    return row
 
 
 #: The most model curves a map with a geometry per pixel computes (nodes and checks)
@@ -429,56 +464,55 @@ def shared_curves(scene, name, values, grid, need, tol, *, interpolation_tol=Non
     return curves
 
 
-def _fit_map_per_pixel(scene, curves, named, shape, table, *, R_L, path, segment, baseline, on_curve, settings,
+def _fit_map_per_pixel(scene, pixels, store, shape, table, *, R_L, path, segment, on_curve, settings,
                        tol=1e-6, delta_max=None, progress=None, **options):
     """:func:`fit_map` with a shape parameter per pixel from ``table``."""
     from .afm import ForceMap
-    from .fitting import N_DEPTHS, fit_record
+    from .fitting import N_DEPTHS, fit
     from .shape_parameters import shape_parameter
 
     param = shape_parameter(table.name)
+    curves = [p.curve for p in pixels]
     xs = _pixel_values_checked(scene, curves, shape, table, R_L, options)
-    rows, records = {}, {}
-    for c, (name, rec) in zip(curves, named):
-        if c.grid not in xs:
-            rows[name] = BatchRow(file=name, status="error", record=rec,
-                                  message=f"pixel {c.grid} is not in the pixel table {table.path}")
-        else:
-            records[name] = rec
-    if not records:
+    inside = [p for p in pixels if p.curve.grid in xs]
+    if not inside:
         raise ValueError(f"{table.path}: none of the map's pixels is in the table")
-    depths = [v for v in _depths(records, segment, R_L).values() if math.isfinite(v) and v > 0]
+    depths = [p.depth for p in inside if p.depth is not None and math.isfinite(p.depth) and p.depth > 0]
     shared = None
     if depths:
         need = max(depths)
         dm = float(delta_max) if delta_max is not None else 1.2 * need
         grid = dm * np.arange(1, N_DEPTHS + 1) / N_DEPTHS
-        values = [xs[c.grid] for c in curves if f"{path}#{c.index}" in records]
-        shared = shared_curves(scene, table.name, values, grid, need, tol, progress=progress)
-    out = []
-    for c, (name, rec) in zip(curves, named):
-        if name not in rows:
-            x = xs[c.grid]
-            try:
-                if shared is None:
-                    raise ValueError("no depth of indentation could be read from any curve of the map")
-                res, used = fit_record(param.set(scene, x), rec, R_L=R_L, segment=segment, baseline=baseline,
-                                       shared=(shared, param.to_theta(x)), tol=tol, **options)
-                rows[name] = BatchRow(file=name, status="ok" if res.success else "failed", result=res, record=rec,
-                                      used=used, message=res.message)
-            except ValueError as exc:
-                rows[name] = BatchRow(file=name, status="error", record=rec, message=" ".join(str(exc).split()))
-            rows[name].extra[_pixel_column(param)] = _num(param.reported(x, R_L))
-        log.info("map: %s: %s", name, rows[name].status)
-        out.append(rows[name])
+        shared = shared_curves(scene, table.name, [xs[p.curve.grid] for p in inside], grid, need, tol,
+                               progress=progress)
+    out, budget = [], rows_per_curve(len(pixels))
+    for p in pixels:
+        grid_at = p.curve.grid
+        data = store.get(p.rows) if p.rows is not None else None
+        if grid_at not in xs:
+            row = _map_row(p, None, data, budget, message=f"pixel {grid_at} is not in the pixel table {table.path}")
+        else:
+            x = xs[grid_at]
+            res = None
+            if data is not None:
+                try:
+                    if shared is None:
+                        raise ValueError("no depth of indentation could be read from any curve of the map")
+                    res = fit(param.set(scene, x), *data, R_L=R_L, baseline=p.baseline, contact_guess=p.guess,
+                              shared=(shared, param.to_theta(x)), tol=tol, **options)
+                    res = finish(res, p)
+                except ValueError as exc:
+                    res = exc
+            row = _map_row(p, res, data, budget, {_pixel_column(param): _num(param.reported(x, R_L))})
+        out.append(row)
         if on_curve is not None:
-            on_curve(rows[name])
+            on_curve(row)
     nodes = tuple(float(param.reported(param.from_theta(t), R_L)) for t in shared.thetas) if shared else ()
     return ForceMap(path=str(path), curves=curves, rows=out, shape=shape, scene=scene, R_L=R_L, segment=segment,
                     settings=settings, pixel_values=table,
                     pixel_nodes=nodes, curves_computed=shared.counter[0] if shared else 0,
                     interpolation_error=shared.interpolation_error if shared else None,
-                    notes=list(shared.notes) if shared else [])
+                    notes=list(shared.notes) if shared else [], sha256=pixels[0].sha256)
 
 
 def _pixel_column(param) -> str:

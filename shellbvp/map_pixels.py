@@ -19,6 +19,10 @@ kept, half of them at or beyond the fitted contact point, a quarter within one c
 before it and a quarter from the rest, and at most :data:`MAX_STORED_ROWS` over the whole map (a
 map of more than 2097 curves keeps fewer per curve).  A map file written before this layout has neither: it still
 shows the map and each curve's numbers (:meth:`MapCurves.pixel`), not its data and model.
+
+A map fitted in one pass (:func:`shellbvp.batch.fit_map`) keeps no records: each curve's rows are
+thinned when it is fitted, with the model at them (:func:`curve_rows`, :class:`CurveRows` in its
+row), so that a map holds at most :data:`MAX_STORED_ROWS` rows whatever its size.
 """
 
 from __future__ import annotations
@@ -31,8 +35,9 @@ import numpy as np
 from .nexus import number_dataset, string_dataset
 from .textdata import printable
 
-__all__ = ["MapPixel", "MapCurves", "MAX_ROWS_PER_CURVE", "MAX_STORED_ROWS", "PIXEL_CHOICES", "thin_rows",
-           "rows_per_curve", "write_curve_data", "read_curves", "parse_pixel", "pixel_of_row", "locate"]
+__all__ = ["MapPixel", "MapCurves", "CurveRows", "curve_rows", "MAX_ROWS_PER_CURVE", "MAX_STORED_ROWS",
+           "PIXEL_CHOICES", "thin_rows", "rows_per_curve", "write_curve_data", "read_curves", "parse_pixel",
+           "pixel_of_row", "locate"]
 
 #: At most this many of a curve's fitted rows are stored (enough for a figure)
 MAX_ROWS_PER_CURVE = 1000
@@ -81,23 +86,61 @@ def thin_rows(rows, displacement, offset, budget=MAX_ROWS_PER_CURVE) -> np.ndarr
     return np.sort(np.concatenate([_evenly(g, k) for g, k in zip(groups, take)]))
 
 
-def _row_arrays(record, used, result, segment, budget):
-    """``(displacement, force, model_force, rows fitted)`` of one curve, thinned (empty arrays
-    when its rows cannot be read)."""
-    empty = np.empty(0)
-    if record is None:
-        return empty, empty, empty, 0
-    if used is None:  # an error row: the segment's rows, if they can be read
-        try:
-            used = record.mask(segment)
-        except ValueError:
-            return empty, empty, empty, 0
-    rows = np.flatnonzero(np.asarray(used, bool))
-    d, f = np.asarray(record.displacement, float), np.asarray(record.force, float)
+@dataclass
+class CurveRows:
+    """One curve's fitted rows as a map keeps them without its record: thinned
+    (:func:`thin_rows`), with the fitted model at them, float32 as the map file stores them.
+
+    Attributes
+    ----------
+    displacement, force, model_force : ndarray
+        m, N, N (``model_force`` NaN: no fit).
+    rows_fitted : int
+        The rows the fit used, before thinning.
+    offset : float
+        The fitted contact point (m; NaN: no fit), where a thinner file thins them again.
+    """
+
+    displacement: np.ndarray
+    force: np.ndarray
+    model_force: np.ndarray
+    rows_fitted: int
+    offset: float = math.nan
+
+
+def curve_rows(d, f, result, budget=MAX_ROWS_PER_CURVE) -> CurveRows:
+    """The :class:`CurveRows` of a curve's fitted rows ``d``, ``f`` (m, N, in the record's
+    order) and its fit ``result`` (a FitResult, or None: no model), at most ``budget`` rows."""
+    d, f = np.asarray(d, float), np.asarray(f, float)
     offset = result.offset if result is not None and result.offset is not None else math.nan
-    keep = thin_rows(rows, d, offset, budget)
+    keep = thin_rows(np.arange(d.size), d, offset, budget)
     model = np.asarray(result.model_force(d[keep]), float) if result is not None else np.full(keep.size, np.nan)
-    return d[keep], f[keep], model, rows.size
+    return CurveRows(*(a.astype(np.float32) for a in (d[keep], f[keep], model)), rows_fitted=int(d.size),
+                     offset=float(offset))
+
+
+def _row_arrays(row, result, segment, budget):
+    """``(displacement, force, model_force, rows fitted)`` of one curve of a map (its
+    :class:`~shellbvp.batch.BatchRow`: its kept :class:`CurveRows`, else its record's rows),
+    thinned, float32 (empty arrays when its rows cannot be read)."""
+    empty = np.empty(0, np.float32)
+    kept = getattr(row, "curve_rows", None)
+    if kept is None:
+        record, used = row.record, row.used
+        if record is None:
+            return empty, empty, empty, 0
+        if used is None:  # an error row: the segment's rows, if they can be read
+            try:
+                used = record.mask(segment)
+            except ValueError:
+                return empty, empty, empty, 0
+        rows = np.flatnonzero(np.asarray(used, bool))
+        kept = curve_rows(record.displacement[rows], record.force[rows], result, budget)
+    arrays = (kept.displacement, kept.force, kept.model_force)
+    if kept.displacement.size > budget:  # kept for a larger budget: thinned again
+        keep = thin_rows(np.arange(kept.displacement.size), kept.displacement, kept.offset, budget)
+        arrays = tuple(a[keep] for a in arrays)
+    return (*arrays, kept.rows_fitted)
 
 
 def rows_per_curve(n_curves, max_rows=MAX_STORED_ROWS) -> int:
@@ -130,7 +173,7 @@ def write_curve_data(entry, rows, segment="loading", max_rows=MAX_STORED_ROWS):
     string_dataset(c, "warnings", [_joined(r, "warnings", " | ") for r in results],
                    "the fit's warnings, joined by ' | '")
     budget = rows_per_curve(len(rows), max_rows)
-    parts = [_row_arrays(r.record, r.used, res, segment, budget) for r, res in zip(rows, results)]
+    parts = [_row_arrays(r, res, segment, budget) for r, res in zip(rows, results)]
     start = np.r_[0, np.cumsum([p[0].size for p in parts])].astype(np.int64)
     g = entry.create_group("curve_data")
     g.attrs.update({"NX_class": "NXcollection", "max_rows_per_curve": budget})
@@ -139,7 +182,8 @@ def write_curve_data(entry, rows, segment="loading", max_rows=MAX_STORED_ROWS):
                                              ("force", "N", "force as read, the fitted rows (thinned)"),
                                              ("model_force", "N", "fitted model at those rows, baseline included; "
                                               "NaN: no fit"))):
-        data = np.concatenate([p[k] for p in parts]).astype(np.float32) if parts else np.empty(0, np.float32)
+        data = np.concatenate([p[k] for p in parts]).astype(np.float32, copy=False) if parts else \
+            np.empty(0, np.float32)
         ds = g.create_dataset(name, data=data, compression="gzip" if data.size else None,
                               shuffle=bool(data.size))
         ds.attrs.update({"units": unit, "long_name": what})
@@ -210,7 +254,8 @@ def pixel_of_row(curve, row, n_curves, segment="loading", source="") -> MapPixel
     """The :class:`MapPixel` of one curve of an in-memory map (``curve``, its ``row``), thinned
     as :func:`write_curve_data` stores it for a map of ``n_curves`` curves."""
     res = row.result if row.status in ("ok", "failed") else None
-    d, f, m, n = _row_arrays(row.record, row.used, res, segment, rows_per_curve(n_curves))
+    *arrays, n = _row_arrays(row, res, segment, rows_per_curve(n_curves))
+    d, f, m = (np.asarray(a, float) for a in arrays)
     nan = math.nan
     return MapPixel(grid=tuple(curve.grid), index=int(curve.index), status=row.status, message=row.message,
                     mu_H=nan if res is None else float(res.mu_H),

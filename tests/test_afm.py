@@ -132,7 +132,7 @@ def test_cli_fits_a_map_into_a_table_a_file_and_a_figure(synthetic_map, tmp_path
     scene, curves = synthetic_map
     path = tmp_path / "cells.jpk-force-map"
     path.write_bytes(b"")  # the file the command names; its curves come from the fixture
-    monkeypatch.setattr(afm, "read_afm", lambda p, **calibration: curves)
+    monkeypatch.setattr(afm, "iter_afm", lambda p, **calibration: iter(curves))
     argv = ["fit", str(path), "--preset", "fit", "--radius", "10um", "-o", str(tmp_path / "m.h5"),
             "--table", str(tmp_path / "m.csv"), "--report", str(tmp_path / "m.png")]
     assert main(argv) == 0

@@ -38,9 +38,10 @@ def _with_force(curve, force):
 
 @pytest.fixture(scope="module")
 def fitted(tmp_path_factory):
-    """``(ForceMap, map file, maker)``: (0, 0) and (1, 1) the model's curves, (1, 0) with a
-    wave on its loading (the fit runs and fails its checks), (0, 1) pulled instead of pushed
-    (refused before a fit: an error row with its data)."""
+    """``(ForceMap, map file, {grid: the curve's record})``: (0, 0) and (1, 1) the model's
+    curves, (1, 0) with a wave on its loading (the fit runs and fails its checks), (0, 1) pulled
+    instead of pushed (refused before a fit: an error row with its data).  The map keeps no
+    records: the test keeps the curves it fitted."""
     maker = _maker()
     folder = tmp_path_factory.mktemp("pixels")
     path = folder / "cells.jpk-force-map"
@@ -52,12 +53,14 @@ def fitted(tmp_path_factory):
                                      np.where(push, f + 0.3 * f.max() * np.sin(np.linspace(0, 40, f.size)), f))
     f, push = curves[at[ERROR]].record.force, curves[at[ERROR]].record.mask("loading")
     curves[at[ERROR]] = _with_force(curves[at[ERROR]], np.where(push, -f, f))
-    fm = fit_map(sb.Scene.preset("fit"), curves, R_L=maker.R_L, path=str(path))
+    records = {c.grid: c.record for c in curves}
+    fm = fit_map(sb.Scene.preset("fit"), iter(curves), R_L=maker.R_L, path=str(path))
     status = {c.grid: r.status for c, r in zip(fm.curves, fm.rows)}
     assert status == {GOOD: "ok", (1, 1): "ok", FAILED: "failed", ERROR: "error"}, [r.message for r in fm.rows]
+    assert all(r.record is None and r.used is None and r.curve_rows is not None for r in fm.rows)
     out = folder / "map.h5"
     fm.to_hdf5(out)
-    return fm, out
+    return fm, out, records
 
 
 def test_the_map_file_keeps_each_curves_fitted_rows_and_model_with_units(fitted):
@@ -65,7 +68,7 @@ def test_the_map_file_keeps_each_curves_fitted_rows_and_model_with_units(fitted)
 
     from shellbvp.nexus import missing_units
 
-    fm, out = fitted
+    fm, out, records = fitted
     assert missing_units(out) == []
     with h5py.File(out) as f:
         g = f["entry/curve_data"]
@@ -77,8 +80,8 @@ def test_the_map_file_keeps_each_curves_fitted_rows_and_model_with_units(fitted)
     mf = read_map_file(out)
     for c, row in zip(fm.curves, fm.rows):
         px = mf.pixel(*c.grid)
-        rec = row.record
-        used = row.used if row.used is not None else rec.mask("loading")
+        rec = records[c.grid]
+        used = rec.mask("loading")  # the rows fitted (and an error row's segment)
         assert px.rows_fitted == used.sum() == px.displacement.size  # 150 rows or so: all kept
         np.testing.assert_allclose(px.displacement, rec.displacement[used], rtol=1e-6)
         np.testing.assert_allclose(px.force, rec.force[used], rtol=1e-6, atol=1e-6 * np.abs(rec.force).max())
@@ -97,7 +100,7 @@ def test_the_map_file_keeps_each_curves_fitted_rows_and_model_with_units(fitted)
 def test_the_view_of_a_good_and_a_failed_pixel_shows_their_residuals(fitted, tmp_path):
     import matplotlib.pyplot as plt
 
-    fm, out = fitted
+    fm, out, _ = fitted
     mf = read_map_file(out)
     rms = {}
     for grid, verdict in ((GOOD, "fit, quality good"), (FAILED, "FAILED fit, quality poor")):
@@ -123,7 +126,7 @@ def test_the_view_of_a_good_and_a_failed_pixel_shows_their_residuals(fitted, tmp
 def test_an_error_pixel_shows_its_data_without_a_model(fitted):
     import matplotlib.pyplot as plt
 
-    _, out = fitted
+    _, out, _ = fitted
     mf = read_map_file(out)
     px = mf.pixel(*ERROR)
     assert px.status == "error" and "force falls as the displacement grows" in px.message
@@ -136,7 +139,7 @@ def test_an_error_pixel_shows_its_data_without_a_model(fitted):
 
 
 def test_pixels_off_the_map_are_one_line_with_the_valid_range(fitted):
-    fm, out = fitted
+    fm, out, _ = fitted
     mf = read_map_file(out)
     for where in (mf, fm):
         with pytest.raises(ValueError, match=r"^pixel \(2, 0\) is outside the map's 2 x 2 grid: ix 0\.\.1, iy 0\.\.1$"):
@@ -151,7 +154,7 @@ def test_pixels_off_the_map_are_one_line_with_the_valid_range(fitted):
 
 
 def test_cli_draws_one_pixel_or_one_figure_per_pixel_and_refuses_too_many(fitted, tmp_path, capsys):
-    _, out = fitted
+    _, out, _ = fitted
     png = tmp_path / "p.png"
     assert main(["plot", str(out), "--pixel", "0,0", "-o", str(png)]) == 0 and png.stat().st_size > 0
     figs = tmp_path / "figs"
@@ -174,7 +177,7 @@ def test_cli_draws_one_pixel_or_one_figure_per_pixel_and_refuses_too_many(fitted
 
 
 def test_pixel_options_are_for_one_force_map_file(fitted, tmp_path, capsys):
-    _, out = fitted
+    _, out, _ = fitted
     other = tmp_path / "data.csv"
     other.write_text("d,F\n0,0\n")
     assert main(["plot", str(other), "--pixel", "0,0"]) == 2
@@ -188,7 +191,7 @@ def test_an_older_map_file_reads_and_says_what_it_cannot_show(fitted, tmp_path, 
     reads: the map, each curve's numbers; the view says why it cannot draw a pixel."""
     import h5py
 
-    _, out = fitted
+    _, out, _ = fitted
     old = tmp_path / "old.h5"
     shutil.copy(out, old)
     with h5py.File(old, "a") as f:
@@ -212,7 +215,7 @@ def test_an_older_map_file_reads_and_says_what_it_cannot_show(fitted, tmp_path, 
 def test_damaged_curve_data_is_one_line_naming_it(fitted, tmp_path):
     import h5py
 
-    _, out = fitted
+    _, out, _ = fitted
     bad = tmp_path / "bad.h5"
     shutil.copy(out, bad)
     with h5py.File(bad, "a") as f:
@@ -245,7 +248,7 @@ def test_thinning_keeps_the_contact_and_bounds_the_rows(fitted, tmp_path):
     from shellbvp.map_pixels import read_curves, rows_per_curve, write_curve_data
 
     assert rows_per_curve(4) == 1000 and rows_per_curve(128 * 128) == 128 and rows_per_curve(1024 * 1024) == 2
-    fm, out = fitted   # a map of many curves keeps fewer rows each: 200 rows over 4 curves here
+    fm, out, records = fitted   # a map of many curves keeps fewer rows each: 200 rows over 4 curves here
     small = tmp_path / "small.h5"
     shutil.copy(out, small)
     with h5py.File(small, "a") as f:
@@ -255,9 +258,9 @@ def test_thinning_keeps_the_contact_and_bounds_the_rows(fitted, tmp_path):
         curves = read_curves(f, fm.shape)
     assert np.diff(curves.start).max() == 50
     px = curves.pixel(*GOOD)
-    row = next(r for c, r in zip(fm.curves, fm.rows) if c.grid == GOOD)
-    assert px.displacement.size == 50 < px.rows_fitted == row.used.sum()
-    assert px.displacement.max() == pytest.approx(row.record.displacement[row.used].max(), rel=1e-6)  # the deepest
+    used = records[GOOD].mask("loading")
+    assert px.displacement.size == 50 < px.rows_fitted == used.sum()
+    assert px.displacement.max() == pytest.approx(records[GOOD].displacement[used].max(), rel=1e-6)  # the deepest
 
 
 def test_the_modules_docstring_examples_run():

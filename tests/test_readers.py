@@ -92,3 +92,36 @@ def test_a_new_reader_is_one_declaration(tmp_path):
     finally:
         registry.READERS.remove(fdx)
     assert readers.reader_for(tmp_path / "seed.fdx").name == "text table"
+
+
+def test_curves_stream_one_at_a_time_through_the_registry_and_a_map_is_bounded():
+    """iter_curves (shellbvp.afm.iter_afm) gives the reader's curves lazily, the same as
+    read_curves; its options are checked at once, and a file of more curves than MAX_MAP_CURVES
+    is refused before its first curve is decoded."""
+    from shellbvp import afm_read
+    from shellbvp.afm import iter_afm, read_afm
+
+    qi = DATA / "qi-data-2x2.jpk-qi-data"
+    assert readers.reader_for(qi).iterate is not None
+    whole, stream = read_afm(qi), iter_afm(qi)
+    assert not isinstance(stream, list)
+    first = next(stream)
+    assert first.grid == whole[0].grid and np.array_equal(first.record.force, whole[0].record.force)
+    assert [c.grid for c in stream] == [c.grid for c in whole[1:]]
+    with pytest.raises(ValueError, match="carries the cantilever's calibration"):
+        iter_afm(qi, spring_constant=0.1)  # not a generator: refused before any reading
+    decoded = []
+
+    class Declared:  # what a JPK archive of more curves than the bound gives: its count, then its curves
+        def __len__(self):
+            return afm_read.MAX_MAP_CURVES + 1
+
+        def __iter__(self):
+            decoded.append(1)
+            return iter(())
+
+    with pytest.raises(ValueError, match=rf"qi-data-2x2.jpk-qi-data: {afm_read.MAX_MAP_CURVES + 1} curves; "
+                                         rf"shellbvp fits at most {afm_read.MAX_MAP_CURVES} curves of a map \(MAX_MAP_CURVES\): "
+                                         rf"cut the map into parts"):
+        next(afm_read.iter_afm(qi, load=lambda path, meta_override: Declared()))
+    assert decoded == []  # refused before its first curve

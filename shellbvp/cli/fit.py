@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import itertools
 import json
 import sys
 from pathlib import Path
@@ -240,7 +241,7 @@ def run(args):
         raise ValueError("give data files (or a directory) or --example (one of them)")
     if len(args.data) == 1 and not any(ch in args.data[0] for ch in "*?[") and not Path(args.data[0]).exists():
         raise ValueError(f"{args.data[0]}: no such file or directory")  # before the numerics are imported
-    from ..afm import read_afm
+    from ..afm import iter_afm
     from ..batch import expand_inputs, read_record
     from ..fitting import example_data_path, fit_record
     from ..paths import check_output_path
@@ -255,11 +256,14 @@ def run(args):
     if len(files) == 1 and not folder and reader_for(files[0]).curves:  # a file of curves: a force map?
         # its one-line error before the file is read
         require_sample(args, bending_per_pixel=_bending_per_pixel(pixel_values))
-        curves = read_afm(files[0], **_calibration(args))
-        if len(curves) > 1:  # a force map: every curve, into a map
+        curves = iter_afm(files[0], **_calibration(args))  # one at a time: a map is never all in memory
+        first = list(itertools.islice(curves, 2))
+        if not first:
+            raise ValueError(f"{printable(files[0])}: afmformats found no force-distance curve in it")
+        if len(first) > 1:  # a force map: every curve, into a map
             if uncertainty:
                 raise ValueError("VALUE+-U (the geometry's uncertainty) is for one curve, not a force map")
-            map_curves = curves
+            map_curves = itertools.chain(first, curves)
     if pixel_values is not None and map_curves is None:
         raise ValueError(f"--pixel-table is for a force map; {files[0]} holds one curve")
     if map_curves is None and (len(files) > 1 or args.table or folder):
@@ -398,7 +402,7 @@ def _fit_map(args, path, curves, scene, R_L, reading, options, pixel_values=None
     if args.table is not None:
         check_output_path(args.table, overwrite=args.force)
     options = dict(options, progress=curve_bars(args, leave=False))
-    bar = progress_bar(len(curves), "curve", args)
+    bar = progress_bar(None, "curve", args)
 
     def step(row):
         bar.update(1)
@@ -429,7 +433,7 @@ def _fit_map(args, path, curves, scene, R_L, reading, options, pixel_values=None
         for w in wrote:
             print(f"wrote {w}", file=sys.stderr)
     else:
-        say(f"data   = {path}: a force map of {len(curves)} curves; fitted the {args.segment} segment of each")
+        say(f"data   = {path}: a force map of {len(fm.rows)} curves; fitted the {args.segment} segment of each")
         say(f"scene  = {scene.describe(R_L)}" + ("" if pixel_values is None else
                                                  f"; in place of its {pixel_values.name}: the pixel table's"))
         say(f"map    = {fm.summary()}")

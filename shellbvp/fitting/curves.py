@@ -28,7 +28,7 @@ from scipy.interpolate import CubicSpline, PchipInterpolator
 
 from .kept import keep, kept_folder, read_kept
 
-__all__ = ["N_DEPTHS", "ModelCurves", "clear_model_curves", "code_fingerprint"]
+__all__ = ["N_DEPTHS", "ModelCurves", "clear_model_curves", "code_fingerprint", "beyond_message"]
 
 #: Depths of every model curve (equally spaced up to delta_max).
 N_DEPTHS = 40
@@ -244,7 +244,7 @@ def point_load_forces(scene, deltas, tol):
     return np.array(out)
 
 
-def _beyond_message(c, need):
+def beyond_message(c, need):
     return (f"the data reach delta = {need:.4g} (deepest displacement / R_L) but the model curve ends at "
             f"delta = {c.delta[-1]:.4g} ({c.stop_reason}): the model cannot explain the deepest points; "
             f"fit the data up to that depth (--max-depth {c.delta[-1]:.4g}, a fraction of R_L; fit(max_depth=...) in "
@@ -281,7 +281,7 @@ class ModelCurves:
         if c.delta[-1] < self.need * (1 - 1e-12):
             if theta is not None:
                 return False
-            raise ValueError(_beyond_message(c, self.need))
+            raise ValueError(beyond_message(c, self.need))
         self.nodes[theta] = c
         shallow = self.grid[self.grid < c.delta[0] * (1 - 1e-9)] if self.source is _model_curve else self.grid[:0]
         F = np.r_[point_load_forces(self.scene_at(theta), shallow, self.tol), c.force]

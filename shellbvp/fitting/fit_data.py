@@ -20,7 +20,8 @@ from .least_squares import BASELINES, DEFAULT_WEIGHTS, WEIGHTS, Fitted, LeastSqu
 from .profile import ProfileSearch, search_of
 from .solid import FIT_MODELS, auto_model, check_solid_fit, shell_or_solid, solid_curve
 
-__all__ = ["fit", "fit_record", "free_parameters", "example_data_path"]
+__all__ = ["fit", "fit_record", "free_parameters", "example_data_path", "fit_inputs", "FitInputs", "record_rows",
+           "RecordRows", "segment_warnings"]
 
 
 def example_data_path():
@@ -102,6 +103,82 @@ def _below_force(d, f, keep, max_force, k):
         raise ValueError(f"max_force = {max_force:.4g} N (--force-max) leaves {np.count_nonzero(keep)} of "
                          f"{np.count_nonzero(np.isfinite(f))} rows; need at least {need}: give a larger force")
     return d[within], f[within], keep
+
+
+@dataclasses.dataclass(frozen=True)
+class FitInputs:
+    """What :func:`fit` fits, its arguments checked (:func:`fit_inputs`): the data's rows
+    ``d``, ``f`` (finite, within the fitting range), ``keep`` (those rows among the given),
+    ``k`` fitted parameters, the contact point's guess ``origin`` (m), the deepest datum's
+    ``depth`` (delta) and the model curve's ``grid`` of depths, the least squares ``mdl``, the
+    noise models (``noise`` and the weights check's ``check``), a free shape parameter's
+    ``search`` (or None) and the fitting ranges reported."""
+    d: np.ndarray
+    f: np.ndarray
+    keep: np.ndarray
+    k: int
+    origin: float
+    depth: float
+    grid: np.ndarray
+    mdl: LeastSquaresModel
+    noise: NoiseModel
+    check: object
+    search: object
+    ranges: dict
+    weights: str
+    baseline: str
+    free: tuple
+
+
+def fit_inputs(scene, displacement, force, *, R_L, fit_offset=True, free=(), bounds=None, weights=None, floor=0.05,
+               delta_max=None, loss="linear", baseline="none", contact_guess=None, shared=None, stability=False,
+               model="auto", max_depth=None, max_force=None, weights_check=True, aliases=None) -> FitInputs:
+    """:func:`fit`'s arguments and data checked (its ValueErrors, before any model curve), as a
+    :class:`FitInputs`; a force map's pixels fitted together (:mod:`shellbvp.fitting.batched`)
+    are checked by the same function."""
+    weights = DEFAULT_WEIGHTS if weights is None else weights
+    if weights not in WEIGHTS:
+        raise ValueError(f"weights must be one of {WEIGHTS}; got {weights!r}")
+    if not (isinstance(floor, (int, float)) and 0 < floor <= 1):
+        raise ValueError(f"floor (of relative weights, fraction of max |force|) must be in (0, 1]; got {floor!r}")
+    free, bounds = free_parameters(free, bounds, aliases or {})
+    if model not in FIT_MODELS:
+        raise ValueError(f"model must be one of {FIT_MODELS}; got {model!r}")
+    if model == "solid":
+        check_solid_fit(scene, free)
+        if stability or shared is not None:
+            raise ValueError("model='solid': the stability check and shared curves (force maps with a geometry per "
+                             "pixel) are the shell model's; use model='shell' for them")
+    if baseline not in BASELINES:
+        raise ValueError(f"baseline must be one of {BASELINES}; got {baseline!r}")
+    origin = 0.0 if contact_guess is None else contact_guess
+    if not (isinstance(origin, (int, float)) and math.isfinite(origin)):
+        raise ValueError(f"contact_guess (m) must be a finite number; got {contact_guess!r}")
+    d = np.asarray(displacement, float).ravel()
+    f = np.asarray(force, float).ravel()
+    keep = np.isfinite(d) & np.isfinite(f) if d.shape == f.shape else None
+    k = 1 + bool(fit_offset) + len(free) + (baseline != "none") + (baseline == "linear")
+    if max_depth is not None and keep is not None:
+        d, f, keep = _within_depth(d, f, keep, max_depth, float(origin), k)
+    if max_force is not None and keep is not None:
+        d, f, keep = _below_force(d, f, keep, max_force, k)
+    d, f = _check_data(d, f, k, float(origin))
+    if not (isinstance(R_L, (int, float)) and math.isfinite(R_L) and R_L > 0):
+        raise ValueError(f"R_L (rim radius, m) must be a finite number > 0; got {R_L!r}")
+    sp = search_of(scene, free[0], bounds.get(free[0])) if free else None
+    depth = (np.max(d) - origin) / R_L  # the deepest datum's delta, if the contact is at the guess
+    dm = 1.2 * depth if delta_max is None else float(delta_max)
+    if not (math.isfinite(dm) and dm > 0):
+        raise ValueError(f"delta_max must be > 0; got {delta_max!r}")
+    grid = dm * np.arange(1, N_DEPTHS + 1) / N_DEPTHS
+    mdl = LeastSquaresModel(d, f, R_L, fit_offset, baseline, loss)
+    noise = NoiseModel(weights, floor)
+    check = NoiseModel(other_weights(weights), floor) if weights_check else None
+    ranges = {"max_depth": None if max_depth is None else float(max_depth),
+              "max_force": None if max_force is None else float(max_force)}
+    return FitInputs(d=d, f=f, keep=keep, k=k, origin=float(origin), depth=float(depth), grid=grid, mdl=mdl,
+                     noise=noise, check=check, search=sp, ranges=ranges, weights=weights, baseline=baseline,
+                     free=free)
 
 
 def fit(scene, displacement, force, *, R_L, fit_offset=True, free=(), bounds=None, weights=None, floor=0.05,
@@ -244,46 +321,14 @@ def fit(scene, displacement, force, *, R_L, fit_offset=True, free=(), bounds=Non
     ...
     ValueError: ...
     """
-    weights = DEFAULT_WEIGHTS if weights is None else weights
-    if weights not in WEIGHTS:
-        raise ValueError(f"weights must be one of {WEIGHTS}; got {weights!r}")
-    if not (isinstance(floor, (int, float)) and 0 < floor <= 1):
-        raise ValueError(f"floor (of relative weights, fraction of max |force|) must be in (0, 1]; got {floor!r}")
-    free, bounds = free_parameters(free, bounds, aliases)
-    if model not in FIT_MODELS:
-        raise ValueError(f"model must be one of {FIT_MODELS}; got {model!r}")
-    if model == "solid":
-        check_solid_fit(scene, free)
-        if stability or shared is not None:
-            raise ValueError("model='solid': the stability check and shared curves (force maps with a geometry per "
-                             "pixel) are the shell model's; use model='shell' for them")
-    if baseline not in BASELINES:
-        raise ValueError(f"baseline must be one of {BASELINES}; got {baseline!r}")
-    origin = 0.0 if contact_guess is None else contact_guess
-    if not (isinstance(origin, (int, float)) and math.isfinite(origin)):
-        raise ValueError(f"contact_guess (m) must be a finite number; got {contact_guess!r}")
-    d = np.asarray(displacement, float).ravel()
-    f = np.asarray(force, float).ravel()
-    keep = np.isfinite(d) & np.isfinite(f) if d.shape == f.shape else None
-    k = 1 + bool(fit_offset) + len(free) + (baseline != "none") + (baseline == "linear")
-    if max_depth is not None and keep is not None:
-        d, f, keep = _within_depth(d, f, keep, max_depth, float(origin), k)
-    if max_force is not None and keep is not None:
-        d, f, keep = _below_force(d, f, keep, max_force, k)
-    d, f = _check_data(d, f, k, float(origin))
-    if not (isinstance(R_L, (int, float)) and math.isfinite(R_L) and R_L > 0):
-        raise ValueError(f"R_L (rim radius, m) must be a finite number > 0; got {R_L!r}")
-    sp = search_of(scene, free[0], bounds.get(free[0])) if free else None
-    depth = (np.max(d) - origin) / R_L  # the deepest datum's delta, if the contact is at the guess
-    dm = 1.2 * depth if delta_max is None else float(delta_max)
-    if not (math.isfinite(dm) and dm > 0):
-        raise ValueError(f"delta_max must be > 0; got {delta_max!r}")
-    grid = dm * np.arange(1, N_DEPTHS + 1) / N_DEPTHS
-    mdl = LeastSquaresModel(d, f, R_L, fit_offset, baseline, loss)
-    noise = NoiseModel(weights, floor)
-    check = NoiseModel(other_weights(weights), floor) if weights_check else None
-    ranges = {"max_depth": None if max_depth is None else float(max_depth),
-              "max_force": None if max_force is None else float(max_force)}
+    inputs = fit_inputs(scene, displacement, force, R_L=R_L, fit_offset=fit_offset, free=free, bounds=bounds,
+                        weights=weights, floor=floor, delta_max=delta_max, loss=loss, baseline=baseline,
+                        contact_guess=contact_guess, shared=shared, stability=stability, model=model,
+                        max_depth=max_depth, max_force=max_force, weights_check=weights_check, aliases=aliases)
+    d, keep, k, origin, sp, depth, grid, mdl, noise, check, ranges = (
+        inputs.d, inputs.keep, inputs.k, inputs.origin, inputs.search, inputs.depth, inputs.grid, inputs.mdl,
+        inputs.noise, inputs.check, inputs.ranges)
+    weights, baseline, free = inputs.weights, inputs.baseline, inputs.free
     if shared is not None:
         if sp is not None:
             raise ValueError(f"{sp.name} is given per pixel: it cannot also be fitted")
@@ -468,6 +513,33 @@ def fit_record(scene, record, *, R_L, segment="loading", baseline="auto", **opti
     >>> print(f"baseline {res.baseline * 1e3:.3f} mN, contact at {res.offset * 1e3:.4f} mm")
     baseline 0.050 mN, contact at 0.0100 mm
     """
+    rows = record_rows(record, segment, baseline, options.get("fit_offset", True))
+    res = fit(scene, rows.d, rows.f, R_L=R_L, baseline=rows.baseline, contact_guess=rows.guess, **options)
+    for code, text in segment_warnings(record, segment, rows.used):
+        res.warnings.append(text)
+        res.warning_codes.append(code)
+    if segment == "loading":
+        record.relabel(res.offset)
+    return res, rows.used
+
+
+@dataclasses.dataclass(frozen=True)
+class RecordRows:
+    """The rows of a record :func:`fit_record` fits: ``used`` (a mask of the record's rows), their
+    displacement ``d`` and force ``f``, the ``baseline`` fitted (``auto`` resolved) and the
+    contact point's first ``guess`` (m)."""
+    used: np.ndarray
+    d: np.ndarray
+    f: np.ndarray
+    baseline: str
+    guess: float
+
+
+def record_rows(record, segment="loading", baseline="auto", fit_offset=True, estimate="find") -> RecordRows:
+    """The rows of ``record``'s ``segment`` that :func:`fit_record` fits, its baseline and contact
+    guess (ValueError: an unknown baseline, a segment of fewer than 3 rows); ``estimate``: the
+    contact estimate of those rows when known (:func:`shellbvp.instrument.estimate_contact`;
+    ``"find"``: found here)."""
     if baseline not in ("auto",) + BASELINES:
         raise ValueError(f"baseline must be one of {('auto',) + BASELINES}; got {baseline!r}")
     used = record.mask(segment)
@@ -477,15 +549,11 @@ def fit_record(scene, record, *, R_L, segment="loading", baseline="auto", **opti
                          f"{' and time' if record.time is not None else ''}); choose another with --segment "
                          f"(one of loading, retraction, all)")
     d, f = record.displacement[used], record.force[used]
-    estimate = estimate_contact(d, f)
+    if isinstance(estimate, str):
+        estimate = estimate_contact(d, f)
     if baseline == "auto":
         baseline = "constant" if estimate is not None else "none"
-    guess = _contact_guess(d, estimate, options.get("fit_offset", True))
-    res = fit(scene, d, f, R_L=R_L, baseline=baseline, contact_guess=guess, **options)
-    _warn_of_segments(res, record, segment, used)
-    if segment == "loading":
-        record.relabel(res.offset)
-    return res, used
+    return RecordRows(used, d, f, baseline, _contact_guess(d, estimate, fit_offset))
 
 
 def _contact_guess(d, estimate, fit_offset):
@@ -501,22 +569,23 @@ def _contact_guess(d, estimate, fit_offset):
     return 0.0 if 0.0 <= lo and np.max(d) <= 3 * np.ptp(d) else lo
 
 
-def _warn_of_segments(res, record, segment, used):
-    """Warnings (added to ``res``) about the record's segments around the ``used`` rows: the
-    loading and the retraction fitted together, or loading passes left out."""
+def segment_warnings(record, segment, used) -> list:
+    """``[(code, text)]``: warnings of a fit of ``record``'s ``used`` rows (``segment``) about
+    its segments: the loading and the retraction fitted together, or loading passes left out."""
+    out = []
     counts = record.counts()
     if segment == "all" and counts.get("retraction") and counts.get("loading"):
-        text = (f"the fitted rows mix the loading ({counts['loading']} rows) and the retraction "
-                f"({counts['retraction']} rows) of the record: with hysteresis the two branches differ and the "
-                f"fit of both is biased; fit one with --segment loading or retraction")
-        res.warnings.append(text)
-        res.warning_codes.append("mixed_segments")
+        out.append(("mixed_segments",
+                    f"the fitted rows mix the loading ({counts['loading']} rows) and the retraction "
+                    f"({counts['retraction']} rows) of the record: with hysteresis the two branches differ and the "
+                    f"fit of both is biased; fit one with --segment loading or retraction"))
     if segment == "loading":
         others = record.other_pushes()
         if others:
             where = ", ".join(f"rows {a + 1}-{b + 1}" for a, b, _ in others)
             rows = np.flatnonzero(used)
-            res.warnings.append(f"the record holds {len(others) + 1} loading passes: rows {rows[0] + 1}-{rows[-1] + 1} "
-                                f"(the longest push) were fitted, {where} left out; if the passes differ (a "
-                                f"sample that changed, a re-test), cut the file and fit each")
-            res.warning_codes.append("several_loadings")
+            out.append(("several_loadings",
+                        f"the record holds {len(others) + 1} loading passes: rows {rows[0] + 1}-{rows[-1] + 1} "
+                        f"(the longest push) were fitted, {where} left out; if the passes differ (a "
+                        f"sample that changed, a re-test), cut the file and fit each"))
+    return out

@@ -21,14 +21,16 @@ from .result import Estimate, FitResult
 
 log = logging.getLogger(__name__)
 
-__all__ = ["result_of"]
+__all__ = ["result_of", "weights_check_of"]
 
 
-def result_of(fitted, mdl, sp, k, notes, keep, weights, baseline, curves_computed, fit_model="shell", check=None):
+def result_of(fitted, mdl, sp, k, notes, keep, weights, baseline, curves_computed, fit_model="shell", check=None,
+              refitted=None):
     """The :class:`FitResult` of what a fit found: Wald (t) intervals of the free parameters
     from the weighted Jacobian, the shape parameter's profile interval, status and warnings;
     ``check``: the :class:`~shellbvp.fitting.least_squares.NoiseModel` the fit's mu*H is checked
-    against (refitted at the fitted shape from the fit's solution), or None."""
+    against (refitted at the fitted shape from the fit's solution), or None; ``refitted``: that
+    refit done already (:func:`weights_check_of`; a force map's pixels refit together)."""
     res, rss, J, w, P, top, R_L = fitted.res, fitted.rss, fitted.J, fitted.w, fitted.P, fitted.top, mdl.R_L
     d, f = mdl.d, mdl.f
     n = d.size
@@ -78,7 +80,8 @@ def result_of(fitted, mdl, sp, k, notes, keep, weights, baseline, curves_compute
     found = notes + checks
     for _, text in found:
         log.info("fit: warning: %s", text)
-    other = None if check is None or fitted.dP is None else _refit_weighted(fitted, mdl, check, dof)
+    other = refitted if refitted is not None else \
+        None if check is None or fitted.dP is None else _refit_weighted(fitted, mdl, check, dof)
     detail = weights_disagreement(weights, mu_H, mu_ci, other) if status == 0 else None
     if detail is not None:
         status = WEIGHTS_DISAGREE
@@ -103,12 +106,17 @@ def _refit_weighted(fitted, mdl, noise, dof):
     """``{"weights", "mu_H", "mu_H_ci95"}``: mu*H and its 95 % (Wald, t) interval refitted with
     the noise model ``noise`` at the fitted shape, from the fit's solution (no model curve)."""
     res, rss, J, _ = noise.irls(mdl, fitted.P, fitted.dP, fitted.top, start=fitted.res.x)
-    mu_H = float(mdl.full(res.x)[0])
+    return weights_check_of(noise.kind, float(mdl.full(res.x)[0]), rss, J, dof)
+
+
+def weights_check_of(kind, mu_H, rss, J, dof) -> dict:
+    """``{"weights", "mu_H", "mu_H_ci95"}`` of a refit with the noise model ``kind``: mu*H, its
+    weighted RSS and Jacobian (mu*H's column first), the degrees of freedom."""
     try:
         half = float(special.stdtrit(dof, 0.975) * math.sqrt(np.linalg.inv(J.T @ J)[0, 0] * rss / dof))
     except (np.linalg.LinAlgError, ValueError):
         half = math.nan
-    return {"weights": noise.kind, "mu_H": mu_H, "mu_H_ci95": (mu_H - half, mu_H + half)}
+    return {"weights": kind, "mu_H": mu_H, "mu_H_ci95": (mu_H - half, mu_H + half)}
 
 
 def _linearised(dq, x, dx_dtheta, mu_H, R_L, cov, t):

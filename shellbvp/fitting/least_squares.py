@@ -100,6 +100,15 @@ class LeastSquaresModel:
             return q[self.free]
         return best[1][self.free]
 
+    def solved_at(self, P, top, d0):
+        """``q = (mu_H, d0, b0, b1)`` with the free linear parameters solved exactly (weights 1) at
+        the contact point ``d0``, as :meth:`start` solves each trial."""
+        coef, *_ = np.linalg.lstsq(np.column_stack(self._columns(P, top, d0)), self.f, rcond=None)
+        q = np.zeros(4)
+        q[[0, 2, 3]] = self._spread(coef)
+        q[1] = d0
+        return q
+
     def _spread(self, coef):
         """(mu_H, b0, b1) from the coefficients of the free linear columns."""
         out = np.zeros(3)

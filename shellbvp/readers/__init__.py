@@ -6,8 +6,8 @@ checks before anything is decoded, the reading options it takes and what it says
 (pointing to the readers that take them), and what it returns: one
 :class:`~shellbvp.instrument_record.InstrumentRecord` (a text table) or a file's curves,
 :class:`~shellbvp.afm_read.AFMCurve` (an AFM file, possibly a force map).  Every caller asks the
-registry (:func:`reader_for`, :func:`read_record`, :func:`read_curves`, :func:`read_table`,
-:func:`check_options`) instead of comparing a file's name with a format.
+registry (:func:`reader_for`, :func:`read_record`, :func:`read_curves`, :func:`iter_curves`,
+:func:`read_table`, :func:`check_options`) instead of comparing a file's name with a format.
 
 The modules of this package:
 
@@ -33,10 +33,11 @@ from __future__ import annotations
 import sys
 
 from .registry import (OPTION_GROUPS, READERS, Reader, check_options, curve_suffixes, discover, folder_suffixes,
-                       install, read_curves, read_record, read_table, reader, reader_for, register, takers)
+                       install, iter_curves, read_curves, read_record, read_table, reader, reader_for, register,
+                       takers)
 
 __all__ = ["Reader", "READERS", "OPTION_GROUPS", "register", "discover", "install", "reader", "reader_for",
-           "takers", "check_options", "read_record", "read_curves", "read_table", "curve_suffixes",
+           "takers", "check_options", "read_record", "read_curves", "iter_curves", "read_table", "curve_suffixes",
            "folder_suffixes"]
 
 for _module in discover(sys.modules[__name__]):

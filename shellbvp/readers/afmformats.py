@@ -106,18 +106,19 @@ def _is_nova(path) -> bool:
     return len(lines) >= 3 and all(_NOVA_LINE.fullmatch(ln) for ln in lines[:-1]) and any(b"," in ln for ln in lines)
 
 
-def _read(check_sizes):
-    """``read(path)``: the curves of a file through afmformats' own loader."""
-    def read(path) -> list:
-        return afm_read.read_afm(path, load=afm_read.load_with_afmformats, check_sizes=check_sizes)
+def _read(check_sizes, how=afm_read.read_afm):
+    """``read(path)``: the curves of a file through afmformats' own loader (``how``:
+    :func:`~shellbvp.afm_read.read_afm`, or :func:`~shellbvp.afm_read.iter_afm` one at a time)."""
+    def read(path):
+        return how(path, load=afm_read.load_with_afmformats, check_sizes=check_sizes)
     return read
 
 
-def _read_calibrated(check_sizes):
+def _read_calibrated(check_sizes, how=afm_read.read_afm):
     """``read(path, spring_constant, sensitivity)``: as :func:`_read`, with the calibration given."""
-    def read(path, *, spring_constant, sensitivity) -> list:
-        return afm_read.read_afm(path, load=afm_read.load_with_afmformats, check_sizes=check_sizes,
-                                 meta_override={"spring constant": spring_constant, "sensitivity": sensitivity})
+    def read(path, *, spring_constant, sensitivity):
+        return how(path, load=afm_read.load_with_afmformats, check_sizes=check_sizes,
+                   meta_override={"spring constant": spring_constant, "sensitivity": sensitivity})
     return read
 
 
@@ -132,13 +133,13 @@ READERS = (
     Reader(name="Asylum", order=20, suffixes=(".ibw",), folder_suffixes=(".ibw",), curves=True,
            what="an Asylum Research Igor binary wave",
            hint="`shellbvp fit FILE` fits its curve (in Python shellbvp.afm.read_afm)",
-           refusals=AFM_REFUSALS, read=_read(check_ibw)),
+           refusals=AFM_REFUSALS, read=_read(check_ibw), iterate=_read(check_ibw, afm_read.iter_afm)),
     Reader(name="AFM Workshop", order=30, sniff=_is_afm_workshop, curves=True,
            what="an AFM Workshop export",
            hint="`shellbvp fit FILE --spring-constant K --sensitivity S` fits it (in Python shellbvp.afm.read_afm)",
            options=_CALIBRATION, requires=_CALIBRATION,
            refusals={**AFM_REFUSALS, "requires": _missing_calibration("an AFM Workshop export", "m/V")},
-           read=_read_calibrated(_check_zip)),
+           read=_read_calibrated(_check_zip), iterate=_read_calibrated(_check_zip, afm_read.iter_afm)),
     Reader(name="NT-MDT Nova", order=40, sniff=_is_nova, curves=True,
            what="an NT-MDT Nova export",
            hint="`shellbvp fit FILE --spring-constant K --sensitivity S` fits it (in Python shellbvp.afm.read_afm)",
@@ -146,9 +147,9 @@ READERS = (
            refusals={**AFM_REFUSALS, "requires": _missing_calibration(
                "an NT-MDT Nova export (height in nm, deflection in nA)", "m/A",
                " (if it is no such export, give it a header row naming its columns and their units)")},
-           read=_read_calibrated(_check_zip)),
+           read=_read_calibrated(_check_zip), iterate=_read_calibrated(_check_zip, afm_read.iter_afm)),
     Reader(name="afmformats", order=90, fallback=True, curves=True,
            what="a file for afmformats",
            hint="in Python shellbvp.afm.read_afm reads the curves of any file afmformats knows",
-           refusals=AFM_REFUSALS, read=_read(_check_zip)),
+           refusals=AFM_REFUSALS, read=_read(_check_zip), iterate=_read(_check_zip, afm_read.iter_afm)),
 )

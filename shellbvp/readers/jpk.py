@@ -36,8 +36,14 @@ def read(path) -> list:
     return afm_read.read_afm(path, load=_load, check_sizes=_check_sizes)
 
 
+def iterate(path):
+    """The curves of a JPK archive one at a time (:func:`shellbvp.afm_read.iter_afm`): a force
+    map's are never all in memory."""
+    return afm_read.iter_afm(path, load=_load, check_sizes=_check_sizes)
+
+
 READERS = (Reader(
     name="JPK", order=10, suffixes=SUFFIXES, folder_suffixes=(".jpk-force",), curves=True,
     what="a JPK archive",
     hint="`shellbvp fit FILE` fits its curve or its force map (in Python shellbvp.afm.read_afm)",
-    refusals=AFM_REFUSALS, read=read),)
+    refusals=AFM_REFUSALS, read=read, iterate=iterate),)

@@ -1,9 +1,9 @@
 """The registry of instrument readers: :class:`Reader`, how the package finds its reader
 modules (:func:`discover`, :func:`install`) and the look-ups every caller asks
-(:func:`reader_for`, :func:`read_record`, :func:`read_curves`, :func:`read_table`,
-:func:`check_options`).  The readers themselves are declared in the other modules of
-:mod:`shellbvp.readers`, one module per format; nothing outside this package compares a
-file's name or first bytes with a format.
+(:func:`reader_for`, :func:`read_record`, :func:`read_curves`, :func:`iter_curves`,
+:func:`read_table`, :func:`check_options`).  The readers themselves are declared in the other
+modules of :mod:`shellbvp.readers`, one module per format; nothing outside this package
+compares a file's name or first bytes with a format.
 """
 
 from __future__ import annotations
@@ -18,7 +18,7 @@ from typing import Callable
 from ..textdata import printable
 
 __all__ = ["Reader", "READERS", "OPTION_GROUPS", "register", "discover", "install", "reader", "reader_for",
-           "takers", "check_options", "read_record", "read_curves", "read_table", "curve_suffixes",
+           "takers", "check_options", "read_record", "read_curves", "iter_curves", "read_table", "curve_suffixes",
            "folder_suffixes"]
 
 #: The reading options, by group: a text table's columns and a cantilever's calibration
@@ -66,6 +66,10 @@ class Reader:
         The message (after the file's name) when options of a group it does not take are given
         (``"text"``, ``"calibration"``), or ``"requires"`` options are missing; ``{takers}``
         becomes the names of the readers that take that group (:func:`takers`).
+    iterate : callable, optional
+        ``iterate(path, **options)`` of a reader of :attr:`curves`: its curves one at a time, in
+        file order (a force map is never all in memory; :func:`iter_curves`); without it
+        :attr:`read`'s list is handed out one by one.
     table : callable, optional
         ``table(path, max_rows=None, what="table")``: the file split into a table (the text
         reader's :func:`shellbvp.readers.text_table.read_table`), for tables of other kinds (a
@@ -85,6 +89,7 @@ class Reader:
     options: tuple = ()
     requires: tuple = ()
     refusals: dict = field(default_factory=dict)
+    iterate: Callable = None
     table: Callable = None
 
     def recognises(self, path) -> bool:
@@ -198,6 +203,15 @@ def read_curves(path, *, spring_constant=None, sensitivity=None) -> list:
     found = reader_for(path, curves=True)
     taken = check_options(found, path, {"spring_constant": spring_constant, "sensitivity": sensitivity})
     return found.read(path, **taken)
+
+
+def iter_curves(path, *, spring_constant=None, sensitivity=None):
+    """:func:`read_curves` one curve at a time (the reader's :attr:`Reader.iterate`, else its
+    list): the options are checked when this is called, the file read as the curves are asked
+    for."""
+    found = reader_for(path, curves=True)
+    taken = check_options(found, path, {"spring_constant": spring_constant, "sensitivity": sensitivity})
+    return found.iterate(path, **taken) if found.iterate is not None else iter(found.read(path, **taken))
 
 
 def read_table(path, *, max_rows=None, what="table"):
