@@ -230,10 +230,12 @@ def _first_instability_json(k, tmp, t):
 # -- options ------------------------------------------------------------------------------------------
 def unread_options():
     """{command: [(option, read)]}: each option of each command and whether its handler reads it
-    (``args.NAME``, ``getattr(args, "NAME")``, an f-string over the shape parameters, or a helper
-    of cli/common.py that reads it and that the handler calls)."""
+    (``args.NAME``, ``getattr(args, "NAME")``, an f-string over the shape parameters, a parameter's
+    ``dest`` of the registry of scene parameters, or a helper of cli/common.py that reads it and
+    that the handler calls)."""
     from shellbvp import cli
     from shellbvp.cli import common
+    from shellbvp.scene_parameters import scene_parameters
     from shellbvp.shape_parameters import SHAPE_PARAMETERS
 
     source = inspect.getsource(common)
@@ -245,6 +247,8 @@ def unread_options():
         names |= {m.replace("{name}", p) for m in re.findall(r"getattr\(args, f\"([\w{}]+)\"", text)
                   for p in SHAPE_PARAMETERS}
         names |= {dest for dest in re.findall(r"\"(\w+)\"", text) if re.search(r"getattr\(args, (dest|k)\b", text)}
+        if re.search(r"getattr\(args, \w+\.dest\b", text):  # the options of the registry of scene parameters
+            names |= {p.dest for p in scene_parameters().values() if p.option}
         return names
 
     parser = cli.build_parser()
