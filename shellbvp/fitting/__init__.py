@@ -26,9 +26,11 @@ the weights from the current model force F_i: ``"uniform"`` (homoscedastic:
 the same force noise at every point), ``"relative"`` (noise proportional to
 the force: residuals divided by ``max(|F_i|, floor * max|F_data|)``) and
 ``"mixed"`` (the default: ``sigma_i^2 = a^2 + b^2 F_i^2``, an additive floor
-plus a proportional part, both estimated from the squared residuals by
+plus a proportional part, both estimated from the residuals' local scatter by
 non-negative least squares -- it covers either kind of noise and anything
-between).  Intervals of mu*H and d0 come from the linearised covariance (with the
+between; the proportional part is weighted at ``floor * max|F_data|`` at least, and the
+noise scale is read from the rows that carry noise: rows read as exactly constant, a
+noise-free approach, do not count).  Intervals of mu*H and d0 come from the linearised covariance (with the
 shape parameter's theta as a third column when fitted) and Student's t; the fitted shape
 parameter's quantities in lab units that depend on mu*H too (the pressure in Pa) from the
 same covariance.  ``benchmarks/fit_coverage.py`` measures their coverage.

@@ -196,7 +196,8 @@ def fit(scene, displacement, force, *, R_L, fit_offset=True, free=(), bounds=Non
         default :data:`DEFAULT_WEIGHTS` ("mixed", see benchmarks/fit_coverage.py).
     floor : float
         With relative weights, forces below ``floor * max|force|`` are weighted
-        as if they were that large (near the contact point F -> 0); in (0, 1].
+        as if they were that large (near the contact point F -> 0); with mixed weights, their
+        proportional part likewise; in (0, 1].
     delta_max : float, optional
         Largest depth of the model curves (default: 1.2 x the largest measured depth/R_L).
     tol : float
@@ -248,7 +249,8 @@ def fit(scene, displacement, force, *, R_L, fit_offset=True, free=(), bounds=Non
     if weights not in WEIGHTS:
         raise ValueError(f"weights must be one of {WEIGHTS}; got {weights!r}")
     if not (isinstance(floor, (int, float)) and 0 < floor <= 1):
-        raise ValueError(f"floor (of relative weights, fraction of max |force|) must be in (0, 1]; got {floor!r}")
+        raise ValueError(f"floor (of relative and mixed weights, fraction of max |force|) must be in (0, 1]; "
+                         f"got {floor!r}")
     free, bounds = free_parameters(free, bounds, aliases)
     if model not in FIT_MODELS:
         raise ValueError(f"model must be one of {FIT_MODELS}; got {model!r}")
@@ -302,7 +304,8 @@ def fit(scene, displacement, force, *, R_L, fit_offset=True, free=(), bounds=Non
             shape.add(None)
             P, dP, top = shape.at(None)
             res, rss, J, w = noise.irls(mdl, P, dP, top)
-            fitted = Fitted(res, rss, J, w, scene, shape.nodes[None], P, top, dP=dP)
+            fitted = Fitted(res, rss, J, w, scene, shape.nodes[None], P, top, dP=dP,
+                            rows=noise.rows(mdl, P, top, mdl.full(res.x), w))
             notes = []
         else:
             search = ProfileSearch(sp, ModelCurves(sp.scene_at, grid, tol, depth, counter, progress), mdl, depth)
@@ -380,7 +383,8 @@ def _fit_on_shared(shared, scene, mdl, noise, depth, k, keep, weights, baseline,
     res, rss, J, w = noise.irls(mdl, P, dP, top)
     near = min(curves.thetas, key=lambda t: abs(t - theta))
     fitted = Fitted(res, rss, J, w, scene, curves.nodes[near], P, top,
-                    interpolation_error=getattr(curves, "interpolation_error", None), dP=dP)
+                    interpolation_error=getattr(curves, "interpolation_error", None), dP=dP,
+                    rows=noise.rows(mdl, P, top, mdl.full(res.x), w))
     return result_of(fitted, mdl, None, k, [], keep, weights, baseline, 0, check=check)
 
 
