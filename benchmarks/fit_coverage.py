@@ -104,8 +104,14 @@ def approach_coverage(scene, seeds, out):
                 for seed in range(seeds):
                     rng = np.random.default_rng(seed)
                     f = F * (1 + p * rng.standard_normal(F.size)) + a * np.max(F) * rng.standard_normal(F.size) + base
-                    r = sb.fit(scene, disp, f, R_L=R_L_, weights=w, floor=floor, baseline="constant",
-                               contact_guess=estimate_contact(disp, f), delta_max=1.15 * top)
+                    options = dict(R_L=R_L_, weights=w, floor=floor, baseline="constant",
+                                   contact_guess=estimate_contact(disp, f))
+                    try:  # one model curve for every seed, unless a contact guess far off needs a deeper one
+                        r = sb.fit(scene, disp, f, delta_max=1.2 * top, **options)
+                    except ValueError as e:
+                        if "model curve ends" not in str(e):
+                            raise
+                        r = sb.fit(scene, disp, f, **options)
                     rows.append(r.to_dict())
                 key = f"{design}/{kind}/{w}" + (f"/floor {floor:g}" if floor != 0.05 else "")
                 out["approach"][key] = {"mu_H": summarise(rows, "mu_H", mu_H), "offset": summarise(rows, "offset", d0),
