@@ -12,7 +12,8 @@ fitted with each noise model of ``sb.fit`` (``weights="uniform"``, ``"relative"`
 how often the 95 % interval of mu*H (and of the offset) contains the truth
 (with a Wilson 95 % interval of that rate), the median interval width and the
 RMS error of mu*H.  Then ``fit_beta=True`` on data made with beta = 0.02 (the
-fit starts from the preset's 0.01): coverage of beta and mu*H.
+fit starts from the preset's 0.01): coverage of beta and mu*H (and the mixed weights with the
+floor of relative weights, 0.05).
 
 Then records with an approach, fitted as ``fit_record`` fits them (a constant baseline and
 the contact point, from ``estimate_contact``'s guess):
@@ -44,6 +45,7 @@ from pathlib import Path
 import numpy as np
 
 import shellbvp as sb
+import shellbvp.fitting  # noqa: F401  (sb.fitting.WEIGHTS below)
 
 R_L, MU_H, D0, NOISE, N = 0.3e-3, 52.0, 10e-6, 0.02, 40
 RESULTS = Path(__file__).parent / "results"
@@ -53,8 +55,8 @@ APPROACH = {"approach": (0.3e-3, 25e-6, 20, 140, 0.4, 52.0, 50e-6),
             "afm": (10e-6, 0.3e-6, 250, 150, 0.3, 0.6e-3, 0.2e-9)}
 #: their noise: (proportional, additive as a fraction of the largest force)
 APPROACH_NOISE = {"proportional": (0.01, 0.0), "mixed": (0.01, 0.005)}
-#: floors of the mixed weights' proportional part tried on the noise-free approaches
-FLOORS = (0.02, 0.1)
+#: floors of the mixed weights' proportional part tried besides the default (sb.fitting.WEIGHT_FLOORS)
+FLOORS = (0.01, 0.05, 0.1)
 
 
 def wilson(k, n, z=1.96):
@@ -96,7 +98,7 @@ def approach_coverage(scene, seeds, out):
     for design, (R_L_, d0, na, nc, top, mu_H, base) in APPROACH.items():
         disp, F = approach_record(scene, design)
         for kind, (p, a) in APPROACH_NOISE.items():
-            cases = [(w, 0.05) for w in sb.fitting.WEIGHTS]
+            cases = [(w, None) for w in sb.fitting.WEIGHTS]
             cases += [("mixed", fl) for fl in FLOORS] if kind == "proportional" else []
             for w, floor in cases:
                 rows = []
@@ -113,7 +115,7 @@ def approach_coverage(scene, seeds, out):
                             raise
                         r = sb.fit(scene, disp, f, **options)
                     rows.append(r.to_dict())
-                key = f"{design}/{kind}/{w}" + (f"/floor {floor:g}" if floor != 0.05 else "")
+                key = f"{design}/{kind}/{w}" + (f"/floor {floor:g}" if floor is not None else "")
                 out["approach"][key] = {"mu_H": summarise(rows, "mu_H", mu_H), "offset": summarise(rows, "offset", d0),
                                         "weights_check_failed": int(sum(r["status"] == 6 for r in rows)),
                                         "seconds_per_fit": (time.perf_counter() - t) / seeds}
@@ -170,21 +172,25 @@ def main():
     # beta: data at beta = 0.02, fit starts at 0.01
     beta_true = 0.02
     disp_b, F_b = truth(scene.replace(beta=beta_true))
-    for w in sb.fitting.WEIGHTS:
+    for w, floor in [(w, None) for w in sb.fitting.WEIGHTS] + [("mixed", 0.05)]:
         rows = []
         t = time.perf_counter()
         for seed in range(args.beta_seeds):
-            r = sb.fit(scene, disp_b, noisy(F_b, "proportional", seed), R_L=R_L, weights=w, fit_beta=True)
+            r = sb.fit(scene, disp_b, noisy(F_b, "proportional", seed), R_L=R_L, weights=w, fit_beta=True,
+                       floor=floor)
             rows.append(r.to_dict())
         betas = np.array([r["beta"] for r in rows])
-        out["beta"][f"proportional/{w}"] = {
+        key = f"proportional/{w}" + (f"/floor {floor:g}" if floor is not None else "")
+        out["beta"][key] = {
             "beta": summarise(rows, "beta", beta_true), "mu_H": summarise(rows, "mu_H", MU_H),
             "beta_median": float(np.median(betas)),
-            "beta_ci95_at_bound": int(sum(("end of the searched range" in r["message"]) for r in rows)),
+            "beta_ci95_at_bound": int(sum(any("end of the searched range" in text for text in [r["message"],
+                                                                                             *r["warnings"]])
+                                          for r in rows)),
             "curves_per_fit": float(np.mean([r["curves_computed"] for r in rows])),
             "interpolation_error_max": float(np.nanmax([r["interpolation_error"] or 0.0 for r in rows])),
             "seconds_per_fit": (time.perf_counter() - t) / args.beta_seeds}
-        print("beta", w, out["beta"][f"proportional/{w}"], flush=True)
+        print("beta", key, out["beta"][key], flush=True)
     approach_coverage(scene, args.seeds, out)
     _write(out, stem, t0, c0)
 
@@ -235,7 +241,7 @@ def report(out):
               "| max interpolation error |",
               "|---|---|---|---|---|---|---|---|---|---|"]
         for key, v in out["beta"].items():
-            w = key.split("/")[1]
+            w = key.split("/", 1)[1].replace("/", ", ")
             b, m = v["beta"], v["mu_H"]
             L.append(f"| {w} | {b['covered']}/{b['n']} = {b['coverage']:.2f} | {v['beta_median']:.4g} | "
                      f"{b['median_width']:.3g} | {b['rms_error']:.2g} | {v['beta_ci95_at_bound']} | "

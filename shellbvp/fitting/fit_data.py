@@ -104,7 +104,7 @@ def _below_force(d, f, keep, max_force, k):
     return d[within], f[within], keep
 
 
-def fit(scene, displacement, force, *, R_L, fit_offset=True, free=(), bounds=None, weights=None, floor=0.05,
+def fit(scene, displacement, force, *, R_L, fit_offset=True, free=(), bounds=None, weights=None, floor=None,
         delta_max=None, tol=1e-6, loss="linear", baseline="none", contact_guess=None, progress=None, shared=None,
         stability=False, model="auto", mesh_check=False, max_depth=None, max_force=None, weights_check=True,
         **aliases):
@@ -194,10 +194,11 @@ def fit(scene, displacement, force, *, R_L, fit_offset=True, free=(), bounds=Non
         Noise model: the same force noise at every point, noise proportional
         to the force, or both (``sigma^2 = a^2 + b^2 F^2``, a and b estimated);
         default :data:`DEFAULT_WEIGHTS` ("mixed", see benchmarks/fit_coverage.py).
-    floor : float
+    floor : float, optional
         With relative weights, forces below ``floor * max|force|`` are weighted
-        as if they were that large (near the contact point F -> 0); with mixed weights, their
-        proportional part likewise; in (0, 1].
+        as if they were that large (near the contact point F -> 0); with mixed weights, the
+        noise's proportional part likewise; in (0, 1].  Default :data:`WEIGHT_FLOORS` (0.05
+        relative, 0.02 mixed; the weights check's other noise model takes its own).
     delta_max : float, optional
         Largest depth of the model curves (default: 1.2 x the largest measured depth/R_L).
     tol : float
@@ -248,7 +249,7 @@ def fit(scene, displacement, force, *, R_L, fit_offset=True, free=(), bounds=Non
     weights = DEFAULT_WEIGHTS if weights is None else weights
     if weights not in WEIGHTS:
         raise ValueError(f"weights must be one of {WEIGHTS}; got {weights!r}")
-    if not (isinstance(floor, (int, float)) and 0 < floor <= 1):
+    if floor is not None and not (isinstance(floor, (int, float)) and 0 < floor <= 1):
         raise ValueError(f"floor (of relative and mixed weights, fraction of max |force|) must be in (0, 1]; "
                          f"got {floor!r}")
     free, bounds = free_parameters(free, bounds, aliases)
@@ -282,8 +283,8 @@ def fit(scene, displacement, force, *, R_L, fit_offset=True, free=(), bounds=Non
         raise ValueError(f"delta_max must be > 0; got {delta_max!r}")
     grid = dm * np.arange(1, N_DEPTHS + 1) / N_DEPTHS
     mdl = LeastSquaresModel(d, f, R_L, fit_offset, baseline, loss)
-    noise = NoiseModel(weights, floor)
-    check = NoiseModel(other_weights(weights), floor) if weights_check else None
+    noise = NoiseModel.of(weights, floor)
+    check = NoiseModel.of(other_weights(weights), floor) if weights_check else None
     ranges = {"max_depth": None if max_depth is None else float(max_depth),
               "max_force": None if max_force is None else float(max_force)}
     if shared is not None:

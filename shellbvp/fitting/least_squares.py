@@ -11,8 +11,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import optimize
 
-__all__ = ["BASELINES", "MODEL_PARAMETERS", "WEIGHTS", "DEFAULT_WEIGHTS", "LeastSquaresModel", "NoiseModel",
-           "Fitted", "local_scatter"]
+__all__ = ["BASELINES", "MODEL_PARAMETERS", "WEIGHTS", "DEFAULT_WEIGHTS", "WEIGHT_FLOORS", "LeastSquaresModel",
+           "NoiseModel", "Fitted", "local_scatter"]
 
 #: Force baselines of :func:`fit` (none; a constant b0; b0 + b1 (d - d0)).
 BASELINES = ("none", "constant", "linear")
@@ -22,6 +22,12 @@ MODEL_PARAMETERS = ("mu_H", "offset", "baseline", "baseline_slope")
 WEIGHTS = ("uniform", "relative", "mixed")
 #: The default noise model (chosen by the coverage measured in benchmarks/fit_coverage.py).
 DEFAULT_WEIGHTS = "mixed"
+#: The default ``floor`` of :func:`~shellbvp.fitting.fit` per noise model: forces below ``floor *
+#: max|force|`` weighted as that (relative weights), the proportional part of the noise taken at
+#: that force at least (mixed weights).  Mixed weights' 0.02 is measured in
+#: benchmarks/fit_coverage.py: it restores the coverage of records with a noise-free approach,
+#: and 0.05 leaves beta undetermined on the shipped example (``--fit-beta``).
+WEIGHT_FLOORS = {"relative": 0.05, "mixed": 0.02}
 
 
 class LeastSquaresModel:
@@ -199,6 +205,11 @@ class NoiseModel:
         w_new = _weights(self.kind, mdl.indentation(P, top, mdl.d, q), mdl.f - mdl.baseline(mdl.d, q), self.floor, w,
                          mdl.d)
         return w_new, np.max(np.abs(w_new / w - 1))
+
+    @classmethod
+    def of(cls, kind, floor=None):
+        """The noise model ``kind`` with ``floor``, default its :data:`WEIGHT_FLOORS` (none for uniform)."""
+        return cls(kind, WEIGHT_FLOORS.get(kind, 0.0) if floor is None else float(floor))
 
     def rows(self, mdl, P, top, q, w):
         """The number of rows the noise scale is read from: each row counts by the share of the
