@@ -106,8 +106,8 @@ def approach_coverage(scene, seeds, out):
                 for seed in range(seeds):
                     rng = np.random.default_rng(seed)
                     f = F * (1 + p * rng.standard_normal(F.size)) + a * np.max(F) * rng.standard_normal(F.size) + base
-                    options = dict(R_L=R_L_, weights=w, floor=floor, baseline="constant",
-                                   contact_guess=estimate_contact(disp, f))
+                    options = dict(R_L=R_L_, weights=w, baseline="constant", contact_guess=estimate_contact(disp, f),
+                                   **({} if floor is None else {"floor": floor}))  # (an older fit: no None)
                     try:  # one model curve for every seed, unless a contact guess far off needs a deeper one
                         r = sb.fit(scene, disp, f, delta_max=1.2 * top, **options)
                     except ValueError as e:
