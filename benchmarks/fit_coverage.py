@@ -177,7 +177,7 @@ def main():
         t = time.perf_counter()
         for seed in range(args.beta_seeds):
             r = sb.fit(scene, disp_b, noisy(F_b, "proportional", seed), R_L=R_L, weights=w, fit_beta=True,
-                       floor=floor)
+                       **({} if floor is None else {"floor": floor}))
             rows.append(r.to_dict())
         betas = np.array([r["beta"] for r in rows])
         key = f"proportional/{w}" + (f"/floor {floor:g}" if floor is not None else "")

@@ -237,7 +237,7 @@ def fit(scene, displacement, force, *, R_L, fit_offset=True, free=(), bounds=Non
     >>> res = sb.fit(sb.Scene.preset("fit"), d, F, R_L=0.3e-3)
     >>> print(f"mu*H = {res.mu_H:.2f} N/m [{res.mu_H_ci95[0]:.2f}, {res.mu_H_ci95[1]:.2f}], "
     ...       f"offset {res.offset * 1e6:.2f} um")
-    mu*H = 51.91 N/m [51.53, 52.29], offset 9.95 um
+    mu*H = 51.91 N/m [51.52, 52.30], offset 9.95 um
 
     Data the fit cannot use are refused before any curve is computed:
 
