@@ -352,7 +352,7 @@ def read_fit(path) -> FitRecord:
     (True, ['mu_H', 'offset'], 'loading', {'displacement': 'mm', 'force': 'mN'})
     >>> lo, hi = fr.intervals["mu_H"]
     >>> print(f"mu*H = {fr.parameters['mu_H']:.2f} N/m, 95% [{lo:.2f}, {hi:.2f}]")
-    mu*H = 51.91 N/m, 95% [51.53, 52.29]
+    mu*H = 51.91 N/m, 95% [51.52, 52.30]
     >>> int(fr.data["used"].sum()), fr.data["model_force"].shape
     (40, (40,))
     """

@@ -5,6 +5,7 @@ import numpy as np
 import pytest
 
 import shellbvp as sb
+from shellbvp.fit_checks import AUTOCORRELATION_LEVEL
 from shellbvp.fitting import QUALITY_RULES, example_data_path, fit_quality
 
 R_L = 0.3e-3
@@ -40,6 +41,25 @@ def test_diagnostics_tell_the_right_model_from_a_wrong_one(data):
     c = right.correlation
     assert c.shape == (2, 2) and np.allclose(c, c.T) and np.allclose(np.diag(c), 1.0) and abs(c[0, 1]) < 1
     assert right.noise_sigma > 0
+
+
+def test_a_wrong_rim_radius_warns_by_the_residuals_autocorrelation(data):
+    """The example (R_L = 0.3 mm) fitted with its lengths in lab units and R_L given as 0.6 mm
+    (rise, tip radius and thickness as measured): mu*H 2.4x the truth, and the residuals in depth
+    order correlated far beyond AUTOCORRELATION_LEVEL (0.06 at the true R_L: no warning)."""
+    d, F = data
+
+    def lab(R):
+        return sb.Scene.preset("fit", gamma=0.75e-3 / R, rho=0.1e-3 / R, thickness=52e-6 / R)
+
+    right = sb.fit(lab(R_L), d, F, R_L=R_L, model="shell")
+    wrong = sb.fit(lab(2 * R_L), d, F, R_L=2 * R_L, model="shell")
+    assert "residual_autocorrelation" not in right.warning_codes
+    assert right.residual_autocorrelation < AUTOCORRELATION_LEVEL
+    assert "residual_autocorrelation" in wrong.warning_codes and wrong.mu_H > 2 * right.mu_H
+    assert wrong.residual_autocorrelation > AUTOCORRELATION_LEVEL
+    text = wrong.warnings[wrong.warning_codes.index("residual_autocorrelation")]
+    assert "--radius" in text and f"{wrong.residual_autocorrelation:.2f}" in text
 
 
 def test_aic_prefers_the_baseline_the_data_have(data):

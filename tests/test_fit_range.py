@@ -11,9 +11,10 @@ import pytest
 
 import shellbvp as sb
 from shellbvp.cli import main
-from shellbvp.fit_checks import FIT_STATUS, WEIGHTS_DISAGREE, other_weights, weights_disagreement
+from shellbvp.fit_checks import FIT_STATUS, WEIGHTS_DISAGREE, WEIGHTS_LEVEL, other_weights, weights_disagreement
 from shellbvp.fitrecord import read_fit
 from shellbvp.fitting import example_data_path
+from shellbvp.segments import estimate_contact
 
 
 
@@ -48,6 +49,46 @@ def test_a_synthetic_fit_passes_its_weights_check(example):
     assert res.to_dict()["weights_check"]["agree"] is True
     unchecked = sb.fit(scene, d, F, R_L=0.3e-3, weights_check=False)
     assert unchecked.weights_check is None and unchecked.mu_H == pytest.approx(res.mu_H, rel=1e-12)
+
+
+def _afm_like(scene, seed, additive=0.0):
+    """An AFM-like record of the closed-form curve (tests/fake_curves.py; delta^1.5 at beta 0.01):
+    250 approach rows read as exactly constant (a 0.2 nN baseline, no noise: a synthetic map's),
+    then 150 rows to delta 0.3 with 1 % proportional noise (and ``additive`` x the largest force);
+    fitted as fit_record fits it (a constant baseline, the contact point).  mu*H = 0.6 mN/m."""
+    R_L, contact = 10e-6, 0.3e-6
+    step = 0.3 * R_L / 150
+    d = np.r_[contact - step * np.arange(250, 0, -1), contact + step * np.arange(1, 151)]
+    clean = 0.6e-3 * R_L * np.clip((d - contact) / R_L, 0, None) ** 1.5 * 1.01
+    rng = np.random.default_rng(seed)
+    f = clean * (1 + 0.01 * rng.standard_normal(d.size)) + additive * clean.max() * rng.standard_normal(d.size)
+    f = f + 0.2e-9
+    return sb.fit(scene, d, f, R_L=R_L, baseline="constant", contact_guess=estimate_contact(d, f)), d, f
+
+
+def test_a_noise_free_approach_neither_narrows_the_interval_nor_fails_the_weights_check(closed_form):
+    """Rows read as exactly constant carry no noise: the mixed weights' noise scale is read from
+    the rows that do (before: 250 of 400 rows of zero residual made the noise look small, mu*H's
+    interval 0.6-0.8x as wide as the contact rows' own, the truth outside it and the weights
+    check failed in 11 of these 12 seeds; the runs test took the approach for one long run)."""
+    res, d, f = _afm_like(sb.Scene.preset("fit"), seed=0)
+    lo, hi = res.mu_H_ci95
+    assert res.success and res.weights_check["agree"] and res.warning_codes == []
+    assert lo < 0.6e-3 < hi
+    contact = d > 0.3e-6   # the contact rows alone, no baseline: every row carries noise
+    alone = sb.fit(sb.Scene.preset("fit"), d[contact], f[contact] - 0.2e-9, R_L=10e-6, contact_guess=0.3e-6)
+    assert (hi - lo) > 0.9 * (alone.mu_H_ci95[1] - alone.mu_H_ci95[0])
+
+
+def test_a_model_that_misses_the_shape_fails_the_weights_check(closed_form):
+    """The same record fitted with a curve of another shape (beta 0.02: delta^1.7): the weightings
+    disagree beyond WEIGHTS_LEVEL times their half-widths, and mu*H (+17 %) is not a success."""
+    res, _, _ = _afm_like(sb.Scene.preset("fit", beta=0.02), seed=3, additive=0.005)
+    other = res.weights_check
+    assert res.status == WEIGHTS_DISAGREE and not res.success and not other["agree"]
+    gap = abs(res.mu_H - other["mu_H"])
+    half = (res.mu_H_ci95[1] - res.mu_H_ci95[0] + other["mu_H_ci95"][1] - other["mu_H_ci95"][0]) / 2
+    assert gap > WEIGHTS_LEVEL * half and res.mu_H > 1.1 * 0.6e-3
 
 
 def test_max_force_leaves_out_the_rows_above_it(example):

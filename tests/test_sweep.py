@@ -313,6 +313,21 @@ def test_geometry_uncertainty_widens_the_interval_to_the_truth():
     assert r.fits_computed == 3
 
 
+def test_geometry_uncertainty_on_the_example_is_not_failed_by_the_weights_check():
+    """The shipped example with gamma 2.5 +- 0.2: the fits at gamma +- u follow the data less well
+    (their weightings disagree: status 6 when checked); they give mu*H's sensitivity, and the
+    interval with the geometry's uncertainty is finite (it was NaN)."""
+    from shellbvp.fitting import example_data_path
+    from shellbvp.uncertainty import fit_with_geometry
+
+    d, F = sb.read_force_csv(example_data_path())
+    r = fit_with_geometry(sb.Scene.preset("fit"), d, F, R_L=0.3e-3, uncertainty={"gamma": 0.2}, workers=1)
+    assert r.success, r.message
+    assert r.nominal.weights_check["agree"]
+    assert r.mu_H_ci95[0] < r.mu_H_ci95_fit[0] < r.mu_H < r.mu_H_ci95_fit[1] < r.mu_H_ci95[1]
+    assert not sb.fit(sb.Scene.preset("fit", gamma=2.7), d, F, R_L=0.3e-3).success   # checked: status 6
+
+
 @pytest.mark.parametrize("text, value", [("2.5+-0.2", (2.5, 0.2)), ("2.5 ± 0.2", (2.5, 0.2)),
                                          ("2.5+/-0.2", (2.5, 0.2)), ("0.01", (0.01, None))])
 def test_plus_minus_is_parsed_without_evaluation(text, value):

@@ -26,10 +26,13 @@ the weights from the current model force F_i: ``"uniform"`` (homoscedastic:
 the same force noise at every point), ``"relative"`` (noise proportional to
 the force: residuals divided by ``max(|F_i|, floor * max|F_data|)``) and
 ``"mixed"`` (the default: ``sigma_i^2 = a^2 + b^2 F_i^2``, an additive floor
-plus a proportional part, both estimated from the squared residuals by
+plus a proportional part, both estimated from the residuals' local scatter by
 non-negative least squares -- it covers either kind of noise and anything
-between).  Intervals of mu*H and d0 come from the linearised covariance (with the
-shape parameter's theta as a third column when fitted) and Student's t; the fitted shape
+between; the proportional part is weighted at ``floor * max|F_data|`` at least, 0.02 by
+default, :data:`WEIGHT_FLOORS`, and the noise scale is read from the rows that carry noise:
+rows read as exactly constant, a noise-free approach, do not count).  Intervals of mu*H and d0
+come from the linearised covariance (with the shape parameter's theta as a third column when
+fitted) and Student's t; the fitted shape
 parameter's quantities in lab units that depend on mu*H too (the pressure in Pa) from the
 same covariance.  ``benchmarks/fit_coverage.py`` measures their coverage.
 
@@ -48,10 +51,10 @@ from ..fit_checks import (FIT_STATUS, FIT_WARNINGS, PLAUSIBLE_MU_H, QUALITY_RULE
 from ..instrument import read_force_csv
 from .curves import N_DEPTHS, clear_model_curves
 from .fit_data import example_data_path, fit, fit_record, free_parameters
-from .least_squares import BASELINES, DEFAULT_WEIGHTS, MODEL_PARAMETERS, WEIGHTS
+from .least_squares import BASELINES, DEFAULT_WEIGHTS, MODEL_PARAMETERS, WEIGHT_FLOORS, WEIGHTS
 from .result import Estimate, FitResult
 
 __all__ = ["FitResult", "fit", "fit_quality", "diagnostics_lines", "QUALITY_RULES", "read_force_csv",
-           "example_data_path", "WEIGHTS", "DEFAULT_WEIGHTS", "FIT_STATUS", "FIT_WARNINGS", "PLAUSIBLE_MU_H",
+           "example_data_path", "WEIGHTS", "DEFAULT_WEIGHTS", "WEIGHT_FLOORS", "FIT_STATUS", "FIT_WARNINGS", "PLAUSIBLE_MU_H",
            "runs_test", "BASELINES", "MODEL_PARAMETERS", "fit_record", "Estimate", "free_parameters", "N_DEPTHS",
            "clear_model_curves"]

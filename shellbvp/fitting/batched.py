@@ -186,31 +186,47 @@ class Stack:
             active[a[stop]] = False
         return p, cost, J, done, its
 
+    def _model_and_force(self, p):
+        """Each pixel's model force and measured force less its baseline, at ``p``."""
+        q = self.full(p)
+        model = q[:, :1] * self.R_L * self.shape((self.d - q[:, 1:2]) / self.R_L)
+        return model, self.f - (q[:, 2:3] + q[:, 3:4] * (self.d - q[:, 1:2]))
+
     def weights(self, kind, floor, p, w):
         """The noise model's new weights (``NoiseModel.reweight`` of every pixel) and each
         pixel's largest relative change of them."""
-        valid, R_L = self.valid, self.R_L
+        valid = self.valid
         if kind == "uniform":
             new = valid.astype(float)
         else:
-            q = self.full(p)
-            model = q[:, :1] * R_L * self.shape((self.d - q[:, 1:2]) / R_L)
-            f = self.f - (q[:, 2:3] + q[:, 3:4] * (self.d - q[:, 1:2]))
+            model, f = self._model_and_force(p)
             m = np.where(valid, np.abs(np.nan_to_num(model)), 0.0)
             fmax = np.max(np.where(valid, np.abs(f), 0.0), axis=1, keepdims=True)
             if kind == "relative":
                 new = np.where(valid, 1.0 / np.maximum(m, floor * fmax), 0.0)
             else:
-                new = self._mixed(np.nan_to_num(model) - f, m / fmax, w)
+                new = self._mixed(np.nan_to_num(model) - f, m / fmax, w, floor)[0]
         with np.errstate(divide="ignore", invalid="ignore"):
             change = np.max(np.where(valid, np.abs(new / w - 1), 0.0), axis=1)
         return new, change
 
-    def _mixed(self, resid, m_rel, w):
-        """Mixed weights (``sigma^2 = a^2 + b^2 F^2``, ``least_squares._weights``): each row's
-        squared noise from the residuals' local scatter in depth order, (a^2, b^2) >= 0 by
-        non-negative least squares scaled by the previous sigma^2 (two unknowns: the best of the
-        unconstrained solution and the two with one coefficient 0, exactly)."""
+    def rows(self, kind, floor, p, w):
+        """``NoiseModel.rows`` of every pixel: the rows its noise scale is read from (all of them
+        but for mixed weights, where rows whose noise lies below the floor count by its share)."""
+        if kind != "mixed":
+            return self.n.astype(float)
+        model, f = self._model_and_force(p)
+        m = np.where(self.valid, np.abs(np.nan_to_num(model)), 0.0)
+        fmax = np.max(np.where(self.valid, np.abs(f), 0.0), axis=1, keepdims=True)
+        return self._mixed(np.nan_to_num(model) - f, m / fmax, w, floor)[1]
+
+    def _mixed(self, resid, m_rel, w, floor):
+        """Mixed weights (``sigma^2 = a^2 + b^2 F^2``, ``least_squares._mixed_variance``) and each
+        pixel's rows read for the noise: each row's squared noise from the residuals' local scatter
+        in depth order, (a^2, b^2) >= 0 by non-negative least squares scaled by the previous
+        sigma^2 (two unknowns: the best of the unconstrained solution and the two with one
+        coefficient 0, exactly); the weights assume the proportional part at ``floor`` of the
+        largest force at least."""
         valid, n, order = self.valid, self.n, self.order
         rs = np.take_along_axis(resid, order, axis=1)
         second = (rs[:, :-2] - 2 * rs[:, 1:-1] + rs[:, 2:]) ** 2 / 6
@@ -238,13 +254,15 @@ class Stack:
             obj = c[:, 0] ** 2 * G00 + 2 * c[:, 0] * c[:, 1] * G01 + c[:, 1] ** 2 * G11 - 2 * (c[:, 0] * h0 + c[:, 1] * h1)
             take = ok & (obj < best)
             best, coef = np.where(take, obj, best), np.where(take[:, None], c, coef)
-        s2 = coef[:, :1] + coef[:, 1:] * m_rel ** 2
-        s2 = np.where(valid, s2, 0.0)
+        noise = np.where(valid, coef[:, :1] + coef[:, 1:] * m_rel ** 2, 0.0)
+        s2 = np.where(valid, coef[:, :1] + coef[:, 1:] * np.maximum(m_rel, floor) ** 2, 0.0)
         top = np.max(s2, axis=1, keepdims=True)
         with np.errstate(divide="ignore", invalid="ignore"):
             s2 = np.maximum(s2, 1e-6 * top)
             out = np.where(valid, 1.0 / np.sqrt(s2 / top), 0.0)
-        return np.where((top > 0) & valid, out, valid.astype(float))
+            rows = np.sum(np.where(valid, noise / s2, 0.0), axis=1)
+        found = top[:, 0] > 0
+        return (np.where((top > 0) & valid, out, valid.astype(float)), np.where(found, rows, self.n.astype(float)))
 
     def start(self, mdls, P, top):
         """``LeastSquaresModel.start`` of every pixel (weights 1): the trial contact point of
@@ -382,9 +400,11 @@ def _fit_chunk(scene, part, curve, interpolated, shape, computed):
     first = part[0][1]
     stack = Stack(mdls, shape)
     p, rss, J, w, ok, its = stack.irls(first.noise.kind, first.noise.floor, stack.start(mdls, P, top))
+    rows = stack.rows(first.noise.kind, first.noise.floor, p, w)
     other = None
     if first.check is not None:
-        po, rsso, Jo, _, _, _ = stack.irls(first.check.kind, first.check.floor, p.copy())
+        po, rsso, Jo, wo, _, _ = stack.irls(first.check.kind, first.check.floor, p.copy())
+        rows_check = stack.rows(first.check.kind, first.check.floor, po, wo)
     results = []
     for b, (_, inputs) in enumerate(part):
         n, k = stack.n[b], inputs.k
@@ -392,10 +412,10 @@ def _fit_chunk(scene, part, curve, interpolated, shape, computed):
                    f"{its[b]} iterations" if ok[b] else
                    f"batched Levenberg-Marquardt: no convergence in {its[b]} iterations")
         res = OptimizeResult(x=p[b].copy(), success=bool(ok[b]), message=message, nfev=int(its[b]))
-        fitted = Fitted(res, float(rss[b]), J[b, :n], w[b, :n], scene, curve, P, top, dP=dP)
+        fitted = Fitted(res, float(rss[b]), J[b, :n], w[b, :n], scene, curve, P, top, dP=dP, rows=float(rows[b]))
         if first.check is not None:
             other = weights_check_of(first.check.kind, float(stack.full(po[b:b + 1])[0, 0]), float(rsso[b]),
-                                     Jo[b, :n], max(n - k, 1))
+                                     Jo[b, :n], max(min(rows_check[b], rows[b]) - k, 1))
         results.append(result_of(fitted, inputs.mdl, None, k, [], inputs.keep, inputs.weights, inputs.baseline,
                                  computed if b == 0 else 0, "shell", inputs.check, refitted=other))
     return results

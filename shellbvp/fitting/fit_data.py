@@ -130,7 +130,7 @@ class FitInputs:
     free: tuple
 
 
-def fit_inputs(scene, displacement, force, *, R_L, fit_offset=True, free=(), bounds=None, weights=None, floor=0.05,
+def fit_inputs(scene, displacement, force, *, R_L, fit_offset=True, free=(), bounds=None, weights=None, floor=None,
                delta_max=None, loss="linear", baseline="none", contact_guess=None, shared=None, stability=False,
                model="auto", max_depth=None, max_force=None, weights_check=True, aliases=None) -> FitInputs:
     """:func:`fit`'s arguments and data checked (its ValueErrors, before any model curve), as a
@@ -139,8 +139,9 @@ def fit_inputs(scene, displacement, force, *, R_L, fit_offset=True, free=(), bou
     weights = DEFAULT_WEIGHTS if weights is None else weights
     if weights not in WEIGHTS:
         raise ValueError(f"weights must be one of {WEIGHTS}; got {weights!r}")
-    if not (isinstance(floor, (int, float)) and 0 < floor <= 1):
-        raise ValueError(f"floor (of relative weights, fraction of max |force|) must be in (0, 1]; got {floor!r}")
+    if floor is not None and not (isinstance(floor, (int, float)) and 0 < floor <= 1):
+        raise ValueError(f"floor (of relative and mixed weights, fraction of max |force|) must be in (0, 1]; "
+                         f"got {floor!r}")
     free, bounds = free_parameters(free, bounds, aliases or {})
     if model not in FIT_MODELS:
         raise ValueError(f"model must be one of {FIT_MODELS}; got {model!r}")
@@ -172,8 +173,8 @@ def fit_inputs(scene, displacement, force, *, R_L, fit_offset=True, free=(), bou
         raise ValueError(f"delta_max must be > 0; got {delta_max!r}")
     grid = dm * np.arange(1, N_DEPTHS + 1) / N_DEPTHS
     mdl = LeastSquaresModel(d, f, R_L, fit_offset, baseline, loss)
-    noise = NoiseModel(weights, floor)
-    check = NoiseModel(other_weights(weights), floor) if weights_check else None
+    noise = NoiseModel.of(weights, floor)
+    check = NoiseModel.of(other_weights(weights), floor) if weights_check else None
     ranges = {"max_depth": None if max_depth is None else float(max_depth),
               "max_force": None if max_force is None else float(max_force)}
     return FitInputs(d=d, f=f, keep=keep, k=k, origin=float(origin), depth=float(depth), grid=grid, mdl=mdl,
@@ -181,7 +182,7 @@ def fit_inputs(scene, displacement, force, *, R_L, fit_offset=True, free=(), bou
                      free=free)
 
 
-def fit(scene, displacement, force, *, R_L, fit_offset=True, free=(), bounds=None, weights=None, floor=0.05,
+def fit(scene, displacement, force, *, R_L, fit_offset=True, free=(), bounds=None, weights=None, floor=None,
         delta_max=None, tol=1e-6, loss="linear", baseline="none", contact_guess=None, progress=None, shared=None,
         stability=False, model="auto", mesh_check=False, max_depth=None, max_force=None, weights_check=True,
         **aliases):
@@ -271,9 +272,11 @@ def fit(scene, displacement, force, *, R_L, fit_offset=True, free=(), bounds=Non
         Noise model: the same force noise at every point, noise proportional
         to the force, or both (``sigma^2 = a^2 + b^2 F^2``, a and b estimated);
         default :data:`DEFAULT_WEIGHTS` ("mixed", see benchmarks/fit_coverage.py).
-    floor : float
+    floor : float, optional
         With relative weights, forces below ``floor * max|force|`` are weighted
-        as if they were that large (near the contact point F -> 0); in (0, 1].
+        as if they were that large (near the contact point F -> 0); with mixed weights, the
+        noise's proportional part likewise; in (0, 1].  Default :data:`WEIGHT_FLOORS` (0.05
+        relative, 0.02 mixed; the weights check's other noise model takes its own).
     delta_max : float, optional
         Largest depth of the model curves (default: 1.2 x the largest measured depth/R_L).
     tol : float
@@ -312,7 +315,7 @@ def fit(scene, displacement, force, *, R_L, fit_offset=True, free=(), bounds=Non
     >>> res = sb.fit(sb.Scene.preset("fit"), d, F, R_L=0.3e-3)
     >>> print(f"mu*H = {res.mu_H:.2f} N/m [{res.mu_H_ci95[0]:.2f}, {res.mu_H_ci95[1]:.2f}], "
     ...       f"offset {res.offset * 1e6:.2f} um")
-    mu*H = 51.91 N/m [51.53, 52.29], offset 9.95 um
+    mu*H = 51.91 N/m [51.52, 52.30], offset 9.95 um
 
     Data the fit cannot use are refused before any curve is computed:
 
@@ -347,7 +350,8 @@ def fit(scene, displacement, force, *, R_L, fit_offset=True, free=(), bounds=Non
             shape.add(None)
             P, dP, top = shape.at(None)
             res, rss, J, w = noise.irls(mdl, P, dP, top)
-            fitted = Fitted(res, rss, J, w, scene, shape.nodes[None], P, top, dP=dP)
+            fitted = Fitted(res, rss, J, w, scene, shape.nodes[None], P, top, dP=dP,
+                            rows=noise.rows(mdl, P, top, mdl.full(res.x), w))
             notes = []
         else:
             search = ProfileSearch(sp, ModelCurves(sp.scene_at, grid, tol, depth, counter, progress), mdl, depth)
@@ -425,7 +429,8 @@ def _fit_on_shared(shared, scene, mdl, noise, depth, k, keep, weights, baseline,
     res, rss, J, w = noise.irls(mdl, P, dP, top)
     near = min(curves.thetas, key=lambda t: abs(t - theta))
     fitted = Fitted(res, rss, J, w, scene, curves.nodes[near], P, top,
-                    interpolation_error=getattr(curves, "interpolation_error", None), dP=dP)
+                    interpolation_error=getattr(curves, "interpolation_error", None), dP=dP,
+                    rows=noise.rows(mdl, P, top, mdl.full(res.x), w))
     return result_of(fitted, mdl, None, k, [], keep, weights, baseline, 0, check=check)
 
 

@@ -13,7 +13,7 @@ import numpy as np
 from scipy import special
 
 from ..fit_checks import (FIT_STATUS, WEIGHTS_DISAGREE, check_result, contact_misfit, fit_diagnostics,
-                          runs_in_depth_order, weights_disagreement)
+                          residual_autocorrelation, runs_in_depth_order, weights_disagreement)
 from ..scene_parameters import scene_parameter
 from ..shape_parameters import SHAPE_PARAMETERS
 from .least_squares import MODEL_PARAMETERS, LeastSquaresModel
@@ -34,7 +34,7 @@ def result_of(fitted, mdl, sp, k, notes, keep, weights, baseline, curves_compute
     res, rss, J, w, P, top, R_L = fitted.res, fitted.rss, fitted.J, fitted.w, fitted.P, fitted.top, mdl.R_L
     d, f = mdl.d, mdl.f
     n = d.size
-    dof = max(n - k, 1)
+    dof = max((n if fitted.rows is None else fitted.rows) - k, 1)  # zero-noise rows do not count
     cov = None
     try:
         cov = np.linalg.inv(J.T @ J) * rss / dof
@@ -76,12 +76,12 @@ def result_of(fitted, mdl, sp, k, notes, keep, weights, baseline, curves_compute
     runs = runs_in_depth_order(resid, d)
     contact = contact_misfit(resid, d, model(d, mu_H, d0, 0.0, 0.0))
     status, checks = check_result(bool(res.success), mu_H, mu_ci, off_ci, bool(np.all(np.isfinite(resid))),
-                                   resid.size, runs, contact)
+                                   resid.size, runs, contact, residual_autocorrelation(w * resid, d))
     found = notes + checks
     for _, text in found:
         log.info("fit: warning: %s", text)
     other = refitted if refitted is not None else \
-        None if check is None or fitted.dP is None else _refit_weighted(fitted, mdl, check, dof)
+        None if check is None or fitted.dP is None else _refit_weighted(fitted, mdl, check, k)
     detail = weights_disagreement(weights, mu_H, mu_ci, other) if status == 0 else None
     if detail is not None:
         status = WEIGHTS_DISAGREE
@@ -90,7 +90,7 @@ def result_of(fitted, mdl, sp, k, notes, keep, weights, baseline, curves_compute
     message = FIT_STATUS[status] + (f": {detail}" if detail else "") + f" (least squares: {res.message})"
     point_weights = np.full(keep.size, np.nan)
     point_weights[keep] = w / np.max(w)
-    diagnostics = fit_diagnostics(cov, rss, n, J.shape[1], w * resid, d, runs)
+    diagnostics = fit_diagnostics(cov, rss, n, J.shape[1], w * resid, d, runs, dof)
     return FitResult(mu_H=mu_H, mu_H_ci95=mu_ci, offset=d0,
                      offset_ci95=off_ci, residual_rms=float(np.sqrt(np.mean(np.nan_to_num(resid, nan=mdl.big) ** 2))),
                      n=n, status=status, message=message, R_L=float(R_L), curve=fitted.curve, _model=model,
@@ -102,10 +102,14 @@ def result_of(fitted, mdl, sp, k, notes, keep, weights, baseline, curves_compute
                      point_weights=point_weights, model=fit_model, weights_check=other, **diagnostics)
 
 
-def _refit_weighted(fitted, mdl, noise, dof):
+def _refit_weighted(fitted, mdl, noise, k):
     """``{"weights", "mu_H", "mu_H_ci95"}``: mu*H and its 95 % (Wald, t) interval refitted with
-    the noise model ``noise`` at the fitted shape, from the fit's solution (no model curve)."""
-    res, rss, J, _ = noise.irls(mdl, fitted.P, fitted.dP, fitted.top, start=fitted.res.x)
+    the noise model ``noise`` at the fitted shape, from the fit's solution (no model curve;
+    ``k`` parameters fitted in all).  Its noise scale is read from the rows that carry noise by
+    either fit's noise model (the mixed one's: rows read as exactly constant do not count)."""
+    res, rss, J, w = noise.irls(mdl, fitted.P, fitted.dP, fitted.top, start=fitted.res.x)
+    rows = noise.rows(mdl, fitted.P, fitted.top, mdl.full(res.x), w)
+    dof = max(min(rows, mdl.d.size if fitted.rows is None else fitted.rows) - k, 1)
     return weights_check_of(noise.kind, float(mdl.full(res.x)[0]), rss, J, dof)
 
 

@@ -11,8 +11,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import optimize
 
-__all__ = ["BASELINES", "MODEL_PARAMETERS", "WEIGHTS", "DEFAULT_WEIGHTS", "LeastSquaresModel", "NoiseModel",
-           "Fitted", "local_scatter"]
+__all__ = ["BASELINES", "MODEL_PARAMETERS", "WEIGHTS", "DEFAULT_WEIGHTS", "WEIGHT_FLOORS", "LeastSquaresModel",
+           "NoiseModel", "Fitted", "local_scatter"]
 
 #: Force baselines of :func:`fit` (none; a constant b0; b0 + b1 (d - d0)).
 BASELINES = ("none", "constant", "linear")
@@ -22,6 +22,12 @@ MODEL_PARAMETERS = ("mu_H", "offset", "baseline", "baseline_slope")
 WEIGHTS = ("uniform", "relative", "mixed")
 #: The default noise model (chosen by the coverage measured in benchmarks/fit_coverage.py).
 DEFAULT_WEIGHTS = "mixed"
+#: The default ``floor`` of :func:`~shellbvp.fitting.fit` per noise model: forces below ``floor *
+#: max|force|`` weighted as that (relative weights), the proportional part of the noise taken at
+#: that force at least (mixed weights).  Mixed weights' 0.02 is measured in
+#: benchmarks/fit_coverage.py: it restores the coverage of records with a noise-free approach,
+#: and 0.05 leaves beta undetermined on the shipped example (``--fit-beta``).
+WEIGHT_FLOORS = {"relative": 0.05, "mixed": 0.02}
 
 
 class LeastSquaresModel:
@@ -159,28 +165,42 @@ def local_scatter(resid, disp):
     return out
 
 
-def _weights(kind, model_force, f, floor, w_prev, disp):
-    """Weights 1/sigma_i of the noise model, from the current model force (IRLS)."""
-    if kind == "uniform":
-        return np.ones_like(f)
+def _mixed_variance(model_force, f, floor, w_prev, disp):
+    """Each row's variance by the mixed noise model, up to a common scale: ``(noise, weighted)``.
+
+    ``noise``: ``sigma^2 = a^2 + b^2 F^2``, (a^2, b^2) >= 0 by least squares on each row's
+    squared noise (each row scaled by the previous sigma^2: squared residuals have variance
+    ~ sigma^4).  The noise is read from the residuals' local scatter, not from the residuals
+    themselves: where the model misses the data (a real curve's contact region), squared residuals
+    would be taken for a large relative noise, its rows weighted down and the misfit kept (issue 56).
+    ``weighted``: the variance the weights assume, the proportional part taken at
+    ``floor * max|force|`` at least (as relative weights do): rows near the contact point, and
+    approach rows without noise (a force read as exactly constant), are not given weights
+    without bound.  None when no noise is found.
+    """
     m = np.abs(np.nan_to_num(model_force))
     fmax = np.max(np.abs(f))
-    if kind == "relative":
-        return 1.0 / np.maximum(m, floor * fmax)
-    # mixed: sigma^2 = a^2 + b^2 F^2, (a^2, b^2) >= 0 by least squares on each row's squared noise
-    # (each row scaled by the previous sigma^2: squared residuals have variance ~ sigma^4).  The
-    # noise is read from the residuals' local scatter, not from the residuals themselves: where the
-    # model misses the data (a real curve's contact region), squared residuals would be taken for
-    # a large relative noise, its rows weighted down and the misfit kept (issue 56).
     r2 = local_scatter(np.nan_to_num(model_force) - f, disp)
     s2_prev = 1.0 / w_prev ** 2
     A = np.column_stack([np.ones_like(m), (m / fmax) ** 2]) / s2_prev[:, None]
     coef, _ = optimize.nnls(A, r2 / s2_prev)
-    s2 = coef[0] + coef[1] * (m / fmax) ** 2
-    if not np.any(s2 > 0):
+    noise = coef[0] + coef[1] * (m / fmax) ** 2
+    weighted = coef[0] + coef[1] * np.maximum(m / fmax, floor) ** 2
+    if not np.any(weighted > 0):
+        return None
+    return noise, np.maximum(weighted, 1e-6 * np.max(weighted))
+
+
+def _weights(kind, model_force, f, floor, w_prev, disp):
+    """Weights 1/sigma_i of the noise model, from the current model force (IRLS)."""
+    if kind == "uniform":
         return np.ones_like(f)
-    s2 = np.maximum(s2, 1e-6 * np.max(s2))
-    return 1.0 / np.sqrt(s2 / np.max(s2))
+    if kind == "relative":
+        return 1.0 / np.maximum(np.abs(np.nan_to_num(model_force)), floor * np.max(np.abs(f)))
+    var = _mixed_variance(model_force, f, floor, w_prev, disp)
+    if var is None:
+        return np.ones_like(f)
+    return 1.0 / np.sqrt(var[1] / np.max(var[1]))
 
 
 @dataclass
@@ -194,6 +214,21 @@ class NoiseModel:
         w_new = _weights(self.kind, mdl.indentation(P, top, mdl.d, q), mdl.f - mdl.baseline(mdl.d, q), self.floor, w,
                          mdl.d)
         return w_new, np.max(np.abs(w_new / w - 1))
+
+    @classmethod
+    def of(cls, kind, floor=None):
+        """The noise model ``kind`` with ``floor``, default its :data:`WEIGHT_FLOORS` (none for uniform)."""
+        return cls(kind, WEIGHT_FLOORS.get(kind, 0.0) if floor is None else float(floor))
+
+    def rows(self, mdl, P, top, q, w):
+        """The number of rows the noise scale is read from: each row counts by the share of the
+        variance its weight assumes that the noise model expects in it (1, except for mixed
+        weights where their floor is above the noise: approach rows read as exactly constant
+        count 0, and do not make the weighted RSS look like small noise)."""
+        if self.kind != "mixed":
+            return float(mdl.d.size)
+        var = _mixed_variance(mdl.indentation(P, top, mdl.d, q), mdl.f - mdl.baseline(mdl.d, q), self.floor, w, mdl.d)
+        return float(mdl.d.size) if var is None else float(np.sum(var[0] / var[1]))
 
     def irls(self, mdl, P, dP, top, start=None):
         """Fit at a fixed shape, iteratively reweighted: (result, RSS, Jacobian, weights);
@@ -215,8 +250,8 @@ class NoiseModel:
 class Fitted:
     """What a fit found: the least-squares result at the fitted shape, its weighted RSS and
     Jacobian (a column for the shape parameter too), the weights, the scene and model curve
-    reported, the shape F(delta) fitted (and its derivative), and the shape parameter's estimate
-    and interval."""
+    reported, the shape F(delta) fitted (and its derivative), the shape parameter's estimate
+    and interval, and the number of rows the noise scale is read from."""
     res: object
     rss: float
     J: np.ndarray
@@ -229,3 +264,4 @@ class Fitted:
     theta_ci: tuple | None = None
     interpolation_error: float | None = None
     dP: object = None  # the shape's derivative (the weights check refits at this shape)
+    rows: float | None = None  # the rows the noise scale is read from (NoiseModel.rows); None: all

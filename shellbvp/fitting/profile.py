@@ -180,7 +180,9 @@ class ProfileSearch:
             theta_hat = self.estimate()
             if change < 1e-6:
                 break
-        dof = max(mdl.d.size - k, 1)
+        P, _, top = shape.at(theta_hat)
+        rows = noise.rows(mdl, P, top, mdl.full(self.profile(theta_hat)[1].x), self.w)
+        dof = max(rows - k, 1)
         margin = special.fdtri(1, dof, 0.95) / dof  # thr = RSS_min (1 + margin)
         theta_hat, interp_err = self._on_a_node(theta_hat, margin)
         rss_min, res = self.profile(theta_hat)
@@ -201,7 +203,7 @@ class ProfileSearch:
         col = self.w * np.nan_to_num((Fp[1] - Fp[0]) / (ths[1] - ths[0]))
         near = min(shape.thetas, key=lambda t: abs(t - theta_hat))
         return Fitted(res, rss, np.column_stack([J, col]), self.w, shape.scene_at(near), shape.nodes[near], P, top,
-                      theta_hat, (c_lo, c_hi), interp_err, dP=dP)
+                      theta_hat, (c_lo, c_hi), interp_err, dP=dP, rows=rows)
 
 
 def _drop(pdt):
