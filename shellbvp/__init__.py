@@ -19,6 +19,7 @@ _LAZY = {"curve": "continuation", "iter_curve": "continuation", "CurveRun": "con
          "UserTip": "geometry", "Curve": "io", "read_curve": "io", "BendingEnergy": "materials", "Gent": "materials",
          "MooneyRivlin": "materials", "NeoHookean": "materials", "RotationBending": "materials",
          "StrainEnergy": "materials", "TraceBending": "materials", "PRESETS": "scene", "Scene": "scene",
+         "ThicknessProfile": "thickness_profile",
          "STATUS_MESSAGES": "solution", "Solution": "solution", "delta_bounds": "bounds", "solve": "state",
          "Dimensions": "units", "beta_from_thickness": "units", "parse_quantity": "units",
          "fit": "fitting", "FitResult": "fitting", "read_force_csv": "fitting", "fit_record": "fitting",
@@ -46,6 +47,7 @@ def __getattr__(name):
 
 __all__ = [
     "Scene",
+    "ThicknessProfile",
     "solve",
     "delta_bounds",
     "inflate",

@@ -251,6 +251,8 @@ def check_solid_scene(scene):
     if scene.closed:
         raise ValueError("the 3D reference holds a shell on its rim; a closed shell (support=substrate/plates) "
                          "has no solid yet")
+    if scene.thickness_profile is not None:
+        raise ValueError("the 3D reference meshes a uniform wall; a thickness_profile has no solid yet")
     _check_material(scene)
 
 

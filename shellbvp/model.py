@@ -69,11 +69,14 @@ def _code_inputs() -> tuple[str, str]:
     return source_fingerprint(Path(__file__).parent / "materials"), importlib.metadata.version("sympy")
 
 
-def structure_description(material, xi: int, shell, tip, bending=None, pressurised=False, substrate=False) -> dict:
+def structure_description(material, xi: int, shell, tip, bending=None, pressurised=False, substrate=False,
+                          thickness=None) -> dict:
     """Everything the generated code depends on, as JSON-able data (``pressurised``: the
     pressure's terms and parameters are generated; ``substrate``: a closed shell's contact with
-    the plane it rests on; descriptions without them are unchanged)."""
+    the plane it rests on; ``thickness``: a wall's profile, ``ThicknessProfile.description``;
+    descriptions without them are unchanged)."""
     return {**({"pressurised": True} if pressurised else {}), **({"substrate": True} if substrate else {}),
+        **({"thickness": thickness} if thickness is not None else {}),
         "bending": bending.description() if bending is not None else {"family": "trace"},
         "codegen": CODEGEN_VERSION,
         "source": _code_inputs()[0],

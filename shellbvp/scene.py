@@ -18,6 +18,7 @@ from .geometry import FlatTip, SphereTip, Spheroid, UserShell, UserTip
 from .materials import MATERIALS, Bending, Gent, Material, MooneyRivlin, TraceBending
 from .model import load_module, structure_description
 from .scene_parameters import scene_parameter
+from .thickness_profile import ThicknessProfile, settle_profile
 
 __all__ = ["Scene", "PRESETS", "CONTACT_MODELS", "RIMS", "SUPPORTS"]
 
@@ -84,7 +85,9 @@ class Scene:
         (:func:`shellbvp.beta_from_thickness`, ``eps^2/3`` for the built-in bending energies)
         and is kept for the 3D reference (:func:`shellbvp.fe_curve`).  Give it or ``beta``:
         both only when they agree.  ``replace(beta=...)`` drops it, ``replace(thickness=...)``
-        sets beta anew.
+        sets beta anew.  A wall whose thickness varies: a :class:`ThicknessProfile` (or a
+        formula's text, H/R_L of S and L); ``thickness`` is then the pole's, which forces,
+        mu*H and beta refer to (docs/thickness.md).
     transverse_shear : bool
         Add the transverse shear compliance of a shell of that ``thickness`` (Reissner-Mindlin,
         shear factor 5/6; :mod:`shellbvp.thickness`): each state's ``shear_delta``, and fits
@@ -108,6 +111,8 @@ class Scene:
         support.  Between plates, or on a substrate under a flat plate, the half above the
         equator is solved (symmetry: the equator stays vertical, free to move out, and moves
         by delta/2); under a curved tip on a substrate both halves are, with a contact each.
+    thickness_profile : ThicknessProfile, optional
+        Set from ``thickness`` when that is a profile (read it here; files store it).
 
     Raises
     ------
@@ -150,6 +155,7 @@ class Scene:
     rim: str = "pinned"
     closed: bool = False
     support: str = None
+    thickness_profile: ThicknessProfile = None
 
     def __post_init__(self):
         # the ranges and their errors are the registry's (shellbvp.scene_parameters)
@@ -159,6 +165,9 @@ class Scene:
             raise ValueError(f"bending must be TraceBending(), RotationBending() or BendingEnergy(...); "
                              f"got {self.bending!r}")
         beta = self.beta
+        if not isinstance(self.shell, (Spheroid, UserShell)):
+            raise ValueError(f"shell must be Spheroid() or UserShell(...); got {self.shell!r}")
+        settle_profile(self)
         if self.thickness is not None:
             eps = _finite("thickness", self.thickness)  # H / R_L: the scene's unit (its lab form H = eps R_L)
             scene_parameter("thickness").check(eps, shown=self.thickness)
@@ -181,8 +190,6 @@ class Scene:
             raise ValueError(f"material must be one of {', '.join(c.__name__ for c in MATERIALS.values())}; "
                              f"got {self.material!r}")
         self.material.validate()
-        if not isinstance(self.shell, (Spheroid, UserShell)):
-            raise ValueError(f"shell must be Spheroid() or UserShell(...); got {self.shell!r}")
         if not isinstance(self.tip, (SphereTip, FlatTip, UserTip)):
             raise ValueError(f"tip must be SphereTip(), FlatTip() or UserTip(...); got {self.tip!r}")
         if isinstance(self.tip, FlatTip):
@@ -250,10 +257,12 @@ class Scene:
         """A copy with some fields changed (validated again).
 
         A new ``beta`` drops the thickness (and the transverse shear that needs it); a new
-        ``thickness`` (or bending energy, with a thickness) sets beta from it.
+        ``thickness`` (or bending energy, with a thickness) sets beta from it.  A new thickness
+        (a number) of a profiled wall scales its profile to that pole thickness.
         """
         if "beta" in changes and "thickness" not in changes:
             changes["thickness"] = None
+            changes.setdefault("thickness_profile", None)
             changes.setdefault("transverse_shear", False)
         elif "beta" not in changes and ("thickness" in changes or "bending" in changes and self.thickness):
             changes["beta"] = None
@@ -274,6 +283,7 @@ class Scene:
             **({"transverse_shear": True} if self.transverse_shear else {}),
             **({"rim": self.rim} if self.rim != "pinned" else {}),
             **({"closed": True, "support": self.support} if self.closed else {}),
+            **({"thickness_profile": self.thickness_profile.to_dict()} if self.thickness_profile else {}),
         }
 
     @classmethod
@@ -335,7 +345,9 @@ class Scene:
                    else False,
                    rim=field(d, "rim", text, "") if "rim" in d else "pinned",
                    closed=field(d, "closed", (bool,), "") if "closed" in d else False,
-                   support=field(d, "support", text, "") if "support" in d else None)
+                   support=field(d, "support", text, "") if "support" in d else None,
+                   thickness_profile=ThicknessProfile.from_dict(d["thickness_profile"])
+                   if "thickness_profile" in d else None)
 
     def describe(self, R_L: float | None = None) -> str:
         """The scene in words, one line; with the rim radius ``R_L`` (m) its lengths in lab units.
@@ -374,8 +386,14 @@ class Scene:
             parts.append(f"indenter: {tip} of radius {length(self.rho)} (rho {self.rho:.4g})" if R_L
                          else f"indenter: {tip}, rho {self.rho:.4g}")
         if self.thickness is not None:
+            at_pole = ""
+            if self.thickness_profile is not None:
+                thickest = self.thickness_profile.thickest(self.shell_length)
+                at_pole = (f" at the pole (forces and mu*H refer to it), up to "
+                           f"{length(thickest) if R_L else f'{thickest:.4g}'} along the wall: "
+                           f"{self.thickness_profile.describe()}")
             parts.append(f"thickness {length(self.thickness) + ' (eps ' if R_L else 'eps '}{self.thickness:.4g}, "
-                         f"beta {self.beta:.4g}{')' if R_L else ''}"
+                         f"beta {self.beta:.4g}{')' if R_L else ''}{at_pole}"
                          + ("; with transverse shear" if self.transverse_shear else ""))
         else:
             parts.append(f"beta {self.beta:.4g} (no thickness given)")
@@ -416,8 +434,9 @@ class Scene:
     # -- generated code ------------------------------------------------------------
     def structure(self) -> dict:
         """The structural choices the generated code is specialised on."""
+        profile = self.thickness_profile.description() if self.thickness_profile is not None else None
         return structure_description(self.material, self.xi, self.shell, self.tip, self.bending,
-                                     pressurised=self.pressurised, substrate=self.two_contacts)
+                                     pressurised=self.pressurised, substrate=self.two_contacts, thickness=profile)
 
     @property
     def halved(self) -> bool:

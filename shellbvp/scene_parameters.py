@@ -354,7 +354,8 @@ THICKNESS = SceneParameter(
         unavailable=lambda scene: None if scene.thickness is not None else (
             "fit_thickness starts from the scene's thickness: give one (Scene(thickness=H/R_L); the CLI's "
             "--thickness)"),
-        default_bounds=lambda scene: (_eps_of_beta(BETA.fit.default_bounds(scene)[0], scene.bending), 0.5),
+        default_bounds=lambda scene: (_eps_of_beta(BETA.fit.default_bounds(scene)[0], scene.bending),
+                                      0.5 * _thickest_over_pole(scene)),
         log_scale=True, step=lambda scene: 0.5 * math.log(2.0), report_lab=True, display_unit="um",
         note="; beta = (H/R_L)^2/3",
         fit_help="also fit the shell's thickness H (beta = (H/R_L)^2/3, a 3D plate's bending), which gives the "
@@ -363,6 +364,13 @@ THICKNESS = SceneParameter(
                    "default from beta = 1e-4 to H/R_L = 0.5)",
         derived=(_modulus("mu", 1.0, "mu*H / H; linearised in ln mu, with H's uncertainty"),
                  _modulus("E", 3.0, "E = 3 mu, incompressible; linearised in ln E"))))
+
+def _thickest_over_pole(scene) -> float:
+    """1, or a profiled wall's pole thickness over its thickest (a fitted thickness scales the
+    profile: the whole wall stays within H/R_L <= 0.5)."""
+    profile = scene.thickness_profile
+    return 1.0 if profile is None else scene.thickness / profile.thickest(scene.shell_length)
+
 
 #: Where the registered materials' parameters stand in :data:`DECLARED`.
 MATERIAL_PARAMETERS = "the materials' parameters"

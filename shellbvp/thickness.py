@@ -52,7 +52,9 @@ def shear_delta(profiles, start: int, edge_r: float, thickness: float) -> float:
     edge_r : float
         That edge's radius (0 under a point load).
     thickness : float
-        eps = H / R_L.
+        eps = H / R_L (at the pole, where the wall's thickness varies: the profiles then hold
+        the local thickness over the pole's, ``thickness``, and the shear strain is
+        ``Q / (kappa mu H(S))``).
     """
     cut = edge_r + 0.5 * thickness
     total = 0.0
@@ -60,6 +62,8 @@ def shear_delta(profiles, start: int, edge_r: float, thickness: float) -> float:
         if kind != "free":
             break  # the shell touches the indenter again: no tilt passes through it
         r, Q = np.asarray(f["r"], float), np.asarray(f["Q"], float)
+        if "thickness" in f:  # a profiled wall: Q in units of mu H0, the strain of the local H
+            Q = Q / np.asarray(f["thickness"], float)
         keep = r >= cut
         if not np.any(keep):
             continue
@@ -155,6 +159,8 @@ def model_error(scene):
     eps = getattr(scene, "thickness", None)
     if eps is None or scene.pressure or scene.sealed or scene.closed:  # the map holds rimmed shells only
         return None
+    if scene.thickness_profile is not None:  # a profiled wall: bounded by its thickest point
+        eps = scene.thickness_profile.thickest(scene.shell_length)
     row = MEASURED_MODEL_ERROR.get((scene.contact, scene.bending.family, bool(scene.transverse_shear)))
     if row is None:
         return None
@@ -172,7 +178,10 @@ def model_error_line(scene) -> str:
     if found is None:
         return f"model  = the shell model's own error against 3D elasticity is not mapped for this model; {tail}"
     error, extrapolated = found
-    eps = scene.thickness
+    eps, thickest = scene.thickness, ""
+    if scene.thickness_profile is not None:
+        eps = scene.thickness_profile.thickest(scene.shell_length)
+        thickest = " (the wall's thickest)"
     where = " (extrapolated beyond the measured eps)" if extrapolated else ""
     if scene.transverse_shear:
         better = "with transverse shear"
@@ -181,5 +190,5 @@ def model_error_line(scene) -> str:
         better = ("without transverse shear; --transverse-shear: up to "
                   f"{100 * sheared[0]:.2g} %" if sheared else "without transverse shear")
     return (f"model  = beside this interval, the shell model's own error against 3D elasticity: up to "
-            f"{100 * error:.2g} % (in F at equal depth or in a fitted mu*H) at eps = {eps:.3g} over the measured "
+            f"{100 * error:.2g} % (in F at equal depth or in a fitted mu*H) at eps = {eps:.3g}{thickest} over the measured "
             f"scenes{where}, {better} (docs: How accurate is the shell model?); {tail}")

@@ -40,8 +40,11 @@ def structure_from_description(desc: dict) -> Structure:
     else:
         tip = geometry.user_tip(_expr(tp["A"], "A(omega)", geometry.OMEGA), _expr(tp["B"], "B(omega)", geometry.OMEGA))
     B = energies.bending_energy(desc.get("bending", {"family": "trace"}))
+    profile = desc.get("thickness")
+    thickness = geometry.thickness_profile(profile, shell) if profile is not None else None
     return Structure(W=W, material_params=mpar, shell=shell, tip=tip, xi=int(desc["xi"]), B=B,
-                     pressurised=bool(desc.get("pressurised", False)), substrate=bool(desc.get("substrate", False)))
+                     pressurised=bool(desc.get("pressurised", False)), substrate=bool(desc.get("substrate", False)),
+                     thickness=thickness)
 
 
 def generate_source(desc: dict) -> str:

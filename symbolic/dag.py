@@ -133,6 +133,10 @@ class Program:
             ds = self._derivative_of_step(s, wrt)
             if ds != 0:
                 result += sp.diff(target, s) * ds
+        if result.has(sp.DiracDelta):
+            # only from a spline's |S - S_k|^3 terms (a thickness table), where the delta comes
+            # multiplied by (S - S_k)^2: zero as a distribution (the spline is C2)
+            result = result.replace(lambda e: isinstance(e, sp.DiracDelta), lambda e: sp.S.Zero)
         return result
 
     def _derivative_of_step(self, sym, wrt):

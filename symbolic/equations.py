@@ -93,6 +93,9 @@ class Structure:
     B: sp.Expr | None = None
     pressurised: bool = False
     substrate: bool = False  # a closed shell on a rigid plane: its lower half's contact ("plane")
+    #: The wall's thickness relative to the pole's, t(S) (``geometry.thickness_profile``): the
+    #: energy per reference area is ``t W + beta t^3 B``; None: uniform (no such terms generated).
+    thickness: sp.Expr | None = None
 
     @property
     def params(self) -> tuple:
@@ -215,24 +218,30 @@ class Derivation:
             "ksR": prog.let(f"ksR{tag}", ksR.xreplace(sub)),
             "ktR": prog.let(f"ktR{tag}", ktR.xreplace(sub)),
         }
+        if self.structure.thickness is not None:
+            out["thk"] = prog.let(f"thk{tag}", self.structure.thickness.xreplace(sub))
         return out
 
-    def _constitutive(self, prog: Program, ls, lt, ks, kt, ksR, ktR, tag=""):
+    def _constitutive(self, prog: Program, ls, lt, ks, kt, ksR, ktR, tag="", thk=None):
         """T, M, tau and U from W and the bending energy; names get suffix ``tag``.
 
         ``m`` is what the rim's ``M_s = 0`` sets to zero: ``tr Delta`` for the paper's bending
         energy (written through it, as the paper does), ``dB/dkappa_s`` for any other.
+        ``thk``: the local thickness over the pole's (a profiled wall): the membrane energy
+        scales with it, the bending stiffness with its cube (``t W + beta t^3 B``).
         """
         st = self.structure
         KS, KT = bending.KS, bending.KT
         h = 1 / (LS * LT)
         sub = {LS: ls, LT: lt, KS: ks, KT: kt}
-        T_s = prog.let(f"T_s{tag}", (sp.diff(st.W, LS) / LT).xreplace(sub))
-        T_t = prog.let(f"T_t{tag}", (sp.diff(st.W, LT) / LS).xreplace(sub))
-        W = prog.let(f"W{tag}", st.W.xreplace(sub))
+        t = sp.S.One if thk is None else thk
+        beta = BETA * t**3
+        T_s = prog.let(f"T_s{tag}", (t * sp.diff(st.W, LS) / LT).xreplace(sub))
+        T_t = prog.let(f"T_t{tag}", (t * sp.diff(st.W, LT) / LS).xreplace(sub))
+        W = prog.let(f"W{tag}", (t * st.W).xreplace(sub))
         if st.B is None:  # the paper's (tr Delta)^2/2
             tr_delta = LS**2 * KS + LT**2 * KT - ksR - ktR
-            U = st.W + BETA / 2 * tr_delta**2
+            U = t * st.W + beta / 2 * tr_delta**2
             m = prog.let(f"m{tag}", tr_delta.xreplace(sub))
 
             def as_m(expr):  # write moments through the named bending strain m
@@ -240,7 +249,7 @@ class Derivation:
 
             M_s = prog.let(f"M_s{tag}", as_m(h * sp.diff(U, KS)))
             M_t = prog.let(f"M_t{tag}", as_m(h * sp.diff(U, KT)))
-            U_ = prog.let(f"U{tag}", W + BETA / 2 * m**2)
+            U_ = prog.let(f"U{tag}", W + beta / 2 * m**2)
             tau_s = prog.let(f"tau_s{tag}", T_s + st.xi * M_s * ks)
             tau_t = prog.let(f"tau_t{tag}", T_t + st.xi * M_t * kt)
         else:
@@ -250,11 +259,11 @@ class Derivation:
             # branch above); for another it is not, and M kappa would break F = dE/ddelta.
             B = st.B.xreplace({bending.KS0: ksR, bending.KT0: ktR})
             m = prog.let(f"m{tag}", sp.diff(B, KS).xreplace(sub))
-            M_s = prog.let(f"M_s{tag}", (h * BETA).xreplace(sub) * m)
-            M_t = prog.let(f"M_t{tag}", (h * BETA * sp.diff(B, KT)).xreplace(sub))
-            U_ = prog.let(f"U{tag}", W + BETA * B.xreplace(sub))
-            bend_s = BETA * (sp.diff(B, LS) - sp.diff(B, KS) * KS / LS) / LT
-            bend_t = BETA * (sp.diff(B, LT) - sp.diff(B, KT) * KT / LT) / LS
+            M_s = prog.let(f"M_s{tag}", (h * beta).xreplace(sub) * m)
+            M_t = prog.let(f"M_t{tag}", (h * beta * sp.diff(B, KT)).xreplace(sub))
+            U_ = prog.let(f"U{tag}", W + beta * B.xreplace(sub))
+            bend_s = beta * (sp.diff(B, LS) - sp.diff(B, KS) * KS / LS) / LT
+            bend_t = beta * (sp.diff(B, LT) - sp.diff(B, KT) * KT / LT) / LS
             tau_s = prog.let(f"tau_s{tag}", T_s + st.xi * bend_s.xreplace(sub))
             tau_t = prog.let(f"tau_t{tag}", T_t + st.xi * bend_t.xreplace(sub))
         return dict(m=m, T_s=T_s, T_t=T_t, M_s=M_s, M_t=M_t, tau_s=tau_s, tau_t=tau_t, W=W, U=U_)
@@ -298,7 +307,7 @@ class Derivation:
         lt = A.let("lt", r / g["R"])
         kt = A.let("kt", sp.sin(phi) / r)
         psi = A.let("psi", ls * g["Psi"])
-        c = self._constitutive(A, ls, lt, ks, kt, g["ksR"], g["ktR"])
+        c = self._constitutive(A, ls, lt, ks, kt, g["ksR"], g["ktR"], thk=g.get("thk"))
         dr = A.let("dr", psi * sp.cos(phi))
         dphi = A.let("dphi", psi * ks)
 
@@ -354,6 +363,8 @@ class Derivation:
             "energy_density": o["U"] * o["R"] * o["Psi"],
             "volume_density": volume_density(r, phi, o["psi"]),
         }
+        if "thk" in o:  # a profiled wall: its thickness over the pole's
+            self.free_profile["thickness"] = o["thk"]
 
     # ------------------------------------------------------------------ contact region
     def _contact_physical(self, tip: TipGeometry):
@@ -373,7 +384,7 @@ class Derivation:
         ks = C.let("ks", t["rho_ks"] / RHO)
         kt = C.let("kt", t["rho_kt"] / RHO)
         psi = C.let("psi", ls * g["Psi"])
-        c = self._constitutive(C, ls, lt, ks, kt, g["ksR"], g["ktR"])
+        c = self._constitutive(C, ls, lt, ks, kt, g["ksR"], g["ktR"], thk=g.get("thk"))
         domega = C.let("domega", ls * g["Psi"] / (RHO * t["G"]))
         dr = C.let("dr", psi * t["cos_phi"])
 
@@ -412,6 +423,8 @@ class Derivation:
             "energy_density": o["U"] * o["R"] * o["Psi"], "omega": sp.Symbol("omega"),
             "volume_density": -sp.pi * o["r"] ** 2 * o["psi"] * t["sin_phi"],
         }
+        if "thk" in o:
+            profile["thickness"] = o["thk"]
         # note: profile z is relative to the tip apex; the solver adds z_tip.
         return P, ys, rhs, profile
 

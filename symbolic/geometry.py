@@ -17,6 +17,7 @@ from dataclasses import dataclass
 import sympy as sp
 
 from .formula import parse_formula
+from .spline import natural_spline_coefficients
 
 __all__ = ["S", "OMEGA", "GAMMA", "ShellGeometry", "TipGeometry", "spheroid", "user_shell",
            "sphere_tip", "flat_tip", "user_tip"]
@@ -168,3 +169,37 @@ def cylinder_of(tip: TipGeometry) -> TipGeometry:
     return TipGeometry(A=sp.simplify(tip.A.subs(OMEGA, w0)) + 0 * OMEGA,
                        B=sp.simplify(tip.B.subs(OMEGA, w0)) + (OMEGA - w0), phi=sp.pi / 2 + 0 * OMEGA,
                        omega_max=None)
+
+
+def thickness_profile(description: dict, shell: ShellGeometry) -> sp.Expr:
+    """The wall's thickness relative to the pole's, ``t(S) = H(S)/H(0)``, from a profile's
+    description: ``{"kind": "formula", "H": text}`` (a formula of S and L, read by the
+    whitelist parser) or ``{"kind": "spline", "S": [...], "H": [...]}`` (knots from the pole
+    to the rim).  A table is interpolated by the natural cubic spline through its rows, written
+    as ``a + b S + sum_k c_k |S - S_k|^3`` (with ``sum c_k = sum c_k S_k = 0``): one smooth
+    (C2) expression, so the derivation differentiates it as any formula.  Its third derivative
+    never enters the equations (it would carry ``|S - S_k|^2 delta(S - S_k) = 0``:
+    :meth:`symbolic.dag.Program.derivative` drops such terms).
+    """
+    kind = description.get("kind")
+    if kind == "formula":
+        L = sp.Symbol("L", positive=True)
+        H = parse_formula(description["H"], {"S": S, "L": L}, name="H(S)").xreplace({L: shell.L})
+    elif kind == "spline":
+        H = natural_spline(description["S"], description["H"])
+    else:
+        raise ValueError(f"unknown thickness profile kind {kind!r} (known: formula, spline)")
+    H0 = H.subs(S, 0)
+    if not (H0.is_number and float(H0) > 0):
+        raise ValueError(f"the thickness at the pole H(0) must be positive; got {H0}")
+    return H / H0
+
+
+def natural_spline(knots, values) -> sp.Expr:
+    """The natural cubic spline through ``(knots, values)`` as one SymPy expression in S."""
+    a, b, c = natural_spline_coefficients(knots, values)
+    expr = sp.Float(a) + sp.Float(b) * S
+    for ck, xk in zip(c, knots):
+        if ck != 0.0:
+            expr += sp.Float(ck) * sp.Abs(S - sp.Float(float(xk))) ** 3
+    return expr

@@ -700,3 +700,79 @@ def test_contact_line_conditions_combine_into_the_weierstrass_excess():
             assert abs(lhs - excess) < 1e-25 * (abs(F2) + abs(ls_c * lt / rho * F1)), (lhs, excess)
             if p is base:
                 assert excess > 0, excess
+
+
+# ------------------------------------------------------------------------------ a profiled wall
+#: A wall whose thickness varies, relative to the pole's (not even in S: a linear term too).
+WALL = 1 - S / 3 + S**2 / 5
+
+
+@functools.lru_cache(maxsize=None)
+def profiled_derivation():
+    W, par = MATERIALS["mooney_rivlin"]
+    return derive(Structure(W=W, material_params=par, shell=geometry.spheroid(), tip=geometry.sphere_tip(),
+                            xi=1, thickness=WALL))
+
+
+def test_profiled_wall_equilibrium_is_euler_lagrange_of_its_energy():
+    """A wall of thickness t(S) H0: the energy per reference area is ``t W + beta t^3 B``
+    (membrane stiffness ~ H, bending ~ H^3), written here on the energy side by hand.  The
+    derivation's equilibrium (eq1, eq2 from its tau, M; and its ODE form dls, dks, dQ) is the
+    Euler-Lagrange system of that energy to 1e-25, as for a uniform wall; and it is not the
+    uniform wall's (the profile's derivative enters)."""
+    W, _ = MATERIALS["mooney_rivlin"]
+    tr = KIN["ls"] ** 2 * KIN["ks"] + KIN["lt"] ** 2 * KIN["kt"] - KS_REF - KT_REF
+    L = (WALL * W.xreplace({LS: KIN["ls"], LT: KIN["lt"]}) + BETA / 2 * WALL**3 * tr**2) * R_REF * PSI_REF
+    Er = sp.diff(L, RJ[0]) - D(sp.diff(L, RJ[1])) + D(D(sp.diff(L, RJ[2])))
+    Ez = sp.diff(L, ZJ[0]) - D(sp.diff(L, ZJ[1])) + D(D(sp.diff(L, ZJ[2])))
+    d = profiled_derivation()
+    args = (S, *RJ[:5], *ZJ[1:5], *d.params)
+    el = sp.lambdify(args, [(Er * _r1 + Ez * _z1) / PSI, (Er * _z1 - Ez * _r1) / PSI], "mpmath")
+    A, o = d.free_phys, d.free_phys_out
+    r, phi, ls, ks, Q = d.free_phys_vars
+    sub = {r: _r0, phi: KIN["phi"], ls: KIN["ls"], ks: KIN["ks"]}
+    f = {k: A.expand(o[k]).xreplace(sub) for k in ("tau_s", "tau_t", "M_s", "M_t", "kt")}
+    Qj = (D(_r0 * f["M_s"]) - _r1 * f["M_t"]) / (_r0 * PSI)
+    eq1 = D(_r0 * f["tau_s"]) - _r1 * f["tau_t"] + KIN["ks"] * _r0 * Qj * PSI
+    eq2 = KIN["ks"] * f["tau_s"] + f["kt"] * f["tau_t"] - D(_r0 * Qj) / (_r0 * PSI)
+    eqs = sp.lambdify(args, [eq1, eq2, Qj, KIN["phi"], KIN["ls"], KIN["ks"], D(KIN["ls"]), D(KIN["ks"]), D(Qj)],
+                      "mpmath")
+    uniform = equilibrium_along_jet("mooney_rivlin", 1)
+    ev = Evaluator(A)
+    with mp.workdps(DPS):
+        for p, rr, zz, S0 in cases("mooney_rivlin", 2, 2, seed=5):
+            jr, jz = meridian_jet(rr, zz, S0)
+            pars = [mpq(p[s]) for s in d.params]
+            Et, En = el(S0, *jr, *jz, *pars)
+            e1, e2, Qv, phv, lsv, ksv, Dls, Dks, DQ = eqs(S0, *jr, *jz, *pars)
+            psi = mp.sqrt(jr[1] ** 2 + jz[0] ** 2)
+            assert abs(Et) > 1e-4 and abs(En) > 1e-4
+            assert rel(Et, -e1) < 1e-25, (Et, -e1)
+            assert rel(En, jr[0] * psi * e2) < 1e-25, (En, jr[0] * psi * e2)
+            assert rel(Et, -uniform(S0, *jr, *jz, *pars)["eq1"]) > 1e-3  # the profile matters
+            state = {S: S0, r: jr[0], phi: phv, ls: lsv, ks: ksv, Q: Qv, **dict(zip(d.params, pars))}
+            dls, dks, dQ = ev([o[k] for k in ("dls", "dks", "dQ")], state)
+            # the ODE form solves the same two balances for (ls', ks'): its rates are the jet's
+            # where the jet satisfies them; off a solution the residuals are the balances'
+            ode1 = jr[0] * (ev([A.derivative(o["tau_s"], ls)], state)[0] * (Dls - dls)
+                            + ev([A.derivative(o["tau_s"], ks)], state)[0] * (Dks - dks))
+            assert rel(Et, -ode1) < 1e-25, (Et, -ode1)
+            assert rel(En, jr[0] * (dQ - DQ)) < 1e-25
+
+
+def test_thickness_table_is_the_natural_cubic_spline():
+    """A table's expression (``a + b S + sum c_k |S - S_k|^3``) passes through its rows and is
+    scipy's natural cubic spline between them, values and two derivatives (C2)."""
+    from scipy.interpolate import CubicSpline
+
+    x = np.array([0.0, 0.3, 0.7, 1.1, np.pi / 2])
+    y = np.array([0.05, 0.048, 0.04, 0.033, 0.03])
+    expr = geometry.natural_spline(x, y)
+    ref = CubicSpline(x, y, bc_type="natural")
+    pts = np.linspace(0.0, np.pi / 2, 23)
+    for k in range(3):
+        f = sp.lambdify(S, sp.diff(expr, S, k).replace(lambda e: isinstance(e, sp.DiracDelta), lambda e: 0), "numpy")
+        got = np.broadcast_to(f(pts), pts.shape)
+        assert np.max(np.abs(got - ref(pts, k))) < 1e-12 * max(1.0, np.max(np.abs(ref(pts, k))))
+    with pytest.raises(ValueError, match="strictly increasing"):
+        geometry.natural_spline([0.0, 0.5, 0.4], [1, 1, 1])

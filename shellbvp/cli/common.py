@@ -340,6 +340,10 @@ def add_scene_options(p, uncertain=False, preset_required=False, solver=("tol", 
     g.add_argument("--thickness", type=thickness_value,
                    help="shell thickness: H/R_L in (0, 0.5], or with a unit (50um) together with --radius; "
                         "sets beta = (H/R_L)^2/3, the bending stiffness of a 3D plate")
+    g.add_argument("--thickness-profile", dest="thickness_profile", metavar="FILE",
+                   help="a wall whose thickness varies: a table with a header, arc_um (or angle_deg, angle_rad, "
+                        "S) and thickness_um (any length unit), from the pole to the rim, with --radius; "
+                        "interpolated by a natural cubic spline.  Forces and mu*H refer to the pole's thickness")
     g.add_argument("--transverse-shear", action="store_true", default=None, dest="transverse_shear",
                    help="with --thickness: add the shell's transverse shear compliance (forces at the thick "
                         "shell's depth; removes most of the model's O(H/R_L) error, see docs/accuracy.md)")
@@ -411,7 +415,23 @@ def scene_from_args(args):
             over[name] = over_rim_radius(args, getattr(args, length), what)
     if getattr(args, "dome", None):
         over["gamma"] = -_dome_rise(args) / args.radius.si
-    return sb.Scene.preset(args.preset or "base", **over)
+    scene = sb.Scene.preset(args.preset or "base", **over)
+    if getattr(args, "thickness_profile", None) is not None:
+        over["thickness"] = _thickness_profile(args, scene)
+        scene = sb.Scene.preset(args.preset or "base", **over)
+    return scene
+
+
+def _thickness_profile(args, scene):
+    """``--thickness-profile FILE`` (lab units) as a ThicknessProfile of the scene's meridian."""
+    from ..thickness_profile import profile_from_file
+
+    if getattr(args, "thickness", None) is not None:
+        raise ValueError("--thickness-profile gives the thickness along the wall (the pole's from its first row): "
+                         "drop --thickness")
+    if getattr(args, "radius", None) is None:
+        raise ValueError("--thickness-profile is in lab units: it needs --radius (the rim radius R_L)")
+    return profile_from_file(args.thickness_profile, args.radius.si, scene)
 
 
 def _dome_rise(args):
@@ -443,7 +463,8 @@ def require_sample(args, bending_per_pixel=False):
         ("the indenter: --indenter-radius (or --rho)", args.rho is not None or args.indenter_radius is not None),
         ("the shell's shape: --rise (or --gamma)", args.gamma is not None or args.rise is not None),
         ("its bending stiffness: --thickness (or --beta)",
-         args.thickness is not None or args.beta is not None or bending_per_pixel))
+         args.thickness is not None or args.beta is not None or bending_per_pixel
+         or getattr(args, "thickness_profile", None) is not None))
         if not given]
     if missing:
         raise ValueError("fit needs the sample: --preset NAME (`shellbvp presets`), or its geometry; missing "

@@ -1,0 +1,114 @@
+"""A wall whose thickness varies along the meridian (``ThicknessProfile``, issue 58).
+
+The derivation's equations with a profile are checked against the energy in
+``tests/test_variational.py``; here the package: a uniform profile is the uniform scene, the
+force is the energy's derivative, small loads see the pole's thickness, and the profile
+travels through scenes and files.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import shellbvp as sb
+from shellbvp.thickness_profile import ThicknessProfile, positions_to_S, read_profile_table
+
+L = math.pi / 2
+
+
+@pytest.fixture(scope="module")
+def uniform():
+    return sb.Scene.preset("base", beta=None, thickness=0.05)
+
+
+def test_a_uniform_profile_is_the_uniform_scene(uniform):
+    """Given as a formula or as a table (the spline through constant rows), a uniform wall's
+    states equal the uniform scene's to 1e-10 (its generated code holds t(S) = 1 as a term)."""
+    by_formula = uniform.replace(thickness=ThicknessProfile.formula("0.05 + 0*S"))
+    by_table = uniform.replace(thickness=ThicknessProfile.table(np.linspace(0, L, 7), np.full(7, 0.05)))
+    assert by_table.structure() != uniform.structure()  # the profiled code, not the uniform one
+    for delta in (0.02, 0.4):
+        ref = sb.solve(uniform, delta=delta, tol=1e-8, estimate_error=False)
+        for scene in (by_formula, by_table):
+            s = sb.solve(scene, delta=delta, tol=1e-8, estimate_error=False)
+            assert s.success and ref.success
+            assert abs(s.force - ref.force) < 1e-10 * max(1.0, abs(ref.force)), (delta, s.force, ref.force)
+            assert abs(s.Sc - ref.Sc) < 1e-10
+
+
+def test_force_is_the_derivative_of_a_profiled_walls_energy(uniform):
+    """F = dE/ddelta on a wall thinning linearly to half at the rim, central differences as
+    for the uniform wall (tests/test_solve.py: the same 5e-6)."""
+    scene = uniform.replace(thickness=ThicknessProfile.formula("0.05*(1 - 0.5*S/L)"))
+    for delta in (0.3,):
+        h = 1e-3
+        s0 = sb.solve(scene, delta=delta, tol=1e-8, estimate_error=False)
+        sp_, sm_ = (sb.solve(scene, delta=delta + k * h, tol=1e-8, guess=s0, estimate_error=False) for k in (1, -1))
+        assert s0.success and sp_.success and sm_.success
+        dE = (sp_.energy - sm_.energy) / (2 * h)
+        assert abs(dE - s0.force) < 5e-6 * max(1.0, s0.force), (delta, s0.force, dE)
+
+
+@pytest.mark.slow
+def test_small_loads_follow_the_poles_thickness(uniform):
+    """A wall equal to H0 near the pole for a few boundary-layer widths (sqrt(R H) ~ 0.22)
+    and twice as thick at the rim: at delta = 0.1 H0 its force is the uniform H0 wall's within
+    2 %; a wall thinner everywhere but at the pole is not the thin wall's."""
+    scene = uniform.replace(thickness=ThicknessProfile.formula("0.05*(1 + exp(-((L - S)/0.25)**2))"))
+    delta = 0.1 * 0.05
+    f_ref = sb.solve(uniform, delta=delta, estimate_error=False).force
+    f = sb.solve(scene, delta=delta, estimate_error=False).force
+    assert abs(f / f_ref - 1) < 0.02, (f, f_ref)
+    thick = 2 * sb.solve(uniform.replace(thickness=0.1), delta=delta, estimate_error=False).force  # units mu H0
+    assert thick / f > 2  # the rim's thickness would be far off
+
+
+def test_a_profile_is_checked_along_the_whole_meridian(uniform):
+    with pytest.raises(ValueError, match=r"thickness profile must stay in \(0, 0.5\]"):
+        uniform.replace(thickness=ThicknessProfile.formula("0.05 - 0.1*S"))
+    with pytest.raises(ValueError, match="from the pole"):
+        uniform.replace(thickness=ThicknessProfile.table([0.2, 1.0, L], [0.05, 0.05, 0.05]))
+    with pytest.raises(ValueError, match="thickness H"):
+        ThicknessProfile.formula("__import__('os')")
+    with pytest.raises(ValueError, match="2 to 64 rows"):
+        ThicknessProfile.table(np.linspace(0, L, 65), np.full(65, 0.05))
+
+
+def test_the_pole_sets_beta_and_a_new_thickness_scales_the_profile(uniform):
+    wall = ThicknessProfile.formula("0.04*(1 + S)")
+    scene = uniform.replace(thickness=wall)
+    assert scene.thickness == pytest.approx(0.04) and scene.beta == pytest.approx(0.04**2 / 3)
+    thicker = scene.replace(thickness=0.08)
+    assert thicker.thickness_profile.at([1.0], L=L)[0] == pytest.approx(0.16)
+    assert thicker.structure() == scene.structure()  # the same generated code: only the scale changed
+    assert scene.replace(beta=0.01).thickness_profile is None
+    assert sb.Scene.from_dict(scene.to_dict()) == scene
+    tab = uniform.replace(thickness=ThicknessProfile.table([0, 0.5, L], [0.05, 0.04, 0.03]))
+    assert sb.Scene.from_dict(tab.to_dict()) == tab
+
+
+def test_a_table_in_lab_units_along_the_arc_or_the_angle(tmp_path):
+    """A thickness file in lab units: along the arc of a prolate spheroid (gamma 2, R_L 300 um)
+    the positions become the package's S through the meridian's arc length."""
+    scene = sb.Scene.preset("prolate2", beta=None, thickness=0.05)
+    S = np.linspace(0.0, L, 2001)
+    arc = np.concatenate([[0], np.cumsum(np.hypot(np.diff(np.sin(S)), np.diff(2 * np.cos(S))))])
+    path = tmp_path / "wall.csv"
+    rows = np.linspace(0.0, arc[-1], 5)
+    path.write_text("arc_um,thickness_um\n" + "".join(f"{a * 300:.9f},{15 - 5 * a / arc[-1]:.9f}\n" for a in rows))
+    pos, H, along = read_profile_table(path, R_L=300e-6)
+    assert along == "arc" and H[0] == pytest.approx(0.05)
+    S_rows = positions_to_S(scene, pos, along)
+    assert S_rows[-1] == pytest.approx(L, rel=1e-6)
+    assert np.interp(S_rows[2], S, arc) == pytest.approx(rows[2], rel=1e-5)
+    bad = tmp_path / "bad.csv"
+    bad.write_text("arc_furlong,thickness_um\n0,1\n1,1\n")
+    with pytest.raises(ValueError, match="length unit"):
+        read_profile_table(bad, R_L=300e-6)
+    bad.write_text("angle_deg,thickness_um\n0,15\n95,15\n")
+    pos, H, along = read_profile_table(bad, R_L=300e-6)
+    with pytest.raises(ValueError, match="must lie in"):
+        positions_to_S(scene, pos, along)
