@@ -230,11 +230,11 @@ def positions_to_S(scene, positions, along: str) -> np.ndarray:
         return x
     L = scene.shell_length
     S = np.linspace(0.0, L, 20001)
-    R, Z = _meridian(scene, S)
+    R, Z, dR, dZ = _meridian(scene, S)
     if along == "arc":
         coordinate = np.concatenate([[0.0], np.cumsum(np.hypot(np.diff(R), np.diff(Z)))])
     else:
-        coordinate = np.abs(np.arctan2(np.gradient(Z, S), np.gradient(R, S)))
+        coordinate = np.abs(np.arctan2(dZ, dR))
         if np.any(np.diff(coordinate) <= 0):
             raise ValueError("along='angle' needs a meridian whose normal turns monotonically from the pole "
                              "to the rim; give the positions along the arc")
@@ -247,17 +247,18 @@ def positions_to_S(scene, positions, along: str) -> np.ndarray:
 
 
 def _meridian(scene, S):
-    """The reference meridian (R, Z) at S, without code generation."""
+    """The reference meridian's (R, Z, R', Z') at S, without code generation."""
     if getattr(scene.shell, "kind", None) == "user":
         import sympy as sp
 
         from symbolic.geometry import S as s_symbol
 
-        R = sp.lambdify(s_symbol, scene.shell.geometry.R, "numpy")(S)
-        Z = sp.lambdify(s_symbol, scene.shell.geometry.Z, "numpy")(S)
-        return np.broadcast_to(np.asarray(R, float), S.shape), np.broadcast_to(np.asarray(Z, float), S.shape)
+        g = scene.shell.geometry
+        exprs = (g.R, g.Z, sp.diff(g.R, s_symbol), sp.diff(g.Z, s_symbol))
+        return tuple(np.broadcast_to(np.asarray(sp.lambdify(s_symbol, e, "numpy")(S), float), S.shape)
+                     for e in exprs)
     gamma = -scene.gamma if scene.closed else scene.gamma
-    return np.sin(S), -gamma * np.cos(S)
+    return np.sin(S), -gamma * np.cos(S), np.cos(S), gamma * np.sin(S)
 
 
 def read_profile_table(path, R_L: float):

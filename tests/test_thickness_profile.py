@@ -112,3 +112,23 @@ def test_a_table_in_lab_units_along_the_arc_or_the_angle(tmp_path):
     pos, H, along = read_profile_table(bad, R_L=300e-6)
     with pytest.raises(ValueError, match="must lie in"):
         positions_to_S(scene, pos, along)
+
+
+def test_the_command_line_reads_a_thickness_file(tmp_path):
+    """``--thickness-profile FILE`` with ``--radius``: the table becomes the scene's profile (the
+    pole's thickness sets beta); without ``--radius``, or with ``--thickness`` too, one line."""
+    from shellbvp.cli import build_parser, scene_from_args
+
+    path = tmp_path / "wall.csv"
+    path.write_text("# sections\nangle_deg,thickness_um\n0,15\n45,12\n90,9\n")
+    args = build_parser().parse_args(["solve", "--preset", "base", "--radius", "300um", "--thickness-profile",
+                                      str(path)])
+    scene = scene_from_args(args)
+    assert scene.thickness == pytest.approx(0.05) and scene.beta == pytest.approx(0.05**2 / 3)
+    assert scene.thickness_profile.at([L / 2], L=L)[0] == pytest.approx(0.04)  # the hemisphere: S is the angle
+    for extra, message in ((["--thickness", "15um"], "drop --thickness"), ([], "needs --radius")):
+        argv = ["solve", "--preset", "base", "--thickness-profile", str(path), *extra]
+        if extra:
+            argv += ["--radius", "300um"]
+        with pytest.raises(ValueError, match=message):
+            scene_from_args(build_parser().parse_args(argv))
