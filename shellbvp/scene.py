@@ -14,6 +14,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from .edge_models import EdgeModel, contact_models, edge_model
 from .geometry import FlatTip, SphereTip, Spheroid, UserShell, UserTip
 from .materials import MATERIALS, Bending, Gent, Material, MooneyRivlin, TraceBending
 from .model import load_module, structure_description
@@ -21,7 +22,8 @@ from .scene_parameters import scene_parameter
 
 __all__ = ["Scene", "PRESETS", "CONTACT_MODELS", "RIMS", "SUPPORTS"]
 
-CONTACT_MODELS = ("smooth", "paper")
+#: The contact models a scene takes (:mod:`shellbvp.edge_models`, which holds what each does)
+CONTACT_MODELS = contact_models()
 #: What is held at the rim S = L besides its circle (lambda_theta = 1, z = 0): ``pinned``
 #: leaves the rotation free (M_s = 0), ``clamped`` holds the slope at the reference's,
 #: phi(L) = Phi(L).
@@ -478,6 +480,12 @@ class Scene:
         return _reference_volume(self)
 
     @property
+    def contact_model(self) -> EdgeModel:
+        """The contact model's object (:mod:`shellbvp.edge_models`): what its edge conditions
+        are and what a curve does with them."""
+        return edge_model(self.contact)
+
+    @property
     def tip_omega_max(self) -> float:
         """Where the tip joins the indenter's cylinder (A' = 0): pi/2 for the sphere."""
         return self.tip.omega_max
@@ -506,7 +514,7 @@ def _support(scene, gamma) -> str:
         raise ValueError("closed=True needs the built-in spheroid (a user meridian from pole to pole is not offered yet)")
     if not gamma > 0:
         raise ValueError(f"gamma (polar / equatorial semi-axis of a closed spheroid) must be > 0; got {gamma!r}")
-    if support == "substrate" and not isinstance(scene.tip, FlatTip) and scene.contact != "smooth":
+    if support == "substrate" and not isinstance(scene.tip, FlatTip) and not scene.contact_model.variational:
         raise ValueError(f"contact={scene.contact!r}: a closed shell on a substrate under a curved tip has the smooth "
                          "(variational) contact model only")
     if scene.rim != "pinned":
