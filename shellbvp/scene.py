@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import functools
 import math
-import warnings
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -462,17 +461,6 @@ class Scene:
         v = self.values()
         v["pole_rise"] = float(pole_rise)
         return np.array([v[name] for name in model.PARAMS], dtype=float)
-
-    def enclosed_volume(self) -> float:
-        """Deprecated: use ``sb.enclosed_volume(scene)`` (:func:`shellbvp.inflation.enclosed_volume`).
-
-        V0 of a sealed scene, which solves the inflated state: a scene itself solves nothing,
-        so this method goes in the next version."""
-        warnings.warn("Scene.enclosed_volume() is deprecated: use shellbvp.enclosed_volume(scene)",
-                      DeprecationWarning, stacklevel=2)
-        from .inflation import enclosed_volume  # the scene's floor is below inflation's
-
-        return enclosed_volume(self)
 
     def reference_volume(self) -> float:
         """V of the undeformed shell, ``-pi Int R^2 Z' dS``: the volume between it and its rim's
