@@ -21,7 +21,11 @@ imports, module flags that tests patch; and of issue 57:
 * function-level imports of the package itself, and separately of optional dependencies (the
   extras of pyproject.toml but ``test`` and ``docs``);
 * instrument formats named outside the readers' registry (``shellbvp/readers/``): a string that
-  is a reader's file name ending (``".jpk-force"``, ``".ibw"``), or a reader's name compared.
+  is a reader's file name ending (``".jpk-force"``, ``".ibw"``), or a reader's name compared;
+* contact and edge models named outside their registry (``shellbvp/edge_models.py``): a
+  comparison with a model's name (``scene.contact == "smooth"``, ``"corner" in models``; the
+  rim's ``"pinned"``, a comparison with ``rim``, is the rim's, not an edge's), and a literal
+  tuple, list or set of two or more of their names (a table of them by hand: ``choices=``).
 
 The numbers are what the redesign is judged by;
 ``--markdown`` prints them as the table of benchmarks/results/architecture.md.  A ``.get`` is
@@ -56,6 +60,10 @@ SOLUTION_OWNERS = ("solution", "diagnosis")
 PARAMETER_REGISTRIES = ("shape_parameters", "scene_parameters")
 #: The readers' registry: the one place that names instrument formats
 READERS_PACKAGE = "readers"
+#: The registry of contact and edge models: the one module that names them
+EDGE_MODELS_MODULE = "edge_models"
+#: A comparison of a scene's rim (``Scene.rim``, whose ``"pinned"`` is not an edge's)
+RIM = re.compile(r"\brim\b")
 #: Extras of pyproject.toml that are tools, not optional dependencies of the package
 TOOL_EXTRAS = ("test", "docs")
 MODULE_LINES = 600
@@ -298,6 +306,35 @@ def format_names(trees, suffixes, names) -> dict:
     return out
 
 
+def edge_model_names(root) -> set:
+    """The contact and edge models' names as ``shellbvp/edge_models.py`` registers them (before
+    it, the names a curve file's ``contact_edge`` took)."""
+    path = root / "shellbvp" / f"{EDGE_MODELS_MODULE}.py"
+    if not path.exists():
+        return {"smooth", "corner", "paper", "pinned"}
+    return set(re.findall(r'EdgeModel\(\s*"(\w+)"', path.read_text()))
+
+
+def edge_model_uses(trees, names) -> tuple:
+    """({module: comparisons with an edge model's name}, {module: literal tables of two or more
+    of them}) outside :data:`EDGE_MODELS_MODULE` (module docstring)."""
+    compared, tables = {}, {}
+    for mod, (_, tree) in trees.items():
+        if mod == EDGE_MODELS_MODULE:
+            continue
+        for n in ast.walk(tree):
+            if isinstance(n, ast.Compare):
+                sides = [n.left, *n.comparators]
+                if any(s in names for side in sides for s in _strings(side)) and \
+                        not any(RIM.search(ast.unparse(side)) for side in sides):
+                    compared[mod] = compared.get(mod, 0) + 1
+            elif isinstance(n, (ast.Tuple, ast.List, ast.Set)):
+                found = {e.value for e in n.elts if isinstance(e, ast.Constant) and isinstance(e.value, str)}
+                if len(found & names) >= 2:
+                    tables[mod] = tables.get(mod, 0) + 1
+    return compared, tables
+
+
 def census(root=ROOT):
     names = configuration_names(root)
     out = {"step_loops": [], "name_comparisons": {}, "long_modules": {}, "long_functions": [], "result_gets": {},
@@ -353,6 +390,7 @@ def census(root=ROOT):
     out["solution_writes"] = solution_writes(trees)
     out["parameter_tables"] = parameter_tables(trees, scene_parameter_names(root))
     out["format_names"] = format_names(trees, *reader_formats(root)) if (pkg / READERS_PACKAGE).is_dir() else {}
+    out["edge_model_comparisons"], out["edge_model_tables"] = edge_model_uses(trees, edge_model_names(root))
     return out
 
 
@@ -433,6 +471,9 @@ def main(argv=None):
         ("parallel parameter lists (scene parameter names tabled outside the registry)",
          total(c["parameter_tables"]), c["parameter_tables"]),
         ("instrument formats named outside the readers' registry", total(c["format_names"]), c["format_names"]),
+        ("comparisons with contact or edge model names outside their registry", total(c["edge_model_comparisons"]),
+         c["edge_model_comparisons"]),
+        ("... tables of their names by hand", total(c["edge_model_tables"]), c["edge_model_tables"]),
         ("lines of shellbvp/*.py", c["lines"], ""),
     ]
     if args.markdown:

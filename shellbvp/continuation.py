@@ -373,7 +373,7 @@ class _Branch:
             return sol
         kw = dict(tol=st.tol, max_nodes=st.max_nodes, bc_tol=st.bc_tol)
         shown = sol
-        if sol.scene.contact == "smooth":
+        if sol.scene.contact_model.variational:  # the lifted-pole and split configurations exist
             last = self.last_shown  # the point computed before this one
             shown = replace_invalid_cap(sol, previous=self.last_liftoff, before=self.liftoff_before, last=last,
                                         **kw)
@@ -390,7 +390,7 @@ class _Branch:
                     return end
                 if end is None:
                     shown = self._before_fold(sol, kw)
-        if is_single_cap(shown) and edge_model(shown) != "pinned" and wall_contact_suspected(shown):
+        if is_single_cap(shown) and not edge_model(shown).held_at_tip_end and wall_contact_suspected(shown):
             wall = None
             if self.last_wall is not None:
                 wall = best_wall_state(self.last_wall, control="delta", value=shown.delta, **kw)

@@ -23,6 +23,7 @@ import numpy as np
 
 from .chain import Edge
 from .configurations import is_single_cap
+from .edge_models import EdgeModel
 
 __all__ = ["LEGENDRE_WATCH", "edge_model", "edge_null_jump", "limit_estimate", "is_corner", "near_limit",
            "other_edge_root"]
@@ -32,20 +33,21 @@ __all__ = ["LEGENDRE_WATCH", "edge_model", "edge_null_jump", "limit_estimate", "
 LEGENDRE_WATCH = 0.1
 
 
-def edge_model(sol) -> str:
-    """The contact-edge model of a cap state's system ("smooth", "corner", "paper", or "pinned":
-    the paper's edge held at the tip's end)."""
+def edge_model(sol) -> EdgeModel:
+    """The contact-edge model of a cap state's system (:mod:`shellbvp.edge_models`): the model
+    its edge switched to along the curve (the corner; the paper's edge held at the tip's end),
+    else the scene's contact model."""
+    contact = sol.scene.contact_model
     sysm = sol.system
     if sysm is None:
-        return sol.scene.contact
-    models = {j.model for j in sysm.junctions if isinstance(j, Edge)}
-    return next((m for m in ("corner", "pinned") if m in models), sol.scene.contact)
+        return contact
+    return next((j.model for j in sysm.junctions if isinstance(j, Edge) and not j.model.contact), contact)
 
 
 def limit_estimate(a, b):
     """Depth where edge_legendre reaches 0, extrapolated linearly from smooth cap states
     ``a`` and ``b``; None if it is not decreasing towards it."""
-    if a is None or b is None or edge_model(a) != "smooth" or edge_model(b) != "smooth":
+    if a is None or b is None or not edge_model(a).convexity_limit or not edge_model(b).convexity_limit:
         return None
     la, lb = a.edge_legendre, b.edge_legendre
     if not (math.isfinite(la) and math.isfinite(lb)) or a.delta == b.delta:
@@ -58,13 +60,13 @@ def limit_estimate(a, b):
 
 def is_corner(sol, tol) -> bool:
     """A converged cap whose edge jumps (beyond solver noise) with a convex free region."""
-    return bool(sol.success and edge_model(sol) == "corner" and abs(sol.edge_jump_ls) > 10 * tol
+    return bool(sol.success and edge_model(sol).jumps and abs(sol.edge_jump_ls) > 10 * tol
                 and sol.legendre_min > 0)
 
 
 def near_limit(sol) -> bool:
     """A smooth-edge cap state of the smooth model close to its convexity limit."""
-    return bool(is_single_cap(sol) and sol.scene.contact == "smooth" and edge_model(sol) == "smooth"
+    return bool(is_single_cap(sol) and edge_model(sol).convexity_limit
                 and sol.edge_legendre < LEGENDRE_WATCH)
 
 

@@ -289,8 +289,7 @@ def best_wall_state(start: Solution, *, control=None, value=None, tol=1e-6, max_
     tried = [] if tried is None else tried
     outcomes = [] if outcomes is None else outcomes
     order = list(WALL_TOPOLOGIES) if is_single_cap(start) else _neighbours(start.topology)
-    if start.scene.contact == "paper":
-        order = [t for t in order if "paper" in configuration(t).contacts]
+    order = [t for t in order if configuration(t).allows(start.scene)]
     valid = []
     for topology in order:
         res = wall_state(start, topology, control=control, value=value, tol=tol, max_nodes=max_nodes,

@@ -95,9 +95,11 @@ def _nodes_and_midpoints(x):
 
 
 def _edge_model(sysm) -> str:
-    """"corner" if any contact edge is a Weierstrass-Erdmann corner, else the edges' model."""
+    """The name ``Solution.contact_edge`` holds: the model of a contact edge that jumps (a
+    Weierstrass-Erdmann corner) if there is one, else the edges' one model ("" if none or mixed)."""
     models = {j.model for j in sysm.junctions if isinstance(j, Edge)}
-    return "corner" if "corner" in models else (models.pop() if len(models) == 1 else "")
+    shown = next((m for m in models if m.jumps), next(iter(models)) if len(models) == 1 else None)
+    return "" if shown is None else shown.name
 
 
 _EDGE_FIELDS = ("axial_force_2pi", "r", "Q", "lambda_s", "kappa_s")  # what the edges' checks read

@@ -24,7 +24,7 @@ contact_edge and edge_jump_ls/ks, which read as NaN and "")::
     /curve/<field>          (n,) each of POINT_FIELDS, plus
                             energy_residual (dE/ddelta - F) and flags (strings);
                             topology (strings: shellbvp.configurations.CONFIGURATION_NAMES),
-                            contact_edge (strings: smooth, corner, paper or pinned);
+                            contact_edge (strings: smooth, corner, paper or pinned, shellbvp.edge_models);
                             error_method (strings: how force_error/delta_error were
                             made: richardson, calibrated, or empty: not estimated);
                             pressure (the pressure below the shell: the scene's, or
@@ -54,6 +54,7 @@ from pathlib import Path
 import numpy as np
 
 from .configurations import CONFIGURATION_NAMES, is_point_load
+from .edge_models import EDGE_MODELS
 from .inflation import INFLATED_FIELDS, InflatedStart
 from .nexus import new_file
 from .paths import open_hdf5
@@ -477,9 +478,8 @@ def _points(g):
         points[k] = _field(g, k, n) if k in g else np.full(n, missing, dtype=type(missing))
     points["topology"] = np.asarray(points["topology"], dtype=str)
     points["contact_edge"] = np.asarray(points["contact_edge"], dtype=str)
-    unknown = sorted(set(points["contact_edge"]) - {"", "smooth", "corner", "paper", "pinned"})
-    if unknown:
-        raise ValueError(f"contact_edge must be one of smooth, corner, paper, pinned; got {str(unknown[0])!r}")
+    if unknown := sorted(set(points["contact_edge"]) - {"", *EDGE_MODELS}):
+        raise ValueError(f"contact_edge must be one of {', '.join(EDGE_MODELS)}; got {str(unknown[0])!r}")
     unknown = sorted(set(points["topology"]) - set(CONFIGURATION_NAMES))
     if unknown:
         raise ValueError(f"topology must be one of {CONFIGURATION_NAMES}; got {str(unknown[0])!r}")

@@ -173,7 +173,8 @@ def _wall_leg(scene, branch, st, last_cap, key, *, reason, deltas=None):
         prev, past_end = best_wall_state(last_cap, tried=tried, outcomes=outcomes, **kw), last_cap
         if prev is None and is_single_cap(last_cap) and _room_may_help(outcomes):
             prev, past_end = _wall_state_deeper(scene, last_cap, st, kw, tried)
-        if prev is None and scene.contact == "paper" and is_single_cap(last_cap):
+        held = scene.contact_model.next
+        if prev is None and held is not None and held.held_at_tip_end and is_single_cap(last_cap):
             prev = _pinned_state(scene, last_cap, last_cap.delta, st, tried)
         if prev is None:  # not a physical end: a configuration that is missing or not found
             return Stop(f"{reason}; no valid contact with the cylinder ({'; '.join(tried)})")
@@ -191,7 +192,7 @@ def _wall_leg(scene, branch, st, last_cap, key, *, reason, deltas=None):
         prev = states[-1]
         tried.clear()
         sol = None
-        if edge_model(prev) == "pinned":  # held at the tip's end while its ring force pushes
+        if edge_model(prev).held_at_tip_end:  # held at the tip's end while its ring force pushes
             sol = _pinned_state(scene, prev, nxt_target, st, tried)
         return sol if sol is not None else best_wall_state(prev, control="delta", value=nxt_target, tried=tried, **kw)
 
@@ -226,7 +227,7 @@ def _pinned_state(scene, start, delta, st, tried):
     shell: at a hemispherical tip's end it is radial and carries no axial force); xi = 0: from
     delta 0.9295, where the free cap's edge reaches the end, to delta 1, where no cap+cylinder
     state exists (its band on the cylinder would have a negative length)."""
-    sysm = make_system(scene, "delta", delta, st.eps, edge="pinned")
+    sysm = make_system(scene, "delta", delta, st.eps, edge=scene.contact_model.next)
     sol = solve_from(sysm, warm_guess(sysm, start), tol=st.tol, max_nodes=step_nodes(start, st),
                      bc_tol=st.bc_tol)
     if sol.success and sol.valid:
@@ -331,7 +332,7 @@ def adaptive(scene, branch, settings):
             sol = solve_point_load(scene, nd, tol=st.tol, max_nodes=st.max_nodes, guess=prev)
         else:
             sol = solve_at_delta(scene, nd, prev, prev2, st)
-            if scene.contact == "smooth" and not scene.two_contacts and prev.Sc < 1e-8 and \
+            if scene.contact_model.point_load_limit and not scene.two_contacts and prev.Sc < 1e-8 and \
                     (not sol.success or sol.Sc < SC_POINT):
                 # the cap is leaving double precision: continue with its point-load limit
                 point = solve_point_load(scene, nd, tol=st.tol, max_nodes=st.max_nodes, guess=prev)
@@ -451,7 +452,7 @@ def adaptive(scene, branch, settings):
             if ds < ds_min:
                 reason = sol.message if not sol.success else "the branch turned back to delta <= 0"
                 leg = cur.edge_legendre
-                if leg < 0.05 and edge_model(cur) == "smooth":
+                if leg < 0.05 and edge_model(cur).convexity_limit:
                     reason = (f"the energy loses convexity at the contact edge (Legendre determinant at Sc+ "
                               f"down to {leg:.2g} of its mid-region value): the free region's equations "
                               f"become singular there, the smooth single-cap branch ends and no corner "

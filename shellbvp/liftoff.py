@@ -563,7 +563,7 @@ def split_again(guess, control, value, *, topology, tol, max_nodes, eps, bc_tol,
 def cap_lifted_off(cap, topology, kw):
     """The asked lifted configuration from the cap, or (auto, smooth model) a valid lifted or
     split state replacing an invalid cap (:func:`replace_invalid_cap`)."""
-    if cap.scene.contact != "smooth" or not cap.success:
+    if not cap.scene.contact_model.variational or not cap.success:
         return cap
     if topology in names("lifted"):
         return liftoff_state(cap, topology, **kw)

@@ -9,11 +9,11 @@ from __future__ import annotations
 
 import functools
 import math
-import warnings
 from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from .edge_models import EdgeModel, contact_models, edge_model
 from .geometry import FlatTip, SphereTip, Spheroid, UserShell, UserTip
 from .materials import MATERIALS, Bending, Gent, Material, MooneyRivlin, TraceBending
 from .model import load_module, structure_description
@@ -22,7 +22,8 @@ from .thickness_profile import ThicknessProfile, settle_profile
 
 __all__ = ["Scene", "PRESETS", "CONTACT_MODELS", "RIMS", "SUPPORTS"]
 
-CONTACT_MODELS = ("smooth", "paper")
+#: The contact models a scene takes (:mod:`shellbvp.edge_models`, which holds what each does)
+CONTACT_MODELS = contact_models()
 #: What is held at the rim S = L besides its circle (lambda_theta = 1, z = 0): ``pinned``
 #: leaves the rotation free (M_s = 0), ``clamped`` holds the slope at the reference's,
 #: phi(L) = Phi(L).
@@ -480,21 +481,16 @@ class Scene:
         v["pole_rise"] = float(pole_rise)
         return np.array([v[name] for name in model.PARAMS], dtype=float)
 
-    def enclosed_volume(self) -> float:
-        """Deprecated: use ``sb.enclosed_volume(scene)`` (:func:`shellbvp.inflation.enclosed_volume`).
-
-        V0 of a sealed scene, which solves the inflated state: a scene itself solves nothing,
-        so this method goes in the next version."""
-        warnings.warn("Scene.enclosed_volume() is deprecated: use shellbvp.enclosed_volume(scene)",
-                      DeprecationWarning, stacklevel=2)
-        from .inflation import enclosed_volume  # the scene's floor is below inflation's
-
-        return enclosed_volume(self)
-
     def reference_volume(self) -> float:
         """V of the undeformed shell, ``-pi Int R^2 Z' dS``: the volume between it and its rim's
         plane (the origin of the pressure's potential ``-p (V - V_ref)``)."""
         return _reference_volume(self)
+
+    @property
+    def contact_model(self) -> EdgeModel:
+        """The contact model's object (:mod:`shellbvp.edge_models`): what its edge conditions
+        are and what a curve does with them."""
+        return edge_model(self.contact)
 
     @property
     def tip_omega_max(self) -> float:
@@ -525,7 +521,7 @@ def _support(scene, gamma) -> str:
         raise ValueError("closed=True needs the built-in spheroid (a user meridian from pole to pole is not offered yet)")
     if not gamma > 0:
         raise ValueError(f"gamma (polar / equatorial semi-axis of a closed spheroid) must be > 0; got {gamma!r}")
-    if support == "substrate" and not isinstance(scene.tip, FlatTip) and scene.contact != "smooth":
+    if support == "substrate" and not isinstance(scene.tip, FlatTip) and not scene.contact_model.variational:
         raise ValueError(f"contact={scene.contact!r}: a closed shell on a substrate under a curved tip has the smooth "
                          "(variational) contact model only")
     if scene.rim != "pinned":

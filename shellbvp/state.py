@@ -96,7 +96,8 @@ def _run_bvp(sysm, guess, tol, max_nodes, bc_tol):
 
 def make_system(scene, control, value, eps, edge=None):
     """The single-cap system (``shellbvp.configurations.cap``) of a scene, control and value;
-    ``edge`` ("smooth", "corner", "paper") defaults to the scene's contact model."""
+    ``edge`` (an :class:`~shellbvp.edge_models.EdgeModel` or its name) defaults to the scene's
+    contact model."""
     return configuration("cap").system(scene, control, value, eps, edge)
 
 
@@ -129,7 +130,7 @@ def cross_convexity_limit(prev, prev2, delta, *, eps, tol, max_nodes, bc_tol, ex
     # state further from the limit is often the better start)
     ladder = sorted({max(delta, prev.delta + k * gap, prev.delta + 0.005) for k in (3, 6, 12)}
                     | {max(delta, prev.delta + 0.02), max(delta, prev.delta + 0.04)})
-    starts = [s for s in (prev, prev2) if s is not None and s.success and edge_model(s) == "smooth"]
+    starts = [s for s in (prev, prev2) if s is not None and s.success and edge_model(s).convexity_limit]
     sol = None
     # seeds: the edge's other root scaled to d_far; else a jump of CORNER_SEED_JUMP in lambda_s
     # (either sign) along the null direction of the edge conditions (gamma = 0 with the numpy
@@ -366,7 +367,7 @@ def _cold_delta(sysm, delta, near_point=None, **kw):
     """Crude guesses at a few cap sizes; then (smooth model) the point-load limit, or a cap
     grown from it; then continuation in delta from a moderate depth.  From ``near_point``
     (a point-load state at another depth) the point-load limit is tried first."""
-    point_route = sysm.scene.contact == "smooth"
+    point_route = sysm.scene.contact_model.point_load_limit
     if point_route and near_point is not None:
         res = _point_route(sysm, delta, near_point, **kw)
         if res is not None:
@@ -480,7 +481,7 @@ def _continue_in_delta(scene, eps, target, starts=(0.1, 0.05), **kw):
         nxt = solve_from(sysm, warm_guess(sysm, res), **kw)
         if up and not nxt.success and near_limit(res):
             nxt = cross_convexity_limit(res, before, nd, eps=eps, **kw) or nxt
-        if not up and scene.contact == "smooth" and (not nxt.success or nxt.Sc < SC_POINT) and res.Sc < 1e-8:
+        if not up and scene.contact_model.point_load_limit and (not nxt.success or nxt.Sc < SC_POINT) and res.Sc < 1e-8:
             # the cap is leaving double precision: continue with its point-load limit
             point = solve_point_load(scene, nd, tol=kw["tol"], max_nodes=kw["max_nodes"], guess=res)
             nxt = point if point.success else nxt

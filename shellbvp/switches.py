@@ -115,10 +115,10 @@ def locate_switches(builder, st):
     for (k1, _, _, s1), (k2, _, _, s2) in zip(rows[:-1], rows[1:]):
         c1, c2 = cap_of(s1), cap_of(s2)
         if c1 is not None and c2 is not None and c1.success and c2.success \
-                and (edge_model(c1), edge_model(c2)) == ("smooth", "corner"):
+                and edge_model(c1).leads_to(edge_model(c2)) and edge_model(c2).jumps:
             builder.switch_located(locate_corner_switch(c1, c2, st))
             continue
-        if s1.valid and s2.valid and (edge_model(s1), edge_model(s2)) == ("paper", "pinned"):
+        if s1.valid and s2.valid and edge_model(s1).leads_to(edge_model(s2)) and edge_model(s2).held_at_tip_end:
             # the free cap's edge reaches the tip's end: from the caps either side of it
             ends = [s1, s2.cap_solution]
             if ends[1] is not None and ends[1].status in (0, 4) and ends[0].tip_end_margin > 0 > ends[1].tip_end_margin:
@@ -184,7 +184,7 @@ def locate_corner_switch(smooth, corner, st, h=0.003):
     for d in sorted((d0 - k * h for k in (1, 2, 3)), key=lambda d: abs(d - smooth.delta)):
         sysm = system_like(lo[-1], "delta", d, st.eps)
         s = solve_from(sysm, warm_guess(sysm, lo[-1]), **kw)
-        if s.success and edge_model(s) == "smooth":
+        if s.success and edge_model(s).convexity_limit:
             lo.append(s)
     lo = sorted(lo[1:], key=lambda s: s.delta)
     first = cross_convexity_limit(lo[-1], lo[0] if len(lo) > 1 else None, d0 + h, eps=st.eps, exact=False,

@@ -285,17 +285,20 @@ def test_the_structure_census_holds_what_the_redesign_reached():
 def test_the_census_counts_that_are_zero_stay_zero():
     """benchmarks/architecture.py on this checkout (issue 57): no string hook, no write of a
     curve's settings below their owner, no instrument format named outside shellbvp/readers/
-    (23 at 971ae76: afm_read 13, batch 6, afm_jpk 4), no module over 600 lines, no
-    natural-continuation loop written out."""
+    (23 at 971ae76: afm_read 13, batch 6, afm_jpk 4), no contact or edge model compared by name, or
+    tabled by hand, outside shellbvp/edge_models.py (26 comparisons and 8 tables at 9070cc8), no
+    module over 600 lines, no natural-continuation loop written out."""
     census = _load("architecture").census()
-    for key in ("string_hooks", "settings_writes", "format_names", "long_modules", "step_loops"):
+    for key in ("string_hooks", "settings_writes", "format_names", "edge_model_comparisons", "edge_model_tables",
+                "long_modules", "step_loops"):
         assert not census[key], (key, census[key])
 
 
 def test_the_census_sees_what_it_counts(tmp_path):
     """Each count of issue 57 on a checkout made to hold one of each: a string hook, a write of a
     Solution's field, a table of scene parameters, late imports of the package and of an optional
-    dependency, and a reader's file name ending outside the readers."""
+    dependency, a reader's file name ending outside the readers, and edge models compared by name
+    and tabled (the rim's "pinned" compared is not an edge's)."""
     pkg = tmp_path / "shellbvp"
     (pkg / "configurations").mkdir(parents=True)
     (pkg / "readers").mkdir()
@@ -304,6 +307,9 @@ def test_the_census_sees_what_it_counts(tmp_path):
     (pkg / "solution.py").write_text("class Solution:\n    force: float = 0.0\n    wall_time: float = 0.0\n")
     (pkg / "readers" / "jpk.py").write_text('SUFFIXES = (".jpk-force",)\nREADERS = (Reader(name="JPK"),)\n')
     (pkg / "state.py").write_text("def solve():\n    pass\n")
+    (pkg / "edge_models.py").write_text('A = EdgeModel("smooth")\nB = EdgeModel("paper")\nC = ("smooth", "paper")\n')
+    (pkg / "edges.py").write_text('def g(scene, m):\n    x = scene.contact == "smooth" or scene.rim == "paper"\n'
+                                  '    return m in ("smooth", "paper") or x\n')
     (pkg / "bad.py").write_text(
         'HOOK = "state:solve"\nNAMES = ("gamma", "rho")\nENDING = ".jpk-force"\n'
         'def f(sol, self):\n    import afmformats\n    from . import state\n    sol.force = 1.0\n'
@@ -317,3 +323,5 @@ def test_the_census_sees_what_it_counts(tmp_path):
     assert census["function_imports_package"] == {"bad": 1}
     assert census["function_imports_optional"] == {"bad": 1}
     assert census["format_names"] == {"bad": 2}           # the ending, and the reader's name compared
+    assert census["edge_model_comparisons"] == {"edges": 2}  # not the rim's, nor inside the registry
+    assert census["edge_model_tables"] == {"edges": 1}

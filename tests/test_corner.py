@@ -7,6 +7,7 @@ from scipy.optimize import fsolve
 
 import shellbvp as sb
 from shellbvp.corner import edge_model
+from shellbvp.edge_models import EDGE_MODELS
 from shellbvp.state import make_system, solve_from, warm_guess
 
 BASE = sb.Scene.preset("base")
@@ -146,7 +147,7 @@ def test_base_curve_passes_the_convexity_limit_with_a_continuous_switch(base_cur
 def _corner_energy(delta, guess, tol=1e-8):
     sysm = make_system(BASE, "delta", delta, guess.system.eps, "corner")
     sol = solve_from(sysm, warm_guess(sysm, guess), tol=tol, max_nodes=50000)
-    assert sol.success and edge_model(sol) == "corner"
+    assert sol.success and edge_model(sol) is EDGE_MODELS["corner"]  # the object, named as files name it
     return sol
 
 

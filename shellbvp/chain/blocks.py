@@ -6,6 +6,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass, fields
 
+from ..edge_models import EdgeModel, edge_model
+
 __all__ = ["Point", "Region", "ContactPole", "FreePole", "PointPole", "Edge", "TipEnd", "Line", "Kink", "Rim",
            "Seam", "Chain", "SIZES", "FREE_STATES", "CONTACT_STATES", "CONTACT_KINDS", "REGION_CODES"]
 
@@ -69,13 +71,17 @@ class PointPole:
 class Edge:
     """Contact edge between contact region ``kc`` and free region ``kf`` (adjacent): 5 rows.
 
-    ``model`` is ``"smooth"`` (variational) or ``"paper"``; see SPEC section 2b.
+    ``model``: its :class:`~shellbvp.edge_models.EdgeModel`, given by name (``"smooth"``,
+    variational; ``"paper"``; ``"corner"``, ``"pinned"``; SPEC section 2b) or as the object.
     """
 
     kc: int
     kf: int
-    model: str = "smooth"
+    model: EdgeModel = edge_model("smooth")
     rows = 5
+
+    def __post_init__(self):
+        object.__setattr__(self, "model", edge_model(self.model))
 
 
 @dataclass(frozen=True)

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..edge_models import edge_model
 from .blocks import FREE_STATES, ContactPole, Edge, FreePole, Kink, Line, PointPole, Rim, Seam, TipEnd
 
 __all__ = ["BoundaryConditions"]
@@ -52,7 +53,7 @@ class BoundaryConditions:
 
     def _edge_function(self, j, what):
         """junction_[cyl_]<model>_<what> of an edge, by its contact region's kind."""
-        return getattr(self.model, f"junction_{self._prefix(self.regions[j.kc].kind)}{j.model}_{what}")
+        return j.model.function(self.model, self._prefix(self.regions[j.kc].kind), what)
 
     # -- conditions -------------------------------------------------------------------------------
     def _edge_states(self, j: Edge, ya, yb):
@@ -141,7 +142,8 @@ class BoundaryConditions:
         return dres
 
     def _line_function(self, j, what):
-        return getattr(self.model, f"junction_{self._prefix(j.on)}smooth_{what}")
+        """A line's rows on the indenter: the smooth edge's (their first three are used)."""
+        return edge_model("smooth").function(self.model, self._prefix(j.on), what)
 
     def _force_function(self, what):
         """force_[cyl_]<what> at the last contact edge (F of the free region beyond it)."""

@@ -11,6 +11,7 @@ import re
 import sys
 from pathlib import Path
 
+from ..edge_models import contact_models
 from ..materials import material_class
 from ..scene_parameters import scene_parameter, scene_parameters
 
@@ -361,7 +362,7 @@ def add_scene_options(p, uncertain=False, preset_required=False, solver=("tol", 
     g.add_argument("--sealed", action="store_true", default=None,
                    help="volume control: the shell encloses the volume it has when inflated at --pressure (a "
                         "sealed capsule); the pressure becomes an unknown of every state")
-    g.add_argument("--contact", choices=("smooth", "paper"), help="contact-line model (default smooth)")
+    g.add_argument("--contact", choices=contact_models(), help="contact-line model (default smooth)")
     b = g.add_mutually_exclusive_group()
     b.add_argument("--bending", choices=bending_families(),
                    help="bending energy B in U = W + beta B: trace (the paper's, default) or rotation (convex)")

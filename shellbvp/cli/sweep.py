@@ -5,6 +5,7 @@ from __future__ import annotations
 import sys
 import time
 
+from ..edge_models import contact_models
 from ..materials import material_class
 from ..scene_parameters import parameters_that
 from .common import (
@@ -37,7 +38,7 @@ def add_parser(sub):
     if not chosen:
         _material_choices(m)
     g.add_argument("--xi", type=int, choices=(0, 1), help="1: full generalised tensions; 0: first approximation")
-    g.add_argument("--contact", choices=("smooth", "paper"), help="contact-line model (default smooth)")
+    g.add_argument("--contact", choices=contact_models(), help="contact-line model (default smooth)")
     w.add_argument("--delta-max", type=number_or("length"), default=0.5, dest="delta_max",
                    help="depth of every curve (default 0.5, in rim radii); with a unit (100um) it needs --radius")
     w.add_argument("--force-max", type=number_or("force"), dest="force_max",

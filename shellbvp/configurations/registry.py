@@ -36,6 +36,7 @@ from dataclasses import dataclass
 from typing import Callable
 
 from .. import chain as ch
+from ..edge_models import contact_models, edge_model
 from ..inflation import enclosed_volume, system_parameters
 from ..solution import attach_tip_table
 
@@ -58,9 +59,10 @@ class Configuration:
         One of :data:`FAMILIES`.
     chain : callable
         ``chain(eps, L, edge)`` -> :class:`shellbvp.chain.Chain` (``edge``: the contact
-        edge's model, "smooth", "corner", "paper" or "pinned").
-    contacts : tuple of str
-        The scene contact models it exists for.
+        edge's model, :mod:`shellbvp.edge_models`, or its name).
+    contacts : tuple
+        The scene contact models it exists for, declared by name (default every one), held as
+        :class:`~shellbvp.edge_models.EdgeModel` (:meth:`allows`).
     controls : tuple of str
         What may be prescribed.
     askable : bool
@@ -86,7 +88,7 @@ class Configuration:
     name: str
     family: str
     chain: Callable
-    contacts: tuple = ("smooth", "paper")
+    contacts: tuple = None
     controls: tuple = ("delta", "force", "lambda0")
     askable: bool = False
     needs_tip_end: bool = False
@@ -94,6 +96,13 @@ class Configuration:
     line_contact: bool = False
     pole_branch_end: bool = False
     half: str = None
+
+    def __post_init__(self):
+        object.__setattr__(self, "contacts", tuple(edge_model(c) for c in self.contacts or contact_models()))
+
+    def allows(self, scene) -> bool:
+        """Whether it exists for the scene's contact model."""
+        return scene.contact_model in self.contacts
 
     @property
     def single_cap(self) -> bool:
@@ -118,8 +127,9 @@ class Configuration:
 
     def check_contact(self, scene):
         """A clear ValueError where the scene's contact model does not have this configuration."""
-        if scene.contact not in self.contacts:
-            raise ValueError(f"topology={self.name!r} needs contact='smooth': the paper's contact model has the "
+        if not self.allows(scene):
+            needs = " or ".join(f"contact={m.name!r}" for m in self.contacts)
+            raise ValueError(f"topology={self.name!r} needs {needs}: the paper's contact model has the "
                              f"single cap only" + (", which may run onto the cylinder ('cap+cylinder')"
                                                    if self.family == "wall" else ""))
 

@@ -10,6 +10,7 @@ import numpy as np
 
 from ..chain import CONTACT_KINDS, Edge, Kink, Line, TipEnd
 from ..configurations import CONFIGURATIONS, is_point_load, of
+from ..edge_models import contact_models, edge_model
 from .form import chain_base, reference_shell
 
 
@@ -53,9 +54,10 @@ def check_supported(state):
     if conf is None:
         return
     scene = state.scene
-    if scene.contact != "smooth":
+    if not scene.contact_model.variational:
+        supported_contacts = " or ".join(f"contact={n!r}" for n in contact_models() if edge_model(n).variational)
         raise ValueError(f"stability: contact={scene.contact!r} is not variational (its edge conditions are not "
-                         f"the natural conditions of an energy); only contact='smooth' is supported")
+                         f"the natural conditions of an energy); only {supported_contacts} is supported")
     if scene.sealed:
         raise ValueError("stability: a sealed shell (volume control) in contact is not supported, only "
                          "pressure control")
@@ -182,11 +184,11 @@ def contact_of(state, S0=None, friction: str = "frictionless") -> Contact:
 
 
 def _corners(state, base):
-    """The :class:`Corner` of every cornered contact edge (``Edge`` of model ``"corner"``)."""
+    """The :class:`Corner` of every cornered contact edge (an ``Edge`` whose model jumps: the corner)."""
     sysm, p = state.system, state.p
     out = []
     for j in sysm.junctions:
-        if not (isinstance(j, Edge) and j.model == "corner"):
+        if not (isinstance(j, Edge) and j.model.jumps):
             continue
         k, tip_side = min(j.kc, j.kf), int(j.kc > j.kf)
         S = float(sysm.S_point(sysm.regions[k].end, p))
