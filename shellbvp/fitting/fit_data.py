@@ -370,11 +370,35 @@ def fit(scene, displacement, force, *, R_L, fit_offset=True, free=(), bounds=Non
         choice, why = auto_model(scene, free, stability)
         res = dataclasses.replace(run("shell"), model_note=why) if choice == "shell" else \
             shell_or_solid(run("shell"), run("solid"))
+    lower = _contact_at_curve_end(res, d, R_L) if fit_offset and delta_max is None else None
+    if lower is not None:  # the contact point ran into the model curve's end: again, on a curve reaching past it
+        again = fit(scene, displacement, force, R_L=R_L, fit_offset=fit_offset, free=free, bounds=bounds, weights=weights,
+                    floor=floor, delta_max=1.2 * (float(np.max(d)) - lower) / R_L, tol=tol, loss=loss,
+                    baseline=baseline, contact_guess=contact_guess, progress=progress, stability=stability,
+                    model=model, mesh_check=mesh_check, max_depth=max_depth, max_force=max_force,
+                    weights_check=weights_check, **aliases)
+        return dataclasses.replace(again, curves_computed=again.curves_computed + res.curves_computed)
     if mesh_check and res.model == "solid" and res.success:
         coarse = run("solid", coarse=True)
         res = dataclasses.replace(res, mesh_error=abs(coarse.mu_H / res.mu_H - 1),
                                   curves_computed=res.curves_computed + coarse.curves_computed)
     return res
+
+
+def _contact_at_curve_end(res, d, R_L):
+    """Where to fit again from when ``res``'s contact point ran into the end of its model curve
+    (the deepest datum ``max(d)`` at the curve's last depth: the data would put the contact
+    lower, e.g. a first guess inside the loaded rows): a contact point (m) half the fitted depth
+    lower (no lower than the start's search, half the data's span below the first row); else None."""
+    depths = getattr(res.curve, "delta", None)
+    if depths is None or not len(depths) or not math.isfinite(res.offset):
+        return None
+    deepest = float(np.max(d))
+    reach = deepest - float(np.max(depths)) * R_L  # the lowest contact point the curve allows
+    if res.offset > reach + 1e-3 * (deepest - reach):
+        return None
+    lower = max(float(np.min(d) - 0.5 * np.ptp(d)), res.offset - 0.5 * (deepest - res.offset))
+    return lower if lower < res.offset else None
 
 
 def _fit_on_shared(shared, scene, mdl, noise, depth, k, keep, weights, baseline, check=None):
