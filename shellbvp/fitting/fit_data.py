@@ -239,7 +239,9 @@ def fit(scene, displacement, force, *, R_L, fit_offset=True, free=(), bounds=Non
     contact_guess : float, optional
         A first guess of the contact point (m; e.g. :func:`shellbvp.instrument.estimate_contact`):
         the model curve is computed to 1.2 x the depth of the data beyond it.  Default 0
-        (displacements measured from about the contact point).
+        (displacements measured from about the contact point).  A contact point that runs into
+        that curve's end (a guess inside the loaded rows) is fitted again, once, on a curve
+        reaching half the fitted depth lower (not with ``delta_max`` given).
     progress : callable, optional
         ``progress(description, delta_max) -> (bar, callback)`` for each model curve computed
         (e.g. ``lambda d, m: shellbvp.progress.curve_progress(m, d)``); None: silent.
@@ -372,8 +374,8 @@ def fit(scene, displacement, force, *, R_L, fit_offset=True, free=(), bounds=Non
             shell_or_solid(run("shell"), run("solid"))
     lower = _contact_at_curve_end(res, d, R_L) if fit_offset and delta_max is None else None
     if lower is not None:  # the contact point ran into the model curve's end: again, on a curve reaching past it
-        again = fit(scene, displacement, force, R_L=R_L, fit_offset=fit_offset, free=free, bounds=bounds, weights=weights,
-                    floor=floor, delta_max=1.2 * (float(np.max(d)) - lower) / R_L, tol=tol, loss=loss,
+        again = fit(scene, displacement, force, R_L=R_L, fit_offset=fit_offset, free=free, bounds=bounds,
+                    weights=weights, floor=floor, delta_max=1.2 * (float(np.max(d)) - lower) / R_L, tol=tol, loss=loss,
                     baseline=baseline, contact_guess=contact_guess, progress=progress, stability=stability,
                     model=model, mesh_check=mesh_check, max_depth=max_depth, max_force=max_force,
                     weights_check=weights_check, **aliases)
