@@ -10,7 +10,8 @@ import numpy as np
 from scipy import special
 
 __all__ = ["FIT_STATUS", "FIT_WARNINGS", "PLAUSIBLE_MU_H", "TREND_P", "RUNS_P", "RUNS_MIN_POINTS", "QUALITY_RULES",
-           "CONTACT_MISFIT", "POOR_WARNINGS", "WEIGHTS_DISAGREE", "WEIGHTS_LEVEL", "AUTOCORRELATION_LEVEL",
+           "CONTACT_MISFIT", "POOR_WARNINGS", "POOR_TOGETHER", "WEIGHTS_DISAGREE", "WEIGHTS_LEVEL",
+           "AUTOCORRELATION_LEVEL",
            "other_weights", "weights_disagreement", "weights_check_line", "rank_trend", "runs_test", "depth_order",
            "runs_in_depth_order", "residual_autocorrelation", "contact_misfit", "fit_diagnostics", "fit_quality",
            "diagnostics_lines", "check_result"]
@@ -87,6 +88,13 @@ AUTOCORRELATION_LEVEL = 0.5
 
 #: Warnings that rate a fit poor whatever its interval (:func:`fit_quality`).
 POOR_WARNINGS = ("contact_misfit",)
+
+
+#: Warnings that rate a fit poor together (:func:`fit_quality`): the residuals' signs run and their
+#: values follow each other in depth order -- they trace a curve the model does not follow (a wrong
+#: rim radius, a contact point the fit could not reach), and mu*H's interval does not say how well
+#: it is known.  Neither warned in 12,800 fits of the right model (benchmarks/weights_check_rate.py).
+POOR_TOGETHER = ("residual_runs", "residual_autocorrelation")
 
 
 def _average_ranks(x):
@@ -214,7 +222,9 @@ def fit_quality(success, warning_codes, mu_H, mu_ci, correlation=None, fitted=()
     """A transparent rating of one fit: ``good``, ``fair`` or ``poor``.
 
     * poor: the fit failed its checks, a warning of :data:`POOR_WARNINGS` (the model misses the
-      contact region), mu*H's 95 % interval is wider than +-20 % of it, or the model's own error
+      contact region) or both of :data:`POOR_TOGETHER` (residuals that trace a curve: their signs
+      run and their values follow each other), mu*H's 95 % interval is wider than +-20 % of it,
+      or the model's own error
       (``model_error``, a fraction, where known) is larger than that
       interval: then the interval does not say how well mu*H is known;
     * good: succeeded without warnings, the interval within +-5 %, and mu*H not correlated with
@@ -224,7 +234,7 @@ def fit_quality(success, warning_codes, mu_H, mu_ci, correlation=None, fitted=()
     The rules are :data:`QUALITY_RULES`; nanite rates curves with a trained regressor instead.
     """
     if not success or not (mu_H > 0) or not all(math.isfinite(v) for v in mu_ci) or \
-            any(code in POOR_WARNINGS for code in warning_codes):
+            any(code in POOR_WARNINGS for code in warning_codes) or all(c in warning_codes for c in POOR_TOGETHER):
         return "poor"
     half = (mu_ci[1] - mu_ci[0]) / 2 / mu_H
     if half > QUALITY_RULES["fair_halfwidth"] or (model_error is not None and model_error > half):

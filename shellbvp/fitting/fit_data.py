@@ -17,6 +17,7 @@ from ..shape_parameters import SHAPE_PARAMETERS, shape_parameter
 from .curves import N_DEPTHS, ModelCurves
 from .intervals import result_of
 from .least_squares import BASELINES, DEFAULT_WEIGHTS, WEIGHTS, Fitted, LeastSquaresModel, NoiseModel
+from .axisymmetry import check_axisymmetry
 from .profile import ProfileSearch, search_of
 from .solid import FIT_MODELS, auto_model, check_solid_fit, shell_or_solid, solid_curve
 
@@ -238,7 +239,9 @@ def fit(scene, displacement, force, *, R_L, fit_offset=True, free=(), bounds=Non
     contact_guess : float, optional
         A first guess of the contact point (m; e.g. :func:`shellbvp.instrument.estimate_contact`):
         the model curve is computed to 1.2 x the depth of the data beyond it.  Default 0
-        (displacements measured from about the contact point).
+        (displacements measured from about the contact point).  A contact point that runs into
+        that curve's end (a guess inside the loaded rows) is fitted again, once, on a curve
+        reaching half the fitted depth lower (not with ``delta_max`` given).
     progress : callable, optional
         ``progress(description, delta_max) -> (bar, callback)`` for each model curve computed
         (e.g. ``lambda d, m: shellbvp.progress.curve_progress(m, d)``); None: silent.
@@ -360,7 +363,7 @@ def fit(scene, displacement, force, *, R_L, fit_offset=True, free=(), bounds=Non
         res = dataclasses.replace(result_of(fitted, mdl, sp, k, notes, keep, weights, baseline, counter[0], name,
                                             check), **ranges)
         if stability and res.scene is not None and math.isfinite(res.offset):
-            _check_axisymmetry(res, (float(np.max(d)) - res.offset) / R_L, tol, progress)
+            check_axisymmetry(res, (float(np.max(d)) - res.offset) / R_L, tol, progress)
         return res
 
     if model != "auto":
@@ -369,6 +372,14 @@ def fit(scene, displacement, force, *, R_L, fit_offset=True, free=(), bounds=Non
         choice, why = auto_model(scene, free, stability)
         res = dataclasses.replace(run("shell"), model_note=why) if choice == "shell" else \
             shell_or_solid(run("shell"), run("solid"))
+    lower = _contact_at_curve_end(res, d, R_L) if fit_offset and delta_max is None else None
+    if lower is not None:  # the contact point ran into the model curve's end: again, on a curve reaching past it
+        again = fit(scene, displacement, force, R_L=R_L, fit_offset=fit_offset, free=free, bounds=bounds,
+                    weights=weights, floor=floor, delta_max=1.2 * (float(np.max(d)) - lower) / R_L, tol=tol, loss=loss,
+                    baseline=baseline, contact_guess=contact_guess, progress=progress, stability=stability,
+                    model=model, mesh_check=mesh_check, max_depth=max_depth, max_force=max_force,
+                    weights_check=weights_check, **aliases)
+        return dataclasses.replace(again, curves_computed=again.curves_computed + res.curves_computed)
     if mesh_check and res.model == "solid" and res.success:
         coarse = run("solid", coarse=True)
         res = dataclasses.replace(res, mesh_error=abs(coarse.mu_H / res.mu_H - 1),
@@ -376,47 +387,20 @@ def fit(scene, displacement, force, *, R_L, fit_offset=True, free=(), bounds=Non
     return res
 
 
-#: Depths of the curve :func:`_check_axisymmetry` analyses
-CHECK_DEPTHS = 12
-
-
-def _check_axisymmetry(res, deepest, tol, progress=None):
-    """``res.first_instability`` and a warning where the fitted scene's curve (at
-    :data:`CHECK_DEPTHS` depths to ``deepest``, stability ``"locate"``) loses axisymmetric
-    stability before the deepest fitted depth ``deepest`` (delta); ``res.stability_note``: what
-    was not analysed; ``res.stability_verdict``: what was found.  ``progress``: as :func:`fit`'s,
-    a bar for the curve and one for the analysis of its states."""
-    from ..continuation import curve
-    from ..curve_stability import assess, verdict
-
-    bar, callback = progress("stability check: curve", deepest) if progress is not None else (None, None)
-    try:
-        c = curve(res.scene, deltas=deepest * np.arange(1, CHECK_DEPTHS + 1) / CHECK_DEPTHS, tol=tol,
-                  estimate_error=False, callback=callback)
-    finally:
-        if bar is not None:
-            bar.close()
-    bar, callback = progress("stability check: states", deepest) if progress is not None else (None, None)
-    try:
-        assess(c, "off" if c.interrupted else "locate", progress=None if callback is None else
-               lambda delta: callback(c, c.solutions[int(np.argmin(np.abs(c.delta - delta)))]))
-    finally:
-        if bar is not None:
-            bar.close()
-    first = c.first_instability if c.first_instability is not None and c.first_instability.delta <= deepest \
-        else None
-    notes = [c.settings.get("stability_note", "")]
-    if not c.complete:
-        notes.append(f"the curve stopped at delta = {c.delta.max() if len(c) else 0:.4g} ({c.stop_reason})")
-    res.first_instability, res.stability_note = first, "; ".join(filter(None, notes))
-    res.stability_verdict = verdict(c)
-    if first is not None:
-        res.warnings.append(
-            f"the fitted depths reach delta = {deepest:.4g} but the axisymmetric shell loses stability at delta = "
-            f"{first.delta:.4g} (mode n = {first.mode}, displacement {res.offset + first.delta * res.R_L:.4g} m): past "
-            f"it the shell is not axisymmetric and the model does not describe it; fit the data up to that depth "
-            f"(--max-depth {first.delta:.4g}, a fraction of R_L; fit(max_depth={first.delta * res.R_L:.4g}) in m)")
-        res.warning_codes.append("unstable_depths")
+def _contact_at_curve_end(res, d, R_L):
+    """Where to fit again from when ``res``'s contact point ran into the end of its model curve
+    (the deepest datum ``max(d)`` at the curve's last depth: the data would put the contact
+    lower, e.g. a first guess inside the loaded rows): a contact point (m) half the fitted depth
+    lower (no lower than the start's search, half the data's span below the first row); else None."""
+    depths = getattr(res.curve, "delta", None)
+    if depths is None or not len(depths) or not math.isfinite(res.offset):
+        return None
+    deepest = float(np.max(d))
+    reach = deepest - float(np.max(depths)) * R_L  # the lowest contact point the curve allows
+    if res.offset > reach + 1e-3 * (deepest - reach):
+        return None
+    lower = max(float(np.min(d) - 0.5 * np.ptp(d)), res.offset - 0.5 * (deepest - res.offset))
+    return lower if lower < res.offset else None
 
 
 def _fit_on_shared(shared, scene, mdl, noise, depth, k, keep, weights, baseline, check=None):
