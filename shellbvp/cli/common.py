@@ -342,9 +342,8 @@ def add_scene_options(p, uncertain=False, preset_required=False, solver=("tol", 
                    help="shell thickness: H/R_L in (0, 0.5], or with a unit (50um) together with --radius; "
                         "sets beta = (H/R_L)^2/3, the bending stiffness of a 3D plate")
     g.add_argument("--thickness-profile", dest="thickness_profile", metavar="FILE",
-                   help="a wall whose thickness varies: a table with a header, arc_um (or angle_deg, angle_rad, "
-                        "S) and thickness_um (any length unit), from the pole to the rim, with --radius; "
-                        "interpolated by a natural cubic spline.  Forces and mu*H refer to the pole's thickness")
+                   help="a wall whose thickness varies: a table arc_um (or angle_deg, angle_rad, S),thickness_um from "
+                        "pole to rim, with --radius (docs/thickness.md); forces and mu*H refer to the pole's")
     g.add_argument("--transverse-shear", action="store_true", default=None, dest="transverse_shear",
                    help="with --thickness: add the shell's transverse shear compliance (forces at the thick "
                         "shell's depth; removes most of the model's O(H/R_L) error, see docs/accuracy.md)")
