@@ -17,7 +17,7 @@ from .edge_models import EdgeModel, contact_models, edge_model
 from .geometry import FlatTip, SphereTip, Spheroid, UserShell, UserTip
 from .materials import MATERIALS, Bending, Gent, Material, MooneyRivlin, TraceBending
 from .model import load_module, structure_description
-from .scene_parameters import scene_parameter
+from .scene_parameters import scene_parameter, scene_parameters
 from .thickness_profile import ThicknessProfile, settle_profile
 
 __all__ = ["Scene", "PRESETS", "CONTACT_MODELS", "RIMS", "SUPPORTS"]
@@ -362,11 +362,14 @@ class Scene:
         def length(x):
             return "" if R_L is None else format_in(abs(x) * R_L, "um" if abs(x) * R_L < 1e-3 else "mm", "length")
 
-        # only presets that could be this scene are built (a user meridian's preset parses formulas)
+        # only presets that could be this scene are built (a user meridian's preset parses formulas):
+        # equal in the scene's own parameters but those the thickness sets
+        shape_and_load = [p for p in scene_parameters().values()
+                          if not p.material and p.name not in scene_parameter("thickness").sets]
         candidates = [n for n, spec in PRESETS.items()
                       if isinstance(spec["scene"].get("shell"), tuple) == isinstance(self.shell, UserShell)
-                      and all(math.isclose(float(spec["scene"][k]), float(getattr(self, k)), rel_tol=1e-12)
-                              for k in ("gamma", "rho", "pressure") if k in spec["scene"])]
+                      and all(math.isclose(float(spec["scene"][p.name]), p.get(self), rel_tol=1e-12)
+                              for p in shape_and_load if p.name in spec["scene"])]
         named = [n for n in candidates if Scene.preset(n) == self]
         extra = [n for n in candidates if self.thickness is not None and Scene.preset(n, thickness=self.thickness) ==
                  replace(self, transverse_shear=False)]
@@ -462,10 +465,10 @@ class Scene:
     def values(self) -> dict:
         """Continuous (run-time) parameters by name (a closed shell's upper half is the dome
         ``Z = gamma cos S``: its meridian's gamma is ``-gamma``)."""
-        v = {"beta": self.beta, "rho": self.rho, "gamma": -self.gamma if self.closed else self.gamma,
-             "pressure": self.pressure,
-             "pole_rise": 0.0}
-        v.update(self.material.values())
+        v = {p.name: p.get(self) for p in scene_parameters().values() if not p.material}
+        v.update(self.material.values(), pole_rise=0.0)
+        if self.closed:
+            v["gamma"] = -self.gamma
         return v
 
     def parameters(self, model=None, *, pole_rise: float = 0.0) -> np.ndarray:

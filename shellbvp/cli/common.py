@@ -388,8 +388,8 @@ def material_options() -> list:
 def scene_from_args(args):
     import shellbvp as sb
 
-    over = {k: getattr(args, k) for k in ("gamma", "rho", "beta", "xi", "contact", "sealed", "transverse_shear",
-                                          "closed", "support")
+    own = [p.dest for p in scene_parameters().values() if p.option and not p.material]  # --gamma, --rho, ...
+    over = {k: getattr(args, k) for k in (*own, "xi", "contact", "sealed", "transverse_shear", "closed", "support")
             if getattr(args, k, None) is not None}
     if getattr(args, "flat_tip", None):
         over["tip"] = sb.FlatTip()
