@@ -132,3 +132,17 @@ def test_the_command_line_reads_a_thickness_file(tmp_path):
             argv += ["--radius", "300um"]
         with pytest.raises(ValueError, match=message):
             scene_from_args(build_parser().parse_args(argv))
+
+
+def test_a_profiled_curve_file_reads_back_with_its_profile(uniform, tmp_path):
+    """The curve file stores the profile: read back, the scene (and so its generated code) is the
+    same, and the states' profiles carry the local thickness over the pole's."""
+    scene = uniform.replace(thickness=ThicknessProfile.formula("0.05*(1 - 0.5*S/L)"))
+    c = sb.curve(scene, delta_max=0.05)
+    c.to_hdf5(tmp_path / "c.h5")
+    back = sb.read_curve(tmp_path / "c.h5")
+    assert back.scene == scene and back.scene.structure() == scene.structure()
+    s = sb.solve(scene, delta=0.05)
+    prof = s.profile()
+    S, t = np.asarray(prof["S"]), np.asarray(prof["thickness"])
+    assert np.allclose(t, 1 - 0.5 * S / L, atol=1e-12)
