@@ -38,6 +38,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .config import OPTIONS
+from .fe_closed import closed_boundary, mirrored, whole
 from .fe_contact import PenaltyContact, TipSurface
 from .fe_newton import Newton
 from .fe_pressure import FollowerPressure
@@ -117,6 +118,9 @@ class _Model:
     elements: tuple
     face: object = None    # HingedFace: the rim face's own unknowns (None: its dofs fixed or free)
     pressure: object = None  # FollowerPressure on the inner surface (None: no pressure)
+    supports: list = field(default_factory=list)  # a closed shell's substrate and spring (fe_closed)
+    delta_weights: dict = None  # delta = pole0 - sum w u over these dofs (None: the mid-surface pole's)
+    approach: float = 1.0  # the indenter's approach per displacement of the tip (2 between plates)
 
 
 def _build(scene, eps, *, through_thickness, element_length, pole_refinement, bulk, penalty, gauss_points,
@@ -126,6 +130,8 @@ def _build(scene, eps, *, through_thickness, element_length, pole_refinement, bu
     total = s_tab[-1]
     h = element_length * eps
     corners = _node_positions(total, h, h / pole_refinement, 4 * eps)
+    if whole(scene):  # a closed shell on a substrate: pole to pole
+        s_tab, R_tab, Z_tab, Phi_tab, corners = mirrored(s_tab, R_tab, Z_tab, Phi_tab, corners)
     n_s, n_t = corners.size - 1, int(through_thickness)
     # quadratic nodes: element corners plus midpoints, along s and through t
     s_nodes = np.empty(2 * n_s + 1)
@@ -161,6 +167,16 @@ def _build(scene, eps, *, through_thickness, element_length, pole_refinement, bu
     region = fem.RegionBiQuadraticQuad(mesh)
     field = fem.FieldsMixed(region, n=3, axisymmetric=True)
     solid = fem.SolidBody(fem.NearlyIncompressible(_material(scene, fem), bulk=bulk), field)
+    pressure = None
+    if scene.pressurised:  # p R_L/(mu H) on the shell is P = p H/R_L on the solid's inner surface (t = -eps/2)
+        bottom = np.array([node(0, j) for j in range(ncol)])
+        pressure = FollowerPressure(points, bottom, scene.pressure * eps, int(np.sum(field.fieldsizes)), gauss_points)
+    if scene.closed:
+        fixed, top, supports, weights, approach = closed_boundary(
+            scene, eps, points, node, n_t, ncol, field, penalty=penalty, gauss_points=gauss_points, band=band)
+        contact = PenaltyContact(TipSurface(scene), points, top, penalty / eps, gauss_points, field, band * eps)
+        return _Model(mesh, region, field, solid, contact, fixed, node(n_t, 0), eps, (n_s, n_t), None, pressure,
+                      supports, weights, approach)
     # boundary: the axis (r = 0) cannot move radially; the rim's mid-thickness point is pinned and
     # its face turns about it, held plane (simple support) or held fixed (clamped)
     axis = np.flatnonzero(points[:, 1] == 0.0)
@@ -171,10 +187,6 @@ def _build(scene, eps, *, through_thickness, element_length, pole_refinement, bu
     fixed = np.unique(np.concatenate([2 * axis + 1, 2 * np.asarray(held), 2 * np.asarray(held) + 1]))
     top = np.array([node(2 * n_t, j) for j in range(ncol)])  # t = +eps/2: faces the indenter
     contact = PenaltyContact(TipSurface(scene), points, top, penalty / eps, gauss_points, field, band * eps)
-    pressure = None
-    if scene.pressurised:  # p R_L/(mu H) on the shell is P = p H/R_L on the solid's inner surface (t = -eps/2)
-        bottom = np.array([node(0, j) for j in range(ncol)])
-        pressure = FollowerPressure(points, bottom, scene.pressure * eps, int(np.sum(field.fieldsizes)), gauss_points)
     return _Model(mesh, region, field, solid, contact, fixed, node(n_t, 0), eps, (n_s, n_t), face, pressure)
 
 
@@ -216,6 +228,7 @@ def fe_size(scene, thickness, **settings) -> FESize:
     n_s = math.ceil(total / h)
     if n_s < 100_000:  # exact (the loop is cheap); beyond, the uniform count is a lower bound
         n_s = _node_positions(total, h, h / opts["pole_refinement"], 4 * eps).size - 1
+    n_s *= 2 if whole(scene) else 1  # a closed shell on a substrate: both halves
     n_t = int(opts["through_thickness"])
     # quadratic displacement nodes, two components; pressure and volume ratio: 4 per element each
     dofs = 2 * (2 * n_s + 1) * (2 * n_t + 1) + 2 * 4 * n_s * n_t
@@ -245,12 +258,13 @@ def coarser(settings):
             "through_thickness": max(2, round(settings["through_thickness"] * 2 / 3))}
 
 
-def check_solid_scene(scene):
+def check_solid_scene(scene, use="fit"):
     """ValueError, in one line, where the scene has no solid here (before any work): a material
-    without a 3D form, a closed shell."""
-    if scene.closed:
-        raise ValueError("the 3D reference holds a shell on its rim; a closed shell (support=substrate/plates) "
-                         "has no solid yet")
+    without a 3D form; for a fit (``use="fit"``, ``fit --model solid``), a closed shell, whose
+    solid :func:`fe_curve` and :func:`shellbvp.validate` hold (``use="curve"``)."""
+    if scene.closed and use == "fit":
+        raise ValueError("a fit of a closed shell (support=substrate/plates) with the 3D solid is not offered yet; "
+                         "fit it with model='shell' (sb.validate and sb.fe_curve measure the shell's error)")
     _check_material(scene)
 
 
@@ -382,7 +396,7 @@ def fe_curve(scene, thickness, deltas, *, at="pole", mesh_check=False, progress=
         raise ValueError("deltas must be finite, > 0 and increasing")
     if at not in ("pole", "indenter"):
         raise ValueError(f"at must be 'pole' or 'indenter'; got {at!r}")
-    check_solid_scene(scene)
+    check_solid_scene(scene, use="curve")
     unknown = set(settings) - set(FE_DEFAULTS)
     if unknown:
         raise ValueError(f"unknown FE setting(s) {sorted(unknown)}; known: {sorted(FE_DEFAULTS)}")
@@ -426,8 +440,8 @@ def _start(scene, eps, n, opts):
 
 def _record(out, i, model, solver):
     _, _, F_i, rc_i = model.contact.evaluate(model.field[0].values.ravel(), with_matrix=False)
-    out.force[i], out.indenter[i], out.delta[i], out.contact_radius[i] = F_i / model.eps, solver.indenter, \
-        solver.delta(), rc_i
+    out.force[i], out.indenter[i], out.delta[i], out.contact_radius[i] = F_i / model.eps, \
+        model.approach * solver.indenter, solver.delta(), rc_i
     out.pressure[i] = solver.pressure / model.eps
 
 
@@ -453,14 +467,16 @@ def _march(scene, eps, targets, opts, progress, pole):
     if scene.sealed:
         solver.seal()
     # a first touch under indenter control (pole control needs a contact to move the pole)
-    if not solver.move(min(0.02 * eps, 0.5 * targets[0])):
+    if not solver.move(min(0.02 * eps, 0.5 * targets[0] / model.approach)):
         return _ended(out, "no equilibrium at first touch")
     step = 0.5 * eps
     cap = lambda x: 0.25 * max(x, eps) + 0.5 * eps  # noqa: E731
     for i, target in enumerate(targets):
-        reached, step = solver.march(target, pole, step, cap)
+        # the indenter's target: its approach to the substrate or the other plate (each plate moves half)
+        reached, step = solver.march(target if pole else target / model.approach, pole, step, cap)
         if not reached:
-            where = f"delta = {solver.delta():.4g}" if pole else f"the indenter's displacement {solver.indenter:.4g}"
+            where = f"delta = {solver.delta():.4g}" if pole else \
+                f"the indenter's displacement {model.approach * solver.indenter:.4g}"
             return _ended(out, f"no equilibrium beyond {where}")
         _record(out, i, model, solver)
         if pole:
