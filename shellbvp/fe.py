@@ -13,6 +13,9 @@ the solid itself, so that a user sees the model's error for his own scene:
 * the rim (:mod:`shellbvp.fe_rim`): the shell model's simple support as the rim face held
   plane and turning about its fixed mid-thickness point (pinning that point alone does not
   converge under refinement); a clamped rim holds the whole face;
+* a closed shell (:mod:`shellbvp.fe_closed`): between plates the half above the equator on its
+  symmetry plane; on a substrate the whole wall on a second, fixed frictionless contact; delta
+  the approach of the mid-surface poles;
 * the indenter: rigid and frictionless, the scene's tip on its cylinder, pressed on the
   surface that faces it (the shell model presses the mid-surface); a penalty on the
   penetration at Gauss points of that surface with the exact (consistent) tangent
@@ -350,7 +353,8 @@ def fe_curve(scene, thickness, deltas, *, at="pole", mesh_check=False, progress=
     ----------
     scene : Scene
         Shell, indenter, material (one with a ``felupe_model``) and rim (``"pinned"``: the rim
-        face held plane and turning about its mid-thickness point; ``"clamped"``: held); beta,
+        face held plane and turning about its mid-thickness point; ``"clamped"``: held), or a
+        closed shell (:mod:`shellbvp.fe_closed`: between plates, or on a substrate); beta,
         xi, the bending energy and the contact model are the shell model's and play no part
         here.  A pressure ``p R_L/(mu H)`` acts on the inner surface as ``p H/R_L`` (a follower
         load, :mod:`shellbvp.fe_pressure`): the solid is inflated first, and its depths are
@@ -360,7 +364,9 @@ def fe_curve(scene, thickness, deltas, *, at="pole", mesh_check=False, progress=
         eps = H / R_L, in (0, 0.5].
     deltas : array_like
         Depths, increasing, > 0: of the mid-surface pole (``at="pole"``, the shell model's delta)
-        or of the indenter from first touch (``at="indenter"``, what an instrument records).
+        or of the indenter from first touch (``at="indenter"``, what an instrument records); of a
+        closed shell, the approach of its mid-surface poles, or of the indenters (the plates, or
+        the tip and the substrate).
     at : {"pole", "indenter"}
         What ``deltas`` are.  Both are reported (``delta`` and ``indenter``).
     mesh_check : bool
