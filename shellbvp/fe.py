@@ -13,6 +13,9 @@ the solid itself, so that a user sees the model's error for his own scene:
 * the rim (:mod:`shellbvp.fe_rim`): the shell model's simple support as the rim face held
   plane and turning about its fixed mid-thickness point (pinning that point alone does not
   converge under refinement); a clamped rim holds the whole face;
+* a closed shell (:mod:`shellbvp.fe_closed`): between plates the half above the equator on its
+  symmetry plane; on a substrate the whole wall on a second, fixed frictionless contact; delta
+  the approach of the mid-surface poles;
 * the indenter: rigid and frictionless, the scene's tip on its cylinder, pressed on the
   surface that faces it (the shell model presses the mid-surface); a penalty on the
   penetration at Gauss points of that surface with the exact (consistent) tangent
@@ -38,6 +41,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .config import OPTIONS
+from .fe_closed import closed_boundary, mirrored, whole
 from .fe_contact import PenaltyContact, TipSurface
 from .fe_newton import Newton
 from .fe_pressure import FollowerPressure
@@ -117,6 +121,9 @@ class _Model:
     elements: tuple
     face: object = None    # HingedFace: the rim face's own unknowns (None: its dofs fixed or free)
     pressure: object = None  # FollowerPressure on the inner surface (None: no pressure)
+    supports: list = field(default_factory=list)  # a closed shell's substrate and spring (fe_closed)
+    delta_weights: dict = None  # delta = pole0 - sum w u over these dofs (None: the mid-surface pole's)
+    approach: float = 1.0  # the indenter's approach per displacement of the tip (2 between plates)
 
 
 def _build(scene, eps, *, through_thickness, element_length, pole_refinement, bulk, penalty, gauss_points,
@@ -126,6 +133,8 @@ def _build(scene, eps, *, through_thickness, element_length, pole_refinement, bu
     total = s_tab[-1]
     h = element_length * eps
     corners = _node_positions(total, h, h / pole_refinement, 4 * eps)
+    if whole(scene):  # a closed shell on a substrate: pole to pole
+        s_tab, R_tab, Z_tab, Phi_tab, corners = mirrored(s_tab, R_tab, Z_tab, Phi_tab, corners)
     n_s, n_t = corners.size - 1, int(through_thickness)
     # quadratic nodes: element corners plus midpoints, along s and through t
     s_nodes = np.empty(2 * n_s + 1)
@@ -161,6 +170,16 @@ def _build(scene, eps, *, through_thickness, element_length, pole_refinement, bu
     region = fem.RegionBiQuadraticQuad(mesh)
     field = fem.FieldsMixed(region, n=3, axisymmetric=True)
     solid = fem.SolidBody(fem.NearlyIncompressible(_material(scene, fem), bulk=bulk), field)
+    pressure = None
+    if scene.pressurised:  # p R_L/(mu H) on the shell is P = p H/R_L on the solid's inner surface (t = -eps/2)
+        bottom = np.array([node(0, j) for j in range(ncol)])
+        pressure = FollowerPressure(points, bottom, scene.pressure * eps, int(np.sum(field.fieldsizes)), gauss_points)
+    if scene.closed:
+        fixed, top, supports, weights, approach = closed_boundary(
+            scene, eps, points, node, n_t, ncol, field, penalty=penalty, gauss_points=gauss_points, band=band)
+        contact = PenaltyContact(TipSurface(scene), points, top, penalty / eps, gauss_points, field, band * eps)
+        return _Model(mesh, region, field, solid, contact, fixed, node(n_t, 0), eps, (n_s, n_t), None, pressure,
+                      supports, weights, approach)
     # boundary: the axis (r = 0) cannot move radially; the rim's mid-thickness point is pinned and
     # its face turns about it, held plane (simple support) or held fixed (clamped)
     axis = np.flatnonzero(points[:, 1] == 0.0)
@@ -171,10 +190,6 @@ def _build(scene, eps, *, through_thickness, element_length, pole_refinement, bu
     fixed = np.unique(np.concatenate([2 * axis + 1, 2 * np.asarray(held), 2 * np.asarray(held) + 1]))
     top = np.array([node(2 * n_t, j) for j in range(ncol)])  # t = +eps/2: faces the indenter
     contact = PenaltyContact(TipSurface(scene), points, top, penalty / eps, gauss_points, field, band * eps)
-    pressure = None
-    if scene.pressurised:  # p R_L/(mu H) on the shell is P = p H/R_L on the solid's inner surface (t = -eps/2)
-        bottom = np.array([node(0, j) for j in range(ncol)])
-        pressure = FollowerPressure(points, bottom, scene.pressure * eps, int(np.sum(field.fieldsizes)), gauss_points)
     return _Model(mesh, region, field, solid, contact, fixed, node(n_t, 0), eps, (n_s, n_t), face, pressure)
 
 
@@ -216,6 +231,7 @@ def fe_size(scene, thickness, **settings) -> FESize:
     n_s = math.ceil(total / h)
     if n_s < 100_000:  # exact (the loop is cheap); beyond, the uniform count is a lower bound
         n_s = _node_positions(total, h, h / opts["pole_refinement"], 4 * eps).size - 1
+    n_s *= 2 if whole(scene) else 1  # a closed shell on a substrate: both halves
     n_t = int(opts["through_thickness"])
     # quadratic displacement nodes, two components; pressure and volume ratio: 4 per element each
     dofs = 2 * (2 * n_s + 1) * (2 * n_t + 1) + 2 * 4 * n_s * n_t
@@ -245,12 +261,13 @@ def coarser(settings):
             "through_thickness": max(2, round(settings["through_thickness"] * 2 / 3))}
 
 
-def check_solid_scene(scene):
+def check_solid_scene(scene, use="fit"):
     """ValueError, in one line, where the scene has no solid here (before any work): a material
-    without a 3D form, a closed shell."""
-    if scene.closed:
-        raise ValueError("the 3D reference holds a shell on its rim; a closed shell (support=substrate/plates) "
-                         "has no solid yet")
+    without a 3D form; for a fit (``use="fit"``, ``fit --model solid``), a closed shell, whose
+    solid :func:`fe_curve` and :func:`shellbvp.validate` hold (``use="curve"``)."""
+    if scene.closed and use == "fit":
+        raise ValueError("a fit of a closed shell (support=substrate/plates) with the 3D solid is not offered yet; "
+                         "fit it with model='shell' (sb.validate and sb.fe_curve measure the shell's error)")
     if scene.thickness_profile is not None:
         raise ValueError("the 3D reference meshes a uniform wall; a thickness_profile has no solid yet")
     _check_material(scene)
@@ -338,7 +355,8 @@ def fe_curve(scene, thickness, deltas, *, at="pole", mesh_check=False, progress=
     ----------
     scene : Scene
         Shell, indenter, material (one with a ``felupe_model``) and rim (``"pinned"``: the rim
-        face held plane and turning about its mid-thickness point; ``"clamped"``: held); beta,
+        face held plane and turning about its mid-thickness point; ``"clamped"``: held), or a
+        closed shell (:mod:`shellbvp.fe_closed`: between plates, or on a substrate); beta,
         xi, the bending energy and the contact model are the shell model's and play no part
         here.  A pressure ``p R_L/(mu H)`` acts on the inner surface as ``p H/R_L`` (a follower
         load, :mod:`shellbvp.fe_pressure`): the solid is inflated first, and its depths are
@@ -348,7 +366,9 @@ def fe_curve(scene, thickness, deltas, *, at="pole", mesh_check=False, progress=
         eps = H / R_L, in (0, 0.5].
     deltas : array_like
         Depths, increasing, > 0: of the mid-surface pole (``at="pole"``, the shell model's delta)
-        or of the indenter from first touch (``at="indenter"``, what an instrument records).
+        or of the indenter from first touch (``at="indenter"``, what an instrument records); of a
+        closed shell, the approach of its mid-surface poles, or of the indenters (the plates, or
+        the tip and the substrate).
     at : {"pole", "indenter"}
         What ``deltas`` are.  Both are reported (``delta`` and ``indenter``).
     mesh_check : bool
@@ -384,7 +404,7 @@ def fe_curve(scene, thickness, deltas, *, at="pole", mesh_check=False, progress=
         raise ValueError("deltas must be finite, > 0 and increasing")
     if at not in ("pole", "indenter"):
         raise ValueError(f"at must be 'pole' or 'indenter'; got {at!r}")
-    check_solid_scene(scene)
+    check_solid_scene(scene, use="curve")
     unknown = set(settings) - set(FE_DEFAULTS)
     if unknown:
         raise ValueError(f"unknown FE setting(s) {sorted(unknown)}; known: {sorted(FE_DEFAULTS)}")
@@ -428,8 +448,8 @@ def _start(scene, eps, n, opts):
 
 def _record(out, i, model, solver):
     _, _, F_i, rc_i = model.contact.evaluate(model.field[0].values.ravel(), with_matrix=False)
-    out.force[i], out.indenter[i], out.delta[i], out.contact_radius[i] = F_i / model.eps, solver.indenter, \
-        solver.delta(), rc_i
+    out.force[i], out.indenter[i], out.delta[i], out.contact_radius[i] = F_i / model.eps, \
+        model.approach * solver.indenter, solver.delta(), rc_i
     out.pressure[i] = solver.pressure / model.eps
 
 
@@ -455,14 +475,16 @@ def _march(scene, eps, targets, opts, progress, pole):
     if scene.sealed:
         solver.seal()
     # a first touch under indenter control (pole control needs a contact to move the pole)
-    if not solver.move(min(0.02 * eps, 0.5 * targets[0])):
+    if not solver.move(min(0.02 * eps, 0.5 * targets[0] / model.approach)):
         return _ended(out, "no equilibrium at first touch")
     step = 0.5 * eps
     cap = lambda x: 0.25 * max(x, eps) + 0.5 * eps  # noqa: E731
     for i, target in enumerate(targets):
-        reached, step = solver.march(target, pole, step, cap)
+        # the indenter's target: its approach to the substrate or the other plate (each plate moves half)
+        reached, step = solver.march(target if pole else target / model.approach, pole, step, cap)
         if not reached:
-            where = f"delta = {solver.delta():.4g}" if pole else f"the indenter's displacement {solver.indenter:.4g}"
+            where = f"delta = {solver.delta():.4g}" if pole else \
+                f"the indenter's displacement {model.approach * solver.indenter:.4g}"
             return _ended(out, f"no equilibrium beyond {where}")
         _record(out, i, model, solver)
         if pole:

@@ -9,7 +9,20 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["TipSurface", "PenaltyContact"]
+__all__ = ["TipSurface", "PenaltyContact", "Plane"]
+
+
+class Plane:
+    """A rigid plane ``z = apex`` with the solid on one side: ``facing = +1`` above it (a
+    substrate), ``-1`` below it (a flat plate pressing down).  ``distance`` as :class:`TipSurface`'s."""
+
+    def __init__(self, facing):
+        self.facing = float(facing)
+
+    def distance(self, x, apex):
+        n = np.zeros((x.shape[0], 2))
+        n[:, 0] = self.facing
+        return self.facing * (x[:, 0] - apex), n, np.zeros((x.shape[0], 2, 2))
 
 
 class TipSurface:
@@ -19,14 +32,16 @@ class TipSurface:
     Points are ``(z, r)`` (FElupe's axisymmetric order: axial first).  ``distance(x)`` returns
     ``(d, n, H)``: ``d < 0`` inside the indenter, ``n = grad d`` (unit, pointing out of the
     indenter), ``H = grad grad d``.  The sphere is written in closed form; other tips by the
-    closest point on their meridian (Newton in omega).
+    closest point on their meridian (Newton in omega); a flat tip is a plane (it has no end).
     """
 
     def __init__(self, scene):
         self.rho = float(scene.rho)
-        self.sphere = scene.tip.description()["kind"] == "sphere"
+        kind = scene.tip.description()["kind"]
+        self.sphere = kind == "sphere"
+        self.plane = Plane(-1) if kind == "flat" else None
         self.omega_max = float(scene.tip_omega_max)
-        if not self.sphere:
+        if not self.sphere and self.plane is None:
             import sympy as sp
 
             from symbolic.geometry import OMEGA
@@ -41,6 +56,8 @@ class TipSurface:
             self._top = self.rho * float(b[-1])  # where the tip meets the cylinder, above the apex
 
     def distance(self, x, apex):
+        if self.plane is not None:
+            return self.plane.distance(x, apex)
         z, r = x[:, 0] - apex, np.abs(x[:, 1])
         if self.sphere:
             return self._capsule(z, r)
@@ -132,10 +149,11 @@ class PenaltyContact:
         xq = np.einsum("ga,ead->egd", self.N, x).reshape(-1, 2)
         return xq
 
-    def bind(self, points):
-        """Fix the reference surface; ``z0`` becomes the apex height of first touch."""
+    def bind(self, points, apex=None):
+        """Fix the reference surface; ``z0`` becomes the apex height of first touch (or ``apex``:
+        a support held there)."""
         self.X_ref = points[self.edges]
-        self.z0 = self.apex = self.first_touch()
+        self.z0 = self.apex = self.first_touch() if apex is None else float(apex)
 
     def first_touch(self, u=None):
         """The apex height at which the descending indenter first touches the surface, undeformed

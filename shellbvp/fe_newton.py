@@ -91,8 +91,12 @@ class Newton:
         if model.face is not None:
             free[model.face.dofs] = False  # moved through the face's own unknowns
         self.free = np.flatnonzero(free)
-        # the pole's axial dof among the reduced unknowns (the face's come after the free dofs)
-        self.pole = int(np.searchsorted(self.free, 2 * model.pole_mid))
+        # delta = pole0 - w . u: the mid-surface pole's displacement (a closed shell's: the poles'
+        # approach, model.delta_weights)
+        self.weights = np.zeros(ndof)
+        for dof, w in (getattr(model, "delta_weights", None) or {2 * model.pole_mid: 1.0}).items():
+            self.weights[dof] = w
+        self.supports = list(getattr(model, "supports", None) or [])  # fixed contacts, springs
         self.shift = np.zeros(ndof)  # a rigid axial shift of the displacement field
         self.shift[0:model.contact.ndof_u:2] = 1.0
         self.newton_iterations = 0
@@ -129,8 +133,13 @@ class Newton:
         self.m.contact.apex = self.m.contact.z0 - a
 
     def delta(self):
-        """The mid-surface pole's displacement, positive down."""
-        return self.pole0 - float(self.m.field[0].values[self.m.pole_mid, 0])
+        """The mid-surface pole's displacement, positive down (a closed shell's: the approach of
+        its mid-surface poles)."""
+        return self.pole0 - self._weighted()
+
+    def _weighted(self):
+        u = self.m.field[0].values.ravel()
+        return float(self.weights[: u.size] @ u)
 
     def _remember(self):
         self.history = (self.history + [self.save()])[-3:]
@@ -156,18 +165,23 @@ class Newton:
     # ------------------------------------------------------------ the system
     def residual(self):
         """``(r, load, K_load, F)`` at the current state (full dofs): the residual, the norm of the
-        loads it is measured against (the contact's and the pressure's), their tangent and the
-        indenter's force.  (A rigid axial shift leaves the pressure's load unchanged: the pole
-        control's border is the contact's alone.)"""
+        loads it is measured against (the contacts', the supports' and the pressure's), their
+        tangent and the indenter's force.  The indenter's own tangent is kept (``K_tip``): a rigid
+        axial shift changes its load alone, so it is the pole control's border."""
         m = self.m
         u = m.field[0].values.ravel()
         with np.errstate(invalid="ignore", divide="ignore", over="ignore"):  # trial states may invert
             r = np.asarray(m.solid.assemble.vector(m.field).todense()).ravel()
         rc, Kc, F, _ = m.contact.evaluate(u)
-        if m.pressure is None:
-            return r + rc, np.linalg.norm(rc), Kc, F
-        rp, Kp = m.pressure.evaluate(u)
-        return r + rc + rp, np.linalg.norm(rc) + np.linalg.norm(rp), Kc + Kp, F
+        self.K_tip = Kc
+        r, load, K = r + rc, np.linalg.norm(rc), Kc
+        for support in self.supports:
+            rs, Ks, _, _ = support.evaluate(u)
+            r, load, K = r + rs, load + np.linalg.norm(rs), K + Ks
+        if m.pressure is not None:
+            rp, Kp = m.pressure.evaluate(u)
+            r, load, K = r + rp, load + np.linalg.norm(rp), K + Kp
+        return r, load, K, F
 
     def system(self, r, K):
         """``(K_reduced, r_reduced, J)``: the Newton system in the unknowns the rim leaves free
@@ -259,10 +273,8 @@ class Newton:
         cols, rows, rhs = [], [], []
         reduced = (lambda v: v[self.free]) if J is None else (lambda v: J.T @ v)  # noqa: E731
         if delta is not None:
-            cols.append(reduced(K_load @ self.shift))
-            row = np.zeros(dq.size)
-            row[self.pole] = 1.0
-            rows.append(row)
+            cols.append(reduced(self.K_tip @ self.shift))
+            rows.append(reduced(self.weights))
             rhs.append(self.delta() - delta)
         if self.V0 is not None:
             u = self.m.field[0].values.ravel()
@@ -311,7 +323,7 @@ class Newton:
                 if step < smallest:
                     return False
         u = self.m.field[0].values
-        self.pole0 = float(u[self.m.pole_mid, 0])
+        self.pole0 = self._weighted()
         self.m.contact.z0 = self.m.contact.apex = self.m.contact.first_touch(u.ravel())
         self.history = [self.save()]
         return True

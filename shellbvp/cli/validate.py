@@ -39,7 +39,7 @@ def run(args):
         raise ValueError("validate needs --thickness (H/R_L, or with a unit and --radius)")
     from ..fe import check_fe_size, check_solid_scene, fe_size
 
-    check_solid_scene(scene)
+    check_solid_scene(scene, use="curve")
     if not (0 < args.delta_max <= 2):
         raise ValueError(f"--delta-max must be in (0, 2]; got {args.delta_max:g}")
     deltas = None
