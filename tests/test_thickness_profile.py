@@ -146,3 +146,15 @@ def test_a_profiled_curve_file_reads_back_with_its_profile(uniform, tmp_path):
     prof = s.profile()
     S, t = np.asarray(prof["S"]), np.asarray(prof["thickness"])
     assert np.allclose(t, 1 - 0.5 * S / L, atol=1e-12)
+
+
+def test_transverse_shear_takes_the_local_thickness():
+    """The shear strain is Q/(kappa mu H(S)): a profile twice the pole's thickness outside the
+    edge halves the tilt that a uniform wall's Q gives (Q in units of mu H0)."""
+    from shellbvp.thickness import shear_delta
+
+    r = np.linspace(0.0, 1.0, 201)
+    Q = -0.1 / (2 * np.pi * np.maximum(r, 1e-3))
+    uniform = shear_delta([("free", {"r": r, "Q": Q})], 0, 0.1, 0.05)
+    thick = shear_delta([("free", {"r": r, "Q": Q, "thickness": np.full_like(r, 2.0)})], 0, 0.1, 0.05)
+    assert uniform > 0 and thick == pytest.approx(uniform / 2, rel=1e-12)
