@@ -314,6 +314,45 @@ def _angle(cosine):
     return math.acos(min(1.0, max(-1.0, float(cosine))))
 
 
+#: The small-delta leg's steps: delta times a factor 0.6, brought halfway to 1 after a failure,
+#: until it exceeds 0.97.
+SMALL_DELTA_STEPS = Steps(first=0.6, advance=lambda d, factor, target: max(target, d * factor),
+                          grow=lambda factor: factor, shrink=lambda factor, d, tried: 1 - (1 - factor) / 2,
+                          too_small=lambda factor, d: factor > 0.97)
+
+
+def _small_delta_leg(scene, first, st):
+    """From the first point down to delta_min (a march with :data:`SMALL_DELTA_STEPS`): yields
+    ``(state, order key)``; returns ``(the first state it accepted or None, solves + 1)``."""
+    solves = [1]
+
+    def solve_at(nd, states):
+        prev, prev2 = states[-1], (states[-2] if len(states) > 1 else None)
+        solves[0] += 1
+        if is_point_load(prev):
+            return solve_point_load(scene, nd, tol=st.tol, max_nodes=st.max_nodes, guess=prev)
+        sol = solve_at_delta(scene, nd, prev, prev2, st)
+        if scene.contact_model.point_load_limit and not scene.two_contacts and prev.Sc < 1e-8 and \
+                (not sol.success or sol.Sc < SC_POINT):
+            # the cap is leaving double precision: continue with its point-load limit
+            point = solve_point_load(scene, nd, tol=st.tol, max_nodes=st.max_nodes, guess=prev)
+            sol = point if point.success else sol
+        return sol
+
+    marching = iter_march(first.delta, st.delta_min, solve_at, SMALL_DELTA_STEPS, history=[first],
+                          max_solves=st.max_steps - 1)
+    while True:
+        try:
+            sol, _ = next(marching)
+        except StopIteration as end:
+            marched = end.value
+            break
+        yield sol, -solves[0]
+    if marched.reason == "step":
+        log.info("small-delta leg stopped at delta = %.4g: %s", marched.at, marched.failed.message)
+    return (marched.states[1] if len(marched.states) > 1 else None), solves[0]
+
+
 def adaptive(scene, branch, settings):
     """The adaptive curve: yields ``(state, order key)``, returns the Stop."""
     st = settings
@@ -321,32 +360,8 @@ def adaptive(scene, branch, settings):
     if isinstance(first, Stop):
         return first
     yield first, 0
-    steps = 1
     # Leg 1: down to delta_min (geometric), resolving the small-delta region.
-    prev, prev2, below = first, None, None
-    d = first.delta
-    factor = 0.6
-    while d > st.delta_min and steps < st.max_steps:
-        nd = max(st.delta_min, d * factor)
-        if is_point_load(prev):
-            sol = solve_point_load(scene, nd, tol=st.tol, max_nodes=st.max_nodes, guess=prev)
-        else:
-            sol = solve_at_delta(scene, nd, prev, prev2, st)
-            if scene.contact_model.point_load_limit and not scene.two_contacts and prev.Sc < 1e-8 and \
-                    (not sol.success or sol.Sc < SC_POINT):
-                # the cap is leaving double precision: continue with its point-load limit
-                point = solve_point_load(scene, nd, tol=st.tol, max_nodes=st.max_nodes, guess=prev)
-                sol = point if point.success else sol
-        steps += 1
-        if sol.success:
-            yield sol, -steps
-            below = below or sol
-            prev2, prev, d = prev, sol, nd
-        else:
-            factor = 1 - (1 - factor) / 2
-            if factor > 0.97:
-                log.info("small-delta leg stopped at delta = %.4g: %s", d, sol.message)
-                break
+    below, steps = yield from _small_delta_leg(scene, first, st)
     # Leg 2: pseudo-arclength upwards from the first point.
     if is_point_load(first) or scene.two_contacts:
         # the cap is below double precision there: no (delta, lambda0, F) branch to follow
