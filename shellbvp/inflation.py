@@ -31,7 +31,7 @@ import numpy as np
 from .chain import Chain, ChainBVP, FreePole, Point, Region, Rim
 from .diagnosis import as_failure, diagnose
 from .march import Steps, march
-from .solution import Solution, attach_tip_table
+from .solution import Solution, attach_tip_table, state_class
 
 __all__ = ["inflate", "InflatedState", "inflated_chain", "inflated_pole_rise", "start_shape", "system_parameters",
            "enclosed_volume", "InflatedStart", "INFLATED_FIELDS", "inflated_start"]
@@ -44,7 +44,7 @@ TOL = 1e-8
 _MAX_NODES = 50000
 
 
-@dataclass(frozen=True, eq=False, repr=False, slots=True)
+@state_class
 class InflatedState(Solution):
     """The shell under its pressure before the indenter touches it: a :class:`Solution`
     of topology ``"inflated"`` with the numbers that fix where a curve starts."""

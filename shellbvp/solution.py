@@ -19,9 +19,9 @@ import numpy as np
 from . import collocation
 from .config import OPTIONS
 
-__all__ = ["STATUS_MESSAGES", "STATE_NUMBERS", "Solution", "failure", "solve_bvp", "run_status", "inadmissible",
-           "cached", "thin_mesh", "warm_mesh", "secant_ratio",
-           "richardson_error", "finished", "penetration", "wall_gap", "attach_tip_table", "default_eps"]
+__all__ = ["STATUS_MESSAGES", "STATE_NUMBERS", "Solution", "state_class", "failure", "solve_bvp", "run_status",
+           "inadmissible", "cached", "thin_mesh", "warm_mesh", "secant_ratio", "richardson_error", "finished",
+           "penetration", "wall_gap", "attach_tip_table", "default_eps"]
 
 
 #: What each ``Solution.status`` means and what to try: ``{status: message}``.
@@ -141,14 +141,26 @@ def solve_bvp(fun, bc, x, y, p=None, *, fun_jac, bc_jac, max_jacobians=None, ker
                                        f"{xa.size} nodes)")
 
 
-@dataclass(frozen=True, eq=False, repr=False, slots=True)
+def _refuse(self, name, value=None):
+    raise dataclasses.FrozenInstanceError(f"cannot assign to {name!r}: a state is never written (with_() makes a new one)")
+
+
+def state_class(cls):
+    """``cls`` as a frozen dataclass with slots, :class:`Solution` or a subclass with a
+    configuration's own fields: a field set or a name not declared raises ``FrozenInstanceError``
+    (CPython < 3.12 raises TypeError for the latter: a frozen class with slots calls super())."""
+    cls = dataclass(frozen=True, eq=False, repr=False, slots=True)(cls)
+    cls.__setattr__ = cls.__delattr__ = _refuse
+    return cls
+
+
+@state_class
 class Solution:
     """Result of :func:`solve`: every state of every configuration, with fixed fields.
 
     A field that a configuration does not have keeps its default (NaN for a number).  Built
-    once, by the one diagnosis of a solve_bvp run (:func:`shellbvp.diagnosis.diagnose`) or,
-    for a search that produced no state, by :func:`failure`, and never written after: a
-    field set raises ``FrozenInstanceError``; what a later step adds (an error estimate, the
+    once (:func:`shellbvp.diagnosis.diagnose`, or :func:`failure` for a search without a state)
+    and never written (``FrozenInstanceError``): what a later step adds (an error estimate, the
     wall time, a flag) makes a new state, :meth:`with_`.  No state holds another.
 
     Attributes
@@ -171,31 +183,25 @@ class Solution:
     scene, system
         The :class:`~shellbvp.scene.Scene` and the solved ``ChainBVP`` (None for a failure
         without a system).
-    S1 : float
-        Where the contact starts (0 when it reaches the pole; a lifted pole's first edge).
-    edge_S : list of float
-        Every contact edge's S, pole to rim.
+    S1, edge_S : float, list of float
+        Where the contact starts (0 when it reaches the pole; a lifted pole's first edge);
+        every contact edge's S, pole to rim.
     x, y, p, sol, rms_residuals, niter
         solve_bvp's mesh on t in [0, 1], stacked states (8, m) (layout in
         ``shellbvp.chain``), unknown parameters, interpolant, residuals, iterations.
-    tol : float
-        The residual tolerance the state was solved to.
-    nodes : int
-    max_residual : float
-        Largest relative collocation residual.
-    z_tip : float
-        The indenter tip's height.
-    energy : float
-        ``E = 2 pi Int U R Psi dS`` (F = dE/ddelta for the smooth model).
+    tol, nodes, max_residual : float, int, float
+        The residual tolerance the state was solved to, its mesh nodes, and the largest
+        relative collocation residual.
+    z_tip, energy : float
+        The indenter tip's height; ``E = 2 pi Int U R Psi dS`` (F = dE/ddelta for the smooth model).
     shear_delta : float
         The transverse-shear depth correction (``shellbvp.thickness``).
     ring_force, cap_force : float
         Axial force of the ring at Sc (jump of Q) and of the pressure on the cap;
         ``force = ring_force + cap_force``.  For ``contact="paper"`` the ring force is ~0.
-    ring_force_inner : float
-        The ring force at the first edge of a configuration with two (else 0).
-    edge_forces : list of float
-        Normal ring force of every edge.
+    ring_force_inner, edge_forces : float, list of float
+        The ring force at the first edge of a configuration with two (else 0); the normal ring
+        force of every edge.
     pressure : float
         The pressure below the shell (``p R_L/(mu H)``): the scene's, or under volume control
         (``Scene.sealed``) the one that holds the enclosed volume.
@@ -206,16 +212,13 @@ class Solution:
         where the energy loses convexity at the contact edge and the branch ends.
     legendre_min, legendre_min_S : float
         The smallest such determinant over the free shell, and where.
-    contact_edge : str
-        The edge conditions in force at Sc (``shellbvp.corner``).
-    edge_jump_ls, edge_jump_ks : float
-        The jumps of lambda_s and kappa_s across the contact edge.
-    penetration : float
-        Largest height of the free shell above the indenter's surface (> 0: it passes
-        through the indenter).
-    wall_gap : float
-        Smallest distance of the free shell above the tip's end from the indenter's
-        cylinder (< 0: through it).
+    contact_edge, edge_jump_ls, edge_jump_ks : str, float, float
+        The edge conditions in force at Sc (``shellbvp.corner``); the jumps of lambda_s and
+        kappa_s across the contact edge.
+    penetration, wall_gap : float
+        Largest height of the free shell above the indenter's surface (> 0: it passes through
+        the indenter); smallest distance of the free shell above the tip's end from the
+        indenter's cylinder (< 0: through it).
     tip_end_margin : float
         How far the last contact on the tip is from the tip's end, in the tip's angle
         (< 0: past it).
@@ -224,11 +227,10 @@ class Solution:
     curvature_excess : float
         A line contact's kappa_s beyond the indenter's (> 0: the shell would cut into it).
     pole_clearance : float
-        A lifted pole's height above the tip (set by the touch-down search).
-    valid : bool
-        pressure_min >= 0, ring_force >= 0, no penetration, contact on the tip.
-    flags : list of str
-        Why the state is not valid (empty when valid).
+        A lifted pole's height above the tip (computed on demand by the touch-down search).
+    valid, flags : bool, list of str
+        pressure_min >= 0, ring_force >= 0, no penetration, contact on the tip; why the state
+        is not valid (empty when valid).
     force_defect : float
         ``max abs(F(S) - F)`` over the free region (F is a first integral there).
     past_tip_end : bool
@@ -334,8 +336,7 @@ class Solution:
         return {k: getattr(self, k) for k in ("delta", "force", "energy", "pressure_min", "Sc")}
 
     def with_(self, **fields) -> Solution:
-        """A copy of this state with ``fields`` replaced (only declared fields; the state itself
-        is never written)."""
+        """A copy of this state with ``fields`` replaced (only declared fields)."""
         return dataclasses.replace(self, **fields)
 
     # -- fields over S ------------------------------------------------------------------
@@ -478,9 +479,8 @@ def inadmissible(res, reason) -> Solution:
 
 
 def cached(sol, name, compute):
-    """``sol``'s number ``name``, computed by ``compute(sol)`` where it is NaN and kept on ``sol``
-    (a number read from the state on demand, for speed: ``pole_clearance``).  The one write into
-    a built state: it adds what the state already determines."""
+    """``sol`` with its number ``name`` computed by ``compute(sol)`` where it is NaN, kept on ``sol``:
+    the one write into a built state, of what it already determines (for speed: ``pole_clearance``)."""
     if math.isnan(getattr(sol, name)):
         object.__setattr__(sol, name, compute(sol))
     return sol
