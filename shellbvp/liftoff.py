@@ -44,8 +44,8 @@ from .solution import (
 
 __all__ = ["solve_liftoff", "solve_liftoff_from", "make_liftoff_system", "liftoff_guess_from_cap",
            "liftoff_warm_guess", "liftoff_state", "valid_liftoff_state", "lift_off_suspected",
-           "replace_invalid_cap", "lifted_replacement", "pole_clearance", "split_state_from", "moved_guess", "lifted_again",
-           "split_again", "cap_lifted_off", "searched_lifted"]
+           "replace_invalid_cap", "lifted_replacement", "pole_clearance", "split_state_from", "moved_guess",
+           "lifted_again", "split_again", "cap_lifted_off", "searched_lifted"]
 
 
 def searched_lifted() -> tuple:

@@ -309,7 +309,8 @@ def _add_switch(builder, st, best, frm, to, k1, k2, criterion):
 
 #: How a switch criterion is measured on a configuration of each family (``Switch.measured_on``):
 #: ``state_at(row, name, settings)``, its state at a recorded point's depth (``row``: the point's
-#: :class:`~shellbvp.recorder.Row`; None if there is none), and ``solved_at(scene, name, delta, near, settings)``, its state at another depth from a
-#: neighbour.  Every switch is measured on a configuration of one of these families (a test checks it).
+#: :class:`~shellbvp.recorder.Row`; None if there is none), and ``solved_at(scene, name, delta,
+#: near, settings)``, its state at another depth from a neighbour.  Every switch is measured on a
+#: configuration of one of these families (a test checks it).
 MEASURED = {"cap": (cap_state_at, cap_solved_at), "lifted": (line_state_at, lifted_solved_at),
             "wall": (wall_state_at, wall_solved_at)}
