@@ -166,6 +166,6 @@ def closed_again(guess, control, value, *, topology, tol, max_nodes, eps, bc_tol
     if not (res.success and res.valid):
         return None
     if estimate_error:
-        richardson_error(res.system, res, tol, bc_tol)
+        res = richardson_error(res.system, res, tol, bc_tol)
     return res
 

@@ -39,7 +39,7 @@ from .lifted_ends import (
     lifted_pole_fold_reason,
     lifted_state_at,
 )
-from .liftoff import lift_off_suspected, replace_invalid_cap
+from .liftoff import lift_off_suspected, lifted_replacement
 from .recorder import Recorder
 from .solution import Solution, default_eps
 from .bounds import check_delta, check_tol
@@ -256,11 +256,12 @@ class CurveRun:
 
     def _accept(self, sol, key):
         """(Stop or None, the recorded state or None) for a leg's state ``sol``."""
-        shown = self.recorder.estimated(self.branch.shown(sol))
+        shown, cap, line = self.branch.shown(sol)
+        shown = self.recorder.estimated(shown)
         end = self.branch.end
         if end and self.settings.mode != "adaptive":  # requested depths only
             return Stop(end, complete=True), None
-        self.recorder.record(shown, key)
+        self.recorder.record(shown, key, cap=cap, line=line)
         self.branch.last_shown = shown
         return (Stop(end, complete=True) if end else None), shown
 
@@ -364,20 +365,25 @@ class _Branch:
         self.last_shown = None  # the state recorded last
         self.end = None  # the stop reason where the followed branch ends physically
         self.end_searched_from = None  # the lifted state from which that end was last searched
+        self.wall_from = None  # (the first wall state of a wall leg, the cap past the tip's end it was found from)
 
-    def shown(self, sol: Solution) -> Solution:
-        """The state the curve records at ``sol``'s depth: ``sol``, or the configuration that
-        replaces it there."""
+    def shown(self, sol: Solution) -> tuple:
+        """(the state the curve records at ``sol``'s depth, the single cap it replaces or None, the
+        line converged at its depth beside a split state or None): ``sol``, or the configuration that
+        replaces it there.  No state holds another: the curve keeps the cap and the line beside the
+        state it records (its switches are located from them)."""
         st = self.settings
+        cap = self.wall_from[1] if self.wall_from is not None and self.wall_from[0] is sol else None
         if st.topology != "auto":
-            return sol
+            return sol, cap, None
         kw = dict(tol=st.tol, max_nodes=st.max_nodes, bc_tol=st.bc_tol)
-        shown = sol
+        shown, line = sol, None
         if sol.scene.contact_model.variational:  # the lifted-pole and split configurations exist
             last = self.last_shown  # the point computed before this one
-            shown = replace_invalid_cap(sol, previous=self.last_liftoff, before=self.liftoff_before, last=last,
-                                        **kw)
-            if shown is not sol:
+            shown, replaced, line = lifted_replacement(sol, previous=self.last_liftoff, before=self.liftoff_before,
+                                                       last=last, **kw)
+            if replaced:
+                cap = sol
                 self.liftoff_before, self.last_liftoff = self.last_liftoff, shown
             elif lift_off_suspected(sol) and self.last_liftoff is not None and sol.delta > self.last_liftoff.delta \
                     and self.end_searched_from is not self.last_liftoff:
@@ -387,35 +393,34 @@ class _Branch:
                 end = lifted_pole_branch_end(self.last_liftoff, self.liftoff_before, **kw)
                 if end is not None and end.delta < sol.delta:
                     self.end = lifted_pole_end_reason(end)
-                    return end
+                    return end, None, None
                 if end is None:
-                    shown = self._before_fold(sol, kw)
+                    shown, cap = self._before_fold(shown, kw)
         if is_single_cap(shown) and not edge_model(shown).held_at_tip_end and wall_contact_suspected(shown):
             wall = None
             if self.last_wall is not None:
                 wall = best_wall_state(self.last_wall, control="delta", value=shown.delta, **kw)
             wall = wall or best_wall_state(shown, **kw)
             if wall is not None:
-                wall.cap_solution = shown
+                cap = shown
                 self.last_wall = shown = wall
-        return shown
+        return shown, cap, line
 
     def _before_fold(self, cap, kw):
         """Where no lifted state was found at the invalid ``cap``'s depth: has the lifted-pole
         branch turned back in delta (a fold) before it?  Then the fold, recorded as the curve's
         physical end (the shell snaps there); if the branch reaches this depth (near a fold the
-        warm starts of :func:`replace_invalid_cap` miss it), its state here, replacing the cap;
-        else the cap."""
+        warm starts of :func:`lifted_replacement` miss it), its state here, replacing the cap;
+        else the cap.  Returns (that state, the cap it replaces or None)."""
         last, before = self.last_liftoff, self.liftoff_before
         # followed one curve step past this depth at most
         fold, on_way = lifted_pole_fold(last, before, delta_limit=2 * cap.delta - last.delta, **kw)
         if fold is not None and fold.delta < cap.delta:
             self.end = lifted_pole_fold_reason(fold)
-            return fold
+            return fold, None
         lifted = lifted_state_at(cap.delta, on_way, fold, **kw)
         if lifted is None:
-            return cap
-        lifted.cap_state = cap.summary()
-        lifted.cap_solution = cap
+            return cap, None
+        lifted = lifted.with_(cap_state=cap.summary())
         self.liftoff_before, self.last_liftoff = last, lifted
-        return lifted
+        return lifted, cap

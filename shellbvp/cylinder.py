@@ -233,8 +233,7 @@ def solve_chain_from(sysm, guess, *, tol=1e-6, max_nodes=10000, bc_tol=1e-10, ma
     with np.errstate(all="ignore"):
         bvp = sysm.solve(x, y, p, tol=tol, bc_tol=bc_tol, max_nodes=max_nodes, max_jacobians=max_jacobians)
         res = diagnose(sysm, bvp, tol)
-    res.wall_time = time.perf_counter() - t0
-    return res
+    return res.with_(wall_time=time.perf_counter() - t0)
 
 
 def _control_of(start, control, value):
@@ -265,9 +264,8 @@ def wall_state(start: Solution, topology: str, *, control=None, value=None, tol=
         res = failure(5, f"no guess for {topology} from a {start.topology} state", scene=sysm.scene,
                       control=None, value=None, topology=topology)
     elif res.success and estimate_error:
-        richardson_error(sysm, res, tol, bc_tol)
-    res.wall_time = time.perf_counter() - t0
-    return res
+        res = richardson_error(sysm, res, tol, bc_tol)
+    return res.with_(wall_time=time.perf_counter() - t0)
 
 
 def _neighbours(topology):
@@ -302,8 +300,7 @@ def best_wall_state(start: Solution, *, control=None, value=None, tol=1e-6, max_
     if not valid:
         return None
     best = min(valid, key=lambda r: r.energy)
-    best.candidates = {r.topology: r.energy for r in valid}
-    return best
+    return best.with_(candidates={r.topology: r.energy for r in valid})
 
 
 def wall_again(guess, control, value, *, topology, tol, max_nodes, eps, bc_tol, estimate_error):
@@ -327,15 +324,12 @@ def cap_onto_wall(cap, topology, kw):
     if not (cap.success or passed_tip_end(cap)):
         return cap
     if topology in WALL_TOPOLOGIES:
-        alt = wall_state(cap, topology, **kw)
-        alt.cap_solution = cap
-        return alt
+        return wall_state(cap, topology, **kw)
     if not wall_contact_suspected(cap):
         return cap
     tried = []
     alt = best_wall_state(cap, tried=tried, **kw)
     if alt is None:
-        cap.flags = list(cap.flags) + ["no valid contact with the indenter's cylinder (" + "; ".join(tried) + ")"]
-        return cap
-    alt.cap_solution = cap
+        return cap.with_(flags=list(cap.flags) + ["no valid contact with the indenter's cylinder (" + "; ".join(tried)
+                                                  + ")"])
     return alt

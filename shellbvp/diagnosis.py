@@ -15,7 +15,7 @@ import math
 import numpy as np
 
 from .chain import FREE_STATES, ContactPole, Edge, FreePole, Line, PointPole, Seam, TipEnd
-from .solution import STATE_NUMBERS, Solution, penetration, set_status, wall_gap
+from .solution import STATE_NUMBERS, Solution, penetration, run_status, wall_gap
 from .thickness import shear_delta
 
 __all__ = ["diagnose", "as_failure"]
@@ -148,8 +148,9 @@ def diagnose(sysm, bvp, tol, converged_note: str = "", result: type = Solution) 
                else ya[sysm.rows(0)][_LS] if isinstance(first, FreePole) else nan)
     edges = _edges(sysm)
     S_edges = [sysm.S_point(pt, p) for pt, _, _ in edges] or [0.0]
-    res = result(
-        topology=sysm.topology, status=int(bvp.status), message=bvp.message, x=bvp.x, y=bvp.y,
+    # the state's fields, gathered here and built into one Solution at the end
+    res = dict(
+        topology=sysm.topology, x=bvp.x, y=bvp.y,
         p=p if p is not None else np.empty(0), sol=bvp.sol,
         rms_residuals=bvp.rms_residuals, tol=tol, niter=int(bvp.niter), nodes=int(bvp.x.size),
         max_residual=float(np.max(bvp.rms_residuals)) if bvp.rms_residuals.size else nan,
@@ -159,9 +160,10 @@ def diagnose(sysm, bvp, tol, converged_note: str = "", result: type = Solution) 
         control=sysm.control, scene=sysm.scene, system=sysm,
         z_tip=sysm.pole_height - float(delta), pressure=sysm.pressure,
     )
+    z_tip = res["z_tip"]
     tip_end = next((j for j in sysm.junctions if isinstance(j, TipEnd)), None)
     if tip_end is not None:
-        res.S_end = sysm.S_point(sysm.regions[tip_end.k].end, p)
+        res["S_end"] = sysm.S_point(sysm.regions[tip_end.k].end, p)
     flags = []
     finite = bool(np.all(np.isfinite(bvp.y)) and (p is None or np.all(np.isfinite(p))) and math.isfinite(force))
     if not finite:
@@ -177,13 +179,12 @@ def diagnose(sysm, bvp, tol, converged_note: str = "", result: type = Solution) 
             flags.append("non-positive stretch")
         if delta < 0:
             flags.append(f"collapsed state with delta = {delta:.3g} < 0")
-    set_status(res, bvp, flags, converged_note)
     if not finite:
-        res.set(energy=nan, shear_delta=nan, pressure_min=nan, penetration=nan, force_defect=nan, edge_legendre=nan,
-                legendre_min=nan, legendre_min_S=nan, edge_jump_ls=nan, edge_jump_ks=nan,
-                contact_edge=_edge_model(sysm),
-                ring_force=nan, ring_force_inner=nan, cap_force=nan, edge_forces=[], valid=False, flags=flags)
-        return _without_iterate_numbers(res)
+        res.update(run_status(bvp, flags, converged_note), energy=nan, shear_delta=nan, pressure_min=nan,
+                   penetration=nan, force_defect=nan, edge_legendre=nan, legendre_min=nan, legendre_min_S=nan,
+                   edge_jump_ls=nan, edge_jump_ks=nan, contact_edge=_edge_model(sysm),
+                   ring_force=nan, ring_force_inner=nan, cap_force=nan, edge_forces=[], valid=False, flags=flags)
+        return _built(result, res)
 
     t = _nodes_and_midpoints(bvp.x)  # from 0 to 1: the regions' ends
     y_t = bvp.sol(t)
@@ -195,37 +196,37 @@ def diagnose(sysm, bvp, tol, converged_note: str = "", result: type = Solution) 
         fi, fo = ends[inner][1], ends[outer][0]
         axial.append(2 * np.pi * float(fo["axial_force_2pi"] - fi["axial_force_2pi"]))
         normal.append(-2 * np.pi * float(fo["r"] * fo["Q"] - fi["r"] * fi["Q"]))
-    res.ring_force = axial[-1] if axial else float(force)  # no edge: a point force
-    res.ring_force_inner = axial[0] if len(axial) > 1 else 0.0
-    res.edge_forces = normal
-    res.cap_force = float(force) - sum(axial) if axial else 0.0
+    res["ring_force"] = axial[-1] if axial else float(force)  # no edge: a point force
+    res["ring_force_inner"] = axial[0] if len(axial) > 1 else 0.0
+    res["edge_forces"] = normal
+    res["cap_force"] = float(force) - sum(axial) if axial else 0.0
     contact = [(k, f) for k, _, f in parts if sysm.regions[k].kind != "free"]
-    res.pressure_min = min((float(np.min(f["P"])) for _, f in contact), default=nan)
+    res["pressure_min"] = min((float(np.min(f["P"])) for _, f in contact), default=nan)
     free = [(k, f) for k, _, f in parts if sysm.regions[k].kind == "free"]
     defect = 0.0
     for k, f in free:
         G = 2 * np.pi * f["axial_force_2pi"]
         ref = 0.0 if (k == 0 and isinstance(first, FreePole)) else G[0]
         defect = max(defect, float(np.max(np.abs(G - ref))))
-    res.force_defect = defect
+    res["force_defect"] = defect
     below = set(_halves(sysm)[1]) if len(_halves(sysm)) > 1 else set()  # the half on the substrate
-    res.penetration = max(float(np.max(f["z"])) - sysm.pole_height if k in below
-                          else penetration(sysm, f["r"], f["z"], res.z_tip) for k, f in free)
-    res.wall_gap = min(wall_gap(sysm, f["r"], f["z"], res.z_tip) for k, f in free if k not in below)
+    res["penetration"] = through = max(float(np.max(f["z"])) - sysm.pole_height if k in below
+                                       else penetration(sysm, f["r"], f["z"], z_tip) for k, f in free)
+    res["wall_gap"] = min(wall_gap(sysm, f["r"], f["z"], z_tip) for k, f in free if k not in below)
     last = len(sysm.regions) - 1
     t_leg = np.array([0.0, 0.5])
     leg = sysm.kernels.active.free_legendre(sysm.S(last, t_leg, p), bvp.sol(t_leg)[sysm.rows(last)], par)[0]
-    res.edge_legendre = float(leg[0] / leg[1]) if leg[1] != 0 else nan
-    res.legendre_min, res.legendre_min_S = _legendre_min(sysm, t, y_t, p)
-    res.contact_edge = _edge_model(sysm)
-    res.edge_jump_ls, res.edge_jump_ks = _edge_jumps(sysm, ends)
-    res.energy = sysm.energy(bvp.sol, bvp.x, p)
-    res.shear_delta = _shear_delta(sysm, parts, edges, ends) if sysm.scene.transverse_shear else 0.0
+    res["edge_legendre"] = float(leg[0] / leg[1]) if leg[1] != 0 else nan
+    res["legendre_min"], res["legendre_min_S"] = legendre = _legendre_min(sysm, t, y_t, p)
+    res["contact_edge"] = _edge_model(sysm)
+    res["edge_jump_ls"], res["edge_jump_ks"] = _edge_jumps(sysm, ends)
+    res["energy"] = sysm.energy(bvp.sol, bvp.x, p)
+    res["shear_delta"] = _shear_delta(sysm, parts, edges, ends) if sysm.scene.transverse_shear else 0.0
 
     admissible, vflags = [], []
     omega_max = sysm.scene.tip_omega_max
     on_tip = [float(np.max(f["omega"])) for k, f in contact if sysm.regions[k].kind == "contact"]
-    res.tip_end_margin = omega_max - max(on_tip) if on_tip else float("nan")  # < 0: past the tip's end
+    res["tip_end_margin"] = omega_max - max(on_tip) if on_tip else float("nan")  # < 0: past the tip's end
     past_end = False
     for k, f in contact:
         lo, hi = float(np.min(f["omega"])), float(np.max(f["omega"]))
@@ -243,9 +244,9 @@ def diagnose(sysm, bvp, tol, converged_note: str = "", result: type = Solution) 
             if j.on == "cylinder" and w < omega_max * (1 - 1e-9):
                 admissible.append("the contact line on the cylinder runs back onto the tip")
     if admissible and bvp.status == 0:
-        set_status(res, bvp, flags + admissible, converged_note)
         flags = flags + admissible
-        res.past_tip_end = past_end  # a reason of its status 4, for the callers that go on on the cylinder
+        res["past_tip_end"] = past_end  # a reason of its status 4, for the callers that go on on the cylinder
+    res.update(run_status(bvp, flags, converged_note))
     if isinstance(first, PointPole) and force < 0:
         vflags.append(f"negative point force ({force:.3g})")
     scale = 10 * tol * (1 + abs(force))
@@ -256,12 +257,12 @@ def diagnose(sysm, bvp, tol, converged_note: str = "", result: type = Solution) 
     for (pt, _, _), N in zip(edges, normal):
         if N < -scale:
             vflags.append(f"negative ring force ({N:.3g}) at the contact edge {pt.name}")
-    if res.legendre_min < 0:
+    if legendre[0] < 0:
         vflags.append(f"the energy is not convex in (lambda_s, kappa_s) in the free region (Legendre "
-                      f"determinant {res.legendre_min:.3g} of its median at S = {res.legendre_min_S:.4g}): "
+                      f"determinant {legendre[0]:.3g} of its median at S = {legendre[1]:.4g}): "
                       f"not an energy minimum")
-    if res.penetration > 10 * tol:
-        vflags.append(f"the free shell passes through the indenter (by {res.penetration:.3g})")
+    if through > 10 * tol:
+        vflags.append(f"the free shell passes through the indenter (by {through:.3g})")
     for j in sysm.junctions:
         if isinstance(j, Line):
             # touching on a circle, the shell must not bend more tightly than the indenter there
@@ -269,14 +270,13 @@ def diagnose(sysm, bvp, tol, converged_note: str = "", result: type = Solution) 
             S = sysm.S_point(sysm.regions[j.k].end, p)
             yin = yb[sysm.rows(j.k)]
             on = _at(sysm, j.on, S, np.array([q[j.chi], yin[_LS]]))
-            res.curvature_excess = float(yin[FREE_STATES.index("ks")] - on["kappa_s"][0])
-            if res.curvature_excess > 10 * tol * max(1.0, abs(float(on["kappa_s"][0]))):
+            res["curvature_excess"] = excess = float(yin[FREE_STATES.index("ks")] - on["kappa_s"][0])
+            if excess > 10 * tol * max(1.0, abs(float(on["kappa_s"][0]))):
                 vflags.append(f"the shell bends more tightly than the indenter at the contact line "
-                              f"(kappa_s exceeds the indenter's by {res.curvature_excess:.3g}): the contact is "
+                              f"(kappa_s exceeds the indenter's by {excess:.3g}): the contact is "
                               f"{'a band' if j.on == 'cylinder' else 'an annulus'}")
-    res.flags = flags + vflags
-    res.valid = res.success and not vflags
-    return _without_iterate_numbers(res)
+    res.update(flags=flags + vflags, valid=res["success"] and not vflags)
+    return _built(result, res)
 
 
 def _halves(sysm) -> list:
@@ -287,31 +287,35 @@ def _halves(sysm) -> list:
     return [list(range(n))] if seam is None else [list(range(seam.ku + 1)), list(range(seam.ku + 1, n))]
 
 
+def _built(result, fields):
+    """The one Solution (``result``: the class) of a diagnosis, built from its ``fields``."""
+    return _without_iterate_numbers(result(**fields))
+
+
 def _without_iterate_numbers(res):
+    """``res``, or where its run did not converge, ``res`` with the state's numbers NaN but the
+    prescribed one (as given)."""
     if res.status in (0, 4):  # converged (admissible or not)
         return res
     prescribed = res.control  # the prescribed delta, lambda0 or force is known all the same
-    for key in STATE_NUMBERS:
-        if key != prescribed:
-            setattr(res, key, float("nan"))
+    nan = float("nan")
+    out = {key: nan for key in STATE_NUMBERS if key != prescribed}
     if prescribed in STATE_NUMBERS and res.system is not None:
-        setattr(res, prescribed, float(res.system.value))  # as given (the iterate's force is not it)
-    res.edge_forces = [float("nan")] * len(res.edge_forces)  # per-edge lists: as many NaN as edges
-    res.edge_S = [float("nan")] * len(res.edge_S)
+        out[prescribed] = float(res.system.value)  # as given (the iterate's force is not it)
+    out.update(edge_forces=[nan] * len(res.edge_forces), edge_S=[nan] * len(res.edge_S), valid=False,
+               # the tip's height follows from delta: known only where delta is prescribed
+               z_tip=res.z_tip if prescribed == "delta" else nan)  # per-edge lists: as many NaN as edges
     if res.system is not None and res.system.volume_control:  # the pressure was an unknown
-        res.pressure = float("nan")
-    # the tip's height follows from delta: known only where delta is prescribed
-    res.z_tip = res.z_tip if prescribed == "delta" else float("nan")
-    res.valid = False
-    return res
+        out["pressure"] = nan
+    return res.with_(**out)
 
 
 def as_failure(res, status, message):
-    """``res`` (a diagnosed Solution) turned into a failure with ``status`` (1, 2, 3 or 5) and
+    """``res`` (a diagnosed Solution) as a failure with ``status`` (1, 2, 3 or 5) and
     ``message``: the state's numbers NaN as for any run that did not converge (a converged
     but inadmissible state that stands for a failed search must not keep its numbers)."""
     if status in (0, 4):
         raise ValueError(f"status must be that of a failure (1, 2, 3 or 5); got {status}")
-    res.status, res.message, res.success = status, message, False
-    res.force_error = res.delta_error = float("nan")
-    return _without_iterate_numbers(res)
+    nan = float("nan")
+    return _without_iterate_numbers(res.with_(status=status, message=message, success=False, force_error=nan,
+                                              delta_error=nan))

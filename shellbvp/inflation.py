@@ -29,9 +29,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from .chain import Chain, ChainBVP, FreePole, Point, Region, Rim
-from .diagnosis import diagnose
+from .diagnosis import as_failure, diagnose
 from .march import Steps, march
-from .solution import Solution, attach_tip_table
+from .solution import Solution, attach_tip_table, state_class
 
 __all__ = ["inflate", "InflatedState", "inflated_chain", "inflated_pole_rise", "start_shape", "system_parameters",
            "enclosed_volume", "InflatedStart", "INFLATED_FIELDS", "inflated_start"]
@@ -44,7 +44,7 @@ TOL = 1e-8
 _MAX_NODES = 50000
 
 
-@dataclass(eq=False, repr=False, slots=True)
+@state_class
 class InflatedState(Solution):
     """The shell under its pressure before the indenter touches it: a :class:`Solution`
     of topology ``"inflated"`` with the numbers that fix where a curve starts."""
@@ -171,32 +171,29 @@ def inflate(scene, tol: float = TOL, max_nodes: int = _MAX_NODES, *, start: Infl
                   too_small=lambda s, u: abs(s) < 1e-6 * max(1.0, abs(target)))
     m = march(0.0, target, solve_at, steps, arrived=lambda u: u == target)
     if not m.reached:
-        out = m.failed if m.last is None else m.last
-        out.success, out.status = False, 5
-        out.message = (f"the inflated state was not reached: continuation in the pressure stalled at "
-                       f"p = {m.at:.4g} of {target:.4g} ({m.failed.message})")
+        out = as_failure(m.failed if m.last is None else m.last, 5,
+                         f"the inflated state was not reached: continuation in the pressure stalled at "
+                         f"p = {m.at:.4g} of {target:.4g} ({m.failed.message})")
         return _finish(out, failed=True)
     return _finish(m.last)
 
 
 def _finish(res, failed=False):
     """The inflated state's own numbers (from its system, ``res.system``), NaN where it failed."""
-    res.topology = "inflated"
     nan = float("nan")
     if failed or not res.success:
-        res.set(pole_rise=nan, pole_stretch=nan, volume_change=nan, rim_hoop_tension=nan)
-        return res
+        return res.with_(topology="inflated", pole_rise=nan, pole_stretch=nan, volume_change=nan, rim_hoop_tension=nan)
     sysm = res.system
     zeta = sysm.S_point(sysm.regions[0].start, None)
     lt, phiS, ls, ks, rQ, z = res.y[:, 0]
     Z0 = float(sysm.model.reference_shell(0.0, sysm.par)["Z"])
     # z(zeta) - z(0) = Int_0^zeta psi sin(phi) dS ~ psi phiS zeta^2/2 (phi ~ phiS S near the pole)
-    res.pole_rise = float(z - ls * sysm.model.reference_shell(zeta, sysm.par)["R"] / zeta * phiS * zeta**2 / 2) - Z0
-    res.pole_stretch = float(ls)
-    res.volume_change = sysm.volume(res.sol, res.x, None) - sysm.scene.reference_volume()
     rim = sysm.model.free_profile(np.array([sysm.L]), res.y[:, -1:], sysm.par)
-    res.rim_hoop_tension = float(rim["tau_theta"][0])
-    return res
+    return res.with_(
+        topology="inflated",
+        pole_rise=float(z - ls * sysm.model.reference_shell(zeta, sysm.par)["R"] / zeta * phiS * zeta**2 / 2) - Z0,
+        pole_stretch=float(ls), volume_change=sysm.volume(res.sol, res.x, None) - sysm.scene.reference_volume(),
+        rim_hoop_tension=float(rim["tau_theta"][0]))
 
 
 def system_parameters(scene, model=None):

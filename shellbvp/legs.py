@@ -178,7 +178,7 @@ def _wall_leg(scene, branch, st, last_cap, key, *, reason, deltas=None):
             prev = _pinned_state(scene, last_cap, last_cap.delta, st, tried)
         if prev is None:  # not a physical end: a configuration that is missing or not found
             return Stop(f"{reason}; no valid contact with the cylinder ({'; '.join(tried)})")
-        prev.cap_solution = past_end  # the cap past the tip's end: where the switch is located from
+        branch.wall_from = (prev, past_end)  # the cap past the tip's end: where the switch is located from
         branch.last_wall = prev
         if targets is None or any(abs(prev.delta - t) < 1e-12 for t in targets):  # (a requested depth)
             key += 1

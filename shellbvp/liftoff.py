@@ -32,11 +32,11 @@ from .cylinder import solve_chain_from, transfer_guess
 from .pointload import solve_point_load
 from .solution import (
     RESIDUAL_ORDER,
-    STATUS_MESSAGES,
     Solution,
     attach_tip_table,
     default_eps,
     finished,
+    inadmissible,
     richardson_error,
     secant_ratio,
     warm_mesh,
@@ -44,8 +44,8 @@ from .solution import (
 
 __all__ = ["solve_liftoff", "solve_liftoff_from", "make_liftoff_system", "liftoff_guess_from_cap",
            "liftoff_warm_guess", "liftoff_state", "valid_liftoff_state", "lift_off_suspected",
-           "replace_invalid_cap", "pole_clearance", "split_state_from", "moved_guess", "lifted_again",
-           "split_again", "cap_lifted_off", "searched_lifted"]
+           "replace_invalid_cap", "lifted_replacement", "pole_clearance", "split_state_from", "moved_guess",
+           "lifted_again", "split_again", "cap_lifted_off", "searched_lifted"]
 
 
 def searched_lifted() -> tuple:
@@ -147,9 +147,8 @@ def solve_liftoff(scene, topology, *, delta=None, force=None, lambda0=None, gues
         guess = liftoff_warm_guess(sysm, guess)
     res = solve_liftoff_from(sysm, guess, tol=tol, max_nodes=max_nodes, bc_tol=bc_tol)
     if res.success and estimate_error:
-        richardson_error(sysm, res, tol, bc_tol)
-    res.wall_time = time.perf_counter() - t0
-    return res
+        res = richardson_error(sysm, res, tol, bc_tol)
+    return res.with_(wall_time=time.perf_counter() - t0)
 
 
 #: One run of a lift-off system from ``(x, y, p)``, diagnosed (the same for every chain).
@@ -231,9 +230,8 @@ def liftoff_state(cap: Solution, topology: str, *, tol=1e-6, max_nodes=10000, bc
     closed = [r for r in tries if _closed_at_pole(r)]
     res = good[0] if good else (closed[0] if closed else tries[-1])
     if _closed_at_pole(res):
-        res.status, res.success, res.valid = 4, False, False
-        res.message = (f"{STATUS_MESSAGES[4]}: the annulus reaches the pole (S1/S2 = "
-                       f"{math.exp(res.p[0] - res.p[1]):.2g}): the state is the single cap")
+        res = inadmissible(res, f"the annulus reaches the pole (S1/S2 = {math.exp(res.p[0] - res.p[1]):.2g}): "
+                                f"the state is the single cap")
     return res
 
 
@@ -270,7 +268,8 @@ def _solve_annulus(sysm, guess, *, tol, max_nodes, bc_tol):
 
 def valid_liftoff_state(cap: Solution, *, tol=1e-6, max_nodes=10000, bc_tol=1e-10, previous=None, before=None,
                         last=None):
-    """A valid line or annular state where the cap is invalid; (state or None, what was tried).
+    """A valid line or annular state where the cap is invalid: (state or None, what was tried,
+    the line converged at a split state's depth or None, :func:`_line_beside`).
 
     A contact radius below ``POINT_LIMIT_SC`` is taken as its point-load limit
     (exponentially close; a line that small strains double precision in its inner cap).
@@ -283,7 +282,7 @@ def valid_liftoff_state(cap: Solution, *, tol=1e-6, max_nodes=10000, bc_tol=1e-1
     if cap.Sc < POINT_LIMIT_SC and cap.control in ("delta", "arclength"):
         res = solve_point_load(cap.scene, cap.delta, tol=tol, max_nodes=max_nodes, guess=cap, bc_tol=bc_tol)
         if res.success and res.valid:
-            return res, tried
+            return res, tried, None
         tried.append("point load: " + (res.message if not res.success else "; ".join(res.flags)))
     order = searched_lifted()
     if previous is not None and previous.topology in order:
@@ -296,7 +295,7 @@ def valid_liftoff_state(cap: Solution, *, tol=1e-6, max_nodes=10000, bc_tol=1e-1
         res = second_zone_state(cap, tol=tol, max_nodes=max_nodes, bc_tol=bc_tol, previous=previous,
                                 before=before, line=line)
         if res.success and res.valid:
-            return _with_line(res, line)
+            return res
         tried.append(f"{res.topology}: {res.message if not res.success else '; '.join(res.flags)}")
         return None
 
@@ -310,32 +309,30 @@ def valid_liftoff_state(cap: Solution, *, tol=1e-6, max_nodes=10000, bc_tol=1e-1
             split_tried = True
             split = split_here()
             if split is not None:
-                return split, tried
+                return split, tried, _line_beside(line)
         res = liftoff_state(cap, topology, tol=tol, max_nodes=max_nodes, bc_tol=bc_tol, previous=previous,
                             before=before)
         if res.success and res.valid:
-            return res, tried
+            return res, tried, None
         line_too_curved |= configuration(topology).line_contact and res.curvature_excess > 0
         line = res if configuration(topology).line_contact else line
         why = res.message if not res.success else "; ".join(res.flags)
         tried.append(f"{topology}: {why}")
     if split_tried or not _pressed_at_the_pole(cap):
-        return None, tried
+        return None, tried, None
     if OPTIONS.split_rule and not _split_possible(last, line, tol):
         tried.append("cap+line(tip): not tried (the pole was lifted at the previous point and the line here "
                      "keeps it above the tip)")
-        return None, tried
-    return split_here(), tried
+        return None, tried, None
+    split = split_here()
+    return split, tried, (_line_beside(line) if split is not None else None)
 
 
-
-
-def _with_line(split, line):
-    """``split`` with ``line_state``: the (invalid) line converged at its depth, where the switch
-    line -> cap+line(tip) is located from (``switches.line_state_at``), not solved again."""
-    if line is not None and line.success:
-        split.line_state = line
-    return split
+def _line_beside(line):
+    """The (invalid) line converged at a split state's depth, which the caller keeps beside it:
+    the switch line -> cap+line(tip) is located from it (``switches.line_state_at``), not solved
+    again; None where it did not converge."""
+    return line if line is not None and line.success else None
 
 
 def _pole_down(line, tol) -> bool:
@@ -411,8 +408,7 @@ def second_zone_state(cap: Solution, *, tol=1e-6, max_nodes=10000, bc_tol=1e-10,
         res = _continue_in_delta(sysm, previous, before if _near(before, cap, sysm.topology) else None,
                                  cap.delta, tol=tol, max_nodes=max_nodes, bc_tol=bc_tol)
         if res is not None:
-            res.wall_time = time.perf_counter() - t0
-            return res
+            return res.with_(wall_time=time.perf_counter() - t0)
     guesses = []
     if previous is not None and previous.topology == sysm.topology:
         q = dict(zip(previous.system.unknowns, previous.p))
@@ -435,8 +431,7 @@ def second_zone_state(cap: Solution, *, tol=1e-6, max_nodes=10000, bc_tol=1e-10,
         res = _probe_then_solve(sysm, guess, solve_chain_from, **kw)
         if res.success and res.valid:
             break
-    res.wall_time = time.perf_counter() - t0
-    return res
+    return res.with_(wall_time=time.perf_counter() - t0)
 
 
 #: Solves of :func:`_continue_in_delta` at most (each a warm start of a few hundred to a few
@@ -515,23 +510,26 @@ def _probe_then_solve(sysm, guess, solve_from, *, tol, max_nodes, bc_tol):
     return solve_from(sysm, (x, probe.sol(x), probe.p), tol=tol, max_nodes=max_nodes, bc_tol=bc_tol)
 
 
-def replace_invalid_cap(cap: Solution, *, tol=1e-6, max_nodes=10000, bc_tol=1e-10, previous=None, before=None,
-                        last=None):
-    """The state to report for a cap state: itself if it does not pull, else the valid
-    lift-off state (with ``cap_state``/``cap_solution`` kept), else the cap flagged with
-    what was tried.  ``previous``, ``before``: the last two lift-off states of a curve
-    (warm starts, :func:`liftoff_state`); ``last``: the curve's previous point
-    (:func:`valid_liftoff_state`)."""
+def replace_invalid_cap(cap: Solution, **kw) -> Solution:
+    """The state to report for a cap state (:func:`lifted_replacement`'s)."""
+    return lifted_replacement(cap, **kw)[0]
+
+
+def lifted_replacement(cap: Solution, *, tol=1e-6, max_nodes=10000, bc_tol=1e-10, previous=None, before=None,
+                       last=None) -> tuple:
+    """(the state to report for a cap state, whether it replaces the cap, the line converged at
+    its depth beside a split state or None): the cap itself if it does not pull, else the valid
+    lift-off state (with the cap's numbers, ``cap_state``), else the cap flagged with what was
+    tried.  ``previous``, ``before``: the last two lift-off states of a curve (warm starts,
+    :func:`liftoff_state`); ``last``: the curve's previous point (:func:`valid_liftoff_state`)."""
     if not lift_off_suspected(cap):
-        return cap
-    alt, tried = valid_liftoff_state(cap, tol=tol, max_nodes=max_nodes, bc_tol=bc_tol, previous=previous,
-                                     before=before, last=last)
+        return cap, False, None
+    alt, tried, line = valid_liftoff_state(cap, tol=tol, max_nodes=max_nodes, bc_tol=bc_tol, previous=previous,
+                                           before=before, last=last)
     if alt is None:
-        cap.flags = list(cap.flags) + ["no valid lift-off state found (" + "; ".join(tried) + ")"]
-        return cap
-    alt.cap_state = cap.summary()
-    alt.cap_solution = cap
-    return alt
+        return cap.with_(flags=list(cap.flags) + ["no valid lift-off state found (" + "; ".join(tried) + ")"]), \
+            False, None
+    return alt.with_(cap_state=cap.summary()), True, line
 
 
 def _pressed_somewhere(cap):

@@ -76,8 +76,7 @@ def solve_point_load(scene, delta, *, tol=1e-6, max_nodes=10000, guess=None, bc_
         res = _point_run(scene, delta, None, **_crude(kw))
     if not res.success:
         res = _from_smaller_depth(scene, delta, **kw) or res
-    res.wall_time = time.perf_counter() - t0
-    return res
+    return res.with_(wall_time=time.perf_counter() - t0)
 
 
 def _point_run(scene, delta, guess, *, tol, max_nodes, bc_tol):

@@ -12,6 +12,7 @@ from __future__ import annotations
 import logging
 import math
 import time
+from typing import NamedTuple
 
 import numpy as np
 
@@ -23,13 +24,26 @@ from .solution import Solution, calibrated_error, richardson_error
 from .state import solve_from
 from .steps import configuration_key
 
-__all__ = ["Recorder", "RICHARDSON_EVERY"]
+__all__ = ["Recorder", "Row", "RICHARDSON_EVERY"]
 
 log = logging.getLogger(__name__)
 
 #: With ``estimate_error="auto"``, a Richardson estimate at least every this many points
 #: (measured: benchmarks/error_estimates.py).
 RICHARDSON_EVERY = 5
+
+
+class Row(NamedTuple):
+    """A recorded point: its order key along the branch, its file record and flags, its state,
+    and kept beside it (no state holds another) the single cap it replaced and the line
+    converged at its depth beside a split state, where the curve's switches are located from."""
+
+    key: float
+    record: dict
+    flags: str
+    state: Solution
+    cap: Solution | None = None
+    line: Solution | None = None
 
 
 class Recorder:
@@ -50,7 +64,7 @@ class Recorder:
         self.out, self.estimate_error = out, estimate_error
         self.settings = settings
         self.tol = settings.tol
-        self.rows = []  # (order key, row, flags, solution)
+        self.rows = []  # Row: (order key, record, flags, solution, cap, line)
         self.since_richardson = None  # points added since the last Richardson estimate
         self.last_configuration = None
         self.last_accepted = None  # perf_counter() when the last point was accepted
@@ -68,22 +82,22 @@ class Recorder:
                 sol = self._richardson(sol)
                 self.since_richardson = 0
             else:
-                sol.error_method = "calibrated"  # values set by finish(), from the Richardson points
+                sol = sol.with_(error_method="calibrated")  # values set by finish(), from the Richardson points
                 self.since_richardson += 1
             self.last_configuration = configuration
         return sol
 
-    def record(self, sol: Solution, key: float):
-        """Keep ``sol``; ``key`` orders points along the branch."""
-        self.rows.append((key, point_record(sol), "; ".join(sol.flags), sol))
+    def record(self, sol: Solution, key: float, cap: Solution | None = None, line: Solution | None = None):
+        """Keep ``sol`` (and beside it the cap it replaced, the line converged at its depth);
+        ``key`` orders points along the branch."""
+        self.rows.append(Row(key, point_record(sol), "; ".join(sol.flags), sol, cap, line))
         self.last_accepted = time.perf_counter()
 
     def _richardson(self, sol):
         """Richardson estimate of ``sol``; returns the point to record: ``sol``, or, where the
         estimate puts its relative F error above tol, the same state solved again at a tighter
         tolerance (:meth:`_tightened`)."""
-        richardson_error(sol.system, sol, self.tol)
-        sol.error_method = "richardson"
+        sol = richardson_error(sol.system, sol, self.tol).with_(error_method="richardson")
         return self._tightened(sol) if self._above_tol(sol) else sol
 
     def _above_tol(self, sol):
@@ -129,11 +143,8 @@ class Recorder:
         if not (fine.success and fine.valid == sol.valid
                 and configuration_key(fine) == configuration_key(sol)):
             return None
-        richardson_error(fine.system, fine, tol)
-        fine.error_method = "richardson"
-        # what the lift-off and wall searches attached
-        fine.set(cap_state=sol.cap_state, cap_solution=sol.cap_solution, line_state=sol.line_state)
-        return fine
+        # with what the lift-off search attached (the states beside it stay in its row)
+        return richardson_error(fine.system, fine, tol).with_(error_method="richardson", cap_state=sol.cap_state)
 
     def _estimate_calibrated(self, final):
         """Fill the calibrated points' estimates (in branch order, per configuration run).
@@ -142,40 +153,44 @@ class Recorder:
         now: switches are located last) puts a calibrated point at an end of the curve or
         next to another configuration.
         """
-        rows = sorted((r for r in self.rows if r[3].error_method), key=lambda r: r[0])
-        configurations = [configuration_key(r[3]) for r in rows]
+        rows = sorted((r for r in self.rows if r.state.error_method), key=lambda r: r.key)
+        configurations = [configuration_key(r.state) for r in rows]
         if final and not self.out.interrupted:
-            for i, (_, _, _, sol) in enumerate(rows):
+            for i, sol in enumerate([r.state for r in rows]):
                 at_edge = i in (0, len(rows) - 1) or configurations[i - 1] != configurations[i] \
                     or configurations[i + 1] != configurations[i]
                 if sol.error_method == "calibrated" and at_edge:
                     rows[i] = self._replace(rows[i], self._richardson(sol))
         anchors = {}  # configuration -> [(key, force ratio, delta ratio)] of its Richardson points
-        for (key, _, _, sol), conf in zip(rows, configurations):
+        for (key, sol), conf in zip([(r.key, r.state) for r in rows], configurations):
             res = float(sol.max_residual)
             errors = (sol.force_error, sol.delta_error)
             ratios = (errors[0] / res, errors[1] / res) if res > 0 else (math.nan, math.nan)
             if sol.error_method == "richardson" and all(map(math.isfinite, ratios)):
                 anchors.setdefault(conf, []).append((key,) + ratios)
         everywhere = [a for run in anchors.values() for a in run]
-        for (key, _, _, sol), conf in zip(rows, configurations):
+        calibrated = {}  # id of a row -> the row with its state's calibrated estimate (its record updated below)
+        for i, (row, conf) in enumerate(zip(rows, configurations)):
+            sol = row.state
             if sol.error_method == "calibrated":
                 near = anchors.get(conf) or everywhere  # another configuration only while incomplete
-                sol.force_error = calibrated_error(sol.max_residual, key, [(a[0], a[1]) for a in near])
-                sol.delta_error = calibrated_error(sol.max_residual, key, [(a[0], a[2]) for a in near])
+                rows[i] = calibrated[id(row)] = row._replace(state=sol.with_(
+                    force_error=calibrated_error(sol.max_residual, row.key, [(a[0], a[1]) for a in near]),
+                    delta_error=calibrated_error(sol.max_residual, row.key, [(a[0], a[2]) for a in near])))
+        self.rows = [calibrated.get(id(r), r) for r in self.rows]
         if final and not self.out.interrupted:  # calibrated points whose estimate is above tol, as above
-            for row in [r for r in rows if r[3].error_method == "calibrated" and self._above_tol(r[3])]:
-                fine = self._tightened(row[3])
-                if fine is not row[3]:
-                    self._replace(row, fine)
+            for row in [r for r in rows if r.state.error_method == "calibrated" and self._above_tol(r.state)]:
+                self._replace(row, self._tightened(row.state))
         for r in self.rows:
-            r[1].update(force_error=r[3].force_error, delta_error=r[3].delta_error, error_method=r[3].error_method)
+            r.record.update(force_error=r.state.force_error, delta_error=r.state.delta_error,
+                            error_method=r.state.error_method)
 
     def _replace(self, row, sol):
-        """``row`` with ``sol`` as its point (in ``self.rows`` too); the row itself if ``sol`` is its own."""
-        if sol is row[3]:
+        """``row`` with ``sol`` as its point (in ``self.rows`` too; the cap and line beside it kept); the
+        row itself if ``sol`` is its own."""
+        if sol is row.state:
             return row
-        new = (row[0], point_record(sol), "; ".join(sol.flags), sol)
+        new = row._replace(record=point_record(sol), flags="; ".join(sol.flags), state=sol)
         self.rows = [new if r is row else r for r in self.rows]
         return new
 
@@ -186,11 +201,11 @@ class Recorder:
     def finish(self, final: bool = True):
         if self.estimate_error == "auto":
             self._estimate_calibrated(final)
-        rows = sorted(self.rows, key=lambda r: r[0])
-        pts = {k: np.array([r[1][k] for r in rows]) for k in POINT_FIELDS}
+        rows = sorted(self.rows, key=lambda r: r.key)
+        pts = {k: np.array([r.record[k] for r in rows]) for k in POINT_FIELDS}
         pts["valid"] = pts["valid"].astype(bool)
         for k in ("status", "nodes", "niter"):
             pts[k] = pts[k].astype(int) if len(rows) else pts[k]
         self.out.points = pts
-        self.out.flags = [r[2] for r in rows]
-        self.out.solutions = [r[3] for r in rows]
+        self.out.flags = [r.flags for r in rows]
+        self.out.solutions = [r.state for r in rows]

@@ -8,6 +8,7 @@ solve_bvp call, error estimates and the checks against the indenter.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 from dataclasses import dataclass, field
@@ -18,9 +19,9 @@ import numpy as np
 from . import collocation
 from .config import OPTIONS
 
-__all__ = ["STATUS_MESSAGES", "STATE_NUMBERS", "Solution", "failure", "solve_bvp", "set_status", "thin_mesh",
-           "warm_mesh", "secant_ratio",
-           "richardson_error", "finished", "penetration", "wall_gap", "attach_tip_table", "default_eps"]
+__all__ = ["STATUS_MESSAGES", "STATE_NUMBERS", "Solution", "state_class", "failure", "solve_bvp", "run_status",
+           "inadmissible", "cached", "thin_mesh", "warm_mesh", "secant_ratio", "richardson_error", "finished",
+           "penetration", "wall_gap", "attach_tip_table", "default_eps"]
 
 
 #: What each ``Solution.status`` means and what to try: ``{status: message}``.
@@ -140,15 +141,27 @@ def solve_bvp(fun, bc, x, y, p=None, *, fun_jac, bc_jac, max_jacobians=None, ker
                                        f"{xa.size} nodes)")
 
 
+def _refuse(self, name, value=None):
+    raise dataclasses.FrozenInstanceError(f"cannot assign to {name!r}: a state is never written (with_() makes a new one)")
 
-@dataclass(eq=False, repr=False, slots=True)
+
+def state_class(cls):
+    """``cls`` as a frozen dataclass with slots, :class:`Solution` or a subclass with a
+    configuration's own fields: a field set or a name not declared raises ``FrozenInstanceError``
+    (CPython < 3.12 raises TypeError for the latter: a frozen class with slots calls super())."""
+    cls = dataclass(frozen=True, eq=False, repr=False, slots=True)(cls)
+    cls.__setattr__ = cls.__delattr__ = _refuse
+    return cls
+
+
+@state_class
 class Solution:
     """Result of :func:`solve`: every state of every configuration, with fixed fields.
 
-    A field that a configuration does not have keeps its default (NaN for a number); a
-    name that is not a field cannot be set (``AttributeError``).  Built by the one
-    diagnosis of a solve_bvp run (:func:`shellbvp.diagnosis.diagnose`) or, for a search
-    that produced no state, by :func:`failure`.
+    A field that a configuration does not have keeps its default (NaN for a number).  Built
+    once (:func:`shellbvp.diagnosis.diagnose`, or :func:`failure` for a search without a state)
+    and never written (``FrozenInstanceError``): what a later step adds (an error estimate, the
+    wall time, a flag) makes a new state, :meth:`with_`.  No state holds another.
 
     Attributes
     ----------
@@ -170,31 +183,25 @@ class Solution:
     scene, system
         The :class:`~shellbvp.scene.Scene` and the solved ``ChainBVP`` (None for a failure
         without a system).
-    S1 : float
-        Where the contact starts (0 when it reaches the pole; a lifted pole's first edge).
-    edge_S : list of float
-        Every contact edge's S, pole to rim.
+    S1, edge_S : float, list of float
+        Where the contact starts (0 when it reaches the pole; a lifted pole's first edge);
+        every contact edge's S, pole to rim.
     x, y, p, sol, rms_residuals, niter
         solve_bvp's mesh on t in [0, 1], stacked states (8, m) (layout in
         ``shellbvp.chain``), unknown parameters, interpolant, residuals, iterations.
-    tol : float
-        The residual tolerance the state was solved to.
-    nodes : int
-    max_residual : float
-        Largest relative collocation residual.
-    z_tip : float
-        The indenter tip's height.
-    energy : float
-        ``E = 2 pi Int U R Psi dS`` (F = dE/ddelta for the smooth model).
+    tol, nodes, max_residual : float, int, float
+        The residual tolerance the state was solved to, its mesh nodes, and the largest
+        relative collocation residual.
+    z_tip, energy : float
+        The indenter tip's height; ``E = 2 pi Int U R Psi dS`` (F = dE/ddelta for the smooth model).
     shear_delta : float
         The transverse-shear depth correction (``shellbvp.thickness``).
     ring_force, cap_force : float
         Axial force of the ring at Sc (jump of Q) and of the pressure on the cap;
         ``force = ring_force + cap_force``.  For ``contact="paper"`` the ring force is ~0.
-    ring_force_inner : float
-        The ring force at the first edge of a configuration with two (else 0).
-    edge_forces : list of float
-        Normal ring force of every edge.
+    ring_force_inner, edge_forces : float, list of float
+        The ring force at the first edge of a configuration with two (else 0); the normal ring
+        force of every edge.
     pressure : float
         The pressure below the shell (``p R_L/(mu H)``): the scene's, or under volume control
         (``Scene.sealed``) the one that holds the enclosed volume.
@@ -205,16 +212,13 @@ class Solution:
         where the energy loses convexity at the contact edge and the branch ends.
     legendre_min, legendre_min_S : float
         The smallest such determinant over the free shell, and where.
-    contact_edge : str
-        The edge conditions in force at Sc (``shellbvp.corner``).
-    edge_jump_ls, edge_jump_ks : float
-        The jumps of lambda_s and kappa_s across the contact edge.
-    penetration : float
-        Largest height of the free shell above the indenter's surface (> 0: it passes
-        through the indenter).
-    wall_gap : float
-        Smallest distance of the free shell above the tip's end from the indenter's
-        cylinder (< 0: through it).
+    contact_edge, edge_jump_ls, edge_jump_ks : str, float, float
+        The edge conditions in force at Sc (``shellbvp.corner``); the jumps of lambda_s and
+        kappa_s across the contact edge.
+    penetration, wall_gap : float
+        Largest height of the free shell above the indenter's surface (> 0: it passes through
+        the indenter); smallest distance of the free shell above the tip's end from the
+        indenter's cylinder (< 0: through it).
     tip_end_margin : float
         How far the last contact on the tip is from the tip's end, in the tip's angle
         (< 0: past it).
@@ -223,11 +227,10 @@ class Solution:
     curvature_excess : float
         A line contact's kappa_s beyond the indenter's (> 0: the shell would cut into it).
     pole_clearance : float
-        A lifted pole's height above the tip (set by the touch-down search).
-    valid : bool
-        pressure_min >= 0, ring_force >= 0, no penetration, contact on the tip.
-    flags : list of str
-        Why the state is not valid (empty when valid).
+        A lifted pole's height above the tip (computed on demand by the touch-down search).
+    valid, flags : bool, list of str
+        pressure_min >= 0, ring_force >= 0, no penetration, contact on the tip; why the state
+        is not valid (empty when valid).
     force_defect : float
         ``max abs(F(S) - F)`` over the free region (F is a first integral there).
     past_tip_end : bool
@@ -238,10 +241,10 @@ class Solution:
         (``"richardson"``: halved mesh, ``"calibrated"``, or ``""``).
     wall_time : float
         Seconds.
-    cap_solution, cap_state, line_state, candidates
-        What a search that replaced a state attached: the cap state it replaced and a
-        summary of it, the line state tried beside it, the energies of the wall
-        configurations that were compared (None where there was no such search).
+    cap_state, candidates
+        What a search that replaced a state attached: the numbers of the cap state it
+        replaced (:meth:`summary`), the energies of the wall configurations that were
+        compared (None where there was no such search).
 
     Notes
     -----
@@ -319,10 +322,8 @@ class Solution:
     force_error: float = _NAN
     delta_error: float = _NAN
     error_method: str = ""
-    # what a search that replaced this state attached
-    cap_solution: Any = None
+    # what a search that replaced this state attached (numbers, not states)
     cap_state: Any = None
-    line_state: Any = None
     candidates: Any = None
 
     def __repr__(self):
@@ -334,11 +335,9 @@ class Solution:
         """The numbers that a replaced state leaves behind (``cap_state``)."""
         return {k: getattr(self, k) for k in ("delta", "force", "energy", "pressure_min", "Sc")}
 
-    def set(self, **fields):
-        """Set several fields at once (names are checked: only declared fields)."""
-        for name, value in fields.items():
-            setattr(self, name, value)
-        return self
+    def with_(self, **fields) -> Solution:
+        """A copy of this state with ``fields`` replaced (only declared fields)."""
+        return dataclasses.replace(self, **fields)
 
     # -- fields over S ------------------------------------------------------------------
     def profile(self, points_per_interval: int = 1):
@@ -374,7 +373,6 @@ class Solution:
             t = np.unique(np.concatenate([np.linspace(a, b, points_per_interval + 1)
                                           for a, b in zip(t[:-1], t[1:])]))
         return sysm.profile(t, self.sol(t), self.p, self.z_tip)
-
 
 
 def thin_mesh(x, keep_every: int = 3):
@@ -433,7 +431,6 @@ def warm_mesh(sol, tol=None):
     return np.interp(np.linspace(0.0, cum[-1], m + 1), cum, x)  # the ends exactly: x[0] and x[-1]
 
 
-
 #: The numbers of a state; a run that did not converge reports them as NaN, all but the
 #: prescribed one (its ``y``, ``x`` and ``p`` stay: the last iterate, for inspection).
 STATE_NUMBERS = ("delta", "force", "lambda0", "Sc", "S1", "S_end", "energy", "shear_delta", "ring_force", "ring_force_inner",
@@ -449,13 +446,11 @@ def failure(status, message, *, scene, control, value, topology="cap", **fields)
     ``wall_time``, ...)."""
     if status in (0, 4):
         raise ValueError(f"status must be that of a failure (1, 2, 3 or 5); got {status}")
-    res = Solution(status=status, message=message, success=False, valid=False, topology=topology, control=control,
-                   scene=scene, pressure=_NAN if scene.sealed else scene.pressure, **fields)
-    for key in STATE_NUMBERS:  # those whose default is a number (S1 = 0 ...)
-        setattr(res, key, _NAN)
+    numbers = dict.fromkeys(STATE_NUMBERS, _NAN)  # those whose default is a number (S1 = 0 ...)
     if control is not None:
-        setattr(res, control, float(value))
-    return res
+        numbers[control] = float(value)
+    return Solution(status=status, message=message, success=False, valid=False, topology=topology, control=control,
+                    scene=scene, pressure=_NAN if scene.sealed else scene.pressure, **{**fields, **numbers})
 
 
 def passed_tip_end(sol) -> bool:
@@ -465,18 +460,30 @@ def passed_tip_end(sol) -> bool:
     return sol.status == 4 and bool(sol.past_tip_end)
 
 
-def set_status(res, bvp, flags, converged_note=""):
-    """status, message and success of a diagnosed state: a converged run whose state
+def run_status(bvp, flags, converged_note="") -> dict:
+    """``status``, ``message`` and ``success`` of a diagnosed run: a converged run whose state
     breaks an admissibility check (``flags``) gets status 4."""
+    status, message = int(bvp.status), bvp.message
     if bvp.status == 0 and flags:
-        res.status = 4
-        res.message = STATUS_MESSAGES[4] + ": " + "; ".join(flags)
+        status, message = 4, STATUS_MESSAGES[4] + ": " + "; ".join(flags)
     elif bvp.status == 0:
-        res.message = STATUS_MESSAGES[0] + converged_note
-    elif not res.message:
-        res.message = STATUS_MESSAGES.get(bvp.status, "")
-    res.success = res.status == 0
+        message = STATUS_MESSAGES[0] + converged_note
+    elif not message:
+        message = STATUS_MESSAGES.get(bvp.status, "")
+    return dict(status=status, message=message, success=status == 0)
 
+
+def inadmissible(res, reason) -> Solution:
+    """``res`` as a converged but inadmissible state (status 4, not valid): ``reason`` says why."""
+    return res.with_(status=4, success=False, valid=False, message=f"{STATUS_MESSAGES[4]}: {reason}")
+
+
+def cached(sol, name, compute):
+    """``sol`` with its number ``name`` computed by ``compute(sol)`` where it is NaN, kept on ``sol``:
+    the one write into a built state, of what it already determines (for speed: ``pole_clearance``)."""
+    if math.isnan(getattr(sol, name)):
+        object.__setattr__(sol, name, compute(sol))
+    return sol
 
 
 def penetration(sysm, r, z, z_tip):
@@ -498,7 +505,6 @@ def penetration(sysm, r, z, z_tip):
     return float(np.max(depth))
 
 
-
 def wall_gap(sysm, r, z, z_tip):
     """Smallest horizontal distance from the indenter's cylinder ``r = rho A(omega_max)`` of the
     free-shell points above the tip's end (negative: through the wall); inf if none is above.
@@ -517,9 +523,8 @@ def attach_tip_table(sysm):
     sysm.tip_A, sysm.tip_B = shape["A"], shape["B"]
 
 
-
-def richardson_error(sysm, res, tol, bc_tol=1e-10):
-    """Set ``force_error`` and ``delta_error`` by Richardson extrapolation (any topology).
+def richardson_error(sysm, res, tol, bc_tol=1e-10) -> Solution:
+    """``res`` with ``force_error`` and ``delta_error`` by Richardson extrapolation (any topology).
 
     The collocation solution (Lobatto IIIA, order 4) is recomputed on the
     converged mesh with every interval halved, without further refinement
@@ -541,23 +546,18 @@ def richardson_error(sysm, res, tol, bc_tol=1e-10):
             run = sysm.solve(x2, y2, p, tol=tol / 100, bc_tol=bc_tol / 100, max_nodes=x2.size)
             if run.status == 2 or not np.all(np.isfinite(run.y)) \
                     or (run.p is not None and not np.all(np.isfinite(run.p))):
-                res.force_error = res.delta_error = float("nan")
-                res.flags = list(res.flags) + ["error estimate failed (Newton on the halved mesh did not converge)"]
-                return
+                return res.with_(force_error=_NAN, delta_error=_NAN, flags=list(res.flags) + [
+                    "error estimate failed (Newton on the halved mesh did not converge)"])
             fine = run.y, run.p
         force, delta = sysm.end_values(fine[0][:, 0], fine[0][:, -1], fine[1])
-    res.force_error = abs(force - res.force) * 16 / 15
-    res.delta_error = abs(delta - res.delta) * 16 / 15
-
-
+    return res.with_(force_error=abs(force - res.force) * 16 / 15, delta_error=abs(delta - res.delta) * 16 / 15)
 
 
 def finished(res, t0, estimate_error, tol, bc_tol):
     """``res`` with its error estimate (if asked for) and its wall time since ``t0``."""
     if estimate_error:
-        richardson_error(res.system, res, tol, bc_tol)
-    res.wall_time = time.perf_counter() - t0
-    return res
+        res = richardson_error(res.system, res, tol, bc_tol)
+    return res.with_(wall_time=time.perf_counter() - t0)
 
 def calibrated_error(residual, key, anchors):
     """An error estimate without a solve, calibrated against Richardson estimates.

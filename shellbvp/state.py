@@ -206,8 +206,7 @@ def solve_from(sysm, guess, *, tol=1e-6, max_nodes=10000, bc_tol=None):
     bvp = _run_bvp(sysm, guess, tol, max_nodes, bc_tol if bc_tol is not None else 1e-10)
     with np.errstate(all="ignore"):  # diagnostics of a failed run may overflow; flagged instead
         res = diagnose(sysm, bvp, tol)
-    res.wall_time = time.perf_counter() - t0
-    return res
+    return res.with_(wall_time=time.perf_counter() - t0)
 
 
 #: What ``solve(topology=...)`` accepts: "auto" and the configurations that may be asked for (as
@@ -323,9 +322,8 @@ def solve(scene, *, delta=None, lambda0=None, force=None, tol=1e-6, max_nodes=10
     if scene.two_contacts:  # a closed shell on a substrate: its own configuration, from the flat plate's
         res = closed_cold(scene, control, value, solve_half=solve, eps=eps, **kw)
         if res.success and estimate_error:
-            richardson_error(res.system, res, tol, bc_tol)
-        res.wall_time = time.perf_counter() - t0
-        return res
+            res = richardson_error(res.system, res, tol, bc_tol)
+        return res.with_(wall_time=time.perf_counter() - t0)
     if guess is not None:
         sysm = system_like(guess, control, value, eps)
         res = solve_from(sysm, warm_guess(sysm, guess, tol=tol), **kw)
@@ -340,11 +338,10 @@ def solve(scene, *, delta=None, lambda0=None, force=None, tol=1e-6, max_nodes=10
         if is_single_cap(res) and (topology == "auto" or configuration(topology).family == family):
             res = replace(res, topology, kw)
     if res.success and estimate_error:
-        richardson_error(res.system, res, tol, bc_tol)
+        res = richardson_error(res.system, res, tol, bc_tol)
     else:
-        res.force_error = res.delta_error = float("nan")
-    res.wall_time = time.perf_counter() - t0
-    return res
+        res = res.with_(force_error=float("nan"), delta_error=float("nan"))
+    return res.with_(wall_time=time.perf_counter() - t0)
 
 
 _SC_GUESSES = (0.05, 0.2, 0.01, 0.002)

@@ -14,6 +14,7 @@ from .configurations import configuration, is_single_cap, names, switch_between
 from .corner import edge_model, is_corner, limit_estimate
 from .cylinder import wall_state
 from .liftoff import liftoff_state, pole_clearance, solve_liftoff
+from .solution import cached
 from .state import cross_convexity_limit, solve_from, system_like, warm_guess
 from .steps import solve_at_delta, step_nodes
 
@@ -23,11 +24,12 @@ __all__ = ["locate_switches", "locate_corner_switch", "regula_falsi", "cap_of", 
 log = logging.getLogger(__name__)
 
 
-def cap_of(sol):
-    """The single-cap state behind a recorded point (itself, or the cap it replaced)."""
-    if is_single_cap(sol):
-        return sol
-    return sol.cap_solution
+def cap_of(row):
+    """The single-cap state behind a recorded point (its state, or the cap it replaced, which the
+    curve keeps beside it: ``row.cap``)."""
+    if is_single_cap(row.state):
+        return row.state
+    return row.cap
 
 
 def _secant_distance(d, f, last):
@@ -105,22 +107,23 @@ def locate_switches(builder, st):
         sol = cap_at(d, near)
         return (sol, sol.tip_end_margin) if sol.status in (0, 4) else (None, None)
 
-    def state_of(on, s):  # the measured configuration's state at a recorded point's depth
-        return MEASURED[configuration(on).family][0](s, on, st)
+    def state_of(on, row):  # the measured configuration's state at a recorded point's depth
+        return MEASURED[configuration(on).family][0](row, on, st)
 
     def solve_on(on):  # ... and solved at another depth from a neighbour
         solve = MEASURED[configuration(on).family][1]
         return lambda d, near: solve(scene, on, d, near, st)
 
-    for (k1, _, _, s1), (k2, _, _, s2) in zip(rows[:-1], rows[1:]):
-        c1, c2 = cap_of(s1), cap_of(s2)
+    for r1, r2 in zip(rows[:-1], rows[1:]):
+        (k1, s1), (k2, s2) = (r1.key, r1.state), (r2.key, r2.state)
+        c1, c2 = cap_of(r1), cap_of(r2)
         if c1 is not None and c2 is not None and c1.success and c2.success \
                 and edge_model(c1).leads_to(edge_model(c2)) and edge_model(c2).jumps:
             builder.switch_located(locate_corner_switch(c1, c2, st))
             continue
         if s1.valid and s2.valid and edge_model(s1).leads_to(edge_model(s2)) and edge_model(s2).held_at_tip_end:
             # the free cap's edge reaches the tip's end: from the caps either side of it
-            ends = [s1, s2.cap_solution]
+            ends = [s1, r2.cap]
             if ends[1] is not None and ends[1].status in (0, 4) and ends[0].tip_end_margin > 0 > ends[1].tip_end_margin:
                 best = regula_falsi(ends[0].delta, ends[0].tip_end_margin, ends[0], ends[1].delta,
                                      ends[1].tip_end_margin, ends[1], cap_end_at)
@@ -132,7 +135,7 @@ def locate_switches(builder, st):
         if not (s1.valid and s2.valid) or switch is None:
             continue
         on = switch.measured_on
-        ends = [s if s.topology == on else state_of(on, s) for s in (s1, s2)]
+        ends = [r.state if r.state.topology == on else state_of(on, r) for r in (r1, r2)]
         if switch.criteria == ("pole_clearance",):
             ends = [_with_pole_clearance(e) for e in ends]
             if any(e is None for e in ends) or not ends[0].pole_clearance * ends[1].pole_clearance < 0:
@@ -228,18 +231,18 @@ def locate_corner_switch(smooth, corner, st, h=0.003):
 
 
 # -- how a switch criterion is measured on a configuration of each family (``MEASURED``) ---------
-def cap_state_at(sol, topology, st):
-    """The single cap at a recorded point's depth (itself, or the cap it replaced)."""
-    return cap_of(sol)
+def cap_state_at(row, topology, st):
+    """The single cap at a recorded point's depth (its state, or the cap it replaced)."""
+    return cap_of(row)
 
 
 def cap_solved_at(scene, topology, d, near, st):
     return solve_at_delta(scene, d, near, None, st)
 
 
-def wall_state_at(sol, topology, st):
+def wall_state_at(row, topology, st):
     """The ``topology`` wall state at a recorded wall point's delta (from it), or None."""
-    line = wall_state(sol, topology, tol=st.tol, max_nodes=st.max_nodes, bc_tol=st.bc_tol)
+    line = wall_state(row.state, topology, tol=st.tol, max_nodes=st.max_nodes, bc_tol=st.bc_tol)
     return line if line.success and not math.isnan(line.curvature_excess) else None
 
 
@@ -266,23 +269,22 @@ def _touchdown_bracket(states, delta):
 
 
 def _with_pole_clearance(line):
-    """``line`` with its ``pole_clearance`` set (None passes).  The touch-down of a lifted pole
-    is located on this gap, which closes transversally, not on the free shell's penetration:
-    that one is the largest over the shell and sits at the contact line, where the shell
-    touches tangentially, so near zero it is noise at the tabulated tip's accuracy."""
-    if line is not None and math.isnan(line.pole_clearance):
-        line.pole_clearance = pole_clearance(line)
-    return line
+    """``line`` with its ``pole_clearance`` (computed once, kept on it: :func:`~shellbvp.solution.cached`;
+    None passes).  The touch-down of a lifted pole is located on this gap, which closes
+    transversally, not on the free shell's penetration: that one is the largest over the shell
+    and sits at the contact line, where the shell touches tangentially, so near zero it is noise
+    at the tabulated tip's accuracy."""
+    return None if line is None else cached(line, "pole_clearance", pole_clearance)
 
 
-def line_state_at(sol, topology, st):
+def line_state_at(row, topology, st):
     """The line state (``topology``) at a lift-off point's delta (the one its search converged,
-    else from its cap), or None."""
-    line = sol.line_state
+    kept beside it: ``row.line``, else from its cap), or None."""
+    line = row.line
     if line is not None and line.topology == topology and line.success and not math.isnan(line.curvature_excess) \
-            and line.delta == sol.delta:
+            and line.delta == row.state.delta:
         return line
-    cap = cap_of(sol)
+    cap = cap_of(row)
     if cap is None:
         return None
     line = liftoff_state(cap, topology, tol=st.tol, max_nodes=st.max_nodes, bc_tol=st.bc_tol)
@@ -306,8 +308,9 @@ def _add_switch(builder, st, best, frm, to, k1, k2, criterion):
 
 
 #: How a switch criterion is measured on a configuration of each family (``Switch.measured_on``):
-#: ``state_at(recorded, name, settings)``, its state at a recorded point's depth (None if there is
-#: none), and ``solved_at(scene, name, delta, near, settings)``, its state at another depth from a
-#: neighbour.  Every switch is measured on a configuration of one of these families (a test checks it).
+#: ``state_at(row, name, settings)``, its state at a recorded point's depth (``row``: the point's
+#: :class:`~shellbvp.recorder.Row`; None if there is none), and ``solved_at(scene, name, delta,
+#: near, settings)``, its state at another depth from a neighbour.  Every switch is measured on a
+#: configuration of one of these families (a test checks it).
 MEASURED = {"cap": (cap_state_at, cap_solved_at), "lifted": (line_state_at, lifted_solved_at),
             "wall": (wall_state_at, wall_solved_at)}

@@ -256,6 +256,27 @@ def test_a_solution_has_fixed_fields_and_one_way_to_fail():
         failure(0, "", scene=scene, control="delta", value=0.1)
 
 
+def test_a_solution_is_built_once_and_holds_no_other_state():
+    """A state is never written after it is built: what a later step adds makes a new state
+    (``with_``), and no state holds another (a lifted state keeps the numbers of the cap it
+    replaced, not the cap)."""
+    import dataclasses
+
+    from shellbvp.solution import Solution
+
+    sol = sb.solve(sb.Scene.preset("base"), delta=0.1)  # a line replacing the cap that pulls
+    assert sol.topology == "line" and sol.cap_state["force"] > 0
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        sol.force = 1.0
+    flagged = sol.with_(flags=["checked"])
+    assert flagged.flags == ["checked"] and sol.flags == [] and flagged.force == sol.force
+    with pytest.raises(TypeError):
+        sol.with_(forse=1.0)
+    values = [getattr(sol, f.name) for f in dataclasses.fields(sol)]
+    values += list(sol.cap_state.values())
+    assert not any(isinstance(v, Solution) for v in values)
+
+
 def test_every_configuration_is_registered_once_with_its_system():
     """The registry names every configuration a state can have; each builds its own system
     (the chain it declares, the tip tabulated) and refuses what it does not allow in one line."""

@@ -295,17 +295,19 @@ def test_where_the_lines_pole_is_down_the_split_is_tried_before_the_annulus(monk
     line = sb.curve(scene, deltas=[0.1], estimate_error=False).solutions[0]
     cap = sb.solve(scene, delta=0.1125, topology="cap", estimate_error=False)
     assert line.topology == "line" and line.valid and not cap.valid
-    split, tried = lo.valid_liftoff_state(cap, previous=line, last=line)
+    split, tried, line_here = lo.valid_liftoff_state(cap, previous=line, last=line)
     assert split.topology == "cap+line(tip)" and split.valid
     assert [t.split(":")[0] for t in tried] == ["line"], tried
-    # the line converged there is kept: the switch line -> cap+line(tip) is located from it
-    line_here = split.line_state
+    # the line converged there is kept beside it (no state holds another): the switch
+    # line -> cap+line(tip) is located from it
     assert line_here.topology == "line" and line_here.delta == split.delta and not line_here.valid
+    from shellbvp.recorder import Row
     from shellbvp.switches import line_state_at as _line_state_at
 
-    assert _line_state_at(split, "line", {}) is line_here  # (no settings needed: nothing is solved)
+    row = Row(0.0, {}, "", split, cap=cap, line=line_here)
+    assert _line_state_at(row, "line", {}) is line_here  # (no settings needed: nothing is solved)
     monkeypatch.setattr(OPTIONS, "split_first", False)
-    again, tried_old = lo.valid_liftoff_state(cap, previous=line, last=line)
+    again, tried_old, _ = lo.valid_liftoff_state(cap, previous=line, last=line)
     assert [t.split(":")[0] for t in tried_old] == ["line", "annulus"], tried_old
     assert again.topology == "cap+line(tip)" and abs(again.force - split.force) < 1e-9
 
