@@ -76,6 +76,13 @@ Cost: the series arithmetic keeps every coefficient as a shared SymPy DAG; deriv
 built-in material with either bending energy takes 0.6-1.7 s, and ``sympy.cse`` reduces the 81
 entries to about 1400 operations (trace) or 2800 (rotation), so no disk cache is needed here.
 
+A wall whose thickness varies (issue 58): the energy per reference area is
+``t W + beta t^3 B`` with ``t(S) = H(S)/H(0)`` a given function of the reference coordinate, so
+``L`` has ``t W + beta t^3 B`` in place of ``U`` and the form is the uniform wall's with its
+membrane part times t and its bending part times t^3 (the perturbation does not move S: no
+derivative of t enters).  Derived with one more symbol, :data:`THK` (``profiled=True``); the
+uniform wall's expressions and generated code are those without it.
+
 Only the xi = 1 model is an energy's: with xi = 0 the equilibrium equations are not the
 Euler-Lagrange equations of Pi (``tests/test_variational.py``), and this second variation is
 not theirs.
@@ -94,7 +101,7 @@ from . import bending
 from .equations import BETA, PRESSURE
 from .materials import LS, LT
 
-__all__ = ["TRC", "DETC", "BASE", "FIELDS", "N_MODE", "invariant_form", "membrane_energy",
+__all__ = ["TRC", "DETC", "BASE", "FIELDS", "N_MODE", "THK", "invariant_form", "membrane_energy",
            "bending_family", "surface_energy_density", "SecondVariation", "second_variation",
            "second_variation_of", "form_module_source", "FORM_UPPER"]
 
@@ -109,6 +116,8 @@ PHI, KS_, DLS, DKS = sp.symbols("phi ks dls dks", real=True)
 DPSI_R, KS0, KT0 = sp.symbols("dPsi kappa_s0 kappa_theta0", real=True)
 #: The base-state symbols the coefficients are written in (besides beta, pressure, material params, n).
 BASE = (R_, PHI, LS_, KS_, DLS, DKS, RR, PSI_R, DPSI_R, KS0, KT0)
+#: The wall's thickness over the pole's at the point, t(S) (a profiled wall; after BASE in the arguments).
+THK = sp.Symbol("thk", positive=True)
 #: The nine amplitudes (u, u', u'', v, v', v'', w, w', w'').
 FIELDS = sp.symbols("u du ddu v dv ddv w dw ddw", real=True)
 
@@ -322,12 +331,13 @@ def _cross(a, b):
 
 
 # ------------------------------------------------------------------------------ the 2D energy
-def surface_energy_density(jets, reference, Wi, family, beta=BETA, pressure=PRESSURE):
+def surface_energy_density(jets, reference, Wi, family, beta=BETA, pressure=PRESSURE, thickness=None):
     """``L`` per ``dS dtheta`` (module docstring) from the jets of the mid-surface.
 
     ``jets``: dict of 3-vectors (lists) ``x, xS, xT, xSS, xST, xTT`` (T for theta), entries SymPy
     expressions or :class:`Series`; ``reference``: dict ``R, Psi, kappa_s0, kappa_theta0``;
-    ``Wi``: W in (TRC, DETC); ``family``: "trace" or "rotation".
+    ``Wi``: W in (TRC, DETC); ``family``: "trace" or "rotation"; ``thickness``: the wall's
+    thickness over the pole's at the point (None: uniform), ``t W + beta t^3 B``.
     """
     R, Psi = reference["R"], reference["Psi"]
     xS, xT = jets["xS"], jets["xT"]
@@ -350,7 +360,10 @@ def surface_energy_density(jets, reference, Wi, family, beta=BETA, pressure=PRES
     else:
         raise ValueError(f"unknown bending family {family!r}")
     bend = (strain - reference["kappa_s0"] - reference["kappa_theta0"]) ** 2 * sp.Rational(1, 2)
-    U = apply2(Wi, trC, detC) + beta * bend
+    if thickness is None:
+        U = apply2(Wi, trC, detC) + beta * bend
+    else:
+        U = thickness * apply2(Wi, trC, detC) + beta * thickness**3 * bend
     x = jets["x"]
     volume = _dot([x[0] / 2, x[1] / 2, 0], m)
     return U * (R * Psi) - pressure * volume
@@ -422,7 +435,8 @@ class SecondVariation:
 
     ``energy``: the base energy per dS dtheta (the axisymmetric L); ``first``: the eta
     coefficient for n = 0; ``params``: (beta, pressure, *material params); ``seconds``: the
-    derivation's wall time.
+    derivation's wall time; ``base``: the point's symbols the coefficients are written in,
+    :data:`BASE` and, for a profiled wall, :data:`THK`.
     """
 
     matrix: sp.Matrix
@@ -432,19 +446,21 @@ class SecondVariation:
     family: str
     params: tuple
     seconds: float
+    base: tuple = BASE
 
     def quadratic_form(self):
         z = sp.Matrix(FIELDS)
         return (z.T * self.matrix * z)[0, 0]
 
 
-def second_variation(W, material_params=(), B=None, pressurised=False) -> SecondVariation:
+def second_variation(W, material_params=(), B=None, pressurised=False, profiled=False) -> SecondVariation:
     """Derive the second variation of mode n for a strain energy W(lambda_s, lambda_theta)
     and a bending energy B (None or ``bending.trace_bending()``: trace; ``rotation_bending()``);
+    ``profiled``: a wall whose thickness varies, ``t W + beta t^3 B`` with t = :data:`THK`.
     ValueError for a W not expressible through (tr C, det C) or another B.  Cached in-process."""
     W = sp.sympify(W, strict=True)
     family = bending_family(B)
-    return _second_variation(W, tuple(material_params), family, bool(pressurised))
+    return _second_variation(W, tuple(material_params), family, bool(pressurised), bool(profiled))
 
 
 def second_variation_of(structure) -> SecondVariation:
@@ -453,24 +469,26 @@ def second_variation_of(structure) -> SecondVariation:
     if structure.xi != 1:
         raise ValueError("the second variation is that of the energy, whose equilibrium equations are the "
                          "xi = 1 model's; with xi = 0 they are not Euler-Lagrange equations of any energy here")
-    return second_variation(structure.W, structure.material_params, structure.B, structure.pressurised)
+    return second_variation(structure.W, structure.material_params, structure.B, structure.pressurised,
+                            structure.thickness is not None)
 
 
 @functools.lru_cache(maxsize=None)
-def _second_variation(W, material_params, family, pressurised):
+def _second_variation(W, material_params, family, pressurised, profiled=False):
     t0 = time.perf_counter()
     Wi = membrane_energy(W)
     p = PRESSURE if pressurised else sp.S.Zero
     out = []
     for parity in ((1, 0), (0, 1)):
-        L = surface_energy_density(_jets(parity), REFERENCE, Wi, family, pressure=p)
+        L = surface_energy_density(_jets(parity), REFERENCE, Wi, family, pressure=p,
+                                   thickness=THK if profiled else None)
         out.append(L)
     Lc, Ls = out
     matrix = (Lc.c2 + Ls.c2) / 2
     first = Lc.c1.subs(N_MODE, 0)
     params = (BETA,) + ((PRESSURE,) if pressurised else ()) + material_params
     return SecondVariation(matrix=matrix, first=first, energy=Lc.c0, W=Wi, family=family, params=params,
-                           seconds=time.perf_counter() - t0)
+                           seconds=time.perf_counter() - t0, base=BASE + ((THK,) if profiled else ()))
 
 
 #: The upper triangle of the 9 x 9 form, in the order the generated ``form`` returns it
@@ -484,7 +502,9 @@ def form_module_source(structure, description: str) -> str:
     the 45 entries of the form's upper triangle (:data:`FORM_UPPER`) at the points given, and
     ``reference(S, *SHELL_PARAMS)``, the reference shell's ``R, Psi, Psi', kappa_s0,
     kappa_theta0``; ``description`` is hashed into the module's ``KEY`` (``codegen.header``).
-    Deterministic: the same structure gives the same text.
+    A profiled wall's module (``PROFILED = True``; a uniform wall's has no such name) takes
+    ``thk`` after ``kappa_theta0`` in ``form`` and holds ``thickness(S, *SHELL_PARAMS)``, the
+    structure's t(S).  Deterministic: the same structure gives the same text.
     """
     from .codegen import Printer, header
     from .geometry import S as S_SYM
@@ -504,7 +524,7 @@ def form_module_source(structure, description: str) -> str:
         lines.append("    return [" + ", ".join(printer.doprint(e) for e in reduced) + "]")
         return "\n".join(lines)
 
-    form = function("form", [str(b) for b in BASE] + params + [str(N_MODE)],
+    form = function("form", [str(b) for b in res.base] + params + [str(N_MODE)],
                     [res.matrix[i, j] for i, j in FORM_UPPER],
                     "The 45 entries of the form's upper triangle (UPPER) at the points given.")
     ref = function("reference", [str(S_SYM)] + shell_params,
@@ -513,4 +533,9 @@ def form_module_source(structure, description: str) -> str:
     head = [*comments, '"""Generated second variation of one shellbvp structure (see the header)."""',
             "import numpy", "", f"KEY = {key!r}", f"PARAMS = {tuple(params)!r}",
             f"SHELL_PARAMS = {tuple(shell_params)!r}", f"UPPER = {FORM_UPPER!r}", ""]
-    return "\n".join(head) + "\n" + form + "\n\n\n" + ref + "\n"
+    if structure.thickness is None:
+        return "\n".join(head) + "\n" + form + "\n\n\n" + ref + "\n"
+    thk = function("thickness", [str(S_SYM)] + shell_params, [structure.thickness],
+                   "The wall's thickness over the pole's, t(S) (a list of one).")
+    head.insert(-1, "PROFILED = True")
+    return "\n".join(head) + "\n" + form + "\n\n\n" + ref + "\n\n\n" + thk + "\n"

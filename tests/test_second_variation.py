@@ -5,6 +5,8 @@ r"""The two-dimensional energy and its second variation (symbolic.second_variati
 * its first variation's Euler-Lagrange expressions are today's equilibrium equations, built from
   the derivation's ``tau, M`` (``symbolic.equations``) along random meridians (not solutions):
   ``E_u = -eq1``, ``E_w = -r psi eq2`` (``w`` along ``N = -n``), numerically to 1e-20 (mpmath);
+  also for a wall whose thickness varies (``t W + beta t^3 B``, issue 58), against the
+  equations derived with the same t(S);
 * rigid motions: translations are null vectors of the second-order energy density of any state,
   rotations of the unstressed one (pointwise, to 1e-25 of the size of the terms); the unstressed
   state's form is positive semidefinite and positive on non-rigid fields;
@@ -42,16 +44,18 @@ MATERIALS = {
 }
 BENDINGS = {"trace": None, "rotation": bending.rotation_bending()}
 MATERIAL_VALUES = {ALPHA: 0.23, JM: 6.5}
+#: A wall's thickness over the pole's for the profiled variants (t(0) = 1).
+THICKNESS = 1 + 3 * S / 10 - S**2 / 5
 
 
 @functools.lru_cache(maxsize=None)
-def variation(material, family, pressurised=True):
+def variation(material, family, pressurised=True, profiled=False):
     W, par = MATERIALS[material]
-    return sv.second_variation(W, par, BENDINGS[family], pressurised=pressurised)
+    return sv.second_variation(W, par, BENDINGS[family], pressurised=pressurised, profiled=profiled)
 
 
 def args_of(res):
-    return sv.BASE + res.params + (sv.N_MODE,)
+    return res.base + res.params + (sv.N_MODE,)
 
 
 @functools.lru_cache(maxsize=None)
@@ -197,19 +201,23 @@ def _base_along(g, r, z):
     return {k: sp.lambdify(S, v.subs(GAMMA, g), "mpmath") for k, v in exprs.items()}
 
 
-@pytest.mark.parametrize("material,family", [("mooney_rivlin", "trace"), ("gent", "rotation")])
-def test_first_variation_gives_the_equilibrium_equations(material, family):
+@pytest.mark.parametrize("material,family,profiled", [("mooney_rivlin", "trace", False), ("gent", "rotation", False),
+                                                      ("mooney_rivlin", "trace", True), ("gent", "rotation", True)])
+def test_first_variation_gives_the_equilibrium_equations(material, family, profiled):
     """Euler-Lagrange of the eta coefficient (n = 0) against eq1, eq2 of symbolic.equations.
 
     ``E_f = dl/df - (dl/df')' + (dl/df'')''`` for f = u, w; eq1, eq2 from the derivation's
     ``tau_s, tau_theta, M_s, M_theta`` (Q from the moment balance, P the pressure's load):
     ``E_u = -eq1`` and ``E_w = -r psi eq2`` to 1e-20 relative, with both sides of size 1e-3 or
-    more (the meridians are not solutions).  S-derivatives by mpmath at 40 digits.
+    more (the meridians are not solutions).  S-derivatives by mpmath at 40 digits.  ``profiled``:
+    the wall's thickness t(S) = :data:`THICKNESS` in both (``thk`` of the form at each S, the
+    structure's ``thickness`` in the equations).
     """
     W, par = MATERIALS[material]
-    res = variation(material, family)
+    res = variation(material, family, profiled=profiled)
     st = Structure(W=W, material_params=par, shell=geometry.spheroid(), tip=geometry.sphere_tip(), xi=1,
-                   B=BENDINGS[family], pressurised=True)
+                   B=BENDINGS[family], pressurised=True, thickness=THICKNESS if profiled else None)
+    thickness = sp.lambdify(S, THICKNESS, "mpmath")
     d = derive(st)
     A, o = d.free_phys, d.free_phys_out
     r_, phi_, ls_, ks_, _ = d.free_phys_vars
@@ -227,12 +235,12 @@ def test_first_variation_gives_the_equilibrium_equations(material, family):
                      POLE_RISE: mp.mpf(0), **{k: mp.mpf(v) for k, v in MATERIAL_VALUES.items()}}
 
             def b(s):
-                return {k: f(s) for k, f in base.items()}
+                return {sv.THK: thickness(s), **{k: f(s) for k, f in base.items()}}
 
             def coeff(name):
                 def f(s):
                     bv = b(s)
-                    return first(*[bv[k] for k in sv.BASE], *[pvals[p] for p in res.params], 0)[idx[name]]
+                    return first(*[bv[k] for k in res.base], *[pvals[p] for p in res.params], 0)[idx[name]]
                 return f
 
             def eq(name):

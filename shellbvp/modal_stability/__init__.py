@@ -63,6 +63,13 @@ are generated code (``symbolic.second_variation.form_module_source``, numpy with
 once per structure into the code cache (``stability_<key>.py``, ~5-10 s) and imported after;
 a state of beta 1e-5 (141 elements, n = 0..33) takes about 1 s.
 
+A wall whose thickness varies (``scene.thickness_profile``, issue 58): the energy per reference
+area is ``t W + beta t^3 B``, so ``A_n`` is the uniform wall's with its membrane part times
+``t(S)`` and its bending part times ``t(S)^3`` (the generated form takes ``thk`` per point:
+:func:`form.wall_thickness`, the structure's own t at the quadrature points).  Eigenvalues stay
+in units of the pole's ``mu H0/R_L^2``; the default mesh and modes follow the thinnest wall
+(:func:`fem.local_beta`).  Checks: tests/test_stability_profile.py.
+
 States on the tip (``contact="smooth"``: the cap, the point load, lifted and split contact)
 -------------------------------------------------------------------------------------------
 Every chain of free regions and regions on the tip joined by contact edges and lines

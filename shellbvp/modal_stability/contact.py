@@ -45,9 +45,6 @@ def check_supported(state):
         raise ValueError(f"stability: topology {state.topology!r} is not supported (only the inflated shell and "
                          f"{built}: the contact running over the tip's end onto the indenter's cylinder and interior "
                          f"corners are not built)")
-    if state.scene is not None and state.scene.thickness_profile is not None:
-        raise ValueError("stability: a wall whose thickness varies (thickness_profile) is not supported yet (the "
-                         "second variation is derived for a uniform wall)")
     if state.scene is not None and state.scene.two_contacts:
         raise ValueError("stability: a closed shell on a substrate under a curved tip is not supported yet (its "
                          "two halves' modes are not assembled together); between plates it is")

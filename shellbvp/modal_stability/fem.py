@@ -369,17 +369,28 @@ def _held_nodes(nodes, intervals):
 EDGE_LEVELS = 8
 
 
+def local_beta(scene) -> float:
+    """The smallest ratio of bending to membrane stiffness along the wall, ``beta t_min^2`` (the
+    energy is ``t W + beta t^3 B``, t the thickness over the pole's): ``beta`` for a uniform wall."""
+    if scene.thickness_profile is None:
+        return scene.beta
+    L = scene.shell_length
+    t = scene.thickness_profile.relative(np.linspace(0.0, L, 2001), L=L)
+    return scene.beta * min(1.0, float(np.min(t))) ** 2
+
+
 def default_elements(scene) -> int:
     """Elements in S: 24 per local buckling wavelength ``2 pi / k_c``, ``k_c = (3/beta)^(1/4)``
-    (the wavenumber of the sphere's classical modes, package units), at least 40."""
-    kc = (3.0 / scene.beta) ** 0.25
+    (the wavenumber of the sphere's classical modes, package units; a profiled wall's at its
+    thinnest, :func:`local_beta`), at least 40."""
+    kc = (3.0 / local_beta(scene)) ** 0.25
     return max(40, int(math.ceil(24 * scene.shell_length * kc / (2 * math.pi))))
 
 
 def default_modes(scene) -> np.ndarray:
     """n = 0 .. N with ``N = ceil(1.3 k_c) + 2``: the classical modes of wavenumber k_c reach
     ``n = k_c r`` on the rim circle (r = 1)."""
-    kc = (3.0 / scene.beta) ** 0.25
+    kc = (3.0 / local_beta(scene)) ** 0.25
     return np.arange(0, int(math.ceil(1.3 * kc)) + 3)
 
 
@@ -407,7 +418,8 @@ def check_stability_size(scene, modes=None, elements=None, max_dofs=None) -> Non
     limit = int(OPTIONS.max_stability_dofs if max_dofs is None else max_dofs)
     ne, nm, dofs, seconds = stability_size(scene, modes, elements)
     if dofs > limit:
-        raise ValueError(f"stability: beta = {scene.beta:.3g} needs {ne} elements x {nm} modes, {dofs:,} unknowns "
+        thinnest = " at the thinnest wall" if scene.thickness_profile is not None else ""
+        raise ValueError(f"stability: beta = {local_beta(scene):.3g}{thinnest} needs {ne} elements x {nm} modes, {dofs:,} unknowns "
                          f"(about {seconds:,.0f} s per state), over the limit of {limit:,} (max_dofs, "
                          f"--max-stability-dofs): fewer modes (modes=) or a larger limit if the time allows it")
 

@@ -4,6 +4,7 @@ structure, the base state from a solution's regions (or a sphere), the contact's
 from __future__ import annotations
 
 import functools
+import json
 
 import numpy as np
 
@@ -11,22 +12,35 @@ from ..chain import CONTACT_STATES, FREE_STATES
 
 
 @functools.lru_cache(maxsize=16)
-def _numeric_form(structure_key):
-    """(upper-triangle entry function of the 9 x 9 form, the entries' (i, j), its parameter
-    names, the reference shell's parameter names, the reference-shell function) for a structure
-    description (a hashable key): the generated module of ``symbolic.second_variation``."""
-    import json
-
+def _module(structure_key):
+    """The generated module of ``symbolic.second_variation`` for a structure description (a
+    hashable key)."""
     from ..model import load_stability_module
 
-    mod = load_stability_module(json.loads(structure_key))
-    return mod.form, list(mod.UPPER), list(mod.PARAMS), list(mod.SHELL_PARAMS), mod.reference
+    return load_stability_module(json.loads(structure_key))
+
+
+def _key(scene):
+    return json.dumps(scene.structure(), sort_keys=True)
 
 
 def form_functions(scene):
-    import json
+    """(upper-triangle entry function of the 9 x 9 form, the entries' (i, j), its parameter
+    names, the reference shell's parameter names, the reference-shell function) of the scene's
+    structure."""
+    mod = _module(_key(scene))
+    return mod.form, list(mod.UPPER), list(mod.PARAMS), list(mod.SHELL_PARAMS), mod.reference
 
-    return _numeric_form(json.dumps(scene.structure(), sort_keys=True))
+
+def wall_thickness(scene, S):
+    """The wall's thickness over the pole's, t(S), at the points S from the generated module (the
+    structure's own expression, as the equilibrium equations hold it); None for a uniform wall."""
+    if scene.thickness_profile is None:
+        return None
+    mod = _module(_key(scene))
+    values = scene.values()
+    t = mod.thickness(S, *[values[p] for p in mod.SHELL_PARAMS])[0]
+    return np.broadcast_to(np.asarray(t, float), S.shape)
 
 
 def state_base(state):
@@ -64,8 +78,9 @@ def form_at(scene, base_of, S, n):
                               for v in ref(S, *[values[p] for p in shell_params]))
     base = base_of(S)
     r = base["lt"] * R
+    thk = wall_thickness(scene, S)  # a profiled wall: t W + beta t^3 B at each point
     args = (r, base["phi"], base["ls"], base["ks"], base["dls"], base["dks"], R, Psi, dPsi, ks0, kt0,
-            *[values[p] for p in params], n)
+            *(() if thk is None else (thk,)), *[values[p] for p in params], n)
     with np.errstate(all="ignore"):
         out = f(*args)
     A = np.empty((9, 9, S.size))
