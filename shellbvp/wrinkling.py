@@ -54,7 +54,8 @@ where (S, r), and the predicted wave number and ``n = k r``.
 
 Stiffnesses in the package's units (``mu H``, lengths by R_L): ``B = beta`` (SPEC section 2) and
 ``Y = 3`` (the small-strain stretching stiffness ``E H`` of an incompressible sheet, E = 3 mu;
-every built-in strain energy has small-strain shear modulus 1).  Finite stretches change both
+every built-in strain energy has small-strain shear modulus 1); on a wall whose thickness varies,
+``beta t^3`` and ``3 t`` with the local ``t = H(S)/H0``.  Finite stretches change both
 (the incremental moduli, the thinned wall): the indicator uses the small-strain values, an
 approximation of its own beside the locality.
 
@@ -241,7 +242,9 @@ def hoop_indicator(state, *, model: str = "strip", points_per_interval: int = 4)
     if state is None or not getattr(state, "success", False):
         return HoopIndicator(ratio=math.nan, model=model)
     prof = state.profile(points_per_interval)
-    B, Y = float(state.scene.beta), STRETCHING_STIFFNESS
+    # a profiled wall's local stiffnesses: bending ~ H^3, stretching ~ H (t = H(S)/H0)
+    t = np.asarray(prof["thickness"], float) if "thickness" in prof else np.ones(prof["S"].shape)
+    B, Y = float(state.scene.beta) * t**3, STRETCHING_STIFFNESS * t
     free = prof["region"] == _FREE
     tau_t = prof["tau_theta"]
     compressed = free & (tau_t < 0)
@@ -255,7 +258,7 @@ def hoop_indicator(state, *, model: str = "strip", points_per_interval: int = 4)
     for a, b in _bands(compressed):
         idx = np.arange(a, b)
         if model == "strip":
-            thr, k = wrinkling_threshold(B, Y, prof["kappa_s"][idx], k_min=LOWEST_WRINKLE / r[idx])
+            thr, k = wrinkling_threshold(B[idx], Y[idx], prof["kappa_s"][idx], k_min=LOWEST_WRINKLE / r[idx])
             ratio = thr / -tau_t[idx]
             m = int(np.argmin(ratio))
             cand = (float(ratio[m]), idx[m], float(thr[m]), float(k[m]))
@@ -278,6 +281,7 @@ def _band_ratio(B, Y, prof, s, idx, span):
     """(ratio, index of the largest compression, threshold there, k) of one compressed band: one
     Galerkin mode ``sin(pi (s - s_a)/W) exp(i k t)`` over the band ``span`` (its nodes and the two
     neighbours where tau_theta changes sign)."""
+    B, Y = B[span], Y[span]  # the local stiffnesses on the band
     sa, sb = s[span[0]], s[span[-1]]
     W = max(sb - sa, 1e-12)
     k_s = math.pi / W
@@ -294,7 +298,8 @@ def _band_ratio(B, Y, prof, s, idx, span):
         num = np.sum(dw * (B * K2**2 + tau_s * k_s**2 + Y * (kap_s * k**2 + kap_t * k_s**2) ** 2 / K2**2))
         return num / (k**2 * np.sum(dw * comp))
 
-    scale = max((Y / B) ** 0.25 * math.sqrt(float(np.max(np.abs(kap_s) + np.abs(kap_t)))), k_s, k_min)
+    scale = max(float(np.median(Y / B)) ** 0.25 * math.sqrt(float(np.max(np.abs(kap_s) + np.abs(kap_t)))),
+                k_s, k_min)
     grid = np.exp(np.linspace(math.log(k_min), math.log(scale) + 4 * math.log(10), 400))
     vals = np.array([quotient(k) for k in grid])
     j = int(np.argmin(vals))

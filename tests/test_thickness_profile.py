@@ -158,3 +158,15 @@ def test_transverse_shear_takes_the_local_thickness():
     uniform = shear_delta([("free", {"r": r, "Q": Q})], 0, 0.1, 0.05)
     thick = shear_delta([("free", {"r": r, "Q": Q, "thickness": np.full_like(r, 2.0)})], 0, 0.1, 0.05)
     assert uniform > 0 and thick == pytest.approx(uniform / 2, rel=1e-12)
+
+
+def test_the_hoop_indicator_takes_the_local_stiffnesses(uniform):
+    """On a uniform profile the wrinkling indicator is the uniform wall's; on a wall thinning to
+    half at the rim it fires no later (the thinner wall's threshold is lower)."""
+    flat = uniform.replace(thickness=ThicknessProfile.formula("0.05 + 0*S"))
+    thin = uniform.replace(thickness=ThicknessProfile.formula("0.05*(1 - 0.5*S/L)"))
+    for model in ("strip", "band"):
+        ref = sb.hoop_indicator(sb.solve(uniform, delta=0.3), model=model)
+        same = sb.hoop_indicator(sb.solve(flat, delta=0.3), model=model)
+        assert same.ratio == pytest.approx(ref.ratio, rel=1e-8)
+    assert sb.hoop_indicator(sb.solve(thin, delta=0.3)).ratio < ref.ratio
