@@ -28,10 +28,16 @@ from pathlib import Path
 
 import numpy as np
 
-from . import readers
+from . import afm_read, readers
+from . import schema as sc
 from .afm_read import AFMCurve, curves_from_afm
 from .map_pixels import MapPixel, locate, pixel_of_row, read_curves, write_curve_data
+from .nexus import new_file, number_dataset, string_dataset
+from .paths import open_hdf5
+from .plotting import map_pixel_notes, plot_map_pixel, require_matplotlib, save_figure
+from .shape_parameters import shape_parameter
 from .textdata import printable
+from .units import format_in
 
 __all__ = ["AFM_SUFFIXES", "AFMCurve", "ForceMap", "MapFile", "is_afm_file", "afm_text_format", "read_afm", "iter_afm",
            "curves_from_afm", "single_curve", "refuse_text_options", "map_shape", "MAP_FORMAT", "is_map_file",
@@ -117,17 +123,15 @@ def map_shape(curves, path="the map") -> tuple:
         images are allocated at this size): a header declaring a 100000 x 100000 grid for the
         few curves present is refused before any curve is fitted.
     """
-    from .afm_read import MAX_MAP_PIXELS
-
     grids = [c.grid for c in curves if c.grid is not None]
     if not grids:
         return (len(curves), 1)
     shape = (max(g[0] for g in grids) + 1, max(g[1] for g in grids) + 1)
     if min(min(g) for g in grids) < 0:
         raise ValueError(f"{printable(path)}: a curve has a negative grid index")
-    if shape[0] * shape[1] > MAX_MAP_PIXELS:
+    if shape[0] * shape[1] > afm_read.MAX_MAP_PIXELS:
         raise ValueError(f"{printable(path)}: its {len(curves)} curves' grid indices span a {shape[0]} x {shape[1]} "
-                         f"grid ({shape[0] * shape[1]} cells); a map has at most {MAX_MAP_PIXELS} cells "
+                         f"grid ({shape[0] * shape[1]} cells); a map has at most {afm_read.MAX_MAP_PIXELS} cells "
                          f"(MAX_MAP_PIXELS; the header's grid size or the curves' positions are wrong)")
     return shape
 
@@ -194,8 +198,6 @@ class ForceMap:
     def pixel_image(self) -> np.ndarray:
         """``(ny, nx)`` image of the per-pixel geometry value in its unit (the thickness in m,
         :meth:`pixel_unit`), NaN where the table has none."""
-        from .shape_parameters import shape_parameter
-
         nx, ny = self.shape
         img = np.full((ny, nx), np.nan)
         if self.pixel_values is None:
@@ -207,8 +209,6 @@ class ForceMap:
         return img
 
     def pixel_unit(self) -> str:
-        from .shape_parameters import shape_parameter
-
         return shape_parameter(self.pixel_values.name).unit if self.pixel_values is not None else ""
 
     def image(self, quantity="mu_H") -> np.ndarray:
@@ -266,8 +266,6 @@ class ForceMap:
         if warned:
             text += "; warnings: " + ", ".join(f"{code} in {len(where)}" for code, (where, _) in warned.items())
         if self.pixel_values is not None and self.pixel_nodes:
-            from .units import format_in
-
             unit = self.pixel_unit()
             show = ((lambda v: format_in(v, "um", "length")) if unit == "m" else (lambda v: f"{v:.4g}"))
             err = self.interpolation_error
@@ -297,8 +295,6 @@ class ForceMap:
         over ``y``, ``x``, its interval, offset, pressure where fitted, status codes) and
         ``/entry/curves`` (one row per curve: index, grid, position, results, status, message)."""
         import json
-
-        from .nexus import new_file, number_dataset, string_dataset
 
         x, y = self.axes()
         with new_file(out, MAP_FORMAT, MAP_FORMAT_VERSION, overwrite=overwrite) as f:
@@ -391,8 +387,6 @@ def draw_pixel(pixel, out=None, axes=None, dpi=150):
     """:func:`shellbvp.plotting.plot_map_pixel` of ``pixel`` with its message and warnings
     under it (on a figure of its own), saved to ``out`` (atomically) and closed when given;
     ValueError when the pixel has no rows to draw."""
-    from .plotting import map_pixel_notes, plot_map_pixel, require_matplotlib, save_figure
-
     if pixel.displacement is None or pixel.displacement.size == 0:
         raise ValueError(f"pixel {pixel.grid}: no rows to draw ({pixel.status}: {printable(pixel.message)})")
     plt = require_matplotlib()
@@ -414,8 +408,6 @@ def draw_pixel(pixel, out=None, axes=None, dpi=150):
 def draw_map(img, x, y, title, out=None, ax=None, dpi=150):
     """A ``(ny, nx)`` image of mu*H (N/m) over the grid's cell centres ``x``, ``y`` (m; None: grid
     indices), with a colour bar; saved to ``out`` when given."""
-    from .plotting import require_matplotlib
-
     plt = require_matplotlib()
     fig = None
     if ax is None:
@@ -539,9 +531,6 @@ def read_map_file(path) -> MapFile:
     ValueError
         Not a force-map file, or an item missing or malformed (naming it).
     """
-    from . import schema as sc
-    from .paths import open_hdf5
-
     with open_hdf5(path, fmt=MAP_FORMAT, group="entry/map", kind="force-map") as h:
         try:
             sc.format_version(h, MAP_FORMAT_VERSION)

@@ -21,11 +21,15 @@ from pathlib import Path
 import numpy as np
 
 from . import readers
+from .afm import ForceMap, map_shape
 from .afm_read import AFMCurve
+from .fitting import N_DEPTHS, fit, fit_record
+from .fitting.curves import ModelCurves
 from .map_fit import finish, fit_pixels, read_pixels, record_depth
 from .map_pixels import curve_rows, rows_per_curve
-from .scene_parameters import LiveNames
-from .shape_parameters import DERIVED, SHAPE_PARAMETERS
+from .paths import atomic_file, check_output_path
+from .scene_parameters import LiveNames, scene_parameter
+from .shape_parameters import DERIVED, SHAPE_PARAMETERS, shape_parameter
 from .textdata import table_cell
 
 log = logging.getLogger(__name__)
@@ -250,8 +254,6 @@ def fit_records(scene, named, *, R_L, segment="loading", baseline="auto", on_fil
     """:func:`fit_files` on records already read: ``named`` is a list of ``(name, record)``, a
     ``ValueError`` in place of a record that could not be read (its row says why).  Records of
     comparable depth share one model curve."""
-    from .fitting import fit_record
-
     paths = [name for name, _ in named]
     records, rows = {}, {}
     for path, rec in named:
@@ -316,8 +318,6 @@ def fit_map(scene, curves, *, R_L, path=None, segment="loading", baseline="auto"
     this map and scene (a pixel outside the grid, a value out of range, a map without grid
     indices) is a ``ValueError`` before any curve.
     """
-    from .afm import ForceMap, map_shape
-
     pixels, store = read_pixels(curves, path, R_L=R_L, segment=segment, baseline=baseline,
                                 fit_offset=options.get("fit_offset", True))
     try:
@@ -371,9 +371,6 @@ MAX_PIXEL_CURVES = 40
 def _pixel_values_checked(scene, curves, shape, table, R_L, options):
     """``{(ix, iy): x}``: the table's nondimensional values, each checked against the scene and
     the map (ValueError naming the table's line otherwise)."""
-    from .scene_parameters import scene_parameter
-    from .shape_parameters import SHAPE_PARAMETERS, shape_parameter
-
     if options.get("free") or any(options.get(f"fit_{name}") for name in SHAPE_PARAMETERS):
         raise ValueError(f"a map with {table.name} per pixel fits mu*H, the offset and the baseline on the "
                          f"table's geometry: no shape parameter is fitted with it")
@@ -423,9 +420,6 @@ def shared_curves(scene, name, values, grid, need, tol, *, interpolation_tol=Non
     ValueError
         A node's curve ends before ``need`` (the deepest data), or cannot be computed.
     """
-    from .fitting.curves import ModelCurves
-    from .shape_parameters import shape_parameter
-
     param = shape_parameter(name)
     limit = tol if interpolation_tol is None else float(interpolation_tol)
     curves = ModelCurves(lambda th: param.set(scene, param.from_theta(th)), grid, tol, need, [0], progress)
@@ -467,10 +461,6 @@ def shared_curves(scene, name, values, grid, need, tol, *, interpolation_tol=Non
 def _fit_map_per_pixel(scene, pixels, store, shape, table, *, R_L, path, segment, on_curve, settings,
                        tol=1e-6, delta_max=None, progress=None, **options):
     """:func:`fit_map` with a shape parameter per pixel from ``table``."""
-    from .afm import ForceMap
-    from .fitting import N_DEPTHS, fit
-    from .shape_parameters import shape_parameter
-
     param = shape_parameter(table.name)
     curves = [p.curve for p in pixels]
     xs = _pixel_values_checked(scene, curves, shape, table, R_L, options)
@@ -529,8 +519,6 @@ def write_table(path, rows, segment="loading", *, overwrite=False):
     FileExistsError
         ``path`` exists and ``overwrite`` is False.
     """
-    from .paths import atomic_file, check_output_path
-
     path = Path(path)
     if path.exists() and not overwrite:
         raise FileExistsError(f"{path} exists; pass overwrite=True (CLI: --overwrite) to replace it")

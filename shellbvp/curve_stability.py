@@ -28,6 +28,8 @@ import time
 import numpy as np
 
 from .io import STABILITY_FIELDS, FirstInstability
+from .modal_stability import default_modes, stability
+from .state import solve
 
 __all__ = ["STABILITY_CHOICES", "STABILITY_FIELDS", "FirstInstability", "check_choice", "point_stability",
            "assess", "locate_zero", "verdict"]
@@ -52,8 +54,6 @@ def check_choice(stability) -> str:
 def point_stability(state, modes=None):
     """(smallest eigenvalue, its mode, "") of ``state``, or (NaN, -1, why) where the analysis does
     not handle it or fails."""
-    from .modal_stability import stability
-
     if state is None or not state.success:
         return math.nan, -1, "the state did not converge"
     try:
@@ -118,7 +118,6 @@ def assess(curve, choice: str = "points", *, delta_tol: float = 1e-4, samples: i
     curve.learned(stability=choice)
     if choice == "off" or n == 0:
         return
-    from .modal_stability import default_modes
 
     t0 = time.perf_counter()
     notes = []
@@ -188,9 +187,6 @@ def _first(curve, i, mins, modes, choice, delta_tol):
 
 
 def _narrowed(curve, j, i, mins, modes, delta_tol):
-    from .modal_stability import default_modes
-    from .state import solve
-
     sols, d = curve.solutions, curve.points["delta"]
     st = curve.settings
     near = {int(modes[i]), int(modes[j])}

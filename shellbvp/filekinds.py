@@ -8,6 +8,12 @@ they can draw, and for the others :func:`wrong_kind` says which command reads th
 
 from __future__ import annotations
 
+from .afm import MAP_FORMAT
+from .fitrecord import FIT_FORMAT
+from .io import FORMAT as CURVE_FORMAT
+from .sweep.layout import FORMAT as SWEEP_FORMAT
+from .validation import FORMAT as VALIDATION_FORMAT
+
 __all__ = ["file_kind", "wrong_kind", "KINDS"]
 
 #: The kinds of file, in the order the messages list them.
@@ -25,12 +31,6 @@ _READ_BY = {
 
 
 def _formats() -> dict:
-    from .afm import MAP_FORMAT
-    from .fitrecord import FIT_FORMAT
-    from .io import FORMAT as CURVE_FORMAT
-    from .sweep.layout import FORMAT as SWEEP_FORMAT
-    from .validation import FORMAT as VALIDATION_FORMAT
-
     return {CURVE_FORMAT: "curve", SWEEP_FORMAT: "sweep", FIT_FORMAT: "fit", MAP_FORMAT: "force-map",
             VALIDATION_FORMAT: "validation"}
 

@@ -58,9 +58,12 @@ from pathlib import Path
 
 import numpy as np
 
+from . import schema as sc
 from .fit_checks import weights_check_line
+from .fitting import fit_quality
 from .nexus import DIMENSIONLESS, number_dataset, string_dataset
 from .paths import atomic_hdf5, check_output_path, open_hdf5
+from .scene import Scene
 from .scene_parameters import LiveMapping
 from .shape_parameters import DERIVED, SHAPE_PARAMETERS
 from .version import __version__
@@ -140,8 +143,6 @@ class FitRecord:
     @property
     def quality(self) -> str:
         """``good``, ``fair`` or ``poor`` (:func:`shellbvp.fitting.fit_quality`), from what the file holds."""
-        from .fitting import fit_quality
-
         error = self.parameters.get("model_error", math.nan)
         return fit_quality(self.success, self.warning_codes, self.parameters["mu_H"],
                            self.intervals.get("mu_H", (math.nan, math.nan)), self.correlation, self.fitted,
@@ -273,8 +274,6 @@ def _error_source(result):
 
 def _inverted(src):
     """The flipped columns of a record's source (files before the option: none)."""
-    from . import schema as sc
-
     if "inverted" not in src:
         return []
     inv = sc.parse_json(sc.text_dataset(src, "inverted", ndim=0), "source/inverted")
@@ -285,8 +284,6 @@ def _inverted(src):
 
 def _notes(src):
     """The reading notes of a record's source (files before them: none)."""
-    from . import schema as sc
-
     if "notes" not in src:
         return []
     notes = sc.parse_json(sc.text_dataset(src, "notes", ndim=0), "source/notes")
@@ -356,9 +353,6 @@ def read_fit(path) -> FitRecord:
     >>> int(fr.data["used"].sum()), fr.data["model_force"].shape
     (40, (40,))
     """
-
-    from . import schema as sc
-    from .scene import Scene
 
     path = Path(path)
     with open_hdf5(path, fmt=FIT_FORMAT, group="fit", kind="fit") as h:

@@ -58,7 +58,9 @@ from .edge_models import EDGE_MODELS
 from .inflation import INFLATED_FIELDS, InflatedStart
 from .nexus import new_file
 from .paths import open_hdf5
-from .schema import MAX_DATASET_BYTES
+from .scene import Scene
+from .schema import MAX_DATASET_BYTES, parse_json
+from .thickness import force_at
 
 __all__ = ["Curve", "FirstInstability", "STABILITY_FIELDS", "POINT_FIELDS", "CAP_FIELD_DEFAULTS", "FORMAT",
            "point_record", "energy_residual", "write_curve", "read_curve", "write_curve_group", "read_curve_group",
@@ -204,8 +206,6 @@ class Curve:
     def force_at(self, deltas):
         """F at pole displacements ``deltas`` of the shell with its thickness: interpolated at
         ``delta + shear_delta`` (:func:`shellbvp.thickness.force_at`); NaN outside the curve."""
-        from .thickness import force_at
-
         return force_at(self, deltas)
 
     def to_hdf5(self, path, *, profiles: bool = False, overwrite: bool = False, units=None):
@@ -419,8 +419,6 @@ def _bool_attr(g, name):
 
 
 def _json_attr(g, name):
-    from .schema import parse_json
-
     v = parse_json(_text_attr(g, name), f"attribute {name}")  # size and depth bounded before parsing
     if not isinstance(v, dict):
         raise ValueError(f"attribute {name} must be a JSON object; got {type(v).__name__}")
@@ -500,8 +498,6 @@ def _check_settings(settings):
 def read_curve_group(g, version: str = ""):
     """The Curve held by the HDF5 group ``g`` (see :func:`write_curve_group`); ``ValueError``
     naming the attribute or dataset that is missing or malformed."""
-    from .scene import Scene
-
     scene_data = _json_attr(g, "scene")
     try:
         scene = Scene.from_dict(scene_data)

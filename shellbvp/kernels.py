@@ -61,6 +61,7 @@ import time
 import types
 from pathlib import Path
 
+from .config import OPTIONS
 from .model import (description_key, holds_key, kernel_path, untrusted_bytecode, untrusted_reason, write_atomic,
                     write_bytecode)
 
@@ -343,8 +344,6 @@ class KernelSet:
         (where they are compiled already, or compiling in the background is allowed)."""
         self.numpy_seconds += seconds
         if self.numpy_seconds >= START_AFTER_S and self.status == "counting":
-            from .config import OPTIONS
-
             if OPTIONS.compile_in_background or _ready(kernel_path(self._structure()), self.numpy.KEY):
                 self._begin()
             else:

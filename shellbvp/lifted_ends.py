@@ -11,6 +11,7 @@ import numpy as np
 
 from .chain import FreePole
 from .configurations import names
+from .convexity import envelope_partner
 from .liftoff import WARM_NODES, make_liftoff_system, moved_guess, pole_clearance, solve_liftoff, solve_liftoff_from
 from .march import Steps, march
 from .solution import Solution
@@ -131,8 +132,6 @@ def pole_corner_partner(end: Solution) -> dict:
     boxes agree to 5 %), so the partner lies inside them.  Where the gap keeps growing the
     envelope's segment runs out with the box, towards lambda_s -> 0 and kappa_s -> infinity: a
     crease, not a corner between two states of the shell."""
-    from .convexity import envelope_partner
-
     sysm = end.system
     t = np.array([0.0])
     S, y = float(sysm.S(0, t, end.p)[0]), end.sol(t)[sysm.rows(0), 0]

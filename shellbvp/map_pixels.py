@@ -32,6 +32,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from . import schema as sc
 from .nexus import number_dataset, string_dataset
 from .textdata import printable
 
@@ -366,8 +367,6 @@ def read_curves(h, shape, path="", source="") -> MapCurves:
     """``/entry/curves`` (and ``/entry/curve_data`` where present) of an open map file, every
     item checked (:mod:`shellbvp.schema`; ValueError naming it)."""
     import h5py
-
-    from . import schema as sc
 
     for name in ("entry/curves", "entry/curve_data"):
         if name in h and not isinstance(h[name], h5py.Group):

@@ -10,6 +10,9 @@ from __future__ import annotations
 
 from contextlib import contextmanager
 
+from .paths import atomic_hdf5, check_output_path
+from .version import __version__
+
 __all__ = ["CURVE_DATASET_UNITS", "DIMENSIONLESS", "label_units", "missing_units", "string_dataset",
            "number_dataset", "file_header", "new_file"]
 
@@ -92,8 +95,6 @@ def file_header(f, fmt: str, version: int) -> None:
     format_version, package_version and the time it was created (UTC)."""
     import datetime as _dt
 
-    from .version import __version__
-
     f.attrs["NX_class"] = "NXroot"
     f.attrs["format"] = fmt
     f.attrs["format_version"] = version
@@ -107,8 +108,6 @@ def new_file(path, fmt: str, version: int, *, overwrite: bool = False):
     ``overwrite``; yields the open file with its :func:`file_header`; on success the datasets get
     their units (:func:`label_units`) and the file replaces ``path``, on any error nothing does."""
     from pathlib import Path
-
-    from .paths import atomic_hdf5, check_output_path
 
     path = Path(path)
     if path.exists() and not overwrite:

@@ -23,7 +23,11 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
+from . import afm_read
+from .readers import read_table
+from .readers.text_table import cell_number, header_name_and_unit
 from .scene_parameters import LiveMapping, parameters_that, scene_parameter
+from .units import unit_factor, unit_kind
 
 __all__ = ["PIXEL_PARAMETERS", "PixelTable", "read_pixel_table"]
 
@@ -75,8 +79,6 @@ class PixelTable:
             raise ValueError(f"a pixel table gives one of {', '.join(PIXEL_PARAMETERS)}; got {self.name!r}")
         kind = PIXEL_PARAMETERS[self.name]
         if self.unit:
-            from .units import unit_factor
-
             if not kind:
                 raise ValueError(f"{self.path}: column {self.name!r} is nondimensional; got the unit {self.unit!r}")
             self._factor = unit_factor(self.unit, kind)  # ValueError naming the unit's kind
@@ -111,12 +113,8 @@ def read_pixel_table(path) -> PixelTable:
         column, two geometry columns, an unknown unit, a pixel index that is not an integer
         >= 0, a value that is not a finite number > 0 (alpha: >= 0), a pixel given twice.
     """
-    from .afm_read import MAX_MAP_PIXELS
-    from .readers import read_table
-    from .readers.text_table import cell_number, header_name_and_unit
-
     # at most one row per cell of the largest map; checked against the map's own grid by fit_map
-    table = read_table(path, max_rows=MAX_MAP_PIXELS, what="pixel table (one row per pixel, MAX_MAP_PIXELS)")
+    table = read_table(path, max_rows=afm_read.MAX_MAP_PIXELS, what="pixel table (one row per pixel, MAX_MAP_PIXELS)")
     if not table.header:
         raise ValueError(f"{path}: no header row; the pixel table needs the columns ix, iy and one of "
                          f"{', '.join(PIXEL_PARAMETERS)} (e.g. thickness_um)")
@@ -142,8 +140,6 @@ def read_pixel_table(path) -> PixelTable:
     kind = PIXEL_PARAMETERS[name]
     param = scene_parameter(name)
     if unit:
-        from .units import unit_kind
-
         if not kind:
             raise ValueError(f"{path}: column {table.header[g]!r}: {name} is nondimensional (no unit)")
         if unit_kind(unit, extended=True) != kind:

@@ -11,11 +11,15 @@ from __future__ import annotations
 
 import numpy as np
 
+from .configurations import is_single_cap
 from .textdata import printable
 from .fitrecord import PARAMETER_UNITS
 from .fitting import diagnostics_lines
 from .fitting.apparent import apparent_modulus
+from .paths import atomic_file
+from .state import solve
 from .thickness import model_error_line
+from .units import unit_factor
 
 __all__ = ["plot_curves", "plot_profiles", "plot_fit", "plot_fit_record", "plot_map_pixel", "map_pixel_notes", "plot_apparent_modulus", "record_apparent_modulus", "fit_report", "fit_summary_lines",
            "require_matplotlib", "scene_label", "save_figure"]
@@ -70,8 +74,6 @@ def plot_curves(curves, ax=None, labels=None, mark_invalid=True):
 def plot_profiles(scene, deltas, ax=None, solutions=None):
     """Deformed meridians at the given depths, the indenter and the undeformed shell."""
     plt = require_matplotlib()
-    from .configurations import is_single_cap
-    from .state import solve
 
     if ax is None:
         _, ax = plt.subplots(figsize=(5, 5))
@@ -132,8 +134,6 @@ def save_figure(fig, path, dpi=150):
     reader never sees half a figure and an earlier one stays whole if drawing fails.
     The format follows the name's suffix (png, pdf, svg, ...)."""
     from pathlib import Path
-
-    from .paths import atomic_file
 
     path = Path(path)
     fmt = path.suffix.lstrip(".").lower() or "png"
@@ -321,8 +321,6 @@ def plot_apparent_modulus(record, ax):
 def _display(record):
     """``show(value, si_unit) -> (number text, unit)``: lengths and forces in the units of the data's
     file (as the fit command prints them), everything else as stored."""
-    from .units import unit_factor
-
     def factor(unit, kind):
         try:
             return unit_factor(unit, kind), unit

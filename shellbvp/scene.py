@@ -15,10 +15,11 @@ import numpy as np
 
 from .edge_models import EdgeModel, contact_models, edge_model
 from .geometry import FlatTip, SphereTip, Spheroid, UserShell, UserTip
-from .materials import MATERIALS, Bending, Gent, Material, MooneyRivlin, TraceBending
+from .materials import MATERIALS, Bending, Gent, Material, MooneyRivlin, TraceBending, bending_class, material_class
 from .model import load_module, structure_description
 from .scene_parameters import scene_parameter, scene_parameters
 from .thickness_profile import ThicknessProfile, settle_profile
+from .units import beta_from_thickness, format_in
 
 __all__ = ["Scene", "PRESETS", "CONTACT_MODELS", "RIMS", "SUPPORTS"]
 
@@ -172,7 +173,6 @@ class Scene:
         if self.thickness is not None:
             eps = _finite("thickness", self.thickness)  # H / R_L: the scene's unit (its lab form H = eps R_L)
             scene_parameter("thickness").check(eps, shown=self.thickness)
-            from .units import beta_from_thickness
 
             from_eps = beta_from_thickness(eps, 1.0, self.bending)
             if beta is not None and not math.isclose(_finite("beta", beta), from_eps, rel_tol=1e-12):
@@ -296,9 +296,6 @@ class Scene:
         file never runs as code.  Malformed data raises ``ValueError`` naming
         the field.
         """
-        from .geometry import UserShell, UserTip
-        from .materials import bending_class, material_class
-
         def field(data, key, kind, where):
             if not isinstance(data, dict) or key not in data:
                 raise ValueError(f"scene data{' ' + where.rstrip('.') if where else ''} has no {key!r}")
@@ -357,8 +354,6 @@ class Scene:
         >>> print(sb.Scene.preset("fit", thickness=0.05).describe(R_L=0.3e-3))
         preset fit with thickness; shell: spheroidal bowl (indented from inside), rise 750 um (gamma 2.5) on a rim radius of 300 um; indenter: sphere of radius 100 um (rho 0.3333); thickness 15 um (eps 0.05, beta 0.0008333); Mooney-Rivlin alpha 0.1; smooth contact
         """
-        from .units import format_in
-
         def length(x):
             return "" if R_L is None else format_in(abs(x) * R_L, "um" if abs(x) * R_L < 1e-3 else "mm", "length")
 

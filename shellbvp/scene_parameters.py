@@ -47,6 +47,7 @@ from dataclasses import dataclass
 from typing import Callable
 
 from .materials import MATERIALS, material_class
+from .units import beta_from_thickness
 
 __all__ = ["SceneParameter", "Lab", "FitSearch", "Derived", "DECLARED", "MATERIAL_PARAMETERS", "ROLES",
            "SCENE_PARAMETERS", "scene_parameters", "scene_parameter", "parameters_that", "scene_with",
@@ -300,8 +301,6 @@ def _pressure_scale(scene):
 
 def _eps_of_beta(beta, bending):
     """eps = H/R_L of a bending stiffness, by the package's map (beta is eps^2 times its value at eps = 1)."""
-    from .units import beta_from_thickness
-
     return math.sqrt(beta / beta_from_thickness(1.0, 1.0, bending))
 
 

@@ -23,6 +23,8 @@ import numpy as np
 
 from symbolic.spline import natural_spline_coefficients
 
+from .units import LENGTH_UNITS
+
 __all__ = ["ThicknessProfile", "MAX_TABLE_ROWS", "ALONG", "positions_to_S", "read_profile_table", "settle_profile",
            "profile_from_file"]
 
@@ -269,8 +271,6 @@ def read_profile_table(path, R_L: float):
     ``angle_deg``/``angle_rad``, or ``S`` (the package's coordinate, no unit), then
     ``thickness_<unit>``.  At most :data:`MAX_TABLE_ROWS` rows.
     """
-    from .units import LENGTH_UNITS
-
     text = _read_text(path)
     lines = [ln.strip() for ln in text.splitlines() if ln.strip() and not ln.lstrip().startswith("#")]
     if not lines:

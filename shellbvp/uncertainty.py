@@ -20,13 +20,15 @@ from __future__ import annotations
 
 import logging
 import math
-import re
 from dataclasses import dataclass, field
 
 import numpy as np
 
+from .fitting import fit, free_parameters
 from .scene_parameters import LiveNames, parameters_that, scene_parameter, scene_with
 from .shape_parameters import SHAPE_PARAMETERS
+from .sweep import local_pool
+from .units import parse_uncertain
 
 log = logging.getLogger(__name__)
 
@@ -37,26 +39,6 @@ __all__ = ["UNCERTAIN_PARAMETERS", "GeometryFit", "fit_with_geometry", "parse_un
 UNCERTAIN_PARAMETERS = LiveNames(lambda: [p.name for p in parameters_that("uncertainty")])
 #: Coverage factor of a 95 % interval of a normal quantity.
 Z95 = 1.959963984540054
-_PLUS_MINUS = re.compile(r"\+-|\+/-|±")
-
-
-def parse_uncertain(text: str, name: str = "value") -> tuple[float, float | None]:
-    """``"2.5+-0.2"`` (or ``2.5±0.2``, ``2.5+/-0.2``) -> (2.5, 0.2); ``"2.5"`` -> (2.5, None).
-
-    Both numbers are plain decimal text (nothing is evaluated); the uncertainty must be > 0.
-    """
-    from .units import plain_number
-
-    parts = _PLUS_MINUS.split(str(text))
-    if len(parts) > 2:
-        raise ValueError(f"{name} must be a number or VALUE+-UNCERTAINTY (e.g. 2.5+-0.2); got {text!r}")
-    value = plain_number(parts[0], name)
-    if len(parts) == 1:
-        return value, None
-    u = plain_number(parts[1], f"the uncertainty of {name}")
-    if not u > 0:
-        raise ValueError(f"the uncertainty of {name} must be > 0; got {parts[1].strip()!r}")
-    return value, u
 
 
 def _perturbed(scene, name, value):
@@ -72,7 +54,6 @@ def _check_uncertainty(scene, uncertainty, fit_kwargs):
     if not isinstance(uncertainty, dict) or not uncertainty:
         raise ValueError(f"uncertainty must be a non-empty mapping of {UNCERTAIN_PARAMETERS} to standard "
                          f"uncertainties; got {uncertainty!r}")
-    from .fitting import free_parameters
 
     aliases = {k: v for k, v in fit_kwargs.items() if k.startswith("fit_") and k[4:] in SHAPE_PARAMETERS}
     free, _ = free_parameters(fit_kwargs.get("free", ()), None, aliases)
@@ -102,8 +83,6 @@ def _check_uncertainty(scene, uncertainty, fit_kwargs):
 
 def fit_record(scene, displacement, force, R_L, fit_kwargs) -> dict:
     """One fit as a plain record (what a worker returns): mu*H, its interval, status."""
-    from .fitting import fit
-
     try:
         r = fit(scene, displacement, force, R_L=R_L, **fit_kwargs)
     except ValueError as exc:  # e.g. the perturbed model curve does not reach the data: reported
@@ -248,9 +227,6 @@ def fit_with_geometry(scene, displacement, force, *, R_L, uncertainty, executor=
     (True, True)
     """
     from scipy import special
-
-    from .fitting import fit
-    from .sweep import local_pool
 
     scenes = _check_uncertainty(scene, uncertainty, fit_kwargs)
     d = np.asarray(displacement, float)

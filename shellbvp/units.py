@@ -16,13 +16,15 @@ import re
 from dataclasses import dataclass
 
 __all__ = ["Dimensions", "parse_quantity", "unit_factor", "unit_kind", "normalize_unit", "format_in",
-           "beta_from_thickness", "plain_number", "PLAIN_NUMBER", "LENGTH_UNITS", "FORCE_UNITS", "TIME_UNITS",
-           "MU_H_UNITS", "PRESSURE_UNITS", "UNIT_TABLES", "SI_UNITS", "split_quantity", "Quantity", "force_unit_of",
-           "readable_unit"]
+           "beta_from_thickness", "plain_number", "parse_uncertain", "PLAIN_NUMBER", "PLUS_MINUS", "LENGTH_UNITS",
+           "FORCE_UNITS", "TIME_UNITS", "MU_H_UNITS", "PRESSURE_UNITS", "UNIT_TABLES", "SI_UNITS", "split_quantity",
+           "Quantity", "force_unit_of", "readable_unit"]
 
 #: A number as a person or a CSV writes it: ASCII digits, optional sign, decimal point and
 #: exponent.  Python's float() also takes "5_0", "inf", "nan", "1e999" and non-ASCII digits.
 PLAIN_NUMBER = re.compile(r"[-+]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][-+]?[0-9]+)?")
+#: The separator of a value and its standard uncertainty: ``2.5+-0.2``, ``2.5+/-0.2``, ``2.5±0.2``
+PLUS_MINUS = re.compile(r"\+-|\+/-|±")
 
 #: SI factors of unit names (the micro sign: ``u``, U+00B5 or U+03BC; see :func:`normalize_unit`).
 LENGTH_UNITS = {"m": 1.0, "cm": 1e-2, "mm": 1e-3, "um": 1e-6, "µm": 1e-6, "micron": 1e-6, "nm": 1e-9}
@@ -147,6 +149,23 @@ def plain_number(text: str, name: str = "value") -> float:
     if not PLAIN_NUMBER.fullmatch(t) or not math.isfinite(v := float(t)):
         raise ValueError(f"{name} must be a plain finite number (e.g. 0.25 or 1e-3); got {text!r}")
     return v
+
+
+def parse_uncertain(text: str, name: str = "value") -> tuple[float, float | None]:
+    """``"2.5+-0.2"`` (or ``2.5±0.2``, ``2.5+/-0.2``) -> (2.5, 0.2); ``"2.5"`` -> (2.5, None).
+
+    Both numbers are plain decimal text (nothing is evaluated); the uncertainty must be > 0.
+    """
+    parts = PLUS_MINUS.split(str(text))
+    if len(parts) > 2:
+        raise ValueError(f"{name} must be a number or VALUE+-UNCERTAINTY (e.g. 2.5+-0.2); got {text!r}")
+    value = plain_number(parts[0], name)
+    if len(parts) == 1:
+        return value, None
+    u = plain_number(parts[1], f"the uncertainty of {name}")
+    if not u > 0:
+        raise ValueError(f"the uncertainty of {name} must be > 0; got {parts[1].strip()!r}")
+    return value, u
 
 
 _EXAMPLE = {"length": "0.3mm", "force": "2mN", "time": "1.5s", "mu_H": "52N/m", "pressure": "0.2MPa"}

@@ -129,6 +129,10 @@ def test_the_command_line_parses_before_numpy_and_scipy_load():
             "print(rc, heavy)")
     r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     assert r.stdout.strip() == "2 []", (r.stdout, r.stderr)
+    uncertain = code.replace("['curve', '--no-such-option']",
+                             "['fit', 'x.csv', '--preset', 'fit', '--gamma', '2.5+-0.1', '--no-such-option']")
+    r = subprocess.run([sys.executable, "-c", uncertain], capture_output=True, text=True)
+    assert r.stdout.strip() == "2 []", (r.stdout, r.stderr)  # VALUE+-U parsed (shellbvp.units) before numpy
     missing = code.replace("['curve', '--no-such-option']", "['fit', 'missing.csv', '--preset', 'fit', '--radius', '0.3mm']")
     r = subprocess.run([sys.executable, "-c", missing], capture_output=True, text=True)
     assert r.stdout.strip() == "2 []" and "missing.csv: no such file" in r.stderr, (r.stdout, r.stderr)

@@ -6,8 +6,10 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..collocation import newton_on_mesh
 from ..kernels import kernel_set
 from ..quadrature import gauss_points
+from ..solution import solve_bvp
 from .blocks import CONTACT_KINDS, REGION_CODES, SIZES, Chain, ContactPole, Edge, FreePole, Line, Point, Rim, Seam
 from .conditions import BoundaryConditions
 
@@ -216,8 +218,6 @@ class ChainBVP(BoundaryConditions):
     def solve(self, x, y, p=None, **kwargs):
         """``shellbvp.solution.solve_bvp`` of this system from a guess (completed, see
         :meth:`complete`); keyword arguments go to solve_bvp."""
-        from ..solution import solve_bvp
-
         y, p = self.complete(x, y, p)
         return solve_bvp(self.fun, self.bc, x, y, p, fun_jac=self.fun_jac, bc_jac=self.bc_jac,
                          kernels=self._elimination, **kwargs)
@@ -232,8 +232,6 @@ class ChainBVP(BoundaryConditions):
         """``shellbvp.collocation.newton_on_mesh`` of this system from a guess (completed, see
         :meth:`complete`) on the fixed mesh ``x``: ``(y, p)`` (``p`` None when there are no
         unknowns), or None where that Newton does not converge."""
-        from ..collocation import newton_on_mesh
-
         y, p = self.complete(x, y, p)
         if self.k:
             fun, fun_jac, bc, bc_jac = self.fun, self.fun_jac, self.bc, self.bc_jac

@@ -24,7 +24,9 @@ import sys
 
 from . import compile, convexity, curve, fit, info, plot, presets, report, solve, sweep, validate
 from ..config import options
-from .common import Parser, limits_of, print_json_error, scene_from_args, show_code_generation
+from ..textdata import printable
+from ..version import __version__
+from .common import Parser, limits_of, os_error_line, print_json_error, scene_from_args, show_code_generation
 
 __all__ = ["main", "build_parser", "scene_from_args"]
 
@@ -34,8 +36,6 @@ COMMANDS = (curve, solve, fit, sweep, plot, report, info, convexity, validate, p
 
 
 def build_parser():
-    from ..version import __version__
-
     p = Parser(prog="shellbvp", description="Indentation of thin curved hyperelastic shells.")
     p.add_argument("-v", "--verbose", action="store_true", help="log progress (INFO)")
     p.add_argument("--version", action="version", version=f"shellbvp {__version__}")
@@ -71,8 +71,6 @@ def _main(argv=None):
     except (ValueError, FileExistsError, ImportError) as exc:  # ImportError: an optional part missing or refused
         if getattr(args, "json", False):
             print_json_error(exc)
-        from ..textdata import printable
-
         print(f"shellbvp: error: {printable(' '.join(str(exc).split()))}", file=sys.stderr)  # one line, always
         return 2
     except KeyboardInterrupt:
@@ -84,8 +82,5 @@ def _main(argv=None):
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 141
     except OSError as exc:  # a file that cannot be written (a full disk): its partial file is removed
-        from ..textdata import printable
-        from .common import os_error_line
-
         print(f"shellbvp: error: {printable(os_error_line(exc))}", file=sys.stderr)
         return 2

@@ -11,9 +11,14 @@ import re
 import sys
 from pathlib import Path
 
+from .. import progress, units
 from ..edge_models import contact_models
-from ..materials import material_class
+from ..geometry import FlatTip
+from ..materials import BENDINGS, MATERIALS, BendingEnergy, NeoHookean, bending_class, material_class
+from ..paths import check_output_path
 from ..scene_parameters import scene_parameter, scene_parameters
+from ..textdata import printable
+from ..units import Quantity, parse_uncertain, split_quantity
 
 __all__ = ["Parser", "print_json_error", "show_code_generation", "plain_number", "plain_numbers", "quantity", "uncertain_value", "pressure_value", "say", "number_or", "thickness_value", "nondimensional", "add_radius_option", "add_mu_h_option", "material_spec", "material_help", "material_options", "bending_families", "add_scene_options", "scene_from_args", "over_rim_radius", "require_sample", "nondimensional_thickness", "nondimensional_pressure", "checkpoint_seconds", "progress_bar", "curve_bars", "MAX_POINTS", "free_default_name", "strict_json", "output_dir", "check_report_path", "add_overwrite_option",
            "NODE_BUDGET", "node_budget", "add_limit_options", "limits_of", "LIMIT_OPTIONS"]
@@ -96,27 +101,21 @@ def os_error_line(exc: OSError) -> str:
 
 def plain_number(text):
     """argparse type: a plain finite number (float() would also take 5_0, inf, nan, 1e999)."""
-    from ..units import plain_number
-
     try:
-        return plain_number(text, "the value")
+        return units.plain_number(text, "the value")
     except ValueError as exc:
         raise argparse.ArgumentTypeError(str(exc)) from None
 
 
 def plain_numbers(text, name):
     """Comma-separated plain finite numbers of an option."""
-    from ..units import plain_number
-
-    return [plain_number(v, name) for v in text.split(",")]
+    return [units.plain_number(v, name) for v in text.split(",")]
 
 
 def quantity(kind, positive=True):
     """argparse type: a quantity with its unit (``0.3mm``, ``52N/m``), > 0 (``positive``; else
     any finite value, ``-5um``); a bare number is an error that says which unit to add.  Every
     subcommand takes dimensional options this way."""
-    from ..units import Quantity
-
     def parse(text):
         try:
             return Quantity.parse(text, kind, "the value", positive=positive)  # argparse names the option
@@ -129,8 +128,6 @@ def quantity(kind, positive=True):
 
 def uncertain_value(text):
     """argparse type: ``VALUE`` or ``VALUE+-U`` (plain numbers) -> (value, U or None)."""
-    from ..uncertainty import parse_uncertain
-
     try:
         return parse_uncertain(text, "the value")
     except ValueError as exc:
@@ -139,12 +136,10 @@ def uncertain_value(text):
 
 def pressure_value(text):
     """argparse type: a plain number (``p R_L/(mu H)``) or a pressure with its unit (``0.2MPa``)."""
-    from ..units import Quantity, plain_number, split_quantity
-
     try:
         if split_quantity(text, "pressure", "the value")[1]:
             return Quantity.parse(text, "pressure", "the value", positive=False)
-        return plain_number(text, "the value")
+        return units.plain_number(text, "the value")
     except ValueError as exc:
         raise argparse.ArgumentTypeError(str(exc)) from None
 
@@ -152,21 +147,17 @@ def pressure_value(text):
 def say(line=""):
     """Print a line that may hold text from a file or a user: control characters escaped
     (shellbvp.textdata), so that a file cannot drive the terminal or forge a result line."""
-    from ..textdata import printable
-
     print(printable(line))
 
 
 def number_or(kind):
     """argparse type: a plain number (nondimensional) or a quantity with its unit (``50um``,
     ``10mN``), which :func:`nondimensional` turns into the model's units."""
-    from ..units import Quantity, plain_number, split_quantity
-
     def parse(text):
         try:
             if split_quantity(text, kind, "the value")[1]:
                 return Quantity.parse(text, kind, "the value")
-            return plain_number(text, "the value")
+            return units.plain_number(text, "the value")
         except ValueError as exc:
             raise argparse.ArgumentTypeError(str(exc)) from None
 
@@ -180,8 +171,6 @@ thickness_value = number_or("length")  # eps = H / R_L, or the thickness with it
 def nondimensional(args, value, option):
     """``value`` of ``option`` in the model's units: a plain number as it is; a length over the rim
     radius (``--radius``), a force over mu*H times it (``--muH`` too)."""
-    from ..units import Quantity
-
     if not isinstance(value, Quantity):
         return value
     if value.kind == "length":
@@ -212,9 +201,6 @@ def add_mu_h_option(p, what):
 def material_spec(text):
     """argparse type: ``FAMILY[:NAME=VALUE,...]`` (``--material yeoh:c2=0.1,c3=0.01``), a registered
     material's family and its parameters by the names files use; read as data, never run."""
-    from ..materials import MATERIALS
-    from ..units import plain_number
-
     try:
         family, _, options = (t.strip() for t in text.partition(":"))
         known = {f: c for f, c in MATERIALS.items() if c.cli}
@@ -227,7 +213,7 @@ def material_spec(text):
             if not equals or name not in names or name in values:
                 wanted = f"give NAME=VALUE once each, NAME one of {', '.join(names)}" if names else "takes no parameters"
                 raise ValueError(f"{family}: {wanted}; got {item!r}")
-            values[name] = plain_number(value, f"{family}: {name}")
+            values[name] = units.plain_number(value, f"{family}: {name}")
         material = known[family](**values)
         material.validate()
         return material
@@ -237,8 +223,6 @@ def material_spec(text):
 
 def material_help() -> str:
     """What --material takes, from the registry of materials."""
-    from ..materials import MATERIALS
-
     kinds = [c.family + "".join(f", {p.name} {p.range_text()}" for p in c.parameters)
              for c in MATERIALS.values() if c.cli]
     return ("a material as FAMILY[:NAME=VALUE,...], e.g. gent:Jm=1 (parameters not given keep their "
@@ -246,8 +230,6 @@ def material_help() -> str:
 
 
 def bending_families() -> tuple:
-    from ..materials import BENDINGS
-
     return tuple(f for f, c in BENDINGS.items() if c.cli)
 
 
@@ -386,26 +368,24 @@ def material_options() -> list:
 
 
 def scene_from_args(args):
-    import shellbvp as sb
+    from ..scene import Scene
 
     own = [p.dest for p in scene_parameters().values() if p.option and not p.material]  # --gamma, --rho, ...
     over = {k: getattr(args, k) for k in (*own, "xi", "contact", "sealed", "transverse_shear", "closed", "support")
             if getattr(args, k, None) is not None}
     if getattr(args, "flat_tip", None):
-        over["tip"] = sb.FlatTip()
+        over["tip"] = FlatTip()
     chosen = [p for p in material_options() if getattr(args, p.dest, None) is not None]
     if chosen:  # its material (the options exclude each other)
         over["material"] = material_class(chosen[0].material)(**{chosen[0].name: getattr(args, chosen[0].dest)})
     elif args.neo_hookean:
-        over["material"] = sb.NeoHookean()
+        over["material"] = NeoHookean()
     elif args.material is not None:
         over["material"] = args.material
     if getattr(args, "bending", None):
-        from ..materials import bending_class
-
         over["bending"] = bending_class(args.bending)()
     elif getattr(args, "bending_formula", None):
-        over["bending"] = sb.BendingEnergy(args.bending_formula)
+        over["bending"] = BendingEnergy(args.bending_formula)
     if getattr(args, "pressure", None) is not None:
         over["pressure"] = nondimensional_pressure(args)
     if getattr(args, "thickness", None) is not None:
@@ -415,10 +395,10 @@ def scene_from_args(args):
             over[name] = over_rim_radius(args, getattr(args, length), what)
     if getattr(args, "dome", None):
         over["gamma"] = -_dome_rise(args) / args.radius.si
-    scene = sb.Scene.preset(args.preset or "base", **over)
+    scene = Scene.preset(args.preset or "base", **over)
     if getattr(args, "thickness_profile", None) is not None:
         over["thickness"] = _thickness_profile(args, scene)
-        scene = sb.Scene.preset(args.preset or "base", **over)
+        scene = Scene.preset(args.preset or "base", **over)
     return scene
 
 
@@ -473,8 +453,6 @@ def require_sample(args, bending_per_pixel=False):
 
 def nondimensional_thickness(args):
     """``--thickness`` as ``H / R_L``: a plain number as it is, a length through ``--radius``."""
-    from ..units import Quantity
-
     if not isinstance(args.thickness, Quantity):
         return args.thickness
     radius = getattr(args, "radius", None)
@@ -487,8 +465,6 @@ def nondimensional_thickness(args):
 def nondimensional_pressure(args):
     """``--pressure`` as ``p R_L/(mu H)``: a plain number as it is, a pressure with a unit through
     ``--radius`` and ``--muH``."""
-    from ..units import Quantity
-
     if not isinstance(args.pressure, Quantity):
         return args.pressure
     if args.command == "fit":
@@ -517,19 +493,16 @@ def checkpoint_seconds():
 
 def progress_bar(total, unit, args):
     """A progress bar on stderr (tqdm; none when quiet, not a terminal, or tqdm absent)."""
-    from ..progress import progress_bar, wanted
-
-    return progress_bar(total, desc=args.command, unit=unit, enabled=wanted(getattr(args, "quiet", False)))
+    enabled = progress.wanted(getattr(args, "quiet", False))
+    return progress.progress_bar(total, desc=args.command, unit=unit, enabled=enabled)
 
 
 def curve_bars(args, leave=True):
     """``progress`` for :func:`shellbvp.fit`: one bar per model curve, over delta."""
-    from ..progress import curve_progress, wanted
-
-    mode = wanted(getattr(args, "quiet", False))
+    mode = progress.wanted(getattr(args, "quiet", False))
     if not mode:
         return None
-    return lambda desc, delta_max: curve_progress(delta_max, desc, enabled=mode, leave=leave)
+    return lambda desc, delta_max: progress.curve_progress(delta_max, desc, enabled=mode, leave=leave)
 
 
 MAX_POINTS = 100_000  # --points: each is a solve (~0.05-0.5 s); more is a typo, not a curve
@@ -567,8 +540,6 @@ def strict_json(value):
 
 def output_dir(path, what, files, suffix, force):
     """A directory for one output per file (created if its parent exists); names checked now."""
-    from ..paths import check_output_path
-
     d = Path(path)
     if d.exists() and not d.is_dir():
         raise ValueError(f"{what} {path}: with several files it must be a directory (one file each)")
@@ -587,8 +558,6 @@ def output_dir(path, what, files, suffix, force):
 
 
 def check_report_path(path, overwrite):
-    from ..paths import check_output_path
-
     if not str(path).lower().endswith((".png", ".pdf")):
         raise ValueError(f"--report must name a .png or .pdf file; got {path!r}")
     return check_output_path(path, overwrite=overwrite)

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from .common import add_scene_options, scene_from_args
+from .common import add_scene_options, quantity, scene_from_args
 
 __all__ = ["add_parser", "run"]
 
@@ -17,14 +17,12 @@ def add_parser(sub):
 
 
 def run(args):
-    from ..kernels import compile_for
+    from ..kernels import compile_for  # its importlib.metadata and subprocess: a third of the parser's time
     from ..scene import PRESETS, Scene
 
     given = any(getattr(args, k, None) not in (None, False) for k in args.scene_keys)
     if given:
         if args.radius is not None:
-            from .common import quantity
-
             args.radius = quantity("length")(args.radius)
         scenes = [("scene", scene_from_args(args))]
     else:

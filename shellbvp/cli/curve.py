@@ -6,6 +6,9 @@ import math
 import sys
 import time
 
+from ..paths import check_output_path, partial_path
+from ..progress import curve_progress, progress_bar, wanted
+from ..units import force_unit_of, format_in
 from .common import (
     MAX_POINTS, add_limit_options, add_mu_h_option, add_overwrite_option, add_radius_option, add_scene_options, checkpoint_seconds,
     free_default_name, nondimensional, number_or, plain_number, scene_from_args,
@@ -45,10 +48,8 @@ def add_parser(sub):
 def run(args):
     import dataclasses
 
-    import shellbvp as sb
-
+    from ..continuation import iter_curve
     from ..io import write_curve
-    from ..paths import check_output_path, partial_path
 
     out = check_output_path(args.output if args.output is not None else free_default_name(args.preset or "base", args.force),
                             overwrite=args.force)
@@ -78,15 +79,14 @@ def run(args):
         deltas = [args.delta_max * (i + 1) / args.points for i in range(args.points)]
 
     every = checkpoint_seconds()
-    from ..progress import curve_progress, wanted
 
     bar, show = curve_progress(args.delta_max, f"curve {args.preset or 'base'}", enabled=wanted(args.quiet))
     last = [time.perf_counter()]
 
     t0 = time.perf_counter()
-    run = sb.iter_curve(scene, args.delta_max, deltas=deltas, force_max=args.force_max,
-                        lambda0_max=args.lambda0_max, max_steps=args.max_steps, tol=args.tol,
-                        max_nodes=args.max_nodes, topology=args.topology)
+    run = iter_curve(scene, args.delta_max, deltas=deltas, force_max=args.force_max,
+                     lambda0_max=args.lambda0_max, max_steps=args.max_steps, tol=args.tol,
+                     max_nodes=args.max_nodes, topology=args.topology)
     try:
         for sol in run:
             so_far = run.snapshot()
@@ -127,7 +127,6 @@ def _assess(c, args):
     """The states' stability, with a bar of its own: the curve's stays at 100 % meanwhile."""
     from ..curve_stability import assess
     from ..modal_stability import stability_size
-    from ..progress import progress_bar, wanted
 
     seconds = stability_size(c.scene)[3]
     total = len(c) if args.stability == "points" else None
@@ -144,8 +143,6 @@ def _print_details(c, args, units):
     the range in lab units, the configurations, the stability note."""
     print(f"  scene: {c.scene.describe(None if args.radius is None else args.radius.si)}")
     if units is not None and len(c):
-        from ..units import force_unit_of, format_in
-
         fu = force_unit_of(args.mu_h.unit)
         scale = args.radius.si * args.mu_h.si
         print(f"  with R_L = {args.radius} and mu*H = {args.mu_h}: displacement up to "

@@ -7,9 +7,12 @@ import json
 import sys
 from pathlib import Path
 
+from .. import units
+from ..paths import check_output_path
 from ..scene_parameters import parameters_that, scene_parameter, scene_parameters
 from ..shape_parameters import SHAPE_PARAMETERS
 from ..textdata import printable
+from ..units import Quantity, format_in, readable_unit, split_quantity, unit_factor, unit_kind
 from .common import (
     add_limit_options, add_overwrite_option, add_scene_options, check_report_path, curve_bars, number_or,
     os_error_line, output_dir, plain_number, progress_bar, quantity, require_sample, say, scene_from_args, strict_json,
@@ -212,8 +215,6 @@ def _max_depth(given, R_L):
 def _search_range(param, text, R_L):
     """``--NAME-range LOW,HIGH`` as the nondimensional bounds of the shape parameter ``param``:
     plain numbers as they are; with a unit (a parameter with a lab unit, e.g. 20um) through R_L."""
-    from ..units import Quantity, plain_number, split_quantity
-
     parts = text.split(",")
     try:
         if len(parts) != 2:
@@ -224,7 +225,7 @@ def _search_range(param, text, R_L):
                 values.append(Quantity.parse(part, param.unit_kind, f"--{param.name}-range").si
                               / param.report_scale(R_L))
             else:
-                values.append(plain_number(part, f"--{param.name}-range"))
+                values.append(units.plain_number(part, f"--{param.name}-range"))
     except ValueError:
         unit = f" (plain, or with a {param.unit_kind} unit)" if param.unit_kind else ""
         raise ValueError(f"--{param.name}-range must be two numbers LOW,HIGH{unit}; got {text!r}") from None
@@ -244,7 +245,6 @@ def run(args):
     from ..afm import iter_afm
     from ..batch import expand_inputs, read_record
     from ..fitting import example_data_path, fit_record
-    from ..paths import check_output_path
     from ..readers import reader_for
 
     inputs = [str(example_data_path())] if args.example else args.data
@@ -341,7 +341,6 @@ def _fit_batch(args, files):
     the same scene and settings, one row each (status ok, failed or error), continuing past
     a file that fails; exit 0 when every file was fitted, 1 otherwise."""
     from ..batch import fit_files, write_table
-    from ..paths import check_output_path
 
     if args.table is not None:
         check_output_path(args.table, overwrite=args.force)
@@ -395,7 +394,6 @@ def _fit_map(args, path, curves, scene, R_L, reading, options, pixel_values=None
     [--pixel-table geometry.csv]``: every curve with the same scene (or with the table's geometry
     per pixel); exit 0 when every curve was fitted, 1 otherwise."""
     from ..batch import fit_map, write_table
-    from ..paths import check_output_path
     from ..readers import check_options, reader_for
 
     check_options(reader_for(path), path, reading)
@@ -476,8 +474,6 @@ def _save_fit(res, record, used, output, report, segment, force, quiet_stdout=Fa
 
 def _print_fit(res, record, used, args):
     """The fit in words, in the data's own units (and mu*H in N/m)."""
-    from ..units import format_in
-
     du, fu = _shown_units(record)
     if not res.success:
         say(f"fit failed (status {res.status}): {res.message}")
@@ -557,8 +553,6 @@ def _shown_units(record):
     and N) the unit that suits its size (um or nm, nN or pN); files keep SI."""
     import numpy as np
 
-    from ..units import readable_unit
-
     du, fu = record.units["displacement"], record.units["force"]
     if du == "m" and np.isfinite(record.displacement).any():
         du = readable_unit(np.nanmax(record.displacement) - np.nanmin(record.displacement), "length")
@@ -578,8 +572,6 @@ def _solid_line(c, mesh_error):
 
 def _estimate_line(e):
     """A line of a quantity a fit reports in lab units (``FitResult.derived``)."""
-    from ..units import unit_factor, unit_kind
-
     f = unit_factor(e.display_unit, unit_kind(e.display_unit))
     c1, c2 = e.ci95
     return f"{e.label:<6s} = {e.value / f:.4g} {e.display_unit}   95% CI [{c1 / f:.4g}, {c2 / f:.4g}] ({e.note})"

@@ -5,6 +5,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from ..paths import check_output_path
+from ..textdata import printable
 from .common import output_dir, plain_numbers
 
 __all__ = ["add_parser", "run", "MAX_PIXEL_FIGURES"]
@@ -40,7 +42,6 @@ def add_parser(sub):
 def run(args):
     from ..filekinds import file_kind
     from ..io import read_curve
-    from ..paths import check_output_path
     from ..plotting import plot_curves, plot_profiles, require_matplotlib, save_figure, scene_label
     from ..sweep import read_sweep
 
@@ -106,8 +107,6 @@ def _pixel_figures(args, kinds):
     number said first and bounded by ``--max-figures``."""
     from ..afm import read_map_file
     from ..map_pixels import parse_pixel
-    from ..paths import check_output_path
-    from ..textdata import printable
 
     option = "--pixel" if args.pixel is not None else "--pixels"
     if len(args.files) != 1 or kinds[0] != "force-map":

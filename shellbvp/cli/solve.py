@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 
+from ..units import force_unit_of, format_in
 from .common import (
     add_scene_options, nondimensional, number_or, plain_number, quantity, scene_from_args, strict_json,
 )
@@ -35,14 +36,14 @@ def add_parser(sub):
 def run(args):
     import numpy as np
 
-    import shellbvp as sb
+    from ..state import solve
 
     scene = scene_from_args(args)
     given = {k: nondimensional(args, v, f"--{k}") for k, v in (("delta", args.delta), ("lambda0", args.lambda0),
                                                                 ("force", args.load)) if v is not None}
     if not given:
         given = {"delta": 0.2}
-    sol = sb.solve(scene, tol=args.tol, max_nodes=args.max_nodes, topology=args.topology, **given)
+    sol = solve(scene, tol=args.tol, max_nodes=args.max_nodes, topology=args.topology, **given)
     keys = ("success", "status", "message", "topology", "delta", "force", "lambda0", "S1", "Sc", "pressure",
             "ring_force", "ring_force_inner", "cap_force",
             "pressure_min", "penetration", "valid", "flags", "energy", "force_defect", "force_error",
@@ -55,8 +56,6 @@ def run(args):
         raise ValueError("--radius and --muH go together (rim radius, e.g. 0.3mm, and mu*H, e.g. 52N/m)")
     shown = {}
     if args.radius is not None:  # the state in the units given: displacement R_L delta, force mu_H R_L F
-        from ..units import force_unit_of, format_in
-
         out["displacement_m"] = args.radius.si * sol.delta
         out["force_N"] = args.mu_h.si * args.radius.si * sol.force
         shown = {"displacement": args.radius.show(out["displacement_m"]),

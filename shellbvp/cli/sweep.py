@@ -5,8 +5,9 @@ from __future__ import annotations
 import sys
 import time
 
+from .. import units
 from ..edge_models import contact_models
-from ..materials import material_class
+from ..materials import NeoHookean, material_class
 from ..scene_parameters import parameters_that
 from .common import (
     MAX_POINTS, add_mu_h_option, add_overwrite_option, add_radius_option, material_help, material_spec, nondimensional,
@@ -79,14 +80,13 @@ def _sweep_values(text, name):
     (n spaced evenly in log), each number plain decimal text (nothing is evaluated)."""
     import numpy as np
 
-    from ..units import plain_number
 
     parts = text.split(":")
     if len(parts) == 1:
-        return [plain_number(v, name) for v in text.split(",")]
+        return [units.plain_number(v, name) for v in text.split(",")]
     if len(parts) not in (3, 4) or (len(parts) == 4 and parts[3] != "log"):
         raise ValueError(f"{name} must be a list a,b,c or a range LOW:HIGH:N[:log]; got {text!r}")
-    lo, hi = plain_number(parts[0], name), plain_number(parts[1], name)
+    lo, hi = units.plain_number(parts[0], name), units.plain_number(parts[1], name)
     if not parts[2].strip().isdigit() or not 1 <= int(parts[2]) <= MAX_SWEEP_VALUES:
         raise ValueError(f"{name}: N of LOW:HIGH:N must be an integer in [1, {MAX_SWEEP_VALUES}]; got {parts[2]!r}")
     n = int(parts[2])
@@ -100,8 +100,7 @@ def _sweep_values(text, name):
 def run(args):
     """``shellbvp sweep``: exit 0 every curve complete, 1 some stopped early, failed or were lost
     (the index says which), 2 bad input, 130 interrupted (the file keeps the finished curves)."""
-    import shellbvp as sb
-
+    from ..scene import Scene
     from ..sweep import check_grid, dask_executor, sweep
 
     grid, swept = {}, parameters_that("sweep")
@@ -113,10 +112,10 @@ def run(args):
         raise ValueError(f"give at least one of {', '.join(p.option for p in swept)} to sweep")
     over = {k: getattr(args, k) for k in ("xi", "contact") if getattr(args, k) is not None}
     if args.neo_hookean:
-        over["material"] = sb.NeoHookean()
+        over["material"] = NeoHookean()
     elif args.material is not None:
         over["material"] = args.material
-    base = sb.Scene.preset(args.preset, **over)
+    base = Scene.preset(args.preset, **over)
     for p in swept:  # a swept material parameter: the preset's material if of its family, else that family's
         if p.material and p.name in grid and base.material.family != p.material:
             base = base.replace(material=material_class(p.material)(**{p.name: grid[p.name][0]}))

@@ -5,6 +5,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..continuation import curve
+from ..curve_stability import assess, verdict
+
 __all__ = ["CHECK_DEPTHS", "check_axisymmetry"]
 
 
@@ -18,9 +21,6 @@ def check_axisymmetry(res, deepest, tol, progress=None):
     stability before the deepest fitted depth ``deepest`` (delta); ``res.stability_note``: what
     was not analysed; ``res.stability_verdict``: what was found.  ``progress``: as :func:`fit`'s,
     a bar for the curve and one for the analysis of its states."""
-    from ..continuation import curve
-    from ..curve_stability import assess, verdict
-
     bar, callback = progress("stability check: curve", deepest) if progress is not None else (None, None)
     try:
         c = curve(res.scene, deltas=deepest * np.arange(1, CHECK_DEPTHS + 1) / CHECK_DEPTHS, tol=tol,

@@ -26,6 +26,13 @@ from pathlib import Path
 import numpy as np
 from scipy.interpolate import CubicSpline, PchipInterpolator
 
+from ..config import OPTIONS
+from ..configurations import is_single_cap
+from ..continuation import curve
+from ..io import read_curve, write_curve
+from ..pointload import solve_point_load
+from ..state import solve
+from ..version import __version__
 from .kept import keep, kept_folder, read_kept
 
 __all__ = ["N_DEPTHS", "ModelCurves", "clear_model_curves", "code_fingerprint", "beyond_message"]
@@ -48,8 +55,6 @@ def clear_model_curves():
 def _model_curve(scene, deltas, tol, counter=None, progress=None):
     """The curve of ``scene`` at ``deltas`` (memoised per process: repeated fits reuse it);
     ``progress(description, delta_max) -> (bar, callback)`` draws its progress."""
-    from ..continuation import curve
-
     try:
         key = (scene, tuple(float(x) for x in deltas), float(tol))
         hash(key)
@@ -94,9 +99,6 @@ def _disk_place(scene, deltas, tol):
     """(path, key) of a model curve in the code cache's ``curves/`` folder, or (None, None)
     where the disk cache is off, the scene does not describe itself as data, or the folder
     cannot hold curves (:func:`shellbvp.fitting.kept.kept_folder`: one warning)."""
-    from ..config import OPTIONS
-    from ..version import __version__
-
     if not OPTIONS.model_curve_cache:
         return None, None
     try:
@@ -160,8 +162,6 @@ def _unsound(c, key, scene, deltas):
 def _read_kept(path, key, scene, deltas):
     """The kept curve at ``path`` when it is sound and holds ``key``, ``scene`` and ``deltas``,
     else None (a bad one set aside with a warning)."""
-    from ..io import read_curve
-
     return read_kept(path, read_curve, lambda c: _unsound(c, key, scene, deltas), what="model curve",
                      max_bytes=MAX_KEPT_BYTES)
 
@@ -169,8 +169,6 @@ def _read_kept(path, key, scene, deltas):
 def _keep(c, path, key):
     """Write the complete curve ``c`` to ``path`` (atomically, read back and checked); a cache
     that cannot be written is skipped with one warning."""
-    from ..io import read_curve, write_curve
-
     if path is None or not c.complete:
         return
     c.settings["model_curve_key"] = key
@@ -211,9 +209,6 @@ def _model_start(scene, deltas, tol):
     Data whose depths are nearly all in that limit are refused before the curve.  A closed shell
     on a substrate starts at the first depth: its configurations include the point loads.
     """
-    from ..configurations import is_single_cap
-    from ..state import solve
-
     if scene.two_contacts:  # a closed shell on a substrate has its point-load states in its own curve
         return 0
     why = ""
@@ -234,8 +229,6 @@ def point_load_forces(scene, deltas, tol):
     """The model's nondimensional force at ``deltas`` shallower than its curve's first depth: the
     point-load limit of the smooth contact (:func:`shellbvp.pointload.solve_point_load`), each
     solved from the shallower one's state; NaN where a solve fails."""
-    from ..pointload import solve_point_load
-
     out, prev = [], None
     for d in deltas:
         sol = solve_point_load(scene, float(d), tol=tol, guess=prev)

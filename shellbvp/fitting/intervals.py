@@ -16,6 +16,7 @@ from ..fit_checks import (FIT_STATUS, WEIGHTS_DISAGREE, check_result, contact_mi
                           residual_autocorrelation, runs_in_depth_order, weights_disagreement)
 from ..scene_parameters import scene_parameter
 from ..shape_parameters import SHAPE_PARAMETERS
+from ..units import format_in
 from .least_squares import MODEL_PARAMETERS, LeastSquaresModel
 from .result import Estimate, FitResult
 
@@ -144,8 +145,6 @@ def _linearised(dq, x, dx_dtheta, mu_H, R_L, cov, t):
 def _given_thickness(scene, mu_H, mu_H_ci, R_L):
     """``{"mu": Estimate, "E": Estimate}`` of a scene with a thickness (mu*H over H, H taken as
     exact; E = 3 mu, incompressible), else {}: the same quantities a fitted thickness gives."""
-    from ..units import format_in
-
     eps = getattr(scene, "thickness", None)  # H / R_L
     if eps is None:
         return {}

@@ -12,6 +12,7 @@ import numpy as np
 from ..fit_checks import fit_quality
 from ..scene_parameters import scene_parameter
 from ..shape_parameters import DERIVED, SHAPE_PARAMETERS
+from ..thickness import model_error
 from .apparent import apparent_modulus
 from .least_squares import DEFAULT_WEIGHTS
 
@@ -261,8 +262,6 @@ class FitResult:
         3D elasticity at this thickness over the mapped scenes (:func:`shellbvp.thickness.model_error`);
         None without a thickness or a map for the model; for the solid, its mesh's error where
         checked (``mesh_error``), else None."""
-        from ..thickness import model_error
-
         if self.model == "solid":
             return None if self.mesh_error is None else (self.mesh_error, False)
         if self.measured_model_error is not None:

@@ -10,6 +10,7 @@ import math
 
 import numpy as np
 
+from ..bounds import check_delta, check_tol
 from ..continuation import curve
 from ..scene_parameters import LiveNames, parameters_that, scene_parameter, scene_with
 
@@ -91,8 +92,6 @@ def check_settings(settings: dict) -> dict:
 
 def check_scenes(base_scene, names, combos, delta_max, settings):
     """Every combination's scene and depth, checked before any curve (ValueError naming it)."""
-    from ..bounds import check_delta, check_tol
-
     tol = settings.get("tol", 1e-6)
     check_tol(tol)
     if isinstance(delta_max, bool) or not isinstance(delta_max, (int, float)) or not math.isfinite(delta_max) \

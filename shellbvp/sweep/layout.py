@@ -12,8 +12,10 @@ from pathlib import Path
 
 import numpy as np
 
+from .. import schema as sc
 from ..io import read_curve_group
 from ..paths import open_hdf5
+from ..scene import Scene
 from .grid import MAX_CELLS, SWEEP_PARAMETERS, combinations
 from .result import STATUSES, Sweep
 
@@ -113,8 +115,6 @@ def _read_attrs(path):
     """
     import h5py
 
-    from .. import schema as sc
-
     with open_hdf5(path, fmt=FORMAT, group="sweep", kind="sweep") as f:
         try:
             version = sc.attr_int(f, "format_version")
@@ -210,8 +210,6 @@ def read_sweep(path) -> Sweep:
     True
     """
     import h5py
-
-    from ..scene import Scene
 
     path = Path(path)
     if not path.is_file():

@@ -12,6 +12,8 @@ import time
 
 import numpy as np
 
+from ..model import load_module
+from ..paths import check_output_path
 from .executors import local_pool
 from .grid import MAX_CELLS, check_grid, check_scenes, check_settings, combinations
 from .layout import new_index, read_sweep, reconcile
@@ -141,9 +143,6 @@ def sweep(base_scene, grid, *, delta_max, executor=None, out=None, workers=None,
     >>> sb.sweep(base, {"beta": [0.005, 0.01, 0.02]}, extend=True, **kw).computed
     1
     """
-    from ..model import load_module
-    from ..paths import check_output_path
-
     grid = check_grid(base_scene, grid, max_cells)
     settings = check_settings(curve_settings)
     if executor is not None and workers is not None:
