@@ -22,6 +22,7 @@ from .config import OPTIONS
 from .corner import LEGENDRE_WATCH, edge_model, limit_estimate, near_limit
 from .cylinder import best_wall_state
 from .march import Steps, iter_march
+from .materials import Gent
 from .pointload import SC_POINT, solve_point_load
 from .solution import passed_tip_end
 from .state import cross_convexity_limit, make_system, solve, solve_from, system_like, warm_guess
@@ -75,8 +76,6 @@ GENT_LOCK = 0.98
 
 def gent_lock_ratio(sol) -> float:
     """max (I1 - 3)/Jm over a state of a Gent scene (NaN for other materials)."""
-    from .materials import Gent
-
     material = sol.scene.material
     if not isinstance(material, Gent):
         return float("nan")

@@ -11,6 +11,7 @@ import numpy as np
 from ..chain import CONTACT_KINDS, Edge, Kink, Line, TipEnd
 from ..configurations import CONFIGURATIONS, is_point_load, of
 from ..edge_models import contact_models, edge_model
+from ..inflation import EPS
 from .form import chain_base, reference_shell
 
 
@@ -135,8 +136,6 @@ def contact_of(state, S0=None, friction: str = "frictionless") -> Contact:
     ``friction`` one of :data:`FRICTION`."""
     check_friction(friction)
     check_supported(state)
-    from ..inflation import EPS
-
     sysm, p = state.system, state.p
     L = float(sysm.L)
     zeta = float(sysm.S_point(sysm.regions[0].start, p))

@@ -13,6 +13,7 @@ import scipy.linalg
 import scipy.sparse
 import scipy.sparse.linalg
 
+from ..config import OPTIONS
 from .form import form_at
 
 
@@ -413,8 +414,6 @@ def stability_size(scene, modes=None, elements=None) -> tuple:
 def check_stability_size(scene, modes=None, elements=None, max_dofs=None) -> None:
     """ValueError, in one line, where one state's analysis exceeds ``max_dofs`` unknowns (default
     ``sb.options``' ``max_stability_dofs``, 300,000: about 15 s)."""
-    from ..config import OPTIONS
-
     limit = int(OPTIONS.max_stability_dofs if max_dofs is None else max_dofs)
     ne, nm, dofs, seconds = stability_size(scene, modes, elements)
     if dofs > limit:

@@ -9,14 +9,13 @@ import json
 import numpy as np
 
 from ..chain import CONTACT_STATES, FREE_STATES
+from ..model import load_stability_module
 
 
 @functools.lru_cache(maxsize=16)
 def _module(structure_key):
     """The generated module of ``symbolic.second_variation`` for a structure description (a
     hashable key)."""
-    from ..model import load_stability_module
-
     return load_stability_module(json.loads(structure_key))
 
 
