@@ -4,7 +4,8 @@ The shell model reduces a solid of thickness H to its mid-surface.  This module 
 the solid itself, so that a user sees the model's error for his own scene:
 
 * the solid: the scene's reference meridian as the mid-surface, thickness ``eps = H/R_L``
-  on either side of it by eps/2 along the normal; 9-node quadratic elements (FElupe's
+  on either side of it by eps/2 along the normal (a wall whose thickness varies,
+  ``scene.thickness_profile``: by H(S)/2, the elements' sizes following the local H); 9-node quadratic elements (FElupe's
   ``RegionBiQuadraticQuad``) with the mixed u/p/J (Hu-Washizu) formulation of
   ``ThreeFieldVariation``, bulk modulus ``bulk`` (5000 mu by default: a Poisson ratio of
   0.4999); the scene's energy on the isochoric invariants, from its material's module
@@ -84,7 +85,8 @@ def _felupe():
 
 # ---------------------------------------------------------------- the solid's mesh
 def _meridian(scene, n_table=4001):
-    """Arclength-parametrised reference mid-surface: s -> (R, Z, Phi), with the total length."""
+    """Arclength-parametrised reference mid-surface: s -> (R, Z, Phi), with the total length,
+    and the package's meridian coordinate S of each tabulated point (a profile's H(S))."""
     mod = scene.model()
     par = scene.parameters(mod, pole_rise=0.0)
     S = np.linspace(0.0, scene.shell_length, n_table)
@@ -93,14 +95,37 @@ def _meridian(scene, n_table=4001):
     ds = np.hypot(np.diff(R), np.diff(Z))
     s = np.concatenate([[0.0], np.cumsum(ds)])
     # chords of 4000 intervals: the arclength to ~1e-8, nodes placed by linear interpolation
-    return s, R, Z, np.asarray(ref["Phi"], float)
+    return s, R, Z, np.asarray(ref["Phi"], float), S
 
 
-def _node_positions(total, h, pole_h, pole_zone):
-    """Meridian nodes of the element corners: length pole_h up to pole_zone, growing to h."""
+def _wall(scene, eps, S):
+    """The wall's thickness H/R_L at the meridian coordinates ``S``: ``eps``, or the scene's
+    profile scaled to the pole thickness ``eps`` (the package's convention, ``Scene.replace``)."""
+    profile = scene.thickness_profile
+    if profile is None:
+        return np.full(np.shape(S), float(eps))
+    return eps * profile.relative(S, L=scene.shell_length)
+
+
+def _corners(s_tab, H_tab, eps, element_length, pole_refinement):
+    """The element corners along the meridian (arc length): ``element_length`` times the local
+    thickness, ``pole_refinement`` times shorter within 4 eps of the pole (eps: the pole's)."""
+    h = element_length * eps
+    local = None if np.all(H_tab == eps) else (lambda x: element_length * np.interp(x, s_tab, H_tab))
+    return _node_positions(s_tab[-1], h, h / pole_refinement, 4 * eps, local)
+
+
+def _node_positions(total, h, pole_h, pole_zone, local=None):
+    """Meridian nodes of the element corners: length pole_h up to pole_zone, growing to h, or
+    to ``local(x)`` (a profiled wall's element length at x: the shorter of its value at the
+    element's start and end)."""
     s, x = [0.0], 0.0
     while x < total - 1e-12:
-        step = pole_h if x < pole_zone else min(h, pole_h * (1 + (x - pole_zone) / max(pole_zone, h)) ** 2)
+        cap = h
+        if local is not None:
+            cap = float(local(x))
+            cap = min(cap, float(local(min(total, x + cap))))
+        step = pole_h if x < pole_zone else min(cap, pole_h * (1 + (x - pole_zone) / max(pole_zone, h)) ** 2)
         x = min(total, x + step)
         if total - x < 0.3 * step:  # no sliver at the rim
             x = total
@@ -129,22 +154,23 @@ class _Model:
 def _build(scene, eps, *, through_thickness, element_length, pole_refinement, bulk, penalty, gauss_points,
            band=1e-5, rim_face="plane"):
     fem = _felupe()
-    s_tab, R_tab, Z_tab, Phi_tab = _meridian(scene)
-    total = s_tab[-1]
-    h = element_length * eps
-    corners = _node_positions(total, h, h / pole_refinement, 4 * eps)
-    if whole(scene):  # a closed shell on a substrate: pole to pole
+    s_tab, R_tab, Z_tab, Phi_tab, S_tab = _meridian(scene)
+    H_tab = _wall(scene, eps, S_tab)  # the wall's thickness at each tabulated point
+    corners = _corners(s_tab, H_tab, eps, element_length, pole_refinement)
+    if whole(scene):  # a closed shell on a substrate: pole to pole, each half its profile from its pole
         s_tab, R_tab, Z_tab, Phi_tab, corners = mirrored(s_tab, R_tab, Z_tab, Phi_tab, corners)
+        H_tab = np.r_[H_tab, H_tab[::-1][1:]]
     n_s, n_t = corners.size - 1, int(through_thickness)
     # quadratic nodes: element corners plus midpoints, along s and through t
     s_nodes = np.empty(2 * n_s + 1)
     s_nodes[0::2] = corners
     s_nodes[1::2] = 0.5 * (corners[:-1] + corners[1:])
-    t_nodes = np.linspace(-0.5 * eps, 0.5 * eps, 2 * n_t + 1)
-    R, Z, Phi = (np.interp(s_nodes, s_tab, v) for v in (R_tab, Z_tab, Phi_tab))
-    # the unit normal towards the indenter: (r, z) = (-sin Phi, cos Phi)
+    t_nodes = np.linspace(-0.5, 0.5, 2 * n_t + 1)  # times the local thickness
+    R, Z, Phi, H = (np.interp(s_nodes, s_tab, v) for v in (R_tab, Z_tab, Phi_tab, H_tab))
+    # the unit normal towards the indenter: (r, z) = (-sin Phi, cos Phi); the wall at +-H/2 along it
     nr, nz = -np.sin(Phi), np.cos(Phi)
     tt, ss = np.meshgrid(t_nodes, np.arange(s_nodes.size), indexing="ij")
+    tt = tt * H[ss]
     points = np.stack([(Z[ss] + tt * nz[ss]).ravel(), (R[ss] + tt * nr[ss]).ravel()], axis=1)
     points[np.isclose(points[:, 1], 0.0, atol=1e-14), 1] = 0.0
     ncol = s_nodes.size
@@ -222,15 +248,18 @@ class FESize:
 
 
 def fe_size(scene, thickness, **settings) -> FESize:
-    """The mesh :func:`fe_curve` would build for ``scene`` at ``thickness`` and its estimated cost,
-    without building it (``settings``: :data:`FE_DEFAULTS` overrides)."""
+    """The mesh :func:`fe_curve` would build for ``scene`` at ``thickness`` (of a profiled wall,
+    the pole's) and its estimated cost, without building it (``settings``: :data:`FE_DEFAULTS`
+    overrides)."""
     opts = {**FE_DEFAULTS, **settings}
     eps = float(thickness)
-    total = _meridian(scene)[0][-1]
-    h = opts["element_length"] * eps
-    n_s = math.ceil(total / h)
-    if n_s < 100_000:  # exact (the loop is cheap); beyond, the uniform count is a lower bound
-        n_s = _node_positions(total, h, h / opts["pole_refinement"], 4 * eps).size - 1
+    s_tab, *_, S_tab = _meridian(scene)
+    H_tab = _wall(scene, eps, S_tab)
+    # elements of the local length element_length * H along the arc: exact count below (the loop is
+    # cheap), beyond it this integral (a lower bound: the pole's refinement adds elements)
+    n_s = math.ceil(np.trapezoid(1.0 / (opts["element_length"] * H_tab), s_tab))
+    if n_s < 100_000:
+        n_s = _corners(s_tab, H_tab, eps, opts["element_length"], opts["pole_refinement"]).size - 1
     n_s *= 2 if whole(scene) else 1  # a closed shell on a substrate: both halves
     n_t = int(opts["through_thickness"])
     # quadratic displacement nodes, two components; pressure and volume ratio: 4 per element each
@@ -268,9 +297,16 @@ def check_solid_scene(scene, use="fit"):
     if scene.closed and use == "fit":
         raise ValueError("a fit of a closed shell (support=substrate/plates) with the 3D solid is not offered yet; "
                          "fit it with model='shell' (sb.validate and sb.fe_curve measure the shell's error)")
-    if scene.thickness_profile is not None:
-        raise ValueError("the 3D reference meshes a uniform wall; a thickness_profile has no solid yet")
     _check_material(scene)
+
+
+def _check_profile(scene, eps):
+    """ValueError, in one line, where the profile scaled to the pole thickness ``eps`` leaves (0, 0.5]."""
+    profile = scene.thickness_profile
+    thickest = eps * profile.thickest(scene.shell_length) / profile.pole
+    if thickest > 0.5:
+        raise ValueError(f"thickness: at the pole's eps = {eps:g} the wall's profile reaches H/R_L = {thickest:.4g}; "
+                         f"it must stay in (0, 0.5] (a pole thickness up to {0.5 * eps / thickest:.4g})")
 
 
 def _check_material(scene):
@@ -294,7 +330,7 @@ class FECurve:
     ----------
     scene : Scene
     thickness : float
-        eps = H / R_L.
+        eps = H / R_L (of a profiled wall, the pole's).
     delta : ndarray
         Mid-surface pole displacement (the shell model's delta).
     force : ndarray
@@ -363,7 +399,11 @@ def fe_curve(scene, thickness, deltas, *, at="pole", mesh_check=False, progress=
         measured from the inflated state, as the shell model's.  ``sealed``: the volume below
         the inner surface is then held, its pressure an unknown (``FECurve.pressure``).
     thickness : float
-        eps = H / R_L, in (0, 0.5].
+        eps = H / R_L, in (0, 0.5]; of a wall whose thickness varies (``scene.thickness_profile``)
+        the pole's, which scales the profile as ``scene.replace(thickness=eps)`` does: the wall is
+        ``eps * H(S)/H(0)`` (at most 0.5 everywhere), its inner and outer surfaces at half that on
+        either side of the reference mid-surface, and forces ``F / (mu R_L H)`` with the pole's H,
+        as the shell model's.
     deltas : array_like
         Depths, increasing, > 0: of the mid-surface pole (``at="pole"``, the shell model's delta)
         or of the indenter from first touch (``at="indenter"``, what an instrument records); of a
@@ -405,6 +445,8 @@ def fe_curve(scene, thickness, deltas, *, at="pole", mesh_check=False, progress=
     if at not in ("pole", "indenter"):
         raise ValueError(f"at must be 'pole' or 'indenter'; got {at!r}")
     check_solid_scene(scene, use="curve")
+    if scene.thickness_profile is not None:
+        _check_profile(scene, eps)
     unknown = set(settings) - set(FE_DEFAULTS)
     if unknown:
         raise ValueError(f"unknown FE setting(s) {sorted(unknown)}; known: {sorted(FE_DEFAULTS)}")

@@ -131,7 +131,9 @@ class Validation:
             sample.attrs.update({"NX_class": "NXsample", "description": self.scene.describe(self.R_L)})
             if self.R_L is not None:
                 number_dataset(sample, "R_L", float(self.R_L), "m", "rim radius")
-                number_dataset(sample, "thickness", float(self.scene.thickness * self.R_L), "m", "shell thickness H")
+                number_dataset(sample, "thickness", float(self.scene.thickness * self.R_L), "m",
+                               "shell thickness H" if self.scene.thickness_profile is None else
+                               "shell thickness H at the pole (the wall's profile: the shell's scene)")
 
 
 def validate(scene, thickness=None, deltas=None, *, delta_max=0.5, mesh_check=False, progress=None,
@@ -142,8 +144,10 @@ def validate(scene, thickness=None, deltas=None, *, delta_max=0.5, mesh_check=Fa
     ----------
     scene : Scene
         Its ``thickness`` is used when ``thickness`` is not given; beta comes from the thickness.
+        A wall whose thickness varies (``scene.thickness_profile``) is meshed as it varies
+        (:func:`shellbvp.fe.fe_curve`); forces and depths refer to the pole's thickness.
     thickness : float, optional
-        eps = H / R_L in (0, 0.5].
+        eps = H / R_L in (0, 0.5]; of a profiled wall the pole's, which scales the profile.
     deltas : array_like, optional
         Mid-surface pole displacements; default :func:`default_depths` up to ``delta_max``.
     mesh_check : bool
@@ -258,9 +262,10 @@ class ValidationFile:
             return format_in(x, "um" if x < 1e-3 else "mm", "length")
 
         lab = "" if self.R_L is None else f", R_L = {length(self.R_L)}, H = {length(self.scene.thickness * self.R_L)}"
+        pole = "" if self.scene.thickness_profile is None else " at the pole"
         lines = [f"sample:    {self.scene.describe(self.R_L)}",
                  f"compared:  the shell model and the 3D solid (FElupe) at {self.delta.size} pole displacements; "
-                 f"eps = H/R_L = {self.scene.thickness:.4g}{lab}"]
+                 f"eps = H/R_L = {self.scene.thickness:.4g}{lab}{pole}"]
         if not self.fe_success:
             lines.append(f"FE:        {self.fe_message}")
         return lines + self.table().splitlines()

@@ -59,7 +59,8 @@ def run(args):
     check_fe_size(size)  # before the shell's curve too: one line, no work
     t0 = time.perf_counter()
     shell = "with its transverse shear" if scene.transverse_shear else "Kirchhoff (no transverse shear)"
-    print(f"scene: {args.preset or 'base'}, eps = H/R_L = {scene.thickness:.4g}, beta = {scene.beta:.4g}; "
+    pole = "" if scene.thickness_profile is None else " at the pole (the wall's profile in the sample line)"
+    print(f"scene: {args.preset or 'base'}, eps = H/R_L = {scene.thickness:.4g}{pole}, beta = {scene.beta:.4g}; "
           f"3D model (FElupe) and shell model, {shell}, at the same pole displacements", flush=True)
     print(f"sample: {scene.describe(None if args.radius is None else args.radius.si)}", flush=True)
     print(f"3D model: {size.describe()} (estimated)", flush=True)

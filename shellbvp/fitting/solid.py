@@ -51,7 +51,9 @@ FIT_MODELS = ("auto", "shell", "solid")
 
 #: ``model="auto"`` measures the shell against the solid from this thickness (eps = H/R_L) up:
 #: thinner shells need a finer solid mesh (its cost grows like 1/eps^2: benchmarks/results/
-#: thick_fits.md), and their shell model is within a few percent of the solid.
+#: thick_fits.md), and their shell model is within a few percent of the solid.  A wall whose
+#: thickness varies is measured from its thickest point this thick up (the model's error line
+#: names the thickest too), when its solid is within the limit of unknowns (``max_fe_dofs``).
 AUTO_SOLID_EPS = 0.05
 
 #: A kept solid curve larger than this is not read (40 depths take about 4 kB).
@@ -131,6 +133,8 @@ def auto_model(scene, free=(), stability=False):
     """``(choice, why)`` of ``model="auto"``: ``"shell"`` with the reason the solid is not used
     here, or ``"both"`` (fit both; :func:`shell_or_solid` keeps one)."""
     eps = scene.thickness
+    if eps is not None and scene.thickness_profile is not None:
+        eps = scene.thickness_profile.thickest(scene.shell_length)
     reason = None
     if eps is None:
         reason = "no thickness given: the 3D solid needs --thickness"
@@ -141,11 +145,13 @@ def auto_model(scene, free=(), stability=False):
     elif scene.transverse_shear:
         reason = "asked for with transverse shear"
     elif eps < AUTO_SOLID_EPS:
-        reason = (f"eps = {eps:.3g} < {AUTO_SOLID_EPS:g}: the solid costs too much to measure the shell by "
-                  f"default; --model solid uses it")
+        thickest = " (the wall's thickest)" if scene.thickness_profile is not None else ""
+        reason = (f"eps = {eps:.3g}{thickest} < {AUTO_SOLID_EPS:g}: the solid costs too much to measure the shell "
+                  f"by default; --model solid uses it")
     else:
         try:
             check_solid_scene(scene)
+            check_fe_size(fe_size(scene, scene.thickness, **FE_DEFAULTS))
         except ValueError as exc:
             reason = f"no 3D solid for this scene: {exc}"
     if reason is None and importlib.util.find_spec("felupe") is None:
