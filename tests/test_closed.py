@@ -146,6 +146,7 @@ def test_a_small_tip_on_a_thin_sphere_on_a_substrate_is_reissners_two_poles_in_s
     assert 0.96 < s.force / d / (4 * math.sqrt(3 * beta)) < 1.0
 
 
+@pytest.mark.slow  # a two-contact curve (~25 s); its file round trip is the rimmed curves' code
 def test_a_curve_of_a_closed_shell_on_a_substrate_is_written_and_read_back(tmp_path):
     c = sb.curve(on_substrate(beta=1e-3, rho=0.3), delta_max=0.04)
     assert np.all(c.status == 0) and np.all(c.valid)

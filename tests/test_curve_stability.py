@@ -196,6 +196,7 @@ def test_locate_on_the_dome_brackets_a_true_sign_change():
     assert points.bracket[0] <= first.delta <= points.bracket[1]
 
 
+@pytest.mark.slow  # a fit with a stability check at every model point (~40 s)
 def test_a_fit_past_the_first_instability_warns_and_records_it(tmp_path):
     scene = sb.Scene.preset("dome", **DOME)
     R_L, mu_H = 1e-3, 40.0

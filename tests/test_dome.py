@@ -117,6 +117,7 @@ def test_spheroidal_dome_pairs_with_its_bowl():
 
 # in the default suite (~26 s): marked slow, it failed unseen until 69c371e, after the adaptive
 # curve's steps moved (a force maximum of F ~ 1e-4 stepped over; legs.MAX_PLOT_TURN)
+@pytest.mark.slow  # the whole snap-through curve (~25 s)
 def test_dome_snaps_at_a_fold_in_delta():
     """Past its force maximum (F 3.28e-4 near delta 0.169) the dome's branch turns back in
     delta at 0.18289 (F about 1.4e-4): under displacement control it snaps there.  Natural

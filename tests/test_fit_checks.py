@@ -124,6 +124,7 @@ def test_infinite_values_are_an_error(good, no_model_curves):
     assert fitting.fit_data._check_data(disp, nan, 2)[0].size == N - 1
 
 
+@pytest.mark.slow  # the model curve is computed before the depths are compared (~25 s)
 def test_data_shallower_than_the_model_starts(good):
     """nm-scale data against a 0.3 mm rim (or a radius too large): a clear error, not an IndexError."""
     scene, disp, F, force = good

@@ -241,6 +241,7 @@ def _auto_base():
     return _AUTO["ks"]
 
 
+@pytest.mark.slow  # a numba compilation in a second process (~25 s)
 @needs_numba
 def test_auto_compiles_in_a_background_process_once_then_loads_from_the_cache():
     ks = _auto_base()
