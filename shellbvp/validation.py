@@ -130,7 +130,8 @@ class Validation:
             sample = entry.create_group("sample")
             sample.attrs.update({"NX_class": "NXsample", "description": self.scene.describe(self.R_L)})
             if self.R_L is not None:
-                number_dataset(sample, "R_L", float(self.R_L), "m", "rim radius")
+                number_dataset(sample, "R_L", float(self.R_L), "m",
+                               "equatorial radius" if self.scene.closed else "rim radius")
                 number_dataset(sample, "thickness", float(self.scene.thickness * self.R_L), "m",
                                "shell thickness H" if self.scene.thickness_profile is None else
                                "shell thickness H at the pole (the wall's profile: the shell's scene)")
