@@ -14,6 +14,15 @@ from pathlib import Path
 
 import numpy as np
 
+from . import schema as sc
+from .continuation import curve
+from .fe import fe_curve
+from .io import read_curve_group, write_curve_group
+from .nexus import new_file, number_dataset
+from .paths import open_hdf5
+from .plotting import require_matplotlib, save_figure
+from .units import format_in
+
 __all__ = ["validate", "Validation", "ValidationFile", "read_validation", "default_depths", "shell_curve", "FORMAT"]
 
 FORMAT = "shellbvp-validation"
@@ -53,7 +62,6 @@ class Validation:
         delta  delta/H     F_shell        F_FE    error  FE mesh
           0.1        1     0.10418    0.089085  +16.94%        -
     """
-
     scene: object
     shell: object
     fe: object
@@ -98,9 +106,6 @@ class Validation:
         settings) and ``sample`` (NXsample: the scene in words; with ``R_L``, the datasets
         ``R_L`` and ``thickness`` in m).  :func:`read_validation` reads it.
         """
-        from .io import write_curve_group
-        from .nexus import new_file, number_dataset
-
         with new_file(path, FORMAT, FORMAT_VERSION, overwrite=overwrite) as f:
             f.attrs["default"] = "entry"
             entry = f.create_group("entry")
@@ -177,8 +182,6 @@ def validate(scene, thickness=None, deltas=None, *, delta_max=0.5, mesh_check=Fa
     >>> print(f"{v.error[-1]:+.3f}")             # the shell model 17 % stiffer at delta = H, eps = 0.1
     +0.169
     """
-    from .fe import fe_curve
-
     if thickness is not None:
         scene = scene.replace(thickness=thickness)
     if scene.thickness is None:
@@ -198,8 +201,6 @@ def shell_curve(scene, deltas, *, tol=1e-6, max_nodes=10000):
     """The shell model's curve at ``deltas``; with ``scene.transverse_shear`` also at ``deltas -
     shear_delta``, whose thick-shell depths ``delta + shear_delta`` fall next to ``deltas`` (then
     :meth:`Curve.force_at` interpolates locally)."""
-    from .continuation import curve
-
     deltas = np.asarray(deltas, dtype=float)
     shell = curve(scene, deltas=deltas, tol=tol, max_nodes=max_nodes, estimate_error=False)
     if not scene.transverse_shear:
@@ -238,7 +239,6 @@ class ValidationFile:
     fe_success : bool
     fe_message : str
     """
-
     path: str
     scene: object
     R_L: object
@@ -257,8 +257,6 @@ class ValidationFile:
 
     def summary_lines(self) -> list:
         """What ``shellbvp info`` prints."""
-        from .units import format_in
-
         def length(x):
             return format_in(x, "um" if x < 1e-3 else "mm", "length")
 
@@ -273,8 +271,6 @@ class ValidationFile:
 
     def plot(self, out=None, dpi=150):
         """F against delta of both models and the shell's error, side by side; saved to ``out``."""
-        from .plotting import require_matplotlib, save_figure
-
         plt = require_matplotlib()
         fig, (a, b) = plt.subplots(1, 2, figsize=(10, 4.2))
         a.plot(self.delta, self.force_fe, "ko", label="3D solid (FElupe)")
@@ -329,10 +325,6 @@ def read_validation(path) -> ValidationFile:
         delta  delta/H     F_shell        F_FE    error  FE mesh
           0.1        1     0.10418    0.089085  +16.94%        -
     """
-    from . import schema as sc
-    from .io import read_curve_group
-    from .paths import open_hdf5
-
     with open_hdf5(path, fmt=FORMAT, group="entry/comparison", kind="validation") as h:
         try:
             sc.format_version(h, FORMAT_VERSION)

@@ -301,7 +301,7 @@ def test_function_level_imports_of_the_package_stand_where_they_are_known():
     are the command line's of modules that load numpy (its parser must not) and, for the rest, only
     in the modules left for a later pass (issue 57: 145 at eab5e9b, in 40 modules)."""
     census = _load("architecture").census()
-    later = {"validation", "cli.validate", "cli.compile"}
+    later = {"cli.compile"}
     assert set(census["function_imports_package_rest"]) <= later, census["function_imports_package_rest"]
     assert census["function_imports_package_rest"].get("cli.compile", 0) <= 1  # kernels: its cost, commented
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from ..paths import check_output_path
 from .common import (
     add_limit_options, add_overwrite_option, add_radius_option, add_scene_options, free_default_name, nondimensional, number_or,
     plain_numbers, scene_from_args,
@@ -47,8 +48,6 @@ def run(args):
         deltas = plain_numbers(args.deltas, "--deltas")
         if any(not 0 < d <= 2 for d in deltas) or any(b <= a for a, b in zip(deltas, deltas[1:])):
             raise ValueError("--deltas must be increasing pole displacements in (0, 2]")
-    from ..paths import check_output_path
-
     out = check_output_path(args.output if args.output is not None
                             else free_default_name(f"{args.preset or 'base'}-validate", args.force), overwrite=args.force)
     try:
