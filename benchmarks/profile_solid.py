@@ -17,6 +17,10 @@ disk's, of the solid, of the shell model and of Kirchhoff's plate with D(r) = mu
 Poisson ratio 1/2 (3D incompressible) and 1 (a bending energy of the mean curvature alone),
 solved here by Ritz on the slope.
 
+With the Gaussian-curvature term: the shell side again with the user bending energy ``GAUSS``
+(Kirchhoff's plate at Poisson ratio 1/2, ``B = (Ds + Dt)^2/2 - Ds Dt/2``), against the same
+stored FE forces: the disk and the hemisphere's walls in ``GAUSS_WALLS``.
+
 Each wall's 3D solid (``sb.fe_curve``, the default mesh and its mesh check) against the shell
 model (smooth contact, trace bending, beta from the pole's thickness), without and with
 transverse shear.  Forces in units of mu R_L H0 (the pole's H).  Reported: ``F_shell / F_FE -
@@ -57,6 +61,14 @@ CASES = {
     0.0125: {"profile": "0.0125*(1 + S/L)", "uniform H0": 0.0125},
 }
 
+#: Kirchhoff's bending at Poisson ratio 1/2 as a user bending energy: the trace energy less half the
+#: product of the bending strains Ds = lambda_s^2 kappa_s - kappa_s0, Dt = lambda_theta^2 kappa_theta - kappa_theta0
+GAUSS = ("(lambda_s**2*kappa_s - kappa_s0 + lambda_theta**2*kappa_theta - kappa_theta0)**2/2"
+         " - (lambda_s**2*kappa_s - kappa_s0)*(lambda_theta**2*kappa_theta - kappa_theta0)/2")
+#: The walls whose shell side is solved with GAUSS too
+GAUSS_WALLS = ((0.025, "profile"), (0.025, "uniform H0"), (0.0125, "profile"), (0.0125, "uniform H0"))
+
+
 def key(pole, name):
     return f"pole {pole:g}: {name}"
 BANDS = (("delta <= H0", lambda k, wrap: k <= 1 + 1e-9 and not wrap),
@@ -82,12 +94,14 @@ def fe_case(args):
                   "elements": list(c.elements), "seconds": c.wall_time}
 
 
-def shell_rows(fe):
-    """The shell model at the FE's depths, without and with transverse shear, in units of mu R_L H0."""
+def shell_rows(fe, bending=None):
+    """The shell model at the FE's depths, without and with transverse shear, in units of mu R_L H0
+    (``bending``: a formula for ``sb.BendingEnergy``, default the trace energy)."""
     d = np.asarray(fe["delta"], float)
     rows = {}
+    over = {} if bending is None else {"bending": sb.BendingEnergy(bending, name="gauss")}
     for label, shear in (("Kirchhoff", False), ("shear", True)):
-        scene = scene_of(fe["wall"], transverse_shear=shear)
+        scene = scene_of(fe["wall"], transverse_shear=shear, **over)
         t0 = time.perf_counter()
         shell = shell_curve(scene, d)
         fake = _FE(d)
@@ -132,18 +146,28 @@ def plate_compliance(t, nu, n=2000):
     return -np.trapezoid(phi, r)
 
 
+def plate_walls(bending=None):
+    """The disk's two walls, uniform and profiled, and its depth (``bending`` as in :func:`shell_rows`)."""
+    eps = PLATE_EPS
+    over = {} if bending is None else {"bending": sb.BendingEnergy(bending, name="gauss")}
+    disk = sb.Scene(gamma=0.0, rho=0.2, material=sb.NeoHookean(), **over)
+    return {"uniform": disk.replace(thickness=eps),
+            "profile": disk.replace(thickness=sb.ThicknessProfile.formula(f"{eps:g}*(1 + S/L)"))}, 0.05 * eps
+
+
+def plate_shell(scene, d):
+    shell = sb.solve(scene, delta=d, estimate_error=False)
+    return float(shell.force) if shell.success else math.nan
+
+
 def plate_case():
     """The disk's stiffness ratios (profile over uniform) of the solid, the shell and Kirchhoff."""
-    eps, d = PLATE_EPS, 0.05 * PLATE_EPS
-    disk = sb.Scene(gamma=0.0, rho=0.2, material=sb.NeoHookean())
-    walls = {"uniform": disk.replace(thickness=eps),
-             "profile": disk.replace(thickness=sb.ThicknessProfile.formula(f"{eps:g}*(1 + S/L)"))}
+    walls, d = plate_walls()
     out = {}
     for name, scene in walls.items():
         t0 = time.perf_counter()
-        fe = sb.fe_curve(scene, eps, [d])
-        shell = sb.solve(scene, delta=d, estimate_error=False)
-        out[name] = {"fe": float(fe.force[0]), "shell": float(shell.force) if shell.success else math.nan,
+        fe = sb.fe_curve(scene, PLATE_EPS, [d])
+        out[name] = {"fe": float(fe.force[0]), "shell": plate_shell(scene, d),
                      "elements": list(fe.elements), "seconds": time.perf_counter() - t0}
     uniform, thick = (lambda r: np.ones_like(r)), (lambda r: 1 + np.arcsin(r) / (math.pi / 2))  # r = sin S
     out["kirchhoff"] = {f"{nu:g}": plate_compliance(uniform, nu) / plate_compliance(thick, nu) for nu in (0.5, 1.0)}
@@ -155,10 +179,7 @@ def pct(x):
 
 
 def report(cache, args):
-    from checkout import commit_label
-
-    lines = [f"Measured {time.strftime('%Y-%m-%d')} on {platform.machine()}, shellbvp {sb.__version__} at "
-             f"{commit_label() or 'unknown commit'}; `nice -n 10 python benchmarks/profile_solid.py"
+    lines = [f"Measured {cache.get('measured') or _measured()}; `nice -n 10 python benchmarks/profile_solid.py"
              f"{' --no-mesh-check' if not args.mesh_check else ''}`.", "",
              "Hemisphere, rho 0.2 (preset base), neo-Hookean, rim pinned.  F_shell / F_FE - 1 in percent at the "
              "same mid-surface pole displacement delta; 3D solid: `sb.fe_curve` with its default mesh (3 elements "
@@ -224,7 +245,77 @@ def report(cache, args):
                   "| 3D solid | shell model | Kirchhoff, nu 1/2 | Kirchhoff, nu 1 |", "|---|---|---|---|",
                   f"| {p['fe'] / u['fe']:.4f} | {p['shell'] / u['shell']:.4f} | {k['0.5']:.4f} | {k['1']:.4f} |", "",
                   f"The uniform disk: F_shell / F_FE - 1 = {pct(u['shell'] / u['fe'] - 1)} %.", ""]
+    if "gauss" in cache:
+        lines += gauss_report(cache)
     return "\n".join(lines)
+
+
+def gauss_report(cache):
+    """The section of the shell side with the Gaussian-curvature term (GAUSS), against the same FE forces."""
+    g = cache["gauss"]
+    lines = ["# With the Gaussian-curvature term (a user bending energy)", "",
+             f"Shell side measured {g['measured']}, against the FE forces above.  "
+             f"`sb.BendingEnergy(\"{g['formula']}\")`: B = (Ds + Dt)^2/2 - Ds Dt/2 with Ds = lambda_s^2 kappa_s "
+             "- kappa_s0, Dt = lambda_theta^2 kappa_theta - kappa_theta0, Kirchhoff's plate at Poisson ratio 1/2 "
+             "(plate limit: stiffness 1, Poisson ratio 0.5; beta = (H0/R_L)^2/3 as the trace energy's).  "
+             "'trace' the columns above, 'Gauss' with this energy.", ""]
+    plate = cache.get("plate")
+    if plate is not None:
+        u, p, gp = plate["uniform"], plate["profile"], g["plate"]
+        lines += ["## The flat disk", "",
+                  "| | 3D solid | shell, trace | shell, Gauss | Kirchhoff, nu 1/2 |", "|---|---|---|---|---|",
+                  f"| profiled / uniform stiffness | {p['fe'] / u['fe']:.4f} | {p['shell'] / u['shell']:.4f} | "
+                  f"{gp['profile'] / gp['uniform']:.4f} | {plate['kirchhoff']['0.5']:.4f} |",
+                  f"| uniform disk, F_shell / F_FE - 1 (%) | | {pct(u['shell'] / u['fe'] - 1)} | "
+                  f"{pct(gp['uniform'] / u['fe'] - 1)} | |",
+                  f"| profiled disk, F_shell / F_FE - 1 (%) | | {pct(p['shell'] / p['fe'] - 1)} | "
+                  f"{pct(gp['profile'] / p['fe'] - 1)} | |", ""]
+    variants = [("shell", "Kirchhoff", "trace, Kirchhoff"), ("shell", "shear", "trace, shear"),
+                ("shell_gauss", "Kirchhoff", "Gauss, Kirchhoff"), ("shell_gauss", "shear", "Gauss, shear")]
+    walls = [(pole, name) for pole, name in GAUSS_WALLS if "shell_gauss" in cache.get(key(pole, name), {})]
+    summary = {}
+    for pole, name in walls:
+        fe = cache[key(pole, name)]
+        d, ff = np.asarray(fe["delta"], float), np.asarray(fe["force"], float) * fe["eps"] / pole
+        lines += [f"## H0 = {pole:g}, {name}: F_shell / F_FE - 1 (%)", "",
+                  "| delta/H0 | F_FE | " + " | ".join(v[2] for v in variants) + " |", "|---|---|" + "---|" * len(variants)]
+        for i, x in enumerate(d):
+            errs = {v[2]: fe[v[0]][v[1]]["force"][i] / ff[i] - 1 for v in variants}
+            lines.append(f"| {x / pole:.3g} | {ff[i]:.5g} | " + " | ".join(pct(e) for e in errs.values()) + " |")
+            summary.setdefault((pole, name), []).append((x / pole, fe["contact_radius"][i] >= 0.95 * 0.2, errs))
+        lines.append("")
+    for pole in dict.fromkeys(p for p, _ in walls):
+        names = [n for p, n in walls if p == pole]
+        lines += [f"## H0 = {pole:g}: the largest |F_shell / F_FE - 1| (percent) by depth band", "",
+                  "| depth | " + " | ".join(f"{n}, {v[2]}" for n in names for v in variants) + " |",
+                  "|---|" + "---|" * (len(names) * len(variants))]
+        for label, test in BANDS:
+            cells = []
+            for name in names:
+                for v in variants:
+                    sel = [abs(e[v[2]]) for k, wrap, e in summary[(pole, name)] if test(k, wrap) and np.isfinite(e[v[2]])]
+                    cells.append(f"{100 * max(sel):.1f}" if sel else "-")
+            lines.append(f"| {label} | " + " | ".join(cells) + " |")
+        lines.append("")
+    lines += ["## The profile's stiffening with the Gaussian term", "",
+              "F(profile) / F(uniform H0) - 1 in percent (Kirchhoff, no shear), and the part of the solid's the "
+              "shell model holds.", "",
+              "| H0 | delta/H0 | solid | shell, trace | shell, Gauss | trace / solid | Gauss / solid |",
+              "|---|---|---|---|---|---|---|"]
+    for pole in dict.fromkeys(p for p, _ in walls):
+        prof, unif = cache.get(key(pole, "profile")), cache.get(key(pole, "uniform H0"))
+        if prof is None or unif is None or "shell_gauss" not in prof or "shell_gauss" not in unif:
+            continue
+        for i, x in enumerate(prof["delta"]):
+            if x > 10 * pole * (1 + 1e-9):
+                continue
+            solid = prof["force"][i] / unif["force"][i] - 1
+            tr = prof["shell"]["Kirchhoff"]["force"][i] / unif["shell"]["Kirchhoff"]["force"][i] - 1
+            ga = prof["shell_gauss"]["Kirchhoff"]["force"][i] / unif["shell_gauss"]["Kirchhoff"]["force"][i] - 1
+            lines.append(f"| {pole:g} | {x / pole:.3g} | {100 * solid:+.1f} | {100 * tr:+.1f} | {100 * ga:+.1f} | "
+                         f"{tr / solid:.3f} | {ga / solid:.3f} |")
+    lines.append("")
+    return lines
 
 
 def main(argv=None):
@@ -252,14 +343,33 @@ def main(argv=None):
             cache[k] = fe
             print(f"{k}: FE {fe['seconds']:.0f} s, {fe['message']}", flush=True)
             _write(store, json.dumps(cache, indent=1, default=float))  # no finished curve is lost
+    if todo or "measured" not in cache:
+        cache["measured"] = _measured()
     if "plate" not in cache or args.recompute:
         cache["plate"] = plate_case()
     for k, fe in cache.items():
-        if k != "plate" and "shell" not in fe:
+        if k.startswith("pole") and "shell" not in fe:
             fe["shell"] = shell_rows(fe)
+    if "gauss" not in cache:
+        walls, d = plate_walls(GAUSS)
+        cache["gauss"] = {"measured": _measured(), "formula": GAUSS,
+                          "plate": {name: plate_shell(scene, d) for name, scene in walls.items()}}
+    for pole, name in GAUSS_WALLS:
+        fe = cache.get(key(pole, name))
+        if fe is not None and "shell_gauss" not in fe:
+            fe["shell_gauss"] = shell_rows(fe, GAUSS)
+            print(f"{key(pole, name)}: shell with the Gaussian term", flush=True)
+            _write(store, json.dumps(cache, indent=1, default=float))
     _write(store, json.dumps(cache, indent=1, default=float))
     _write(out / "profile_solid.md", report(cache, args))
     print(f"wrote {out / 'profile_solid.md'}")
+
+
+def _measured():
+    from checkout import commit_label
+
+    return (f"{time.strftime('%Y-%m-%d')} on {platform.machine()}, shellbvp {sb.__version__} at "
+            f"{commit_label() or 'unknown commit'}")
 
 
 def _write(path, text):

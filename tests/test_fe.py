@@ -27,6 +27,12 @@ def test_plate_limits_are_derived_and_match_the_classes():
                             " + (kappa_s - kappa_s0)*(kappa_theta - kappa_theta0)")
     assert (user.plate_stiffness, user.plate_poisson) == (2.0, 0.5)   # a 3D plate's Poisson ratio
     assert sb.beta_from_thickness(0.05, bending=user) == pytest.approx(0.05**2 / 6)
+    # docs/thickness.md's energy for walls whose thickness varies: Kirchhoff's plate at Poisson ratio 1/2
+    gauss = sb.BendingEnergy("(lambda_s**2*kappa_s - kappa_s0 + lambda_theta**2*kappa_theta - kappa_theta0)**2/2"
+                             " - (lambda_s**2*kappa_s - kappa_s0)*(lambda_theta**2*kappa_theta - kappa_theta0)/2")
+    assert (gauss.plate_stiffness, gauss.plate_poisson) == (1.0, 0.5)
+    wall = sb.ThicknessProfile.formula("0.025*(1 + S/L)")
+    assert sb.Scene.preset("base", bending=gauss, thickness=wall).beta == pytest.approx(0.025**2 / 3)
 
 
 def test_beta_from_thickness_is_the_3d_plate():
