@@ -4,6 +4,7 @@ The fast tests check the plan and argument parsing only; the slow one runs
 ``run.py --quick`` into a temporary directory (a smoke test of every step).
 """
 
+import functools
 import importlib.util
 import json
 import math
@@ -15,6 +16,12 @@ from pathlib import Path
 import pytest
 
 BENCH = Path(__file__).resolve().parent.parent / "benchmarks"
+
+
+@functools.lru_cache(maxsize=1)
+def _census():
+    """This checkout's census, measured once for the tests that read it (~7 s each)."""
+    return _load("architecture").census()
 
 
 def _load(name):
@@ -252,7 +259,7 @@ def test_the_modules_split_by_job_are_none_over_600_lines():
     """benchmarks/architecture.py on this checkout: fitting, sweep, the 3D reference, the chain and
     the instrument files are split by job, none of their modules over 600 lines (at f55cc39
     ``chain`` had 851 and ``instrument`` 768)."""
-    census = _load("architecture").census()
+    census = _census()
     split = {m: n for m, n in census["long_modules"].items()
              if m.split(".")[0] in ("fitting", "sweep", "fe", "chain", "instrument", "instrument_record", "segments")}
     assert not split, split
@@ -262,7 +269,7 @@ def test_the_structure_census_holds_what_the_redesign_reached():
     """benchmarks/architecture.py on this checkout: no natural-continuation loop written out
     beside shellbvp.march, results built in two places only (the diagnosis, failure()), and no
     .get on a result (what is left are dicts of other kinds: scene, switch, settings, points)."""
-    census = _load("architecture").census()
+    census = _census()
     assert census["step_loops"] == []
     assert census["solution_builds"] == {"diagnosis": 1, "solution": 1}
     receivers = {where.split("(")[1].rstrip(")") for where in census["result_gets"]}
@@ -290,7 +297,7 @@ def test_the_census_counts_that_are_zero_stay_zero():
     module over 600 lines, no natural-continuation loop written out, no write of a Solution's field
     outside solution and diagnosis (a state is built once; 37 at 9070cc8: liftoff 11, cylinder 6,
     recorder 5, state 5, inflation 4, continuation 3, legs 1, pointload 1, switches 1)."""
-    census = _load("architecture").census()
+    census = _census()
     for key in ("string_hooks", "settings_writes", "format_names", "edge_model_comparisons", "edge_model_tables",
                 "long_modules", "step_loops", "solution_writes"):
         assert not census[key], (key, census[key])
@@ -300,7 +307,7 @@ def test_function_level_imports_of_the_package_stand_where_they_are_known():
     """benchmarks/architecture.py on this checkout (issue 57): the package's imports inside functions
     are the command line's of modules that load numpy (its parser must not) and, for the rest, only
     in the modules left for a later pass (issue 57: 145 at eab5e9b, in 40 modules)."""
-    census = _load("architecture").census()
+    census = _census()
     later = {"cli.compile"}
     assert set(census["function_imports_package_rest"]) <= later, census["function_imports_package_rest"]
     assert census["function_imports_package_rest"].get("cli.compile", 0) <= 1  # kernels: its cost, commented
