@@ -486,7 +486,7 @@ def layers(root=ROOT):
     other module stands one above the highest it imports (a subpackage is one module)."""
     pkg = root / "shellbvp"
     files = {p.stem: [p] for p in pkg.glob("*.py") if p.stem not in ("__init__", "__main__")}
-    files.update({d.name + "/": sorted(d.glob("*.py")) for d in pkg.iterdir()
+    files.update({d.name + "/": sorted(d.rglob("*.py")) for d in pkg.iterdir()  # cli/handlers/ is cli/'s
                   if d.is_dir() and (d / "__init__.py").exists()})
     deps = {}
     for mod, paths in files.items():
@@ -494,8 +494,8 @@ def layers(root=ROOT):
         for path in paths:
             for node in ast.walk(ast.parse(path.read_text())):
                 if isinstance(node, ast.ImportFrom) and node.level >= 1:
-                    inside = path.parent != pkg  # a subpackage's ".x" is its own module
-                    if inside and node.level == 1:
+                    # inside a subpackage, an import that does not climb to the package is its own
+                    if node.level < len(path.relative_to(pkg).parts):
                         continue
                     targets = [node.module] if node.module else [a.name for a in node.names]
                     for t in targets:

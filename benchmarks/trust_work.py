@@ -6,8 +6,8 @@
   space), a first instability with an unknown bracket end (strict JSON in the file, read back),
   and the stability verdict printed and stored when the curve is stable;
 * ``options``: every option each command accepts is read by its handler (a static check of the
-  parser against the handler's source and the shared helpers it calls), and invalid node budgets
-  are refused.
+  parser against the sources of the command's module, its handler in ``shellbvp/cli/handlers/`` and
+  the shared helpers they call), and invalid node budgets are refused.
 
 Run: ``python3 benchmarks/trust_tally.py --only options,work --out benchmarks/results/trust_work.md`` (about
 3 minutes; results/trust_work.md: 259 inputs, 0 defects).
@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import argparse
 import ast
+import importlib
 import inspect
 import json
 import math
@@ -229,10 +230,10 @@ def _first_instability_json(k, tmp, t):
 
 # -- options ------------------------------------------------------------------------------------------
 def unread_options():
-    """{command: [(option, read)]}: each option of each command and whether its handler reads it
-    (``args.NAME``, ``getattr(args, "NAME")``, an f-string over the shape parameters, a parameter's
-    ``dest`` of the registry of scene parameters, or a helper of cli/common.py that reads it and
-    that the handler calls)."""
+    """{command: [(option, read)]}: each option of each command and whether its module or its handler
+    (``shellbvp/cli/handlers/NAME.py``) reads it (``args.NAME``, ``getattr(args, "NAME")``, an
+    f-string over the shape parameters, a parameter's ``dest`` of the registry of scene parameters,
+    or a helper of cli/common.py that reads it and that either calls)."""
     from shellbvp import cli
     from shellbvp.cli import common
     from shellbvp.scene_parameters import scene_parameters
@@ -255,7 +256,9 @@ def unread_options():
     sub = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
     out = {}
     for name, sp in sub.choices.items():
-        text = inspect.getsource(sys.modules[f"shellbvp.cli.{name}"])
+        # the command's module (its parser) and its handler, which the parser imports on dispatch
+        text = "".join(inspect.getsource(importlib.import_module(f"shellbvp.cli.{where}{name}"))
+                       for where in ("", "handlers."))
         called = {h for h in helpers if re.search(rf"\b{h}\(", text)}
         called |= {g for h in list(called) for g in helpers if re.search(rf"\b{g}\(", helpers[h])}
         used = reads(text).union(*(reads(helpers[h]) for h in called)) | {"json", "command", "verbose"}

@@ -305,12 +305,27 @@ def test_the_census_counts_that_are_zero_stay_zero():
 
 def test_function_level_imports_of_the_package_stand_where_they_are_known():
     """benchmarks/architecture.py on this checkout (issue 57): the package's imports inside functions
-    are the command line's of modules that load numpy (its parser must not) and, for the rest, only
-    in the modules left for a later pass (issue 57: 145 at eab5e9b, in 40 modules)."""
+    are the command line's of modules that load numpy (its parser must not), and only these: each
+    subcommand's module imports its handler (``cli/handlers/NAME.py``, whose imports stand at its
+    top) on dispatch, and cli/common.py's ``scene_from_args`` the scene (145 at eab5e9b, in 40
+    modules; 59 at 33d1b76, 58 of them the command line's in its handlers)."""
+    import ast
+
+    from shellbvp.cli import COMMANDS
+
     census = _census()
-    later = {"cli.compile"}
-    assert set(census["function_imports_package_rest"]) <= later, census["function_imports_package_rest"]
-    assert census["function_imports_package_rest"].get("cli.compile", 0) <= 1  # kernels: its cost, commented
+    assert census["function_imports_package_rest"] == {}
+    commands = {c.__name__.removeprefix("shellbvp.") for c in COMMANDS}
+    deferred = census["function_imports_cli_deferred"]
+    assert {m: n for m, n in deferred.items() if m in commands} == dict.fromkeys(commands, 1)
+    assert set(deferred) - commands <= {"cli.common"} and deferred.get("cli.common", 0) <= 2, deferred
+    assert set(census["function_imports_package"]) == set(deferred)  # none in the handlers
+    for command in COMMANDS:  # the one late import of a subcommand's module is its handler's
+        name = command.__name__.rpartition(".")[2]
+        tree = ast.parse(Path(command.__file__).read_text())
+        late = [ast.unparse(n) for f in tree.body if isinstance(f, ast.FunctionDef) for n in ast.walk(f)
+                if isinstance(n, (ast.Import, ast.ImportFrom))]
+        assert late == [f"from .handlers import {name}"], (name, late)
 
 
 def test_the_census_knows_which_modules_load_numpy():

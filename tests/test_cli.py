@@ -275,7 +275,7 @@ def test_sweep_takes_its_depth_and_force_in_lab_units_as_curve_does(tmp_path):
 
 def test_data_in_bare_si_is_printed_in_units_that_suit_its_size(tmp_path):
     # AFM files come in m and N: a fit of a 2 um, 3 nN curve prints um and nN (files keep SI)
-    from shellbvp.cli.fit import _shown_units
+    from shellbvp.cli.handlers.fit import _shown_units
     from shellbvp.units import readable_unit
 
     assert [readable_unit(v, "length") for v in (0.3, 2e-3, 2e-6, 1.5e-7, 1e-12, 0.0)] == ["mm", "mm", "um", "nm",

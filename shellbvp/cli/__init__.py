@@ -31,7 +31,7 @@ from .common import Parser, limits_of, os_error_line, print_json_error, scene_fr
 __all__ = ["main", "build_parser", "scene_from_args"]
 
 #: The subcommands, in the order ``shellbvp --help`` lists them; each module holds its parser
-#: (``add_parser``) beside its handler (``run``)
+#: (``add_parser``) and a ``run`` that imports its handler, ``handlers/NAME.py``, on dispatch
 COMMANDS = (curve, solve, fit, sweep, plot, report, info, convexity, validate, presets, compile)
 
 

@@ -2,9 +2,10 @@
 
 from __future__ import annotations
 
-from .common import add_scene_options, quantity, scene_from_args
+from .common import add_scene_options
 
 __all__ = ["add_parser", "run"]
+
 
 def add_parser(sub):
     """The ``compile`` subcommand's arguments, on ``sub`` (the subparsers)."""
@@ -17,26 +18,7 @@ def add_parser(sub):
 
 
 def run(args):
-    from ..kernels import compile_for  # its importlib.metadata and subprocess: a third of the parser's time
-    from ..scene import PRESETS, Scene
+    """The handler (``handlers/compile.py``), imported now: the parser loads no numpy."""
+    from .handlers import compile
 
-    given = any(getattr(args, k, None) not in (None, False) for k in args.scene_keys)
-    if given:
-        if args.radius is not None:
-            args.radius = quantity("length")(args.radius)
-        scenes = [("scene", scene_from_args(args))]
-    else:
-        scenes = [(name, Scene.preset(name)) for name in PRESETS]
-    seen = set()
-    for name, scene in scenes:
-        key = scene.model().KEY
-        if key in seen:
-            continue
-        seen.add(key)
-        try:
-            how, seconds = compile_for(scene)
-        except ImportError as exc:
-            raise ValueError(str(exc)) from None
-        print(f"{name}: kernels {how} in {seconds:.1f} s ({key[:12]})")
-    print(f"{len(seen)} structure(s) ready; curves, solves and fits load these kernels from now on")
-    return 0
+    return compile.run(args)

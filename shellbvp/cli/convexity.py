@@ -2,8 +2,7 @@
 
 from __future__ import annotations
 
-
-from .common import add_scene_options, quantity, scene_from_args
+from .common import add_scene_options, quantity
 
 __all__ = ["add_parser", "run"]
 
@@ -19,8 +18,7 @@ def add_parser(sub):
 
 
 def run(args):
-    """``shellbvp convexity``: where the scene's energy is convex in stretch and curvature."""
-    from ..convexity import convexity_report
+    """The handler (``handlers/convexity.py``), imported now: the parser loads no numpy."""
+    from .handlers import convexity
 
-    print(convexity_report(scene_from_args(args)))
-    return 0
+    return convexity.run(args)

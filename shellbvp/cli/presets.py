@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-
-
 __all__ = ["add_parser", "run"]
 
 
@@ -14,14 +12,7 @@ def add_parser(sub):
 
 
 def run(args):
-    from ..scene import PRESETS
+    """The handler (``handlers/presets.py``), imported now: the parser loads no numpy."""
+    from .handlers import presets
 
-    for name, p in PRESETS.items():
-        sc = p["scene"]
-        shape = (f"shell=R,Z,L=({', '.join(sc['shell'])})" if isinstance(sc.get("shell"), tuple)
-                 else f"gamma={sc['gamma']:<5g}")
-        extra = f" pressure={sc['pressure']:g}" if sc.get("pressure") else ""
-        extra += " sealed" if sc.get("sealed") else ""
-        print(f"{name:9s} {shape} rho={sc['rho']:<7.4g} beta={sc['beta']:<6g} "
-              f"xi={sc['xi']} material={sc['material']!r}{extra}  -- {p['doc']}")
-    return 0
+    return presets.run(args)
