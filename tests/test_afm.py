@@ -127,12 +127,12 @@ def test_a_force_map_file_reads_back_and_info_and_plot_take_it(synthetic_map, tm
 
 def test_cli_fits_a_map_into_a_table_a_file_and_a_figure(synthetic_map, tmp_path, monkeypatch, capsys):
     pytest.importorskip("matplotlib")
-    import shellbvp.afm as afm
+    import shellbvp.cli.handlers.fit as fit_command  # where the command reads the map's curves
 
     scene, curves = synthetic_map
     path = tmp_path / "cells.jpk-force-map"
     path.write_bytes(b"")  # the file the command names; its curves come from the fixture
-    monkeypatch.setattr(afm, "iter_afm", lambda p, **calibration: iter(curves))
+    monkeypatch.setattr(fit_command, "iter_afm", lambda p, **calibration: iter(curves))
     argv = ["fit", str(path), "--preset", "fit", "--radius", "10um", "-o", str(tmp_path / "m.h5"),
             "--table", str(tmp_path / "m.csv"), "--report", str(tmp_path / "m.png")]
     assert main(argv) == 0
