@@ -73,7 +73,7 @@ class ThicknessProfile:
                 raise ValueError(f"thickness table: 2 to {MAX_TABLE_ROWS} rows; got {knots.size}")
             if not (np.all(np.isfinite(knots)) and np.all(np.isfinite(values)) and np.all(values > 0)):
                 raise ValueError("thickness table: positions and thicknesses must be finite, thicknesses > 0")
-            natural_spline_coefficients(knots, values)  # raises on too few or unordered rows
+            self._spline = natural_spline_coefficients(knots, values)  # raises on too few or unordered rows
             self.shape = (tuple(float(x) for x in knots), tuple(float(h) for h in values))
         shape_pole = self._shape_at(np.array([0.0]), L=1.0)[0]
         if not (np.isfinite(shape_pole) and shape_pole > 0):
@@ -100,7 +100,7 @@ class ThicknessProfile:
         S = np.asarray(S, dtype=float)
         if self.kind == "spline":
             knots = np.asarray(self.shape[0])
-            a, b, c = natural_spline_coefficients(knots, self.shape[1])
+            a, b, c = self._spline
             return a + b * S + (c[:, None] * np.abs(S[None, :] - knots[:, None]) ** 3).sum(axis=0)
         if self._relative is None:
             import sympy as sp
@@ -119,10 +119,7 @@ class ThicknessProfile:
 
     def scaled(self, pole: float) -> "ThicknessProfile":
         """The same shape with the pole's thickness ``pole`` (a fitted thickness)."""
-        return ThicknessProfile(self.kind, self._shape_arg(), pole)
-
-    def _shape_arg(self):
-        return self.shape
+        return ThicknessProfile(self.kind, self.shape, pole)
 
     def thickest(self, L: float) -> float:
         """The largest thickness from the pole to the rim (units of the rim radius)."""

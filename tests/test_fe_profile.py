@@ -2,7 +2,11 @@
 fe_curve's, validate and the solid fitting model on profiled scenes, and the issue's check
 against the shell model (benchmarks/profile_solid.py measures it in full)."""
 
+import functools
+import importlib.util
 import math
+import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -65,32 +69,22 @@ def test_fe_curves_thickness_is_the_poles_and_scales_the_profile():
         sb.fe_curve(PROFILE, 0.3, [0.1])
 
 
-def _plate_compliance(t, nu, n=2000):
-    """Centre deflection per unit central load of a simply supported disk (radius 1) of bending
-    stiffness t(r)^3, Kirchhoff with Poisson ratio nu (Ritz on the slope, as
-    benchmarks/profile_solid.py)."""
-    from scipy.sparse import diags
-    from scipy.sparse.linalg import spsolve
+@functools.lru_cache(maxsize=1)
+def _profile_solid():
+    """benchmarks/profile_solid.py, which holds Kirchhoff's disk of varying stiffness (Ritz)."""
+    bench = Path(__file__).resolve().parents[1] / "benchmarks"
+    spec = importlib.util.spec_from_file_location("_bench_profile_solid", bench / "profile_solid.py")
+    module = importlib.util.module_from_spec(spec)
+    sys.path.insert(0, str(bench))
+    try:
+        spec.loader.exec_module(module)
+    finally:
+        sys.path.remove(str(bench))
+    return module
 
-    r = np.linspace(0.0, 1.0, n + 1) ** 2
-    g, gw = np.polynomial.legendre.leggauss(4)
-    a, b = r[:-1, None], r[1:, None]
-    h = b - a
-    x = a + (g + 1) / 2 * h
-    w = gw * h / 2
-    N0, N1, d0, d1 = (b - x) / h, (x - a) / h, -1 / h, 1 / h
-    c = 2 * math.pi * x * t(x) ** 3 * w
-    k00 = (c * (d0 * d0 + 2 * nu * d0 * N0 / x + N0 * N0 / x**2)).sum(1)
-    k11 = (c * (d1 * d1 + 2 * nu * d1 * N1 / x + N1 * N1 / x**2)).sum(1)
-    k01 = (c * (d0 * d1 + nu * (d0 * N1 + d1 * N0) / x + N0 * N1 / x**2)).sum(1)
-    main = np.zeros(n + 1)
-    main[:-1] += k00
-    main[1:] += k11
-    f = np.zeros(n + 1)
-    f[:-1] -= (N0 * w).sum(1)
-    f[1:] -= (N1 * w).sum(1)
-    phi = np.r_[0.0, spsolve(diags([k01, main, k01], [-1, 0, 1]).tocsc()[1:, 1:], f[1:])]
-    return -np.trapezoid(phi, r)
+
+def _plate_compliance(t, nu):
+    return _profile_solid().plate_compliance(t, nu)
 
 
 def test_a_thickening_disk_bends_as_kirchhoffs_plate_of_varying_stiffness():
