@@ -17,7 +17,7 @@ FLAT_TOP = ("sin(S)", "cos(S) - 0.2*cos(S)**3", "pi/2")
 
 
 def closed(shell, support="plates", **kw):
-    tip = dict(tip=sb.FlatTip()) if support == "plates" else dict(tip=sb.SphereTip(), rho=1.0)
+    tip = dict(tip=sb.FlatTip()) if support == "plates" else dict(tip=sb.SphereTip(), rho=kw.pop("rho", 1.0))
     kw.setdefault("beta", None if "thickness" in kw else 1e-3)
     return sb.Scene(closed=True, support=support, shell=shell, **tip, **kw)
 
@@ -96,6 +96,15 @@ def test_a_closed_user_meridian_is_written_read_back_and_described(tmp_path):
     assert np.array_equal(back.force, c.force)
 
 
+def test_a_flattened_top_between_plates_is_fitted():
+    scene = closed(sb.UserShell(*FLAT_TOP))
+    depths, R_L, mu_H = np.linspace(0.02, 0.2, 8), 30e-6, 0.5
+    force = np.array([sb.solve(scene, delta=d, estimate_error=False).force for d in depths])
+    noise = 1 + 0.005 * np.random.default_rng(3).standard_normal(depths.size)
+    res = sb.fit(scene, depths * R_L, force * mu_H * R_L * noise, R_L=R_L)
+    assert res.success, res.message
+    assert res.mu_H_ci95[0] < mu_H < res.mu_H_ci95[1] and res.mu_H_ci95[1] - res.mu_H_ci95[0] < 0.05
+
 def cli(*args, cwd):
     return subprocess.run([sys.executable, "-m", "shellbvp", *args], capture_output=True, text=True, cwd=cwd,
                           timeout=600)
@@ -112,3 +121,23 @@ def test_the_command_line_takes_a_closed_meridian(tmp_path):
     both = cli("curve", "--closed", "--gamma", "2", "--meridian", *FLAT_TOP, cwd=tmp_path)
     assert both.returncode == 2 and "not allowed with argument" in both.stderr
     assert not (tmp_path / "bad.h5").exists()
+
+
+@pytest.mark.slow  # the user meridian's substrate structure derived and a two-contact curve (~160 s on a fresh cache)
+def test_a_flattened_top_on_a_substrate_under_a_sphere_is_solved_along_a_curve():
+    scene = closed(sb.UserShell(*FLAT_TOP), support="substrate", rho=0.5)
+    c = sb.curve(scene, delta_max=0.1)
+    assert c.complete and np.all(c.status == 0) and np.all(c.valid) and np.all(np.diff(c.force) > 0)
+    h, s = 1e-4, sb.solve(scene, delta=0.1)
+    E = [sb.solve(scene, delta=0.1 + sign * h, guess=s).energy for sign in (-1, 1)]
+    assert (E[1] - E[0]) / (2 * h) == pytest.approx(s.force, rel=1e-5)
+
+
+@pytest.mark.slow  # a pressurised structure of its own derived (~55 s on a fresh cache)
+def test_a_sealed_spheroids_meridian_between_plates_is_the_built_in_sealed_capsule():
+    kw = dict(closed=True, support="plates", tip=sb.FlatTip(), beta=1e-3, pressure=0.05, sealed=True)
+    built_in = sb.solve(sb.Scene(gamma=0.7, **kw), delta=0.2)
+    user = sb.solve(sb.Scene(shell=sb.UserShell(*SPHEROID), **kw), delta=0.2)
+    assert built_in.success and user.success
+    assert user.force == pytest.approx(built_in.force, rel=1e-8)
+    assert user.pressure == pytest.approx(built_in.pressure, rel=1e-8)
