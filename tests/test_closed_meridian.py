@@ -111,16 +111,22 @@ def cli(*args, cwd):
 
 
 def test_the_command_line_takes_a_closed_meridian(tmp_path):
-    r = cli("curve", "--closed", "--support", "plates", "--flat-tip", "--meridian", *FLAT_TOP, "--beta", "1e-3",
+    r = cli("curve", "--closed", "--support", "plates", "--flat-tip", "--meridian", "; ".join(FLAT_TOP), "--beta", "1e-3",
             "--delta-max", "0.05", "-o", "flat.h5", cwd=tmp_path)
     assert r.returncode == 0, r.stderr
     back = sb.read_curve(tmp_path / "flat.h5")
     assert back.scene == closed(sb.UserShell(*FLAT_TOP)) and back.delta[-1] == pytest.approx(0.05)
-    bad = cli("curve", "--closed", "--flat-tip", "--meridian", "sin(S)", "cos(S)", "1.5", "-o", "bad.h5", cwd=tmp_path)
+    bad = cli("curve", "--closed", "--flat-tip", "--meridian", "sin(S); cos(S); 1.5", "-o", "bad.h5", cwd=tmp_path)
     assert bad.returncode == 2 and "R'(L) = 0" in bad.stderr and len(bad.stderr.strip().splitlines()) == 1
-    both = cli("curve", "--closed", "--gamma", "2", "--meridian", *FLAT_TOP, cwd=tmp_path)
-    assert both.returncode == 2 and "not allowed with argument" in both.stderr
     assert not (tmp_path / "bad.h5").exists()
+    for args, message in ((("--gamma", "2", "--meridian", "; ".join(FLAT_TOP)), "not allowed with argument"),
+                          (("--meridian", "sin(S); cos(S)"), "three formulas 'R(S); Z(S); L'")):
+        r = cli("curve", "--closed", *args, cwd=tmp_path)
+        assert r.returncode == 2 and message in r.stderr, r.stderr
+    rimmed = cli("curve", "--meridian", "sin(S); -2*cos(S); pi/2", "--delta-max", "0.02", "--points", "2", "-o",
+                 "rim.h5", cwd=tmp_path)  # a rimmed shell's meridian, pole to rim (the gamma = 2 spheroid's)
+    assert rimmed.returncode == 0, rimmed.stderr
+    assert sb.read_curve(tmp_path / "rim.h5").scene.shell == sb.UserShell("sin(S)", "-2*cos(S)", "pi/2")
 
 
 @pytest.mark.slow  # the user meridian's substrate structure derived and a two-contact curve (~160 s on a fresh cache)
