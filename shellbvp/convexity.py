@@ -25,7 +25,7 @@ def _determinant(scene):
     B = st.B if st.B is not None else bending.trace_bending()
     values = scene.values()
     W = st.W.xreplace({p: values[p.name] for p in st.material_params})
-    k0 = float(scene.shell.pole_curvature({"gamma": scene.gamma}))
+    k0 = float(scene.shell.pole_curvature(values))  # the meridian's own (a closed shell's upper half: -gamma)
     det = bending.legendre_determinant(W, B.xreplace({bending.KS0: k0, bending.KT0: k0}),
                                        beta=sp.Float(scene.beta))
     return det, k0

@@ -145,6 +145,16 @@ def test_a_closed_shell_on_a_substrate_is_solved_cold_at_a_force():
         sb.solve(scene, lambda0=1.01)
 
 
+def test_a_closed_spheres_convexity_is_its_upper_halfs_the_dome():
+    from shellbvp.convexity import convexity_limits
+
+    closed = sb.Scene(closed=True, support="plates", tip=sb.SphereTip(), rho=0.5, gamma=1.0, beta=1e-2)
+    dome, bowl = (sb.Scene(tip=sb.SphereTip(), rho=0.5, gamma=g, beta=1e-2) for g in (-1.0, 1.0))
+    limits = convexity_limits(closed, stretches=(1.0, 1.5), kappa_max=10)
+    assert limits == convexity_limits(dome, stretches=(1.0, 1.5), kappa_max=10)
+    assert limits != convexity_limits(bowl, stretches=(1.0, 1.5), kappa_max=10)
+
+
 def test_a_small_tip_on_a_thin_sphere_on_a_substrate_is_reissners_two_poles_in_series():
     # a small load: a point force at each pole, as between plates (to 1e-4)
     eps = 0.02
