@@ -70,6 +70,20 @@ def test_the_family_is_registered_and_on_the_command_line(capsys):
     assert "koiter" in capsys.readouterr().out
 
 
+def test_koiters_energy_is_not_convex_at_large_bending_as_the_trace_energy():
+    """Bilinear in (psi, phi') like the trace energy (lambda_s^2 kappa_s = psi phi'/Psi^2): the
+    Legendre determinant changes sign at large bending (Mooney-Rivlin 0.1, beta 0.01), as
+    the class's docstring and docs/limits.md's corner say of both."""
+    from symbolic import materials
+
+    W = materials.mooney_rivlin(sp.Rational(1, 10))
+    det = sbend.legendre_determinant(W, sbend.koiter_bending().xreplace({sbend.KS0: 1, sbend.KT0: 1}),
+                                     beta=sp.Rational(1, 100))
+    signs = {bool(det.evalf(subs={LS: ls, LT: 1.1, sbend.KS: ks, sbend.KT: ks}) > 0)
+             for ls in (0.8, 1.2, 1.6) for ks in (0.0, 2.0, 5.0, 10.0)}
+    assert signs == {True, False}
+
+
 # ------------------------------------------------------------------ Euler-Lagrange
 WALL = tv.WALL
 

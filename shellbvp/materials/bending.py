@@ -76,7 +76,9 @@ class KoiterBending(Bending):
     stiffness as the trace energy, so ``beta = (H/R_L)^2/3`` stays.  Koiter's energy
     ``nu (tr Delta)^2/2 + (1 - nu) tr(Delta^2)/2`` of the bending strain ``Delta = A^{-1} (b - b0)``
     (W. T. Koiter, On the nonlinear theory of thin elastic shells, Proc. Kon. Ned. Akad.
-    Wetensch. B 69, 1966); ``sb.stability`` derives its second variation.
+    Wetensch. B 69, 1966); ``sb.stability`` derives its second variation.  Like the trace
+    energy it is not convex in the meridional stretch and curvature at large bending (a corner
+    at the contact edge past that limit; ``sb.convexity_limits``).
 
     Examples
     --------
