@@ -15,6 +15,11 @@ trace energy, for deciding the default (issue 58): F of every preset (``sb.PRESE
 unstable along ``sb.curve(scene, delta_max=1)`` (``assess(curve, "locate")``) with each.
 
     nice -n 10 python benchmarks/bending_choice.py --koiter   # writes results/bending_koiter.md
+
+``--koiter-map``: the shell model with Koiter's energy, without and with transverse shear, against
+the 3D solids of the model's error map (the FE curves kept in ``results/validation.json``, not
+solved again), beside the trace energy's stored rows there: the largest ``|F_shell / F_FE - 1|``
+by thickness and depth band (``results/bending_koiter_map.md``, its rows in ``..._map.json``).
 """
 
 from __future__ import annotations
@@ -127,11 +132,84 @@ def koiter_main():
     print(out.read_text())
 
 
+def koiter_map_main():
+    """Koiter's energy on the error map's stored FE curves (module docstring)."""
+    import json
+
+    import validation as vmap
+    from checkout import commit_label
+    from shellbvp.validation import shell_curve
+
+    store = HERE / "results" / "validation.json"
+    cache = json.loads(store.read_text())
+    out_json = HERE / "results" / "bending_koiter_map.json"
+    done = json.loads(out_json.read_text()) if out_json.exists() else {}
+    for k, fe in cache.items():
+        if not fe.get("success") or k in done:
+            continue
+        d = np.asarray(fe["delta"], float)
+        row = {}
+        for label, shear in (("smooth, koiter", False), ("smooth, koiter, shear", True)):
+            scene = vmap.scene_of(fe["gamma"], fe["rho"], fe["eps"], bending=sb.KoiterBending(), transverse_shear=shear)
+            row[label] = shell_curve(scene, d).force_at(d).tolist()
+        done[k] = row
+        tmp = out_json.with_suffix(".json.tmp")
+        tmp.write_text(json.dumps(done, indent=1, default=float))
+        tmp.replace(out_json)
+        print(k, flush=True)
+    variants = ("smooth", "smooth, koiter", "smooth, shear", "smooth, koiter, shear")
+    bands = (("delta <= H", lambda k, wrap: k <= 1 + 1e-9 and not wrap),
+             ("H < delta < 5H", lambda k, wrap: 1 + 1e-9 < k < 5 - 1e-9 and not wrap),
+             ("delta >= 5H, short of the tip's equator", lambda k, wrap: k >= 5 - 1e-9 and not wrap),
+             ("contact round the tip's equator", lambda k, wrap: wrap))
+    summary = []
+    for k, fe in cache.items():
+        if k not in done:
+            continue
+        ff = np.asarray(fe["force"], float)
+        forces = {v: np.asarray(fe["shell"][v]["force"], float) for v in ("smooth", "smooth, shear")}
+        forces.update({v: np.asarray(done[k][v], float) for v in ("smooth, koiter", "smooth, koiter, shear")})
+        for i, x in enumerate(fe["delta"]):
+            wrap = fe["contact_radius"][i] >= 0.95 * fe["rho"]
+            summary.append((fe["eps"], x / fe["eps"], wrap, {v: forces[v][i] / ff[i] - 1 for v in variants}))
+    lines = ["# Koiter's energy on the model's error map", "",
+             f"Measured {time.strftime('%Y-%m-%d')} on {platform.machine()}, shellbvp {sb.__version__} at "
+             f"{commit_label() or 'unknown commit'}; `nice -n 10 python benchmarks/bending_choice.py --koiter-map`.  "
+             "The 3D solids and the trace energy's rows ('smooth', 'smooth, shear') are those kept in "
+             "results/validation.json (benchmarks/validation.py: the hemisphere and a prolate shell at rho 0.1-0.5, "
+             "a dome; neo-Hookean; beta = eps^2/3); 'koiter' the same shell model with `sb.KoiterBending()`, "
+             "solved here at the solid's depths.  Each cell: the largest |F_shell / F_FE - 1| in percent over the "
+             f"scenes ({len(done)} FE curves).", "",
+             "| eps | depth | " + " | ".join(variants) + " |", "|---|---|" + "---|" * len(variants)]
+    for eps in sorted({e for e, *_ in summary}, reverse=True):
+        for label, test in bands:
+            cells = []
+            for v in variants:
+                sel = [abs(e[v]) for ee, kk, w, e in summary if ee == eps and test(kk, w) and np.isfinite(e[v])]
+                cells.append(f"{100 * max(sel):.1f}" if sel else "-")
+            lines.append(f"| {eps:g} | {label} | " + " | ".join(cells) + " |")
+    diffs = [abs((1 + e["smooth, koiter"]) / (1 + e["smooth"]) - 1) for *_, e in summary
+             if np.isfinite(e["smooth, koiter"]) and np.isfinite(e["smooth"])]
+    if diffs:
+        lines += ["", f"F koiter / F trace - 1 (no shear) over the map's points: largest {100 * max(diffs):.1f} %, "
+                      f"median {100 * float(np.median(diffs)):.2f} %."]
+    out = HERE / "results" / "bending_koiter_map.md"
+    tmp = out.with_suffix(".md.tmp")
+    tmp.write_text("\n".join(lines) + "\n")
+    tmp.replace(out)
+    print(out.read_text())
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--koiter", action="store_true", help="Koiter's energy against the trace energy "
                     "(results/bending_koiter.md) instead of the convexity table")
-    if ap.parse_args(argv).koiter:
+    ap.add_argument("--koiter-map", action="store_true", dest="koiter_map",
+                    help="Koiter's energy on the error map's stored 3D solids (results/bending_koiter_map.md)")
+    args = ap.parse_args(argv)
+    if args.koiter_map:
+        return koiter_map_main()
+    if args.koiter:
         return koiter_main()
     rows, t0 = [], time.perf_counter()
     variants = (("smooth, paper's B (corner)", dict()), ("paper's contact model", dict(contact="paper")),
