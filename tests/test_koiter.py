@@ -56,6 +56,12 @@ def test_plate_limit_is_the_incompressible_plates_and_beta_stays():
     text = ("(lambda_s**2*kappa_s - kappa_s0 + lambda_theta**2*kappa_theta - kappa_theta0)**2/2"
             " - (lambda_s**2*kappa_s - kappa_s0)*(lambda_theta**2*kappa_theta - kappa_theta0)/2")
     assert sp.expand(sb.BendingEnergy(text).B - sbend.koiter_bending()) == 0
+    # ... so its second variation is the family's (docs/stability.md); another formula is refused
+    from symbolic.second_variation import bending_family
+
+    assert bending_family(sb.BendingEnergy(text).B) == bending_family(sbend.koiter_bending()) == "koiter"
+    with pytest.raises(ValueError, match="trace, rotation and koiter"):
+        bending_family(sbend.koiter_bending() + (LS - 1) ** 2 * (sbend.KS - sbend.KS0) ** 2)
 
 
 def test_the_family_is_registered_and_on_the_command_line(capsys):
