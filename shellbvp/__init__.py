@@ -17,7 +17,7 @@ from .version import __version__  # noqa: F401  (sb.__version__)
 # finds the CLI's handler in place.
 _LAZY = {"curve": "continuation", "iter_curve": "continuation", "CurveRun": "continuation", "SphereTip": "geometry", "FlatTip": "geometry", "Spheroid": "geometry", "UserShell": "geometry",
          "UserTip": "geometry", "Curve": "io", "read_curve": "io", "BendingEnergy": "materials", "Gent": "materials",
-         "MooneyRivlin": "materials", "NeoHookean": "materials", "RotationBending": "materials",
+         "MooneyRivlin": "materials", "NeoHookean": "materials", "RotationBending": "materials", "KoiterBending": "materials",
          "StrainEnergy": "materials", "TraceBending": "materials", "PRESETS": "scene", "Scene": "scene",
          "ThicknessProfile": "thickness_profile",
          "STATUS_MESSAGES": "solution", "Solution": "solution", "delta_bounds": "bounds", "solve": "state",
@@ -92,6 +92,7 @@ __all__ = [
     "StrainEnergy",
     "TraceBending",
     "RotationBending",
+    "KoiterBending",
     "BendingEnergy",
     "convexity_limits",
     "Spheroid",

@@ -68,8 +68,9 @@ class Scene:
         ``UserShell(R, Z, L)`` / ``UserTip(A, B)``; default spheroid and sphere.
     bending : Bending, optional
         The bending energy ``B`` in ``U = W + beta B``: ``TraceBending()`` (the paper's,
-        default), ``RotationBending()`` (convex in stretch and curvature) or
-        ``BendingEnergy(formula)``.
+        default), ``RotationBending()`` (convex in stretch and curvature), ``KoiterBending()``
+        (with the Gaussian curvature's energy at the solid's Poisson ratio 1/2: for walls whose
+        thickness varies) or ``BendingEnergy(formula)``.
     pressure : float
         Pressure difference ``p R_L/(mu H)`` across the shell, from the side away from
         the indenter (below it): > 0 inflates a dome or a cell indented from outside.
@@ -166,7 +167,7 @@ class Scene:
         rho = _finite("rho", self.rho)
         scene_parameter("rho").check(rho, shown=self.rho)
         if not isinstance(self.bending, Bending):
-            raise ValueError(f"bending must be TraceBending(), RotationBending() or BendingEnergy(...); "
+            raise ValueError(f"bending must be TraceBending(), RotationBending(), KoiterBending() or BendingEnergy(...); "
                              f"got {self.bending!r}")
         beta = self.beta
         if not isinstance(self.shell, (Spheroid, UserShell)):

@@ -295,8 +295,8 @@ def beta_from_thickness(H: float, R_L: float = 1.0, bending=None) -> float:
 
     A plate of an incompressible solid (Poisson ratio 1/2, shear modulus mu) has the bending
     stiffness ``D = E H^3/(12 (1 - nu^2)) = mu H^3/3``; the shell model's ``U = W + beta B``
-    bends a flat sheet with ``mu H R_L^2 beta k``, k = d2B/dkappa_s2 at rest (1 for the trace and
-    rotation energies; ``symbolic.bending.plate_limit`` derives both).  So ``beta = eps^2/(3 k)``,
+    bends a flat sheet with ``mu H R_L^2 beta k``, k = d2B/dkappa_s2 at rest (1 for the trace,
+    rotation and koiter energies; ``symbolic.bending.plate_limit`` derives each).  So ``beta = eps^2/(3 k)``,
     ``eps = H/R_L``.  A 3D finite-element model agrees (``shellbvp validate``; the docs' page on
     the model's accuracy).  Builds before issue 41 returned the paper's ``eps^2/12``, 4x too small.
 

@@ -21,6 +21,16 @@ Built in:
   U is convex in (psi, phi') wherever W is convex in lambda_s: the Legendre condition never
   fails through bending.  Same small-strain stiffness as ``trace`` (both give d^2B/dkappa_s^2 = 1
   at the reference state).
+* ``koiter``: ``B = (Delta_s + Delta_theta)^2/2 - (1 - nu) Delta_s Delta_theta`` with
+  ``nu = 1/2``, ``Delta_s = lambda_s^2 kappa_s - kappa_s0``, ``Delta_theta = lambda_theta^2
+  kappa_theta - kappa_theta0`` (the eigenvalues of the trace energy's curvature change):
+  Koiter's bending energy ``nu (tr Delta)^2/2 + (1 - nu) tr(Delta^2)/2`` (W. T. Koiter, On the
+  nonlinear theory of thin elastic shells, Proc. Kon. Ned. Akad. Wetensch. B 69, 1966, 1-54),
+  ``Delta`` his bending strain ``A^{-1}(b - b_0)``, at the Poisson ratio of an incompressible
+  solid.  For a flat plate it is Kirchhoff's ``(k1 + k2)^2/2 - (1 - nu) k1 k2``: the trace
+  energy is the same at nu = 1, with no energy in the Gaussian curvature.  Same stiffness 1, so
+  ``beta = eps^2/3`` stays; ``plate_limit`` gives ``(1, 1/2)``, the 3D plate's
+  (:func:`plate_3d`).  Like ``trace``, bilinear in (psi, phi'): not convex at large bending.
 """
 
 from __future__ import annotations
@@ -29,7 +39,8 @@ import sympy as sp
 
 from .materials import FLOAT_ZERO, LS, LT
 
-__all__ = ["KS", "KT", "KS0", "KT0", "BENDING_SYMBOLS", "trace_bending", "rotation_bending", "check_bending",
+__all__ = ["KS", "KT", "KS0", "KT0", "BENDING_SYMBOLS", "trace_bending", "rotation_bending", "koiter_bending",
+           "KOITER_POISSON", "check_bending",
            "legendre_determinant", "plate_limit", "plate_3d"]
 
 KS, KT = sp.symbols("kappa_s kappa_theta", real=True)
@@ -45,6 +56,17 @@ def trace_bending():
 
 def rotation_bending():
     return (LS * KS + LT * KT - KS0 - KT0) ** 2 / 2
+
+
+#: The Poisson ratio of :func:`koiter_bending`: the 3D incompressible plate's (``plate_3d``)
+KOITER_POISSON = sp.Rational(1, 2)
+
+
+def koiter_bending():
+    """Koiter's bending energy at Poisson ratio 1/2 (module docstring): the trace energy less
+    ``(1 - nu) Delta_s Delta_theta``, the energy of the change of Gaussian curvature."""
+    ds, dt = LS**2 * KS - KS0, LT**2 * KT - KT0
+    return (ds + dt) ** 2 / 2 - (1 - KOITER_POISSON) * ds * dt
 
 
 def _zero(e) -> bool:
@@ -118,7 +140,8 @@ def plate_limit(B):
     a 3D plate of thickness ``eps = H/R_L`` when ``beta * stiffness = eps^2 * D/(mu H^3)``, i.e.
     ``beta = eps^2 / (3 stiffness)``: ``eps^2/3`` for the trace and rotation energies (both
     ``(1, 1)``: their bending Poisson ratio is 1, the plate's 1/2, which matters where the
-    Gaussian curvature's energy does: at a free or simply supported edge).
+    Gaussian curvature's energy does: at a free or simply supported edge, and where the wall's
+    thickness varies) and for the koiter energy (``(1, 1/2)``, the plate's).
     """
     flat = {LS: 1, LT: 1, KS0: 0, KT0: 0}
     B = sp.sympify(B, strict=True).subs(flat)  # an expression already, never text

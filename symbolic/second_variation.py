@@ -35,7 +35,15 @@ mid-surface ``x(S, theta)`` that need not be axisymmetric, per ``dS dtheta``:
     ``C`` and ``K`` together, and the axisymmetric states (``C`` and ``K`` coaxial) do not fix
     how it depends on the angle between their principal axes: this is the simplest extension,
     not the only one;
-  - a user bending energy is refused (same reason).
+  - ``koiter``: ``B = (tr Delta)^2/2 - (1 - nu) det Delta`` with nu = 1/2 and ``Delta = K - K0``
+    the mixed tensor of the curvature change (``K0 = diag(kappa_s0, kappa_theta0)``, the reference
+    shell's ``A^{-1} b0``): ``det Delta = (b_SS/A_SS - kappa_s0)(b_thth/A_thth - kappa_theta0) -
+    b_Sth^2/(A_SS A_thth)``.  A function of ``K`` alone like ``trace``, so its isotropic extension
+    from the axisymmetric states (where ``det Delta = Delta_s Delta_theta``) is unique too.  On
+    a flat unstressed region ``B = (Laplacian w)^2/2 - (1 - nu) (w_xx w_yy - w_xy^2)``: a
+    harmonic deflection now costs bending energy (a test shows it);
+  - a user bending energy is refused (same reason as ``rotation``'s caveat: its axisymmetric form
+    does not fix its 2D one).
 * pressure: ``(x, y, 0)/2`` has divergence 1 and no flux through a horizontal plane; on an
   axisymmetric state the term is ``p r^2 z'/2``.  For non-axisymmetric fields it is the volume up
   to terms at the rim (item 2's boundary conditions).
@@ -215,16 +223,18 @@ def _membrane_energy(W):
 
 
 def bending_family(B):
-    """``"trace"`` or ``"rotation"`` for a structure's bending energy (None: the paper's trace);
-    ValueError for any other."""
+    """``"trace"``, ``"rotation"`` or ``"koiter"`` for a structure's bending energy (None: the
+    paper's trace); ValueError for any other."""
     if B is None or sp.expand(B - bending.trace_bending()) == 0:
         return "trace"
     if sp.expand(B - bending.rotation_bending()) == 0:
         return "rotation"
+    if sp.expand(B - bending.koiter_bending()) == 0:
+        return "koiter"
     raise ValueError(
         "the two-dimensional form of a user bending energy is not determined by its axisymmetric "
         "form (it fixes B only where the stretch and curvature tensors are coaxial); the second "
-        "variation is derived for the trace and rotation bending energies only")
+        "variation is derived for the trace, rotation and koiter bending energies only")
 
 
 # ------------------------------------------------------------------------------ truncated series
@@ -336,7 +346,7 @@ def surface_energy_density(jets, reference, Wi, family, beta=BETA, pressure=PRES
 
     ``jets``: dict of 3-vectors (lists) ``x, xS, xT, xSS, xST, xTT`` (T for theta), entries SymPy
     expressions or :class:`Series`; ``reference``: dict ``R, Psi, kappa_s0, kappa_theta0``;
-    ``Wi``: W in (TRC, DETC); ``family``: "trace" or "rotation"; ``thickness``: the wall's
+    ``Wi``: W in (TRC, DETC); ``family``: "trace", "rotation" or "koiter"; ``thickness``: the wall's
     thickness over the pole's at the point (None: uniform), ``t W + beta t^3 B``.
     """
     R, Psi = reference["R"], reference["Psi"]
@@ -349,7 +359,8 @@ def surface_energy_density(jets, reference, Wi, family, beta=BETA, pressure=PRES
     inv_norm = apply(lambda g: 1 / sp.sqrt(g), _dot(m, m))
     bSS, bST, bTT = (_dot(jets[k], m) * inv_norm for k in ("xSS", "xST", "xTT"))
     trK = bSS / A1 + bTT / A2
-    if family == "trace":
+    ks0, kt0 = reference["kappa_s0"], reference["kappa_theta0"]
+    if family in ("trace", "koiter"):
         strain = trK
     elif family == "rotation":
         # tr(C^{-1/2} K) = (trU trK - (tr(CK) + sqrt(det C) trK)/trU)/sqrt(det C), U = C^{1/2}
@@ -359,7 +370,10 @@ def surface_energy_density(jets, reference, Wi, family, beta=BETA, pressure=PRES
         strain = (trU * trK - (trCK + J * trK) / trU) / J
     else:
         raise ValueError(f"unknown bending family {family!r}")
-    bend = (strain - reference["kappa_s0"] - reference["kappa_theta0"]) ** 2 * sp.Rational(1, 2)
+    bend = (strain - ks0 - kt0) ** 2 * sp.Rational(1, 2)
+    if family == "koiter":  # less (1 - nu) det(K - K0), K = A^{-1} b (mixed), K0 = diag(ks0, kt0)
+        det_change = (bSS / A1 - ks0) * (bTT / A2 - kt0) - bST * bST / (A1 * A2)
+        bend = bend - (1 - bending.KOITER_POISSON) * det_change
     if thickness is None:
         U = apply2(Wi, trC, detC) + beta * bend
     else:
@@ -455,7 +469,8 @@ class SecondVariation:
 
 def second_variation(W, material_params=(), B=None, pressurised=False, profiled=False) -> SecondVariation:
     """Derive the second variation of mode n for a strain energy W(lambda_s, lambda_theta)
-    and a bending energy B (None or ``bending.trace_bending()``: trace; ``rotation_bending()``);
+    and a bending energy B (None or ``bending.trace_bending()``: trace; ``rotation_bending()``,
+    ``koiter_bending()``);
     ``profiled``: a wall whose thickness varies, ``t W + beta t^3 B`` with t = :data:`THK`.
     ValueError for a W not expressible through (tr C, det C) or another B.  Cached in-process."""
     W = sp.sympify(W, strict=True)

@@ -20,14 +20,17 @@ from symbolic import bending as sbend
 # ------------------------------------------------------------------ the thickness map
 def test_plate_limits_are_derived_and_match_the_classes():
     assert sbend.plate_3d() == (sp.Rational(1, 3), sp.Rational(1, 2))  # D / (mu H^3), nu: incompressible
-    for B, cls in ((sbend.trace_bending(), sb.TraceBending), (sbend.rotation_bending(), sb.RotationBending)):
+    for B, cls, want in ((sbend.trace_bending(), sb.TraceBending, (1.0, 1.0)),
+                         (sbend.rotation_bending(), sb.RotationBending, (1.0, 1.0)),
+                         (sbend.koiter_bending(), sb.KoiterBending, (1.0, 0.5))):   # the 3D plate's nu
         stiffness, poisson = sbend.plate_limit(B)
-        assert (float(stiffness), float(poisson)) == (cls.plate_stiffness, cls.plate_poisson) == (1.0, 1.0)
+        assert (float(stiffness), float(poisson)) == (cls.plate_stiffness, cls.plate_poisson) == want
+        assert sb.beta_from_thickness(0.05, bending=cls()) == pytest.approx(0.05**2 / 3)
     user = sb.BendingEnergy("(kappa_s - kappa_s0)**2 + (kappa_theta - kappa_theta0)**2"
                             " + (kappa_s - kappa_s0)*(kappa_theta - kappa_theta0)")
     assert (user.plate_stiffness, user.plate_poisson) == (2.0, 0.5)   # a 3D plate's Poisson ratio
     assert sb.beta_from_thickness(0.05, bending=user) == pytest.approx(0.05**2 / 6)
-    # docs/thickness.md's energy for walls whose thickness varies: Kirchhoff's plate at Poisson ratio 1/2
+    # Koiter's energy written as a user formula: Kirchhoff's plate at Poisson ratio 1/2
     gauss = sb.BendingEnergy("(lambda_s**2*kappa_s - kappa_s0 + lambda_theta**2*kappa_theta - kappa_theta0)**2/2"
                              " - (lambda_s**2*kappa_s - kappa_s0)*(lambda_theta**2*kappa_theta - kappa_theta0)/2")
     assert (gauss.plate_stiffness, gauss.plate_poisson) == (1.0, 0.5)

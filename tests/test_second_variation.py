@@ -42,7 +42,7 @@ MATERIALS = {
     "mooney_rivlin": (materials.mooney_rivlin(ALPHA), (ALPHA,)),
     "gent": (materials.gent(JM), (JM,)),
 }
-BENDINGS = {"trace": None, "rotation": bending.rotation_bending()}
+BENDINGS = {"trace": None, "rotation": bending.rotation_bending(), "koiter": bending.koiter_bending()}
 MATERIAL_VALUES = {ALPHA: 0.23, JM: 6.5}
 #: A wall's thickness over the pole's for the profiled variants (t(0) = 1).
 THICKNESS = 1 + 3 * S / 10 - S**2 / 5
@@ -160,13 +160,14 @@ def test_user_energies_accepted_through_the_invariants_or_refused():
 
 
 # ------------------------------------------------------------------------------ restriction to U
-@pytest.mark.parametrize("material,family", [("mooney_rivlin", "trace"), ("gent", "rotation")])
+@pytest.mark.parametrize("material,family", [("mooney_rivlin", "trace"), ("gent", "rotation"),
+                                             ("neo_hookean", "koiter")])
 def test_energy_restricted_to_axisymmetric_states_is_todays(material, family):
     """The base energy of the expansion, L(x0), is U R Psi + p r^2 z'/2 exactly (simplify to 0)
     with U = W(lambda_s, r/R) + beta B of symbolic.bending, kappa_theta = sin(phi)/r."""
     res = variation(material, family)
     W, _ = MATERIALS[material]
-    B = bending.trace_bending() if family == "trace" else bending.rotation_bending()
+    B = BENDINGS[family] if BENDINGS[family] is not None else bending.trace_bending()
     lt = sv.R_ / sv.RR
     at = {LS: sv.LS_, LT: lt, bending.KS: sv.KS_, bending.KT: sp.sin(sv.PHI) / sv.R_,
           bending.KS0: sv.KS0, bending.KT0: sv.KT0}
@@ -202,7 +203,9 @@ def _base_along(g, r, z):
 
 
 @pytest.mark.parametrize("material,family,profiled", [("mooney_rivlin", "trace", False), ("gent", "rotation", False),
-                                                      ("mooney_rivlin", "trace", True), ("gent", "rotation", True)])
+                                                      ("mooney_rivlin", "trace", True), ("gent", "rotation", True),
+                                                      pytest.param("neo_hookean", "koiter", False, marks=pytest.mark.slow),
+                                                      ("mooney_rivlin", "koiter", True)])
 def test_first_variation_gives_the_equilibrium_equations(material, family, profiled):
     """Euler-Lagrange of the eta coefficient (n = 0) against eq1, eq2 of symbolic.equations.
 
@@ -281,7 +284,7 @@ def test_first_variation_gives_the_equilibrium_equations(material, family, profi
 
 # ------------------------------------------------------------------------------ rigid motions
 @pytest.mark.parametrize("material,family", [("mooney_rivlin", "trace"), ("gent", "rotation"),
-                                             ("neo_hookean", "rotation")])
+                                             ("neo_hookean", "rotation"), ("mooney_rivlin", "koiter")])
 def test_rigid_motions_are_null_vectors(material, family):
     """Translations (n = 0 axial, n = 1 lateral) leave the second-order density of any state at 0
     (also with the pressure: its density is at most linear in a translation); the rotations
@@ -302,7 +305,7 @@ def test_rigid_motions_are_null_vectors(material, family):
                 assert abs(q) > 1e-4 * size, (n, q, size)
 
 
-@pytest.mark.parametrize("family", ["trace", "rotation"])
+@pytest.mark.parametrize("family", ["trace", "rotation", "koiter"])
 def test_unstressed_form_is_positive_semidefinite_and_positive_off_rigid_motions(family):
     """At unstressed points the 9x9 form has no negative eigenvalue (to 1e-12 of its largest);
     on the hemisphere (gamma = 1, beta = 1e-3) the integrated n = 2 energy of smooth fields that
@@ -349,13 +352,17 @@ def test_unstressed_form_is_positive_semidefinite_and_positive_off_rigid_motions
 
 
 # ------------------------------------------------------------------------------ closed form
-@pytest.mark.parametrize("family,material", [("trace", "mooney_rivlin"), ("rotation", "gent")])
+@pytest.mark.parametrize("family,material", [("trace", "mooney_rivlin"), ("rotation", "gent"),
+                                             ("koiter", "mooney_rivlin")])
 def test_flat_membrane_under_equibiaxial_prestretch(family, material):
     """Flat disk stretched to r = lambda S (phi = 0, kappa = 0, R = S, Psi = 1): the w block of the
     form is S/4 [T (w'^2 + n^2 w^2/S^2) + beta c^2 (w'' + w'/S - n^2 w/S^2)^2], T the tension
-    (1/lambda) dW/dlambda_s at (lambda, lambda), c = 1 (trace) or 1/lambda (rotation), and w does
-    not couple to u, v (module docstring of the tests for the sources).  Checked symbolically in
-    lambda, S, n, w, w', w'' at beta, pressure 0 and the material parameter fixed."""
+    (1/lambda) dW/dlambda_s at (lambda, lambda), c = 1 (trace, koiter) or 1/lambda (rotation), and w does
+    not couple to u, v (module docstring of the tests for the sources).  Koiter's energy adds
+    ``-beta S (1 - nu) <det grad grad w>``, the theta-average of the Hessian's determinant in the
+    reference polar coordinates, ``(1/2) [w'' (w'/S - n^2 w/S^2) - n^2 (w'/S - w/S^2)^2]`` (Kirchhoff's
+    Gaussian-curvature term; the prestretch does not enter it, as it does not the trace's).  Checked
+    symbolically in lambda, S, n, w, w', w'' at beta, pressure 0 and the material parameter fixed."""
     res = variation(material, family)
     lam, s = sp.symbols("lambda S_", positive=True)
     W, par = MATERIALS[material]
@@ -370,17 +377,20 @@ def test_flat_membrane_under_equibiaxial_prestretch(family, material):
             assert sp.simplify(M[i, j]) == 0, (i, j, M[i, j])
     w, dw, ddw = sv.FIELDS[6:]
     n = sv.N_MODE
-    c = 1 if family == "trace" else 1 / lam
+    c = 1 / lam if family == "rotation" else 1
     want = s / 4 * (T.subs({p: at[p] for p in par}) * (dw**2 + n**2 * w**2 / s**2)
                     + BETA * c**2 * (ddw + dw / s - n**2 * w / s**2) ** 2)
+    if family == "koiter":
+        det = (ddw * (dw / s - n**2 * w / s**2) - n**2 * (dw / s - w / s**2) ** 2) / 2
+        want -= BETA * s * (1 - bending.KOITER_POISSON) * det
     z = sp.Matrix(sv.FIELDS[6:])
     got = (z.T * M[6:, 6:] * z)[0, 0]
     assert sp.simplify(got - want) == 0
 
 
 def test_harmonic_deflection_of_a_flat_plate_costs_nothing():
-    """A documented property, not a wish: with bending Poisson ratio 1 (both built-in energies,
-    ``bending.plate_limit``) the 2D bending energy is (Laplacian w)^2/2 on a flat unstressed plate,
+    """A documented property, not a wish: with bending Poisson ratio 1 (the trace and rotation
+    energies, ``bending.plate_limit``) the 2D bending energy is (Laplacian w)^2/2 on a flat unstressed plate,
     so w = S^n cos(n theta) (harmonic) has zero second variation, for n = 2 and 3: on a flat
     region only a tension resists such modes."""
     for family in ("trace", "rotation"):
@@ -397,6 +407,25 @@ def test_harmonic_deflection_of_a_flat_plate_costs_nothing():
             fields = [0, 0, 0, 0, 0, 0, w, sp.diff(w, s), sp.diff(w, s, 2)]
             q = res.quadratic_form().xreplace(at).xreplace(dict(zip(sv.FIELDS, fields))).subs(sv.N_MODE, n)
             assert sp.simplify(q).subs(s, sp.Rational(1, 2)) > 0
+
+
+def test_harmonic_deflection_costs_the_gaussian_terms_energy_with_koiters():
+    """With Koiter's energy (bending Poisson ratio 1/2) the same harmonic w = S^n cos(n theta) on a
+    flat unstressed plate costs ``beta S (1 - nu) |grad grad w|^2/2`` per dS dtheta, Kirchhoff's
+    ``-D (1 - nu) det grad grad w`` with Laplacian w = 0 and ``|grad grad w|^2 = 2 n^2 (n - 1)^2
+    S^(2n - 4)`` (w = Re z^n): ``beta n^2 (n - 1)^2 S^(2n - 3)/2``, exactly, for n = 2 and 3;
+    the trace energy's is 0 (the test above)."""
+    res = variation("mooney_rivlin", "koiter")
+    s = sp.Symbol("S_", positive=True)
+    at = {sv.R_: s, sv.PHI: 0, sv.LS_: 1, sv.KS_: 0, sv.DLS: 0, sv.DKS: 0, sv.RR: s, sv.PSI_R: 1,
+          sv.DPSI_R: 0, sv.KS0: 0, sv.KT0: 0, PRESSURE: 0, ALPHA: sp.Rational(23, 100)}
+    for n in (2, 3):
+        w = s**n
+        fields = [0, 0, 0, 0, 0, 0, w, sp.diff(w, s), sp.diff(w, s, 2)]
+        q = res.quadratic_form().xreplace(at).xreplace(dict(zip(sv.FIELDS, fields))).subs(sv.N_MODE, n)
+        want = BETA * n**2 * (n - 1) ** 2 * s ** (2 * n - 3) / 2
+        assert sp.simplify(q - want) == 0, (n, q)
+        assert sp.simplify(q) != 0
 
 
 def test_modes_decouple_at_n0():

@@ -361,7 +361,9 @@ def add_scene_options(p, uncertain=False, preset_required=False, solver=("tol", 
     g.add_argument("--contact", choices=contact_models(), help="contact-line model (default smooth)")
     b = g.add_mutually_exclusive_group()
     b.add_argument("--bending", choices=bending_families(),
-                   help="bending energy B in U = W + beta B: trace (the paper's, default) or rotation (convex)")
+                   help="bending energy B in U = W + beta B: trace (the paper's, default), rotation (convex) or "
+                        "koiter (Koiter's, with the Gaussian curvature's energy at Poisson ratio 1/2: walls "
+                        "whose thickness varies)")
     b.add_argument("--bending-formula", dest="bending_formula",
                    help="a user bending energy B per beta in lambda_s, lambda_theta, kappa_s, kappa_theta, "
                         "kappa_s0, kappa_theta0 (the reference curvatures)")
