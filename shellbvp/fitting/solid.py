@@ -64,6 +64,8 @@ FIT_MODELS = ("auto", "shell", "solid")
 #: thick_fits.md), and their shell model is within a few percent of the solid.  A wall whose
 #: thickness varies is measured from its thickest point this thick up (the model's error line
 #: names the thickest too), when its solid is within the limit of unknowns (``max_fe_dofs``).
+#: The same for closed shells, whose solid on a substrate (the whole wall) has twice the elements
+#: of the half between plates.
 AUTO_SOLID_EPS = 0.05
 
 #: A kept solid curve larger than this is not read (40 depths take about 4 kB).
