@@ -128,3 +128,17 @@ def test_cli_fits_a_capsule_between_plates_with_the_solid(tmp_path, capsys):
     assert "rim face" not in text
     rec = sb.read_fit(out)
     assert rec.settings["model"] == "solid" and rec.parameters["mu_H"] == pytest.approx(MU_H, rel=2e-3)
+
+
+@pytest.mark.slow  # two solids on the default and a finer mesh, ~1 min
+def test_a_sealed_capsule_is_fitted_by_the_solid_from_a_finer_solids_record(monkeypatch):
+    # the fitting model on its default mesh, the record on one 1.5x finer each way (as
+    # benchmarks/thick_fits.py): a sealed capsule between plates, eps 0.1, 1 % noise
+    monkeypatch.setattr(solid, "FE_DEFAULTS", fe.FE_DEFAULTS)
+    scene = SCENES["plates"].replace(sealed=True)
+    c = sb.fe_curve(scene, 0.1, DEPTHS, at="indenter", element_length=0.33, through_thickness=4)
+    assert c.success and np.all(c.pressure > 0)  # the held volume's pressure rises
+    F = MU_H * R_L * c.force * (1 + 0.01 * np.random.default_rng(7).normal(size=DEPTHS.size))
+    res = sb.fit(scene, CONTACT + DEPTHS * R_L, F, R_L=R_L, model="solid")
+    lo, hi = res.mu_H_ci95
+    assert res.success and lo < MU_H < hi and res.mu_H == pytest.approx(MU_H, rel=0.01)
