@@ -9,6 +9,8 @@ the state on the substrate is near the upper half of the first at an approach ``
 lower half of the second at ``dl``, where both carry the same force and ``(du + dl)/2`` is
 the prescribed delta (each half's pole moves by half its problem's approach).  Those halves,
 joined at the equator, are the guess; their contacts (cap or ring) choose the configuration.
+Under force control the two problems are solved at that force directly, and delta is their
+approaches' mean.
 A state of a curve is solved again from its neighbour (``solve(guess=...)``,
 :func:`closed_again`), and cold where that fails or is not valid.
 """
@@ -108,24 +110,39 @@ def _joined(sysm, upper, lower, delta):
     return x, np.vstack(parts), sysm.pack(**named)
 
 
+def _at_force(scene, value, solve_half, kw):
+    """The two symmetric halves at the force ``value``, or a reason why not."""
+    halves = []
+    for sym in symmetric_scenes(scene):
+        s = solve_half(sym, force=value, estimate_error=False, **kw)
+        if not s.success or _half(s) is None:
+            return None, (f"the shell between two {'plates' if sym.tip == FlatTip() else 'tips'} at force "
+                          f"{value:.6g} gave {s.topology} ({s.message})")
+        halves.append(s)
+    return halves, ""
+
+
 def closed_cold(scene, control, value, *, solve_half, eps, tol, max_nodes, bc_tol):
-    """A state of a closed shell on a substrate at ``control = value`` (delta only), from the
-    two symmetric problems (``solve_half``: :func:`shellbvp.state.solve`)."""
+    """A state of a closed shell on a substrate at ``control = value``, from the two symmetric
+    problems at the same force (``solve_half``: :func:`shellbvp.state.solve`): under delta control
+    matched so that their approaches average to delta, under force control solved at it."""
     def failed(message):
         return failure(5, f"closed shell on a substrate: {message}", scene=scene, control=control, value=value,
                        topology=closed_name("cap", "cap"))
 
-    if control != "delta":
-        return failed(f"solved cold at a given delta; {control} control needs a neighbouring state (guess=)")
     kw = dict(eps=eps, tol=tol, max_nodes=max_nodes, bc_tol=bc_tol)
-    halves, why = _matched(scene, value, solve_half, kw)
+    if control == "delta":
+        halves, why = _matched(scene, value, solve_half, kw)
+    else:
+        halves, why = _at_force(scene, value, solve_half, kw)
     if halves is None:
         return failed(why)
     res = None
     for upper, lower in _contacts_tried(halves, solve_half, kw):
         name = closed_name(_half(upper), _half(lower))
         sysm = _system(scene, name, control, value, eps)
-        res = solve_chain_from(sysm, _joined(sysm, upper, lower, value), tol=tol, max_nodes=max_nodes, bc_tol=bc_tol)
+        delta = value if control == "delta" else 0.5 * (upper.delta + lower.delta)
+        res = solve_chain_from(sysm, _joined(sysm, upper, lower, delta), tol=tol, max_nodes=max_nodes, bc_tol=bc_tol)
         if res.success and res.valid:
             return res
     if not res.success:

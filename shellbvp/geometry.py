@@ -152,11 +152,12 @@ class UserShell:
             self.geometry = sg.user_shell(R, Z, L, legacy_srepr=legacy_srepr)
             self._desc = {"kind": "user", "R": formula_text(self.geometry.R), "Z": formula_text(self.geometry.Z),
                           "L": formula_text(self.geometry.L)}
-            ks, kt = self.geometry.curvatures()
+            ks, kt = self._curvatures = self.geometry.curvatures()
             pole_kt = sp.limit(kt, sg.S, 0, "+")
         if not (pole_kt.is_real and pole_kt.is_finite):
             raise ValueError(f"shell: the pole curvature kappa_theta(0) must be finite; got {pole_kt}")
         self._pole_kt = float(pole_kt)
+        self._closed_problem = ...  # not asked yet (closed_problem)
 
     def description(self):
         """The formulas as plain text (what files store)."""
@@ -165,6 +166,26 @@ class UserShell:
     def pole_curvature(self, values):
         """kappa_theta^R at the pole (after rescaling)."""
         return self._pole_kt
+
+    def closed_problem(self) -> str | None:
+        """Why this meridian is not the upper half of a closed shell, or None.
+
+        A closed shell's meridian (``Scene(closed=True, shell=...)``) runs from its pole (S = 0)
+        to its equator (S = L), the lower half its mirror image: it leaves the pole horizontally
+        (``R'(0) > 0``), meets the equator with a vertical tangent (``R'(L) = 0``, ``Z'(L) < 0``),
+        is smooth (``Psi > 0``, finite curvatures), off the axis (``R > 0``) and above the
+        equator (``Z > 0``) in between, and highest at its pole (a plate meets the pole first).
+        Checked on 2001 points of [0, L] and, at the ends, in 30 digits.
+
+        >>> import shellbvp as sb
+        >>> sb.UserShell("sin(S)", "0.7*cos(S)", "pi/2").closed_problem() is None
+        True
+        >>> sb.UserShell("sin(S)", "cos(S)", "1.5").closed_problem()[:60]
+        "shell: a closed shell's meridian ends at its equator S = L w"
+        """
+        if self._closed_problem is ...:
+            self._closed_problem = _closed_problem(self.geometry, self._curvatures)
+        return self._closed_problem
 
     def __repr__(self):
         return f"UserShell(R={str(self.geometry.R)!r}, Z={str(self.geometry.Z)!r}, L={str(self.geometry.L)!r})"
@@ -236,3 +257,45 @@ class UserTip:
 
     def __hash__(self):
         return hash(str(self._desc))
+
+
+def _closed_problem(g, curvatures) -> str | None:
+    """:meth:`UserShell.closed_problem` of the geometry ``g`` with its curvatures ``(ks, kt)``."""
+    import numpy as np
+    import sympy as sp
+
+    from symbolic.geometry import S
+
+    L = float(g.L)
+    dR, dZ = sp.diff(g.R, S), sp.diff(g.Z, S)
+    ends = [complex(sp.N(e.subs(S, at), 30)) for e in (dR, dZ) for at in (0, g.L)]
+    if any(abs(v.imag) > 1e-12 or not np.isfinite(v.real) for v in ends):
+        return f"shell: R'(S) and Z'(S) must be real and finite at the pole and the equator (S = 0, L = {L:.6g})"
+    dR0, dRL, _, dZL = (v.real for v in ends)
+    if not dR0 > 0:
+        return f"shell: a closed shell's meridian leaves its pole horizontally, R'(0) > 0; got R'(0) = {dR0:.3g}"
+    if not abs(dRL) <= 1e-9:
+        return (f"shell: a closed shell's meridian ends at its equator S = L with a vertical tangent, R'(L) = 0 "
+                f"(|R'(L)| <= 1e-9; give the upper half, pole to equator); got R'(L) = {dRL:.3g} at L = {L:.6g}")
+    if not dZL < 0:
+        return (f"shell: a closed shell's meridian runs down to its equator, Z'(L) < 0 (the pole above it); "
+                f"got Z'(L) = {dZL:.3g}")
+    s = np.linspace(0.0, L, 2001)[1:]
+    with np.errstate(all="ignore"):
+        R, Z, dRs, dZs, ks, kt = (np.broadcast_to(np.asarray(f(s), dtype=complex), s.shape) for f in
+                                  (sp.lambdify(S, e, "numpy") for e in (g.R, g.Z, dR, dZ, *curvatures)))
+    Z0 = float(sp.N(g.Z.subs(S, 0), 30))
+    checks = (
+        (np.isfinite(R) & np.isfinite(Z) & (abs(R.imag) + abs(Z.imag) <= 1e-12), "R(S), Z(S) must be real and finite"),
+        (R.real > 0, "R(S) must be > 0 between the pole and the equator (off the axis)"),
+        (np.hypot(abs(dRs), abs(dZs)) > 1e-9, "Psi = sqrt(R'^2 + Z'^2) must be > 0 (a smooth meridian)"),
+        (np.isfinite(ks) & np.isfinite(kt) & (abs(ks.imag) + abs(kt.imag) <= 1e-12),
+         "the curvatures must be real and finite (a smooth meridian)"),
+        (Z.real < Z0, "the pole must be the highest point, Z(S) < Z(0) (a plate meets the pole first)"),
+        (np.r_[Z.real[:-1] > 0, True], "Z(S) must be > 0 before the equator (the upper half above it)"),
+    )
+    for ok, what in checks:
+        if not np.all(ok):
+            bad = s[np.argmin(ok)]
+            return f"shell: a closed shell's meridian: {what} on 0 < S <= L = {L:.6g}; not at S = {bad:.4g}"
+    return None

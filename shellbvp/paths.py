@@ -8,7 +8,7 @@ import tempfile
 from contextlib import contextmanager
 from pathlib import Path
 
-__all__ = ["check_output_path", "partial_path", "atomic_file", "atomic_hdf5", "open_hdf5", "read_input_bytes",
+__all__ = ["require_file", "check_output_path", "partial_path", "atomic_file", "atomic_hdf5", "open_hdf5", "read_input_bytes",
            "MAX_INPUT_BYTES"]
 
 #: The largest input file read whole (a measured curve is kilobytes to a few megabytes).
@@ -50,6 +50,13 @@ def read_input_bytes(path, max_bytes=MAX_INPUT_BYTES) -> bytes:
         raise ValueError(f"{path}: cannot read ({exc.strerror})") from None
     finally:
         os.close(fd)
+
+
+def require_file(path) -> None:
+    """ValueError in one line unless ``path`` exists: the reading commands' first check, made
+    before their handlers load numpy and h5py (``shellbvp info missing.h5`` answers at once)."""
+    if not os.path.exists(path):
+        raise ValueError(f"{path}: no such file")
 
 
 def open_hdf5(path, *, fmt: str, group, kind: str):

@@ -105,7 +105,9 @@ class Scene:
     closed : bool
         A complete spheroid instead of a shell held on its rim (a cell, a capsule, a pollen
         grain): ``gamma`` is then its polar over its equatorial semi-axis (> 0) and lengths are
-        in units of its equatorial radius (``R_L``).  Default False.
+        in units of its equatorial radius (``R_L``).  A ``UserShell`` is then the upper half's
+        meridian, pole to equator, the lower half its mirror image
+        (:meth:`UserShell.closed_problem` says what it must be).  Default False.
     support : {"substrate", "plates"}, optional
         What a closed shell rests on (default ``"substrate"``, a rigid frictionless plane) or
         ``"plates"`` (compressed between two parallel plates: ``tip=FlatTip()``; with a curved
@@ -377,7 +379,8 @@ class Scene:
             parts.append(f"shell: {self.shell_side()}, {rise}" + (f" on a rim radius of {length(1.0)}"
                                                                    if R_L and not self.closed else ""))
         else:
-            parts.append("shell: user meridian" + (f" on a rim radius of {length(1.0)}" if R_L else ""))
+            parts.append(f"shell: {self.shell_side()}" + (f" on {'an equatorial' if self.closed else 'a rim'} radius of "
+                                                           f"{length(1.0)}" if R_L else ""))
         tip = "sphere" if isinstance(self.tip, SphereTip) else "user tip"
         if isinstance(self.tip, FlatTip):
             parts.append("indenter: flat plate")
@@ -415,9 +418,10 @@ class Scene:
         ('spheroidal bowl (indented from inside)', 'spheroidal dome (indented from outside)')
         """
         if self.closed:
+            shape = "closed spheroid" if isinstance(self.shell, Spheroid) else "closed shell (user meridian)"
             if self.support == "plates":
-                return "closed spheroid between " + ("plates" if isinstance(self.tip, FlatTip) else "two indenters")
-            return "closed spheroid on a substrate"
+                return f"{shape} between " + ("plates" if isinstance(self.tip, FlatTip) else "two indenters")
+            return f"{shape} on a substrate"
         if not isinstance(self.shell, Spheroid):
             return "user meridian"
         if self.gamma == 0:
@@ -515,9 +519,9 @@ def _support(scene, gamma) -> str:
     support = "substrate" if scene.support is None else scene.support
     if support not in SUPPORTS:
         raise ValueError(f"support must be one of {SUPPORTS} for a closed shell; got {support!r}")
-    if not isinstance(scene.shell, Spheroid):
-        raise ValueError("closed=True needs the built-in spheroid (a user meridian from pole to pole is not offered yet)")
-    if not gamma > 0:
+    if isinstance(scene.shell, UserShell) and (why := scene.shell.closed_problem()):  # its upper half
+        raise ValueError(why)
+    if isinstance(scene.shell, Spheroid) and not gamma > 0:
         raise ValueError(f"gamma (polar / equatorial semi-axis of a closed spheroid) must be > 0; got {gamma!r}")
     if support == "substrate" and not isinstance(scene.tip, FlatTip) and not scene.contact_model.variational:
         raise ValueError(f"contact={scene.contact!r}: a closed shell on a substrate under a curved tip has the smooth "

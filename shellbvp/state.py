@@ -301,6 +301,9 @@ def solve(scene, *, delta=None, lambda0=None, force=None, tol=1e-6, max_nodes=10
         raise ValueError(f"topology must be one of {asked()}; got {topology!r}")
     if control == "delta":
         check_delta("delta", value, scene, tol)
+    if control == "lambda0" and scene.two_contacts:
+        raise ValueError("lambda0 control is not offered for a closed shell on a substrate under a curved tip "
+                         "(its configurations take delta or force); give delta or force")
     if topology != "auto":
         configuration(topology).check_contact(scene)
     again = AGAIN.get(of(guess).family) if guess is not None and of(guess) is not None else None

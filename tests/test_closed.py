@@ -134,6 +134,17 @@ def test_a_closed_shell_on_a_substrate_under_a_sphere_has_its_force_from_its_ene
     assert (E[1] - E[0]) / (2 * h) == pytest.approx(s.force, rel=1e-5)
 
 
+def test_a_closed_shell_on_a_substrate_is_solved_cold_at_a_force():
+    # cold: the two symmetric problems at that force, joined; the state is the delta-controlled one
+    scene = on_substrate()
+    s = sb.solve(scene, delta=0.1, estimate_error=False)
+    f = sb.solve(scene, force=s.force, estimate_error=False)
+    assert f.success and f.valid and f.topology == s.topology
+    assert f.delta == pytest.approx(0.1, abs=1e-6)
+    with pytest.raises(ValueError, match="lambda0 control is not offered for a closed shell on a substrate"):
+        sb.solve(scene, lambda0=1.01)
+
+
 def test_a_small_tip_on_a_thin_sphere_on_a_substrate_is_reissners_two_poles_in_series():
     # a small load: a point force at each pole, as between plates (to 1e-4)
     eps = 0.02

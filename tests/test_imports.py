@@ -136,3 +136,7 @@ def test_the_command_line_parses_before_numpy_and_scipy_load():
     missing = code.replace("['curve', '--no-such-option']", "['fit', 'missing.csv', '--preset', 'fit', '--radius', '0.3mm']")
     r = subprocess.run([sys.executable, "-c", missing], capture_output=True, text=True)
     assert r.stdout.strip() == "2 []" and "missing.csv: no such file" in r.stderr, (r.stdout, r.stderr)
+    for command in (["info", "missing.h5"], ["report", "missing.h5"], ["plot", "missing.h5"]):
+        r = subprocess.run([sys.executable, "-c", code.replace("['curve', '--no-such-option']", repr(command))],
+                           capture_output=True, text=True)
+        assert r.stdout.strip() == "2 []" and "missing.h5: no such file" in r.stderr, (command, r.stdout, r.stderr)

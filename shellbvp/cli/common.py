@@ -13,14 +13,14 @@ from pathlib import Path
 
 from .. import progress, units
 from ..edge_models import contact_models
-from ..geometry import FlatTip
+from ..geometry import FlatTip, UserShell
 from ..materials import BENDINGS, MATERIALS, BendingEnergy, NeoHookean, bending_class, material_class
 from ..paths import check_output_path
 from ..scene_parameters import scene_parameter, scene_parameters
 from ..textdata import printable
 from ..units import Quantity, parse_uncertain, split_quantity
 
-__all__ = ["Parser", "print_json_error", "show_code_generation", "plain_number", "plain_numbers", "quantity", "uncertain_value", "pressure_value", "say", "number_or", "thickness_value", "nondimensional", "add_radius_option", "add_mu_h_option", "material_spec", "material_help", "material_options", "bending_families", "add_scene_options", "scene_from_args", "over_rim_radius", "require_sample", "nondimensional_thickness", "nondimensional_pressure", "checkpoint_seconds", "progress_bar", "curve_bars", "MAX_POINTS", "free_default_name", "strict_json", "output_dir", "check_report_path", "add_overwrite_option",
+__all__ = ["Parser", "print_json_error", "show_code_generation", "plain_number", "plain_numbers", "quantity", "uncertain_value", "pressure_value", "say", "number_or", "thickness_value", "meridian_value", "nondimensional", "add_radius_option", "add_mu_h_option", "material_spec", "material_help", "material_options", "bending_families", "add_scene_options", "scene_from_args", "over_rim_radius", "require_sample", "nondimensional_thickness", "nondimensional_pressure", "checkpoint_seconds", "progress_bar", "curve_bars", "MAX_POINTS", "free_default_name", "strict_json", "output_dir", "check_report_path", "add_overwrite_option",
            "NODE_BUDGET", "node_budget", "add_limit_options", "limits_of", "LIMIT_OPTIONS"]
 
 
@@ -168,6 +168,15 @@ def number_or(kind):
 thickness_value = number_or("length")  # eps = H / R_L, or the thickness with its unit
 
 
+def meridian_value(text):
+    """``--meridian 'R; Z; L'``: the three formulas' text (parsed by the scene's whitelist later)."""
+    parts = [part.strip() for part in text.split(";")]
+    if len(parts) != 3 or not all(parts):
+        raise argparse.ArgumentTypeError(f"give three formulas 'R(S); Z(S); L' separated by ';'; got {len(parts)} "
+                                         f"part{'s' if len(parts) != 1 else ''} in {printable(text)!r}")
+    return tuple(parts)
+
+
 def nondimensional(args, value, option):
     """``value`` of ``option`` in the model's units: a plain number as it is; a length over the rim
     radius (``--radius``), a force over mu*H times it (``--muH`` too)."""
@@ -302,6 +311,11 @@ def add_scene_options(p, uncertain=False, preset_required=False, solver=("tol", 
                        help="how far the pole lies below the rim's plane, with its unit (with --radius): gamma = "
                             "rise / R_L; > 0 a bowl indented from inside (5um), < 0 a dome indented from outside "
                             "(-5um, or 5um with --dome)")
+    shape.add_argument("--meridian", type=meridian_value, metavar="'R; Z; L'",
+                       help="a reference meridian of your own, 'R(S); Z(S); L': formulas in S for 0 <= S <= L (read "
+                            "by a whitelist, never run; rescaled to R(L) = 1, Z(L) = 0), e.g. 'sin(S); -2*cos(S); "
+                            "pi/2': pole to rim, or with --closed the upper half, pole to equator (R'(L) = 0), its "
+                            "mirror image the lower half")
     g.add_argument("--dome", action="store_true", default=None,
                    help="the shell is a dome indented from outside (its convex side): --rise is the pole's height "
                         "above the rim's plane, gamma = -rise / R_L")
@@ -314,7 +328,8 @@ def add_scene_options(p, uncertain=False, preset_required=False, solver=("tol", 
                      help="the indenter is a flat plate (FlatTip: no radius)")
     g.add_argument("--closed", action="store_true", default=None,
                    help="a complete spheroid (a cell, capsule or pollen grain) instead of a shell held on its rim: "
-                        "--radius is its equatorial radius, --gamma (or --rise) its polar semi-axis over it")
+                        "--radius is its equatorial radius, --gamma (or --rise) its polar semi-axis over it "
+                        "(or --meridian its upper half)")
     g.add_argument("--support", choices=("substrate", "plates"),
                    help="with --closed: resting on a rigid plane (default) or compressed between two plates; "
                         "both under a flat plate (--flat-tip) for now")
@@ -375,6 +390,8 @@ def scene_from_args(args):
             if getattr(args, k, None) is not None}
     if getattr(args, "flat_tip", None):
         over["tip"] = FlatTip()
+    if getattr(args, "meridian", None):
+        over["shell"] = UserShell(*args.meridian)
     chosen = [p for p in material_options() if getattr(args, p.dest, None) is not None]
     if chosen:  # its material (the options exclude each other)
         over["material"] = material_class(chosen[0].material)(**{chosen[0].name: getattr(args, chosen[0].dest)})
@@ -442,7 +459,8 @@ def require_sample(args, bending_per_pixel=False):
     missing = [what for what, given in (
         ("the indenter: --indenter-radius (or --rho, or --flat-tip)",
          args.rho is not None or args.indenter_radius is not None or bool(getattr(args, "flat_tip", None))),
-        ("the shell's shape: --rise (or --gamma)", args.gamma is not None or args.rise is not None),
+        ("the shell's shape: --rise (or --gamma, --meridian)",
+         args.gamma is not None or args.rise is not None or getattr(args, "meridian", None) is not None),
         ("its bending stiffness: --thickness (or --beta)",
          args.thickness is not None or args.beta is not None or bending_per_pixel
          or getattr(args, "thickness_profile", None) is not None))

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from ..paths import require_file
+
 __all__ = ["add_parser", "run"]
 
 
@@ -13,7 +15,8 @@ def add_parser(sub):
 
 
 def run(args):
-    """The handler (``handlers/info.py``), imported now: the parser loads no numpy."""
+    """The handler (``handlers/info.py``), imported once the file is known to exist: the parser loads no numpy."""
+    require_file(args.file)
     from .handlers import info
 
     return info.run(args)

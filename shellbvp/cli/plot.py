@@ -3,6 +3,8 @@ pixel of a force map (``--pixel IX,IY``) or one figure per pixel (``--pixels all
 
 from __future__ import annotations
 
+from ..paths import require_file
+
 __all__ = ["add_parser", "run", "MAX_PIXEL_FIGURES"]
 
 #: ``--pixels`` writes at most this many figures unless ``--max-figures`` says more
@@ -34,7 +36,9 @@ def add_parser(sub):
 
 
 def run(args):
-    """The handler (``handlers/plot.py``), imported now: the parser loads no numpy."""
+    """The handler (``handlers/plot.py``), imported once the file is known to exist: the parser loads no numpy."""
+    for path in args.files:
+        require_file(path)
     from .handlers import plot
 
     return plot.run(args)

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 from .common import add_overwrite_option
 
+from ..paths import require_file
+
 __all__ = ["add_parser", "run"]
 
 
@@ -18,7 +20,8 @@ def add_parser(sub):
 
 
 def run(args):
-    """The handler (``handlers/report.py``), imported now: the parser loads no numpy."""
+    """The handler (``handlers/report.py``), imported once the file is known to exist: the parser loads no numpy."""
+    require_file(args.file)
     from .handlers import report
 
     return report.run(args)
