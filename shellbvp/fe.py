@@ -290,13 +290,11 @@ def coarser(settings):
             "through_thickness": max(2, round(settings["through_thickness"] * 2 / 3))}
 
 
-def check_solid_scene(scene, use="fit"):
-    """ValueError, in one line, where the scene has no solid here (before any work): a material
-    without a 3D form; for a fit (``use="fit"``, ``fit --model solid``), a closed shell, whose
-    solid :func:`fe_curve` and :func:`shellbvp.validate` hold (``use="curve"``)."""
-    if scene.closed and use == "fit":
-        raise ValueError("a fit of a closed shell (support=substrate/plates) with the 3D solid is not offered yet; "
-                         "fit it with model='shell' (sb.validate and sb.fe_curve measure the shell's error)")
+def check_solid_scene(scene):
+    """ValueError, in one line, where the scene has no solid (before any work): a material
+    without a 3D form.  Every shell the solid holds -- rimmed, or closed between plates or on a
+    substrate, open, under a pressure or sealed -- is also a fitting model (``fit --model
+    solid``): its curve at the indenters' approach (``at="indenter"``) is what a fit reads."""
     _check_material(scene)
 
 
@@ -444,7 +442,7 @@ def fe_curve(scene, thickness, deltas, *, at="pole", mesh_check=False, progress=
         raise ValueError("deltas must be finite, > 0 and increasing")
     if at not in ("pole", "indenter"):
         raise ValueError(f"at must be 'pole' or 'indenter'; got {at!r}")
-    check_solid_scene(scene, use="curve")
+    check_solid_scene(scene)
     if scene.thickness_profile is not None:
         _check_profile(scene, eps)
     unknown = set(settings) - set(FE_DEFAULTS)

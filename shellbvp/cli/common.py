@@ -459,7 +459,8 @@ def require_sample(args, bending_per_pixel=False):
     if args.preset is not None:
         return
     missing = [what for what, given in (
-        ("the indenter: --indenter-radius (or --rho)", args.rho is not None or args.indenter_radius is not None),
+        ("the indenter: --indenter-radius (or --rho, or --flat-tip)",
+         args.rho is not None or args.indenter_radius is not None or bool(getattr(args, "flat_tip", None))),
         ("the shell's shape: --rise (or --gamma, --meridian)",
          args.gamma is not None or args.rise is not None or getattr(args, "meridian", None) is not None),
         ("its bending stiffness: --thickness (or --beta)",

@@ -74,7 +74,8 @@ def add_parser(sub):
     f.add_argument("--model", choices=("auto", "shell", "solid"), default="auto",
                    help="what is compared with the data: shell (the shell model; its mid-surface pole's "
                         "displacement taken as the data's), solid (the shell as a 3D solid of the given "
-                        "--thickness, indented by the indenter's displacement as the instrument records it; "
+                        "--thickness, indented by the indenter's displacement as the instrument records it (a "
+                        "closed shell: the indenters' approach); "
                         "needs '.[fe]'; one FE curve per sample, kept in the code cache) or auto (default: with a "
                         "thickness of at least 0.05 R_L, both, and the shell where the solid measures its error "
                         "within the interval, else the solid; otherwise the shell); the summary says which and why")

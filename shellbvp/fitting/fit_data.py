@@ -198,7 +198,8 @@ def fit(scene, displacement, force, *, R_L, fit_offset=True, free=(), bounds=Non
         What is compared with the data: the shell model's curve (its delta, the mid-surface
         pole's displacement, taken as the data's displacement) or the scene's 3D solid
         (:func:`shellbvp.fe_curve`; needs ``scene.thickness`` and the ``fe`` extra), indented by
-        the indenter's displacement from first touch, as an instrument records it
+        the indenter's displacement from first touch, as an instrument records it (of a closed
+        shell, the approach of the plates, or of the tip and the substrate)
         (:mod:`shellbvp.fitting.solid`).  The solid fits mu*H, the contact point and a
         baseline; shape parameters, ``stability`` and shared curves are shell-only.
         ``"auto"`` (default): where the solid can be this fit's model and is affordable

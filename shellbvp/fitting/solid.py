@@ -7,6 +7,16 @@ the indenter's, which also compresses and thins the wall under the tip.  On thic
 by 6-20 % (issue 54).  The solid has neither: its abscissa is the indenter's displacement from
 first touch (at the pole or on a ring, where it really is), divided by R_L.
 
+A closed shell (``Scene(closed=True)``, :mod:`shellbvp.fe_closed`) is fitted the same way: its
+abscissa is the approach of the indenters from first touch -- the two plates' (or tips'), or
+the tip's towards the fixed substrate -- which is also the closed shell model's delta (the
+approach of its mid-surface poles, which press the indenters directly); the solid's poles'
+approach is shorter by the wall's compression under both contacts.  Between plates the solid is
+the half above the equator and each plate moves by half the approach; on a substrate the whole
+wall on a second, fixed contact, its cost twice the half's elements (:func:`shellbvp.fe.fe_size`).
+Open, under a pressure or sealed: the nondimensional pressure (or the held volume) is part of
+the scene, so the curve still scales with mu*H.
+
 For a material whose energy scales with mu at fixed shape parameters (neo-Hookean,
 Mooney-Rivlin at a given alpha, Gent at a given Jm, ...), the solid's force is mu times one
 curve: ``F_SI = mu_H R_L F(d / R_L)`` with ``F = force / (mu R_L H)``, exactly the shell
@@ -41,7 +51,7 @@ from .curves import code_fingerprint
 from .kept import checksum, keep, kept_folder, read_kept
 
 __all__ = ["SolidCurve", "solid_curve", "clear_solid_curves", "check_solid_fit", "auto_model", "shell_or_solid",
-           "FIT_MODELS", "AUTO_SOLID_EPS", "MAX_KEPT_BYTES"]
+           "shell_words", "solid_words", "FIT_MODELS", "AUTO_SOLID_EPS", "MAX_KEPT_BYTES"]
 
 log = logging.getLogger(__name__)
 
@@ -54,6 +64,8 @@ FIT_MODELS = ("auto", "shell", "solid")
 #: thick_fits.md), and their shell model is within a few percent of the solid.  A wall whose
 #: thickness varies is measured from its thickest point this thick up (the model's error line
 #: names the thickest too), when its solid is within the limit of unknowns (``max_fe_dofs``).
+#: The same for closed shells, whose solid on a substrate (the whole wall) has twice the elements
+#: of the half between plates.
 AUTO_SOLID_EPS = 0.05
 
 #: A kept solid curve larger than this is not read (40 depths take about 4 kB).
@@ -76,11 +88,13 @@ class SolidCurve:
     scene : Scene
     delta : ndarray
         The indenter's displacement from first touch / R_L at the depths reached (the fit's
-        abscissa: named as the shell curve's so that a fit reads either).
+        abscissa: named as the shell curve's so that a fit reads either); of a closed shell, the
+        approach of the plates, or of the tip and the substrate.
     force : ndarray
         Indenter force / (mu R_L H) there.
     pole_delta : ndarray
-        The mid-surface pole's displacement / R_L there (the shell model's delta).
+        The mid-surface pole's displacement / R_L there (of a closed shell, the approach of its
+        two mid-surface poles).
     contact_radius : ndarray
         Radius of the outermost surface point in contact / R_L.
     complete : bool
@@ -127,6 +141,23 @@ def check_solid_fit(scene, free=()):
 
 #: How the summary names the shell model: what it takes the data's displacement to be.
 SHELL_WORDS = "shell model, its mid-surface pole's displacement taken as the data's"
+#: ... of a closed shell, whose model presses the indenters with its mid-surface poles.
+CLOSED_SHELL_WORDS = "shell model, its mid-surface poles' approach taken as the data's"
+
+
+def shell_words(scene):
+    """The summary's name of the shell model of ``scene`` (None: a rimmed shell's)."""
+    return CLOSED_SHELL_WORDS if getattr(scene, "closed", False) else SHELL_WORDS
+
+
+def solid_words(scene):
+    """``(solid, abscissa)``: how the summary describes the solid of ``scene`` (its support)
+    and what it takes the data's displacement to be."""
+    if not scene.closed:
+        return "the rim face hinged at mid-thickness", "its indenter's displacement from first touch"
+    if scene.support == "plates":
+        return "the half above the equator on its symmetry plane", "the indenters' approach from first touch"
+    return "the whole wall on a frictionless substrate", "the tip's approach to the substrate from first touch"
 
 
 def auto_model(scene, free=(), stability=False):
@@ -156,7 +187,7 @@ def auto_model(scene, free=(), stability=False):
             reason = f"no 3D solid for this scene: {exc}"
     if reason is None and importlib.util.find_spec("felupe") is None:
         reason = "the 3D solid needs FElupe: pip install 'shellbvp[fe]'"
-    return ("both", "") if reason is None else ("shell", f"{SHELL_WORDS} ({reason})")
+    return ("both", "") if reason is None else ("shell", f"{shell_words(scene)} ({reason})")
 
 
 def shell_or_solid(shell, solid):
@@ -164,9 +195,10 @@ def shell_or_solid(shell, solid):
     error on this scene, measured by the solid as the difference of their mu*H, lies within
     its 95 % interval; the solid otherwise (``model_note`` says which and why)."""
     computed = shell.curves_computed + solid.curves_computed
+    words = shell_words(shell.scene)
     if not solid.success:
         return dataclasses.replace(shell, curves_computed=computed, model_note=(
-            f"{SHELL_WORDS} (the 3D solid's fit failed: {solid.message}; its error is not measured)"))
+            f"{words} (the 3D solid's fit failed: {solid.message}; its error is not measured)"))
     if not shell.success:
         return dataclasses.replace(solid, curves_computed=computed, model_note=(
             f"3D solid (the shell model's fit failed: {shell.message})"))
@@ -176,7 +208,7 @@ def shell_or_solid(shell, solid):
                 f"solid {solid.mu_H:.4g} N/m)")
     if abs(error) <= half:
         return dataclasses.replace(shell, curves_computed=computed, measured_model_error=abs(error), model_note=(
-            f"{SHELL_WORDS}; its error, {measured}, is within its interval (+-{100 * half:.2g} %)"))
+            f"{words}; its error, {measured}, is within its interval (+-{100 * half:.2g} %)"))
     return dataclasses.replace(solid, curves_computed=computed, measured_model_error=abs(error), model_note=(
         f"3D solid; the shell model's error, {measured}, is beyond the shell's interval (+-{100 * half:.2g} %)"))
 

@@ -18,7 +18,7 @@ from ...batch import expand_inputs, fit_files, fit_map, read_record, write_table
 from ...fit_checks import weights_check_line
 from ...fitrecord import read_fit, write_fit
 from ...fitting import diagnostics_lines, example_data_path, fit_record
-from ...fitting.solid import check_solid_fit
+from ...fitting.solid import check_solid_fit, solid_words
 from ...modal_stability import check_stability_size
 from ...paths import check_output_path
 from ...pixel_table import read_pixel_table
@@ -450,8 +450,9 @@ def _solid_line(c, mesh_error):
     where = "kept in the code cache" if c.kept else f"computed in {c.wall_time:.1f} s"
     error = ("--mesh-check measures its mesh's error" if mesh_error is None else
              f"mu*H {100 * mesh_error:.2g} % off on a mesh 2/3 as fine")
-    return (f"solid  = FElupe, {c.elements[0]}x{c.elements[1]} quadratic elements ({error}), the rim face hinged "
-            f"at mid-thickness; its indenter's displacement from first touch as the data's; curve {where}")
+    held, abscissa = solid_words(c.scene)
+    return (f"solid  = FElupe, {c.elements[0]}x{c.elements[1]} quadratic elements ({error}), {held}; "
+            f"{abscissa} as the data's; curve {where}")
 
 
 def _estimate_line(e):

@@ -19,7 +19,7 @@ def run(args):
     args.delta_max = nondimensional(args, args.delta_max, "--delta-max")
     if scene.thickness is None:
         raise ValueError("validate needs --thickness (H/R_L, or with a unit and --radius)")
-    check_solid_scene(scene, use="curve")
+    check_solid_scene(scene)
     if not (0 < args.delta_max <= 2):
         raise ValueError(f"--delta-max must be in (0, 2]; got {args.delta_max:g}")
     deltas = None
