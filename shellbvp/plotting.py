@@ -342,8 +342,10 @@ def _display(record):
 
 
 #: A fit's model in words (``FitRecord.settings["model"]``).
-_MODEL_WORDS = {"shell": "the shell model (its mid-surface pole's displacement as the data's)",
-                "solid": "the 3D solid (its indenter's displacement from first touch as the data's)"}
+_MODEL_WORDS = {("shell", False): "the shell model (its mid-surface pole's displacement as the data's)",
+                ("solid", False): "the 3D solid (its indenter's displacement from first touch as the data's)",
+                ("shell", True): "the shell model (its mid-surface poles' approach as the data's)",
+                ("solid", True): "the 3D solid (its indenters' approach from first touch as the data's)"}
 
 
 def fit_summary_lines(record):
@@ -355,7 +357,7 @@ def fit_summary_lines(record):
              *(f"note: {text}" for text in record.source["notes"]),
              f"fit: {'succeeded' if record.success else 'FAILED'} (status {record.status}); "
              f"{record.settings['segment']} segment, {int(p['n_points'])} rows; baseline {record.settings['baseline_model']}; "
-             f"{record.settings['weights']} weights; model: " + _MODEL_WORDS[record.settings.get("model", "shell")]]
+             f"{record.settings['weights']} weights; model: " + _MODEL_WORDS[record.settings.get("model", "shell"), bool(record.scene.closed)]]
 
     def line(name, extra=""):
         value, unit = show(p[name], PARAMETER_UNITS[name])

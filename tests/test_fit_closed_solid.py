@@ -128,6 +128,10 @@ def test_cli_fits_a_capsule_between_plates_with_the_solid(tmp_path, capsys):
     assert "rim face" not in text
     rec = sb.read_fit(out)
     assert rec.settings["model"] == "solid" and rec.parameters["mu_H"] == pytest.approx(MU_H, rel=2e-3)
+    from shellbvp.plotting import fit_summary_lines
+
+    summary = "\n".join(fit_summary_lines(rec))
+    assert "model: the 3D solid (its indenters' approach from first touch as the data's)" in summary
 
 
 @pytest.mark.slow  # two solids on the default and a finer mesh, ~1 min

@@ -331,8 +331,8 @@ def add_scene_options(p, uncertain=False, preset_required=False, solver=("tol", 
                         "--radius is its equatorial radius, --gamma (or --rise) its polar semi-axis over it "
                         "(or --meridian its upper half)")
     g.add_argument("--support", choices=("substrate", "plates"),
-                   help="with --closed: resting on a rigid plane (default) or compressed between two plates; "
-                        "both under a flat plate (--flat-tip) for now")
+                   help="with --closed: resting on a rigid plane (default; under a sphere, your tip or a flat "
+                        "plate) or compressed between two plates (--flat-tip, or two of the same tip)")
     kind_of, note = kind("beta")
     g.add_argument("--beta", type=kind_of, help=f"bending stiffness B/(mu R_L^2) (> 0){note}")
     g.add_argument("--thickness", type=thickness_value,
