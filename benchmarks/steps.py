@@ -201,9 +201,10 @@ RECORDS = {
     "fe_speed-old-alt.*": "fe_speed.py with other FE settings (--set), for comparison",
     "fe_speed-new-grow.*": "fe_speed.py with other FE settings (--set), for comparison",
     "fit_coverage-before.*": "fit_coverage.py --approach-only --tag before with another checkout's package",
-    "run.json": "run.py's own summary",
-    "run-quick.json": "run.py --quick's own summary",
 }
+
+#: What run.py itself writes into results/ (its summary of a run)
+DRIVER = ("run.json", "run-quick.json")
 
 
 def select(only=None):
@@ -221,5 +222,5 @@ def select(only=None):
 def claimed(path_name):
     """Whether a file of results/ is written by a step (either mode) or kept as a record."""
     pats = [o.split("/", 1)[1] for s in STEPS for o in s.outputs + s.quick_outputs if o.startswith("results/")]
-    pats += list(RECORDS)
+    pats += list(RECORDS) + list(DRIVER)
     return any(re.fullmatch(re.escape(p).replace(r"\*", ".*"), path_name) for p in pats)
