@@ -27,10 +27,11 @@ from pathlib import Path
 import numpy as np
 
 import shellbvp as sb
+from shellbvp.sweep import sweep  # not sb.sweep: importing shellbvp.uncertainty makes that the subpackage
+from shellbvp.uncertainty import fit_with_geometry
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from checkout import add_output_args, results_dir  # noqa: E402
-from shellbvp.uncertainty import fit_with_geometry
 
 HERE = Path(__file__).resolve().parent
 
@@ -70,7 +71,7 @@ def run_sweeps(grid, delta_max, tmp):
 
     def timed(name, **kw):
         t0 = time.perf_counter()
-        res = sb.sweep(base, grid, delta_max=delta_max, out=Path(tmp) / f"{name}.h5", **kw)
+        res = sweep(base, grid, delta_max=delta_max, out=Path(tmp) / f"{name}.h5", **kw)
         runs[name] = (time.perf_counter() - t0, res)
         print(f"{name}: {runs[name][0]:.1f} s, {res.counts()}", flush=True)
 

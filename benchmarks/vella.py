@@ -33,8 +33,6 @@ from pathlib import Path
 
 import shellbvp as sb
 
-from checkout import add_output_args, results_dir  # benchmarks/ is on sys.path
-
 HERE = Path(__file__).resolve().parent
 TAUS = (0.0, 0.1, 0.3, 1.0, 3.0, 10.0)
 
@@ -71,6 +69,8 @@ def row(beta: float, tau: float, frac: float) -> dict:
 
 
 def main(argv=None):
+    from checkout import add_output_args, results_dir  # benchmarks/ is on sys.path (tests load this module alone)
+
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true")
     add_output_args(ap)
