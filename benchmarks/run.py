@@ -1,7 +1,7 @@
 """Regenerate every benchmark result (issue 5): one command.
 
     python benchmarks/run.py                 # every result (8 h or more on 2 shared cores; below)
-    python benchmarks/run.py --quick         # each step's quick mode, ~10 min: a smoke test (*-quick files)
+    python benchmarks/run.py --quick         # each step's quick mode, ~6 min: a smoke test (*-quick files)
     python benchmarks/run.py --figures       # ... and the paper's figures (benchmarks/paper_figures.py)
     python benchmarks/run.py --only work_precision,profile    # steps by name
     python benchmarks/run.py --only solid,stability           # or by group
@@ -31,8 +31,9 @@ Time: the full plan's stated costs (each result file's own time for its whole ru
 of its per-case times; ``--list`` prints them) add up to 26,340 s (7.3 h on 2 shared cores)
 over 35 of the 48 steps; the other 13 (shooting, profile, point_budget, codegen_timing, kernels,
 sweep_scaling, sweep_kill_resume, topologies, vella, stability_pressure, fit_baseline_coverage,
-contact_estimate, profile_fit) give no time: about 8 h in all is a floor.  ``--quick`` took
-QUICK_TIME on the same machine, loaded by other work (per step: ``results/run-quick.json``).
+contact_estimate, profile_fit) give no time: about 8 h in all is a floor.  ``--quick`` (23
+steps) took 380 s measured on the same machine at load 6 (nice 10; 1,260 s at load 10-12 with
+the whole trust tally), 2-76 s a step; the per-step times go to ``results/run-quick.json``.
 """
 
 from __future__ import annotations
@@ -78,7 +79,7 @@ def plan(quick=False, only=None, figures=False, out=None, skipped=None):
 
 def parse_args(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--quick", action="store_true", help="each step's quick mode (~10 min), *-quick result files")
+    ap.add_argument("--quick", action="store_true", help="each step's quick mode (~6 min), *-quick result files")
     ap.add_argument("--figures", action="store_true", help="also regenerate the paper's figures (slow)")
     ap.add_argument("--only", type=lambda s: [x for x in s.split(",") if x], default=None,
                     help="comma-separated steps or groups (" + ",".join(GROUPS) + "): "
