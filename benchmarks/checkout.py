@@ -39,3 +39,46 @@ def commit_label(src=ROOT, default=None):
     changed = git("status", "--porcelain", "--untracked-files=no", "--", ".",
                   *(f":(exclude){path}" for path in RESULTS))
     return head.stdout.strip() + ("-dirty" if changed.stdout.strip() else "")
+
+
+# -- where a benchmark writes (benchmarks/run.py passes ``--out-dir``) ----------------------------
+
+HERE = ROOT / "benchmarks"
+
+
+def add_output_args(ap, quick=None):
+    """Add ``--out-dir DIR`` (``results/`` and ``figures/`` under DIR; default ``benchmarks/``) and, when
+    ``quick`` is its help text, ``--quick`` (a smaller problem whose files carry a ``-quick`` suffix)."""
+    ap.add_argument("--out-dir", type=Path, default=None,
+                    help="write results/ (and figures/) under this directory (default benchmarks/)")
+    if quick:
+        ap.add_argument("--quick", action="store_true", help=f"{quick} (writes *-quick files)")
+    return ap
+
+
+def results_dir(out_dir=None) -> Path:
+    """``results/`` under ``out_dir`` (default ``benchmarks/``), made if missing."""
+    path = (Path(out_dir) if out_dir else HERE) / "results"
+    path.mkdir(parents=True, exist_ok=True)
+    return path
+
+
+def figures_dir(out_dir=None) -> Path:
+    """``figures/`` under ``out_dir`` (default ``benchmarks/``), made if missing."""
+    path = (Path(out_dir) if out_dir else HERE) / "figures"
+    path.mkdir(parents=True, exist_ok=True)
+    return path
+
+
+def stem(name, quick=False):
+    """A result's file name without its suffix: ``name`` or ``name-quick``."""
+    return f"{name}-quick" if quick else name
+
+
+def write_atomic(path, text):
+    """Write ``text`` to ``path`` through a temporary file beside it (no half-written result)."""
+    path = Path(path)
+    tmp = path.with_name(f".{path.name}.tmp")
+    tmp.write_text(text)
+    os.replace(tmp, path)
+    return path

@@ -14,7 +14,8 @@ import statistics
 import subprocess
 import sys
 import tempfile
-from pathlib import Path
+
+from checkout import add_output_args, results_dir  # benchmarks/ is on sys.path
 
 SCENES = {
     "base (Mooney-Rivlin, xi=1)": "sb.Scene.preset('base')",
@@ -48,7 +49,7 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeat", type=int, default=5)
     ap.add_argument("--quick", action="store_true", help="base only, one repeat (writes codegen-quick.*)")
-    ap.add_argument("--out-dir", default=None, help="write results/ under this directory (default benchmarks/)")
+    add_output_args(ap)
     args = ap.parse_args(argv)
     scenes = dict(list(SCENES.items())[:1]) if args.quick else SCENES
     if args.quick:
@@ -67,8 +68,7 @@ def main(argv=None):
             "warm_process_wall_s": med(warm, "process_wall_s"),
             "import_shellbvp_s": med(warm, "import_s"),
         }
-    res = (Path(args.out_dir) if args.out_dir else Path(__file__).parent) / "results"
-    res.mkdir(parents=True, exist_ok=True)
+    res = results_dir(args.out_dir)
     name = "codegen-quick" if args.quick else "codegen"
     (res / f"{name}.json").write_text(json.dumps({"repeat": args.repeat, "python": sys.version.split()[0],
                                                  "rows": rows}, indent=2))

@@ -17,7 +17,7 @@ alike; a ratio is the median of the per-repeat ratios.  Cold: the first run of `
 an empty code cache (the equations derived and their code generated), once per side.
 Commands the baseline does not have are measured on this commit only.
 
-    python benchmarks/commands.py [--repeat 5] [--quick]
+    python benchmarks/commands.py [--repeat 5] [--quick] [--out-dir DIR]
 
 Writes ``benchmarks/results/commands.md`` and ``.json`` (``--quick``: ``commands-quick.*``;
 ``--only NAME``: ``commands-<name>.*``, the cold curve only when it is among them).
@@ -47,7 +47,7 @@ HERE = Path(__file__).resolve().parent
 REPO = HERE.parent
 sys.path.insert(0, str(HERE))
 
-from checkout import commit_label  # noqa: E402
+from checkout import add_output_args, commit_label, results_dir  # noqa: E402
 from speed_vs_baseline import extract  # noqa: E402
 
 #: (name, argv after ``python -m shellbvp``, expected exit status, on the baseline too)
@@ -120,6 +120,7 @@ def main(argv=None):
     ap.add_argument("--only", action="append", metavar="NAME",
                     help="only the commands whose name starts with NAME (may be given again): "
                          + "; ".join(c[0] for c in COMMANDS))
+    add_output_args(ap)
     args = ap.parse_args(argv)
     repeat = 3 if args.quick else args.repeat
     commands = [c for c in COMMANDS if (not args.quick or c[0] in QUICK)
@@ -203,7 +204,7 @@ def main(argv=None):
     suffix = "-quick" if args.quick else ""
     if args.only:
         suffix += "-" + "-".join("".join(ch if ch.isalnum() else "-" for ch in n).strip("-") for n in args.only)
-    out = HERE / "results"
+    out = results_dir(args.out_dir)
     (out / f"commands{suffix}.json").write_text(json.dumps(result, indent=1))
     (out / f"commands{suffix}.md").write_text(report(result, args.baseline, list(sides)))
     print(report(result, args.baseline, list(sides)))

@@ -3,13 +3,15 @@
 central differences of E (the same configuration solved again at delta +- h, +- 2h from the
 state, tol 1e-8; h = 0.002), with the differencing estimate |D(h) - D(2h)|.
 
-    python benchmarks/configurations.py     # writes benchmarks/results/configurations.md
+    python benchmarks/configurations.py [--quick] [--out-dir DIR]   # results/configurations[-quick].md
+
+``--quick``: the point, line and cap configurations of the base scene only.
 """
 
 from __future__ import annotations
 
+import argparse
 import time
-from pathlib import Path
 
 import numpy as np
 
@@ -18,6 +20,8 @@ from shellbvp.chain import ChainBVP
 from shellbvp.corner import edge_model
 from shellbvp.solution import attach_tip_table
 from shellbvp.state import solve_from
+
+from checkout import add_output_args, results_dir, stem  # benchmarks/ is on sys.path
 
 #: (configuration, scene label, preset, overrides, depth (or the curve's depths, the last the
 #: one used), solve kwargs); beta 0.1 asked for 0.38 alone records an invalid cap: the split
@@ -66,9 +70,17 @@ def state(preset, overrides, depths, kwargs):
     return min(c.solutions, key=lambda s: abs(s.delta - depths[-1]))
 
 
-def main():
+QUICK = ("point", "line", "cap")
+
+
+def main(argv=None):
+    ap = add_output_args(argparse.ArgumentParser(description=__doc__.splitlines()[0]),
+                         quick="the point, line and cap of the base scene")
+    args = ap.parse_args(argv)
     rows, t0 = [], time.perf_counter()
     for name, label, preset, overrides, depths, kwargs in CASES:
+        if args.quick and name not in QUICK:
+            continue
         sol = state(preset, overrides, depths, kwargs)
         mid = resolve(sol, sol.delta)
 
@@ -80,13 +92,13 @@ def main():
         rows.append((name, label, mid.delta, mid.force, topology, bool(mid.valid), abs((4 * d1 - d2) / 3 - mid.force),
                      abs(d1 - d2)))
         print(rows[-1], flush=True)
-    lines = [f"Measured {time.strftime('%Y-%m-%d')}, shellbvp {sb.__version__}; `python benchmarks/configurations.py`, "
+    lines = [f"Measured {time.strftime('%Y-%m-%d')}, shellbvp {sb.__version__}; `python benchmarks/configurations.py{' --quick' if args.quick else ''}`, "
              f"total {time.perf_counter() - t0:.0f} s on 2 shared cores.", "",
              "| configuration | scene | delta | F | recorded as | valid | abs(F - dE/ddelta) | differencing estimate |",
              "|---|---|---|---|---|---|---|---|"]
     for name, label, d, F, topo, valid, err, est in rows:
         lines.append(f"| {name} | {label} | {d:g} | {F:.7g} | {topo} | {'yes' if valid else 'no'} | {err:.2g} | {est:.2g} |")
-    out = Path(__file__).parent / "results" / "configurations.md"
+    out = results_dir(args.out_dir) / f"{stem('configurations', args.quick)}.md"
     out.write_text("\n".join(lines) + "\n")
     print(out.read_text())
 

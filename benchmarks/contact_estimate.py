@@ -17,6 +17,9 @@ without an approach (issue 55).
   test files), beside the one of the package at ``--against`` (a checkout's path), if given.
 
     python benchmarks/contact_estimate.py [--records 2000] [--fits 10] [--afm-dir DIR] [--against CHECKOUT]
+                                          [--quick] [--out-dir DIR]
+
+Writes results/contact_estimate.md (``--quick``: 100 records, no fits: contact_estimate-quick.md).
 """
 
 import argparse
@@ -28,6 +31,8 @@ import numpy as np
 from scipy.interpolate import PchipInterpolator
 
 import shellbvp as sb
+
+from checkout import add_output_args, results_dir, stem  # benchmarks/ is on sys.path
 from shellbvp.segments import estimate_contact
 
 DATA = Path(sb.__file__).parent / "data" / "capsule_plates_synthetic.csv"
@@ -157,13 +162,15 @@ def main():
     p.add_argument("--fits", type=int, default=0)
     p.add_argument("--afm-dir", default=None)
     p.add_argument("--against", default=None, help="a checkout whose shellbvp/segments.py is compared")
-    p.add_argument("--out", default=str(Path(__file__).parent / "results"))
+    add_output_args(p, quick="100 records, no fits")
     args = p.parse_args()
+    if args.quick:
+        args.records, args.fits = 100, 0
     import tempfile
 
     with tempfile.TemporaryDirectory() as tmp:
         lines = ["# The contact point's first estimate", "",
-                 f"`python benchmarks/contact_estimate.py --records {args.records}"
+                 f"`python benchmarks/contact_estimate.py{' --quick' if args.quick else ''} --records {args.records}"
                  + (f" --fits {args.fits}" if args.fits else "")
                  + (" --afm-dir DIR" if args.afm_dir else "") + (" --against CHECKOUT" if args.against else "")
                  + "` (see its docstring).", "", "## The shipped capsule record without its approach", ""]
@@ -174,7 +181,7 @@ def main():
                   ""] + fit_lines(args.fits)
     if args.afm_dir:
         lines += ["", "## AFM curves", ""] + afm_lines(args.afm_dir, args.against)
-    out = Path(args.out) / "contact_estimate.md"
+    out = results_dir(args.out_dir) / f"{stem('contact_estimate', args.quick)}.md"
     out.write_text("\n".join(lines) + "\n")
     print("\n".join(lines))
     print(f"wrote {out}")

@@ -5,15 +5,19 @@ located switch (``settings["topology_switches"]``): delta* from the smooth side 
 Legendre determinant -> 0) and from the corner side (the jump of lambda_s -> 0), the jumps of F
 and E across it extrapolated from each side, its kind, and the jump of lambda_s at delta = 1.
 
-    python benchmarks/corner_switches.py     # writes benchmarks/results/corner_switches.md
+    python benchmarks/corner_switches.py [--quick] [--out-dir DIR]   # results/corner_switches[-quick].md
+
+``--quick``: the base scene only.
 """
 
 from __future__ import annotations
 
+import argparse
 import time
-from pathlib import Path
 
 import shellbvp as sb
+
+from checkout import add_output_args, results_dir, stem  # benchmarks/ is on sys.path
 
 SCENES = {
     "base": {}, "beta=0.1": dict(beta=0.1), "gamma=0": dict(gamma=0.0), "gamma=0.5": dict(gamma=0.5),
@@ -23,9 +27,13 @@ SCENES = {
 }
 
 
-def main():
+def main(argv=None):
+    ap = add_output_args(argparse.ArgumentParser(description=__doc__.splitlines()[0]), quick="the base scene only")
+    args = ap.parse_args(argv)
     rows, t0 = [], time.perf_counter()
     for name, kw in SCENES.items():
+        if args.quick and name != "base":
+            continue
         t = time.perf_counter()
         c = sb.curve(sb.Scene.preset("base", **kw), delta_max=1.0, estimate_error=False)
         sw = [s for s in c.settings.get("topology_switches", []) if s["to"] == "cap (corner edge)"]
@@ -44,7 +52,7 @@ def main():
     for r in rows:
         lines.append(f"| {r[0]} | {r[1]:.4g} | {r[2]} | {r[3]:.6f} | {r[4]:.6f} | {r[5]:.1e} | {r[6]:.1e} | {r[7]} | "
                      f"{r[8]:.3f} | {r[9]:.1f} |")
-    out = Path(__file__).parent / "results" / "corner_switches.md"
+    out = results_dir(args.out_dir) / f"{stem('corner_switches', args.quick)}.md"
     out.write_text("\n".join(lines) + "\n")
     print(out.read_text())
 

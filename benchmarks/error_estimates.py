@@ -23,6 +23,7 @@ other users' load): the ratios, not the seconds, are the result.
     python benchmarks/error_estimates.py                      # all presets (~20 min on 2 shared cores)
     python benchmarks/error_estimates.py --presets base fit   # a subset (JSON per preset is merged)
     python benchmarks/error_estimates.py --rebuild            # only rewrite the Markdown from the JSON
+    python benchmarks/error_estimates.py --out-dir DIR        # results/ under DIR
 """
 
 from __future__ import annotations
@@ -38,7 +39,7 @@ from pathlib import Path
 
 import numpy as np
 
-from checkout import commit_label  # benchmarks/ is on sys.path when run as a script
+from checkout import add_output_args, commit_label, results_dir  # benchmarks/ is on sys.path when run as a script
 
 HERE = Path(__file__).resolve().parent
 RESULTS = HERE / "results"
@@ -244,7 +245,10 @@ def main(argv=None):
     ap.add_argument("--rebuild", action="store_true", help="only rewrite the Markdown from the JSON")
     ap.add_argument("--reuse-reference", action="store_true",
                     help="reuse a preset's tol-1e-10 reference from the JSON when its states are identical")
+    add_output_args(ap)
     args = ap.parse_args(argv)
+    global RESULTS
+    RESULTS = results_dir(args.out_dir)
     js = RESULTS / "error_estimates.json"
     old = json.loads(js.read_text()) if js.exists() else {"presets": {}, "meta": {}}
     if not args.rebuild:

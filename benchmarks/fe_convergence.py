@@ -4,11 +4,12 @@ H/2, H and 5H from first touch, on the default mesh (0.5 H along the meridian, 3
 through H) and on the records' mesh of ``thick_fits.py`` (0.33 H, 4; ``--finest`` adds 0.25 H,
 6).  The paper's seed (eps 1/6) is in ``thick_fits.py``'s convergence table.
 
-    python benchmarks/fe_convergence.py [--finest]
+    python benchmarks/fe_convergence.py [--finest] [--out-dir DIR]   # results/fe_convergence.{json,md}
 """
 
 from __future__ import annotations
 
+import argparse
 import json
 import platform
 import sys
@@ -22,14 +23,20 @@ sys.path.insert(0, str(HERE.parent))  # this checkout's package
 
 import shellbvp as sb  # noqa: E402
 
+sys.path.insert(0, str(HERE))
+from checkout import add_output_args, results_dir  # noqa: E402
+
 EPS = 0.02
 DEPTHS = [0.5 * EPS, EPS, 5 * EPS]
 MESHES = [dict(element_length=0.5, through_thickness=3), dict(element_length=0.33, through_thickness=4)]
 FINEST = dict(element_length=0.25, through_thickness=6)
 
 
-def main():
-    meshes = MESHES + ([FINEST] if "--finest" in sys.argv[1:] else [])
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--finest", action="store_true", help="also the 0.25 H, 6 mesh (slow)")
+    args = add_output_args(ap).parse_args(argv)
+    meshes = MESHES + ([FINEST] if args.finest else [])
     scene = sb.Scene(gamma=1.0, rho=0.2, material=sb.NeoHookean(), thickness=EPS)
     rows, t_all = [], time.perf_counter()
     for mesh in meshes:
@@ -43,7 +50,7 @@ def main():
         row["vs_finest"] = list(map(float, np.array(row["force"]) / finest - 1))
     doc = {"scene": "hemisphere rho 0.2, eps 0.02, neo-Hookean", "depths": DEPTHS, "rows": rows,
            "machine": platform.platform(), "version": sb.__version__, "seconds": time.perf_counter() - t_all}
-    out = HERE / "results" / "fe_convergence"
+    out = results_dir(args.out_dir) / "fe_convergence"
     out.with_suffix(".json").write_text(json.dumps(doc, indent=1))
     lines = [f"# The solid's mesh convergence on a thin shell\n",
              f"`python benchmarks/fe_convergence.py` ({doc['seconds']:.0f} s, {doc['machine']}, shellbvp "

@@ -12,7 +12,7 @@ Scenes: the hemisphere ``Scene(gamma=1, rho=0.2, NeoHookean, thickness=eps)`` at
 Reported: FE and shell wall times, their ratio, Newton iterations, FE forces (kept in the JSON,
 so that a later run is compared with them: ``--compare results/fe_speed-before.json``).
 
-    python benchmarks/fe_speed.py [--thin] [--only NAME ...] [--profile NAME] [--tag before]
+    python benchmarks/fe_speed.py [--thin] [--only NAME ...] [--profile NAME] [--tag before] [--quick] [--out-dir DIR]
 """
 
 from __future__ import annotations
@@ -36,6 +36,9 @@ sys.path.insert(0, str(HERE.parent))  # this checkout's package
 
 import shellbvp as sb  # noqa: E402
 from shellbvp import fe  # noqa: E402
+
+sys.path.insert(0, str(HERE))
+from checkout import add_output_args, results_dir  # noqa: E402
 
 
 def hemisphere(eps):
@@ -119,7 +122,10 @@ def main(argv=None):
     ap.add_argument("--tag", default="", help="results/fe_speed[-TAG].{md,json}")
     ap.add_argument("--compare", help="a JSON of an earlier run: forces compared with it")
     ap.add_argument("--set", nargs="*", default=[], help="FE settings, NAME=VALUE")
+    add_output_args(ap, quick="the hemisphere at eps 0.05 only")
     args = ap.parse_args(argv)
+    if args.quick:
+        args.only, args.tag = ["eps 0.05"], (f"{args.tag}-quick" if args.tag else "quick")
     settings = {k: (v if k == "rim_face" else float(v)) for k, v in (s.split("=", 1) for s in args.set)}
     if "through_thickness" in settings:
         settings["through_thickness"] = int(settings["through_thickness"])
@@ -142,7 +148,7 @@ def main(argv=None):
                             text=True).stdout.strip()
     meta = {"date": time.strftime("%Y-%m-%d"), "machine": platform.machine(), "commit": commit,
             "settings": settings, "command": " ".join(["python benchmarks/fe_speed.py", *(argv or sys.argv[1:])])}
-    res = HERE / "results"
+    res = results_dir(args.out_dir)
     name = "fe_speed" + (f"-{args.tag}" if args.tag else "")
     (res / f"{name}.json").write_text(json.dumps({"meta": meta, "rows": rows}, indent=1))
     lines = [f"Measured {meta['date']} on {meta['machine']} at {commit}; `{meta['command']}`.", "",

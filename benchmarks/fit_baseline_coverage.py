@@ -9,12 +9,13 @@ the record, loading to delta = 0.4), 2 % proportional and 2 uN additive noise, s
 * ``approach, no baseline``: the pushing rows alone, baseline 0 and not fitted;
 * ``contact rows only``: the rows 2 um or more past the contact (no approach), no baseline.
 
-    python benchmarks/fit_baseline_coverage.py [--seeds 200] [--out benchmarks/results]
+    python benchmarks/fit_baseline_coverage.py [--seeds 200] [--quick] [--out-dir DIR]
+
+Writes results/fit_baseline_coverage.md (``--quick``: 5 seeds, fit_baseline_coverage-quick.md).
 """
 
 import argparse
 import time
-from pathlib import Path
 
 import numpy as np
 from scipy.interpolate import PchipInterpolator
@@ -23,14 +24,18 @@ import shellbvp as sb
 from shellbvp.fitting import fit_record
 from shellbvp.instrument import InstrumentRecord, segment
 
+from checkout import add_output_args, results_dir, stem  # benchmarks/ is on sys.path
+
 R_L, MU_H, D0, BASE = 0.3e-3, 40.0, 25e-6, 150e-6
 
 
 def main():
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--seeds", type=int, default=200)
-    p.add_argument("--out", default=str(Path(__file__).parent / "results"))
+    add_output_args(p, quick="5 seeds")
     args = p.parse_args()
+    if args.quick:
+        args.seeds = 5
     scene = sb.Scene.preset("fit")
     c = sb.curve(scene, deltas=np.linspace(0.005, 0.45, 90), estimate_error=False)
     shape = PchipInterpolator(np.r_[0, c.delta], np.r_[0, c.force])
@@ -65,7 +70,7 @@ def main():
              "| data | mu*H coverage | offset coverage | RMS error of mu*H (N/m) | median 95 % width (N/m) |",
              "|---|---|---|---|---|"]
     lines += [f"| {case} | {cov[0]:.3f} | {cov[1]:.3f} | {rms:.3f} | {w:.3f} |" for case, cov, rms, w, _ in rows]
-    out = Path(args.out) / "fit_baseline_coverage.md"
+    out = results_dir(args.out_dir) / f"{stem('fit_baseline_coverage', args.quick)}.md"
     out.write_text("\n".join(lines) + "\n")
     print(f"wrote {out}")
 

@@ -27,7 +27,7 @@ with *proportional* noise F (1 + 0.01 e) -- the approach rows exactly noise-free
 synthetic force map -- and *mixed* noise F (1 + 0.01 e1) + 0.005 max(F) e2; and the mixed
 weights with other floors (``fit(..., floor=)``) on the noise-free approaches.
 
-    python benchmarks/fit_coverage.py [--seeds 200] [--beta-seeds 20] [--report-only]
+    python benchmarks/fit_coverage.py [--seeds 200] [--beta-seeds 20] [--report-only] [--quick] [--out-dir DIR]
     python benchmarks/fit_coverage.py --approach-only --tag before   # another checkout's package
 
 Writes benchmarks/results/fit_coverage.md and .json.  The fit's model curve
@@ -46,6 +46,8 @@ import numpy as np
 
 import shellbvp as sb
 import shellbvp.fitting  # noqa: F401  (sb.fitting.WEIGHTS below)
+
+from checkout import add_output_args, results_dir  # benchmarks/ is on sys.path
 
 R_L, MU_H, D0, NOISE, N = 0.3e-3, 52.0, 10e-6, 0.02, 40
 RESULTS = Path(__file__).parent / "results"
@@ -142,8 +144,13 @@ def main():
     ap.add_argument("--approach-only", action="store_true", dest="approach_only",
                     help="only the records with an approach (e.g. another checkout's package on PYTHONPATH)")
     ap.add_argument("--tag", default="", help="a suffix of the result files' names (fit_coverage-TAG.md)")
+    add_output_args(ap, quick="5 seeds, 1 for beta")
     args = ap.parse_args()
-    stem = "fit_coverage" + (f"-{args.tag}" if args.tag else "")
+    if args.quick:
+        args.seeds, args.beta_seeds = 5, 1
+    global RESULTS
+    RESULTS = results_dir(args.out_dir)
+    stem = "fit_coverage" + (f"-{args.tag}" if args.tag else "") + ("-quick" if args.quick else "")
     if args.report_only:
         out = json.loads((RESULTS / f"{stem}.json").read_text())
         (RESULTS / f"{stem}.md").write_text(report(out))

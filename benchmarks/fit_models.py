@@ -10,7 +10,7 @@
    benchmarks/paper_figures.py (the same adaptive curves to delta = 0.5, both
    contact models), each with the rule that decides "confirmed"/"contradicted".
 
-    python benchmarks/fit_models.py [--fresh]
+    python benchmarks/fit_models.py [--fresh] [--out-dir DIR]
 
 The claims' curves are memoised in a temporary file (keyed by scene and
 package version), so a rerun of the report costs only the fits.
@@ -31,6 +31,7 @@ import numpy as np
 import shellbvp as sb
 
 sys.path.insert(0, str(Path(__file__).parent))
+from checkout import add_output_args, results_dir  # noqa: E402
 from paper_figures import DELTA_MAX, families, model_curve  # noqa: E402
 
 R_L, MU_H, D0, NOISE = 0.3e-3, 52.0, 10e-6, 0.02
@@ -391,7 +392,10 @@ def report(out):
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--fresh", action="store_true", help="recompute the claims' curves (no disk cache)")
+    add_output_args(ap)
     args = ap.parse_args()
+    global RESULTS
+    RESULTS = results_dir(args.out_dir)
     if args.fresh and _DISK.exists():
         _DISK.unlink()
     t0 = time.perf_counter()

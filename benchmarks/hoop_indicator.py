@@ -14,6 +14,7 @@ Writes benchmarks/results/hoop_indicator.json and .md.
 
     python benchmarks/hoop_indicator.py                # every scene (~15 min on 2 shared cores)
     python benchmarks/hoop_indicator.py --only dome    # a subset (regex on the id)
+    python benchmarks/hoop_indicator.py --quick [--out-dir DIR]   # hoop_indicator-quick.* (under DIR/results)
 """
 
 from __future__ import annotations
@@ -32,11 +33,11 @@ from pathlib import Path
 HERE = Path(__file__).parent
 sys.path.insert(0, str(HERE))
 
-from checkout import commit_label  # noqa: E402
+from checkout import add_output_args, commit_label, results_dir  # noqa: E402
 from stability_modes import scenes, time_limit, worker_scene  # noqa: E402
 from stability_modes import run_one as run_scene  # noqa: E402
 
-RESULTS = HERE / "results"
+QUICK = r"^preset base$"  # --quick: the base preset's curve only
 MODELS = ("strip", "band")
 
 
@@ -213,7 +214,10 @@ def main():
     ap.add_argument("--only", help="regex on the scene id")
     ap.add_argument("--delta-max", type=float, default=1.0)
     ap.add_argument("--time-limit", type=float, default=600.0, help="seconds per scene")
+    add_output_args(ap, quick="the base preset's curve only")
     args = ap.parse_args()
+    if args.quick:
+        args.only = QUICK
     if args.worker:
         worker(*args.worker)
         return 0
@@ -231,8 +235,10 @@ def main():
             "machine": f"{platform.platform()}, Python {platform.python_version()}, {os.cpu_count()} cores",
             "seconds": time.perf_counter() - t0, "summary": summarise(rows)}
     suffix = "" if not args.only else "-" + re.sub(r"[^A-Za-z0-9]+", "_", args.only).strip("_")
-    (RESULTS / f"hoop_indicator{suffix}.json").write_text(json.dumps({"meta": meta, "rows": rows}, indent=1))
-    (RESULTS / f"hoop_indicator{suffix}.md").write_text(markdown(rows, meta))
+    suffix = "-quick" if args.quick else suffix
+    res = results_dir(args.out_dir)
+    (res / f"hoop_indicator{suffix}.json").write_text(json.dumps({"meta": meta, "rows": rows}, indent=1))
+    (res / f"hoop_indicator{suffix}.md").write_text(markdown(rows, meta))
     print(markdown(rows, meta))
     return 0
 

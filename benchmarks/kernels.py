@@ -39,7 +39,7 @@ import time
 import timeit
 from pathlib import Path
 
-from checkout import checkout_env  # benchmarks/ is on sys.path when run as a script
+from checkout import add_output_args, checkout_env, results_dir  # benchmarks/ is on sys.path when run as a script
 
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent
@@ -342,7 +342,7 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="one run each, the base curve only, no 'never slower' runs (kernels-quick.*)")
     ap.add_argument("--repeat", type=int, default=None, help="runs per measurement (default 5, quick 1)")
-    ap.add_argument("--out-dir", default=None, help="write results/ under this directory (default benchmarks/)")
+    add_output_args(ap)
     args = ap.parse_args(argv)
     if importlib.util.find_spec("numba") is None:
         print("kernels.py: numba is not installed (pip install 'shellbvp[fast]'): nothing to measure")
@@ -380,8 +380,7 @@ def main(argv=None):
     finally:
         _wait_unlocked(warm)
         shutil.rmtree(warm, ignore_errors=True)
-    res = (Path(args.out_dir) if args.out_dir else HERE) / "results"
-    res.mkdir(parents=True, exist_ok=True)
+    res = results_dir(args.out_dir)
     name = "kernels-quick" if args.quick else "kernels"
     (res / f"{name}.json").write_text(json.dumps(data, indent=1) + "\n")
     text = markdown(data)

@@ -32,6 +32,7 @@ HERE = Path(__file__).resolve().parent
 REPO = HERE.parent
 sys.path.insert(0, str(HERE))
 
+from checkout import add_output_args, results_dir  # noqa: E402
 from make_force_map import write_map  # noqa: E402  (a script beside this one)
 
 COMMAND = ["fit", "{map}", "--preset", "fit", "--radius", "10um", "-o", "{out}"]
@@ -64,7 +65,7 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--large", action="store_true", help="also the 64 x 64 map (4,096 curves; minutes)")
     ap.add_argument("--before", metavar="DIR", help="also time the package of this checkout (its shellbvp/)")
-    ap.add_argument("--out-dir", default=str(HERE / "results"))
+    add_output_args(ap)
     args = ap.parse_args(argv)
     sizes = (16, 32, 64) if args.large else (16, 32)
     work = Path(tempfile.mkdtemp(prefix="map-scaling-"))
@@ -94,8 +95,7 @@ def main(argv=None):
                   f"(CPU {warm[1]:.1f} s), peak {max(cold[2], warm[2]):.0f} MiB", flush=True)
     result = {"sizes": sizes, "command": " ".join(COMMAND), "rows": rows, "load": os.getloadavg(),
               "commits": {side: commit_of(path) for side, path in sides.items()}}
-    out = Path(args.out_dir)
-    out.mkdir(parents=True, exist_ok=True)
+    out = results_dir(args.out_dir)
     stem = "map_scaling-large" if args.large else "map_scaling"
     (out / f"{stem}.json").write_text(json.dumps(result, indent=1))
     (out / f"{stem}.md").write_text(report(result))

@@ -3,7 +3,7 @@
 Writes PNGs to benchmarks/figures/: each F-delta figure draws the variational
 ("smooth", solid) and the paper's ("paper", dashed) contact-line model.
 
-    python benchmarks/paper_figures.py [--only beta_xi,rho,gamma,material,profiles,hemisphere_beta01,fit]
+    python benchmarks/paper_figures.py [--only beta_xi,rho,gamma,material,profiles,hemisphere_beta01,fit] [--out-dir DIR]
 
 The scenes of each figure are in FAMILIES (benchmarks/fit_models.py checks the
 paper's claims on the same scenes).
@@ -17,6 +17,8 @@ import numpy as np
 
 import shellbvp as sb
 from shellbvp.plotting import plot_fit, plot_profiles, require_matplotlib
+
+from checkout import add_output_args, figures_dir  # benchmarks/ is on sys.path
 
 OUT = Path(__file__).parent / "figures"
 FIGURES = ("beta_xi", "rho", "gamma", "material", "profiles", "hemisphere_beta01", "fit")
@@ -116,7 +118,10 @@ def make_figure(name, fam=None):
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--only", help="comma-separated figures: " + ",".join(FIGURES))
+    add_output_args(ap)
     args = ap.parse_args()
+    global OUT
+    OUT = figures_dir(args.out_dir)
     only = set(FIGURES if not args.only else args.only.split(","))
     if only - set(FIGURES):
         ap.error(f"unknown figures {sorted(only - set(FIGURES))}; choose from {FIGURES}")

@@ -199,14 +199,18 @@ def main(argv=None):
     ap.add_argument("--presets", default="base,base-xi0,flat,gent1")
     ap.add_argument("--kernels", default="numba,numpy", help="comma-separated SHELLBVP_KERNELS values")
     ap.add_argument("--repeat", type=int, default=5)
-    ap.add_argument("--out-dir", default=str(HERE / "results"))
     ap.add_argument("--worker", default=None, help=argparse.SUPPRESS)
+    sys.path.insert(0, str(HERE))
+    from checkout import add_output_args, results_dir, stem
+
+    add_output_args(ap, quick="base, numpy kernels, one repeat")
     args = ap.parse_args(argv)
+    if args.quick:
+        args.presets, args.kernels, args.repeat = "base", "numpy", 1
     if args.repeat < 1:
         ap.error(f"--repeat must be >= 1; got {args.repeat}")
     if args.worker:
         return worker(args.worker, args.repeat)
-    sys.path.insert(0, str(HERE))
     from checkout import checkout_env
     from speed_vs_baseline import cpu_model, this_commit, write_atomic
 
@@ -231,10 +235,9 @@ def main(argv=None):
     meta = dict(date=datetime.date.today().isoformat(), machine=f"{platform.machine()} {platform.system()}",
                 cpu=cpu_model(), cpus=os.cpu_count(), python=platform.python_version(), numpy=np.__version__,
                 scipy=scipy.__version__, commit=this_commit(), repeat=args.repeat)
-    out = Path(args.out_dir)
-    out.mkdir(parents=True, exist_ok=True)
-    write_atomic(out / "point_budget.json", json.dumps(dict(meta=meta, rows=rows), indent=1))
-    write_atomic(out / "point_budget.md", markdown(rows, meta) + "\n")
+    out, name = results_dir(args.out_dir), stem("point_budget", args.quick)
+    write_atomic(out / f"{name}.json", json.dumps(dict(meta=meta, rows=rows), indent=1))
+    write_atomic(out / f"{name}.md", markdown(rows, meta) + "\n")
 
 
 if __name__ == "__main__":

@@ -16,11 +16,13 @@ from pathlib import Path
 
 import shellbvp as sb
 
+from checkout import add_output_args, results_dir  # benchmarks/ is on sys.path
+
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="base preset, smooth contact (writes preset_curves-quick.*)")
-    ap.add_argument("--out-dir", default=None, help="write results/ under this directory (default benchmarks/)")
+    add_output_args(ap)
     args = ap.parse_args(argv)
     presets = ("base",) if args.quick else sb.PRESETS
     contacts = ("smooth",) if args.quick else ("smooth", "paper")
@@ -41,8 +43,7 @@ def main(argv=None):
                                  valid=int(c.valid.sum()) if c else 0,
                                  energy_identity_max=float(abs(c.energy_residual[1:-1]).max()) if c and len(c) > 3 else None))
                 print(rows[-1], flush=True)
-    res = (Path(args.out_dir) if args.out_dir else Path(__file__).parent) / "results"
-    res.mkdir(parents=True, exist_ok=True)
+    res = results_dir(args.out_dir)
     base = "preset_curves-quick" if args.quick else "preset_curves"
     (res / f"{base}.json").write_text(json.dumps(rows, indent=1))
     lines = ["| preset | contact | time (s) | points | valid | max delta | stopped | max abs(dE/ddelta - F) |",

@@ -31,7 +31,7 @@ from pathlib import Path
 
 import numpy as np
 
-from checkout import commit_label  # benchmarks/ is on sys.path when run as a script
+from checkout import add_output_args, commit_label, results_dir  # benchmarks/ is on sys.path when run as a script
 
 HERE = Path(__file__).resolve().parent
 
@@ -331,7 +331,7 @@ def markdown(data):
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--out-dir", default=None, help="write results/ under this directory (default benchmarks/)")
+    add_output_args(ap)
     ap.add_argument("--quick", action="store_true", help="one timed run, 10 depths (writes profile-quick.*)")
     args = ap.parse_args(argv)
     import platform
@@ -359,8 +359,7 @@ def main(argv=None):
                         python=platform.python_version(), numpy=numpy.__version__, scipy=scipy.__version__,
                         shellbvp=sb.__version__, quick=args.quick,
                         git=os.environ.get("SHELLBVP_SOURCE_NOTE") or commit_label(src, "not a git checkout"))
-    out = (Path(args.out_dir) if args.out_dir else HERE) / "results"
-    out.mkdir(parents=True, exist_ok=True)
+    out = results_dir(args.out_dir)
     name = "profile-quick" if args.quick else "profile"
     (out / f"{name}.json").write_text(json.dumps(data, indent=1, default=float))
     md = markdown(data) + "\n" + suggestions(data)

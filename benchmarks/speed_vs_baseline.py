@@ -67,7 +67,7 @@ from pathlib import Path
 
 import numpy as np
 
-from checkout import commit_label  # benchmarks/ is on sys.path when run as a script
+from checkout import add_output_args, commit_label, results_dir  # benchmarks/ is on sys.path when run as a script
 
 HERE = Path(__file__).resolve().parent
 REPO = HERE.parent
@@ -812,7 +812,7 @@ def parse_args(argv=None):
                     help="with --reuse-shooting: only these presets' rows (the others are measured)")
     ap.add_argument("--work-dir", default=None,
                     help="the baseline's tree and both code caches (default: a folder in ~/.cache)")
-    ap.add_argument("--out-dir", default=None, help="write results/ under this directory (default benchmarks/)")
+    add_output_args(ap)
     ap.add_argument("--worker", default=None, help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
     if args.repeat < 1:
@@ -907,8 +907,7 @@ def main(argv=None):
                     r.pop(k, None)
     data["targets"] = targets(data)
     data["meta"] = meta(args, baseline, time.perf_counter() - t_all, head)
-    res = (Path(args.out_dir) if args.out_dir else HERE) / "results"
-    res.mkdir(parents=True, exist_ok=True)
+    res = results_dir(args.out_dir)
     name = "speed_vs_baseline-quick" if args.quick else "speed_vs_baseline"
     write_atomic(res / f"{name}.json", json.dumps(data, indent=1, default=float))
     md = markdown(data)

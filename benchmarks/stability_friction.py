@@ -14,6 +14,7 @@ Writes benchmarks/results/stability_friction.json and .md.
 
     python benchmarks/stability_friction.py                # the three cases (a few minutes)
     python benchmarks/stability_friction.py --only rho     # a subset (regex on the id)
+    python benchmarks/stability_friction.py --quick [--out-dir DIR]   # stability_friction-quick.* (under DIR/results)
 """
 
 from __future__ import annotations
@@ -32,10 +33,10 @@ from pathlib import Path
 HERE = Path(__file__).parent
 sys.path.insert(0, str(HERE))
 
-from checkout import commit_label  # noqa: E402
+from checkout import add_output_args, commit_label, results_dir  # noqa: E402
 from stability import make_scene as grid_scene  # noqa: E402
 
-RESULTS = HERE / "results"
+QUICK = r"^dome"  # --quick: the dome near its crossing only
 FRICTIONS = ("frictionless", "sticking")
 DELTA_TOL = 1e-4
 
@@ -226,7 +227,10 @@ def markdown(results, meta):
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--only", help="regex on the scene id")
+    add_output_args(ap, quick="the dome near its crossing only")
     args = ap.parse_args()
+    if args.quick:
+        args.only = QUICK
     t0 = time.perf_counter()
     results = []
     for cid, build, dmax, start, ref in cases():
@@ -240,8 +244,10 @@ def main():
             "machine": f"{platform.platform()}, Python {platform.python_version()}, {os.cpu_count()} cores",
             "seconds": time.perf_counter() - t0}
     suffix = "" if not args.only else "-" + re.sub(r"[^A-Za-z0-9]+", "_", args.only).strip("_")
-    (RESULTS / f"stability_friction{suffix}.json").write_text(json.dumps({"meta": meta, "results": results}, indent=1))
-    (RESULTS / f"stability_friction{suffix}.md").write_text(markdown(results, meta))
+    suffix = "-quick" if args.quick else suffix
+    res = results_dir(args.out_dir)
+    (res / f"stability_friction{suffix}.json").write_text(json.dumps({"meta": meta, "results": results}, indent=1))
+    (res / f"stability_friction{suffix}.md").write_text(markdown(results, meta))
     print(markdown(results, meta))
     return 0
 

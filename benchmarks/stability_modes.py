@@ -11,6 +11,7 @@ Writes benchmarks/results/stability_modes.json and .md.
 
     python benchmarks/stability_modes.py                # everything (long: hours on 2 shared cores)
     python benchmarks/stability_modes.py --only dome    # a subset (regex on the id)
+    python benchmarks/stability_modes.py --quick [--out-dir DIR]   # stability_modes-quick.* (under DIR/results)
 """
 
 from __future__ import annotations
@@ -33,10 +34,10 @@ from pathlib import Path
 HERE = Path(__file__).parent
 sys.path.insert(0, str(HERE))
 
-from checkout import commit_label  # noqa: E402
+from checkout import add_output_args, commit_label, results_dir  # noqa: E402
 from stability import grid as stability_grid  # noqa: E402
 
-RESULTS = HERE / "results"
+QUICK = r"^preset base$"  # --quick: the base preset's curve only
 DOME_RHOS = (0.05, 0.2, 0.5)
 
 
@@ -178,7 +179,10 @@ def main():
     ap.add_argument("--only", help="regex on the scene id")
     ap.add_argument("--delta-max", type=float, default=1.0)
     ap.add_argument("--time-limit", type=float, default=900.0, help="seconds per scene")
+    add_output_args(ap, quick="the base preset's curve only")
     args = ap.parse_args()
+    if args.quick:
+        args.only = QUICK
     if args.worker:
         worker(*args.worker)
         return 0
@@ -194,8 +198,10 @@ def main():
             "machine": f"{platform.platform()}, Python {platform.python_version()}, {os.cpu_count()} cores",
             "seconds": time.perf_counter() - t0}
     suffix = "" if not args.only else "-" + re.sub(r"[^A-Za-z0-9]+", "_", args.only).strip("_")
-    (RESULTS / f"stability_modes{suffix}.json").write_text(json.dumps({"meta": meta, "rows": rows}, indent=1))
-    (RESULTS / f"stability_modes{suffix}.md").write_text(markdown(rows, meta))
+    suffix = "-quick" if args.quick else suffix
+    res = results_dir(args.out_dir)
+    (res / f"stability_modes{suffix}.json").write_text(json.dumps({"meta": meta, "rows": rows}, indent=1))
+    (res / f"stability_modes{suffix}.md").write_text(markdown(rows, meta))
     print(markdown(rows, meta))
     return 0
 

@@ -44,6 +44,8 @@ from scipy.optimize import brentq
 import shellbvp as sb
 from shellbvp import modal_stability as st
 
+from checkout import add_output_args, results_dir  # benchmarks/ is on sys.path
+
 OUT = Path(__file__).parent / "results"
 
 
@@ -390,7 +392,10 @@ def main():
                     help="cap parameters of clamped caps of sphere radius 10 (half as steep)")
     ap.add_argument("--only", choices=["clamped"],
                     help="only the clamped caps; the other results are those of stability_pressure.json")
+    add_output_args(ap)
     args = ap.parse_args()
+    global OUT
+    OUT = results_dir(args.out_dir)
     rows = []
     if args.only == "clamped":
         last = json.loads((OUT / "stability_pressure.json").read_text())

@@ -10,9 +10,10 @@ time per cold solve).
 import argparse
 import json
 import time
-from pathlib import Path
 
 import shellbvp as sb
+
+from checkout import add_output_args, results_dir  # benchmarks/ is on sys.path
 
 DELTAS = (0.05, 0.1, 0.2, 0.3)
 
@@ -20,7 +21,7 @@ DELTAS = (0.05, 0.1, 0.2, 0.3)
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="base preset, delta 0.1 and 0.3 (writes states-quick.*)")
-    ap.add_argument("--out-dir", default=None, help="write results/ under this directory (default benchmarks/)")
+    add_output_args(ap)
     args = ap.parse_args(argv)
     presets = ("base",) if args.quick else sb.PRESETS
     deltas = (0.1, 0.3) if args.quick else DELTAS
@@ -38,8 +39,7 @@ def main(argv=None):
                                  ring_force=s.ring_force, pressure_min=s.pressure_min,
                                  valid=bool(s.valid), force_error=s.force_error,
                                  nodes=s.nodes, seconds=time.perf_counter() - t0))
-    out = (Path(args.out_dir) if args.out_dir else Path(__file__).parent) / "results"
-    out.mkdir(parents=True, exist_ok=True)
+    out = results_dir(args.out_dir)
     name = "states-quick" if args.quick else "states"
     (out / f"{name}.json").write_text(json.dumps(rows, indent=1, default=float))
     lines = ["| preset | contact | delta | topology | F | Sc | lambda0 | ring force | min P | valid | F error | nodes "

@@ -27,6 +27,9 @@ import numpy as np
 
 import shellbvp as sb
 
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from checkout import add_output_args, results_dir  # noqa: E402
+
 HERE = Path(__file__).resolve().parent
 GRID = ["--beta", "0.005,0.01,0.02", "--rho", "0.15:0.3:3", "--delta-max", "0.3"]
 
@@ -74,7 +77,7 @@ def max_dF(a, b):
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--out-dir", type=Path, default=HERE / "results")
+    add_output_args(ap)
     args = ap.parse_args(argv)
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
@@ -101,8 +104,8 @@ def main(argv=None):
         finally:
             os.killpg(cluster.pid, signal.SIGTERM)
             cluster.wait()
-    args.out_dir.mkdir(parents=True, exist_ok=True)
-    (args.out_dir / "sweep_kill_resume.json").write_text(json.dumps(
+    res = results_dir(args.out_dir)
+    (res / "sweep_kill_resume.json").write_text(json.dumps(
         {"grid": GRID, "uninterrupted_s": whole, "runs": rows}, indent=1) + "\n")
     lines = ["# `shellbvp sweep` killed (SIGKILL) and resumed", "",
              f"`python benchmarks/sweep_kill_resume.py`: `shellbvp sweep --preset base {' '.join(GRID)}`, "
@@ -112,8 +115,8 @@ def main(argv=None):
     for r in rows:
         lines.append(f"| {r['executor']} | {r['killed_after_s']:.1f} | {r['after_kill']} | {r['resume_computed']} | "
                      f"{r['resume_s']:.1f} | {r['resume_exit']} | {r['final']} | {r['max_abs_dF_vs_uninterrupted']:.3g} |")
-    (args.out_dir / "sweep_kill_resume.md").write_text("\n".join(lines) + "\n")
-    print(f"wrote {args.out_dir / 'sweep_kill_resume.md'}")
+    (res / "sweep_kill_resume.md").write_text("\n".join(lines) + "\n")
+    print(f"wrote {res / 'sweep_kill_resume.md'}")
     return 0
 
 

@@ -27,7 +27,11 @@ from pathlib import Path
 import numpy as np
 
 import shellbvp as sb
+from shellbvp.sweep import sweep  # not sb.sweep: importing shellbvp.uncertainty makes that the subpackage
 from shellbvp.uncertainty import fit_with_geometry
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from checkout import add_output_args, results_dir  # noqa: E402
 
 HERE = Path(__file__).resolve().parent
 
@@ -67,7 +71,7 @@ def run_sweeps(grid, delta_max, tmp):
 
     def timed(name, **kw):
         t0 = time.perf_counter()
-        res = sb.sweep(base, grid, delta_max=delta_max, out=Path(tmp) / f"{name}.h5", **kw)
+        res = sweep(base, grid, delta_max=delta_max, out=Path(tmp) / f"{name}.h5", **kw)
         runs[name] = (time.perf_counter() - t0, res)
         print(f"{name}: {runs[name][0]:.1f} s, {res.counts()}", flush=True)
 
@@ -116,7 +120,7 @@ def geometry_fit(workers):
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--quick", action="store_true", help="a 2x2 grid of short curves (a smoke test)")
-    ap.add_argument("--out-dir", type=Path, default=HERE / "results")
+    add_output_args(ap)
     args = ap.parse_args(argv)
     grid, delta_max = grid_of(args.quick)
     before = parallel_capacity()
@@ -129,10 +133,10 @@ def main(argv=None):
     geo = geometry_fit(2)
     print(geo["table"], flush=True)
     suffix = "-quick" if args.quick else ""
-    args.out_dir.mkdir(parents=True, exist_ok=True)
+    res = results_dir(args.out_dir)
     record = {"grid": grid, "delta_max": delta_max, "cores": os.cpu_count(), "package_version": sb.__version__,
               "sweeps": rows, "geometry_fit": geo, "free_cores_before": before, "free_cores_after": after}
-    (args.out_dir / f"sweep_scaling{suffix}.json").write_text(json.dumps(record, indent=1, default=float) + "\n")
+    (res / f"sweep_scaling{suffix}.json").write_text(json.dumps(record, indent=1, default=float) + "\n")
     lines = [f"# Sweeps and the fit with the geometry's uncertainty ({'quick' if args.quick else 'full'})", "",
              f"`python benchmarks/sweep_scaling.py{' --quick' if args.quick else ''}` on {os.cpu_count()} cores "
              f"(shared), shellbvp {sb.__version__}.", "",
@@ -153,8 +157,8 @@ def main(argv=None):
               "from the data's noise alone",
               f"* 95 % CI [{g['mu_H_ci95'][0]:.4g}, {g['mu_H_ci95'][1]:.4g}] with the geometry's uncertainty "
               f"(u_geometry = {g['u_geometry']:.3g} N/m)", "", "```", g["table"], "```", ""]
-    (args.out_dir / f"sweep_scaling{suffix}.md").write_text("\n".join(lines))
-    print(f"wrote {args.out_dir / f'sweep_scaling{suffix}.md'}")
+    (res / f"sweep_scaling{suffix}.md").write_text("\n".join(lines))
+    print(f"wrote {res / f'sweep_scaling{suffix}.md'}")
     return 0
 
 

@@ -15,11 +15,12 @@ import argparse
 import itertools
 import json
 import time
-from pathlib import Path
 
 import numpy as np
 
 import shellbvp as sb
+
+from checkout import add_output_args, results_dir  # benchmarks/ is on sys.path
 
 DELTAS = (0.05, 0.1, 0.2)
 
@@ -33,7 +34,7 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true",
                     help="base preset, delta 0.05, curve to 0.15 (writes topologies-quick.*)")
-    ap.add_argument("--out-dir", default=None, help="write results/ under this directory (default benchmarks/)")
+    add_output_args(ap)
     args = ap.parse_args(argv)
     presets = ("base",) if args.quick else sb.PRESETS
     scenes = {name: sb.Scene.preset(name) for name in presets}
@@ -59,8 +60,7 @@ def main(argv=None):
                            energy_identity_max=float(np.nanmax(np.abs(c.energy_residual))),
                            invalid_flags=sorted({f for f, v in zip(c.flags, c.valid) if not v}),
                            seconds=time.perf_counter() - t0))
-    out = (Path(args.out_dir) if args.out_dir else Path(__file__).parent) / "results"
-    out.mkdir(parents=True, exist_ok=True)
+    out = results_dir(args.out_dir)
     stem = "topologies-quick" if args.quick else "topologies"
     (out / f"{stem}.json").write_text(json.dumps(dict(states=states, curves=curves), indent=1, default=float))
     lines = ["States (smooth contact, tol 1e-8): the valid state (`auto`) against the single-cap model.", "",

@@ -32,6 +32,7 @@ sys.path.insert(0, str(HERE.parent))  # this checkout's package
 
 import shellbvp as sb  # noqa: E402
 from shellbvp.validation import default_depths, shell_curve  # noqa: E402
+from checkout import add_output_args, results_dir  # noqa: E402
 
 EPS = (0.1, 0.05, 0.02, 0.01)
 #: (gamma, rho): hemisphere and a prolate Lepidium-like shell at three indenter sizes (the
@@ -182,13 +183,12 @@ def main(argv=None):
                     help="no FE: recompute the shell model's rows of every cached FE curve")
     ap.add_argument("--eps", default=None, help="only these thicknesses, comma-separated (default: 0.1,0.05,0.02,0.01); "
                     "the report shows every cached one")
-    ap.add_argument("--out-dir", default=None, help="write results/ under this directory (default benchmarks/)")
+    add_output_args(ap)
     args = ap.parse_args(argv)
     plan = {"scenes": ((1.0, 0.2),), "eps": (0.1, 0.05)} if args.quick else {"scenes": SCENES, "eps": EPS}
     todo_eps = plan["eps"] if args.eps is None else tuple(float(x) for x in args.eps.split(","))
     suffix = "-quick" if args.quick else ""
-    out = (Path(args.out_dir) if args.out_dir else HERE) / "results"
-    out.mkdir(parents=True, exist_ok=True)
+    out = results_dir(args.out_dir)
     store = out / f"validation{suffix}.json"
     cache = {} if args.recompute or not store.exists() else json.loads(store.read_text())
     todo = [(g, r, e, args.mesh_check) for g, r in plan["scenes"] for e in todo_eps

@@ -3,7 +3,9 @@
 Hemisphere, rho 0.2, neo-Hookean; shell model with beta = eps^2/3, both contact models, with
 and without transverse shear.  One FE curve per eps (``sb.fe_curve`` at delta = H and 0.3).
 
-    python benchmarks/validation_table.py [--eps 0.1,0.05,0.02,0.01] [--workers 2]
+    python benchmarks/validation_table.py [--eps 0.1,0.05,0.02,0.01] [--workers 2] [--quick] [--out-dir DIR]
+
+Writes results/validation_table.{json,md} (``--quick``: eps 0.1 only, validation_table-quick.*).
 """
 
 from __future__ import annotations
@@ -23,6 +25,9 @@ sys.path.insert(0, str(HERE.parent))
 
 import shellbvp as sb  # noqa: E402
 from shellbvp.validation import shell_curve  # noqa: E402
+
+sys.path.insert(0, str(HERE))
+from checkout import add_output_args, commit_label, results_dir, stem  # noqa: E402
 
 VARIANTS = {"smooth": dict(contact="smooth"), "smooth, shear": dict(contact="smooth", transverse_shear=True),
             "paper": dict(contact="paper"), "paper, shear": dict(contact="paper", transverse_shear=True)}
@@ -46,16 +51,19 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--eps", default="0.1,0.05,0.02,0.01")
     ap.add_argument("--workers", type=int, default=2)
+    add_output_args(ap, quick="eps 0.1 only")
     args = ap.parse_args(argv)
+    if args.quick:
+        args.eps = "0.1"
+    name = stem("validation_table", args.quick)
     eps = [float(x) for x in args.eps.split(",")]
     with ProcessPoolExecutor(max_workers=args.workers) as pool:
         rows = list(pool.map(row, eps))
-    out = HERE / "results"
-    (out / "validation_table.json").write_text(json.dumps(rows, indent=1))
-    from checkout import commit_label
-
+    out = results_dir(args.out_dir)
+    (out / f"{name}.json").write_text(json.dumps(rows, indent=1))
     lines = [f"Measured {time.strftime('%Y-%m-%d')} on {platform.machine()}, shellbvp at "
-             f"{commit_label() or 'unknown commit'}; `python benchmarks/validation_table.py`.", "",
+             f"{commit_label() or 'unknown commit'}; `python benchmarks/validation_table.py"
+             f"{' --quick' if args.quick else ''}`.", "",
              "Hemisphere, rho 0.2, neo-Hookean, beta = eps^2/3: F_shell / F_FE - 1 in percent at the "
              f"mid-surface pole displacement delta = H and delta = {DEPTH:g}; 'shear': "
              "`transverse_shear=True`.", "",
@@ -64,7 +72,7 @@ def main(argv=None):
         for i, label in enumerate(("H", f"{DEPTH:g}")):
             lines.append(f"| {r['eps']:g} | {label} | " + " | ".join(f"{100 * r[v][i]:+.1f}" for v in VARIANTS)
                          + f" | {r['fe_seconds']:.0f} |")
-    (out / "validation_table.md").write_text("\n".join(lines) + "\n")
+    (out / f"{name}.md").write_text("\n".join(lines) + "\n")
     print("\n".join(lines))
 
 

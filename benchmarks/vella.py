@@ -69,9 +69,11 @@ def row(beta: float, tau: float, frac: float) -> dict:
 
 
 def main(argv=None):
+    from checkout import add_output_args, results_dir  # benchmarks/ is on sys.path (tests load this module alone)
+
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true")
-    ap.add_argument("--out-dir", default=None, help="write results/ under this directory (default benchmarks/)")
+    add_output_args(ap)
     args = ap.parse_args(argv)
     plan = [(1e-4, t, 0.003) for t in (0.0, 1.0, 3.0)] if args.quick else (
         [(1e-4, t, f) for f in (0.003, 0.03) for t in TAUS] + [(1e-5, t, f) for f in (0.003, 0.03) for t in TAUS])
@@ -81,8 +83,7 @@ def main(argv=None):
         r = rows[-1]
         print(f"beta {beta:g} delta/h {frac:g} tau {tau:g}: {r['success']} k/k_formula {r['ratio']:.4f}", flush=True)
     suffix = "-quick" if args.quick else ""
-    out = (Path(args.out_dir) if args.out_dir else HERE) / "results"
-    out.mkdir(parents=True, exist_ok=True)
+    out = results_dir(args.out_dir)
     (out / f"vella{suffix}.json").write_text(json.dumps(rows, indent=1, default=float))
     lines = [f"Measured {time.strftime('%Y-%m-%d')} on {platform.machine()}, shellbvp {sb.__version__}; "
              f"`python benchmarks/vella.py{' --quick' if args.quick else ''}`.  Hemispherical dome indented at its "

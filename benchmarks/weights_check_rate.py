@@ -40,7 +40,7 @@ interval misses the truth, which no check flags (the truth outside the interval,
 warning), and which are *silently wrong* (those, and a quality better than poor: a shell fit
 with a thickness is rated poor where its mapped model error exceeds its interval).
 
-    nice -n 10 python benchmarks/weights_check_rate.py [--seeds 200] [--power-seeds 100] [--no-thick]
+    nice -n 10 python benchmarks/weights_check_rate.py [--seeds 200] [--power-seeds 100] [--no-thick] [--out-dir DIR]
     python benchmarks/weights_check_rate.py --report-only
 
 Writes benchmarks/results/weights_check_rate.md and .json.
@@ -67,6 +67,8 @@ sys.path.insert(0, str(HERE))
 import shellbvp as sb  # noqa: E402
 from shellbvp import fit_checks  # noqa: E402
 from shellbvp.segments import estimate_contact  # noqa: E402
+
+from checkout import add_output_args, results_dir  # noqa: E402
 
 RESULTS = HERE / "results"
 #: design: (R_L (m), contact (m), approach rows, contact rows, deepest delta, mu*H (N/m), baseline (N))
@@ -280,7 +282,10 @@ def main():
                     help="rewrite the .md from the .json of the last run")
     ap.add_argument("--example-only", action="store_true", dest="example_only",
                     help="only the shipped example at wrong rim radii, merged into the last run's results")
+    add_output_args(ap)
     args = ap.parse_args()
+    global RESULTS
+    RESULTS = results_dir(args.out_dir)
     if args.report_only or args.example_only:
         out = json.loads((RESULTS / "weights_check_rate.json").read_text())
         if args.example_only:

@@ -45,34 +45,95 @@ def wp():
     return _load("work_precision")
 
 
+def test_every_script_is_a_step_or_a_listed_tool(run):
+    """A script added to benchmarks/ must be given a step in benchmarks/steps.py or be listed
+    there as a tool (with the reason); a listed tool must exist."""
+    steps = _load("steps")
+    scripts = {p.name for p in BENCH.glob("*.py")}
+    in_plan = {s.script for s in steps.STEPS}
+    stray = sorted(scripts - in_plan - set(steps.TOOLS))
+    assert not stray, f"neither a step nor a tool in benchmarks/steps.py: {stray}"
+    assert not (in_plan | set(steps.TOOLS)) - scripts, "a step or tool without its script"
+    assert not in_plan & set(steps.TOOLS), "both a step and a tool"
+    assert all(why.strip() for why in steps.TOOLS.values())
+
+
+def test_every_result_file_is_written_by_a_step_or_kept_as_a_record():
+    """Each file of benchmarks/results/ is an output of a step (full or quick) or a record listed
+    with why it is kept (a run at another commit, text kept by hand)."""
+    steps = _load("steps")
+    unclaimed = sorted(p.name for p in (BENCH / "results").iterdir() if p.is_file() and not steps.claimed(p.name))
+    assert not unclaimed, unclaimed
+    assert steps.claimed("stability-quick.json") and not steps.claimed("stability-nope.json")
+    for pattern in steps.RECORDS:  # a record that no longer exists is dropped from the list
+        assert list((BENCH / "results").glob(pattern)), pattern
+
+
 def test_full_plan_regenerates_everything(run):
-    names = [s.name for s, _ in run.plan()]
-    assert names == ["work_precision", "profile", "stability", "shooting", "states_table", "preset_curves",
-                     "topologies", "codegen_timing", "kernels", "vella", "speed_vs_baseline"]
+    steps = _load("steps")
+    names = [s.name for s in steps.STEPS]
+    assert len(names) == len(set(names))
+    planned = [s.name for s, _ in run.plan()]
+    assert set(names) - set(planned) <= {"paper_figures"} | {s.name for s in steps.STEPS if s.needs}
     for s, argv in run.plan():
         assert argv[0] == sys.executable and Path(argv[1]).exists()
-        assert "--quick" not in argv
+        assert "--quick" not in argv and s.outputs
+        assert all(o.startswith(("results/", "figures/")) for o in s.outputs)
     assert "paper_figures" in [s.name for s, _ in run.plan(figures=True)]
+    assert {s.group for s in steps.STEPS} == set(steps.GROUPS)
+
+
+def test_the_out_option_of_each_step_is_one_its_script_takes():
+    """``out="dir"``: the script takes --out-dir (through checkout.add_output_args, or its own);
+    ``out=None``: it takes none yet (when it does, the plan must pass it); a quick mode is the
+    script's own --quick."""
+    steps = _load("steps")
+    for s in steps.STEPS:
+        src = (BENCH / s.script).read_text()
+        takes_dir = "add_output_args(" in src or '"--out-dir"' in src
+        if s.out == "dir":
+            assert takes_dir, s.name
+        elif s.out is None:
+            assert not takes_dir, f"{s.name}: its script takes --out-dir now: set out='dir' in steps.py"
+        else:
+            assert f'"{s.out[0]}"' in src, s.name
+        if s.quick is not None:
+            assert s.quick[0] == "--quick" and ('"--quick"' in src or "quick=" in src), s.name
 
 
 def test_quick_plan_writes_separate_files(run, tmp_path):
-    steps = run.plan(quick=True, out=tmp_path)
+    skipped = []
+    steps = run.plan(quick=True, out=tmp_path, skipped=skipped)
     names = [s.name for s, _ in steps]
     assert "work_precision" in names and "shooting" not in names and "paper_figures" not in names
     for s, argv in steps:
         assert "--quick" in argv
-        assert argv[argv.index("--out-dir") + 1] == str(tmp_path)
+        if s.out == "dir":
+            assert argv[argv.index("--out-dir") + 1] == str(tmp_path)
+        else:
+            assert argv[argv.index(s.out[0]) + 1].startswith(str(tmp_path / "results") + "/")
         assert s.quick_outputs and all("-quick" in o for o in s.quick_outputs)
+    assert {s.name for s, _ in skipped} | set(names) == {s.name for s in _load("steps").STEPS}
     # --out with a step that has no output option: left out rather than writing into benchmarks/
-    assert run.plan(figures=True, out=tmp_path)[-1][0].name != "paper_figures"
+    full = run.plan(figures=True, out=tmp_path)
+    assert "bending_choice" not in [s.name for s, _ in full]
+    for s, argv in full:  # nothing of benchmarks/ named as an output
+        assert str(tmp_path) in " ".join(argv) or s.out == "dir" and "--out-dir" in argv, s.name
+        assert not any(a.startswith(str(BENCH / "results")) for a in argv), s.name
     shoot = dict((s.name, a) for s, a in run.plan(out=tmp_path))["shooting"]
     assert shoot[shoot.index("--out") + 1] == str(tmp_path / "results" / "shooting.json")
+    shoot = dict((s.name, a) for s, a in run.plan())["shooting"]
+    assert shoot[shoot.index("--out") + 1] == str(BENCH / "results" / "shooting.json")
 
 
 def test_arguments(run):
     a = run.parse_args(["--quick", "--only", "work_precision,profile", "--out", "/tmp/x"])
     assert a.quick and a.only == ["work_precision", "profile"] and a.out == "/tmp/x"
     assert [s.name for s, _ in run.plan(a.quick, a.only, a.figures, a.out)] == ["work_precision", "profile"]
+    by_group = [s.name for s, _ in run.plan(only=["stability", "vella"])]
+    assert by_group[:2] == ["vella", "stability"]  # plan order: vella (model) before the stability group
+    assert "hoop_indicator" in by_group and by_group[-1] == "stability_pressure"
+    assert [s.name for s, _ in run.plan(only=["model"])][-1] == "vella"
     with pytest.raises(ValueError, match="unknown steps"):
         run.plan(only=["nope"])
     assert run.main(["--only", "nope"]) == 2
@@ -81,7 +142,8 @@ def test_arguments(run):
 def test_list(run, capsys):
     assert run.main(["--list", "--quick"]) == 0
     out = capsys.readouterr().out
-    assert "work_precision.py --quick" in out and "shooting" not in out
+    assert "work_precision.py --quick" in out and "shooting" in out
+    assert "shooting precision: left out: no quick mode" in " ".join(out.split())
 
 
 def test_work_precision_arguments(wp):
@@ -121,13 +183,17 @@ def test_equal_error_both_ways(wp):
 def test_quick_run_smoke(tmp_path):
     start = time.time()
     r = subprocess.run([sys.executable, str(BENCH / "run.py"), "--quick", "--out", str(tmp_path)],
-                       capture_output=True, text=True, timeout=900)
+                       capture_output=True, text=True, timeout=3600)
     assert r.returncode == 0, r.stdout[-3000:] + r.stderr[-3000:]
     summary = json.loads((tmp_path / "results" / "run-quick.json").read_text())
     assert all(s["returncode"] == 0 for s in summary["steps"])
-    for name in ("work_precision-quick.json", "work_precision-quick.md", "profile-quick.md",
-                 "stability-quick.json", "states-quick.json", "preset_curves-quick.json", "codegen-quick.json"):
-        assert (tmp_path / "results" / name).exists(), name
+    ran = {s["step"] for s in summary["steps"]}
+    steps = _load("steps")
+    assert ran == {s.name for s in steps.STEPS if s.quick is not None}
+    for s in steps.STEPS:  # every quick step wrote what the plan says it writes (kernels: only with numba)
+        if s.name in ran and not (s.name == "kernels" and importlib.util.find_spec("numba") is None):
+            for name in s.quick_outputs:
+                assert (tmp_path / name).exists(), (s.name, name)
     wp = json.loads((tmp_path / "results" / "work_precision-quick.json").read_text())
     base = wp["presets"]["base"]
     assert all(r["all_converged"] for r in base["natural"])
