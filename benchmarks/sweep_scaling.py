@@ -27,7 +27,7 @@ from pathlib import Path
 import numpy as np
 
 import shellbvp as sb
-from shellbvp.sweep import sweep  # not sb.sweep: importing shellbvp.uncertainty makes that the subpackage
+from shellbvp.sweeps import sweep
 from shellbvp.uncertainty import fit_with_geometry
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))

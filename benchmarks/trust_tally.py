@@ -990,7 +990,7 @@ def _check_sweep(sw):
 
 
 def kind_sweepfiles(n, rng, tmp):
-    from shellbvp.sweep import sweep
+    from shellbvp.sweeps import sweep
 
     marker = tmp / "MARKER"
     good = tmp / "good.h5"

@@ -24,7 +24,7 @@ _LAZY = {"curve": "continuation", "iter_curve": "continuation", "CurveRun": "con
          "Dimensions": "units", "beta_from_thickness": "units", "parse_quantity": "units",
          "fit": "fitting", "FitResult": "fitting", "read_force_csv": "fitting", "fit_record": "fitting",
          "read_instrument": "instrument", "fit_files": "batch", "read_fit": "fitrecord",
-         "sweep": "sweep", "read_sweep": "sweep", "Sweep": "sweep",
+         "sweep": "sweeps", "read_sweep": "sweeps", "Sweep": "sweeps",
          "fit_with_geometry": "uncertainty", "GeometryFit": "uncertainty", "convexity_limits": "convexity",
          "inflate": "inflation", "enclosed_volume": "inflation", "stability": "modal_stability", "hoop_indicator": "wrinkling", "HoopIndicator": "wrinkling", "Stability": "modal_stability", "options": "config", "Options": "config", "fe_curve": "fe", "FECurve": "fe", "validate": "validation",
          "Validation": "validation", "read_validation": "validation"}

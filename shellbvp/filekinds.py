@@ -11,7 +11,7 @@ from __future__ import annotations
 from .afm import MAP_FORMAT
 from .fitrecord import FIT_FORMAT
 from .io import FORMAT as CURVE_FORMAT
-from .sweep.layout import FORMAT as SWEEP_FORMAT
+from .sweeps.layout import FORMAT as SWEEP_FORMAT
 from .validation import FORMAT as VALIDATION_FORMAT
 
 __all__ = ["file_kind", "wrong_kind", "KINDS"]

@@ -27,7 +27,7 @@ import numpy as np
 from .fitting import fit, free_parameters
 from .scene_parameters import LiveNames, parameters_that, scene_parameter, scene_with
 from .shape_parameters import SHAPE_PARAMETERS
-from .sweep import local_pool
+from .sweeps import local_pool
 from .units import parse_uncertain
 
 log = logging.getLogger(__name__)

@@ -401,7 +401,7 @@ def test_the_census_knows_which_modules_load_numpy():
     census = _load("architecture")
     numeric = census.numeric_modules(BENCH.parent)
     light = ["shellbvp.units", "shellbvp.cli.common", "shellbvp.scene_parameters", "shellbvp.paths"]
-    heavy = ["shellbvp.scene", "shellbvp.readers.registry", "shellbvp.chain.blocks", "shellbvp.sweep.executors"]
+    heavy = ["shellbvp.scene", "shellbvp.readers.registry", "shellbvp.chain.blocks", "shellbvp.sweeps.executors"]
     assert not set(light) & numeric and set(heavy) <= numeric
     code = ("import importlib, sys\nfor m in sys.argv[1:]:\n    importlib.import_module(m)\n"
             "    print('numpy' in sys.modules)\n")

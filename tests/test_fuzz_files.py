@@ -61,7 +61,7 @@ def _damage(path, item, value):
 
 @pytest.fixture(scope="module")
 def files(tmp_path_factory):
-    from shellbvp.sweep import sweep
+    from shellbvp.sweeps import sweep
 
     d = tmp_path_factory.mktemp("good")
     fit = d / "fit.h5"

@@ -222,7 +222,7 @@ def test_a_sweep_over_the_pressure(tmp_path):
     """The pressure is a sweep axis (turgor series): each curve equals its own serial curve."""
     from concurrent.futures import ThreadPoolExecutor
 
-    from shellbvp.sweep import read_sweep, sweep
+    from shellbvp.sweeps import read_sweep, sweep
 
     base = sb.Scene.preset("dome")
     deltas = [0.02, 0.05]

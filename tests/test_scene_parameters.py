@@ -39,7 +39,7 @@ def test_the_tables_read_from_the_registry_hold_what_they_held():
     sweep's axes and of the fit's table columns is the registry's."""
     from shellbvp.pixel_table import PIXEL_PARAMETERS
     from shellbvp.shape_parameters import SHAPE_PARAMETERS
-    from shellbvp.sweep import SWEEP_PARAMETERS
+    from shellbvp.sweeps import SWEEP_PARAMETERS
     from shellbvp.uncertainty import UNCERTAIN_PARAMETERS
 
     assert SWEEP_PARAMETERS == ("beta", "rho", "gamma", "alpha", "Jm", "pressure")
@@ -86,7 +86,7 @@ def test_every_parameter_reaches_the_command_line_the_sweep_the_uncertainty_and_
     from shellbvp.cli.common import scene_from_args
     from shellbvp.fitrecord import PARAMETER_UNITS
     from shellbvp.pixel_table import PIXEL_PARAMETERS, read_pixel_table
-    from shellbvp.sweep.grid import check_grid
+    from shellbvp.sweeps.grid import check_grid
     from shellbvp.uncertainty import UNCERTAIN_PARAMETERS, _check_uncertainty
 
     fit, sweep, solve = _options("fit"), _options("sweep"), _options("solve")
@@ -163,8 +163,8 @@ def test_a_material_parameter_with_its_flags_reaches_every_user(monkeypatch, tmp
     from shellbvp.fitrecord import PARAMETER_UNITS
     from shellbvp.pixel_table import PIXEL_PARAMETERS, read_pixel_table
     from shellbvp.shape_parameters import SHAPE_PARAMETERS, shape_parameter
-    from shellbvp.sweep import SWEEP_PARAMETERS
-    from shellbvp.sweep.grid import check_grid
+    from shellbvp.sweeps import SWEEP_PARAMETERS
+    from shellbvp.sweeps.grid import check_grid
     from shellbvp.uncertainty import UNCERTAIN_PARAMETERS, _check_uncertainty
 
     assert "kappa" not in SCENE_PARAMETERS

@@ -1,4 +1,4 @@
-"""Sweeps (shellbvp.sweep): results that travel between processes, the resumable sweep file,
+"""Sweeps (shellbvp.sweeps): results that travel between processes, the resumable sweep file,
 executors (a process pool, Dask), and the fit with an uncertain geometry."""
 
 import multiprocessing
@@ -40,6 +40,17 @@ def test_solution_and_curve_come_back_from_a_worker_process():
 
 
 # -- sweeps ---------------------------------------------------------------------------------------
+def test_sb_sweep_stays_the_function_whatever_imported_the_subpackage_first():
+    # the subpackage is `sweeps`: importing it (shellbvp.uncertainty does) does not replace sb.sweep
+    import subprocess
+    import sys
+
+    code = ("import shellbvp as sb, shellbvp.uncertainty, shellbvp.sweeps.layout\n"
+            "print(callable(sb.sweep), sb.sweep.__module__)")
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert r.stdout.split() == ["True", "shellbvp.sweeps.run"], (r.stdout, r.stderr)
+
+
 BASE = sb.Scene.preset("base")
 GRID = {"beta": [0.005, 0.01], "rho": [0.2, 0.25]}
 DELTA_MAX = 0.15
@@ -68,7 +79,7 @@ def _spawn_pool(n):
 
 
 def test_a_2x2_sweep_on_two_processes_equals_serial_curves(tmp_path, serial):
-    from shellbvp.sweep import read_sweep, sweep
+    from shellbvp.sweeps import read_sweep, sweep
 
     out = tmp_path / "grid.h5"
     with _spawn_pool(2) as pool:
@@ -90,7 +101,7 @@ def test_a_2x2_sweep_on_two_processes_equals_serial_curves(tmp_path, serial):
 def test_every_dataset_of_a_sweep_file_has_units(tmp_path):
     import h5py
 
-    from shellbvp.sweep import sweep
+    from shellbvp.sweeps import sweep
 
     out = tmp_path / "one.h5"
     sweep(BASE, {"beta": [0.01]}, delta_max=0.1, out=out, workers=1, deltas=[0.1], estimate_error=False)
@@ -139,7 +150,7 @@ def _contents(path):
 
 
 def test_an_interrupted_sweep_resumes_with_only_the_rest(tmp_path, serial):
-    from shellbvp.sweep import read_sweep, sweep
+    from shellbvp.sweeps import read_sweep, sweep
 
     whole, broken = tmp_path / "whole.h5", tmp_path / "broken.h5"
     sweep(BASE, GRID, delta_max=DELTA_MAX, out=whole, workers=1, **SETTINGS)
@@ -165,7 +176,7 @@ def test_an_interrupted_sweep_resumes_with_only_the_rest(tmp_path, serial):
 
 
 def test_a_changed_sweep_is_refused_or_extended_when_asked(tmp_path):
-    from shellbvp.sweep import read_sweep, sweep
+    from shellbvp.sweeps import read_sweep, sweep
 
     out = tmp_path / "g.h5"
     kw = {"deltas": [0.1], "estimate_error": False}
@@ -200,7 +211,7 @@ def test_a_changed_sweep_is_refused_or_extended_when_asked(tmp_path):
     ({"beta": [0.01]}, {"ds": 1}, "unknown curve setting 'ds'"),
 ])
 def test_bad_sweeps_are_refused_before_any_curve(tmp_path, grid, kw, match):
-    from shellbvp.sweep import sweep
+    from shellbvp.sweeps import sweep
 
     kw = {"delta_max": 0.1, **kw}
     out = tmp_path / "never.h5"
@@ -211,7 +222,7 @@ def test_bad_sweeps_are_refused_before_any_curve(tmp_path, grid, kw, match):
 
 def test_the_same_2x2_sweep_on_a_dask_local_cluster(tmp_path, serial):
     distributed = pytest.importorskip("dask.distributed")
-    from shellbvp.sweep import sweep
+    from shellbvp.sweeps import sweep
 
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cl, \
             distributed.Client(cl) as client:
@@ -227,8 +238,8 @@ def test_a_dask_cluster_that_goes_away_mid_run_leaves_its_curves_pending(tmp_pat
     import importlib
     from concurrent.futures import Future
 
-    sw = importlib.import_module("shellbvp.sweep")  # the subpackage (the package's attribute is the function)
-    from shellbvp.sweep.work import _executor_gone
+    sw = importlib.import_module("shellbvp.sweeps")
+    from shellbvp.sweeps.work import _executor_gone
 
     class Client:
         status = "closed"  # what a dask Client says once its scheduler is gone for good
@@ -272,7 +283,7 @@ def test_a_sweep_file_is_nexus_with_f_over_the_grid_and_plots(tmp_path):
     nx = pytest.importorskip("nexusformat.nexus")
     pytest.importorskip("matplotlib")
     from shellbvp.cli import main
-    from shellbvp.sweep import read_sweep, sweep
+    from shellbvp.sweeps import read_sweep, sweep
 
     out = tmp_path / "g.h5"
     kw = {"deltas": [0.05, 0.1], "estimate_error": False}
@@ -381,7 +392,7 @@ def test_fit_cli_uncertainty_errors(argv, match, capsys):
 
 def test_a_second_sweep_on_the_same_file_is_refused_while_one_runs(tmp_path):
     fcntl = pytest.importorskip("fcntl")
-    from shellbvp.sweep import sweep
+    from shellbvp.sweeps import sweep
 
     out = tmp_path / "g.h5"
     with open(tmp_path / "g.h5.lock", "a+") as held:  # as a running sweep holds it

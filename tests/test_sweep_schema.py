@@ -8,7 +8,7 @@ import pytest
 
 import shellbvp as sb
 from shellbvp.cli import main
-from shellbvp.sweep import read_sweep, sweep
+from shellbvp.sweeps import read_sweep, sweep
 
 KW = dict(delta_max=0.1, workers=1, deltas=[0.05, 0.1], estimate_error=False)
 GRID = {"beta": [0.005, 0.01]}
@@ -112,7 +112,7 @@ def _peer(mode):
 @pytest.mark.parametrize("mode,match", [("silent", "did not answer within"), ("junk", "cannot use the Dask")])
 def test_a_scheduler_that_never_answers_or_answers_junk_is_one_line(mode, match):
     pytest.importorskip("dask.distributed")
-    from shellbvp.sweep import dask_executor
+    from shellbvp.sweeps import dask_executor
 
     with pytest.raises(ValueError, match=match):
         dask_executor(_peer(mode), timeout=1.0)

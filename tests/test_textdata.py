@@ -60,7 +60,7 @@ def test_sweep_cleanup_treats_the_output_name_as_a_name(tmp_path):
     other = tmp_path / ".run1.h5.abc.tmp"
     other.write_text("another writer")
     out = tmp_path / "run[12].h5"
-    from shellbvp.sweep import sweep
+    from shellbvp.sweeps import sweep
 
     grid = sweep(sb.Scene.preset("base"), {"beta": [0.01]}, delta_max=0.05, out=out, workers=1)
     assert np.all(np.asarray(grid.index["status"]) == "complete")
@@ -71,7 +71,7 @@ def test_a_sweep_grid_is_counted_before_anything_is_allocated(capsys):
     """1e8 combinations ended in MemoryError after 9 s: now one line, at once (issue 42)."""
     import time
 
-    from shellbvp.sweep import sweep
+    from shellbvp.sweeps import sweep
 
     t0 = time.perf_counter()
     v = ",".join(str(0.005 + i * 1e-5) for i in range(100))

@@ -26,7 +26,7 @@ from ...plotting import fit_report
 from ...readers import check_options, reader_for
 from ...scene_parameters import parameters_that, scene_parameter, scene_parameters
 from ...shape_parameters import SHAPE_PARAMETERS
-from ...sweep import dask_executor
+from ...sweeps import dask_executor
 from ...textdata import printable
 from ...thickness import model_error_line
 from ...uncertainty import fit_with_geometry

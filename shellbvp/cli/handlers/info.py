@@ -14,7 +14,7 @@ from ...filekinds import file_kind
 from ...fitrecord import read_fit
 from ...io import read_curve
 from ...plotting import fit_summary_lines
-from ...sweep import read_sweep
+from ...sweeps import read_sweep
 from ...validation import read_validation
 from ..common import say
 

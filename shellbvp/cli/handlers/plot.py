@@ -12,7 +12,7 @@ from ...io import read_curve
 from ...map_pixels import parse_pixel
 from ...paths import check_output_path
 from ...plotting import plot_curves, plot_fit_record, plot_profiles, require_matplotlib, save_figure, scene_label
-from ...sweep import read_sweep
+from ...sweeps import read_sweep
 from ...textdata import printable
 from ...validation import read_validation
 from ..common import output_dir, plain_numbers

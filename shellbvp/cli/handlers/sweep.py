@@ -12,7 +12,7 @@ from ... import units
 from ...materials import NeoHookean, material_class
 from ...scene import Scene
 from ...scene_parameters import parameters_that
-from ...sweep import check_grid, dask_executor, sweep
+from ...sweeps import check_grid, dask_executor, sweep
 from ..common import MAX_POINTS, nondimensional
 
 __all__ = ["run"]

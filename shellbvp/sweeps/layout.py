@@ -1,4 +1,4 @@
-"""The sweep file's layout (format ``shellbvp-sweep``, see :mod:`shellbvp.sweep`): its index
+"""The sweep file's layout (format ``shellbvp-sweep``, see :mod:`shellbvp.sweeps`): its index
 and overview written, the file read back with every item checked (:func:`read_sweep`), and
 an existing file reconciled with the sweep asked of it (resume, extend or refuse)."""
 

@@ -32,12 +32,12 @@ file write per batch of finished curves; the batches are whatever has finished w
 previous write ran, so the writer keeps up as long as writing the file is faster than the
 workers finish curves (see the README for the arithmetic).
 
-The package's modules, each one job: :mod:`~shellbvp.sweep.grid` (the grid and its checks),
-:mod:`~shellbvp.sweep.run` (:func:`sweep`), :mod:`~shellbvp.sweep.work` (a curve in a worker,
-the queue through an executor), :mod:`~shellbvp.sweep.executors` (local pools, Dask),
-:mod:`~shellbvp.sweep.layout` (the file's layout, reading it back, resuming),
-:mod:`~shellbvp.sweep.writer` (the lock and the atomic writes) and
-:mod:`~shellbvp.sweep.result` (:class:`Sweep`).
+The package's modules, each one job: :mod:`~shellbvp.sweeps.grid` (the grid and its checks),
+:mod:`~shellbvp.sweeps.run` (:func:`sweep`), :mod:`~shellbvp.sweeps.work` (a curve in a worker,
+the queue through an executor), :mod:`~shellbvp.sweeps.executors` (local pools, Dask),
+:mod:`~shellbvp.sweeps.layout` (the file's layout, reading it back, resuming),
+:mod:`~shellbvp.sweeps.writer` (the lock and the atomic writes) and
+:mod:`~shellbvp.sweeps.result` (:class:`Sweep`).
 """
 
 from __future__ import annotations
