@@ -230,9 +230,11 @@ def _element_basis(xg, h, hs):
 #: M_s = 0) or clamped (``w'`` held too: the slope is), named as ``Scene.rim``; or the equator of
 #: a complete sphere for modes symmetric (u = 0, w' = 0; Q and the in-plane shear vanish
 #: naturally) or antisymmetric (v = w = 0; w'' = 0 naturally) about it; ``held-symmetric``: a closed
-#: shell between plates, symmetric, its spin about the axis (n = 0, v) held at the equator.
+#: shell between plates, symmetric, its spin about the axis (n = 0, v) held at the equator;
+#: ``seam``: nothing held, the end tied to the other half's (a closed shell on a substrate,
+#: :mod:`shellbvp.modal_stability.closed`).
 END_CONDITIONS = {"pinned": (0, 2, 4), "clamped": (0, 2, 4, 5), "symmetric": (0, 5), "antisymmetric": (2, 4),
-                  "held-symmetric": (0, 5)}
+                  "held-symmetric": (0, 5), "seam": ()}
 
 
 def _constraints(n, m, end="pinned", S0_over_hs=0.0, held=(), pole_held=False, lines=(), stuck=(),
@@ -407,7 +409,7 @@ def stability_size(scene, modes=None, elements=None) -> tuple:
     cost grows like 1/sqrt(beta).  Negative eigenvalues are recomputed on finer meshes on top."""
     ne = int(elements or default_elements(scene))
     nm = len(default_modes(scene)) if modes is None else len(set(int(n) for n in modes))
-    dofs = 6 * (ne + 1) * nm
+    dofs = 6 * (ne + 1) * nm * (2 if scene.two_contacts else 1)  # a closed shell on a substrate: two halves
     return ne, nm, dofs, _SECONDS_PER_DOF * dofs
 
 
