@@ -218,3 +218,31 @@ def test_contact_of_a_shell_on_a_substrate_names_halves_of(branch):
     _, mid, _ = branch
     with pytest.raises(ValueError, match="halves_of"):
         st.contact_of(mid)
+
+
+def test_a_closed_shells_crossing_is_narrowed_without_n1(monkeypatch):
+    """Locating the first instability along a curve asks the modes near those found: of a closed
+    shell never n = 1 (on a substrate under a curved tip negative at every depth: the narrowing
+    would find its own bracket's end; between plates zero).  Measured before: the thin sphere on a
+    substrate under rho 0.3 was reported unstable at delta 0.325 in n = 1 (n = 3 from 0.36)."""
+    from types import SimpleNamespace
+
+    from shellbvp import curve_stability as cs
+
+    asked = []
+    state = SimpleNamespace(success=True, topology="closed-cap-cap", force=1.0)
+    monkeypatch.setattr(cs, "solve", lambda scene, delta, **kw: SimpleNamespace(**vars(state), delta=delta))
+
+    def point(s, modes=None):
+        asked.append(None if modes is None else [int(n) for n in modes])
+        return 0.2 - s.delta if hasattr(s, "delta") else 0.1, 2, ""
+
+    monkeypatch.setattr(cs, "point_stability", point)
+    for scene in (on_substrate(), sb.Scene(closed=True, support="plates", tip=sb.FlatTip(), gamma=1.0, beta=1e-2)):
+        curve = SimpleNamespace(solutions=[state, state], points={"delta": np.array([0.1, 0.3]),
+                                "force": np.array([1.0, 2.0])}, settings={"tol": 1e-6, "max_nodes": 1000}, scene=scene)
+        found = cs._narrowed(curve, 0, 1, np.array([0.1, -0.1]), np.array([0, 2]), 1e-3)
+        assert found.located and found.delta == pytest.approx(0.2, abs=1e-3)
+    chosen = [m for m in asked if m is not None]
+    assert chosen and all(0 in m and 2 in m and 4 in m and 1 not in m for m in chosen)
+    assert 1 in st.checked_modes(sb.Scene.preset("base")) and 1 not in st.checked_modes(on_substrate())

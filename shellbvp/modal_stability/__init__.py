@@ -258,12 +258,12 @@ from ..configurations import of
 from .closed import spectrum_closed
 from .contact import FRICTION, NOT_BUILT, Contact, check_friction, check_supported, contact_of, halves_of, supported
 from .fem import (
-    END_CONDITIONS, Stability, check_stability_size, default_elements, default_modes, either_side, mesh, spectrum,
-    stability_size,
+    END_CONDITIONS, Stability, check_stability_size, checked_modes, default_elements, default_modes, either_side,
+    mesh, spectrum, stability_size,
 )
 from .form import chain_base, form_functions, sphere_base, state_base
 
-__all__ = ["stability", "Stability", "spectrum", "state_base", "sphere_base", "mesh", "default_modes",
+__all__ = ["stability", "Stability", "spectrum", "state_base", "sphere_base", "mesh", "default_modes", "checked_modes",
            "default_elements", "END_CONDITIONS", "sphere_stretch", "NOT_BUILT", "supported", "Contact", "check_supported",
            "contact_of", "halves_of", "spectrum_closed", "chain_base", "form_functions", "FRICTION", "stability_size", "check_stability_size"]
 
@@ -341,11 +341,10 @@ def stability(state, modes=None, *, elements: int | None = None, S0: float | Non
     modes = None if modes is None else [int(n) for n in modes]
     check_stability_size(state.scene, modes, elements, max_dofs)
     sysm = state.system
-    # a closed shell on frictionless plates: n = 1 slides it sideways and turns it about a horizontal
-    # axis at no cost (left out); its spin about the axis (n = 0) is held at the equator (fem).  On
-    # a substrate under a curved tip n = 1 is the shell slipping out sideways (closed.py): left out too
+    # a closed shell: n = 1 is left out (fem.checked_modes; the spin about the axis, n = 0, is held
+    # at the equator)
     if modes is None and state.scene.closed:
-        modes = [n for n in default_modes(state.scene) if n != 1]
+        modes = [int(n) for n in checked_modes(state.scene)]
     if two:  # both halves, each from its own pole, tied at the equator
         def solve(modes, S0, elements=elements, **kw):
             return spectrum_closed(state.scene, halves_of(state, S0, friction), float(sysm.L), modes,

@@ -397,6 +397,16 @@ def default_modes(scene) -> np.ndarray:
     return np.arange(0, int(math.ceil(1.3 * kc)) + 3)
 
 
+def checked_modes(scene) -> np.ndarray:
+    """The modes :func:`shellbvp.stability` checks unless told: :func:`default_modes`, without
+    n = 1 for a closed shell -- between frictionless plates it slides sideways and turns at no
+    cost, on a substrate under a curved tip it slips out sideways (negative at every depth) or
+    rolls in place (zero): rigid motions of the frictionless model, not buckling
+    (:mod:`shellbvp.modal_stability.closed`)."""
+    modes = default_modes(scene)
+    return modes[modes != 1] if scene.closed else modes
+
+
 #: Seconds per unknown (summed over the modes) of a state's analysis, measured on the inflated
 #: hemisphere: 3.7 s for 250 elements x 59 modes (beta 1e-6), 10 s for 445 x 101 (1e-7).
 _SECONDS_PER_DOF = 4e-5
