@@ -236,11 +236,22 @@ variation, that the displacement modes do not carry.  A negative eigenvalue of a
 therefore proves it unstable; a positive one is stability against the perturbations that keep
 the corner where it is (``Stability.held_corners`` names them).
 
+A closed shell (``Scene(closed=True)``): between plates (or under a flat tip) its half above the
+equator is solved, and its modes are those of that half with the equator's conditions for modes
+symmetric (``u = w' = 0``, and ``v = 0`` at n = 0: the spin about the axis held) and
+antisymmetric (``v = w = 0``) about it.  On a substrate under a curved tip both halves are
+solved, each from its own pole, and their modes are tied at the equator into one problem
+(:mod:`.closed`, :func:`.contact.halves_of`).  n = 1 is left out unless asked for
+(:func:`.fem.checked_modes`): the frictionless model's rigid motions (sliding and turning between
+plates at no cost; on a substrate under a curved tip slipping out sideways, negative, and rolling
+in place, zero).
+
 Refused (ValueError, one line): the contact running over the tip's end onto the cylinder
 (``"cap+cylinder"``: held on both sides of a corner of the obstacle, across which material
 would have to slide), an interior corner (``"line+corner"``: the package's searches find no state
 of it to check the corner's terms on), ``contact="paper"``, a line whose gap is not positive, more than one line,
-an edge inside [0, S0] of a configuration with several, a sealed shell in contact, and a state
+an edge inside [0, S0] of a configuration with several, a sealed shell in contact (a closed shell
+under volume control included), and a state
 whose negative eigenvalue is not resolved: it still moves on 16 times the elements (an edge next
 to its convexity limit) or with the mesh starting 10 times further from the pole (the form's
 1/r^3 coefficients cancelling there; :func:`stability`'s checks).
