@@ -40,7 +40,8 @@ import time
 import numpy as np
 import scipy.sparse
 
-from .fem import Stability, _constraints, _held_nodes, _smallest, default_elements, default_modes, mesh, stiffness
+from .fem import (Stability, constraints, default_elements, default_modes, held_nodes, mesh, smallest_pairs,
+                  stiffness)
 
 #: The lower half's equator dofs (u, u', v, v', w, w') as the upper's times these (the
 #: derivative dofs also times the ratio of the halves' derivative scales).
@@ -50,7 +51,7 @@ SEAM_SIGNS = (-1.0, 1.0, 1.0, -1.0, 1.0, -1.0)
 def _half(contact, L, elements):
     """The mesh and held nodes of one half (``contact``: its :class:`~.contact.Contact`)."""
     nodes = mesh(contact.S0, L, elements, contact.edges)
-    held = _held_nodes(nodes, contact.held)
+    held = held_nodes(nodes, contact.held)
     lines = tuple(int(np.flatnonzero(nodes == S)[0]) for S in contact.lines)
     stuck, points = (), ()
     if contact.friction == "sticking":
@@ -101,7 +102,7 @@ def spectrum_closed(scene, contacts, L, modes=None, *, elements=None, count=2, v
         Ks, Ms, Ts = [], [], []
         for c, h in zip(contacts, halves):
             K, M = stiffness(scene, c.base, int(n), h["nodes"], c)
-            Ts.append(_constraints(int(n), h["nodes"].size, "seam", h["nodes"][0] / h["hs"], h["held"], c.pole_held,
+            Ts.append(constraints(int(n), h["nodes"].size, "seam", h["nodes"][0] / h["hs"], h["held"], c.pole_held,
                                    h["lines"], stuck=h["stuck"], stuck_points=h["stuck_points"]))
             Ks.append(K)
             Ms.append(M)
@@ -111,7 +112,7 @@ def spectrum_closed(scene, contacts, L, modes=None, *, elements=None, count=2, v
         K, M = scipy.sparse.block_diag(Ks).tocsr(), scipy.sparse.block_diag(Ms).tocsr()
         Kr, Mr = (T.T @ K @ T).tocsr(), (T.T @ M @ T).tocsr()
         Kr = ((Kr + Kr.T) / 2).tocsr()
-        lam, X = _smallest(Kr, Mr, count)
+        lam, X = smallest_pairs(Kr, Mr, count)
         out[k] = lam
         if vectors:
             vecs[int(n)] = _pole_to_pole(T @ X[:, 0], halves, L)

@@ -159,7 +159,7 @@ def _banded(A, bandwidth):
     return ab
 
 
-def _smallest(K, M, count):
+def smallest_pairs(K, M, count):
     """The ``count`` smallest eigenvalues (and vectors) of K q = lambda M q, K symmetric, M
     positive definite, both banded sparse: shift-invert Lanczos (``eigsh``) about a shift below
     the spectrum, which a banded Cholesky factorisation of ``K - sigma M`` certifies (it
@@ -237,7 +237,7 @@ END_CONDITIONS = {"pinned": (0, 2, 4), "clamped": (0, 2, 4, 5), "symmetric": (0,
                   "held-symmetric": (0, 5), "seam": ()}
 
 
-def _constraints(n, m, end="pinned", S0_over_hs=0.0, held=(), pole_held=False, lines=(), stuck=(),
+def constraints(n, m, end="pinned", S0_over_hs=0.0, held=(), pole_held=False, lines=(), stuck=(),
                  stuck_points=(), ties=()):
     """The reduced basis T (sparse, ndof x nfree) that imposes the pole (node 0) and end
     (node m-1) conditions: q = T q_free.  ``S0_over_hs``: S0 over the derivative dofs' scale
@@ -352,7 +352,7 @@ def mesh(S0: float, L: float, elements: int, edges=()) -> np.ndarray:
     return nodes
 
 
-def _held_nodes(nodes, intervals):
+def held_nodes(nodes, intervals):
     """The nodes on the tip: within one of the held S-intervals; of a corner's twin nodes at an
     interval's end only the one on the interval's side (the element it bounds lies inside)."""
     held = set()
@@ -480,7 +480,7 @@ def spectrum(scene, base_of, S0, L, modes=None, *, elements=None, count=2, vecto
     held, pole_held, lines, ties, stuck, stuck_points = (), False, (), [], (), ()
     if contact is not None:
         pole_held = contact.pole_held
-        held = _held_nodes(nodes, contact.held)
+        held = held_nodes(nodes, contact.held)
         lines = tuple(int(np.flatnonzero(nodes == S)[0]) for S in contact.lines)
         ties = [t for c in contact.corners for t in corner_ties(c, int(np.flatnonzero(nodes == c.S)[0]), hs)]
         if contact.friction == "sticking":
@@ -492,11 +492,11 @@ def spectrum(scene, base_of, S0, L, modes=None, *, elements=None, count=2, vecto
     vecs = {}
     for k, n in enumerate(modes):
         K, M = stiffness(scene, base_of, int(n), nodes, contact)
-        T = _constraints(int(n), nodes.size, end, nodes[0] / hs, held, pole_held, lines, stuck=stuck,
+        T = constraints(int(n), nodes.size, end, nodes[0] / hs, held, pole_held, lines, stuck=stuck,
                          stuck_points=stuck_points, ties=ties)
         Kr, Mr = (T.T @ K @ T).tocsr(), (T.T @ M @ T).tocsr()
         Kr = ((Kr + Kr.T) / 2).tocsr()
-        lam, X = _smallest(Kr, Mr, count)
+        lam, X = smallest_pairs(Kr, Mr, count)
         out[k] = lam
         if vectors:
             q = (T @ X[:, 0]).reshape(-1, 6)
