@@ -275,6 +275,11 @@ def _closed_lines(rows):
         for r in sub["n1"]:
             lines.append(f"| {r['delta']:.4g} | {r['topology']} | {r['force']:.4g} | {r['n0']:.4g} | {r['slip']:.4g} | "
                          f"{r['rigid']:.4g} | {r['roll']:.2g} |")
+        lines += ["", "The slip follows the rigid ball at delta 0.018 and grows more negative than it as the sphere "
+                  "flattens (its contacts widen).  At the shallowest state the ring on the tip is next to its switch "
+                  "to an annulus (the curvature gap near 0: solved there from scratch the gap is -1.8e-6 and the state "
+                  "is refused), where the ring's rolling term `f w1^2/gap` is large: there neither n = 1 value is "
+                  "resolved (the roll reads -1.9e-5 instead of 0)."]
     return lines + [""]
 
 
@@ -329,6 +334,8 @@ def write(res):
             lines.append(f"| {r['where']} | {r['lambda0']:.5f} | {r['delta']:.7f} | {r['S0']:.2e} | {r['elements']} | "
                          f"{r['n0']:.4g} | {r['n2']:.3g} |")
         lines.append("")
+    if "closed" in res:
+        lines += _closed_lines(res["closed"])
     lines += ["## First crossing along the dome's curve, by rho", "",
               "H = sqrt(3 beta) = 0.00548 (`shellbvp.units.beta_from_thickness`, beta = eps^2/3); the paper's "
               "h = sqrt(12 beta) = 0.01095 beside it.  `shift 2x`: how far the crossing moves with twice the "
@@ -341,8 +348,6 @@ def write(res):
             continue
         lines.append(f"| {o['rho']} | n >= {o['first']} | {o['delta']:.5f} | {o['over_H']:.2f} | {o['over_h12']:.2f} | "
                      f"{o['n']} | {o['topology']} | {o['force']:.4e} | {o['shift_2x']:.1e} | {o['seconds']:.0f} s |")
-    if "closed" in res:
-        lines += [""] + _closed_lines(res["closed"])[:-1]
     lines += ["", "The crossing hardly depends on rho: the contact (a point, a cap of radius 0.001 or 0.012) is "
               "small against the dimple whose edge buckles, and the states at the crossing carry the same force "
               "to 1e-4.", "", "Literature (searched in the stored pages; only the opening of each is stored): Vaziri & "
