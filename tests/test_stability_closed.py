@@ -140,6 +140,29 @@ def test_energy_along_the_branch_is_both_halves_n0_form(branch):
     assert abs(eu - dF) > 0.2 * dF and abs(el - dF) > 0.2 * dF
 
 
+@pytest.mark.slow  # a pressurised structure on a substrate: its own derivation
+def test_energy_along_the_branch_under_pressure():
+    """The same with pressure 0.1 (the pressure's terms of both halves: each half's volume closed
+    across the equator, which the halves share): dF/ddelta 0.53200, the two halves' form 0.31992
+    + 0.21203, 9e-5 below it; the assembled stiffness 3e-5 above."""
+    scene = on_substrate(pressure=0.1)
+    mid = sb.solve(scene, delta=0.2, tol=1e-8, estimate_error=False)
+    lo, hi = (sb.solve(scene, delta=0.2 + s * 1.25e-4, guess=mid, tol=1e-8, estimate_error=False) for s in (-1, 1))
+    assert all(s.success and s.valid and s.topology == "closed-line-cap" for s in (lo, mid, hi))
+    upper, lower = _halves(mid)
+    dF = (hi.force - lo.force) / (hi.delta - lo.delta)
+    form = _elastic(lo, mid, hi, upper, 1.0) + _elastic(lo, mid, hi, lower, -1.0)
+    assert abs(form - dF) < 3e-4 * dF
+    total = 0.0
+    for regions, contact, lift in zip(_halves(mid), st.halves_of(mid), (1.0, -1.0)):
+        nodes = fem.mesh(contact.S0, float(mid.system.L), 2 * fem.default_elements(mid.scene), contact.edges)
+        K, _ = fem.stiffness(mid.scene, contact.base, 0, nodes, contact)
+        q = _hermite_dofs(lo, mid, hi, regions, nodes, lift)
+        total += 2 * math.pi * float(q @ (K @ q))
+    assert total == pytest.approx(dF, rel=1e-3)
+    assert st.stability(mid).stable
+
+
 def test_the_branch_tangent_meets_the_seams_ties(branch):
     """The physical tangent (the same vector field, x' + e_z above, its mirror image below) at
     the equator in each half's frame: (u, u', w, w') tied by SEAM_SIGNS, each not small
@@ -210,8 +233,12 @@ def test_eigenvalues_converge_and_n1_slips_and_rolls(branch):
     assert slip.eigenvalues[0, 0] == pytest.approx(rigid, rel=0.15)
     assert abs(slip.eigenvalues[0, 1]) < 1e-5
     assert st.stability(mid, modes=[1], friction="sticking").minimum > 0.1
-    default = st.stability(mid, elements=40)
+    default = st.stability(mid, elements=40, vectors=True)
     assert 1 not in default.modes and 0 in default.modes and default.stable
+    v = default.vectors[2]  # pole to pole: S from the upper pole through the equator (L) to 2 L - S0
+    L = float(mid.system.L)
+    assert np.all(np.diff(v["S"]) > 0) and v["S"][0] < 1e-3 and v["S"][-1] > 2 * L - 1e-3
+    assert all(v[k].shape == v["S"].shape for k in ("u", "v", "w", "dw"))
 
 
 def test_contact_of_a_shell_on_a_substrate_names_halves_of(branch):
@@ -246,3 +273,18 @@ def test_a_closed_shells_crossing_is_narrowed_without_n1(monkeypatch):
     chosen = [m for m in asked if m is not None]
     assert chosen and all(0 in m and 2 in m and 4 in m and 1 not in m for m in chosen)
     assert 1 in st.checked_modes(sb.Scene.preset("base")) and 1 not in st.checked_modes(on_substrate())
+
+
+def test_the_mesh_starts_at_s0_with_a_contact_edge_next_to_the_pole():
+    """A ring on the tip closer to the pole than half an element (the lifted pole of the state
+    above: S1 0.0137, h 0.039): the mesh still starts at S0, where the pole's conditions are
+    imposed, graded towards it (the edge's nodes used to take S0's place: the mesh started at
+    0.0039), and without an edge near the pole the mesh is as it was."""
+    S0, L = 1.57e-4, math.pi / 2
+    nodes = fem.mesh(S0, L, 40, (0.0137,))
+    assert nodes[0] == S0 and 0.0137 in nodes
+    first = np.diff(nodes[:3])
+    assert nodes[1] < 0.002 and first[1] > 2 * first[0]  # graded towards S0
+    h = (L - S0) / 40
+    plain = fem.mesh(S0, L, 40, (0.5,))
+    assert plain[0] == S0 and plain[1] == pytest.approx(S0 + h / 16) and plain[2] == pytest.approx(S0 + h / 4)

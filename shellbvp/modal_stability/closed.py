@@ -23,14 +23,23 @@ equator) and antisymmetric (``v = w = u' = 0``) about it: the halved shell's two
 with the natural conditions ``v' = 0``, ``u' = 0`` imposed (tests/test_stability_closed.py).
 
 *Rigid motions.*  At n = 0 the spin about the axis costs nothing on frictionless contacts: the
-equator's ``v`` is held (with ``friction="sticking"`` the contacts hold it).  The vertical
-translation is held by both contacts.  At n = 1 nothing is free: sliding sideways moves the
-upper contact off the tip's apex, and the squeezed shell slips out from under a curved tip on a
-frictionless plane (a rigid ball of radius R between a ball of radius rho and a plane loses
-``F X^2/(2(R + rho))`` of energy when moved sideways by X) -- a negative n = 1 eigenvalue at
-every depth, the frictionless model's, which any friction at the plane or the tip removes.
-:func:`shellbvp.stability` leaves n = 1 out by default, as between plates, and reports n = 0 and
-n >= 2 (the polygonal modes); ``modes=[1]`` computes it.
+equator's ``v`` is held (with ``friction="sticking"``, which sticks both halves to their
+indenters, the contacts hold it).  The vertical translation is held by both contacts.  At n = 1
+two modes are the frictionless model's, not buckling:
+
+* the slip: moved sideways, the shell's upper contact leaves the tip's apex and the squeezed
+  shell slips out from under a curved tip on a frictionless plane (a rigid ball of radius R
+  between a ball of radius rho and a plane loses ``F X^2/(2(R + rho))`` of energy when moved
+  sideways by X): negative at every depth (measured: within 6 % of the rigid ball's
+  ``-F/(R + rho)/(4 pi)`` at beta 0.01, delta 0.2; on a thin sphere 0.7 % at delta 0.018, 45 %
+  more negative at 0.6 as it flattens; benchmarks/results/stability_contact.md);
+* the roll: the sphere's material turned about a horizontal axis through its centre, the
+  deformed shape unchanged (the reference sphere's symmetry), at zero (5e-7, falling with the
+  mesh like h^2).
+
+Sticking holds both (n = 1 positive).  :func:`shellbvp.stability` leaves n = 1 out by default
+(:func:`.fem.checked_modes`), as between plates, and reports n = 0 and n >= 2 (the polygonal
+modes); ``modes=[1]`` computes it.
 """
 
 from __future__ import annotations

@@ -337,19 +337,20 @@ def mesh(S0: float, L: float, elements: int, edges=()) -> np.ndarray:
     the grading the eigenvalues converged only like h)."""
     nodes = np.linspace(S0, L, elements + 1)
     h = nodes[1] - nodes[0]
-    extra = []
-    d = h * POLE_RATIO
-    while d > 4 * S0:
-        extra.append(S0 + d)
-        d *= POLE_RATIO
-    nodes = np.concatenate([nodes[:1], np.array(extra[::-1]), nodes[1:]])
     steps = h * 0.5 ** np.arange(1, EDGE_LEVELS + 1)
     for edge in edges:
         near = np.concatenate([edge - steps, [edge], edge + steps])
         near = near[(near > S0) & (near < L)]
-        far = nodes[(np.abs(nodes - edge) >= h / 2) | np.isin(nodes, edges)]  # uniform nodes closer than h/2 give way
+        # uniform nodes closer than h/2 give way, but not the mesh's start S0 (the pole's conditions are imposed there)
+        far = nodes[(np.abs(nodes - edge) >= h / 2) | np.isin(nodes, edges) | (nodes == S0)]
         nodes = np.unique(np.concatenate([far, near]))
-    return nodes
+    # the first element (uniform, or ending at an edge's nodes near the pole) split towards S0
+    extra = []
+    d = (nodes[1] - S0) * POLE_RATIO
+    while d > 4 * S0:
+        extra.append(S0 + d)
+        d *= POLE_RATIO
+    return np.unique(np.concatenate([nodes, extra]))
 
 
 def held_nodes(nodes, intervals):
