@@ -24,7 +24,8 @@
   ``sb.curve(..., stability="locate")`` to delta 0.6 (plates: 0.7), the first instability's
   delta and n (n = 1 left out: the slip and roll of the frictionless model), the mode's eigenvalue
   past it with twice the elements and where the mode lives; along the substrate's curve n = 1's
-  slip against a rigid ball's ``-F/(R + rho)/(4 pi)``.
+  slip against a rigid ball's ``-F/(R + rho)/(4 pi)``; and the ``cell-glass`` preset (eps 0.04,
+  turgor 0.15, rho 0.34) to delta 1.
 
 Writes benchmarks/results/stability_contact.md (and .json).
 
@@ -199,10 +200,14 @@ def onset(rho, first):
 
 def closed_sphere(support, eps=0.02, rho=0.3):
     """The first instability of a thin closed sphere on a substrate under a sphere tip, or between
-    plates (the benchmark's ``closed`` section)."""
+    plates, or of the ``cell-glass`` preset (``support="cell-glass"``; the benchmark's ``closed``
+    section)."""
     t0 = time.perf_counter()
     beta = eps**2 / 3
-    if support == "substrate":
+    if support == "cell-glass":
+        scene = sb.Scene.preset("cell-glass")
+        eps, rho, delta_max = math.sqrt(3 * scene.beta), scene.rho, 1.0
+    elif support == "substrate":
         scene = sb.Scene(closed=True, tip=sb.SphereTip(), rho=rho, gamma=1.0, beta=beta,
                          material=sb.MooneyRivlin(0.1))
         delta_max = 0.6
@@ -211,7 +216,7 @@ def closed_sphere(support, eps=0.02, rho=0.3):
                          material=sb.MooneyRivlin(0.1))
         delta_max = 0.7  # its curve stops near 0.74 (continuation)
     curve = sb.curve(scene, delta_max=delta_max, stability="locate")
-    out = {"support": support, "eps": eps, "rho": rho if support == "substrate" else None, "delta_max": delta_max,
+    out = {"support": support, "eps": eps, "rho": rho if support != "plates" else None, "delta_max": delta_max,
            "stop": curve.stop_reason, "topologies": sorted({str(t) for t in curve.topology}),
            "points": len(curve), "last_delta": float(curve.delta[-1])}
     fi = curve.first_instability
@@ -241,12 +246,12 @@ def closed_sphere(support, eps=0.02, rho=0.3):
 
 
 def closed():
-    return [closed_sphere("substrate"), closed_sphere("plates")]
+    return [closed_sphere("substrate"), closed_sphere("plates"), closed_sphere("cell-glass")]
 
 
 def _closed_lines(rows):
-    lines = ["## A thin closed sphere on a substrate under a sphere tip, and between plates", "",
-             "eps = H/R = 0.02 (beta = eps^2/3 = 1.33e-4), Mooney-Rivlin 0.1, smooth contact, frictionless; "
+    lines = ["## A thin closed sphere on a substrate under a sphere tip, between plates, and the cell-glass preset", "",
+             "eps = H/R = 0.02 (beta = eps^2/3 = 1.33e-4; the preset's 0.04), Mooney-Rivlin 0.1, smooth contact, frictionless; "
              "`sb.curve(..., stability=\"locate\")` (the CLI's `shellbvp curve --closed ... --stability locate`) "
              "with the default mesh and modes, n = 1 left out (the frictionless model's slip and roll, below).  "
              "`S peak`: where the mode's |w| is largest, the reference arclength from the upper pole (pi/2 the "
@@ -254,7 +259,8 @@ def _closed_lines(rows):
              "| support | first unstable delta | delta/H | n | topology there | F | eigenvalue past it (2x elements) "
              "| S peak | time |", "|---|---|---|---|---|---|---|---|---|"]
     for r in rows:
-        name = f"substrate, sphere tip rho {r['rho']}" if r["support"] == "substrate" else "plates"
+        name = {"substrate": f"substrate, sphere tip rho {r['rho']}", "plates": "plates"}.get(
+            r["support"], f"preset {r['support']} (eps {r['eps']:.2g}, rho {r['rho']}, pressure 0.15)")
         if "n" not in r:
             lines.append(f"| {name} | stable to delta {r['last_delta']:.3g} ({r['points']} points; {r['stop']}) | | | "
                          f"{', '.join(r['topologies'])} | | | | {r['seconds']:.0f} s |")
