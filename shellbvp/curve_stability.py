@@ -28,7 +28,7 @@ import time
 import numpy as np
 
 from .io import STABILITY_FIELDS, FirstInstability
-from .modal_stability import default_modes, stability
+from .modal_stability import checked_modes, default_modes, stability
 from .state import solve
 
 __all__ = ["STABILITY_CHOICES", "STABILITY_FIELDS", "FirstInstability", "check_choice", "point_stability",
@@ -190,9 +190,9 @@ def _narrowed(curve, j, i, mins, modes, delta_tol):
     sols, d = curve.solutions, curve.points["delta"]
     st = curve.settings
     near = {int(modes[i]), int(modes[j])}
-    every = default_modes(curve.scene)
+    every = set(checked_modes(curve.scene).tolist())  # a closed shell's n = 1 (rigid motions) left out
     chosen = np.array(sorted({int(m) for c in near for m in range(c - NEAR_MODES, c + NEAR_MODES + 1)
-                              if every[0] <= m <= every[-1]}))
+                              if m in every}))
     states = {}
 
     def f(delta):

@@ -206,9 +206,7 @@ def test_a_sphere_between_plates_is_checked_on_both_sides_of_its_equator():
     assert either_side([a, b]).eigenvalues.tolist() == [[0.5, 1.0], [5.0, 6.0]]
 
 
-def test_what_a_closed_shell_does_not_have_yet_is_refused():
-    with pytest.raises(ValueError, match="on a substrate under a curved tip is not supported yet"):
-        sb.stability(sb.solve(on_substrate(), delta=0.1))
+def test_a_closed_shell_on_a_substrate_under_a_curved_tip_has_the_smooth_contact_only():
     with pytest.raises(ValueError, match="smooth"):
         on_substrate(contact="paper")
 

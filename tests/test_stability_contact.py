@@ -213,14 +213,14 @@ def test_n1_needs_the_slopes_held_at_the_start(monkeypatch, cap_state):
     def n1(ratio, slopes_held=True):
         monkeypatch.setattr(fem, "mesh", first_element(ratio))
         if not slopes_held:
-            full = fem._constraints
+            full = fem.constraints
 
             def constraints(n, m, *args, **kwargs):
                 T = full(n, m, *args, **kwargs)
                 # release u'(S0), v'(S0): the columns of the reduced basis that carry them are absent,
                 # so rebuild with the two dofs free
                 return _release(T, (1, 3))
-            monkeypatch.setattr(fem, "_constraints", constraints)
+            monkeypatch.setattr(fem, "constraints", constraints)
         out = st.spectrum(state.scene, contact.base, contact.S0, float(state.system.L), [1], contact=contact)
         monkeypatch.undo()
         return out.smallest[0]

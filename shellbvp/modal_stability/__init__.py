@@ -236,11 +236,22 @@ variation, that the displacement modes do not carry.  A negative eigenvalue of a
 therefore proves it unstable; a positive one is stability against the perturbations that keep
 the corner where it is (``Stability.held_corners`` names them).
 
+A closed shell (``Scene(closed=True)``): between plates (or under a flat tip) its half above the
+equator is solved, and its modes are those of that half with the equator's conditions for modes
+symmetric (``u = w' = 0``, and ``v = 0`` at n = 0: the spin about the axis held) and
+antisymmetric (``v = w = 0``) about it.  On a substrate under a curved tip both halves are
+solved, each from its own pole, and their modes are tied at the equator into one problem
+(:mod:`.closed`, :func:`.contact.halves_of`).  n = 1 is left out unless asked for
+(:func:`.fem.checked_modes`): the frictionless model's rigid motions (sliding and turning between
+plates at no cost; on a substrate under a curved tip slipping out sideways, negative, and rolling
+in place, zero).
+
 Refused (ValueError, one line): the contact running over the tip's end onto the cylinder
 (``"cap+cylinder"``: held on both sides of a corner of the obstacle, across which material
 would have to slide), an interior corner (``"line+corner"``: the package's searches find no state
 of it to check the corner's terms on), ``contact="paper"``, a line whose gap is not positive, more than one line,
-an edge inside [0, S0] of a configuration with several, a sealed shell in contact, and a state
+an edge inside [0, S0] of a configuration with several, a sealed shell in contact (a closed shell
+under volume control included), and a state
 whose negative eigenvalue is not resolved: it still moves on 16 times the elements (an edge next
 to its convexity limit) or with the mesh starting 10 times further from the pole (the form's
 1/r^3 coefficients cancelling there; :func:`stability`'s checks).
@@ -255,16 +266,17 @@ import numpy as np
 
 from ..geometry import Spheroid
 from ..configurations import of
-from .contact import FRICTION, NOT_BUILT, Contact, check_friction, check_supported, contact_of, supported
+from .closed import spectrum_closed
+from .contact import FRICTION, NOT_BUILT, Contact, check_friction, check_supported, contact_of, halves_of, supported
 from .fem import (
-    END_CONDITIONS, Stability, check_stability_size, default_elements, default_modes, either_side, mesh, spectrum,
-    stability_size,
+    END_CONDITIONS, Stability, check_stability_size, checked_modes, default_elements, default_modes, either_side,
+    mesh, spectrum, stability_size,
 )
 from .form import chain_base, form_functions, sphere_base, state_base
 
-__all__ = ["stability", "Stability", "spectrum", "state_base", "sphere_base", "mesh", "default_modes",
+__all__ = ["stability", "Stability", "spectrum", "state_base", "sphere_base", "mesh", "default_modes", "checked_modes",
            "default_elements", "END_CONDITIONS", "sphere_stretch", "NOT_BUILT", "supported", "Contact", "check_supported",
-           "contact_of", "chain_base", "form_functions", "FRICTION", "stability_size", "check_stability_size"]
+           "contact_of", "halves_of", "spectrum_closed", "chain_base", "form_functions", "FRICTION", "stability_size", "check_stability_size"]
 
 
 def stability(state, modes=None, *, elements: int | None = None, S0: float | None = None,
@@ -335,15 +347,20 @@ def stability(state, modes=None, *, elements: int | None = None, S0: float | Non
     """
     t0 = time.perf_counter()
     check_friction(friction)
-    check_supported(state)
+    two = state.scene is not None and state.scene.two_contacts
+    check_supported(state, halves=two)
     modes = None if modes is None else [int(n) for n in modes]
     check_stability_size(state.scene, modes, elements, max_dofs)
     sysm = state.system
-    # a closed shell on frictionless plates: n = 1 slides it sideways and turns it about a horizontal
-    # axis at no cost (left out); its spin about the axis (n = 0) is held at the equator (fem)
+    # a closed shell: n = 1 is left out (fem.checked_modes; the spin about the axis, n = 0, is held
+    # at the equator)
     if modes is None and state.scene.closed:
-        modes = [n for n in default_modes(state.scene) if n != 1]
-    if of(state) is None:  # the inflated shell: no contact
+        modes = [int(n) for n in checked_modes(state.scene)]
+    if two:  # both halves, each from its own pole, tied at the equator
+        def solve(modes, S0, elements=elements, **kw):
+            return spectrum_closed(state.scene, halves_of(state, S0, friction), float(sysm.L), modes,
+                                   elements=elements, **kw)
+    elif of(state) is None:  # the inflated shell: no contact
         zeta = float(sysm.S_point(sysm.regions[0].start, None))
         S0 = zeta if S0 is None else max(float(S0), zeta)
 
@@ -356,10 +373,11 @@ def stability(state, modes=None, *, elements: int | None = None, S0: float | Non
             return spectrum(state.scene, contact.base, contact.S0, float(sysm.L), modes, elements=elements,
                             contact=contact, end=end, **kw)
 
-    def solve(modes, S0, **kw):
-        # a closed shell's half: the modes symmetric and antisymmetric about its equator
-        ends = ("held-symmetric", "antisymmetric") if state.scene.closed else (state.scene.rim,)
-        return either_side([solve_end(modes, S0, end, **kw) for end in ends])
+    if not two:
+        def solve(modes, S0, **kw):
+            # a closed shell's half: the modes symmetric and antisymmetric about its equator
+            ends = ("held-symmetric", "antisymmetric") if state.scene.closed else (state.scene.rim,)
+            return either_side([solve_end(modes, S0, end, **kw) for end in ends])
     out = solve(modes, S0, count=count, vectors=vectors)
     _refine_negative(out, solve)
     _check_pole_floor(out, solve)

@@ -4,11 +4,11 @@
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ..chain import CONTACT_KINDS, Edge, Kink, Line, TipEnd
+from ..chain import CONTACT_KINDS, FREE_STATES, Edge, Kink, Line, PointPole, Seam, TipEnd
 from ..configurations import CONFIGURATIONS, is_point_load, of
 from ..edge_models import contact_models, edge_model
 from ..inflation import EPS
@@ -25,6 +25,8 @@ FRICTION = ("frictionless", "sticking")
 #: free regions and regions on the tip joined by edges (smooth or cornered) and lines -- is.
 NOT_BUILT = (Kink, TipEnd)
 
+_LS, _KS = FREE_STATES.index("ls"), FREE_STATES.index("ks")
+
 
 def supported(conf) -> bool:
     """Whether the stability of a registered configuration's states is built (no junction of its
@@ -34,10 +36,12 @@ def supported(conf) -> bool:
     return not any(isinstance(j, NOT_BUILT) for j in conf.chain(1e-3, 1.0, "smooth").junctions)
 
 
-def check_supported(state):
+def check_supported(state, halves: bool = False):
     """ValueError (one line, naming what is not supported) unless :func:`stability` handles
     ``state``: a converged state of a configuration whose chain is :func:`supported`, with the
-    smooth contact edge, under pressure (not volume) control."""
+    smooth contact edge, under pressure (not volume) control; a closed shell on a substrate
+    under a curved tip (``scene.two_contacts``) only where its two halves are asked for
+    (``halves``: :func:`halves_of`)."""
     if not state.success:
         raise ValueError(f"stability: the state did not converge ({state.message})")
     conf = of(state)
@@ -46,9 +50,9 @@ def check_supported(state):
         raise ValueError(f"stability: topology {state.topology!r} is not supported (only the inflated shell and "
                          f"{built}: the contact running over the tip's end onto the indenter's cylinder and interior "
                          f"corners are not built)")
-    if state.scene is not None and state.scene.two_contacts:
-        raise ValueError("stability: a closed shell on a substrate under a curved tip is not supported yet (its "
-                         "two halves' modes are not assembled together); between plates it is")
+    if state.scene is not None and state.scene.two_contacts and not halves:
+        raise ValueError("stability: a closed shell on a substrate under a curved tip has two halves, each "
+                         "from its own pole: contact_of takes one chain from one pole, halves_of the two")
     if conf is None:
         return
     scene = state.scene
@@ -137,26 +141,89 @@ def contact_of(state, S0=None, friction: str = "frictionless") -> Contact:
     check_friction(friction)
     check_supported(state)
     sysm, p = state.system, state.p
-    L = float(sysm.L)
-    zeta = float(sysm.S_point(sysm.regions[0].start, p))
-    S0 = max(EPS * L, zeta) if S0 is None else max(float(S0), zeta)
-    base = chain_base(state)
-    apex = state.scene.tip.apex_curvature() / state.scene.rho
     points = _junction_points(sysm, p)
-    if is_point_load(state) or (len(points) == 1 and points[0][0] <= S0 * (1 + 1e-9)):
+    gaps = [-float(state.curvature_excess) if kind is Line else math.nan for _, kind, _, _ in points]
+    regions = range(len(sysm.regions))
+    apex = state.scene.tip.apex_curvature() / state.scene.rho
+    contact = _contact(state, regions, S0, friction, points, list(state.edge_forces), gaps, is_point_load(state), apex)
+    return replace(contact, corners=_corners(state, contact.base))
+
+
+def halves_of(state, S0=None, friction: str = "frictionless") -> tuple:
+    """The :class:`Contact` of each half of a closed shell on a substrate under a curved tip
+    (``scene.two_contacts``), upper (on the tip) then lower (on the plane, in its mirror image
+    z -> -z, as the chain solves it), each from its own pole to the equator: ring forces
+    ``-2 pi [r Q]`` and line gaps from the regions' profiles, the plane's curvature 0 (its
+    pressure's and rings' sliding terms vanish: kappa_s = 0, sin(phi) = 0 there)."""
+    check_friction(friction)
+    check_supported(state, halves=True)
+    sysm, p = state.system, state.p
+    seam = next(j for j in sysm.junctions if isinstance(j, Seam))
+    out = []
+    for regions, apex in ((range(seam.ku + 1), state.scene.tip.apex_curvature() / state.scene.rho),
+                          (range(seam.ku + 1, len(sysm.regions)), 0.0)):
+        points = [pt for pt in _junction_points(sysm, p) if pt[2] in regions]
+        forces, gaps = _ring_forces(state, points)
+        point = any(isinstance(j, PointPole) and j.k == regions[0] for j in sysm.junctions)
+        out.append(_contact(state, regions, S0, friction, points, forces, gaps, point, apex))
+    return tuple(out)
+
+
+def _ring_forces(state, points):
+    """The normal ring force ``-2 pi [r Q]`` (outer minus inner) at each of ``points``
+    (:func:`_junction_points`) and, at a line, the curvature gap (the indenter's kappa_s minus the
+    shell's; NaN at an edge), from the regions' profiles at their ends."""
+    sysm, p = state.system, state.p
+    par, q = sysm.par_at(p), sysm.quantities(p)
+    kernels = sysm.kernels.active
+    y0, y1 = state.sol(0.0), state.sol(1.0)  # every region runs from t = 0 to t = 1
+
+    def end(k, at_end):
+        S = np.array([float(sysm.S_point(sysm.regions[k].end if at_end else sysm.regions[k].start, p))])
+        y = (y1 if at_end else y0)[sysm.rows(k)]
+        return getattr(kernels, f"{sysm.regions[k].kind}_profile")(S, y[:, None], par), y
+
+    lines = {j.k: j for j in sysm.junctions if isinstance(j, Line)}
+    forces, gaps = [], []
+    for S, kind, inner, outer in points:
+        inner, outer = min(inner, outer), max(inner, outer)
+        (fi, yin), (fo, _) = end(inner, True), end(outer, False)
+        rq = [float(np.ravel(np.asarray(f["r"]) * np.asarray(f["Q"]))[0]) for f in (fi, fo)]
+        forces.append(-2 * np.pi * (rq[1] - rq[0]))
+        if kind is Line:
+            j = lines[inner]
+            on = getattr(kernels, f"{j.on}_profile")(np.array([S]), np.array([[q[j.chi]], [yin[_LS]]]), par)
+            gaps.append(float(np.ravel(on["kappa_s"])[0]) - float(yin[_KS]))
+        else:
+            gaps.append(math.nan)
+    return forces, gaps
+
+
+def _contact(state, regions, S0, friction, points, forces, gaps, point, apex) -> Contact:
+    """The :class:`Contact` of the chain of ``regions`` (all, or a closed shell's half) with its
+    contact edges and lines ``points`` (:func:`_junction_points`), their normal ring forces and
+    line gaps; ``point``: the pole held at a point (a point load); ``apex``: the indenter's
+    curvature at its apex."""
+    sysm, p = state.system, state.p
+    regions = list(regions)
+    L = float(sysm.L)
+    zeta = float(sysm.S_point(sysm.regions[regions[0]].start, p))
+    S0 = max(EPS * L, zeta) if S0 is None else max(float(S0), zeta)
+    base = chain_base(state, regions)
+    if point or (len(points) == 1 and points[0][0] <= S0 * (1 + 1e-9)):
         # the one contact (a cap or a line) lies within the pole's disc: a point contact there
         return Contact(base, S0, pole_held=True, pole_force=float(state.force), apex_curvature=apex,
                        friction=friction)
     if points[0][0] <= S0 * (1 + 1e-9):
         raise ValueError(f"stability: a contact edge at S = {points[0][0]:.3g} inside the mesh's start "
                          f"S0 = {S0:.3g} of a {state.topology!r} state is not supported")
-    held = tuple((max(float(sysm.S_point(r.start, p)), S0), float(sysm.S_point(r.end, p)))
-                 for r in sysm.regions if r.kind in CONTACT_KINDS)
+    held = tuple((max(float(sysm.S_point(sysm.regions[k].start, p)), S0), float(sysm.S_point(sysm.regions[k].end, p)))
+                 for k in regions if sysm.regions[k].kind in CONTACT_KINDS)
     lines = [S for S, kind, _, _ in points if kind is Line]
     if len(lines) > 1:
         raise ValueError("stability: more than one line contact is not supported")
     rings = []
-    for (S, kind, k, other), force in zip(points, state.edge_forces):
+    for (S, kind, k, other), force, gap in zip(points, forces, gaps):
         side = S * (1 - 1e-12) if k < other else S * (1 + 1e-12)  # inside region k: the tip's side of an edge
         at = base(np.array([side]))
         R, Psi = (float(v[0]) for v in reference_shell(state.scene, np.array([S])))
@@ -169,14 +236,13 @@ def contact_of(state, S0=None, friction: str = "frictionless") -> Contact:
         # a line: the gap's second variation with the contact point rolling along the meridian,
         # kappa_S u^2 + 2 u w'/psi - w'^2/(psi^2 gap) + kappa_theta v^2 (module docstring), with
         # gap = kappa_s(indenter) - kappa_s(shell) = -curvature_excess > 0, kappa_S the shell's
-        gap = -float(state.curvature_excess)
         if not gap > 0:
             raise ValueError(f"stability: the line contact's curvature gap {gap:.3g} is not positive (the shell "
                              f"bends as tightly as the indenter there: a band), not supported")
         psi = float(at["ls"][0]) * Psi
         rings.append((S, (-f * ks, -f * kt, -f / psi, f / (psi**2 * gap))))
     return Contact(base, S0, held=held, lines=tuple(lines), rings=tuple(rings), apex_curvature=apex,
-                   corners=_corners(state, base), friction=friction)
+                   friction=friction)
 
 
 def _corners(state, base):

@@ -159,7 +159,7 @@ def _banded(A, bandwidth):
     return ab
 
 
-def _smallest(K, M, count):
+def smallest_pairs(K, M, count):
     """The ``count`` smallest eigenvalues (and vectors) of K q = lambda M q, K symmetric, M
     positive definite, both banded sparse: shift-invert Lanczos (``eigsh``) about a shift below
     the spectrum, which a banded Cholesky factorisation of ``K - sigma M`` certifies (it
@@ -230,12 +230,14 @@ def _element_basis(xg, h, hs):
 #: M_s = 0) or clamped (``w'`` held too: the slope is), named as ``Scene.rim``; or the equator of
 #: a complete sphere for modes symmetric (u = 0, w' = 0; Q and the in-plane shear vanish
 #: naturally) or antisymmetric (v = w = 0; w'' = 0 naturally) about it; ``held-symmetric``: a closed
-#: shell between plates, symmetric, its spin about the axis (n = 0, v) held at the equator.
+#: shell between plates, symmetric, its spin about the axis (n = 0, v) held at the equator;
+#: ``seam``: nothing held, the end tied to the other half's (a closed shell on a substrate,
+#: :mod:`shellbvp.modal_stability.closed`).
 END_CONDITIONS = {"pinned": (0, 2, 4), "clamped": (0, 2, 4, 5), "symmetric": (0, 5), "antisymmetric": (2, 4),
-                  "held-symmetric": (0, 5)}
+                  "held-symmetric": (0, 5), "seam": ()}
 
 
-def _constraints(n, m, end="pinned", S0_over_hs=0.0, held=(), pole_held=False, lines=(), stuck=(),
+def constraints(n, m, end="pinned", S0_over_hs=0.0, held=(), pole_held=False, lines=(), stuck=(),
                  stuck_points=(), ties=()):
     """The reduced basis T (sparse, ndof x nfree) that imposes the pole (node 0) and end
     (node m-1) conditions: q = T q_free.  ``S0_over_hs``: S0 over the derivative dofs' scale
@@ -335,22 +337,23 @@ def mesh(S0: float, L: float, elements: int, edges=()) -> np.ndarray:
     the grading the eigenvalues converged only like h)."""
     nodes = np.linspace(S0, L, elements + 1)
     h = nodes[1] - nodes[0]
-    extra = []
-    d = h * POLE_RATIO
-    while d > 4 * S0:
-        extra.append(S0 + d)
-        d *= POLE_RATIO
-    nodes = np.concatenate([nodes[:1], np.array(extra[::-1]), nodes[1:]])
     steps = h * 0.5 ** np.arange(1, EDGE_LEVELS + 1)
     for edge in edges:
         near = np.concatenate([edge - steps, [edge], edge + steps])
         near = near[(near > S0) & (near < L)]
-        far = nodes[(np.abs(nodes - edge) >= h / 2) | np.isin(nodes, edges)]  # uniform nodes closer than h/2 give way
+        # uniform nodes closer than h/2 give way, but not the mesh's start S0 (the pole's conditions are imposed there)
+        far = nodes[(np.abs(nodes - edge) >= h / 2) | np.isin(nodes, edges) | (nodes == S0)]
         nodes = np.unique(np.concatenate([far, near]))
-    return nodes
+    # the first element (uniform, or ending at an edge's nodes near the pole) split towards S0
+    extra = []
+    d = (nodes[1] - S0) * POLE_RATIO
+    while d > 4 * S0:
+        extra.append(S0 + d)
+        d *= POLE_RATIO
+    return np.unique(np.concatenate([nodes, extra]))
 
 
-def _held_nodes(nodes, intervals):
+def held_nodes(nodes, intervals):
     """The nodes on the tip: within one of the held S-intervals; of a corner's twin nodes at an
     interval's end only the one on the interval's side (the element it bounds lies inside)."""
     held = set()
@@ -395,6 +398,16 @@ def default_modes(scene) -> np.ndarray:
     return np.arange(0, int(math.ceil(1.3 * kc)) + 3)
 
 
+def checked_modes(scene) -> np.ndarray:
+    """The modes :func:`shellbvp.stability` checks unless told: :func:`default_modes`, without
+    n = 1 for a closed shell -- between frictionless plates it slides sideways and turns at no
+    cost, on a substrate under a curved tip it slips out sideways (negative at every depth) or
+    rolls in place (zero): rigid motions of the frictionless model, not buckling
+    (:mod:`shellbvp.modal_stability.closed`)."""
+    modes = default_modes(scene)
+    return modes[modes != 1] if scene.closed else modes
+
+
 #: Seconds per unknown (summed over the modes) of a state's analysis, measured on the inflated
 #: hemisphere: 3.7 s for 250 elements x 59 modes (beta 1e-6), 10 s for 445 x 101 (1e-7).
 _SECONDS_PER_DOF = 4e-5
@@ -407,7 +420,7 @@ def stability_size(scene, modes=None, elements=None) -> tuple:
     cost grows like 1/sqrt(beta).  Negative eigenvalues are recomputed on finer meshes on top."""
     ne = int(elements or default_elements(scene))
     nm = len(default_modes(scene)) if modes is None else len(set(int(n) for n in modes))
-    dofs = 6 * (ne + 1) * nm
+    dofs = 6 * (ne + 1) * nm * (2 if scene.two_contacts else 1)  # a closed shell on a substrate: two halves
     return ne, nm, dofs, _SECONDS_PER_DOF * dofs
 
 
@@ -468,7 +481,7 @@ def spectrum(scene, base_of, S0, L, modes=None, *, elements=None, count=2, vecto
     held, pole_held, lines, ties, stuck, stuck_points = (), False, (), [], (), ()
     if contact is not None:
         pole_held = contact.pole_held
-        held = _held_nodes(nodes, contact.held)
+        held = held_nodes(nodes, contact.held)
         lines = tuple(int(np.flatnonzero(nodes == S)[0]) for S in contact.lines)
         ties = [t for c in contact.corners for t in corner_ties(c, int(np.flatnonzero(nodes == c.S)[0]), hs)]
         if contact.friction == "sticking":
@@ -480,11 +493,11 @@ def spectrum(scene, base_of, S0, L, modes=None, *, elements=None, count=2, vecto
     vecs = {}
     for k, n in enumerate(modes):
         K, M = stiffness(scene, base_of, int(n), nodes, contact)
-        T = _constraints(int(n), nodes.size, end, nodes[0] / hs, held, pole_held, lines, stuck=stuck,
+        T = constraints(int(n), nodes.size, end, nodes[0] / hs, held, pole_held, lines, stuck=stuck,
                          stuck_points=stuck_points, ties=ties)
         Kr, Mr = (T.T @ K @ T).tocsr(), (T.T @ M @ T).tocsr()
         Kr = ((Kr + Kr.T) / 2).tocsr()
-        lam, X = _smallest(Kr, Mr, count)
+        lam, X = smallest_pairs(Kr, Mr, count)
         out[k] = lam
         if vectors:
             q = (T @ X[:, 0]).reshape(-1, 6)

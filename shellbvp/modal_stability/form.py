@@ -115,8 +115,9 @@ def reference_shell(scene, S):
 PROFILE_STEP = 1e-6
 
 
-def chain_base(state):
-    """The base state of any chain of regions as a function of S: ``phi, ls, ks, dls, dks, lt``,
+def chain_base(state, regions=None):
+    """The base state of any chain of regions (``regions``: their indices, a closed shell's half
+    running from its own pole; default all) as a function of S: ``phi, ls, ks, dls, dks, lt``,
     the contact pressure ``P`` (0 in free regions) and the meridional moment ``Ms``, from each region's generated profile
     (``*_profile``, as ``Solution.profile`` reads them) on the state's interpolant; ``dls, dks``
     are the interpolant's derivatives where they are states of the region (``ls`` always,
@@ -128,14 +129,16 @@ def chain_base(state):
     dsol = state.sol.derivative()
     kernels = sysm.kernels.active
     par = sysm.par_at(p)
-    edges = [float(sysm.S_point(reg.end, p)) for reg in sysm.regions[:-1]]
+    regions = list(range(len(sysm.regions))) if regions is None else list(regions)
+    edges = [float(sysm.S_point(sysm.regions[k].end, p)) for k in regions[:-1]]
 
     def base(S):
         S = np.asarray(S, float)
         out = {k: np.empty_like(S) for k in ("phi", "ls", "ks", "dls", "dks", "lt", "P", "Ms")}
         which = np.searchsorted(edges, S, side="right")
-        for k, reg in enumerate(sysm.regions):
-            sel = which == k
+        for i, k in enumerate(regions):
+            reg = sysm.regions[k]
+            sel = which == i
             if not np.any(sel):
                 continue
             Sk = S[sel]
