@@ -145,6 +145,16 @@ def test_a_closed_shell_on_a_substrate_is_solved_cold_at_a_force():
         sb.solve(scene, lambda0=1.01)
 
 
+def test_a_closed_shells_profile_keeps_the_substrate_where_it_is():
+    s = sb.solve(on_substrate(), delta=0.2, estimate_error=False)
+    f = s.profile()
+    on_plane = f["region"] == 3
+    assert on_plane.any() and np.ptp(f["z"][on_plane]) < 1e-12
+    edge = np.nonzero(np.diff(on_plane.astype(int)) == -1)[0][0]  # the plane's edge, then the lower free shell
+    assert f["S"][edge] == pytest.approx(f["S"][edge + 1], abs=1e-12)
+    assert f["z"][edge] == pytest.approx(f["z"][edge + 1], abs=1e-9)  # was off by delta
+
+
 def test_a_closed_spheres_convexity_is_its_upper_halfs_the_dome():
     from shellbvp.convexity import convexity_limits
 
