@@ -89,8 +89,8 @@ def test_presets_lists_all():
     (["fit", "--example", "--radius", "0mm"], ["--radius", "> 0"]),
     (["curve", "--radius", "0.3mm", "--muH", "52N", "-o", "x.h5"], ["--muH", "unknown mu_H unit", "N/m"]),
 ])
-def test_bad_input_exits_with_one_line_message(tmp_path, args, words):
-    r = run(*args, cwd=tmp_path)
+def test_bad_input_exits_with_one_line_message(tmp_path, cli_main, args, words):
+    r = cli_main(*args, cwd=tmp_path)  # in this process: the same checks (the entry point: the tests around)
     assert r.returncode == 2, (r.stdout, r.stderr)
     lines = r.stderr.strip().splitlines()
     assert len(lines) == 1 and "Traceback" not in r.stderr, r.stderr

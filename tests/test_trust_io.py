@@ -145,11 +145,11 @@ def test_solve_with_a_point_load_guess_starts_cold():
     ("", ["empty"]),
     ("in.h5/x.h5", ["in.h5", "not a directory"]),
 ])
-def test_bad_output_paths_are_refused_before_any_work(tmp_path, command, output, words):
+def test_bad_output_paths_are_refused_before_any_work(tmp_path, cli_main, command, output, words):
     (tmp_path / "sub").mkdir()
     (tmp_path / "in.h5").write_bytes(b"")  # plot would fail on reading it: the path is checked first
     t0 = time.perf_counter()
-    r = run(*command, "-o", output, cwd=tmp_path)
+    r = cli_main(*command, "-o", output, cwd=tmp_path)  # in this process: the command's own checks
     one_line_error(r, *words)
     assert time.perf_counter() - t0 < 20  # import only: no curve, no fit
     assert sorted(p.name for p in tmp_path.iterdir()) == ["in.h5", "sub"]  # nothing left behind
