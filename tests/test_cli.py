@@ -98,12 +98,12 @@ def test_bad_input_exits_with_one_line_message(tmp_path, cli_main, args, words):
         assert w in lines[0], lines[0]
 
 
-def test_info_rejects_foreign_and_corrupt_files(tmp_path):
+def test_info_rejects_foreign_and_corrupt_files(tmp_path, cli_main):
     with h5py.File(tmp_path / "foreign.h5", "w") as f:
         f["x"] = [1]
     (tmp_path / "corrupt.h5").write_bytes(b"not hdf5 at all")
     for name in ("foreign.h5", "corrupt.h5"):
-        r = run("info", name, cwd=tmp_path)
+        r = cli_main("info", name, cwd=tmp_path)  # in this process
         assert r.returncode == 2 and name in r.stderr and "Traceback" not in r.stderr
 
 

@@ -95,9 +95,8 @@ def test_fit_shape_parameter_options_are_validated():
     (["--fit-alpha", "--gent-jm", "1"], "Mooney-Rivlin"),
     (["--weights", "poisson"], "invalid choice"),
 ])
-def test_fit_cli_shape_options_errors(argv, match):
-    r = subprocess.run([sys.executable, "-m", "shellbvp", "fit", "--example", "--preset", "fit", "--radius", "0.3mm",
-                        *argv], capture_output=True, text=True, env=dict(os.environ), timeout=600)
+def test_fit_cli_shape_options_errors(cli_main, argv, match):
+    r = cli_main("fit", "--example", "--preset", "fit", "--radius", "0.3mm", *argv)  # in this process
     assert r.returncode == 2 and match in r.stderr, r.stderr
     assert len(r.stderr.strip().splitlines()) == 1
 

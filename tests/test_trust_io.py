@@ -181,7 +181,8 @@ def test_check_output_path_api(tmp_path):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["a.h5"]  # the write probe is removed
 
 
-def test_points_and_delta_max_limits_on_the_command_line(tmp_path):
+def test_points_and_delta_max_limits_on_the_command_line(tmp_path, cli_main):
+    run = cli_main  # in this process: the command's own checks
     one_line_error(run("curve", "--points", "1000000000", "-o", "p.h5", cwd=tmp_path), "--points", "[2, 100000]")
     one_line_error(run("curve", "--delta-max", "1e-300", "-o", "p.h5", cwd=tmp_path), "delta_max = 1e-300",
                    "[1e-06, 2.927]")
@@ -344,8 +345,10 @@ def test_read_curve_names_what_is_wrong_with_a_tampered_file(tmp_path, good_file
     assert text.startswith(f"{path}: ") and message in text and "\n" not in text, text
 
 
-def test_info_answers_every_tampered_file_in_one_line(tmp_path, good_file):
+def test_info_answers_every_tampered_file_in_one_line(tmp_path, good_file, cli_main):
     import shutil
+
+    run = cli_main  # in this process: info's own reading and one-line answers
 
     import h5py
 
