@@ -193,7 +193,8 @@ def test_header_in_kN_on_data_in_mN(good, tmp_path):
 
 
 # -- CLI: exit status, warnings, one JSON document -------------------------------------------------
-def test_cli_failed_fit_exits_1_with_json(good, tmp_path):
+def test_cli_failed_fit_exits_1_with_json(good, tmp_path, cli_main):
+    run = cli_main  # the command's main in this process
     scene, disp, F, _ = good
     p = write_csv(tmp_path / "undetermined.csv", disp, _undetermined(F))
     r = run("fit", str(p), "--preset", "fit", "--radius", "0.3mm", "--json", "-o", str(tmp_path / "x.h5"))
@@ -205,7 +206,8 @@ def test_cli_failed_fit_exits_1_with_json(good, tmp_path):
     assert r.returncode == 1 and "fit failed (status 5)" in r.stdout
 
 
-def test_cli_warnings_in_text_json_and_saved_file(good, tmp_path):
+def test_cli_warnings_in_text_json_and_saved_file(good, tmp_path, cli_main):
+    run = cli_main  # in this process
     scene, disp, F, _ = good
     step = np.where(disp > disp.mean(), F.max(), 0.02 * F.max())
     p = write_csv(tmp_path / "step.csv", disp, step)
