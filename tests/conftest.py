@@ -80,3 +80,27 @@ def closed_form(monkeypatch):
         return FakeCurve(scene, deltas)
 
     monkeypatch.setattr(shellbvp.fitting.curves, "_model_curve", fake)
+
+
+@pytest.fixture
+def cli_main(monkeypatch, capsys):
+    """``cli_main(*args, cwd=None)``: the command line's ``main`` run in this process, answered as
+    ``subprocess.run`` would (returncode, stdout, stderr).  The same parsing, checks and one-line
+    errors as ``python -m shellbvp``, without an interpreter's start (~1 s of CPU each); the tests
+    that run the command as a user does (tests/test_cli.py's ``run``) keep the entry point covered."""
+    import subprocess
+
+    from shellbvp.cli import main
+
+    def run(*args, cwd=None):
+        if cwd is not None:
+            monkeypatch.chdir(cwd)
+        capsys.readouterr()
+        try:
+            code = main(list(args))
+        except SystemExit as exc:  # the parser's own exits (--help, usage errors)
+            code = exc.code if isinstance(exc.code, int) else 0 if exc.code is None else 1
+        out, err = capsys.readouterr()
+        return subprocess.CompletedProcess(["shellbvp", *args], code or 0, out, err)
+
+    return run

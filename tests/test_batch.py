@@ -99,7 +99,8 @@ def test_the_model_curve_is_computed_once_for_the_batch(folder, monkeypatch):
     assert "cannot read" in rows[3].message
 
 
-def test_batch_outputs_are_checked_before_any_fit(folder):
+def test_batch_outputs_are_checked_before_any_fit(folder, cli_main):
+    run = cli_main  # the command's main in this process
     (folder / "taken.csv").write_text("x")
     r = run("fit", "data", "--preset", "fit", "--radius", "0.3mm", "--table", "taken.csv", cwd=folder)
     assert r.returncode == 2 and "exists" in r.stderr

@@ -47,7 +47,8 @@ def test_curve_with_options_and_points(tmp_path):
         assert len(g["delta"]) == 4 and "force_N" in g and g.attrs["R_L_m"] == 0.001
 
 
-def test_solve_prints_state_and_json(tmp_path):
+def test_solve_prints_state_and_json(tmp_path, cli_main):
+    run = cli_main  # the command's main in this process (python -m shellbvp: the tests above)
     r = run("solve", "--preset", "base", "--delta", "0.2", "--json")
     assert r.returncode == 0, r.stderr
     out = json.loads(r.stdout)
@@ -89,8 +90,8 @@ def test_presets_lists_all():
     (["fit", "--example", "--radius", "0mm"], ["--radius", "> 0"]),
     (["curve", "--radius", "0.3mm", "--muH", "52N", "-o", "x.h5"], ["--muH", "unknown mu_H unit", "N/m"]),
 ])
-def test_bad_input_exits_with_one_line_message(tmp_path, args, words):
-    r = run(*args, cwd=tmp_path)
+def test_bad_input_exits_with_one_line_message(tmp_path, cli_main, args, words):
+    r = cli_main(*args, cwd=tmp_path)  # in this process: the same checks (the entry point: the tests around)
     assert r.returncode == 2, (r.stdout, r.stderr)
     lines = r.stderr.strip().splitlines()
     assert len(lines) == 1 and "Traceback" not in r.stderr, r.stderr
@@ -98,12 +99,12 @@ def test_bad_input_exits_with_one_line_message(tmp_path, args, words):
         assert w in lines[0], lines[0]
 
 
-def test_info_rejects_foreign_and_corrupt_files(tmp_path):
+def test_info_rejects_foreign_and_corrupt_files(tmp_path, cli_main):
     with h5py.File(tmp_path / "foreign.h5", "w") as f:
         f["x"] = [1]
     (tmp_path / "corrupt.h5").write_bytes(b"not hdf5 at all")
     for name in ("foreign.h5", "corrupt.h5"):
-        r = run("info", name, cwd=tmp_path)
+        r = cli_main("info", name, cwd=tmp_path)  # in this process
         assert r.returncode == 2 and name in r.stderr and "Traceback" not in r.stderr
 
 
@@ -222,10 +223,11 @@ def test_every_option_has_help():
     assert bare == []
 
 
-def test_depths_and_forces_in_lab_units_are_made_nondimensional_by_the_scales(tmp_path):
+def test_depths_and_forces_in_lab_units_are_made_nondimensional_by_the_scales(tmp_path, cli_main):
     """``solve --delta 60um``, ``--force 5.7mN`` and ``curve --delta-max 60um`` with --radius
     (and --muH for a force) are the model's delta = 60 um / R_L and F = F / (mu H R_L); without
     the scales, a one-line error names what is missing."""
+    run = cli_main  # in this process
     r = run("solve", "--preset", "base", "--delta", "60um", "--radius", "0.3mm", "--muH", "52N/m", "--json")
     assert r.returncode == 0, r.stderr
     assert json.loads(r.stdout)["delta"] == pytest.approx(0.2, rel=1e-12)
@@ -241,9 +243,10 @@ def test_depths_and_forces_in_lab_units_are_made_nondimensional_by_the_scales(tm
     assert sb.read_curve(out).delta[-1] == pytest.approx(0.2, rel=1e-9)
 
 
-def test_validate_takes_its_depth_in_lab_units_with_the_rim_radius(tmp_path):
+def test_validate_takes_its_depth_in_lab_units_with_the_rim_radius(tmp_path, cli_main):
     """validate --delta-max 1mm with --radius 0.3mm is 3.33 rim radii: refused by its range, in
     rim radii, before the 3D model is built; without --radius the unit is refused by name."""
+    run = cli_main  # in this process
     r = run("validate", "--thickness", "0.05", "--delta-max", "1mm", "--radius", "0.3mm", cwd=tmp_path)
     assert r.returncode == 2 and "--delta-max must be in (0, 2]; got 3.33333" in r.stderr, r.stderr
     r = run("validate", "--thickness", "0.05", "--delta-max", "100um", cwd=tmp_path)

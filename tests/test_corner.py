@@ -205,7 +205,7 @@ def test_the_corner_is_seeded_along_the_null_direction_where_no_other_root_is_fo
     from shellbvp.state import cross_convexity_limit
 
     scene = sb.Scene.preset("base", gamma=0.0)
-    prev2 = sb.solve(scene, delta=0.675, estimate_error=False)
+    prev2 = sb.curve(scene, deltas=[0.4, 0.675], estimate_error=False).solutions[-1]  # a cold solve there: 9 s
     prev = sb.solve(scene, delta=0.7008, guess=prev2, estimate_error=False)
     assert prev2.success and prev.success and prev.contact_edge == "smooth"
     direction = edge_null_jump(prev)

@@ -108,19 +108,14 @@ def test_assess_of_an_empty_curve_is_harmless():
     assert c.first_instability is None and len(c.points["stability_min"]) == 0
 
 
-def test_cli_curve_stability_option(tmp_path):
-    import subprocess
-    import sys
-
-    r = subprocess.run([sys.executable, "-m", "shellbvp", "curve", "--preset", "flat", "--beta", "0.02", "--contact",
-                        "paper", "--points", "2", "--delta-max", "0.2", "--stability", "points", "-o", "s.h5"],
-                       capture_output=True, text=True, cwd=tmp_path, timeout=600)
+def test_cli_curve_stability_option(tmp_path, cli_main):
+    r = cli_main("curve", "--preset", "flat", "--beta", "0.02", "--contact", "paper", "--points", "2",
+                 "--delta-max", "0.2", "--stability", "points", "-o", "s.h5", cwd=tmp_path)  # in this process
     assert r.returncode == 0, r.stderr
     assert "stability not computed where:" in r.stdout
     c = sb.read_curve(tmp_path / "s.h5")
     assert c.settings["stability"] == "points" and np.all(np.isnan(c.points["stability_min"]))
-    bad = subprocess.run([sys.executable, "-m", "shellbvp", "curve", "--stability", "maybe"], capture_output=True,
-                         text=True, cwd=tmp_path, timeout=600)
+    bad = cli_main("curve", "--stability", "maybe", cwd=tmp_path)
     assert bad.returncode == 2 and "--stability" in bad.stderr
 
 
@@ -211,13 +206,11 @@ def test_a_fit_past_the_first_instability_warns_and_records_it(tmp_path):
     assert shallow.mu_H == pytest.approx(mu_H, rel=1e-3)
 
 
-def test_cli_fit_stability_option(tmp_path):
+def test_cli_fit_stability_option(tmp_path, cli_main):
     import json
-    import subprocess
-    import sys
 
-    r = subprocess.run([sys.executable, "-m", "shellbvp", "fit", "--example", "--preset", "fit", "--radius", "0.3mm",
-                        "--stability", "--json"], capture_output=True, text=True, cwd=tmp_path, timeout=600)
+    r = cli_main("fit", "--example", "--preset", "fit", "--radius", "0.3mm", "--stability", "--json",
+                 cwd=tmp_path)  # in this process
     assert r.returncode == 0, r.stderr
     out = json.loads(r.stdout)
     # the example's depths stay on the stable branch (benchmarks/results/stability_modes.md: preset fit)

@@ -95,9 +95,8 @@ def test_fit_shape_parameter_options_are_validated():
     (["--fit-alpha", "--gent-jm", "1"], "Mooney-Rivlin"),
     (["--weights", "poisson"], "invalid choice"),
 ])
-def test_fit_cli_shape_options_errors(argv, match):
-    r = subprocess.run([sys.executable, "-m", "shellbvp", "fit", "--example", "--preset", "fit", "--radius", "0.3mm",
-                        *argv], capture_output=True, text=True, env=dict(os.environ), timeout=600)
+def test_fit_cli_shape_options_errors(cli_main, argv, match):
+    r = cli_main("fit", "--example", "--preset", "fit", "--radius", "0.3mm", *argv)  # in this process
     assert r.returncode == 2 and match in r.stderr, r.stderr
     assert len(r.stderr.strip().splitlines()) == 1
 
@@ -244,16 +243,14 @@ def test_fit_cli_with_csv(model, tmp_path):
     assert rec.scene == sb.Scene.preset("fit") and rec.parameters["mu_H"] == pytest.approx(out["mu_H"], rel=1e-12)
 
 
-def test_plots_headless_produce_png(model, tmp_path):
+def test_plots_headless_produce_png(model, tmp_path, cli_main):
     pytest.importorskip("matplotlib")
     from shellbvp.plotting import plot_fit, require_matplotlib
 
     scene, c = model
     c.to_hdf5(tmp_path / "m.h5")
     out = tmp_path / "fig.png"
-    r = subprocess.run([sys.executable, "-m", "shellbvp", "plot", str(tmp_path / "m.h5"), "-o", str(out),
-                        "--profiles", "0.1,0.3"], capture_output=True, text=True, env=dict(os.environ),
-                       timeout=600)
+    r = cli_main("plot", str(tmp_path / "m.h5"), "-o", str(out), "--profiles", "0.1,0.3")  # in this process
     assert r.returncode == 0, r.stderr
     assert out.stat().st_size > 10_000 and out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     disp, force = synthetic(model, 30, seed=9)
@@ -265,9 +262,8 @@ def test_plots_headless_produce_png(model, tmp_path):
     assert (tmp_path / "fit.png").stat().st_size > 10_000
 
 
-def test_fit_example_shipped_with_the_package():
-    r = subprocess.run([sys.executable, "-m", "shellbvp", "fit", "--example", "--preset", "fit", "--radius",
-                        "0.3mm", "--json"], capture_output=True, text=True, env=dict(os.environ), timeout=600)
+def test_fit_example_shipped_with_the_package(cli_main):
+    r = cli_main("fit", "--example", "--preset", "fit", "--radius", "0.3mm", "--json")  # in this process
     assert r.returncode == 0, r.stderr
     out = json.loads(r.stdout)
     assert out["mu_H_ci95"][0] < 52.0 < out["mu_H_ci95"][1]

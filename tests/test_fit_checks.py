@@ -193,7 +193,8 @@ def test_header_in_kN_on_data_in_mN(good, tmp_path):
 
 
 # -- CLI: exit status, warnings, one JSON document -------------------------------------------------
-def test_cli_failed_fit_exits_1_with_json(good, tmp_path):
+def test_cli_failed_fit_exits_1_with_json(good, tmp_path, cli_main):
+    run = cli_main  # the command's main in this process
     scene, disp, F, _ = good
     p = write_csv(tmp_path / "undetermined.csv", disp, _undetermined(F))
     r = run("fit", str(p), "--preset", "fit", "--radius", "0.3mm", "--json", "-o", str(tmp_path / "x.h5"))
@@ -205,7 +206,8 @@ def test_cli_failed_fit_exits_1_with_json(good, tmp_path):
     assert r.returncode == 1 and "fit failed (status 5)" in r.stdout
 
 
-def test_cli_warnings_in_text_json_and_saved_file(good, tmp_path):
+def test_cli_warnings_in_text_json_and_saved_file(good, tmp_path, cli_main):
+    run = cli_main  # in this process
     scene, disp, F, _ = good
     step = np.where(disp > disp.mean(), F.max(), 0.02 * F.max())
     p = write_csv(tmp_path / "step.csv", disp, step)
@@ -232,13 +234,13 @@ def test_cli_warnings_in_text_json_and_saved_file(good, tmp_path):
     ("noise.csv", lambda d, F: np.abs(np.random.default_rng(1).normal(0.5e-3, 0.3e-3, d.size)), ["increase"]),
     ("nm.csv", None, ["shallowest depth", "--radius"]),
 ])
-def test_cli_bad_data_exit_2_with_one_line_and_one_json(good, tmp_path, name, make, words):
+def test_cli_bad_data_exit_2_with_one_line_and_one_json(good, tmp_path, cli_main, name, make, words):
     scene, disp, F, force = good
     if make is None:  # nm-scale depths against a 0.3 mm rim
         p = write_csv(tmp_path / name, disp * 1e3, force, "displacement (nm),force (mN)")  # 1e-3 x the depths
     else:
         p = write_csv(tmp_path / name, disp, make(disp, F))
-    r = run("fit", str(p), "--preset", "fit", "--radius", "0.3mm", "--json")
+    r = cli_main("fit", str(p), "--preset", "fit", "--radius", "0.3mm", "--json")  # in this process
     assert r.returncode == 2 and "Traceback" not in r.stderr
     lines = r.stderr.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith("shellbvp: error: "), r.stderr
@@ -298,13 +300,13 @@ def test_line_numbers_count_comment_and_blank_lines(tmp_path):
         sb.read_force_csv(p)
 
 
-def test_cli_data_deeper_than_the_scene_allows(good, tmp_path):
+def test_cli_data_deeper_than_the_scene_allows(good, tmp_path, cli_main):
     """Data deeper than the scene's geometric bound (delta 4.69 for preset fit) exit 2 at once, one
     line, no traceback.  (Until the corner edge, the model curve of preset fit ended at its convexity
     limit, delta 1.56, and 8x deeper data failed there after ~40 s; it now reaches such data.)"""
     scene, disp, F, force = good
     p = write_csv(tmp_path / "deep.csv", 20 * disp, 20 * force)
-    r = run("fit", str(p), "--preset", "fit", "--radius", "0.3mm")
+    r = cli_main("fit", str(p), "--preset", "fit", "--radius", "0.3mm")  # in this process
     assert r.returncode == 2 and "Traceback" not in r.stderr, r.stderr
     assert "outside [" in r.stderr and "4.692" in r.stderr and len(r.stderr.strip().splitlines()) == 1
 

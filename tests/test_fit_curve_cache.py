@@ -5,6 +5,7 @@ on changes; a damaged file is ignored."""
 import json
 import subprocess
 import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -51,6 +52,8 @@ def test_another_process_reads_the_kept_curve(data, tmp_path):
             "r = sb.fit(sb.Scene.preset('base'), np.array(d), np.array(F), R_L=1e-3); "
             "print(r.curves_computed, repr(r.mu_H))")
     env = dict(__import__("os").environ, SHELLBVP_CACHE_DIR=str(tmp_path))
+    module = Path(sb.Scene.preset("base").model().__file__)  # the structure's code: not derived again there
+    (tmp_path / module.name).write_bytes(module.read_bytes())
     runs = [subprocess.run([sys.executable, "-c", code], input=json.dumps([list(d), list(F)]), capture_output=True,
                            text=True, env=env, timeout=600) for _ in range(2)]
     assert all(r.returncode == 0 for r in runs), runs[0].stderr

@@ -122,8 +122,9 @@ def test_every_file_the_package_writes_has_units_on_every_dataset(fit_file, tmp_
     assert missing_units(tmp_path / "bare.h5") == ["x"]
 
 
-def test_plot_and_report_of_a_fit_file(fit_file, tmp_path):
+def test_plot_and_report_of_a_fit_file(fit_file, tmp_path, cli_main):
     pytest.importorskip("matplotlib")
+    run = cli_main  # the commands' main in this process (the fit itself: the fixture's subprocess)
     path, _ = fit_file
     png = path.with_suffix(".png")  # written by fit --report
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and png.stat().st_size > 30_000
@@ -150,10 +151,11 @@ def test_plot_and_report_of_a_fit_file(fit_file, tmp_path):
     assert any(ln.startswith("rms residual = ") and f" {fu}; R_L = " in ln for ln in lines)
 
 
-def test_a_fit_file_is_not_replaced_without_force_and_a_corrupt_one_is_named(fit_file, instrument_file, tmp_path):
+def test_a_fit_file_is_not_replaced_without_force_and_a_corrupt_one_is_named(fit_file, instrument_file, tmp_path,
+                                                                             cli_main):
     path, _ = fit_file
     before = path.read_bytes()
-    r = run("fit", str(instrument_file), "--preset", "fit", "--radius", "0.3mm", "-o", str(path))
+    r = cli_main("fit", str(instrument_file), "--preset", "fit", "--radius", "0.3mm", "-o", str(path))
     assert r.returncode == 2 and "exists" in r.stderr and path.read_bytes() == before
     bad = tmp_path / "bad.h5"
     bad.write_bytes(before)

@@ -9,7 +9,6 @@ import importlib.util
 import json
 import logging
 import os
-import subprocess
 import sys
 from pathlib import Path
 
@@ -180,7 +179,7 @@ def tamper(src, dst, scene_dict):
 
 
 @pytest.mark.parametrize("where", ["material", "shell", "tip", "srepr"])
-def test_tampered_file_never_runs_its_payload(curve_file, tmp_path, where):
+def test_tampered_file_never_runs_its_payload(curve_file, tmp_path, cli_main, where):
     marker = tmp_path / "PWNED"
     payload = f"__import__('os').system('touch {marker}')"
     d = sb.read_curve(curve_file).scene.to_dict()
@@ -197,7 +196,7 @@ def test_tampered_file_never_runs_its_payload(curve_file, tmp_path, where):
     with pytest.raises(ValueError, match="not allowed"):
         sb.read_curve(bad)
     for cmd in (["info", str(bad)], ["plot", str(bad), "-o", str(tmp_path / "x.png")]):
-        r = subprocess.run([sys.executable, "-m", "shellbvp", *cmd], capture_output=True, text=True, timeout=300)
+        r = cli_main(*cmd)  # the command's main in this process: a payload run would leave the marker
         assert r.returncode == 2, (cmd, r.stdout, r.stderr)
         assert r.stderr.startswith("shellbvp: error:") and "Traceback" not in r.stderr and "not allowed" in r.stderr
     assert not marker.exists()

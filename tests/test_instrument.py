@@ -7,8 +7,6 @@ of 150 uN and 2 % noise: the truth is known.
 """
 
 import json
-import os
-import subprocess
 import sys
 
 import numpy as np
@@ -126,19 +124,16 @@ def test_linear_baseline_recovers_its_slope(truth, tmp_path):
     assert res.mu_H_ci95[0] < MU_H < res.mu_H_ci95[1] and abs(res.offset - D0) < 2e-6
 
 
-def test_cli_fits_the_loading_by_default_and_prints_the_data_units(truth, tmp_path):
+def test_cli_fits_the_loading_by_default_and_prints_the_data_units(truth, tmp_path, cli_main):
     _, t, d, f = truth
     path = write(tmp_path / "rec.txt", t, d, f, "tab")
-    env = dict(os.environ)
-    r = subprocess.run([sys.executable, "-m", "shellbvp", "fit", str(path), "--preset", "fit", "--radius", "0.3mm"],
-                       capture_output=True, text=True, env=env, timeout=600)
+    r = cli_main("fit", str(path), "--preset", "fit", "--radius", "0.3mm")  # in this process
     assert r.returncode == 0, r.stderr
     assert "fitted the loading segment" in r.stdout and "retraction 1" in r.stdout
     offset_line = next(ln for ln in r.stdout.splitlines() if ln.startswith("offset"))
     assert offset_line.split()[3] == "um" and abs(float(offset_line.split()[2]) - 25) < 2, offset_line
     assert any(ln.startswith("baseline") and "\u00b5N" in ln for ln in r.stdout.splitlines()), r.stdout
-    r = subprocess.run([sys.executable, "-m", "shellbvp", "fit", str(path), "--preset", "fit", "--radius", "0.3mm",
-                        "--json"], capture_output=True, text=True, env=env, timeout=600)
+    r = cli_main("fit", str(path), "--preset", "fit", "--radius", "0.3mm", "--json")
     out = json.loads(r.stdout)
     assert out["mu_H_ci95"][0] < MU_H < out["mu_H_ci95"][1] and out["baseline_model"] == "constant"
 

@@ -147,15 +147,8 @@ def test_energy_identity_through_the_switch_on_a_fine_grid():
     assert np.nanmax(np.abs(c.energy_residual)) < 5e-5
 
 
-def _cli(*args, cwd=None):
-    import subprocess
-    import sys
-
-    return subprocess.run([sys.executable, "-m", "shellbvp", *args], capture_output=True, text=True, cwd=cwd,
-                          timeout=600)
-
-
-def test_cli_reports_the_topology(tmp_path):
+def test_cli_reports_the_topology(tmp_path, cli_main):
+    _cli = cli_main  # the command's main in this process
     import json
 
     r = _cli("solve", "--preset", "dome", "--delta", "0.1", "--topology", "cap", "--json")

@@ -145,11 +145,11 @@ def test_solve_with_a_point_load_guess_starts_cold():
     ("", ["empty"]),
     ("in.h5/x.h5", ["in.h5", "not a directory"]),
 ])
-def test_bad_output_paths_are_refused_before_any_work(tmp_path, command, output, words):
+def test_bad_output_paths_are_refused_before_any_work(tmp_path, cli_main, command, output, words):
     (tmp_path / "sub").mkdir()
     (tmp_path / "in.h5").write_bytes(b"")  # plot would fail on reading it: the path is checked first
     t0 = time.perf_counter()
-    r = run(*command, "-o", output, cwd=tmp_path)
+    r = cli_main(*command, "-o", output, cwd=tmp_path)  # in this process: the command's own checks
     one_line_error(r, *words)
     assert time.perf_counter() - t0 < 20  # import only: no curve, no fit
     assert sorted(p.name for p in tmp_path.iterdir()) == ["in.h5", "sub"]  # nothing left behind
@@ -181,7 +181,8 @@ def test_check_output_path_api(tmp_path):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["a.h5"]  # the write probe is removed
 
 
-def test_points_and_delta_max_limits_on_the_command_line(tmp_path):
+def test_points_and_delta_max_limits_on_the_command_line(tmp_path, cli_main):
+    run = cli_main  # in this process: the command's own checks
     one_line_error(run("curve", "--points", "1000000000", "-o", "p.h5", cwd=tmp_path), "--points", "[2, 100000]")
     one_line_error(run("curve", "--delta-max", "1e-300", "-o", "p.h5", cwd=tmp_path), "delta_max = 1e-300",
                    "[1e-06, 2.927]")
@@ -344,8 +345,10 @@ def test_read_curve_names_what_is_wrong_with_a_tampered_file(tmp_path, good_file
     assert text.startswith(f"{path}: ") and message in text and "\n" not in text, text
 
 
-def test_info_answers_every_tampered_file_in_one_line(tmp_path, good_file):
+def test_info_answers_every_tampered_file_in_one_line(tmp_path, good_file, cli_main):
     import shutil
+
+    run = cli_main  # in this process: info's own reading and one-line answers
 
     import h5py
 
