@@ -211,6 +211,7 @@ RECORDS = {
     "fe_speed-old-alt.*": "fe_speed.py with other FE settings (--set), for comparison",
     "fe_speed-new-grow.*": "fe_speed.py with other FE settings (--set), for comparison",
     "fit_coverage-before.*": "fit_coverage.py --approach-only --tag before with another checkout's package",
+    "suite_cost.md": "the test suite's CPU per test (pytest with a local timing plugin over two full runs), written by hand",
 }
 
 #: What run.py itself writes into results/ (its summary of a run)
