@@ -56,7 +56,7 @@ def _crude_point_guess(sysm):
     return x, y
 
 
-def solve_point_load(scene, delta, *, tol=1e-6, max_nodes=10000, guess=None, bc_tol=1e-10):
+def solve_point_load(scene, delta, *, tol=1e-6, max_nodes=10000, guess=None, bc_tol=1e-10, march_up=True):
     """The point-load limit of the smooth model at pole displacement ``delta``.
 
     When the contact cap is exponentially small (``Sc`` below ~1e-30, which
@@ -67,14 +67,15 @@ def solve_point_load(scene, delta, *, tol=1e-6, max_nodes=10000, guess=None, bc_
 
     Started from ``guess`` (a cap or point-load state at a nearby depth) if given, else
     (or if that fails) from the undeformed shell, and where that fails too, from the
-    undeformed shell at a smaller depth, continued in delta (:func:`_from_smaller_depth`).
+    undeformed shell at a smaller depth, continued in delta (:func:`_from_smaller_depth`;
+    ``march_up=False``: not, for a caller with cheaper routes left to try first).
     """
     t0 = time.perf_counter()
     kw = dict(tol=tol, max_nodes=max_nodes, bc_tol=bc_tol)
     res = _point_run(scene, delta, guess, **(kw if guess is not None else _crude(kw)))
     if guess is not None and not res.success:  # e.g. a cap of 1e-30 whose free region is no start
         res = _point_run(scene, delta, None, **_crude(kw))
-    if not res.success:
+    if not res.success and march_up:
         res = _from_smaller_depth(scene, delta, **kw) or res
     return res.with_(wall_time=time.perf_counter() - t0)
 

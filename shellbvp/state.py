@@ -366,10 +366,12 @@ def _tighten(sysm, res, **kw):
 def _cold_delta(sysm, delta, near_point=None, **kw):
     """Crude guesses at a few cap sizes; then (smooth model) the point-load limit, or a cap
     grown from it; then continuation in delta from a moderate depth.  From ``near_point``
-    (a point-load state at another depth) the point-load limit is tried first."""
+    (a point-load state at another depth) the point-load limit is tried first, from it and
+    the undeformed shell only: the march up from a smaller depth (seconds) comes after the
+    crude caps (milliseconds where they converge)."""
     point_route = sysm.scene.contact_model.point_load_limit
     if point_route and near_point is not None:
-        res = _point_route(sysm, delta, near_point, **kw)
+        res = _point_route(sysm, delta, near_point, march_up=False, **kw)
         if res is not None:
             return res
     best = None
@@ -398,7 +400,7 @@ _SC_FROM_POINT = (1e-6, 1e-3)
 _POINT_CLEARANCE = 1e-12
 
 
-def _point_route(sysm, delta, near_point=None, **kw):
+def _point_route(sysm, delta, near_point=None, *, march_up=True, **kw):
     """The point-load limit at ``delta`` where the crude caps fail, or a cap grown from it;
     None if it does not converge or the free shell passes through the tip.
 
@@ -417,7 +419,7 @@ def _point_route(sysm, delta, near_point=None, **kw):
     """
     scene = sysm.scene
     pkw = dict(tol=kw["tol"], max_nodes=kw["max_nodes"], bc_tol=kw["bc_tol"])
-    point = solve_point_load(scene, delta, guess=near_point, **pkw)
+    point = solve_point_load(scene, delta, guess=near_point, march_up=march_up, **pkw)
     if not point.success:
         return None
     touching = point.valid and point.penetration <= _POINT_CLEARANCE
