@@ -34,8 +34,14 @@ _Z = 5  # z in a free region's states
 
 
 def symmetric_scenes(scene):
-    """The shell squeezed between two of its tips, and between two plates."""
-    return scene.replace(support="plates"), scene.replace(support="plates", tip=FlatTip())
+    """The shell squeezed between two of its tips, and between two plates: of a shell whose
+    halves differ (``UserShell.closed_halves``) its upper half (mirrored) between two tips and its
+    lower half (mirrored) between plates."""
+    lower = getattr(scene.shell, "lower", None)
+    if lower is None:
+        return scene.replace(support="plates"), scene.replace(support="plates", tip=FlatTip())
+    return (scene.replace(support="plates", shell=scene.shell.upper_half()),
+            scene.replace(support="plates", tip=FlatTip(), shell=lower))
 
 
 def _half(state):

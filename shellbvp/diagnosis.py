@@ -39,9 +39,11 @@ def _edges(sysm):
     return out
 
 
-def _at(sysm, kind, S, y):
-    """The generated profile of a ``kind`` region at one point S with state y (kernel set's)."""
-    return getattr(sysm.kernels.active, f"{kind}_profile")(np.array([S], dtype=float), y[:, None], sysm.par)
+def _at(sysm, k, kind, S, y):
+    """The generated profile of a ``kind`` region at one point S with state y (the kernel set of
+    region ``k``'s half)."""
+    return getattr(sysm.region_kernels[k].active, f"{kind}_profile")(np.array([S], dtype=float), y[:, None],
+                                                                      sysm.par)
 
 
 def _shear_delta(sysm, parts, edges, ends):
@@ -63,7 +65,7 @@ def _legendre_min(sysm, t, y, p):
         if reg.kind != "free":
             continue
         S = sysm.S(k, t, p)
-        det = sysm.kernels.active.free_legendre(S, y[sysm.rows(k)], sysm.par)[0]
+        det = sysm.region_kernels[k].active.free_legendre(S, y[sysm.rows(k)], sysm.par)[0]
         scale = _median(np.abs(det))
         if not scale > 0:
             continue
@@ -170,7 +172,8 @@ def diagnose(sysm, bvp, tol, converged_note: str = "", result: type = Solution) 
         flags.append("non-finite state")
     elif bvp.status == 0:
         for half in _halves(sysm):  # each half of a closed shell on a substrate from its own pole
-            bounds = [sysm.S_point(sysm.regions[k].start, p) for k in half] + [sysm.L]
+            bounds = [sysm.S_point(sysm.regions[k].start, p) for k in half]
+            bounds.append(sysm.S_point(sysm.regions[half[-1]].end, p))
             if not (bounds[0] > 0 and np.all(np.diff(bounds) > 0)):
                 flags.append("region boundaries not ordered inside (0, L): " + ", ".join(f"{b:.3g}" for b in bounds))
         stretches = [bvp.y[sysm.offsets[k] + (_LS if r.kind == "free" else 1)] for k, r in enumerate(sysm.regions)]
@@ -210,12 +213,13 @@ def diagnose(sysm, bvp, tol, converged_note: str = "", result: type = Solution) 
         defect = max(defect, float(np.max(np.abs(G - ref))))
     res["force_defect"] = defect
     below = set(_halves(sysm)[1]) if len(_halves(sysm)) > 1 else set()  # the half on the substrate
-    res["penetration"] = through = max(float(np.max(f["z"])) - sysm.pole_height if k in below
+    res["penetration"] = through = max(float(np.max(f["z"])) - sysm.half_pole_height(k) if k in below
                                        else penetration(sysm, f["r"], f["z"], z_tip) for k, f in free)
     res["wall_gap"] = min(wall_gap(sysm, f["r"], f["z"], z_tip) for k, f in free if k not in below)
     last = len(sysm.regions) - 1
     t_leg = np.array([0.0, 0.5])
-    leg = sysm.kernels.active.free_legendre(sysm.S(last, t_leg, p), bvp.sol(t_leg)[sysm.rows(last)], par)[0]
+    leg = sysm.region_kernels[last].active.free_legendre(sysm.S(last, t_leg, p), bvp.sol(t_leg)[sysm.rows(last)],
+                                                        par)[0]
     res["edge_legendre"] = float(leg[0] / leg[1]) if leg[1] != 0 else nan
     res["legendre_min"], res["legendre_min_S"] = legendre = _legendre_min(sysm, t, y_t, p)
     res["contact_edge"] = _edge_model(sysm)
@@ -269,7 +273,7 @@ def diagnose(sysm, bvp, tol, converged_note: str = "", result: type = Solution) 
             # (else it passes through it next to the line: the contact is a band)
             S = sysm.S_point(sysm.regions[j.k].end, p)
             yin = yb[sysm.rows(j.k)]
-            on = _at(sysm, j.on, S, np.array([q[j.chi], yin[_LS]]))
+            on = _at(sysm, j.k, j.on, S, np.array([q[j.chi], yin[_LS]]))
             res["curvature_excess"] = excess = float(yin[FREE_STATES.index("ks")] - on["kappa_s"][0])
             if excess > 10 * tol * max(1.0, abs(float(on["kappa_s"][0]))):
                 vflags.append(f"the shell bends more tightly than the indenter at the contact line "

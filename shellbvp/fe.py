@@ -294,8 +294,12 @@ def check_solid_scene(scene):
     """ValueError, in one line, where the scene has no solid (before any work): a material
     without a 3D form.  Every shell the solid holds -- rimmed, or closed between plates or on a
     substrate, open, under a pressure or sealed -- is also a fitting model (``fit --model
-    solid``): its curve at the indenters' approach (``at="indenter"``) is what a fit reads."""
+    solid``): its curve at the indenters' approach (``at="indenter"``) is what a fit reads.
+    A closed shell whose halves differ has none yet (the solid mirrors the upper half)."""
     _check_material(scene)
+    if getattr(scene.shell, "lower", None) is not None:
+        raise ValueError("shell: the 3D solid of a closed shell whose halves differ (UserShell.closed_halves) is not "
+                         "offered yet; it mirrors the upper half (give UserShell(R, Z, L) for a symmetric one)")
 
 
 def _check_profile(scene, eps):

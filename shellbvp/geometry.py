@@ -158,10 +158,53 @@ class UserShell:
             raise ValueError(f"shell: the pole curvature kappa_theta(0) must be finite; got {pole_kt}")
         self._pole_kt = float(pole_kt)
         self._closed_problem = ...  # not asked yet (closed_problem)
+        self.lower = None  # a closed shell's lower half, where it differs (closed_halves)
+
+    @classmethod
+    def closed_halves(cls, upper, lower, *, legacy_srepr: bool = False) -> "UserShell":
+        """A closed shell whose halves differ (an egg): each half's meridian ``(R, Z, L)`` from its
+        own pole to the equator, as :meth:`closed_problem` asks of an upper half (rescaled so the
+        equator is ``R = 1``, ``Z = 0``): the lower half in its mirror image, ``Z > 0`` above the
+        equator meaning below it.  For ``Scene(closed=True)`` on a substrate under a curved tip
+        (both halves solved); between plates the mirror symmetry is needed.
+
+        >>> import shellbvp as sb
+        >>> egg = sb.UserShell.closed_halves(("sin(S)", "1.3*cos(S)", "pi/2"), ("sin(S)", "0.7*cos(S)", "pi/2"))
+        >>> egg.lower.pole_curvature({})
+        -0.7
+        """
+        for name, half in (("upper", upper), ("lower", lower)):
+            if not (isinstance(half, (tuple, list)) and len(half) == 3 and all(isinstance(t, str) for t in half)):
+                raise ValueError(f"shell: closed_halves' {name} half must be its meridian's (R, Z, L) as three "
+                                 f"texts; got {half!r}")
+        shell, other = cls(*upper, legacy_srepr=legacy_srepr), cls(*lower, legacy_srepr=legacy_srepr)
+        shell._upper, shell.lower = cls(*upper, legacy_srepr=legacy_srepr), other
+        shell._desc["lower"] = {k: other._desc[k] for k in "RZL"}
+        return shell
+
+    def halves_problem(self, scene) -> str | None:
+        """Why ``scene`` cannot take this shell's lower half of its own (yet), or None."""
+        if self.lower is None:
+            return None
+        if not scene.closed:
+            return "shell: a lower half of its own (UserShell.closed_halves) needs closed=True"
+        if not scene.two_contacts:
+            return ("shell: halves that differ need support='substrate' under a curved tip; between plates (or "
+                    "under a flat plate) the shell must be mirror-symmetric about its equator (UserShell(R, Z, L))")
+        if scene.pressure or scene.sealed:
+            return "shell: halves that differ are offered without pressure only (pressure=0, sealed=False) for now"
+        if scene.thickness_profile is not None:
+            return "shell: halves that differ are offered with a constant thickness only (no thickness profile) for now"
+        return None
+
+    def upper_half(self) -> "UserShell":
+        """This meridian without its lower half (the one its code is generated for)."""
+        return self if self.lower is None else self._upper
 
     def description(self):
-        """The formulas as plain text (what files store)."""
-        return dict(self._desc)
+        """The formulas as plain text (what files store; a closed shell's different lower half
+        under ``lower``)."""
+        return {k: (dict(v) if isinstance(v, dict) else v) for k, v in self._desc.items()}
 
     def pole_curvature(self, values):
         """kappa_theta^R at the pole (after rescaling)."""
@@ -185,10 +228,15 @@ class UserShell:
         """
         if self._closed_problem is ...:
             self._closed_problem = _closed_problem(self.geometry, self._curvatures)
+            if self._closed_problem is None and self.lower is not None and (why := self.lower.closed_problem()):
+                self._closed_problem = why.replace("shell: ", "shell: the lower half (in its mirror image): ", 1)
         return self._closed_problem
 
     def __repr__(self):
-        return f"UserShell(R={str(self.geometry.R)!r}, Z={str(self.geometry.Z)!r}, L={str(self.geometry.L)!r})"
+        if self.lower is None:
+            return f"UserShell(R={str(self.geometry.R)!r}, Z={str(self.geometry.Z)!r}, L={str(self.geometry.L)!r})"
+        halves = [", ".join(repr(str(e)) for e in (g.R, g.Z, g.L)) for g in (self.geometry, self.lower.geometry)]
+        return f"UserShell.closed_halves(upper=({halves[0]}), lower=({halves[1]}))"
 
     def __eq__(self, other):
         return isinstance(other, UserShell) and self._desc == other._desc

@@ -40,7 +40,7 @@ from pathlib import Path
 from symbolic.version import CODEGEN_VERSION, description_key, source_fingerprint
 
 __all__ = ["cache_dir", "structure_description", "description_key", "load_module", "load_stability_module",
-           "stability_description", "module_path",
+           "stability_description", "module_path", "lower_structure",
            "kernel_path", "kernel_source_path", "holds_key", "write_atomic", "untrusted_reason",
            "untrusted_bytecode", "write_bytecode"]
 
@@ -298,3 +298,14 @@ def kernel_source_path(desc: dict) -> Path:
         write_atomic(path, generate_sources(desc)[1])
         log.info("derived and generated %s in %.2f s", path.name, time.perf_counter() - t0)
     return path
+
+
+def lower_structure(scene) -> dict | None:
+    """The structure of a closed shell's lower half where its meridian is its own
+    (``UserShell.closed_halves``, both halves solved; else None): the scene's, with that
+    meridian.  Both halves' modules take the same run-time parameters."""
+    lower = getattr(scene.shell, "lower", None)
+    if lower is None or not scene.two_contacts:
+        return None
+    return structure_description(scene.material, scene.xi, lower, scene.tip, scene.bending,
+                                 pressurised=scene.pressurised, substrate=True)

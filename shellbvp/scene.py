@@ -199,6 +199,8 @@ class Scene:
         if isinstance(self.tip, FlatTip):
             rho = 1.0  # a plate has no radius: rho is its length scale
         object.__setattr__(self, "support", _support(self, gamma))
+        if isinstance(self.shell, UserShell) and (why := self.shell.halves_problem(self)):
+            raise ValueError(why)
         # First contact at the pole: kappa_theta^R(0) < B''(0)/(rho A'(0)^2).
         k_shell = self.shell.pole_curvature({"gamma": -gamma if self.closed else gamma})
         k_tip = self.tip.apex_curvature() / rho
@@ -322,7 +324,10 @@ class Scene:
         if kind == "spheroid":
             shell = Spheroid()
         elif kind == "user":
-            shell = UserShell(*(field(sh, k, text, "shell.") for k in "RZL"), legacy_srepr=True)
+            halves = [tuple(field(h, k, text, "shell.") for k in "RZL")
+                      for h in [sh] + ([field(sh, "lower", (dict,), "shell.")] if "lower" in sh else [])]
+            shell = UserShell.closed_halves(*halves, legacy_srepr=True) if len(halves) == 2 else UserShell(
+                *halves[0], legacy_srepr=True)
         else:
             raise ValueError(f"scene data: unknown shell kind {kind!r}")
         kind = field(tp, "kind", text, "tip.")
@@ -419,7 +424,8 @@ class Scene:
         ('spheroidal bowl (indented from inside)', 'spheroidal dome (indented from outside)')
         """
         if self.closed:
-            shape = "closed spheroid" if isinstance(self.shell, Spheroid) else "closed shell (user meridian)"
+            shape = "closed spheroid" if isinstance(self.shell, Spheroid) else (
+                "closed shell (user meridian" + ("s, halves that differ)" if self.shell.lower else ")"))
             if self.support == "plates":
                 return f"{shape} between " + ("plates" if isinstance(self.tip, FlatTip) else "two indenters")
             return f"{shape} on a substrate"
@@ -439,7 +445,8 @@ class Scene:
     def structure(self) -> dict:
         """The structural choices the generated code is specialised on."""
         profile = self.thickness_profile.description() if self.thickness_profile is not None else None
-        return structure_description(self.material, self.xi, self.shell, self.tip, self.bending,
+        shell = self.shell.upper_half() if isinstance(self.shell, UserShell) else self.shell
+        return structure_description(self.material, self.xi, shell, self.tip, self.bending,
                                      pressurised=self.pressurised, substrate=self.two_contacts, thickness=profile)
 
     @property

@@ -8,6 +8,7 @@ import numpy as np
 
 from ..collocation import newton_on_mesh
 from ..kernels import kernel_set
+from ..model import load_module, lower_structure
 from ..quadrature import gauss_points
 from ..solution import solve_bvp
 from .blocks import CONTACT_KINDS, REGION_CODES, SIZES, Chain, ContactPole, Edge, FreePole, Line, Point, Rim, Seam
@@ -111,8 +112,25 @@ class ChainBVP(BoundaryConditions):
         self.n_conditions = (sum(j.rows for j in self.junctions) + (self.extra is not None)
                              + (2 if self.volume_control else 0))
         self.rim_slope = self._clamped_rim_slope()
+        # a closed shell's equator: each half's (L, Phi(L)), the slopes' departures opposite
+        seam = next((j for j in self.junctions if isinstance(j, Seam)), None)
+        self.seam_slopes = None if seam is None else tuple(
+            (L, float(self.models[k].reference_shell(L, self.par)["Phi"]))
+            for k in (seam.ku, seam.kl) for L in [float(self.S_point(self.regions[k].end, None))])
+        # halves that differ: their reference curvatures jump at the equator, so lambda_s and
+        # kappa_s do too, tau_s and M_s are continuous instead; each half's undeformed state
+        # there (stress-free) is where its stresses are measured from (BoundaryConditions._seam)
+        self.seam_references = None
+        if seam is not None and self.models[seam.ku] is not self.models[seam.kl]:
+            self.seam_references = tuple(self._undeformed(k, L) for k, (L, _) in zip((seam.ku, seam.kl),
+                                                                                      self.seam_slopes))
         # a closed shell solved on the half above its equator (its mirror image the other half)
         self.mirrored = scene.closed and any(isinstance(j, Rim) for j in self.junctions)
+
+    def _undeformed(self, k, S) -> np.ndarray:
+        """The free states of region ``k``'s half undeformed at ``S`` (its reference)."""
+        ref = self.models[k].reference_shell(S, self.par)
+        return np.array([1.0, float(ref["Phi"]) / S, 1.0, float(ref["kappa_s"]), 0.0, float(ref["Z"])])
 
     def _clamped_rim_slope(self):
         """``Phi(L)/L``, the reference slope over L that a clamped rim or a closed shell's equator
@@ -150,7 +168,8 @@ class ChainBVP(BoundaryConditions):
     # pickling: the generated module is code, not data; it is loaded again (from the code
     # cache) by the scene on unpickling, so results can travel between processes
     def __getstate__(self):
-        return {k: v for k, v in self.__dict__.items() if k not in ("model", "kernels", "_vol", "_vol_jac")}
+        unbound = ("model", "kernels", "models", "region_kernels", "_vol", "_vol_jac")
+        return {k: v for k, v in self.__dict__.items() if k not in unbound}
 
     def __setstate__(self, state):
         self.__dict__.update(state)
@@ -290,20 +309,39 @@ class ChainBVP(BoundaryConditions):
     def _bind(self):
         """The regions' right-hand sides and Jacobians (the hot path) come from the structure's
         kernel set: the generated numpy functions, or the compiled ones once they are ready
-        (``shellbvp.kernels``; looked up on every call, so a curve switches as soon as they are)."""
+        (``shellbvp.kernels``; looked up on every call, so a curve switches as soon as they are).
+        A closed shell whose halves differ (``shellbvp.model.lower_structure``) has a module and kernel set
+        per half: the regions after its seam's upper one are its lower half's; both modules take
+        the same run-time parameters."""
         self.kernels = kernel_set(self.model, self.scene.structure)
+        desc = lower_structure(self.scene)
+        seam = next((j for j in self.chain.junctions if isinstance(j, Seam)), None)
+        if desc is not None and seam is not None:
+            lower = load_module(desc)
+            if tuple(lower.PARAMS) != tuple(self.model.PARAMS):
+                raise ValueError("the closed shell's halves' generated modules take different parameters")
+            lower_kernels = kernel_set(lower, lambda: desc)
+            self.models = [self.model if k <= seam.ku else lower for k in range(len(self.regions))]
+            self.region_kernels = [self.kernels if k <= seam.ku else lower_kernels for k in range(len(self.regions))]
+        else:
+            self.models = [self.model] * len(self.regions)
+            self.region_kernels = [self.kernels] * len(self.regions)
         self._rhs_names = [f"{r.kind}_rhs" for r in self.regions]
         self._jac_names = [f"{r.kind}_jac" for r in self.regions]
         if "pressure" in self.model.PARAMS:  # volume control's functions (pressurised structures)
             self._i_pressure = self.model.PARAMS.index("pressure")
-            self._vol = [getattr(self.model, f"{r.kind}_vol") for r in self.regions]
-            self._vol_jac = [getattr(self.model, f"{r.kind}_vol_jac") for r in self.regions]
+            self._vol = [getattr(m, f"{r.kind}_vol") for m, r in zip(self.models, self.regions)]
+            self._vol_jac = [getattr(m, f"{r.kind}_vol_jac") for m, r in zip(self.models, self.regions)]
+
+    def _active(self, k):
+        """Region ``k``'s kernels (its half's, of a closed shell whose halves differ)."""
+        return self.region_kernels[k].active
 
     def _rhs(self, k):
-        return getattr(self.kernels.active, self._rhs_names[k])
+        return getattr(self._active(k), self._rhs_names[k])
 
     def _jac(self, k):
-        return getattr(self.kernels.active, self._jac_names[k])
+        return getattr(self._active(k), self._jac_names[k])
 
 
     # -- ODE ------------------------------------------------------------------------------------
@@ -366,7 +404,7 @@ class ChainBVP(BoundaryConditions):
                 vy, vS = self._vol_jac[k](S, y[rows], par)
                 dfdy[v, rows] = (b - a) * vy[0]
                 dfdp[rows, self.col["pressure"]] = (b - a) * getattr(
-                    self.kernels.active, f"{reg.kind}_jac_par")(S, y[rows], par)[:, self._i_pressure]
+                    self._active(k), f"{reg.kind}_jac_par")(S, y[rows], par)[:, self._i_pressure]
             if dfdp is None:
                 continue
             # d/da and d/db of (b - a) g(exp(a + t (b - a)), y), and of the volume rate
@@ -400,7 +438,7 @@ class ChainBVP(BoundaryConditions):
         out = []
         for k, reg in enumerate(self.regions):
             S = self.S(k, t, p)
-            out.append((k, S, getattr(self.kernels.active, f"{reg.kind}_profile")(S, y[self.rows(k)],
+            out.append((k, S, getattr(self._active(k), f"{reg.kind}_profile")(S, y[self.rows(k)],
                                                                                    self.par_at(p))))
         return out
 
@@ -445,6 +483,13 @@ class ChainBVP(BoundaryConditions):
             h = self._pole_height = float(self.model.reference_shell(0.0, self.par)["Z"]) + self._param("pole_rise")
         return h
 
+    def half_pole_height(self, k) -> float:
+        """:attr:`pole_height` of region ``k``'s half: a closed shell's lower half's pole is its own
+        meridian's (in its mirror image), where the substrate finds it."""
+        if self.models[k] is self.model:
+            return self.pole_height
+        return float(self.models[k].reference_shell(0.0, self.par)["Z"]) + self._param("pole_rise")
+
     def energy(self, sol, x, p) -> float:
         """``E = 2 pi Int U R Psi dS - p (V - V_ref)``, twice that for a closed shell (the half
         above its equator is solved): the elastic energy over every region
@@ -474,12 +519,12 @@ class ChainBVP(BoundaryConditions):
         total = 0.0
         for k, reg in enumerate(self.regions):  # the generated energy density alone, not the profile
             S = self.S(k, t, p)
-            density = getattr(self.kernels.active, f"{reg.kind}_energy")(S, y[self.rows(k)], par)[0]
+            density = getattr(self._active(k), f"{reg.kind}_energy")(S, y[self.rows(k)], par)[0]
             total += float(np.sum(w * density * S)) * (self.ln_S(reg.end, p) - self.ln_S(reg.start, p))
         for j in self.junctions:
             if isinstance(j, (ContactPole, FreePole)):
                 zeta = self.S_point(self.regions[j.k].start, p)
-                energy = getattr(self.kernels.active, f"{self.regions[j.k].kind}_energy")
+                energy = getattr(self._active(j.k), f"{self.regions[j.k].kind}_energy")
                 density = energy(np.array([zeta]), sol(np.array([0.0]))[self.rows(j.k)], par)[0]
                 total += 0.5 * float(density[0]) * zeta
         return 2 * np.pi * total

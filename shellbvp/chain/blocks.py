@@ -139,7 +139,9 @@ class Seam:
     end of its lower half's ``kl`` (each half running from its own pole, the lower in the
     mirror image z -> -z): r, z, the slope, lambda_s, kappa_s and the shear force continuous,
     6 rows, linear in the states (``lt``, ``ls``, ``ks`` equal; ``z``, ``rQ`` and the slopes'
-    departures from the reference opposite)."""
+    departures from the reference opposite).  Where the halves differ
+    (``UserShell.closed_halves``: each its own module and L) their reference curvatures jump
+    there: ``tau_s`` and ``M_s`` are continuous instead of ``ls`` and ``ks``."""
 
     ku: int
     kl: int

@@ -49,11 +49,11 @@ class BoundaryConditions:
         return 0.0 if j.on == "plane" else q["delta"]
 
     def _pole_function(self, j, what):
-        return getattr(self.model, f"{self._prefix(self.regions[j.k].kind)}pole_{what}")
+        return getattr(self.models[j.k], f"{self._prefix(self.regions[j.k].kind)}pole_{what}")
 
     def _edge_function(self, j, what):
         """junction_[cyl_]<model>_<what> of an edge, by its contact region's kind."""
-        return j.model.function(self.model, self._prefix(self.regions[j.kc].kind), what)
+        return j.model.function(self.models[j.kc], self._prefix(self.regions[j.kc].kind), what)
 
     # -- conditions -------------------------------------------------------------------------------
     def _edge_states(self, j: Edge, ya, yb):
@@ -68,10 +68,11 @@ class BoundaryConditions:
         return self.regions[j.k].end, np.array([q[j.chi], yin[_LS]]), yin, ya[self.rows(j.k + 1)]
 
     def bc(self, ya, yb, p=None):
-        mod, par = self.model, self.par_at(p)
+        par = self.par_at(p)
         q = self.quantities(p)
         parts = []
         for j in self.junctions:
+            mod = self._junction_model(j)
             if isinstance(j, ContactPole):
                 y0 = ya[self.rows(j.k)]
                 parts.append(self._pole_function(j, "res")(y0[0], y0[1], q[j.stretch], par))
@@ -98,7 +99,12 @@ class BoundaryConditions:
                           (yr - yl)[_KINK_CONTINUOUS]]
             elif isinstance(j, Seam):
                 yu, yl = yb[self.rows(j.ku)], yb[self.rows(j.kl)]
-                parts += [(yu - yl)[_SEAM_EQUAL], (yu + yl)[_SEAM_OPPOSITE], [yu[_PHIS] + yl[_PHIS] - 2 * self.rim_slope]]
+                (Lu, wu), (Ll, wl) = self.seam_slopes
+                equal = (yu - yl)[_SEAM_EQUAL]
+                if self.seam_references is not None:  # halves that differ: [tau_s] = [M_s] = 0
+                    equal[1:] = self._seam_stress_jumps(j, yu, yl, par)[0]
+                parts += [equal, (yu + yl)[_SEAM_OPPOSITE],
+                          [(Lu * yu[_PHIS] + Ll * yl[_PHIS] - wu - wl) / (0.5 * (Lu + Ll))]]
             elif isinstance(j, Rim):
                 parts.append(self._rim_res(self.S_point(self.regions[j.k].end, p), yb[self.rows(j.k)], par,
                                            q["delta"] if "delta" in q else 0.0))
@@ -115,6 +121,18 @@ class BoundaryConditions:
         if self.volume_control:
             parts += [[ya[self.n_shell]], [yb[self.n_shell] - self.enclosed_volume]]
         return np.concatenate(parts)
+
+    def _seam_stress_jumps(self, j, yu, yl, par, jac=False):
+        """``tau_s`` and ``M_s`` of the upper half minus the lower's at the equator (each from
+        its own module, as its corner's jumps from its undeformed state, where both vanish),
+        and with ``jac`` their derivatives by ``yu`` and ``yl``."""
+        (Lu, _), (Ll, _) = self.seam_slopes
+        ru, rl = self.seam_references
+        mu, ml = self.models[j.ku], self.models[j.kl]
+        jumps = mu.kink_res(Lu, ru, yu, par)[:2] - ml.kink_res(Ll, rl, yl, par)[:2]
+        if not jac:
+            return jumps, None, None
+        return jumps, mu.kink_jac(Lu, ru, yu, par)[:2, 7:13], -ml.kink_jac(Ll, rl, yl, par)[:2, 7:13]
 
     def _rim_res(self, S, y, par, delta):
         res = self.model.rim_res(S, y, par)
@@ -143,13 +161,18 @@ class BoundaryConditions:
 
     def _line_function(self, j, what):
         """A line's rows on the indenter: the smooth edge's (their first three are used)."""
-        return edge_model("smooth").function(self.model, self._prefix(j.on), what)
+        return edge_model("smooth").function(self.models[j.k], self._prefix(j.on), what)
+
+    def _junction_model(self, j):
+        """The generated module of the half a junction is on (a closed shell's halves may differ)."""
+        k = j.ku if isinstance(j, Seam) else j.kc if isinstance(j, Edge) else j.k
+        return self.models[k]
 
     def _force_function(self, what):
         """force_[cyl_]<what> at the last contact edge (F of the free region beyond it)."""
         j = self.force_at
-        return getattr(self.model, f"force_{self._prefix(self.regions[j.kc].kind if isinstance(j, Edge) else '')}"
-                                   f"{what}")
+        kind = self.regions[j.kc].kind if isinstance(j, Edge) else ""
+        return getattr(self._junction_model(j), f"force_{self._prefix(kind)}{what}")
 
     def _force_args(self, ya, yb, p, q):
         """(point, S, yc, yf, free region, free state at its start?) of the force condition."""
@@ -172,7 +195,7 @@ class BoundaryConditions:
             P[rows, self.col["pressure"]] += dres_dpar[..., self._i_pressure]
 
     def bc_jac(self, ya, yb, p=None):
-        mod, par = self.model, self.par_at(p)
+        par = self.par_at(p)
         q = self.quantities(p)
         m, n = self.n_conditions, self.n
         A, B = np.zeros((m, n)), np.zeros((m, n))
@@ -181,6 +204,7 @@ class BoundaryConditions:
         r = 0
         for j in self.junctions:
             rows = slice(r, r + j.rows)
+            mod = self._junction_model(j)
             if isinstance(j, ContactPole):
                 o = self.offsets[j.k]
                 y0 = ya[self.rows(j.k)]
@@ -263,9 +287,14 @@ class BoundaryConditions:
                     B[row, l0 + c] = -1.0
             elif isinstance(j, Seam):
                 ou, ol = self.offsets[j.ku], self.offsets[j.kl]
-                for row, c in enumerate(_SEAM_EQUAL + _SEAM_OPPOSITE + [_PHIS], start=r):
+                for row, c in enumerate(_SEAM_EQUAL + _SEAM_OPPOSITE, start=r):
                     B[row, ou + c] = 1.0
                     B[row, ol + c] = -1.0 if c in _SEAM_EQUAL else 1.0
+                (Lu, _), (Ll, _) = self.seam_slopes
+                B[r + 5, ou + _PHIS], B[r + 5, ol + _PHIS] = Lu / (0.5 * (Lu + Ll)), Ll / (0.5 * (Lu + Ll))
+                if self.seam_references is not None:  # halves that differ: [tau_s] = [M_s] = 0
+                    _, du, dl = self._seam_stress_jumps(j, yb[self.rows(j.ku)], yb[self.rows(j.kl)], par, jac=True)
+                    B[r + 1:r + 3, self.rows(j.ku)], B[r + 1:r + 3, self.rows(j.kl)] = du, dl
             elif isinstance(j, Rim):
                 S = self.S_point(self.regions[j.k].end, p)
                 B[rows, self.rows(j.k)] = self._rim_jac(S, yb[self.rows(j.k)], par)

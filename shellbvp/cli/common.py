@@ -316,6 +316,9 @@ def add_scene_options(p, uncertain=False, preset_required=False, solver=("tol", 
                             "by a whitelist, never run; rescaled to R(L) = 1, Z(L) = 0), e.g. 'sin(S); -2*cos(S); "
                             "pi/2': pole to rim, or with --closed the upper half, pole to equator (R'(L) = 0), its "
                             "mirror image the lower half")
+    g.add_argument("--meridian-lower", type=meridian_value, metavar="'R; Z; L'", dest="meridian_lower",
+                   help="with --closed --meridian on a substrate under a curved tip: the lower half's own meridian, "
+                        "pole to equator in its mirror image (an egg: Z > 0 is below the equator)")
     g.add_argument("--dome", action="store_true", default=None,
                    help="the shell is a dome indented from outside (its convex side): --rise is the pole's height "
                         "above the rim's plane, gamma = -rise / R_L")
@@ -392,8 +395,10 @@ def scene_from_args(args):
             if getattr(args, k, None) is not None}
     if getattr(args, "flat_tip", None):
         over["tip"] = FlatTip()
+    if (lower := getattr(args, "meridian_lower", None)) and not getattr(args, "meridian", None):
+        raise ValueError("--meridian-lower needs --meridian (the upper half, pole to equator) and --closed")
     if getattr(args, "meridian", None):
-        over["shell"] = UserShell(*args.meridian)
+        over["shell"] = UserShell.closed_halves(args.meridian, lower) if lower else UserShell(*args.meridian)
     chosen = [p for p in material_options() if getattr(args, p.dest, None) is not None]
     if chosen:  # its material (the options exclude each other)
         over["material"] = material_class(chosen[0].material)(**{chosen[0].name: getattr(args, chosen[0].dest)})

@@ -73,11 +73,13 @@ _DELTA_ONLY = frozenset({"point"})
 
 def closed_chain(upper: str, lower: str):
     """``chain(eps, L)`` of a closed shell whose upper half touches the tip by ``upper`` and lower
-    half the plane by ``lower``."""
-    def chain(eps: float, L: float) -> Chain:
-        end = Point("L", None, math.log(L))
-        ru, ju, uu = HALVES[upper](0, "contact", end, eps, False)
-        rl, jl, ul = HALVES[lower](len(ru), "plane", end, eps, True)
+    half the plane by ``lower``; ``L``: both halves' meridians' ends, or ``(L_upper, L_lower)``
+    where the halves differ (``UserShell.closed_halves``)."""
+    def chain(eps: float, L) -> Chain:
+        L_upper, L_lower = (L, L) if isinstance(L, (int, float)) else map(float, L)
+        ru, ju, uu = HALVES[upper](0, "contact", Point("L", None, math.log(L_upper)), eps, False)
+        rl, jl, ul = HALVES[lower](len(ru), "plane", Point("L_b" if L_lower != L_upper else "L", None,
+                                                          math.log(L_lower)), eps, True)
         seam = Seam(len(ru) - 1, len(ru) + len(rl) - 1)
         return Chain(closed_name(upper, lower), ru + rl, jl + ju + (seam,), uu + ul, eps)
     return chain

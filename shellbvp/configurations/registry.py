@@ -145,7 +145,10 @@ class Configuration:
         its inflated state (solved here, once per scene, not by the system)."""
         self.check(scene, control)
         model = scene.model()
-        sysm = ch.ChainBVP(scene, self.chain(eps, scene.shell_length, edge or scene.contact), control, value,
+        lower = getattr(scene.shell, "lower", None)  # a closed shell's lower half of its own: its L
+        L = (scene.shell_length, float(lower.geometry.L)) if lower is not None and self.family == "closed" else (
+            scene.shell_length)
+        sysm = ch.ChainBVP(scene, self.chain(eps, L, edge or scene.contact), control, value,
                            model=model, par=system_parameters(scene, model),
                            enclosed_volume=self.enclosed_volume(scene) if scene.sealed else None)
         attach_tip_table(sysm)
