@@ -455,7 +455,7 @@ class ChainBVP(BoundaryConditions):
             for k, _, fields in parts:
                 v = np.broadcast_to(fields[key], t.shape)
                 if key == "z" and self.regions[k].kind == "plane":
-                    v = v + self.pole_height  # the substrate stays where the pole was at delta = 0
+                    v = v + self.half_pole_height(k)  # the substrate stays where the lower pole was at delta = 0
                 elif key == "z" and self.regions[k].kind in CONTACT_KINDS:
                     v = v + z_tip  # the generated contact z is measured from the tip's apex
                 vals.append(v)
