@@ -14,6 +14,7 @@ import time
 from pathlib import Path
 
 import pytest
+from benchmark_modules import load_benchmark
 
 BENCH = Path(__file__).resolve().parent.parent / "benchmarks"
 
@@ -25,14 +26,7 @@ def _census():
 
 
 def _load(name):
-    spec = importlib.util.spec_from_file_location(f"_bench_{name}", BENCH / f"{name}.py")
-    mod = importlib.util.module_from_spec(spec)
-    sys.path.insert(0, str(BENCH))
-    try:
-        spec.loader.exec_module(mod)
-    finally:
-        sys.path.remove(str(BENCH))
-    return mod
+    return load_benchmark(name)
 
 
 @pytest.fixture(scope="module")

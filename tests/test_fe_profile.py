@@ -3,15 +3,13 @@ fe_curve's, validate and the solid fitting model on profiled scenes, and the iss
 against the shell model (benchmarks/profile_solid.py measures it in full)."""
 
 import functools
-import importlib.util
 import math
-import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
 
 import shellbvp as sb
+from benchmark_modules import load_benchmark
 from shellbvp.cli import main
 from shellbvp.fitting import solid
 from shellbvp.validation import shell_curve
@@ -72,15 +70,7 @@ def test_fe_curves_thickness_is_the_poles_and_scales_the_profile():
 @functools.lru_cache(maxsize=1)
 def _profile_solid():
     """benchmarks/profile_solid.py, which holds Kirchhoff's disk of varying stiffness (Ritz)."""
-    bench = Path(__file__).resolve().parents[1] / "benchmarks"
-    spec = importlib.util.spec_from_file_location("_bench_profile_solid", bench / "profile_solid.py")
-    module = importlib.util.module_from_spec(spec)
-    sys.path.insert(0, str(bench))
-    try:
-        spec.loader.exec_module(module)
-    finally:
-        sys.path.remove(str(bench))
-    return module
+    return load_benchmark("profile_solid")
 
 
 def _plate_compliance(t, nu):

@@ -20,10 +20,8 @@ plate's closed form, a harmonic deflection's cost) are in tests/test_second_vari
 
 from __future__ import annotations
 
-import importlib.util
 import json
 import math
-import sys
 from pathlib import Path
 
 import mpmath as mp
@@ -38,6 +36,7 @@ from symbolic.geometry import S
 from symbolic.materials import LS, LT
 
 import test_variational as tv
+from benchmark_modules import load_benchmark
 from test_bending import _energy_identity_error
 from test_stability_contact import _neighbours, branch_check
 
@@ -207,16 +206,8 @@ def test_koiter_and_trace_eigenvalues_differ():
 
 # ------------------------------------------------------------------ the 3D solid's flat disk
 def _profile_solid():
-    """benchmarks/profile_solid.py (its disk and its shell solve), as tests/test_fe_profile.py loads it."""
-    bench = RESULTS.parents[1]
-    spec = importlib.util.spec_from_file_location("_bench_profile_solid_koiter", bench / "profile_solid.py")
-    module = importlib.util.module_from_spec(spec)
-    sys.path.insert(0, str(bench))
-    try:
-        spec.loader.exec_module(module)
-    finally:
-        sys.path.remove(str(bench))
-    return module
+    """benchmarks/profile_solid.py (its disk and its shell solve)."""
+    return load_benchmark("profile_solid")
 
 
 @pytest.mark.slow  # ~25 s: two structures' code (a profiled wall is structural)
