@@ -367,7 +367,7 @@ def test_function_level_imports_of_the_package_stand_where_they_are_known():
     """benchmarks/architecture.py on this checkout (issue 57): the package's imports inside functions
     are the command line's of modules that load numpy (its parser must not), and only these: each
     subcommand's module imports its handler (``cli/handlers/NAME.py``, whose imports stand at its
-    top) on dispatch, and cli/common.py's ``scene_from_args`` the scene (145 at eab5e9b, in 40
+    top) on dispatch, and cli/scene_options.py's ``scene_from_args`` the scene (145 at eab5e9b, in 40
     modules; 59 at 33d1b76, 58 of them the command line's in its handlers)."""
     import ast
 
@@ -378,7 +378,7 @@ def test_function_level_imports_of_the_package_stand_where_they_are_known():
     commands = {c.__name__.removeprefix("shellbvp.") for c in COMMANDS}
     deferred = census["function_imports_cli_deferred"]
     assert {m: n for m, n in deferred.items() if m in commands} == dict.fromkeys(commands, 1)
-    assert set(deferred) - commands <= {"cli.common"} and deferred.get("cli.common", 0) <= 2, deferred
+    assert set(deferred) - commands <= {"cli.scene_options"} and deferred.get("cli.scene_options", 0) <= 2, deferred
     assert set(census["function_imports_package"]) == set(deferred)  # none in the handlers
     for command in COMMANDS:  # the one late import of a subcommand's module is its handler's
         name = command.__name__.rpartition(".")[2]
