@@ -157,6 +157,8 @@ STEPS = (
     Step("fit_coverage", "fit_coverage.py", "fits", [], ["--quick"], _r("fit_coverage"), cost=439, source="stated"),
     Step("fit_baseline_coverage", "fit_baseline_coverage.py", "fits", [], ["--quick"],
          ["results/fit_baseline_coverage.md"]),
+    Step("closed_matrix", "closed_matrix.py", "fits", [], ["--quick"], _r("closed_matrix", ext=("md",)), cost=869,
+         source="stated"),
     Step("fit_models", "fit_models.py", "fits", [], None, _r("fit_models"), cost=52, source="stated",
          note="52 s with the claims' curves memoised in the temporary directory; without them longer"),
     Step("weights_check_rate", "weights_check_rate.py", "fits", [], None, _r("weights_check_rate"),
