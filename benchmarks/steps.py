@@ -190,7 +190,8 @@ TOOLS = {
                        "results/architecture.md is its --markdown table inside prose kept by hand",
     "same_curves.py": "compares this checkout's curves with another commit's (--against COMMIT); "
                       "its answer is the exit status, no result file",
-    "make_example_data.py": "writes the records shipped in shellbvp/data/, not a result",
+    "make_example_data.py": "writes the records shipped in shellbvp/data/ (--write) or the same files elsewhere "
+                            "(--out-dir), not a result; tests/test_benchmark_scripts.py compares them",
     "make_force_map.py": "writes a synthetic JPK map (for commands.py, map_scaling.py and users)",
     "make_instrument_examples.py": "writes example records into a folder (docs/fitting.md's batch example)",
     "regression_reference.py": "writes tests/data/regression_states.json, run at commit 1109cdf: "
