@@ -194,7 +194,7 @@ TOOLS = {
                             "(--out-dir), not a result; tests/test_benchmark_scripts.py compares them",
     "make_force_map.py": "writes a synthetic JPK map (for commands.py, map_scaling.py and users)",
     "make_instrument_examples.py": "writes example records into a folder (docs/fitting.md's batch example)",
-    "regression_reference.py": "writes tests/data/regression_states.json, run at commit 1109cdf: "
+    "regression_reference.py": "writes tests/data/regression_states.json (--out, --overwrite), run at commit 1109cdf: "
                                "run here it would compare the code with itself",
     "trust_afm.py": "kinds 13-14 of trust_tally.py (steps trust_tally, trust_afm)",
     "trust_cache.py": "kinds 9-12 of trust_tally.py (steps trust_tally, trust_cache)",

@@ -50,3 +50,21 @@ def test_make_example_data_makes_the_shipped_records(tmp_path):
         assert new.shape == shipped.shape and np.array_equal(new[:, 0], shipped[:, 0]), name
         np.testing.assert_allclose(new[:, 1], shipped[:, 1], rtol=1e-4, atol=1e-6, err_msg=name)
         assert (tmp_path / name).read_text().splitlines()[:2] == (med.DATA / name).read_text().splitlines()[:2]
+
+
+def test_regression_reference_writes_where_told_only(tmp_path):
+    """The output is an explicit --out (was: the first argument, whatever it was); an existing
+    file (tests/data/regression_states.json, written at 1109cdf) is kept unless --overwrite."""
+    rr = load_benchmark("regression_reference")
+    kept = BENCH.parent / "tests" / "data" / "regression_states.json"
+    before = kept.stat().st_mtime_ns
+    assert _run("regression_reference", "--help").returncode == 0
+    for args in ([], [str(tmp_path / "x.json")], ["--out", str(kept)], ["--out", str(tmp_path / "x.txt")],
+                 ["--out", str(tmp_path / "no" / "x.json")], ["--out", str(tmp_path / "x.json"), "--bogus"]):
+        with pytest.raises(SystemExit) as e:
+            rr.parse_args(args)
+        assert e.value.code == 2, args
+    assert _run("regression_reference", str(kept)).returncode == 2
+    assert kept.stat().st_mtime_ns == before
+    assert rr.parse_args(["--out", str(kept), "--overwrite"]).out == kept
+    assert rr.parse_args(["--out", str(tmp_path / "x.json")]).out == tmp_path / "x.json"
