@@ -68,3 +68,28 @@ def test_regression_reference_writes_where_told_only(tmp_path):
     assert kept.stat().st_mtime_ns == before
     assert rr.parse_args(["--out", str(kept), "--overwrite"]).out == kept
     assert rr.parse_args(["--out", str(tmp_path / "x.json")]).out == tmp_path / "x.json"
+
+
+def _table(text):
+    return [[c.strip() for c in line.strip("|").split("|")] for line in text.splitlines()
+            if line.startswith("| ") and not line.startswith("| mesh")]
+
+
+def test_fe_convergence_reports_each_mesh_against_the_finest():
+    """benchmarks/fe_convergence.py's table (step fe_convergence; docs/accuracy.md quotes it): the
+    forces of each mesh, then each coarser mesh against the finest; the committed table's
+    differences are those of its forces."""
+    fc = load_benchmark("fe_convergence")
+    rows = [dict(element_length=e, through_thickness=t, elements=[n, t], force=f, success=True, seconds=1.0)
+            for e, t, n, f in ((0.5, 3, 167, [1.0, 2.0, 4.0]), (0.33, 4, 253, [1.001, 2.0, 3.96]),
+                               (0.25, 6, 334, [1.002, 2.002, 4.0]))]
+    doc = dict(scene="s", force_units="mu R_L H", rows=rows, machine="m", version="v", seconds=3.0)
+    table = _table(fc.report(doc))
+    assert "--finest" in fc.report(doc) and "--finest" not in fc.report(dict(doc, rows=rows[:2]))
+    assert table[0][:3] == ["0.5, 3 (default)", "167x3", "1"] and len(table) == 5
+    assert table[3] == ["0.5, 3 against 0.25, 6", "", "-0.200 %", "-0.100 %", "+0.000 %", ""]
+    assert table[4][2:5] == ["-0.100 %", "-0.100 %", "-1.000 %"]
+    committed = _table((BENCH / "results" / "fe_convergence.md").read_text())
+    forces = [np.array([float(x) for x in row[2:5]]) for row in committed[:2]]
+    stated = [float(x.rstrip(" %")) for x in committed[2][2:5]]
+    np.testing.assert_allclose(100 * (forces[0] / forces[1] - 1), stated, atol=6e-4)
