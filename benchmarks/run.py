@@ -19,8 +19,8 @@ kept by hand).  tests/test_benchmarks.py fails for a script or a result file in 
 
 Each step is its own script, run as a fresh process with this interpreter and this checkout's
 package; results go to benchmarks/results/ (figures to benchmarks/figures/) or under ``--out``.
-A step whose script cannot write elsewhere yet is left out with ``--out`` rather than writing
-into the checkout (``--list --out DIR`` names them).  ``--quick`` runs every step's own quick
+Every step's script takes an output option; one that took none would be left out with ``--out``
+rather than write into the checkout (``--list --out DIR`` would name it).  ``--quick`` runs every step's own quick
 mode, whose files carry a ``-quick`` suffix, so the committed full results are never
 overwritten; steps without a quick mode that is fast enough (about a minute) are left out of
 ``--quick`` (the shooting peer needs its 10-20 s cold starts; the solid's curves, the maps, the

@@ -27,7 +27,7 @@
   slip against a rigid ball's ``-F/(R + rho)/(4 pi)``; and the ``cell-glass`` preset (eps 0.04,
   turgor 0.15, rho 0.34) to delta 1.
 
-Writes benchmarks/results/stability_contact.md (and .json).
+Writes benchmarks/results/stability_contact.md (and .json), or DIR/results/ with ``--out-dir DIR``.
 
     python benchmarks/stability_contact.py
     python benchmarks/stability_contact.py --rewrite   # the .md again from the .json
@@ -36,9 +36,11 @@ Writes benchmarks/results/stability_contact.md (and .json).
 
 from __future__ import annotations
 
+import argparse
 import json
 import math
 import platform
+import sys
 import time
 from pathlib import Path
 
@@ -48,7 +50,11 @@ from scipy.optimize import brentq, minimize_scalar
 import shellbvp as sb
 from shellbvp import modal_stability as st
 
-OUT = Path(__file__).parent / "results"
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from checkout import add_output_args, results_dir, write_atomic  # noqa: E402
+
+#: the sections, each rerun alone by ``--only``
+SECTIONS = ("fold", "base", "lifted", "onset", "closed")
 RS = 5.0
 BETA = 1e-5
 FOLD = 0.18289  # tests/test_dome.py
@@ -289,9 +295,9 @@ def _closed_lines(rows):
     return lines + [""]
 
 
-def write(res):
-    OUT.mkdir(exist_ok=True)
-    (OUT / "stability_contact.json").write_text(json.dumps(res, indent=1, default=str))
+def write(res, out):
+    """The .json and the .md into the folder ``out``."""
+    write_atomic(out / "stability_contact.json", json.dumps(res, indent=1, default=str))
     f = res["fold"]
     lines = ["# Stability of states on the tip: the dome's fold and the first non-axisymmetric crossings", "",
              "Written by `benchmarks/stability_contact.py` (issue 44, item 2).  Dome: the spherical cap of "
@@ -363,21 +369,32 @@ def write(res):
               "so none are quoted here.", "",
               f"Total {res['seconds']:.0f} s. {platform.platform()}, Python {platform.python_version()}, "
               f"{time.strftime('%Y-%m-%d')}; 2 shared cores.", ""]
-    (OUT / "stability_contact.md").write_text("\n".join(lines))
+    write_atomic(out / "stability_contact.md", "\n".join(lines))
 
 
-def main():
-    import sys
+def parse_args(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    again = ap.add_mutually_exclusive_group()
+    again.add_argument("--rewrite", action="store_true", help="the .md again from the .json (nothing solved)")
+    again.add_argument("--only", choices=SECTIONS, help="rerun this section, the others kept from the .json")
+    return add_output_args(ap).parse_args(argv)
 
-    if "--rewrite" in sys.argv:  # the report again from the stored numbers
-        write(json.loads((OUT / "stability_contact.json").read_text()))
+
+def main(argv=None):
+    args = parse_args(argv)
+    out = results_dir(args.out_dir)
+    stored = out / "stability_contact.json"
+    if (args.rewrite or args.only) and not stored.exists():
+        raise SystemExit(f"stability_contact.py: --rewrite and --only need {stored} (a whole run first)")
+    if args.rewrite:  # the report again from the stored numbers
+        write(json.loads(stored.read_text()), out)
         return
-    if "--only" in sys.argv:  # one section, the others kept from the stored numbers
-        which = sys.argv[sys.argv.index("--only") + 1]
-        res = json.loads((OUT / "stability_contact.json").read_text())
+    if args.only:  # one section, the others kept from the stored numbers
+        which = args.only
+        res = json.loads(stored.read_text())
         res[which] = {"fold": dome_fold, "base": base_curve, "lifted": lifted_fold, "closed": closed}[which]() if which != "onset" else \
             [onset(rho, first) for rho in (0.05, 0.2, 0.5) for first in (2, 1)]
-        write(res)
+        write(res, out)
         return
     t0 = time.perf_counter()
     res = {"fold": dome_fold()}
@@ -394,7 +411,7 @@ def main():
             res["onset"].append(o)
     res["closed"] = closed()
     res["seconds"] = time.perf_counter() - t0
-    write(res)
+    write(res, out)
 
 
 if __name__ == "__main__":
