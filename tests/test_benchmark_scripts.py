@@ -1,6 +1,8 @@
 """Scripts of benchmarks/ that write files: each takes its output through an option, refuses
 what it does not know, and does no work on ``--help`` or without the arguments it needs."""
 
+import json
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -93,3 +95,27 @@ def test_fe_convergence_reports_each_mesh_against_the_finest():
     forces = [np.array([float(x) for x in row[2:5]]) for row in committed[:2]]
     stated = [float(x.rstrip(" %")) for x in committed[2][2:5]]
     np.testing.assert_allclose(100 * (forces[0] / forces[1] - 1), stated, atol=6e-4)
+
+
+def test_stability_contact_says_which_run_wrote_each_section(tmp_path):
+    """``--only SECTION`` reruns one section: the report's last lines name, for each section, the
+    run that wrote it, and keep the last whole run's time (it once wrote today's date over all);
+    ``--rewrite`` renders the committed report from the committed numbers."""
+    sc = load_benchmark("stability_contact")
+    committed = BENCH / "results" / "stability_contact.json"
+    (tmp_path / "results").mkdir()
+    shutil.copy(committed, tmp_path / "results")
+    sc.main(["--rewrite", "--out-dir", str(tmp_path)])
+    assert (tmp_path / "results" / "stability_contact.md").read_text() == committed.with_suffix(".md").read_text()
+    res = json.loads(committed.read_text())
+    assert set(res["runs"]) == set(sc.SECTIONS)
+    sc.stamp(res, ["base"], commit="abc1234", date="2026-12-08")
+    text = " ".join(sc.provenance(res))
+    assert "fold, onset: committed in 1f0c934 (2026-12-06" in text and "base: run at abc1234 (2026-12-08" in text
+    assert "lifted: committed in f4c37fc" in text and "took 311 s" in text
+    sc.stamp(res, sc.SECTIONS, seconds=5.0, commit="def5678", date="2026-12-09")
+    text = " ".join(sc.provenance(res))
+    assert "fold, base, lifted, onset, closed: run at def5678 (2026-12-09" in text and "took 5 s" in text
+    assert "1f0c934" not in text
+    with pytest.raises(SystemExit):
+        sc.main(["--only", "base", "--out-dir", str(tmp_path / "empty")])  # no stored sections to keep
