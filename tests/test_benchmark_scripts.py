@@ -119,3 +119,23 @@ def test_stability_contact_says_which_run_wrote_each_section(tmp_path):
     assert "1f0c934" not in text
     with pytest.raises(SystemExit):
         sc.main(["--only", "base", "--out-dir", str(tmp_path / "empty")])  # no stored sections to keep
+
+
+def test_contact_estimate_reads_the_afm_files_the_repository_ships():
+    """The step contact_estimate passes ``--afm-dir tests/data/afm`` (on a fresh machine there is no
+    other); its estimates there are the committed table's for the same files, which was made on all
+    of afmformats' test files (tests/data/afm/README.md names where each file came from)."""
+    ce = load_benchmark("contact_estimate")
+    step = {s.name: s for s in load_benchmark("steps").STEPS}["contact_estimate"]
+    for args in (step.full, step.quick):
+        afm = BENCH.parent / args[args.index("--afm-dir") + 1]
+        assert afm.is_dir()
+    rows = {r[0]: r[1:3] for r in _table("\n".join(ce.afm_lines(afm, None))) if "#" in r[0]}
+    committed = {r[0]: r[1:3] for r in _table((BENCH / "results" / "contact_estimate.md").read_text())}
+    renamed = {"SiN_FD_plot.ibw#1": "fmt-igor-fd_SiN_FD_plot.ibw#1",
+               "flipsign_2015.05.22-15.31.49.352.jpk-force#0": "fmt-jpk-fd_flipsign_2015.05.22-15.31.49.352.jpk-#0",
+               "spot3-0192.jpk-force#0": "fmt-jpk-fd_spot3-0192.jpk-force#0",
+               **{f"qi-data-2x2.jpk-qi-data#{i}": f"fmt-jpk-fd_2020.02.07-16.29.05.036.jpk-qi-data#{i}" for i in range(4)}}
+    assert set(rows) == set(renamed)
+    for name, row in rows.items():
+        assert row == committed[renamed[name]], name
