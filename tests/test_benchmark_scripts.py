@@ -135,7 +135,40 @@ def test_contact_estimate_reads_the_afm_files_the_repository_ships():
     renamed = {"SiN_FD_plot.ibw#1": "fmt-igor-fd_SiN_FD_plot.ibw#1",
                "flipsign_2015.05.22-15.31.49.352.jpk-force#0": "fmt-jpk-fd_flipsign_2015.05.22-15.31.49.352.jpk-#0",
                "spot3-0192.jpk-force#0": "fmt-jpk-fd_spot3-0192.jpk-force#0",
-               **{f"qi-data-2x2.jpk-qi-data#{i}": f"fmt-jpk-fd_2020.02.07-16.29.05.036.jpk-qi-data#{i}" for i in range(4)}}
+               **{f"qi-data-2x2.jpk-qi-data#{i}": f"fmt-jpk-fd_2020.02.07-16.29.05.036.jpk-qi-data#{i}"
+                  for i in range(4)}}
     assert set(rows) == set(renamed)
     for name, row in rows.items():
         assert row == committed[renamed[name]], name
+
+
+def test_profile_solid_quick_mode_is_its_own():
+    """profile_solid.py --quick: its own walls and depths, afresh, into *-quick files; the report
+    leaves out the pole thicknesses it did not solve."""
+    ps = load_benchmark("profile_solid")
+    for args in (["--quick", "--pole", "0.025"], ["--quick", "--recompute"], ["--pole", "0.3"]):
+        with pytest.raises(SystemExit) as e:
+            ps.main(args + ["--out-dir", str(BENCH / "nope")])
+        assert e.value.code == 2, args
+    assert not (BENCH / "nope").exists()
+    committed = json.loads((BENCH / "results" / "profile_solid.json").read_text())
+    cache = {ps.key(p, n): committed[ps.key(p, n)] for p, n in ps.QUICK_WALLS}
+    text = ps.report(cache, ps.argparse.Namespace(quick=True, mesh_check=False))
+    assert "--quick --no-mesh-check" in text and "# H0 = 0.025" in text and "# H0 = 0.0125" not in text
+    assert "profile, Kirchhoff | profile, shear | uniform H0, Kirchhoff | uniform H0, shear |" in text
+
+
+@pytest.mark.slow
+def test_profile_solid_quick_solids_are_the_full_runs(tmp_path):
+    """The quick mode's solids (~25 s CPU) at the committed run's first depths: the same forces."""
+    ps = load_benchmark("profile_solid")
+    r = _run("profile_solid", "--quick", "--out-dir", str(tmp_path))  # a process: its pool pickles fe_case
+    assert r.returncode == 0, r.stderr[-2000:]
+    quick = json.loads((tmp_path / "results" / "profile_solid-quick.json").read_text())
+    committed = json.loads((BENCH / "results" / "profile_solid.json").read_text())
+    for p, n in ps.QUICK_WALLS:
+        q, c = quick[ps.key(p, n)], committed[ps.key(p, n)]
+        assert q["success"] and q["delta"] == pytest.approx([p * k for k in ps.QUICK_DEPTHS])
+        np.testing.assert_allclose(q["force"], c["force"][:len(q["force"])], rtol=1e-6)
+        assert c["delta"][:len(q["delta"])] == pytest.approx(q["delta"])
+    assert (tmp_path / "results" / "profile_solid-quick.md").exists()
