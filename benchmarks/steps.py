@@ -154,7 +154,7 @@ STEPS = (
     Step("thick_fits_closed", "thick_fits.py", "solid", ["--set", "closed", "--no-convergence", "--timing"], None,
          _r("thick_fits_closed"), cost=224, source="stated"),
     Step("profile_solid", "profile_solid.py", "solid", [], ["--quick"], _r("profile_solid"), cost=653, source="sum",
-         note="quick: two walls to delta = H0 without the mesh check, 21 s CPU (91 s wall at load 14)"),
+         note="quick: two walls to delta = H0 without the mesh check: 21 s CPU, 41-91 s wall at load 13-14"),
     Step("closed_solid", "closed_solid.py", "solid", ["--sealed"], None, _r("closed_solid"), cost=1346, source="sum",
          note="FE curves are kept in its JSON: into an empty --out DIR every one is computed again"),
     # -- fits: interval coverage, the models' checks, the contact estimate
