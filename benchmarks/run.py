@@ -19,8 +19,8 @@ kept by hand).  tests/test_benchmarks.py fails for a script or a result file in 
 
 Each step is its own script, run as a fresh process with this interpreter and this checkout's
 package; results go to benchmarks/results/ (figures to benchmarks/figures/) or under ``--out``.
-A step whose script cannot write elsewhere yet is left out with ``--out`` rather than writing
-into the checkout (``--list --out DIR`` names them).  ``--quick`` runs every step's own quick
+Every step's script takes an output option; one that took none would be left out with ``--out``
+rather than write into the checkout (``--list --out DIR`` would name it).  ``--quick`` runs every step's own quick
 mode, whose files carry a ``-quick`` suffix, so the committed full results are never
 overwritten; steps without a quick mode that is fast enough (about a minute) are left out of
 ``--quick`` (the shooting peer needs its 10-20 s cold starts; the solid's curves, the maps, the
@@ -32,7 +32,7 @@ of its per-case times; ``--list`` prints them) add up to 27,515 s (7.6 h on 2 sh
 over 37 of the 52 steps; the other 15 (shooting, profile, point_budget, codegen_timing, kernels,
 sweep_scaling, sweep_kill_resume, topologies, bending_koiter_map, vella, stability_pressure,
 fit_baseline_coverage, contact_estimate, profile_fit, paper_figures) give no time, so 7.6 h is
-a floor.  ``--quick`` (23 steps) took 380 s measured on the same machine at load 6 (nice 10;
+a floor.  ``--quick`` (24 steps; 23 before profile_solid's) took 380 s measured on the same machine at load 6 (nice 10;
 1,260 s at load 10-12 with the whole trust tally), 2-76 s a step; the per-step times go to ``results/run-quick.json``.
 """
 

@@ -52,6 +52,7 @@ sys.path.insert(0, str(HERE.parent))  # this checkout's package
 
 import shellbvp as sb  # noqa: E402
 from shellbvp.fe import fe_size  # noqa: E402
+from checkout import add_output_args, results_dir, write_atomic  # noqa: E402  (benchmarks/ is on sys.path)
 
 R_L = 0.3e-3          # m
 MU = 1e6              # Pa
@@ -208,7 +209,7 @@ def timing(name, path, cache):
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = add_output_args(argparse.ArgumentParser(description=__doc__.splitlines()[0]))
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--set", choices=list(SETS), default="held-out",
                     help="held-out: issue 54's five scenes (default); mapped: the error map's scenes")
@@ -236,20 +237,20 @@ def main():
     if args.eps is not None:
         stem += f"_eps{args.eps:g}"
     result["set"] = args.set
-    write(result, stem)  # the fits, before the timing
+    write(result, stem, args.out_dir)  # the fits, before the timing
     if args.timing:
         timed = [n for n in names if n in CLOSED] or names[:1]
         result["timing"] = {}
         for n in timed:
             with tempfile.TemporaryDirectory() as cache:
                 result["timing"][n] = timing(n, made[n][0], cache)
-    write(result, stem)
+    write(result, stem, args.out_dir)
     print(report(result))
 
 
-def write(result, stem):
-    (HERE / "results" / f"{stem}.json").write_text(json.dumps(result, indent=1))
-    (HERE / "results" / f"{stem}.md").write_text(report(result))
+def write(result, stem, out_dir=None):
+    write_atomic(results_dir(out_dir) / f"{stem}.json", json.dumps(result, indent=1))
+    write_atomic(results_dir(out_dir) / f"{stem}.md", report(result))
 
 
 def report(r):

@@ -108,9 +108,12 @@ def test_quick_plan_writes_separate_files(run, tmp_path):
             assert argv[argv.index(s.out[0]) + 1].startswith(str(tmp_path / "results") + "/")
         assert s.quick_outputs and all("-quick" in o for o in s.quick_outputs)
     assert {s.name for s, _ in skipped} | set(names) == {s.name for s in _load("steps").STEPS}
-    # --out with a step that has no output option: left out rather than writing into benchmarks/
+    # --out: every step writes under it (bending_choice, stability_contact, thick_fits and closed_solid
+    # took no output option before); a step without one is left out rather than write into benchmarks/
     full = run.plan(figures=True, out=tmp_path)
-    assert "bending_choice" not in [s.name for s, _ in full]
+    assert [s.name for s, _ in full] == [s.name for s, _ in run.plan(figures=True)]
+    lone = _load("steps").Step("x", "x.py", "model", out=None)
+    assert lone.argv(False, None, "py") and lone.argv(False, tmp_path, "py") is None
     for s, argv in full:  # nothing of benchmarks/ named as an output
         assert str(tmp_path) in " ".join(argv) or s.out == "dir" and "--out-dir" in argv, s.name
         assert not any(a.startswith(str(BENCH / "results")) for a in argv), s.name
