@@ -109,7 +109,8 @@ class Scene:
         grain): ``gamma`` is then its polar over its equatorial semi-axis (> 0) and lengths are
         in units of its equatorial radius (``R_L``).  A ``UserShell`` is then the upper half's
         meridian, pole to equator, the lower half its mirror image
-        (:meth:`UserShell.closed_problem` says what it must be).  Default False.
+        (:meth:`UserShell.closed_problem` says what it must be), or its whole meridian from pole
+        to pole (:meth:`UserShell.pole_to_pole`).  Default False.
     support : {"substrate", "plates"}, optional
         What a closed shell rests on (default ``"substrate"``, a rigid frictionless plane) or
         ``"plates"`` (compressed between two parallel plates: ``tip=FlatTip()``; with a curved
