@@ -444,13 +444,14 @@ def _split_at_equator(R, Z, L, legacy_srepr):
         if not Lf > 0:
             raise ValueError(f"shell: a meridian from pole to pole ends at its bottom pole S = L > 0; got L = {L}")
         dR, dZ = sp.diff(R, S), sp.diff(Z, S)
-        for what, e, at in (("R(0) = 0 (the top pole on the axis)", R, 0), ("R(L) = 0 (the bottom pole on the axis)",
-                            R, L), ("Z'(0) = 0 (a smooth top pole)", dZ, 0), ("Z'(L) = 0 (a smooth bottom pole)", dZ, L)):
+        for what, e, at in (("R(0) = 0 (the top pole on the axis)", R, 0),
+                            ("R(L) = 0 (the bottom pole on the axis)", R, L),
+                            ("Z'(0) = 0 (a smooth top pole)", dZ, 0), ("Z'(L) = 0 (a smooth bottom pole)", dZ, L)):
             if sp.simplify(e.subs(S, at)) != 0:
                 got = number(e.subs(S, at))
+                exactly = f" (give L exactly: pi, not {Lf:.5g})" if abs(got) < 1e-3 else ""
                 raise ValueError(f"shell: a meridian from pole to pole has {what}; got {got:.3g} at S = "
-                                 + (f"L = {Lf:.6g}" + (f" (give L exactly: pi, not {Lf:.5g})" if abs(got) < 1e-3 else "")
-                                    if at is L else "0"))
+                                 + (f"L = {Lf:.6g}{exactly}" if at is L else "0"))
         slopes = number(dR.subs(S, 0)), number(dR.subs(S, L))
         if not (slopes[0] > 0 and slopes[1] < 0):
             raise ValueError(f"shell: a meridian from pole to pole leaves both poles horizontally, R'(0) > 0 and "
@@ -466,8 +467,8 @@ def _split_at_equator(R, Z, L, legacy_srepr):
         d = d.real
         zeros = _zeros(lambda x: np.real(fn(x)), s, d)
         if len(zeros) != 1:
-            where = ("R' keeps its sign" if not zeros else
-                     f"R'(S) = 0 at {len(zeros)} points, S = " + ", ".join(f"{(lo + hi) / 2:.4g}" for lo, hi in zeros[:5]))
+            where = ("R' keeps its sign" if not zeros else f"R'(S) = 0 at {len(zeros)} points, S = "
+                     + ", ".join(f"{(lo + hi) / 2:.4g}" for lo, hi in zeros[:5]))
             raise ValueError(f"shell: a meridian from pole to pole has one widest point (its equator), where R'(S) = 0 "
                              f"between the poles; {where} on 0 < S < L = {Lf:.6g}")
         lo, hi = zeros[0]
