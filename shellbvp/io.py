@@ -281,8 +281,8 @@ def write_curve_group(g, curve, *, profiles=False, units=None):
     g.attrs["scene"] = json.dumps(scene, sort_keys=True)
     for k, v in scene.items():
         if isinstance(v, dict):
-            for kk, vv in v.items():
-                g.attrs[f"scene_{k}_{kk}"] = vv
+            for kk, vv in v.items():  # a nested one (a shell's lower half or meridian pole to pole) as JSON
+                g.attrs[f"scene_{k}_{kk}"] = json.dumps(vv, sort_keys=True) if isinstance(vv, dict) else vv
         else:
             g.attrs[f"scene_{k}"] = v
     g.attrs["settings"] = json.dumps(curve.settings, sort_keys=True, default=float)

@@ -109,7 +109,8 @@ class Scene:
         grain): ``gamma`` is then its polar over its equatorial semi-axis (> 0) and lengths are
         in units of its equatorial radius (``R_L``).  A ``UserShell`` is then the upper half's
         meridian, pole to equator, the lower half its mirror image
-        (:meth:`UserShell.closed_problem` says what it must be).  Default False.
+        (:meth:`UserShell.closed_problem` says what it must be), or its whole meridian from pole
+        to pole (:meth:`UserShell.pole_to_pole`).  Default False.
     support : {"substrate", "plates"}, optional
         What a closed shell rests on (default ``"substrate"``, a rigid frictionless plane) or
         ``"plates"`` (compressed between two parallel plates: ``tip=FlatTip()``; with a curved
@@ -324,6 +325,9 @@ class Scene:
         kind = field(sh, "kind", text, "shell.")
         if kind == "spheroid":
             shell = Spheroid()
+        elif kind == "user" and "pole_to_pole" in sh:  # the meridian as given; its halves are derived from it
+            shell = UserShell.pole_to_pole(*(field(field(sh, "pole_to_pole", (dict,), "shell."), k, text,
+                                                   "shell.pole_to_pole.") for k in "RZL"), legacy_srepr=True)
         elif kind == "user":
             halves = [tuple(field(h, k, text, "shell.") for k in "RZL")
                       for h in [sh] + ([field(sh, "lower", (dict,), "shell.")] if "lower" in sh else [])]
@@ -426,7 +430,8 @@ class Scene:
         """
         if self.closed:
             shape = "closed spheroid" if isinstance(self.shell, Spheroid) else (
-                "closed shell (user meridian" + ("s, halves that differ)" if self.shell.lower else ")"))
+                "closed shell (user meridian" + (", pole to pole" if self.shell.meridian else "") +
+                (("s" if not self.shell.meridian else "") + ", halves that differ)" if self.shell.lower else ")"))
             if self.support == "plates":
                 return f"{shape} between " + ("plates" if isinstance(self.tip, FlatTip) else "two indenters")
             return f"{shape} on a substrate"
@@ -524,6 +529,9 @@ def _support(scene, gamma) -> str:
     if not scene.closed:
         if scene.support not in (None, "rim"):
             raise ValueError(f"support={scene.support!r} needs closed=True; a shell held on its rim has support 'rim'")
+        if isinstance(scene.shell, UserShell) and scene.shell.meridian is not None:
+            raise ValueError("shell: a meridian from pole to pole (UserShell.pole_to_pole) is a closed shell's: it needs "
+                             "closed=True (--closed)")
         return "rim"
     support = "substrate" if scene.support is None else scene.support
     if support not in SUPPORTS:

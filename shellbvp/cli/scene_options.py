@@ -86,11 +86,14 @@ def add_scene_options(p, uncertain=False, preset_required=False, solver=("tol", 
     shape.add_argument("--meridian", type=meridian_value, metavar="'R; Z; L'",
                        help="a reference meridian of your own, 'R(S); Z(S); L': formulas in S for 0 <= S <= L (read "
                             "by a whitelist, never run; rescaled to R(L) = 1, Z(L) = 0), e.g. 'sin(S); -2*cos(S); "
-                            "pi/2': pole to rim, or with --closed the upper half, pole to equator (R'(L) = 0), its "
-                            "mirror image the lower half")
+                            "pi/2': pole to rim; with --closed the upper half, pole to equator (R'(L) = 0), its "
+                            "mirror image the lower half, or the whole meridian from pole to pole when it returns to "
+                            "the axis at S = L (R(L) = 0, e.g. 'sin(S); cos(S)*(1 + 0.3*cos(S)); pi': an egg), split "
+                            "at its widest point (the equator, R = 1, Z = 0)")
     g.add_argument("--meridian-lower", type=meridian_value, metavar="'R; Z; L'", dest="meridian_lower",
                    help="with --closed --meridian on a substrate under a curved tip: the lower half's own meridian, "
-                        "pole to equator in its mirror image (an egg: Z > 0 is below the equator)")
+                        "pole to equator in its mirror image (an egg: Z > 0 is below the equator); not with a --meridian "
+                        "from pole to pole, which holds both halves")
     g.add_argument("--dome", action="store_true", default=None,
                    help="the shell is a dome indented from outside (its convex side): --rise is the pole's height "
                         "above the rim's plane, gamma = -rise / R_L")
@@ -104,7 +107,7 @@ def add_scene_options(p, uncertain=False, preset_required=False, solver=("tol", 
     g.add_argument("--closed", action="store_true", default=None,
                    help="a complete spheroid (a cell, capsule or pollen grain) instead of a shell held on its rim: "
                         "--radius is its equatorial radius, --gamma (or --rise) its polar semi-axis over it "
-                        "(or --meridian its upper half)")
+                        "(or --meridian its upper half, or its meridian from pole to pole)")
     g.add_argument("--support", choices=("substrate", "plates"),
                    help="with --closed: resting on a rigid plane (default; under a sphere, your tip or a flat "
                         "plate) or compressed between two plates (--flat-tip, or two of the same tip)")
@@ -169,8 +172,14 @@ def scene_from_args(args):
         over["tip"] = FlatTip()
     if (lower := getattr(args, "meridian_lower", None)) and not getattr(args, "meridian", None):
         raise ValueError("--meridian-lower needs --meridian (the upper half, pole to equator) and --closed")
-    if getattr(args, "meridian", None):
-        over["shell"] = UserShell.closed_halves(args.meridian, lower) if lower else UserShell(*args.meridian)
+    if meridian := getattr(args, "meridian", None):
+        whole = UserShell.returns_to_axis(meridian[0], meridian[2])  # R(L) = 0: pole to pole
+        if whole and lower:
+            raise ValueError("--meridian-lower: --meridian returns to the axis at S = L (R(L) = 0), a whole meridian "
+                             "from pole to pole; give either that alone, or the upper half (pole to equator) with "
+                             "--meridian-lower")
+        over["shell"] = (UserShell.pole_to_pole(*meridian) if whole else
+                         UserShell.closed_halves(meridian, lower) if lower else UserShell(*meridian))
     chosen = [p for p in material_options() if getattr(args, p.dest, None) is not None]
     if chosen:  # its material (the options exclude each other)
         over["material"] = material_class(chosen[0].material)(**{chosen[0].name: getattr(args, chosen[0].dest)})
