@@ -153,7 +153,7 @@ class UserShell:
             self.geometry = sg.user_shell(R, Z, L, legacy_srepr=legacy_srepr)
             self._desc = {"kind": "user", "R": formula_text(self.geometry.R), "Z": formula_text(self.geometry.Z),
                           "L": formula_text(self.geometry.L)}
-            ks, kt = self._curvatures = self.geometry.curvatures()
+            ks, kt = self._curvatures = self.geometry.curvatures(simplify=False)  # checks evaluate them
             pole_kt = sp.limit(kt, sg.S, 0, "+")
         if not (pole_kt.is_real and pole_kt.is_finite):
             raise ValueError(f"shell: the pole curvature kappa_theta(0) must be finite; got {pole_kt}")
@@ -182,7 +182,8 @@ class UserShell:
                 raise ValueError(f"shell: closed_halves' {name} half must be its meridian's (R, Z, L) as three "
                                  f"texts; got {half!r}")
         shell, other = cls(*upper, legacy_srepr=legacy_srepr), cls(*lower, legacy_srepr=legacy_srepr)
-        shell._upper, shell.lower = cls(*upper, legacy_srepr=legacy_srepr), other
+        shell._upper, shell.lower = copy.copy(shell), other  # the upper half alone, before it carries the lower
+        shell._upper._desc = dict(shell._desc)
         shell._desc["lower"] = {k: other._desc[k] for k in "RZL"}
         return shell
 
