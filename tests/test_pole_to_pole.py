@@ -140,7 +140,8 @@ def test_the_command_line_reads_a_meridian_that_returns_to_the_axis_pole_to_pole
     assert "shell=UserShell.pole_to_pole(R='sin(S)', Z='0.7*cos(S)', L='pi')" in info.stdout
     assert "closed shell (user meridian, pole to pole) between plates" in info.stdout
     for args, message in ((("--closed", "--meridian", spheroid, "--meridian-lower", "sin(S); cos(S); pi/2"),
-                           "--meridian-lower: --meridian returns to the axis at S = L"),
+                           "--meridian, --meridian-lower: --meridian returns to the axis at S = L"),
+                          (("--closed", "--meridian", "sin(S); cos(S); -1"), "--meridian: L must be a positive number"),
                           (("--meridian", spheroid), "it needs closed=True (--closed)"),
                           (("--closed", "--meridian", "sin(S); cos(S)**3; pi"), "must be vertical")):
         r = cli("solve", *args, "--delta", "0.02", cwd=tmp_path)

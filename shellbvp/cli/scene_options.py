@@ -173,13 +173,7 @@ def scene_from_args(args):
     if (lower := getattr(args, "meridian_lower", None)) and not getattr(args, "meridian", None):
         raise ValueError("--meridian-lower needs --meridian (the upper half, pole to equator) and --closed")
     if meridian := getattr(args, "meridian", None):
-        whole = UserShell.returns_to_axis(meridian[0], meridian[2])  # R(L) = 0: pole to pole
-        if whole and lower:
-            raise ValueError("--meridian-lower: --meridian returns to the axis at S = L (R(L) = 0), a whole meridian "
-                             "from pole to pole; give either that alone, or the upper half (pole to equator) with "
-                             "--meridian-lower")
-        over["shell"] = (UserShell.pole_to_pole(*meridian) if whole else
-                         UserShell.closed_halves(meridian, lower) if lower else UserShell(*meridian))
+        over["shell"] = _user_shell(meridian, lower)
     chosen = [p for p in material_options() if getattr(args, p.dest, None) is not None]
     if chosen:  # its material (the options exclude each other)
         over["material"] = material_class(chosen[0].material)(**{chosen[0].name: getattr(args, chosen[0].dest)})
@@ -205,6 +199,20 @@ def scene_from_args(args):
         over["thickness"] = _thickness_profile(args, scene)
         scene = Scene.preset(args.preset or "base", **over)
     return scene
+
+
+def _user_shell(meridian, lower):
+    """``--meridian`` (and ``--meridian-lower``) as a UserShell; its errors name the options."""
+    options = "--meridian, --meridian-lower" if lower else "--meridian"
+    try:
+        whole = UserShell.returns_to_axis(meridian[0], meridian[2])  # R(L) = 0: pole to pole
+        if whole and lower:
+            raise ValueError("--meridian returns to the axis at S = L (R(L) = 0), a whole meridian from pole to pole; "
+                             "give either that alone, or the upper half (pole to equator) with --meridian-lower")
+        return (UserShell.pole_to_pole(*meridian) if whole else
+                UserShell.closed_halves(meridian, lower) if lower else UserShell(*meridian))
+    except ValueError as exc:
+        raise ValueError(f"{options}: {str(exc).removeprefix('shell: ')}") from None
 
 
 def _thickness_profile(args, scene):
