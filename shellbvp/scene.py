@@ -453,12 +453,15 @@ class Scene:
     @property
     def halved(self) -> bool:
         """A closed shell solved on the half above its equator: between two plates (or two
-        identical tips), or on a substrate under a flat plate (the same problem)."""
-        return self.closed and (self.support == "plates" or isinstance(self.tip, FlatTip))
+        identical tips), or on a substrate under a flat plate (the same problem); not a shell
+        whose halves differ (``UserShell.closed_halves``), which has no mirror symmetry."""
+        return (self.closed and (self.support == "plates" or isinstance(self.tip, FlatTip))
+                and getattr(self.shell, "lower", None) is None)
 
     @property
     def two_contacts(self) -> bool:
-        """A closed shell on a substrate under a curved tip: both halves solved, two contacts."""
+        """A closed shell on a substrate under a curved tip, or one whose halves differ between
+        plates (on a substrate under a flat plate): both halves solved, two contacts."""
         return self.closed and not self.halved
 
     @property
