@@ -269,13 +269,9 @@ def _check_units(units):
 
 
 def _flat(data: dict, prefix: str):
-    """``(prefix_key[_subkey...], value)`` of nested mappings (a closed shell's lower half:
-    ``scene_shell_lower_R``)."""
+    """``(prefix_key[_subkey...], value)`` of nested mappings (``scene_shell_lower_R``)."""
     for k, v in data.items():
-        if isinstance(v, dict):
-            yield from _flat(v, f"{prefix}_{k}")
-        else:
-            yield f"{prefix}_{k}", v
+        yield from _flat(v, f"{prefix}_{k}") if isinstance(v, dict) else ((f"{prefix}_{k}", v),)
 
 
 def write_curve_group(g, curve, *, profiles=False, units=None):
@@ -289,8 +285,7 @@ def write_curve_group(g, curve, *, profiles=False, units=None):
     g.attrs["axes"] = np.array(["delta"], dtype=h5py.string_dtype())
     scene = curve.scene.to_dict()
     g.attrs["scene"] = json.dumps(scene, sort_keys=True)
-    for k, v in _flat(scene, "scene"):
-        g.attrs[k] = v
+    g.attrs.update(_flat(scene, "scene"))
     g.attrs["settings"] = json.dumps(curve.settings, sort_keys=True, default=float)
     g.attrs["stop_reason"] = curve.stop_reason
     g.attrs["complete"] = bool(curve.complete)
