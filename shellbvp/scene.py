@@ -116,7 +116,8 @@ class Scene:
         tip, between two such indenters); delta is the approach of the indenter and the
         support.  Between plates, or on a substrate under a flat plate, the half above the
         equator is solved (symmetry: the equator stays vertical, free to move out, and moves
-        by delta/2); under a curved tip on a substrate both halves are, with a contact each.
+        by delta/2); under a curved tip on a substrate both halves are, with a contact each, as
+        are a shell's whose halves differ (``UserShell.closed_halves``) between plates.
     thickness_profile : ThicknessProfile, optional
         Set from ``thickness`` when that is a profile (read it here; files store it).
 
