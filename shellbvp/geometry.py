@@ -170,7 +170,7 @@ class UserShell:
         own pole to the equator, as :meth:`closed_problem` asks of an upper half (rescaled so the
         equator is ``R = 1``, ``Z = 0``): the lower half in its mirror image, ``Z > 0`` above the
         equator meaning below it.  For ``Scene(closed=True)`` on a substrate under a curved tip
-        (both halves solved); between plates the mirror symmetry is needed.
+        (both halves solved), or between plates (on a substrate under a flat plate: the same problem).
 
         >>> import shellbvp as sb
         >>> egg = sb.UserShell.closed_halves(("sin(S)", "1.3*cos(S)", "pi/2"), ("sin(S)", "0.7*cos(S)", "pi/2"))
@@ -256,9 +256,10 @@ class UserShell:
             return None
         if not scene.closed:
             return "shell: a lower half of its own (UserShell.closed_halves) needs closed=True"
-        if not scene.two_contacts:
-            return ("shell: halves that differ need support='substrate' under a curved tip; between plates (or "
-                    "under a flat plate) the shell must be mirror-symmetric about its equator (UserShell(R, Z, L))")
+        if scene.support == "plates" and not isinstance(scene.tip, FlatTip):
+            return ("shell: halves that differ rest on a substrate (under any tip) or lie between plates (a flat tip); "
+                    "between two curved tips (support='plates' with a curved tip) the shell must be mirror-symmetric "
+                    "about its equator (UserShell(R, Z, L))")
         if scene.pressure or scene.sealed:
             return "shell: halves that differ are offered without pressure only (pressure=0, sealed=False) for now"
         if scene.thickness_profile is not None:

@@ -117,7 +117,8 @@ class Scene:
         tip, between two such indenters); delta is the approach of the indenter and the
         support.  Between plates, or on a substrate under a flat plate, the half above the
         equator is solved (symmetry: the equator stays vertical, free to move out, and moves
-        by delta/2); under a curved tip on a substrate both halves are, with a contact each.
+        by delta/2); under a curved tip on a substrate both halves are, with a contact each, as
+        are a shell's whose halves differ (``UserShell.closed_halves``) between plates.
     thickness_profile : ThicknessProfile, optional
         Set from ``thickness`` when that is a profile (read it here; files store it).
 
@@ -458,12 +459,15 @@ class Scene:
     @property
     def halved(self) -> bool:
         """A closed shell solved on the half above its equator: between two plates (or two
-        identical tips), or on a substrate under a flat plate (the same problem)."""
-        return self.closed and (self.support == "plates" or isinstance(self.tip, FlatTip))
+        identical tips), or on a substrate under a flat plate (the same problem); not a shell
+        whose halves differ (``UserShell.closed_halves``), which has no mirror symmetry."""
+        return (self.closed and (self.support == "plates" or isinstance(self.tip, FlatTip))
+                and getattr(self.shell, "lower", None) is None)
 
     @property
     def two_contacts(self) -> bool:
-        """A closed shell on a substrate under a curved tip: both halves solved, two contacts."""
+        """A closed shell on a substrate under a curved tip, or one whose halves differ between
+        plates (on a substrate under a flat plate): both halves solved, two contacts."""
         return self.closed and not self.halved
 
     @property
