@@ -191,8 +191,6 @@ class UserShell:
         if not scene.two_contacts:
             return ("shell: halves that differ need support='substrate' under a curved tip; between plates (or "
                     "under a flat plate) the shell must be mirror-symmetric about its equator (UserShell(R, Z, L))")
-        if scene.pressure or scene.sealed:
-            return "shell: halves that differ are offered without pressure only (pressure=0, sealed=False) for now"
         if scene.thickness_profile is not None:
             return "shell: halves that differ are offered with a constant thickness only (no thickness profile) for now"
         return None
