@@ -260,8 +260,6 @@ class UserShell:
             return ("shell: halves that differ rest on a substrate (under any tip) or lie between plates (a flat tip); "
                     "between two curved tips (support='plates' with a curved tip) the shell must be mirror-symmetric "
                     "about its equator (UserShell(R, Z, L))")
-        if scene.pressure or scene.sealed:
-            return "shell: halves that differ are offered without pressure only (pressure=0, sealed=False) for now"
         if scene.thickness_profile is not None:
             return "shell: halves that differ are offered with a constant thickness only (no thickness profile) for now"
         return None

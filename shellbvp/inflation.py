@@ -18,6 +18,16 @@ buckling literature); it is offered here only, not in contact.
 The inflated pole rises by ``pole_rise`` above ``Z(0)``; delta is measured from there
 (the generated code's ``z_tip = Z(0) + pole_rise - delta``), so every curve starts at
 delta = 0 from the inflated shape, which is also what the crude guesses start from.
+
+A closed shell is solved on the half above its equator (the rim's rows hold its tangent
+vertical, no horizontal force, the equator at its height), exact where its halves are mirror
+images.  One whose halves differ (``UserShell.closed_halves``, an egg) inflates as a whole: both
+halves free from their poles to the equator, joined there as on the substrate (the chain's
+``Seam``: the slope, the radius, the height, ``tau_s``, ``M_s`` and the shear continuous), the
+equator's tangent free to tilt.  The lower pole's axial force then follows from the upper's and
+the seam (both halves' axial force is the same first integral), so its row holds the rigid
+translation instead: the equator at ``z = 0``.  Each pole's rise (the upper's ``pole_rise``, the
+lower's ``lower_pole_rise``, in its mirror image) is where the tip, and the substrate, find it.
 """
 
 from __future__ import annotations
@@ -28,13 +38,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .chain import Chain, ChainBVP, FreePole, Point, Region, Rim
+from .chain import Chain, ChainBVP, FreePole, Point, Region, Rim, Seam
 from .diagnosis import as_failure, diagnose
 from .march import Steps, march
+from .model import lower_structure
 from .solution import Solution, attach_tip_table, state_class
 
 __all__ = ["inflate", "InflatedState", "inflated_chain", "inflated_pole_rise", "start_shape", "system_parameters",
-           "enclosed_volume", "InflatedStart", "INFLATED_FIELDS", "inflated_start"]
+           "enclosed_volume", "InflatedStart", "INFLATED_FIELDS", "inflated_start", "halves_chain", "lower_pole_rise"]
 
 #: Pole start of the inflated state, ``zeta = EPS * L`` (the free pole's truncation error
 #: is O(zeta^2): 1e-8 relative, below the inflation's tolerance).
@@ -53,6 +64,8 @@ class InflatedState(Solution):
     pole_stretch: float = math.nan
     volume_change: float = math.nan
     rim_hoop_tension: float = math.nan
+    #: a closed shell whose halves differ: its lower pole's rise (in its mirror image; NaN otherwise)
+    lower_pole_rise: float = math.nan
 
 
 #: The inflated state's numbers that a curve carries and its file keeps: (name, units, what it is)
@@ -90,19 +103,57 @@ def inflated_chain(L: float) -> Chain:
                  (FreePole(0), Rim(0)), (), EPS)
 
 
-def _reference_states(sysm, S):
-    """The unstressed reference shell in the free region's states (lt, phiS, ls, ks, rQ, z)."""
-    ref = sysm.model.reference_shell(S, sysm.par)
+def halves_chain(L_upper: float, L_lower: float) -> Chain:
+    """A closed shell whose halves differ, free: each half from a regular pole (at ``EPS`` times
+    its L) to the equator, where they meet (the upper's region first)."""
+    regions = tuple(Region("free", Point("zeta", None, math.log(L) + math.log(EPS)), Point(end, None, math.log(L)))
+                    for L, end in ((L_upper, "L"), (L_lower, "L_b")))
+    return Chain("inflated", regions, (FreePole(0), FreePole(1), Seam(0, 1)), (), EPS)
+
+
+class _HalvesInflated(ChainBVP):
+    """The inflated chain of a closed shell whose halves differ: the lower pole's axial-force row
+    (implied by the upper's and the seam's) holds the equator's height instead, ``z = 0``."""
+
+    _ROW = 5  # FreePole(1)'s third row, G = 0
+    _Z = 5  # z in a free region's states
+
+    def bc(self, ya, yb, p=None):
+        res = super().bc(ya, yb, p)
+        res[self._ROW] = yb[self.offsets[0] + self._Z]
+        return res
+
+    def bc_jac(self, ya, yb, p=None):
+        A, B = super().bc_jac(ya, yb, p)
+        A[self._ROW], B[self._ROW] = 0.0, 0.0
+        B[self._ROW, self.offsets[0] + self._Z] = 1.0
+        return A, B
+
+
+def _reference_states(sysm, S, k=0):
+    """The unstressed reference shell in the free region's states (lt, phiS, ls, ks, rQ, z): of
+    region ``k``'s half."""
+    ref = sysm.models[k].reference_shell(S, sysm.par)
     one = np.ones_like(S)
     return np.vstack([one, ref["Phi"] / S, one, ref["kappa_s"] * one, 0 * S, ref["Z"] * one])
+
+
+def _halves_differ(scene) -> bool:
+    """A closed shell whose halves differ, both solved (``UserShell.closed_halves``)."""
+    return lower_structure(scene) is not None
 
 
 def _system(scene, pressure):
     """The inflated chain of ``scene`` at ``pressure`` (a step of the continuation)."""
     scene = scene.replace(pressure=pressure)
     mod = scene.model()
-    sysm = ChainBVP(scene, inflated_chain(scene.shell_length), "delta", 0.0, model=mod,
-                    par=scene.parameters(mod, pole_rise=0.0), volume_control=False)
+    par = scene.parameters(mod, pole_rise=0.0)
+    if _halves_differ(scene):
+        sysm = _HalvesInflated(scene, halves_chain(scene.shell_length, float(scene.shell.lower.geometry.L)), "delta",
+                               0.0, model=mod, par=par, volume_control=False)
+    else:
+        sysm = ChainBVP(scene, inflated_chain(scene.shell_length), "delta", 0.0, model=mod, par=par,
+                        volume_control=False)
     attach_tip_table(sysm)
     return sysm
 
@@ -139,8 +190,11 @@ def inflate(scene, tol: float = TOL, max_nodes: int = _MAX_NODES, *, start: Infl
         Topology ``"inflated"``; ``pole_rise`` (the pole's height above ``Z(0)``),
         ``pole_stretch``, ``volume_change`` (``V - V_ref``, V the volume between the shell
         and its rim's plane), ``rim_hoop_tension`` and the usual fields (``force`` is 0 to
-        tolerance: no indenter).  ``success`` False with a message if the continuation
-        stalled.
+        tolerance: no indenter).  A closed shell whose halves differ (``UserShell.closed_halves``,
+        inflated as a whole): also ``lower_pole_rise`` (its lower pole's, in its mirror image,
+        the equator at height 0), the whole shell's ``volume_change``, and the upper half's
+        other numbers (``rim_hoop_tension`` at its equator).  ``success`` False with a message
+        if the continuation stalled.
 
     Examples
     --------
@@ -161,7 +215,7 @@ def inflate(scene, tol: float = TOL, max_nodes: int = _MAX_NODES, *, start: Infl
         return _finish(_solve(_system(scene, target), start.x[keep], start.y[:, keep], tol, max_nodes))
     sysm = _system(scene, 0.0)
     x = np.linspace(0.0, 1.0, 81)
-    y = _reference_states(sysm, sysm.S(0, x, None))
+    y = np.vstack([_reference_states(sysm, sysm.S(k, x, None), k) for k in range(len(sysm.regions))])
     if target == 0.0:
         return _finish(_solve(sysm, x, y, tol, max_nodes))
     def solve_at(p_next, states):
@@ -178,22 +232,30 @@ def inflate(scene, tol: float = TOL, max_nodes: int = _MAX_NODES, *, start: Infl
     return _finish(m.last)
 
 
+def _pole_rise(sysm, y0, k) -> float:
+    """The rise of region ``k``'s pole above its half's ``Z(0)`` from its states ``y0`` at zeta."""
+    zeta = sysm.S_point(sysm.regions[k].start, None)
+    lt, phiS, ls, ks, rQ, z = y0
+    ref = sysm.models[k].reference_shell
+    # z(zeta) - z(0) = Int_0^zeta psi sin(phi) dS ~ psi phiS zeta^2/2 (phi ~ phiS S near the pole)
+    return float(z - ls * ref(zeta, sysm.par)["R"] / zeta * phiS * zeta**2 / 2) - float(ref(0.0, sysm.par)["Z"])
+
+
 def _finish(res, failed=False):
     """The inflated state's own numbers (from its system, ``res.system``), NaN where it failed."""
     nan = float("nan")
     if failed or not res.success:
-        return res.with_(topology="inflated", pole_rise=nan, pole_stretch=nan, volume_change=nan, rim_hoop_tension=nan)
+        return res.with_(topology="inflated", pole_rise=nan, pole_stretch=nan, volume_change=nan, rim_hoop_tension=nan,
+                         lower_pole_rise=nan)
     sysm = res.system
-    zeta = sysm.S_point(sysm.regions[0].start, None)
-    lt, phiS, ls, ks, rQ, z = res.y[:, 0]
-    Z0 = float(sysm.model.reference_shell(0.0, sysm.par)["Z"])
-    # z(zeta) - z(0) = Int_0^zeta psi sin(phi) dS ~ psi phiS zeta^2/2 (phi ~ phiS S near the pole)
-    rim = sysm.model.free_profile(np.array([sysm.L]), res.y[:, -1:], sysm.par)
+    halves = len(sysm.regions) == 2  # a closed shell whose halves differ: the upper's numbers, and its lower pole's
+    rows = sysm.rows(0)
+    rim = sysm.model.free_profile(np.array([sysm.S_point(sysm.regions[0].end, None)]), res.y[rows, -1:], sysm.par)
+    volume = sysm.scene.closed_volume() if halves else sysm.scene.reference_volume()
     return res.with_(
-        topology="inflated",
-        pole_rise=float(z - ls * sysm.model.reference_shell(zeta, sysm.par)["R"] / zeta * phiS * zeta**2 / 2) - Z0,
-        pole_stretch=float(ls), volume_change=sysm.volume(res.sol, res.x, None) - sysm.scene.reference_volume(),
-        rim_hoop_tension=float(rim["tau_theta"][0]))
+        topology="inflated", pole_rise=_pole_rise(sysm, res.y[rows, 0], 0), pole_stretch=float(res.y[rows, 0][2]),
+        volume_change=sysm.volume(res.sol, res.x, None) - volume, rim_hoop_tension=float(rim["tau_theta"][0]),
+        lower_pole_rise=_pole_rise(sysm, res.y[sysm.rows(1), 0], 1) if halves else nan)
 
 
 def system_parameters(scene, model=None):
@@ -202,10 +264,21 @@ def system_parameters(scene, model=None):
     return scene.parameters(model, pole_rise=inflated_pole_rise(scene) if scene.pressure else 0.0)
 
 
+def lower_pole_rise(scene) -> float | None:
+    """Where the substrate finds the lower pole of a closed shell whose halves differ under
+    pressure (:func:`inflate`'s ``lower_pole_rise``, the lower half's ``pole_rise`` parameter),
+    None for any other scene (its halves share the upper's)."""
+    if not (scene.pressure and _halves_differ(scene)):
+        return None
+    inflated_pole_rise(scene)  # a ValueError if the inflated state was not found
+    return float(inflate(scene).lower_pole_rise)
+
+
 def enclosed_volume(scene) -> float:
     """V0 of a sealed scene: the volume between the shell and its rim's plane in the inflated
     state at ``scene.pressure`` (the reference volume at pressure 0).  What a sealed scene's
-    systems hold the volume at.
+    systems hold the volume at.  A closed shell's: of the half above its equator; of one whose
+    halves differ, the whole shell's (both halves').
 
     Parameters
     ----------
@@ -224,13 +297,14 @@ def enclosed_volume(scene) -> float:
     >>> round(sb.enclosed_volume(scene) - scene.reference_volume(), 4)  # the inflated state's volume change
     0.088
     """
+    reference = scene.closed_volume() if _halves_differ(scene) else scene.reference_volume()
     if not scene.pressure:
-        return scene.reference_volume()
+        return reference
     state = inflate(scene.replace(sealed=False))
     if not state.success:
         raise ValueError(f"the inflated state at pressure {scene.pressure:g} was not found "
                          f"({state.message}): no enclosed volume for the sealed shell")
-    return scene.reference_volume() + state.volume_change
+    return reference + state.volume_change
 
 
 def inflated_pole_rise(scene) -> float:
@@ -252,4 +326,4 @@ def start_shape(scene, S):
         raise ValueError(f"pressure = {scene.pressure:g}: {state.message}")
     sysm = state.system
     t = np.clip(sysm.t_of(0, np.maximum(S, sysm.S_point(sysm.regions[0].start, None)), None), 0.0, 1.0)
-    return state.sol(t)
+    return state.sol(t)[sysm.rows(0)]  # (a closed shell whose halves differ: its upper half)

@@ -16,7 +16,7 @@ import numpy as np
 from .edge_models import EdgeModel, contact_models, edge_model
 from .geometry import FlatTip, SphereTip, Spheroid, UserShell, UserTip
 from .materials import MATERIALS, Bending, Material, MooneyRivlin, TraceBending, bending_class, material_class
-from .model import load_module, structure_description
+from .model import load_module, lower_structure, structure_description
 from .presets import PRESETS
 from .scene_parameters import scene_parameter, scene_parameters
 from .thickness_profile import ThicknessProfile, settle_profile
@@ -506,6 +506,15 @@ class Scene:
         plane (the origin of the pressure's potential ``-p (V - V_ref)``)."""
         return _reference_volume(self)
 
+    def closed_volume(self) -> float:
+        """V inside the undeformed closed shell: its halves' volumes above and below the equator's
+        plane, each of its own meridian where they differ (``UserShell.closed_halves`` on a
+        substrate); twice :meth:`reference_volume` where they are mirror images."""
+        if not self.closed:
+            raise ValueError("closed_volume: a shell held on its rim encloses no volume of its own (see reference_volume)")
+        lower = lower_structure(self)
+        return _reference_volume(self) + (_reference_volume(self) if lower is None else _lower_reference_volume(self))
+
     @property
     def contact_model(self) -> EdgeModel:
         """The contact model's object (:mod:`shellbvp.edge_models`): what its edge conditions
@@ -554,10 +563,19 @@ def _support(scene, gamma) -> str:
 
 @functools.lru_cache(maxsize=64)
 def _reference_volume(scene) -> float:
+    return _half_volume(scene.model(), scene.parameters(pole_rise=0.0), scene.shell_length)
+
+
+@functools.lru_cache(maxsize=64)
+def _lower_reference_volume(scene) -> float:
+    """The lower half's of a closed shell whose halves differ (in its mirror image)."""
+    return _half_volume(load_module(lower_structure(scene)), scene.parameters(pole_rise=0.0),
+                        float(scene.shell.lower.geometry.L))
+
+
+def _half_volume(mod, par, L) -> float:
     from scipy.integrate import quad
 
-    mod = scene.model()
-    par = scene.parameters(mod, pole_rise=0.0)
-    value, _ = quad(lambda S: float(mod.reference_shell(S, par)["volume_density"]), 0.0, scene.shell_length,
+    value, _ = quad(lambda S: float(mod.reference_shell(S, par)["volume_density"]), 0.0, L,
                     epsabs=1e-13, epsrel=1e-12, limit=200)
     return value

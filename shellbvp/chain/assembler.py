@@ -52,10 +52,14 @@ class ChainBVP(BoundaryConditions):
         V0, the volume a sealed shell holds; needed under volume control
         (``shellbvp.inflation.enclosed_volume``, which a configuration's system passes): the
         system solves nothing to find it.
+    lower_pole_rise : float, optional
+        A closed shell's lower half of its own (``UserShell.closed_halves``) under pressure: its
+        pole's rise in the inflated state, where the substrate finds it (the lower half's
+        ``pole_rise`` parameter, :meth:`half_par`; ``par`` carries the upper's).
     """
 
     def __init__(self, scene, chain: Chain, control: str, value, model=None, par=None, volume_control=None,
-                 enclosed_volume=None):
+                 enclosed_volume=None, lower_pole_rise=None):
         if control not in CONTROLS:
             raise ValueError(f"control must be one of {CONTROLS}; got {control!r}")
         self.scene, self.chain, self.control = scene, chain, control
@@ -67,6 +71,10 @@ class ChainBVP(BoundaryConditions):
         self.par = scene.parameters(mod) if par is None else np.asarray(par, float)
         self.regions = chain.regions
         self._bind()
+        self.lower_pole_rise = None
+        if lower_pole_rise is not None and self.models[-1] is not self.model:
+            self.lower_pole_rise = float(lower_pole_rise)
+            self._i_rise = mod.PARAMS.index("pole_rise")
         self.sizes = [SIZES[r.kind] for r in chain.regions]
         self.offsets = np.cumsum([0, *self.sizes])[:-1].tolist()
         self.n_shell = int(sum(self.sizes))  # the regions' states; then the volume state
@@ -217,7 +225,7 @@ class ChainBVP(BoundaryConditions):
     def _volume_rates(self, t, y, p, k):
         a, b = self.ln_S(self.regions[k].start, p), self.ln_S(self.regions[k].end, p)
         S = np.exp(a + t * (b - a))
-        return (b - a) * self._vol[k](S, y[self.rows(k)], self.par)[0]
+        return (b - a) * self._vol[k](S, y[self.rows(k)], self.half_par(self.par, k))[0]
 
     def complete(self, x, y, p):
         """``(y, p)`` for a solve from a guess of the regions' states and the unknowns before
@@ -381,10 +389,11 @@ class ChainBVP(BoundaryConditions):
             a, b = self.ln_S(reg.start, p), self.ln_S(reg.end, p)
             rows = self.rows(k)
             S = np.exp(a + t * (b - a))
-            gs.append(self._rhs(k)(S, y[rows], par))
+            par_k = self.half_par(par, k)
+            gs.append(self._rhs(k)(S, y[rows], par_k))
             f[rows] = (b - a) * gs[-1]
             if self.volume_control:
-                f[self.n_shell] += (b - a) * self._vol[k](S, y[rows], par)[0]
+                f[self.n_shell] += (b - a) * self._vol[k](S, y[rows], par_k)[0]
         return f, gs
 
     def fun_jac(self, t, y, p=None):
@@ -397,14 +406,15 @@ class ChainBVP(BoundaryConditions):
             a, b = self.ln_S(reg.start, p), self.ln_S(reg.end, p)
             rows = self.rows(k)
             S = np.exp(a + t * (b - a))
-            gy, gS = self._jac(k)(S, y[rows], par)
+            par_k = self.half_par(par, k)
+            gy, gS = self._jac(k)(S, y[rows], par_k)
             dfdy[rows, rows] = (b - a) * gy
             if self.volume_control:
                 v = self.n_shell
-                vy, vS = self._vol_jac[k](S, y[rows], par)
+                vy, vS = self._vol_jac[k](S, y[rows], par_k)
                 dfdy[v, rows] = (b - a) * vy[0]
                 dfdp[rows, self.col["pressure"]] = (b - a) * getattr(
-                    self._active(k), f"{reg.kind}_jac_par")(S, y[rows], par)[:, self._i_pressure]
+                    self._active(k), f"{reg.kind}_jac_par")(S, y[rows], par_k)[:, self._i_pressure]
             if dfdp is None:
                 continue
             # d/da and d/db of (b - a) g(exp(a + t (b - a)), y), and of the volume rate
@@ -413,9 +423,9 @@ class ChainBVP(BoundaryConditions):
                 if point.unknown is None:
                     continue
                 if g is None:
-                    g = hit[1][k] if hit is not None else self._rhs(k)(S, y[rows], par)
+                    g = hit[1][k] if hit is not None else self._rhs(k)(S, y[rows], par_k)
                     if self.volume_control:
-                        rate = self._vol[k](S, y[rows], par)[0]
+                        rate = self._vol[k](S, y[rows], par_k)[0]
                 dfdp[rows, self.col[point.unknown]] += sign * g + (b - a) * gS * S * dS_dln
                 if self.volume_control:
                     dfdp[v, self.col[point.unknown]] += sign * rate + (b - a) * vS[0] * S * dS_dln
@@ -439,7 +449,7 @@ class ChainBVP(BoundaryConditions):
         for k, reg in enumerate(self.regions):
             S = self.S(k, t, p)
             out.append((k, S, getattr(self._active(k), f"{reg.kind}_profile")(S, y[self.rows(k)],
-                                                                                   self.par_at(p))))
+                                                                                   self.half_par(self.par_at(p), k))))
         return out
 
     def profile(self, t, y, p, z_tip: float) -> dict:
@@ -469,6 +479,15 @@ class ChainBVP(BoundaryConditions):
         names = self.model.PARAMS
         return float(self.par[names.index(name)]) if name in names else 0.0
 
+    def half_par(self, par, k) -> np.ndarray:
+        """``par`` as region ``k``'s half takes it: a lower half of its own (``lower_pole_rise``)
+        with its own pole rise; the other parameters are both halves'."""
+        if self.lower_pole_rise is None or self.models[k] is self.model:
+            return par
+        par = par.copy()
+        par[self._i_rise] = self.lower_pole_rise
+        return par
+
     @property
     def pressure(self) -> float:
         """The pressure of the parameters (under volume control: of the solution, see :meth:`at`)."""
@@ -488,7 +507,8 @@ class ChainBVP(BoundaryConditions):
         meridian's (in its mirror image), where the substrate finds it."""
         if self.models[k] is self.model:
             return self.pole_height
-        return float(self.models[k].reference_shell(0.0, self.par)["Z"]) + self._param("pole_rise")
+        rise = self._param("pole_rise") if self.lower_pole_rise is None else self.lower_pole_rise
+        return float(self.models[k].reference_shell(0.0, self.par)["Z"]) + rise
 
     def energy(self, sol, x, p) -> float:
         """``E = 2 pi Int U R Psi dS - p (V - V_ref)``, twice that for a closed shell (the half
@@ -497,8 +517,9 @@ class ChainBVP(BoundaryConditions):
         each pole disc ``[0, zeta]``) and the pressure's potential (``shellbvp.inflation``).
         Under volume control the pressure does no work (V is held): E is the elastic energy."""
         elastic = self._elastic_energy(sol, x, p)
-        if not (self.volume_control or not self.pressure):  # V_ref: of the half a closed shell's inflation solves
-            reference = self.scene.reference_volume() * (2 if self.scene.two_contacts and not self.mirrored else 1)
+        if not (self.volume_control or not self.pressure):  # V_ref: of what is solved, a half or the whole
+            reference = (self.scene.closed_volume() if self.scene.two_contacts and not self.mirrored
+                         else self.scene.reference_volume())
             elastic -= self.pressure * (self.volume(sol, x, p) - reference)
         return 2 * elastic if self.mirrored else elastic
 
@@ -519,12 +540,12 @@ class ChainBVP(BoundaryConditions):
         total = 0.0
         for k, reg in enumerate(self.regions):  # the generated energy density alone, not the profile
             S = self.S(k, t, p)
-            density = getattr(self._active(k), f"{reg.kind}_energy")(S, y[self.rows(k)], par)[0]
+            density = getattr(self._active(k), f"{reg.kind}_energy")(S, y[self.rows(k)], self.half_par(par, k))[0]
             total += float(np.sum(w * density * S)) * (self.ln_S(reg.end, p) - self.ln_S(reg.start, p))
         for j in self.junctions:
             if isinstance(j, (ContactPole, FreePole)):
                 zeta = self.S_point(self.regions[j.k].start, p)
                 energy = getattr(self._active(j.k), f"{self.regions[j.k].kind}_energy")
-                density = energy(np.array([zeta]), sol(np.array([0.0]))[self.rows(j.k)], par)[0]
+                density = energy(np.array([zeta]), sol(np.array([0.0]))[self.rows(j.k)], self.half_par(par, j.k))[0]
                 total += 0.5 * float(density[0]) * zeta
         return 2 * np.pi * total

@@ -68,11 +68,12 @@ class BoundaryConditions:
         return self.regions[j.k].end, np.array([q[j.chi], yin[_LS]]), yin, ya[self.rows(j.k + 1)]
 
     def bc(self, ya, yb, p=None):
-        par = self.par_at(p)
+        par_all = self.par_at(p)
         q = self.quantities(p)
         parts = []
         for j in self.junctions:
             mod = self._junction_model(j)
+            par = self.half_par(par_all, self._junction_k(j))
             if isinstance(j, ContactPole):
                 y0 = ya[self.rows(j.k)]
                 parts.append(self._pole_function(j, "res")(y0[0], y0[1], q[j.stretch], par))
@@ -102,12 +103,13 @@ class BoundaryConditions:
                 (Lu, wu), (Ll, wl) = self.seam_slopes
                 equal = (yu - yl)[_SEAM_EQUAL]
                 if self.seam_references is not None:  # halves that differ: [tau_s] = [M_s] = 0
-                    equal[1:] = self._seam_stress_jumps(j, yu, yl, par)[0]
+                    equal[1:] = self._seam_stress_jumps(j, yu, yl, par_all)[0]
                 parts += [equal, (yu + yl)[_SEAM_OPPOSITE],
                           [(Lu * yu[_PHIS] + Ll * yl[_PHIS] - wu - wl) / (0.5 * (Lu + Ll))]]
             elif isinstance(j, Rim):
                 parts.append(self._rim_res(self.S_point(self.regions[j.k].end, p), yb[self.rows(j.k)], par,
                                            q["delta"] if "delta" in q else 0.0))
+        par = self.half_par(par_all, self._junction_k(self.force_at)) if self.force_at is not None else par_all
         if self.extra == "force":
             _, S, yc, yf, _, _ = self._force_args(ya, yb, p, q)
             parts.append(self._force_function("res")(S, yc, yf, q["delta"], q["F"], par))
@@ -129,10 +131,11 @@ class BoundaryConditions:
         (Lu, _), (Ll, _) = self.seam_slopes
         ru, rl = self.seam_references
         mu, ml = self.models[j.ku], self.models[j.kl]
-        jumps = mu.kink_res(Lu, ru, yu, par)[:2] - ml.kink_res(Ll, rl, yl, par)[:2]
+        pu, pl = self.half_par(par, j.ku), self.half_par(par, j.kl)
+        jumps = mu.kink_res(Lu, ru, yu, pu)[:2] - ml.kink_res(Ll, rl, yl, pl)[:2]
         if not jac:
             return jumps, None, None
-        return jumps, mu.kink_jac(Lu, ru, yu, par)[:2, 7:13], -ml.kink_jac(Ll, rl, yl, par)[:2, 7:13]
+        return jumps, mu.kink_jac(Lu, ru, yu, pu)[:2, 7:13], -ml.kink_jac(Ll, rl, yl, pl)[:2, 7:13]
 
     def _rim_res(self, S, y, par, delta):
         res = self.model.rim_res(S, y, par)
@@ -163,10 +166,14 @@ class BoundaryConditions:
         """A line's rows on the indenter: the smooth edge's (their first three are used)."""
         return edge_model("smooth").function(self.models[j.k], self._prefix(j.on), what)
 
+    @staticmethod
+    def _junction_k(j):
+        """The region whose half a junction is on (its module, its parameters)."""
+        return j.ku if isinstance(j, Seam) else j.kc if isinstance(j, Edge) else j.k
+
     def _junction_model(self, j):
         """The generated module of the half a junction is on (a closed shell's halves may differ)."""
-        k = j.ku if isinstance(j, Seam) else j.kc if isinstance(j, Edge) else j.k
-        return self.models[k]
+        return self.models[self._junction_k(j)]
 
     def _force_function(self, what):
         """force_[cyl_]<what> at the last contact edge (F of the free region beyond it)."""
@@ -195,7 +202,7 @@ class BoundaryConditions:
             P[rows, self.col["pressure"]] += dres_dpar[..., self._i_pressure]
 
     def bc_jac(self, ya, yb, p=None):
-        par = self.par_at(p)
+        par_all = self.par_at(p)
         q = self.quantities(p)
         m, n = self.n_conditions, self.n
         A, B = np.zeros((m, n)), np.zeros((m, n))
@@ -205,6 +212,7 @@ class BoundaryConditions:
         for j in self.junctions:
             rows = slice(r, r + j.rows)
             mod = self._junction_model(j)
+            par = self.half_par(par_all, self._junction_k(j))
             if isinstance(j, ContactPole):
                 o = self.offsets[j.k]
                 y0 = ya[self.rows(j.k)]
@@ -293,7 +301,7 @@ class BoundaryConditions:
                 (Lu, _), (Ll, _) = self.seam_slopes
                 B[r + 5, ou + _PHIS], B[r + 5, ol + _PHIS] = Lu / (0.5 * (Lu + Ll)), Ll / (0.5 * (Lu + Ll))
                 if self.seam_references is not None:  # halves that differ: [tau_s] = [M_s] = 0
-                    _, du, dl = self._seam_stress_jumps(j, yb[self.rows(j.ku)], yb[self.rows(j.kl)], par, jac=True)
+                    _, du, dl = self._seam_stress_jumps(j, yb[self.rows(j.ku)], yb[self.rows(j.kl)], par_all, jac=True)
                     B[r + 1:r + 3, self.rows(j.ku)], B[r + 1:r + 3, self.rows(j.kl)] = du, dl
             elif isinstance(j, Rim):
                 S = self.S_point(self.regions[j.k].end, p)
@@ -303,6 +311,7 @@ class BoundaryConditions:
                 if vc:
                     self._pressure_column(P, rows, self._rim_jac(S, yb[self.rows(j.k)], par, "jac_par"))
             r += j.rows
+        par = self.half_par(par_all, self._junction_k(self.force_at)) if self.force_at is not None else par_all
         if self.extra in ("force", "arclength"):
             w = 1.0 if self.extra == "force" else 2 * np.pi * self.arc_tangent[2] / self.arc_scale[2]
             F = q["F"] if self.extra == "force" else 0.0

@@ -37,7 +37,7 @@ from typing import Callable
 
 from .. import chain as ch
 from ..edge_models import contact_models, edge_model
-from ..inflation import enclosed_volume, system_parameters
+from ..inflation import enclosed_volume, lower_pole_rise, system_parameters
 from ..solution import attach_tip_table
 
 __all__ = ["Configuration", "CONFIGURATIONS", "FAMILIES", "configuration", "names", "register", "family_of", "of",
@@ -136,8 +136,9 @@ class Configuration:
     @staticmethod
     def enclosed_volume(scene) -> float:
         """V0 a sealed scene's system holds: its inflated state's, solved on the half above the
-        equator of a closed shell, so both halves' where both are solved."""
-        return enclosed_volume(scene) * (2 if scene.two_contacts else 1)
+        equator of a closed shell, so both halves' where both are solved (solved whole where the
+        halves differ)."""
+        return enclosed_volume(scene) * (2 if scene.two_contacts and not getattr(scene.shell, "lower", None) else 1)
 
     def system(self, scene, control, value, eps, edge=None):
         """The ChainBVP of this configuration for ``scene`` with ``control`` = ``value``, its
@@ -150,7 +151,8 @@ class Configuration:
             scene.shell_length)
         sysm = ch.ChainBVP(scene, self.chain(eps, L, edge or scene.contact), control, value,
                            model=model, par=system_parameters(scene, model),
-                           enclosed_volume=self.enclosed_volume(scene) if scene.sealed else None)
+                           enclosed_volume=self.enclosed_volume(scene) if scene.sealed else None,
+                           lower_pole_rise=lower_pole_rise(scene))
         attach_tip_table(sysm)
         return sysm
 

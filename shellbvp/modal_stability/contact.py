@@ -50,6 +50,10 @@ def check_supported(state, halves: bool = False):
         raise ValueError(f"stability: topology {state.topology!r} is not supported (only the inflated shell and "
                          f"{built}: the contact running over the tip's end onto the indenter's cylinder and interior "
                          f"corners are not built)")
+    if conf is None and state.scene is not None and state.scene.two_contacts:
+        raise ValueError("stability: the inflated state of a closed shell on a substrate under a curved tip is not "
+                         "built; check a state in contact (a mirror-symmetric shell's inflated state is the same "
+                         "between plates, support='plates')")
     if state.scene is not None and state.scene.two_contacts and not halves:
         raise ValueError("stability: a closed shell on a substrate under a curved tip has two halves, each "
                          "from its own pole: contact_of takes one chain from one pole, halves_of the two")
