@@ -341,9 +341,14 @@ def numeric_modules(root) -> set:
 def cli_deferred(root, mod, path, node, numeric=None) -> bool:
     """Whether the function-level import ``node`` of module ``mod`` (census's name: ``cli.fit``)
     is one the command line defers past its parser: a module of ``shellbvp/cli/`` importing a
-    module that loads a numeric library (:func:`numeric_modules`)."""
+    module that loads a numeric library (:func:`numeric_modules`), or a subcommand's module
+    importing its own handler on dispatch (every subcommand does, whatever its handler loads)."""
     if mod.split(".")[0] != CLI_PACKAGE:
         return False
+    own = mod.rpartition(".")[2]
+    if isinstance(node, ast.ImportFrom) and node.level == 1 and node.module == "handlers" \
+            and [a.name for a in node.names] == [own]:
+        return True
     numeric = numeric_modules(root) if numeric is None else numeric
     name = "shellbvp." + (mod[:-len(".__init__")] if mod.endswith(".__init__") else mod)
     return bool(_run_by(name, path, node, _local_modules(root)) & numeric)

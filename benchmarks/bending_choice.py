@@ -8,6 +8,7 @@ energy-identity error |dE/ddelta - F| with dE/ddelta by Richardson-extrapolated 
 differences of E (h = 0.01, 0.005), next to its differencing error.
 
     python benchmarks/bending_choice.py   # writes benchmarks/results/bending_choice.md
+    python benchmarks/bending_choice.py --out-dir /tmp/b   # writes /tmp/b/results/bending_choice.md
 
 ``--koiter``: Koiter's energy at Poisson ratio 1/2 (``sb.KoiterBending``) against the paper's
 trace energy, for deciding the default (issue 58): F of every preset (``sb.PRESETS``) at
@@ -19,7 +20,9 @@ unstable along ``sb.curve(scene, delta_max=1)`` (``assess(curve, "locate")``) wi
 ``--koiter-map``: the shell model with Koiter's energy, without and with transverse shear, against
 the 3D solids of the model's error map (the FE curves kept in ``results/validation.json``, not
 solved again), beside the trace energy's stored rows there: the largest ``|F_shell / F_FE - 1|``
-by thickness and depth band (``results/bending_koiter_map.md``, its rows in ``..._map.json``).
+by thickness and depth band (``results/bending_koiter_map.md``, its rows in ``..._map.json``: kept, and
+not solved again, under the same ``--out-dir``).  The FE curves are read from benchmarks/results/
+whatever ``--out-dir`` says: they are this step's input, not its output.
 """
 
 from __future__ import annotations
@@ -38,6 +41,9 @@ sys.path.insert(0, str(HERE.parent))  # this checkout's package
 
 import shellbvp as sb  # noqa: E402
 from shellbvp.state import system_like, solve_from, warm_guess  # noqa: E402
+
+sys.path.insert(0, str(HERE))
+from checkout import add_output_args, results_dir, write_atomic  # noqa: E402
 
 DELTAS = (0.7, 0.8, 0.9, 1.0)
 TOL = 1e-8
@@ -97,7 +103,7 @@ def first_instabilities():
     return out
 
 
-def koiter_main():
+def koiter_main(res):
     from checkout import commit_label
 
     t0 = time.perf_counter()
@@ -125,14 +131,14 @@ def koiter_main():
               "| scene | energy | verdict | seconds |", "|---|---|---|---|"]
     for label, name, verdict, _, _, secs in stab:
         lines.append(f"| {label} | {name} | {verdict} | {secs:.0f} |")
-    out = HERE / "results" / "bending_koiter.md"
+    out = res / "bending_koiter.md"
     tmp = out.with_suffix(".md.tmp")
     tmp.write_text("\n".join(lines) + "\n")
     tmp.replace(out)
     print(out.read_text())
 
 
-def koiter_map_main():
+def koiter_map_main(res):
     """Koiter's energy on the error map's stored FE curves (module docstring)."""
     import json
 
@@ -142,7 +148,7 @@ def koiter_map_main():
 
     store = HERE / "results" / "validation.json"
     cache = json.loads(store.read_text())
-    out_json = HERE / "results" / "bending_koiter_map.json"
+    out_json = res / "bending_koiter_map.json"
     done = json.loads(out_json.read_text()) if out_json.exists() else {}
     for k, fe in cache.items():
         if not fe.get("success") or k in done:
@@ -193,7 +199,7 @@ def koiter_map_main():
     if diffs:
         lines += ["", f"F koiter / F trace - 1 (no shear) over the map's points: largest {100 * max(diffs):.1f} %, "
                       f"median {100 * float(np.median(diffs)):.2f} %."]
-    out = HERE / "results" / "bending_koiter_map.md"
+    out = res / "bending_koiter_map.md"
     tmp = out.with_suffix(".md.tmp")
     tmp.write_text("\n".join(lines) + "\n")
     tmp.replace(out)
@@ -206,11 +212,12 @@ def main(argv=None):
                     "(results/bending_koiter.md) instead of the convexity table")
     ap.add_argument("--koiter-map", action="store_true", dest="koiter_map",
                     help="Koiter's energy on the error map's stored 3D solids (results/bending_koiter_map.md)")
-    args = ap.parse_args(argv)
+    args = add_output_args(ap).parse_args(argv)
+    res = results_dir(args.out_dir)
     if args.koiter_map:
-        return koiter_map_main()
+        return koiter_map_main(res)
     if args.koiter:
-        return koiter_main()
+        return koiter_main(res)
     rows, t0 = [], time.perf_counter()
     variants = (("smooth, paper's B (corner)", dict()), ("paper's contact model", dict(contact="paper")),
                 ("smooth, rotation B", dict(bending=sb.RotationBending())))
@@ -222,7 +229,7 @@ def main(argv=None):
                 err, scale = identity_error(s) if s.success else (np.nan, np.nan)
                 rows.append((preset, label, s.delta, s.force, s.contact_edge, s.edge_jump_ls, err, scale, s.valid))
             print(preset, label, c.summary(), flush=True)
-    out = Path(__file__).parent / "results" / "bending_choice.md"
+    out = res / "bending_choice.md"
     lines = [f"Measured {time.strftime('%Y-%m-%d')} on {platform.machine()} ({platform.python_version()}), "
              f"shellbvp {sb.__version__}; `sb.curve(scene, deltas={list(DELTAS)}, tol={TOL:g})`; "
              f"total {time.perf_counter() - t0:.0f} s.", "",
@@ -234,7 +241,7 @@ def main(argv=None):
                      f"{'yes' if valid else 'no'} |")
     lines += ["", "The paper's contact model has no energy identity (its edge conditions are not the natural ones): "
               "its error is the model's, not the solver's."]
-    out.write_text("\n".join(lines) + "\n")
+    write_atomic(out, "\n".join(lines) + "\n")
     print(out.read_text())
 
 

@@ -9,9 +9,10 @@ equatorial radii), and at the solid's mid-surface poles' approach (``sb.validate
 with the solid's mesh error (``mesh_check``: 2/3 the elements each way).  ``--sealed`` adds the sealed capsule between plates (volume held).
 
 Results cached in ``results/closed_solid.json`` (keyed by scene and eps; ``--recompute`` to
-start afresh); the table in ``results/closed_solid.md``.
+start afresh); the table in ``results/closed_solid.md``; both under ``--out-dir DIR`` if given
+(an empty DIR: every curve computed again).
 
-    nice -n 10 python benchmarks/closed_solid.py [--eps 0.05] [--sealed] [--no-mesh-check]
+    nice -n 10 python benchmarks/closed_solid.py [--eps 0.05] [--sealed] [--no-mesh-check] [--out-dir DIR]
 """
 
 from __future__ import annotations
@@ -29,6 +30,9 @@ HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parent))  # this checkout's package
 
 import shellbvp as sb  # noqa: E402
+
+sys.path.insert(0, str(HERE))
+from checkout import add_output_args, results_dir  # noqa: E402
 
 EPS = (0.05, 0.02)
 DELTAS = (0.025, 0.05, 0.1, 0.2)
@@ -145,9 +149,9 @@ def main(argv=None):
     ap.add_argument("--sealed", action="store_true", help="also the sealed capsule between plates")
     ap.add_argument("--no-mesh-check", action="store_false", dest="mesh_check", help="no coarser mesh")
     ap.add_argument("--recompute", action="store_true", help="ignore the cached curves")
-    args = ap.parse_args(argv)
+    args = add_output_args(ap).parse_args(argv)
     eps_list = EPS if args.eps is None else tuple(float(x) for x in args.eps.split(","))
-    out = HERE / "results"
+    out = results_dir(args.out_dir)
     store = out / "closed_solid.json"
     cache = {} if args.recompute or not store.exists() else json.loads(store.read_text())
     names = list(SCENES) + (list(SEALED) if args.sealed else [])

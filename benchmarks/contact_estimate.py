@@ -13,8 +13,10 @@ without an approach (issue 55).
 * With ``--fits N``: N of the capsule's records loaded from their first row (0.5-1 % proportional
   noise, 0-0.5 % additive) that still get an estimate, fitted as ``fit_record`` fits them (a
   constant baseline, the contact's first guess at the estimate): mu*H's coverage of the truth.
-* With ``--afm-dir``: the estimate on the first curves of every AFM file there (afmformats'
-  test files), beside the one of the package at ``--against`` (a checkout's path), if given.
+* With ``--afm-dir``: the estimate on the first curves of every AFM file there, beside the one
+  of the package at ``--against`` (a checkout's path), if given.  The step of ``run.py`` passes
+  ``tests/data/afm`` (the AFM files the repository ships: 6 of afmformats' test files); the
+  committed table was made on all of afmformats' test files (its repository's ``tests/data/``).
 
     python benchmarks/contact_estimate.py [--records 2000] [--fits 10] [--afm-dir DIR] [--against CHECKOUT]
                                           [--quick] [--out-dir DIR]
@@ -32,7 +34,7 @@ from scipy.interpolate import PchipInterpolator
 
 import shellbvp as sb
 
-from checkout import add_output_args, results_dir, stem  # benchmarks/ is on sys.path
+from checkout import add_output_args, results_dir, stem, write_atomic  # benchmarks/ is on sys.path
 from shellbvp.segments import estimate_contact
 
 DATA = Path(sb.__file__).parent / "data" / "capsule_plates_synthetic.csv"
@@ -134,11 +136,14 @@ def afm_lines(folder, against):
         spec.loader.exec_module(other)
     lines = ["| curve | pushing rows | estimate (m) | at --against |", "|---|---|---|---|"]
     same = total = 0
-    for path in sorted(glob.glob(str(Path(folder) / "*"))):
+    paths = sorted(glob.glob(str(Path(folder) / "*")))
+    read = 0
+    for path in paths:
         try:
             curves = read_afm(path)
         except ValueError:
             continue
+        read += 1
         for c in curves[:4]:
             m = c.record.mask("loading") if c.record is not None else None
             if m is None or m.sum() < 3:
@@ -151,19 +156,31 @@ def afm_lines(folder, against):
             show = lambda v: "None" if v is None else f"{v:.5g}"  # noqa: E731
             lines.append(f"| {Path(path).name[:48]}#{c.index} | {d.size} | {show(e)} | "
                          f"{show(o) if other else '-'} |")
+    lines.append(f"\n{total} curves (up to four a file) from the {read} of the folder's {len(paths)} files that "
+                 "`read_afm` reads.")
     if other is not None:
         lines.append(f"\n{same} of {total} estimates as at --against.")
     return lines
+
+
+def _shown(folder):
+    """``folder`` relative to the checkout when inside it (tests/data/afm), else DIR."""
+    path, root = Path(folder).resolve(), Path(__file__).resolve().parents[1]
+    return str(path.relative_to(root)) if path.is_relative_to(root) else "DIR"
 
 
 def main():
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--records", type=int, default=2000)
     p.add_argument("--fits", type=int, default=0)
-    p.add_argument("--afm-dir", default=None)
+    p.add_argument("--afm-dir", default=None, help="a folder of AFM files (the repository's: tests/data/afm)")
     p.add_argument("--against", default=None, help="a checkout whose shellbvp/segments.py is compared")
     add_output_args(p, quick="100 records, no fits")
     args = p.parse_args()
+    if args.afm_dir is not None and not Path(args.afm_dir).is_dir():
+        p.error(f"--afm-dir: {args.afm_dir} is not a folder")
+    if args.against is not None and not (Path(args.against) / "shellbvp" / "segments.py").is_file():
+        p.error(f"--against: {args.against} has no shellbvp/segments.py")
     if args.quick:
         args.records, args.fits = 100, 0
     import tempfile
@@ -172,7 +189,8 @@ def main():
         lines = ["# The contact point's first estimate", "",
                  f"`python benchmarks/contact_estimate.py{' --quick' if args.quick else ''} --records {args.records}"
                  + (f" --fits {args.fits}" if args.fits else "")
-                 + (" --afm-dir DIR" if args.afm_dir else "") + (" --against CHECKOUT" if args.against else "")
+                 + (f" --afm-dir {_shown(args.afm_dir)}" if args.afm_dir else "")
+                 + (" --against CHECKOUT" if args.against else "")
                  + "` (see its docstring).", "", "## The shipped capsule record without its approach", ""]
         lines += capsule_lines(Path(tmp) / "capsule_loading_only.csv")
     lines += ["", f"## Synthetic records ({args.records})", ""] + rates(args.records)
@@ -182,7 +200,7 @@ def main():
     if args.afm_dir:
         lines += ["", "## AFM curves", ""] + afm_lines(args.afm_dir, args.against)
     out = results_dir(args.out_dir) / f"{stem('contact_estimate', args.quick)}.md"
-    out.write_text("\n".join(lines) + "\n")
+    write_atomic(out, "\n".join(lines) + "\n")
     print("\n".join(lines))
     print(f"wrote {out}")
 

@@ -12,14 +12,29 @@
   "capsule-plates") of radius 30 um and mu*H = 0.5 N/m, an approach of 15 rows to the contact
   at 3 um, 30 points to 0.4 of the radius, the same noise (seed 3), in um and uN.
 
-    python benchmarks/make_example_data.py
+    python benchmarks/make_example_data.py --write             # the shipped records, rewritten
+    python benchmarks/make_example_data.py --out-dir /tmp/x    # the same files elsewhere (to compare)
+    python benchmarks/make_example_data.py --out-dir /tmp/x --only cell_glass_synthetic.csv
+
+One of ``--write`` or ``--out-dir`` is required: without either the script does nothing.
+Each file is written atomically and read back (the numbers it holds, against those computed).
 """
 
+from __future__ import annotations
+
+import argparse
+import sys
 from pathlib import Path
 
 import numpy as np
 
 import shellbvp as sb
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from checkout import write_atomic  # noqa: E402
+
+#: where the shipped records live
+DATA = Path(__file__).resolve().parents[1] / "shellbvp" / "data"
 
 #: (file, preset, R_L (m), mu*H (N/m), contact offset (m), noise, seed, depths over R_L, units and scales)
 RECORDS = (
@@ -35,7 +50,7 @@ RECORDS = (
 APPROACH_NOISE = 5e-4
 
 
-def write(name, preset, R_L, mu_H, d0, noise, seed, deltas, units, approach=0):
+def write(out_dir, name, preset, R_L, mu_H, d0, noise, seed, deltas, units, approach=0):
     scene = sb.Scene.preset(preset)
     c = sb.curve(scene, deltas=deltas, estimate_error=False)
     rng = np.random.default_rng(seed)
@@ -45,18 +60,39 @@ def write(name, preset, R_L, mu_H, d0, noise, seed, deltas, units, approach=0):
         disp = np.r_[np.linspace(0.0, d0, approach, endpoint=False), disp]
         force = np.r_[APPROACH_NOISE * force.max() * rng.standard_normal(approach), force]
     du, ds, fu, fs = units
-    out = Path(__file__).parents[1] / "shellbvp" / "data" / name
+    out = Path(out_dir) / name
     lines = [f"# synthetic: preset {preset}, R_L = {R_L * ds:g} {du}, mu*H = {mu_H:g} N/m, contact at "
              f"{d0 * ds:g} {du}, {noise:.0%} noise (seed {seed})" + (f", an approach of {approach} rows" if approach
                                                                       else ""), f"displacement ({du}),force ({fu})"]
     lines += [f"{d * ds:.6f},{f * fs:.6f}" for d, f in zip(disp, force)]
-    out.write_text("\n".join(lines) + "\n")
-    print(f"wrote {out}")
+    write_atomic(out, "\n".join(lines) + "\n")
+    back = np.loadtxt(out, delimiter=",", comments="#", skiprows=2)
+    if back.shape != (len(disp), 2) or not np.allclose(back, np.c_[disp * ds, force * fs], rtol=0, atol=1e-6):
+        raise SystemExit(f"make_example_data.py: {out} does not read back as written")
+    print(f"wrote {out} ({len(disp)} rows, read back)")
+    return out
 
 
-def main():
+def parse_args(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0],
+                                 epilog="One of --write or --out-dir is required.")
+    where = ap.add_mutually_exclusive_group(required=True)
+    where.add_argument("--write", action="store_true", help=f"rewrite the shipped records in {DATA}")
+    where.add_argument("--out-dir", type=Path, help="write the records into this existing directory instead")
+    ap.add_argument("--only", action="append", choices=[r[0] for r in RECORDS], metavar="FILE",
+                    help="only this record (repeatable; choices: " + ", ".join(r[0] for r in RECORDS) + ")")
+    args = ap.parse_args(argv)
+    if args.out_dir is not None and not args.out_dir.is_dir():
+        ap.error(f"--out-dir: {args.out_dir} is not a directory")
+    return args
+
+
+def main(argv=None):
+    args = parse_args(argv)
+    out_dir = DATA if args.write else args.out_dir
     for record in RECORDS:
-        write(*record)
+        if args.only is None or record[0] in args.only:
+            write(out_dir, *record)
 
 
 if __name__ == "__main__":

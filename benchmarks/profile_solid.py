@@ -30,9 +30,11 @@ transverse shear.  Forces in units of mu R_L H0 (the pole's H).  Reported: ``F_s
 1`` at each depth and its largest magnitude by depth band, as ``results/validation.md``.
 
 FE curves are kept in ``results/profile_solid.json`` (a second run recomputes only what is
-missing; ``--recompute`` starts afresh).
+missing; ``--recompute`` starts afresh).  ``--quick`` (a smoke test, about a minute; afresh each
+time, into ``profile_solid-quick.{json,md}``): H0 = 0.025's profile and uniform wall to delta = H0
+(``QUICK_DEPTHS``), without the mesh check, Koiter's energy or the flat disk.
 
-    nice -n 10 python benchmarks/profile_solid.py [--workers 1] [--no-mesh-check]
+    nice -n 10 python benchmarks/profile_solid.py [--workers 1] [--no-mesh-check] [--quick] [--out-dir DIR]
 """
 
 from __future__ import annotations
@@ -57,6 +59,9 @@ sys.path.insert(0, str(HERE.parent))  # this checkout's package
 import shellbvp as sb  # noqa: E402
 from shellbvp.validation import Validation, default_depths, shell_curve  # noqa: E402
 
+sys.path.insert(0, str(HERE))
+from checkout import add_output_args, results_dir, stem  # noqa: E402
+
 DELTA_MAX = 0.5
 #: Each pole thickness H0 and its walls: a profile's formula or a uniform thickness
 CASES = {
@@ -73,6 +78,11 @@ GAUSS = ("(lambda_s**2*kappa_s - kappa_s0 + lambda_theta**2*kappa_theta - kappa_
 KOITER_WALLS = ((0.025, "profile"), (0.025, "uniform H0"), (0.0125, "profile"), (0.0125, "uniform H0"))
 
 
+#: ``--quick``: the walls and the depths over H0
+QUICK_WALLS = ((0.025, "profile"), (0.025, "uniform H0"))
+QUICK_DEPTHS = (0.25, 0.5, 1.0)
+
+
 def key(pole, name):
     return f"pole {pole:g}: {name}"
 BANDS = (("delta <= H0", lambda k, wrap: k <= 1 + 1e-9 and not wrap),
@@ -87,10 +97,10 @@ def scene_of(wall, **over):
 
 
 def fe_case(args):
-    pole, name, mesh_check = args
+    pole, name, mesh_check, quick = args
     wall = CASES[pole][name]
     scene = scene_of(wall)
-    depths = default_depths(pole, DELTA_MAX)
+    depths = [pole * k for k in QUICK_DEPTHS] if quick else default_depths(pole, DELTA_MAX)
     c = sb.fe_curve(scene, scene.thickness, depths, mesh_check=mesh_check)
     return key(pole, name), {"wall": wall, "pole": pole, "eps": scene.thickness, "delta": c.delta.tolist(), "force": c.force.tolist(),
                   "indenter": c.indenter.tolist(), "contact_radius": c.contact_radius.tolist(),
@@ -184,7 +194,7 @@ def pct(x):
 
 def report(cache, args):
     lines = [f"Measured {cache.get('measured') or _measured()}; `nice -n 10 python benchmarks/profile_solid.py"
-             f"{' --no-mesh-check' if not args.mesh_check else ''}`.", "",
+             f"{' --quick' if args.quick else ''}{' --no-mesh-check' if not args.mesh_check else ''}`.", "",
              "Hemisphere, rho 0.2 (preset base), neo-Hookean, rim pinned.  F_shell / F_FE - 1 in percent at the "
              "same mid-surface pole displacement delta; 3D solid: `sb.fe_curve` with its default mesh (3 elements "
              "through the local thickness, the local H/2 along the meridian, H0/4 near the pole), 'FE mesh' its "
@@ -193,6 +203,9 @@ def report(cache, args):
              "mu R_L H0, H0 the profile's pole thickness; delta/H0 likewise.", ""]
     for pole, walls in CASES.items():
         summary = {}
+        if not any(key(pole, name) in cache for name in walls):
+            continue
+        walls = [name for name in walls if key(pole, name) in cache]
         lines += [f"# H0 = {pole:g}", ""]
         for name in walls:
             fe = cache.get(key(pole, name))
@@ -342,16 +355,20 @@ def main(argv=None):
     ap.add_argument("--recompute", action="store_true", help="ignore the kept FE curves")
     ap.add_argument("--pole", default=None, help="only these pole thicknesses, comma-separated (default: "
                     + ",".join(f"{p:g}" for p in CASES) + "); the report shows every kept one")
-    ap.add_argument("--out-dir", default=None, help="write results/ under this directory (default benchmarks/)")
+    add_output_args(ap, quick="H0 0.025's profile and uniform wall to delta = H0, no mesh check, Koiter or disk")
     args = ap.parse_args(argv)
     poles = tuple(CASES) if args.pole is None else tuple(float(x) for x in args.pole.split(","))
     if not set(poles) <= set(CASES):
         ap.error(f"--pole must be among {', '.join(f'{p:g}' for p in CASES)}")
-    out = (Path(args.out_dir) if args.out_dir else HERE) / "results"
-    out.mkdir(parents=True, exist_ok=True)
-    store = out / "profile_solid.json"
-    cache = {} if args.recompute or not store.exists() else json.loads(store.read_text())
-    todo = [(p, n, args.mesh_check) for p in poles for n in CASES[p]
+    if args.quick and (args.pole is not None or args.recompute):
+        ap.error("--quick takes its own walls, afresh: give neither --pole nor --recompute with it")
+    out = results_dir(args.out_dir)
+    store = out / f"{stem('profile_solid', args.quick)}.json"
+    cache = {} if args.recompute or args.quick or not store.exists() else json.loads(store.read_text())
+    if args.quick:
+        args.mesh_check = False
+    walls = QUICK_WALLS if args.quick else [(p, n) for p in poles for n in CASES[p]]
+    todo = [(p, n, args.mesh_check, args.quick) for p, n in walls
             if key(p, n) not in cache or not cache[key(p, n)].get("success")]
     with ProcessPoolExecutor(max_workers=max(1, args.workers)) as pool:
         for k, fe in pool.map(fe_case, todo):
@@ -361,23 +378,25 @@ def main(argv=None):
             _write(store, json.dumps(cache, indent=1, default=float))  # no finished curve is lost
     if todo or "measured" not in cache:
         cache["measured"] = _measured()
-    if "plate" not in cache or args.recompute:
+    if not args.quick and ("plate" not in cache or args.recompute):
         cache["plate"] = plate_case()
     for k, fe in cache.items():
         if k.startswith("pole") and "shell" not in fe:
             fe["shell"] = shell_rows(fe)
-    if "koiter" not in cache:
+    if not args.quick and "koiter" not in cache:
         walls, d = plate_walls(sb.KoiterBending())
         cache["koiter"] = {"measured": _measured(), "plate": {name: plate_shell(scene, d) for name, scene in walls.items()}}
-    for pole, name in KOITER_WALLS:
+    for pole, name in () if args.quick else KOITER_WALLS:
         fe = cache.get(key(pole, name))
         if fe is not None and "shell_koiter" not in fe:
             fe["shell_koiter"] = shell_rows(fe, sb.KoiterBending())
             print(f"{key(pole, name)}: shell with Koiter's energy", flush=True)
             _write(store, json.dumps(cache, indent=1, default=float))
     _write(store, json.dumps(cache, indent=1, default=float))
-    _write(out / "profile_solid.md", report(cache, args))
-    print(f"wrote {out / 'profile_solid.md'}")
+    _write(store.with_suffix(".md"), report(cache, args))
+    if json.loads(store.read_text()).keys() != cache.keys():
+        raise SystemExit(f"profile_solid.py: {store} does not read back as written")
+    print(f"wrote {store.with_suffix('.md')}")
 
 
 def _measured():

@@ -1,6 +1,6 @@
 """Regenerate every benchmark result (issue 5): one command.
 
-    python benchmarks/run.py                 # every result (7.6 h or more on 2 shared cores; below)
+    python benchmarks/run.py                 # every result (8.0 h or more on 2 shared cores; below)
     python benchmarks/run.py --quick         # each step's quick mode, ~6 min: a smoke test (*-quick files)
     python benchmarks/run.py --figures       # ... and the paper's figures (benchmarks/paper_figures.py)
     python benchmarks/run.py --only work_precision,profile    # steps by name
@@ -19,8 +19,8 @@ kept by hand).  tests/test_benchmarks.py fails for a script or a result file in 
 
 Each step is its own script, run as a fresh process with this interpreter and this checkout's
 package; results go to benchmarks/results/ (figures to benchmarks/figures/) or under ``--out``.
-A step whose script cannot write elsewhere yet is left out with ``--out`` rather than writing
-into the checkout (``--list --out DIR`` names them).  ``--quick`` runs every step's own quick
+Every step's script takes an output option; one that took none would be left out with ``--out``
+rather than write into the checkout (``--list --out DIR`` would name it).  ``--quick`` runs every step's own quick
 mode, whose files carry a ``-quick`` suffix, so the committed full results are never
 overwritten; steps without a quick mode that is fast enough (about a minute) are left out of
 ``--quick`` (the shooting peer needs its 10-20 s cold starts; the solid's curves, the maps, the
@@ -28,11 +28,11 @@ trust kinds beyond the tally's own quick mode take minutes).  A summary (step, s
 status) goes to ``results/run[-quick].json``; the exit status is non-zero if any step failed.
 
 Time: the full plan's stated costs (each result file's own time for its whole run, or the sum
-of its per-case times; ``--list`` prints them) add up to 27,780 s (7.7 h on 2 shared cores)
-over 40 of the 55 steps; the other 15 (shooting, profile, point_budget, codegen_timing, kernels,
+of its per-case times; ``--list`` prints them) add up to 28,649 s (8.0 h on 2 shared cores)
+over 41 of the 56 steps; the other 15 (shooting, profile, point_budget, codegen_timing, kernels,
 sweep_scaling, sweep_kill_resume, topologies, bending_koiter_map, vella, stability_pressure,
-fit_baseline_coverage, contact_estimate, profile_fit, paper_figures) give no time, so 7.7 h is
-a floor.  ``--quick`` (23 steps) took 380 s measured on the same machine at load 6 (nice 10;
+fit_baseline_coverage, contact_estimate, profile_fit, paper_figures) give no time, so 8.0 h is
+a floor.  ``--quick`` (24 steps; 23 before profile_solid's) took 380 s measured on the same machine at load 6 (nice 10;
 1,260 s at load 10-12 with the whole trust tally), 2-76 s a step; the per-step times go to ``results/run-quick.json``.
 """
 

@@ -27,7 +27,10 @@
   slip against a rigid ball's ``-F/(R + rho)/(4 pi)``; and the ``cell-glass`` preset (eps 0.04,
   turgor 0.15, rho 0.34) to delta 1.
 
-Writes benchmarks/results/stability_contact.md (and .json).
+Writes benchmarks/results/stability_contact.md (and .json), or DIR/results/ with ``--out-dir DIR``.
+The JSON's ``runs`` says which run wrote each section (the commit, the date, the machine), and
+``whole_run`` the last run of every section at once; ``--only`` updates its section's entry only,
+and the report's last lines say which sections were run at which commit.
 
     python benchmarks/stability_contact.py
     python benchmarks/stability_contact.py --rewrite   # the .md again from the .json
@@ -36,9 +39,11 @@ Writes benchmarks/results/stability_contact.md (and .json).
 
 from __future__ import annotations
 
+import argparse
 import json
 import math
 import platform
+import sys
 import time
 from pathlib import Path
 
@@ -48,7 +53,11 @@ from scipy.optimize import brentq, minimize_scalar
 import shellbvp as sb
 from shellbvp import modal_stability as st
 
-OUT = Path(__file__).parent / "results"
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from checkout import add_output_args, commit_label, results_dir, write_atomic  # noqa: E402
+
+#: the sections, each rerun alone by ``--only``
+SECTIONS = ("fold", "base", "lifted", "onset", "closed")
 RS = 5.0
 BETA = 1e-5
 FOLD = 0.18289  # tests/test_dome.py
@@ -289,9 +298,9 @@ def _closed_lines(rows):
     return lines + [""]
 
 
-def write(res):
-    OUT.mkdir(exist_ok=True)
-    (OUT / "stability_contact.json").write_text(json.dumps(res, indent=1, default=str))
+def write(res, out):
+    """The .json and the .md into the folder ``out``."""
+    write_atomic(out / "stability_contact.json", json.dumps(res, indent=1, default=str))
     f = res["fold"]
     lines = ["# Stability of states on the tip: the dome's fold and the first non-axisymmetric crossings", "",
              "Written by `benchmarks/stability_contact.py` (issue 44, item 2).  Dome: the spherical cap of "
@@ -360,24 +369,64 @@ def write(res):
               "Mahadevan, PNAS 105 (2008) 7913, and Nasto's thesis (MIT 2013) / Nasto et al. state that past a "
               "critical indentation the deformation ceases to be axisymmetric (s-cones), and that the indenter's "
               "curvature affects it; the critical depths and mode numbers themselves were not in the stored text, "
-              "so none are quoted here.", "",
-              f"Total {res['seconds']:.0f} s. {platform.platform()}, Python {platform.python_version()}, "
-              f"{time.strftime('%Y-%m-%d')}; 2 shared cores.", ""]
-    (OUT / "stability_contact.md").write_text("\n".join(lines))
+              "so none are quoted here.", "", *provenance(res), ""]
+    write_atomic(out / "stability_contact.md", "\n".join(lines))
 
 
-def main():
-    import sys
+def stamp(res, sections, seconds=None, commit=None, date=None):
+    """Record in ``res`` that ``sections`` were just run (at ``commit``, default this checkout's, on
+    ``date``, default today); ``seconds``: the time of a run of every section."""
+    run = {"commit": commit or commit_label(default="unknown commit"), "date": date or time.strftime("%Y-%m-%d"),
+           "machine": platform.platform(), "python": platform.python_version()}
+    res.setdefault("runs", {}).update({k: dict(run) for k in sections})
+    if seconds is not None:
+        res["whole_run"] = dict(run, sections=list(sections), seconds=seconds)
+    return res
 
-    if "--rewrite" in sys.argv:  # the report again from the stored numbers
-        write(json.loads((OUT / "stability_contact.json").read_text()))
+
+def provenance(res):
+    """The report's last lines: which sections which run wrote, and the last whole run's time."""
+    runs, groups = res.get("runs", {}), {}
+    for k in SECTIONS:
+        if k in res:
+            r = runs.get(k)
+            key = (("committed in " + r["committed"]) if "committed" in r else "run at " + r["commit"],
+                   r["date"], r["machine"], r["python"]) if r else ("of an unrecorded run", "", "", "")
+            groups.setdefault(key, []).append(k)
+    parts = [f"{', '.join(ks)}: {how}" + (f" ({date}; {machine}, Python {py})" if date else "")
+             for (how, date, machine, py), ks in groups.items()]
+    lines = ["Sections by the run that wrote them: " + "; ".join(parts) + "; 2 shared cores."]
+    w = res.get("whole_run")
+    if w:
+        how = f"committed in {w['committed']}" if "committed" in w else f"at {w['commit']}"
+        lines += ["", f"The last whole run ({how}, {w['date']}; its sections then: {', '.join(w['sections'])}) took "
+                      f"{w['seconds']:.0f} s; each section's own time is given with it above."]
+    return lines
+
+
+def parse_args(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    again = ap.add_mutually_exclusive_group()
+    again.add_argument("--rewrite", action="store_true", help="the .md again from the .json (nothing solved)")
+    again.add_argument("--only", choices=SECTIONS, help="rerun this section, the others kept from the .json")
+    return add_output_args(ap).parse_args(argv)
+
+
+def main(argv=None):
+    args = parse_args(argv)
+    out = results_dir(args.out_dir)
+    stored = out / "stability_contact.json"
+    if (args.rewrite or args.only) and not stored.exists():
+        raise SystemExit(f"stability_contact.py: --rewrite and --only need {stored} (a whole run first)")
+    if args.rewrite:  # the report again from the stored numbers
+        write(json.loads(stored.read_text()), out)
         return
-    if "--only" in sys.argv:  # one section, the others kept from the stored numbers
-        which = sys.argv[sys.argv.index("--only") + 1]
-        res = json.loads((OUT / "stability_contact.json").read_text())
+    if args.only:  # one section, the others kept from the stored numbers
+        which = args.only
+        res = json.loads(stored.read_text())
         res[which] = {"fold": dome_fold, "base": base_curve, "lifted": lifted_fold, "closed": closed}[which]() if which != "onset" else \
             [onset(rho, first) for rho in (0.05, 0.2, 0.5) for first in (2, 1)]
-        write(res)
+        write(stamp(res, [which]), out)
         return
     t0 = time.perf_counter()
     res = {"fold": dome_fold()}
@@ -393,8 +442,7 @@ def main():
             print(o, flush=True)
             res["onset"].append(o)
     res["closed"] = closed()
-    res["seconds"] = time.perf_counter() - t0
-    write(res)
+    write(stamp(res, SECTIONS, seconds=time.perf_counter() - t0), out)
 
 
 if __name__ == "__main__":

@@ -27,7 +27,8 @@ instead of the trace energy (the default), into files named by it (``thick_fits_
 ``thick_fits_mapped_eps0.05_koiter.md``).  The records are the solid's, whatever the shell's energy;
 the solid's own fit (``model="solid"``) does not use it and is left out.  ``--records FILE.json``
 fits the records kept in an earlier result file instead of making them again (the solid's records
-at eps 0.02 take an hour).
+at eps 0.02 take an hour); a bare name is read from the results folder the run writes to
+(``benchmarks/results/`` or ``--out-dir``'s).
 
 Then the solid's convergence on the paper's seed (the rim face hinged against the pinned
 mid-thickness point; three meshes) and, with ``--timing``, whole ``shellbvp fit`` commands on
@@ -37,7 +38,7 @@ measured in one run.
     python benchmarks/thick_fits.py [--workers 2] [--timing] [--only seed]
     python benchmarks/thick_fits.py --set mapped --eps 0.02 --no-convergence
     python benchmarks/thick_fits.py --set mapped --eps 0.02 --no-convergence --bending koiter \
-        --records benchmarks/results/thick_fits_mapped_eps0.02.json
+        --records thick_fits_mapped_eps0.02.json
 """
 
 from __future__ import annotations
@@ -61,6 +62,7 @@ sys.path.insert(0, str(HERE.parent))  # this checkout's package
 
 import shellbvp as sb  # noqa: E402
 from shellbvp.fe import fe_size  # noqa: E402
+from checkout import add_output_args, results_dir, write_atomic  # noqa: E402  (benchmarks/ is on sys.path)
 
 R_L = 0.3e-3          # m
 MU = 1e6              # Pa
@@ -220,7 +222,7 @@ def timing(name, path, cache):
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = add_output_args(argparse.ArgumentParser(description=__doc__.splitlines()[0]))
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--set", choices=list(SETS), default="held-out",
                     help="held-out: issue 54's five scenes (default); mapped: the error map's scenes")
@@ -231,11 +233,14 @@ def main():
     ap.add_argument("--bending", choices=list(BENDINGS), default="trace",
                     help="the shell model's bending energy (default trace); results into files named by it")
     ap.add_argument("--records", type=Path, metavar="FILE.json",
-                    help="fit the records kept in this result file (its scenes') instead of making them")
+                    help="fit the records kept in this result file (its scenes') instead of making them; "
+                         "a bare file name is looked for in the results folder this run writes to")
     args = ap.parse_args()
     if args.timing and args.bending != "trace":
         ap.error(f"--timing times the trace energy's commands: not with --bending {args.bending}")
     names = [args.only] if args.only else [n for n, s in SETS[args.set].items() if args.eps in (None, s[2])]
+    if args.records is not None and args.records.parent == Path():  # a bare name: in the results this run writes
+        args.records = results_dir(args.out_dir) / args.records.name
     kept = kept_records(args.records, names) if args.records else None  # checked before any work
     folder = Path(tempfile.mkdtemp())
     t0 = time.perf_counter()
@@ -262,16 +267,17 @@ def main():
         stem += f"_{args.bending}"
     result["set"], result["bending"] = args.set, args.bending
     if args.records:
-        result["records_from"] = str(args.records)
+        beside = args.records.resolve().parent == results_dir(args.out_dir).resolve()
+        result["records_from"] = args.records.name if beside else str(args.records)  # as --records takes it
     result["eps"] = args.eps
-    write(result, stem)  # the fits, before the timing
+    write(result, stem, args.out_dir)  # the fits, before the timing
     if args.timing:
         timed = [n for n in names if n in CLOSED] or names[:1]
         result["timing"] = {}
         for n in timed:
             with tempfile.TemporaryDirectory() as cache:
                 result["timing"][n] = timing(n, made[n][0], cache)
-    write(result, stem)
+    write(result, stem, args.out_dir)
     print(report(result))
 
 
@@ -297,9 +303,9 @@ def write_record(name, folder, text, seconds):
     return path, seconds
 
 
-def write(result, stem):
-    (HERE / "results" / f"{stem}.json").write_text(json.dumps(result, indent=1))
-    (HERE / "results" / f"{stem}.md").write_text(report(result))
+def write(result, stem, out_dir=None):
+    write_atomic(results_dir(out_dir) / f"{stem}.json", json.dumps(result, indent=1))
+    write_atomic(results_dir(out_dir) / f"{stem}.md", report(result))
 
 
 def command(r):

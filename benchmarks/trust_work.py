@@ -233,15 +233,17 @@ def unread_options():
     """{command: [(option, read)]}: each option of each command and whether its module or its handler
     (``shellbvp/cli/handlers/NAME.py``) reads it (``args.NAME``, ``getattr(args, "NAME")``, an
     f-string over the shape parameters, a parameter's ``dest`` of the registry of scene parameters,
-    or a helper of cli/common.py that reads it and that either calls)."""
+    or a helper of cli/common.py or cli/scene_options.py that reads it and that either calls)."""
     from shellbvp import cli
-    from shellbvp.cli import common
+    from shellbvp.cli import common, scene_options
     from shellbvp.scene_parameters import scene_parameters
     from shellbvp.shape_parameters import SHAPE_PARAMETERS
 
-    source = inspect.getsource(common)
-    helpers = {f.name: ast.get_source_segment(source, f) for f in ast.parse(source).body
-               if isinstance(f, ast.FunctionDef) and not f.name.startswith("add_")}
+    helpers = {}
+    for module in (common, scene_options):
+        source = inspect.getsource(module)
+        helpers.update({f.name: ast.get_source_segment(source, f) for f in ast.parse(source).body
+                        if isinstance(f, ast.FunctionDef) and not f.name.startswith("add_")})
 
     def reads(text):
         names = set(re.findall(r"args\.(\w+)", text)) | set(re.findall(r"getattr\(args, \"(\w+)\"", text))

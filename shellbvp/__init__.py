@@ -18,7 +18,7 @@ from .version import __version__  # noqa: F401  (sb.__version__)
 _LAZY = {"curve": "continuation", "iter_curve": "continuation", "CurveRun": "continuation", "SphereTip": "geometry", "FlatTip": "geometry", "Spheroid": "geometry", "UserShell": "geometry",
          "UserTip": "geometry", "Curve": "io", "read_curve": "io", "BendingEnergy": "materials", "Gent": "materials",
          "MooneyRivlin": "materials", "NeoHookean": "materials", "RotationBending": "materials", "KoiterBending": "materials",
-         "StrainEnergy": "materials", "TraceBending": "materials", "PRESETS": "scene", "Scene": "scene",
+         "StrainEnergy": "materials", "TraceBending": "materials", "PRESETS": "presets", "Scene": "scene",
          "ThicknessProfile": "thickness_profile",
          "STATUS_MESSAGES": "solution", "Solution": "solution", "delta_bounds": "bounds", "solve": "state",
          "Dimensions": "units", "beta_from_thickness": "units", "parse_quantity": "units",

@@ -12,8 +12,8 @@ contact_edge and edge_jump_ls/ks, which read as NaN and "")::
     /entry/curve            NXdata group (below: /curve for short); attrs:
                               NX_class = "NXdata", signal = "force", axes = ["delta"],
                               scene (JSON: rebuilds the Scene exactly, user formulas as plain text),
-                              scene_<key> (gamma, rho, beta, xi, contact, material_family, ...:
-                              the same, readable at a glance),
+                              scene_<key> (gamma, rho, beta, xi, contact, material_family, ...,
+                              shell_lower_R of halves that differ: the same, readable at a glance),
                               settings (JSON: solver and continuation settings),
                               stop_reason, complete (bool), interrupted (bool),
                               energy_identity_max (max |dE/ddelta - F| over the points),
@@ -268,6 +268,12 @@ def _check_units(units):
     return R_L, mu_H
 
 
+def _flat(data: dict, prefix: str):
+    """``(prefix_key[_subkey...], value)`` of nested mappings (``scene_shell_lower_R``)."""
+    for k, v in data.items():
+        yield from _flat(v, f"{prefix}_{k}") if isinstance(v, dict) else ((f"{prefix}_{k}", v),)
+
+
 def write_curve_group(g, curve, *, profiles=False, units=None):
     """Fill the HDF5 group ``g`` with ``curve`` in the layout of the module docstring (the
     ``/curve`` group of a curve file; sweep files hold one such group per curve)."""
@@ -279,12 +285,7 @@ def write_curve_group(g, curve, *, profiles=False, units=None):
     g.attrs["axes"] = np.array(["delta"], dtype=h5py.string_dtype())
     scene = curve.scene.to_dict()
     g.attrs["scene"] = json.dumps(scene, sort_keys=True)
-    for k, v in scene.items():
-        if isinstance(v, dict):
-            for kk, vv in v.items():
-                g.attrs[f"scene_{k}_{kk}"] = vv
-        else:
-            g.attrs[f"scene_{k}"] = v
+    g.attrs.update(_flat(scene, "scene"))
     g.attrs["settings"] = json.dumps(curve.settings, sort_keys=True, default=float)
     g.attrs["stop_reason"] = curve.stop_reason
     g.attrs["complete"] = bool(curve.complete)

@@ -15,8 +15,9 @@ import numpy as np
 
 from .edge_models import EdgeModel, contact_models, edge_model
 from .geometry import FlatTip, SphereTip, Spheroid, UserShell, UserTip
-from .materials import MATERIALS, Bending, Gent, Material, MooneyRivlin, TraceBending, bending_class, material_class
+from .materials import MATERIALS, Bending, Material, MooneyRivlin, TraceBending, bending_class, material_class
 from .model import load_module, structure_description
+from .presets import PRESETS
 from .scene_parameters import scene_parameter, scene_parameters
 from .thickness_profile import ThicknessProfile, settle_profile
 from .units import beta_from_thickness, format_in
@@ -108,14 +109,16 @@ class Scene:
         grain): ``gamma`` is then its polar over its equatorial semi-axis (> 0) and lengths are
         in units of its equatorial radius (``R_L``).  A ``UserShell`` is then the upper half's
         meridian, pole to equator, the lower half its mirror image
-        (:meth:`UserShell.closed_problem` says what it must be).  Default False.
+        (:meth:`UserShell.closed_problem` says what it must be), or its whole meridian from pole
+        to pole (:meth:`UserShell.pole_to_pole`).  Default False.
     support : {"substrate", "plates"}, optional
         What a closed shell rests on (default ``"substrate"``, a rigid frictionless plane) or
         ``"plates"`` (compressed between two parallel plates: ``tip=FlatTip()``; with a curved
         tip, between two such indenters); delta is the approach of the indenter and the
         support.  Between plates, or on a substrate under a flat plate, the half above the
         equator is solved (symmetry: the equator stays vertical, free to move out, and moves
-        by delta/2); under a curved tip on a substrate both halves are, with a contact each.
+        by delta/2); under a curved tip on a substrate both halves are, with a contact each, as
+        are a shell's whose halves differ (``UserShell.closed_halves``) between plates.
     thickness_profile : ThicknessProfile, optional
         Set from ``thickness`` when that is a profile (read it here; files store it).
 
@@ -323,6 +326,9 @@ class Scene:
         kind = field(sh, "kind", text, "shell.")
         if kind == "spheroid":
             shell = Spheroid()
+        elif kind == "user" and "pole_to_pole" in sh:  # the meridian as given; its halves are derived from it
+            shell = UserShell.pole_to_pole(*(field(field(sh, "pole_to_pole", (dict,), "shell."), k, text,
+                                                   "shell.pole_to_pole.") for k in "RZL"), legacy_srepr=True)
         elif kind == "user":
             halves = [tuple(field(h, k, text, "shell.") for k in "RZL")
                       for h in [sh] + ([field(sh, "lower", (dict,), "shell.")] if "lower" in sh else [])]
@@ -425,7 +431,8 @@ class Scene:
         """
         if self.closed:
             shape = "closed spheroid" if isinstance(self.shell, Spheroid) else (
-                "closed shell (user meridian" + ("s, halves that differ)" if self.shell.lower else ")"))
+                "closed shell (user meridian" + (", pole to pole" if self.shell.meridian else "") +
+                (("s" if not self.shell.meridian else "") + ", halves that differ)" if self.shell.lower else ")"))
             if self.support == "plates":
                 return f"{shape} between " + ("plates" if isinstance(self.tip, FlatTip) else "two indenters")
             return f"{shape} on a substrate"
@@ -452,12 +459,15 @@ class Scene:
     @property
     def halved(self) -> bool:
         """A closed shell solved on the half above its equator: between two plates (or two
-        identical tips), or on a substrate under a flat plate (the same problem)."""
-        return self.closed and (self.support == "plates" or isinstance(self.tip, FlatTip))
+        identical tips), or on a substrate under a flat plate (the same problem); not a shell
+        whose halves differ (``UserShell.closed_halves``), which has no mirror symmetry."""
+        return (self.closed and (self.support == "plates" or isinstance(self.tip, FlatTip))
+                and getattr(self.shell, "lower", None) is None)
 
     @property
     def two_contacts(self) -> bool:
-        """A closed shell on a substrate under a curved tip: both halves solved, two contacts."""
+        """A closed shell on a substrate under a curved tip, or one whose halves differ between
+        plates (on a substrate under a flat plate): both halves solved, two contacts."""
         return self.closed and not self.halved
 
     @property
@@ -523,6 +533,9 @@ def _support(scene, gamma) -> str:
     if not scene.closed:
         if scene.support not in (None, "rim"):
             raise ValueError(f"support={scene.support!r} needs closed=True; a shell held on its rim has support 'rim'")
+        if isinstance(scene.shell, UserShell) and scene.shell.meridian is not None:
+            raise ValueError("shell: a meridian from pole to pole (UserShell.pole_to_pole) is a closed shell's: it needs "
+                             "closed=True (--closed)")
         return "rim"
     support = "substrate" if scene.support is None else scene.support
     if support not in SUPPORTS:
@@ -548,50 +561,3 @@ def _reference_volume(scene) -> float:
     value, _ = quad(lambda S: float(mod.reference_shell(S, par)["volume_density"]), 0.0, scene.shell_length,
                     epsabs=1e-13, epsrel=1e-12, limit=200)
     return value
-
-
-#: The paper's scenes by name: ``{name: {"doc": description, "scene": Scene fields}}``
-#: (``Scene.preset(name)``; ``shellbvp presets`` lists them).  A user shell is written as its
-#: ``(R, Z, L)`` formulas, parsed when the preset is used (importing shellbvp needs no SymPy).
-PRESETS = {
-    "base": {"doc": "paper's base case: hemisphere, rho 0.2, beta 0.01, Mooney-Rivlin 0.1, xi 1",
-             "scene": dict(gamma=1.0, rho=0.2, beta=0.01, material=MooneyRivlin(0.1), xi=1)},
-    "base-xi0": {"doc": "base with the first approximation xi = 0",
-                 "scene": dict(gamma=1.0, rho=0.2, beta=0.01, material=MooneyRivlin(0.1), xi=0)},
-    "prolate2": {"doc": "prolate spheroid gamma = 2",
-                 "scene": dict(gamma=2.0, rho=0.2, beta=0.01, material=MooneyRivlin(0.1), xi=1)},
-    "fit": {"doc": "Lepidium endosperm fit case: gamma 2.5, rho 1/3",
-            "scene": dict(gamma=2.5, rho=1 / 3, beta=0.01, material=MooneyRivlin(0.1), xi=1)},
-    "flat": {"doc": "flat plate gamma = 0",
-             "scene": dict(gamma=0.0, rho=0.2, beta=0.01, material=MooneyRivlin(0.1), xi=1)},
-    "gent1": {"doc": "base with Gent Jm = 1 (strain-stiffening)",
-              "scene": dict(gamma=1.0, rho=0.2, beta=0.01, material=Gent(1.0), xi=1)},
-    "dome": {"doc": "dome gamma = -1, indented from the convex side",
-             "scene": dict(gamma=-1.0, rho=0.2, beta=0.01, material=MooneyRivlin(0.1), xi=1)},
-    "balloon": {"doc": "inflated membrane patch: a spherical cap of radius 2 clamped on its rim (half-angle 30 "
-                       "degrees), indented from outside, pressure 0.1 (tau = p R^2/(4 sqrt(3 beta)) = 5.8)",
-                "scene": dict(shell=("2*sin(S/2)", "2*cos(S/2)", "2*asin(1/2)"), rho=0.2, beta=1e-4,
-                              material=MooneyRivlin(0.1), xi=1, pressure=0.1)},
-    "cell": {"doc": "walled cell with turgor: a near-complete sphere held on a ring 144 degrees from the pole "
-                    "(sphere radius 1.70), colloidal probe rho 0.34, beta 1.55e-3, pressure 0.089 (yeast-like: "
-                    "radius 2.5 um, wall 0.1 um: eps = H/R_L = 0.068, beta = eps^2/3; mu H 3.3 N/m, turgor 0.2 MPa)",
-             "scene": dict(shell=("sin(S)", "cos(S)", "4*pi/5"), rho=0.34, beta=1.55e-3,
-                           material=MooneyRivlin(0.1), xi=1, pressure=0.089)},
-    "capsule": {"doc": "sealed liquid-filled capsule: the cell's near-complete sphere with no pressure before "
-                       "indenting, under volume control (the pressure rises as it is indented)",
-                "scene": dict(shell=("sin(S)", "cos(S)", "4*pi/5"), rho=0.34, beta=1.55e-3,
-                              material=MooneyRivlin(0.1), xi=1, sealed=True)},
-    "cell-glass": {"doc": "walled cell with turgor resting on glass under a colloidal probe: a complete sphere, wall "
-                          "eps = H/R = 0.04 (beta 5.3e-4), probe rho 0.34, pressure 0.15 (yeast-like: radius 2.5 um, "
-                          "wall 0.1 um, probe 0.85 um, mu H 3.3 N/m, turgor 0.2 MPa)",
-                   "scene": dict(closed=True, support="substrate", tip=SphereTip(), gamma=1.0, rho=0.34,
-                                 beta=0.04**2 / 3, material=MooneyRivlin(0.1), xi=1, pressure=0.15)},
-    "pollen": {"doc": "dry pollen grain on a substrate under a colloidal probe: a complete sphere of radius 25 um, "
-                      "wall 1 um (eps 0.04, beta 5.3e-4), probe radius 2 um (rho 0.08), no pressure",
-               "scene": dict(closed=True, support="substrate", tip=SphereTip(), gamma=1.0, rho=0.08,
-                             beta=0.04**2 / 3, material=MooneyRivlin(0.1), xi=1)},
-    "capsule-plates": {"doc": "sealed liquid-filled capsule compressed between two plates: a complete sphere, wall "
-                              "eps = H/R = 0.02 (beta 1.33e-4), no pressure before compressing (volume control)",
-                       "scene": dict(closed=True, support="plates", tip=FlatTip(), gamma=1.0, rho=1.0,
-                                     beta=0.02**2 / 3, material=MooneyRivlin(0.1), xi=1, sealed=True)},
-}

@@ -40,14 +40,14 @@ class ShellGeometry:
     def Psi(self):
         return sp.sqrt(sp.diff(self.R, S) ** 2 + sp.diff(self.Z, S) ** 2)
 
-    def curvatures(self):
-        """(kappa_s^R, kappa_theta^R) as expressions in S."""
+    def curvatures(self, simplify: bool = True):
+        """(kappa_s^R, kappa_theta^R) as expressions in S; ``simplify=False`` leaves them as
+        derived (the same values, for checks that evaluate them: simplifying costs seconds)."""
         Rp, Zp = sp.diff(self.R, S), sp.diff(self.Z, S)
         Rpp, Zpp = sp.diff(Rp, S), sp.diff(Zp, S)
         Psi = self.Psi
-        ks = sp.simplify((Rp * Zpp - Zp * Rpp) / Psi**3)
-        kt = sp.simplify(Zp / (self.R * Psi))
-        return ks, kt
+        ks, kt = (Rp * Zpp - Zp * Rpp) / Psi**3, Zp / (self.R * Psi)
+        return (sp.simplify(ks), sp.simplify(kt)) if simplify else (ks, kt)
 
 
 @dataclass(frozen=True)

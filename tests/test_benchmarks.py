@@ -108,9 +108,12 @@ def test_quick_plan_writes_separate_files(run, tmp_path):
             assert argv[argv.index(s.out[0]) + 1].startswith(str(tmp_path / "results") + "/")
         assert s.quick_outputs and all("-quick" in o for o in s.quick_outputs)
     assert {s.name for s, _ in skipped} | set(names) == {s.name for s in _load("steps").STEPS}
-    # --out with a step that has no output option: left out rather than writing into benchmarks/
+    # --out: every step writes under it (bending_choice, stability_contact, thick_fits and closed_solid
+    # took no output option before); a step without one is left out rather than write into benchmarks/
     full = run.plan(figures=True, out=tmp_path)
-    assert "bending_choice" not in [s.name for s, _ in full]
+    assert [s.name for s, _ in full] == [s.name for s, _ in run.plan(figures=True)]
+    lone = _load("steps").Step("x", "x.py", "model", out=None)
+    assert lone.argv(False, None, "py") and lone.argv(False, tmp_path, "py") is None
     for s, argv in full:  # nothing of benchmarks/ named as an output
         assert str(tmp_path) in " ".join(argv) or s.out == "dir" and "--out-dir" in argv, s.name
         assert not any(a.startswith(str(BENCH / "results")) for a in argv), s.name
@@ -367,7 +370,7 @@ def test_function_level_imports_of_the_package_stand_where_they_are_known():
     """benchmarks/architecture.py on this checkout (issue 57): the package's imports inside functions
     are the command line's of modules that load numpy (its parser must not), and only these: each
     subcommand's module imports its handler (``cli/handlers/NAME.py``, whose imports stand at its
-    top) on dispatch, and cli/common.py's ``scene_from_args`` the scene (145 at eab5e9b, in 40
+    top) on dispatch, and cli/scene_options.py's ``scene_from_args`` the scene (145 at eab5e9b, in 40
     modules; 59 at 33d1b76, 58 of them the command line's in its handlers)."""
     import ast
 
@@ -378,7 +381,7 @@ def test_function_level_imports_of_the_package_stand_where_they_are_known():
     commands = {c.__name__.removeprefix("shellbvp.") for c in COMMANDS}
     deferred = census["function_imports_cli_deferred"]
     assert {m: n for m, n in deferred.items() if m in commands} == dict.fromkeys(commands, 1)
-    assert set(deferred) - commands <= {"cli.common"} and deferred.get("cli.common", 0) <= 2, deferred
+    assert set(deferred) - commands <= {"cli.scene_options"} and deferred.get("cli.scene_options", 0) <= 2, deferred
     assert set(census["function_imports_package"]) == set(deferred)  # none in the handlers
     for command in COMMANDS:  # the one late import of a subcommand's module is its handler's
         name = command.__name__.rpartition(".")[2]

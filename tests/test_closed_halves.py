@@ -31,8 +31,8 @@ def test_a_half_that_is_no_closed_shells_half_is_refused_in_one_line(halves, mes
 
 
 @pytest.mark.parametrize("kw, message", [
-    (dict(support="plates", tip=sb.FlatTip()), "need support='substrate' under a curved tip"),
-    (dict(tip=sb.FlatTip()), "need support='substrate' under a curved tip"),
+    (dict(support="plates"), "the shell must be mirror-symmetric about its equator"),
+    (dict(support="plates", rho=0.5), "the shell must be mirror-symmetric about its equator"),
     (dict(pressure=0.05), "without pressure only"),
     (dict(pressure=0.05, sealed=True), "without pressure only"),
 ])
@@ -95,8 +95,8 @@ def test_the_command_line_takes_a_lower_meridian_and_refuses_it_without_its_uppe
 
     lower = "; ".join(OBLATE)
     for args, message in ((("--meridian-lower", lower), "--meridian-lower needs --meridian"),
-                          (("--support", "plates", "--flat-tip", "--meridian", "; ".join(PROLATE), "--meridian-lower",
-                            lower), "need support='substrate' under a curved tip"),
+                          (("--support", "plates", "--rho", "0.5", "--meridian", "; ".join(PROLATE), "--meridian-lower",
+                            lower), "the shell must be mirror-symmetric about its equator"),
                           (("--meridian", "; ".join(PROLATE), "--meridian-lower", "sin(S); cos(S); 1.5"),
                            "the lower half (in its mirror image)")):
         r = cli(*args)

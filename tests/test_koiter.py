@@ -38,7 +38,7 @@ from symbolic.materials import LS, LT
 import test_variational as tv
 from benchmark_modules import load_benchmark
 from test_bending import _energy_identity_error
-from test_stability_contact import _neighbours, branch_check
+from branch_tangent import branch_check, neighbours
 
 RESULTS = Path(__file__).resolve().parents[1] / "benchmarks" / "results" / "profile_solid.json"
 
@@ -156,13 +156,13 @@ def test_force_is_the_energys_derivative_on_a_koiter_state():
 @pytest.mark.slow  # ~30 s: two structures' second variations and three solves
 def test_energy_along_a_koiter_cap_branch(monkeypatch):
     """Base scene with Koiter's energy at delta 0.5 (cap): the n = 0 second variation on the
-    branch tangent with the contact's terms is dF/ddelta (tests/test_stability_contact.py);
+    branch tangent with the contact's terms is dF/ddelta (tests/branch_tangent.py);
     with the trace energy's generated form in its place it is not (the Gaussian term enters the
     axisymmetric modes)."""
     from shellbvp.modal_stability import form
 
     scene = sb.Scene.preset("base", bending=sb.KoiterBending())
-    lo, mid, hi = _neighbours(scene, 0.5)
+    lo, mid, hi = neighbours(scene, 0.5)
     assert mid.topology == "cap" and mid.valid
     dF, elastic, contact = branch_check(lo, mid, hi)
     assert abs(elastic + contact - dF) < 2e-3 * dF, (dF, elastic, contact)

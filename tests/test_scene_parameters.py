@@ -83,7 +83,7 @@ def test_the_scene_raises_the_registry_errors():
 
 def test_every_parameter_reaches_the_command_line_the_sweep_the_uncertainty_and_the_pixel_tables(tmp_path):
     from shellbvp.batch import TABLE_COLUMNS
-    from shellbvp.cli.common import scene_from_args
+    from shellbvp.cli.scene_options import scene_from_args
     from shellbvp.fitrecord import PARAMETER_UNITS
     from shellbvp.pixel_table import PIXEL_PARAMETERS, read_pixel_table
     from shellbvp.sweeps.grid import check_grid
@@ -159,7 +159,7 @@ def test_a_material_parameter_with_its_flags_reaches_every_user(monkeypatch, tmp
     """A material's module is all a new material takes: its flagged parameter is swept, given an
     uncertainty, taken per pixel and fitted, and the command line offers it (no curve computed)."""
     from shellbvp.batch import TABLE_COLUMNS
-    from shellbvp.cli.common import scene_from_args
+    from shellbvp.cli.scene_options import scene_from_args
     from shellbvp.fitrecord import PARAMETER_UNITS
     from shellbvp.pixel_table import PIXEL_PARAMETERS, read_pixel_table
     from shellbvp.shape_parameters import SHAPE_PARAMETERS, shape_parameter

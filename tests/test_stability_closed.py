@@ -17,12 +17,12 @@ import math
 
 import numpy as np
 import pytest
+from branch_tangent import closed_offset, elastic, tangent
 
 import shellbvp as sb
 from shellbvp import modal_stability as st
 from shellbvp.modal_stability import fem
 from shellbvp.modal_stability.closed import SEAM_SIGNS, spectrum_closed
-from shellbvp.modal_stability.form import form_at
 
 
 def on_substrate(beta=1e-2, rho=0.5, **kw):
@@ -44,80 +44,15 @@ def _halves(state):
     return [list(range(seam.ku + 1)), list(range(seam.ku + 1, len(state.system.regions)))]
 
 
-def _frame(state, regions, S):
-    """Position ((r, z) rows, the half's own frame), its first and second S-derivatives, the base
-    fields, t, N, psi, psi' of a half at S."""
-    base = st.chain_base(state, regions)(S)
-    _, _, _, shell_params, ref = st.form_functions(state.scene)
-    values = state.scene.values()
-    R, Psi, dPsi, _, _ = (np.broadcast_to(np.asarray(v, float), S.shape)
-                          for v in ref(S, *[values[p] for p in shell_params]))
-    sysm = state.system
-    z = np.empty_like(S)
-    edges = [float(sysm.S_point(sysm.regions[k].end, state.p)) for k in regions[:-1]]
-    which = np.searchsorted(edges, S, side="right")
-    for i, k in enumerate(regions):
-        sel = which == i
-        if np.any(sel):
-            reg = sysm.regions[k]
-            t = sysm.t_of(k, S[sel], state.p)
-            prof = getattr(sysm.kernels.active, f"{reg.kind}_profile")(S[sel], state.sol(t)[sysm.rows(k)],
-                                                                        sysm.par_at(state.p))
-            # the tip's z is measured from its apex; the plane's from the unmoved pole (delta 0)
-            z[sel] = prof["z"] + {"contact": state.z_tip, "plane": sysm.pole_height}.get(reg.kind, 0.0)
-    phi, ls, ks = base["phi"], base["ls"], base["ks"]
-    psi, dpsi = ls * Psi, base["dls"] * Psi + ls * dPsi
-    t = np.array([np.cos(phi), np.sin(phi)])
-    N = np.array([-np.sin(phi), np.cos(phi)])
-    x = np.array([base["lt"] * R, z])
-    return x, psi * t, dpsi * t + psi * psi * ks * N, base, t, N, psi, dpsi, R
-
-
 def _tangent(lo, mid, hi, regions, S, lift):
-    """zeta = (u, u', u'', 0.., w, w', w'') of the branch tangent relative to the tip, ``x' +
-    lift e_z`` in the half's frame (the tip moves down: lift +1 above, -1 in the mirror image)."""
-    h = hi.delta - lo.delta
-    x, xS, xSS, base, t, N, psi, dpsi, R = _frame(mid, regions, S)
-    (xl, xSl, xSSl), (xh, xSh, xSSh) = (_frame(s, regions, S)[:3] for s in (lo, hi))
-    d, dS, dSS = (xh - xl) / h, (xSh - xSl) / h, (xSSh - xSSl) / h
-    d = d + np.array([0.0, lift])[:, None]
-    phS = psi * base["ks"]
-    phSS = dpsi * base["ks"] + psi * base["dks"]
-
-    def dot(a, b):
-        return a[0] * b[0] + a[1] * b[1]
-
-    u, w = dot(d, t), dot(d, N)
-    zeta = np.zeros((9, S.size))
-    zeta[0], zeta[6] = u, w
-    zeta[1] = dot(dS, t) + phS * w
-    zeta[2] = dot(dSS, t) + 2 * phS * dot(dS, N) + phSS * w - phS**2 * u
-    zeta[7] = dot(dS, N) - phS * u
-    zeta[8] = dot(dSS, N) - 2 * phS * dot(dS, t) - phSS * u - phS**2 * w
-    return zeta, base, R, psi
+    """zeta of the branch tangent relative to the tip, ``x' + lift e_z`` in the half's frame (the tip
+    moves down: lift +1 above, -1 in the mirror image); tests/branch_tangent.py."""
+    return tangent(lo, mid, hi, S, regions, lift, closed_offset)
 
 
-def _edge(state, regions):
-    sysm = state.system
-    return float(sysm.S_point(sysm.regions[regions[0]].end, state.p))
-
-
-def _elastic(lo, mid, hi, regions, lift, S0=1e-3):
-    """``8 pi Int zeta^T A_0 zeta dS`` of a half on the tangent (A_0 without the contact terms),
-    quadrature refined at the half's moving edge."""
-    L = float(mid.system.L)
-    edges = [_edge(s, regions) for s in (lo, mid, hi)]
-    e = edges[1]
-    brk = np.unique(np.concatenate([np.geomspace(S0, e, 200), np.linspace(e, L, 600), np.linspace(min(edges), max(edges), 9),
-                                    np.linspace(0.98 * e, 1.02 * e, 41)]))
-    brk = brk[(brk >= S0) & (brk <= L)]
-    xg, wg = np.polynomial.legendre.leggauss(6)
-    hb = np.diff(brk)
-    S = (brk[:-1, None] + hb[:, None] * (xg + 1)[None, :] / 2).ravel()
-    W = (hb[:, None] * wg[None, :] / 2).ravel()
-    zeta, base, _, _ = _tangent(lo, mid, hi, regions, S, lift)
-    A, _ = form_at(mid.scene, lambda s: dict(base, P=np.zeros_like(S)), S, 0)
-    return 8 * math.pi * float(np.sum(W * np.einsum("ig,ijg,jg->g", zeta, A, zeta)))
+def _elastic(lo, mid, hi, regions, lift):
+    """``8 pi Int zeta^T A_0 zeta dS`` of a half on the tangent (A_0 without the contact terms)."""
+    return elastic(lo, mid, hi, regions, lift, z_offset=closed_offset)
 
 
 def test_energy_along_the_branch_is_both_halves_n0_form(branch):

@@ -11,149 +11,25 @@ r"""Stability of states on the tip (shellbvp.modal_stability; issue 44, item 2).
 * unsupported states are refused with one line that names what is not supported.
 
 The dome's fold (n = 0) and where its n >= 2 eigenvalues cross zero:
-benchmarks/stability_contact.py.
+benchmarks/stability_contact.py.  The branch tangent's check: tests/branch_tangent.py.
 """
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 import pytest
+from branch_tangent import branch_check, neighbours
 
 import shellbvp as sb
 from shellbvp import modal_stability as st
 from shellbvp.modal_stability import fem
-from shellbvp.modal_stability.form import form_at
-from shellbvp.chain import CONTACT_KINDS
 from shellbvp.solution import Solution
-
-
-# -- the branch tangent --------------------------------------------------------------------------
-def _frame(state, S):
-    """Position, its first and second S-derivatives ((r, z) rows), the base fields, the tangent
-    t and normal N, psi and psi' of ``state`` at the points S."""
-    base = st.chain_base(state)(S)
-    f, upper, params, shell_params, ref = st.form_functions(state.scene)
-    values = state.scene.values()
-    R, Psi, dPsi, _, _ = (np.broadcast_to(np.asarray(v, float), S.shape)
-                          for v in ref(S, *[values[p] for p in shell_params]))
-    sysm = state.system
-    z = np.empty_like(S)
-    edges = [float(sysm.S_point(reg.end, state.p)) for reg in sysm.regions[:-1]]
-    which = np.searchsorted(edges, S, side="right")
-    for k, reg in enumerate(sysm.regions):
-        sel = which == k
-        if np.any(sel):
-            t = sysm.t_of(k, S[sel], state.p)
-            prof = getattr(sysm.kernels.active, f"{reg.kind}_profile")(S[sel], state.sol(t)[sysm.rows(k)],
-                                                                        sysm.par_at(state.p))
-            z[sel] = prof["z"] + (state.z_tip if reg.kind in CONTACT_KINDS else 0.0)
-    phi, ls, ks = base["phi"], base["ls"], base["ks"]
-    psi, dpsi = ls * Psi, base["dls"] * Psi + ls * dPsi
-    t = np.array([np.cos(phi), np.sin(phi)])
-    N = np.array([-np.sin(phi), np.cos(phi)])
-    x = np.array([base["lt"] * R, z])
-    return x, psi * t, dpsi * t + psi * psi * ks * N, base, t, N, psi, dpsi, R, Psi
-
-
-def _edge(state):
-    sysm = state.system
-    return float(sysm.S_point(sysm.regions[0].end, state.p))
-
-
-def branch_check(lo, mid, hi, S0=1e-3):
-    """(dF/ddelta, the elastic second variation on the tangent, the constraint's terms) at
-    ``mid`` from its neighbours ``lo``, ``hi`` on the branch (a cap or a line).
-
-    The tangent ``x' = (x_hi - x_lo)/(delta_hi - delta_lo)`` at fixed S, in (u, w) with their
-    S-derivatives; ``8 pi Int zeta^T A_0 zeta dS`` (A_0 without the contact terms) is
-    ``d^2 Pi(x', x')``; relative to the tip (which moves down) the tangent is ``x' + e_z``.
-    The contact edge moves with delta and lambda_s' jumps there, so the tangent's u' jumps
-    inside [edge_lo, edge_hi]: the quadrature has nodes there."""
-    h = hi.delta - lo.delta
-    edge = _edge(mid)
-    L = float(mid.system.L)
-    inner = np.linspace(_edge(lo), _edge(hi), 9)
-    brk = np.unique(np.concatenate([np.geomspace(S0, edge, 200), np.linspace(edge, L, 600), inner,
-                                    np.linspace(0.98 * edge, 1.02 * edge, 41)]))
-    brk = brk[(brk >= S0) & (brk <= L)]
-    xg, wg = np.polynomial.legendre.leggauss(6)
-    hb = np.diff(brk)
-    S = (brk[:-1, None] + hb[:, None] * (xg + 1)[None, :] / 2).ravel()
-    W = (hb[:, None] * wg[None, :] / 2).ravel()
-    x, xS, xSS, base, t, N, psi, dpsi, R, Psi = _frame(mid, S)
-    (xl, xSl, xSSl), (xh, xSh, xSSh) = (_frame(s, S)[:3] for s in (lo, hi))
-    d, dS, dSS = (xh - xl) / h, (xSh - xSl) / h, (xSSh - xSSl) / h
-    phS = psi * base["ks"]
-    phSS = dpsi * base["ks"] + psi * base["dks"]
-
-    def dot(a, b):
-        return a[0] * b[0] + a[1] * b[1]
-
-    u, w = dot(d, t), dot(d, N)
-    zeta = np.zeros((9, S.size))
-    zeta[0], zeta[6] = u, w
-    zeta[1] = dot(dS, t) + phS * w
-    zeta[2] = dot(dSS, t) + 2 * phS * dot(dS, N) + phSS * w - phS**2 * u
-    zeta[7] = dot(dS, N) - phS * u
-    zeta[8] = dot(dSS, N) - 2 * phS * dot(dS, t) - phSS * u - phS**2 * w
-    elastic_base = dict(base, P=np.zeros_like(S))
-    A, _ = form_at(mid.scene, lambda s: elastic_base, S, 0)
-    elastic = 8 * math.pi * float(np.sum(W * np.einsum("ig,ijg,jg->g", zeta, A, zeta)))
-    # the tangent relative to the tip along t (the pressure's term, 2 pi Int p^ kappa_s dt^2)
-    rel = u + np.sin(base["phi"])
-    pressure = -2 * math.pi * float(np.sum(W * base["P"] * base["lt"] * R * psi * base["ks"] * rel**2))
-    # at the edge or line
-    Se = np.array([edge])
-    xl, xh = (_frame(s, Se)[0] for s in (lo, hi))
-    be, te = _frame(mid, np.array([edge * (1 - 1e-12)]))[3:5]
-    de = (xh - xl)[:, 0] / h
-    ks = float(be["ks"][0])
-    u0 = float(de @ te[:, 0]) + float(te[1, 0])
-    f = float(mid.edge_forces[0])
-    if mid.topology == "cap":
-        ring = -f * ks * u0**2
-    else:  # the line: kappa_S u0^2 + 2 u0 w1 - w1^2/gap, w1 = d(dt . N)/dsigma
-        gap = -float(mid.curvature_excess)
-        w1 = _slope_at_line(lo, mid, hi)
-        ring = -f * (ks * u0**2 + 2 * u0 * w1 - w1**2 / gap)
-    return (hi.force - lo.force) / h, elastic, pressure + ring
-
-
-def _slope_at_line(lo, mid, hi):
-    """``w1 = d(dt . N)/dsigma`` of the tangent relative to the tip at the line.  The
-    difference quotient is off by O(h) between the neighbours' lines (their x_SSS jumps there),
-    so it is extrapolated linearly to the line from 2 and 3 such widths on each side and the
-    two sides averaged (the exact tangent's slope is continuous there)."""
-    h = hi.delta - lo.delta
-    edge = _edge(mid)
-    width = abs(_edge(hi) - _edge(lo))
-    sides = []
-    for sign in (-1, 1):
-        S = edge + sign * width * np.array([2.0, 3.0])
-        (xl, xSl), (xh, xSh) = (_frame(s, S)[:2] for s in (lo, hi))
-        _, _, _, b, t, N, psi, _, _, _ = _frame(mid, S)
-        d, dS = (xh - xl) / h, (xSh - xSl) / h
-        phS = psi * b["ks"]
-        w_S = (dS * N).sum(0) - phS * ((d * t).sum(0) + np.sin(b["phi"]))
-        w1 = w_S / psi
-        sides.append(w1[0] - 2 * (w1[1] - w1[0]))  # linear, from 2 and 3 widths to 0
-    return float(np.mean(sides))
-
-
-def _neighbours(scene, delta, h=5e-4, **kw):
-    mid = sb.solve(scene, delta=delta, tol=1e-8, estimate_error=False, **kw)
-    lo, hi = (sb.solve(scene, delta=delta + s * h / 2, guess=mid, tol=1e-8, estimate_error=False, **kw)
-              for s in (-1, 1))
-    assert all(s.success and s.topology == mid.topology for s in (lo, hi)), (lo.topology, hi.topology)
-    return lo, mid, hi
 
 
 def test_energy_along_a_cap_branch_fixes_the_contact_terms_sign():
     """Base scene at delta 0.6 (cap, Sc 0.14): dF/ddelta 3.6468; with the terms 3.6503
     (1e-3: the tangent's difference quotient, 3e-4 at h/4), reversed 3.895, without 3.772."""
-    lo, mid, hi = _neighbours(sb.Scene.preset("base"), 0.6)
+    lo, mid, hi = neighbours(sb.Scene.preset("base"), 0.6)
     assert mid.topology == "cap" and mid.valid
     dF, elastic, contact = branch_check(lo, mid, hi)
     assert contact < -0.1  # the pressure's and the ring's terms are not small here
@@ -168,7 +44,7 @@ def test_energy_along_a_line_branch():
     (``w1 = gap (u0 + dsigma1/ddelta)``), which leaves the ring's term ``-f (kappa_T u0^2 - gap
     dsigma1^2)`` at about 1e-5 of dF/ddelta here: too small to tell its sign (the rolling
     term's sign rests on the derivation and the rigid-rotation check, module docstring)."""
-    lo, mid, hi = _neighbours(sb.Scene.preset("base"), 0.1, h=2.5e-4)
+    lo, mid, hi = neighbours(sb.Scene.preset("base"), 0.1, h=2.5e-4)
     assert mid.topology == "line" and mid.valid
     dF, elastic, contact = branch_check(lo, mid, hi)
     # measured: contact 3.9e-5 dF (2.1e-3 at h = 1e-3: the slope's extrapolation, 1/gap), the

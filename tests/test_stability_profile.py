@@ -25,13 +25,13 @@ import math
 
 import numpy as np
 import pytest
+from branch_tangent import branch_check, neighbours
 
 import shellbvp as sb
 from shellbvp import modal_stability as st
 from shellbvp.modal_stability import form
 from shellbvp.thickness_profile import ThicknessProfile
 
-from test_stability_contact import _neighbours, branch_check
 
 L = math.pi / 2
 THINNING = ThicknessProfile.formula("0.05*(1 - 0.5*S/L)")  # half as thick at the rim
@@ -91,7 +91,7 @@ def test_energy_along_a_profiled_cap_branch(uniform, monkeypatch):
     """The wall thinning to half at the rim, delta 0.3 (cap): dF/ddelta 2.2255, the form on the
     tangent with the contact's terms 2.5e-5 off (the uniform wall's check: 2.4e-5); with t = 1 in
     the form 28 % off, with t^2 in place of t 20 %."""
-    lo, mid, hi = _neighbours(uniform.replace(thickness=THINNING), 0.3)
+    lo, mid, hi = neighbours(uniform.replace(thickness=THINNING), 0.3)
     assert mid.topology == "cap" and mid.valid
     dF, elastic, contact = branch_check(lo, mid, hi)
     assert abs(elastic + contact - dF) < 2e-4 * dF, (dF, elastic, contact)

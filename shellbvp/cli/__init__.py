@@ -26,7 +26,8 @@ from . import compile, convexity, curve, fit, info, plot, presets, report, solve
 from ..config import options
 from ..textdata import printable
 from ..version import __version__
-from .common import Parser, limits_of, os_error_line, print_json_error, scene_from_args, show_code_generation
+from .common import Parser, limits_of, os_error_line, print_json_error, show_code_generation
+from .scene_options import scene_from_args
 
 __all__ = ["main", "build_parser", "scene_from_args"]
 

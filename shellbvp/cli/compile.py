@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from .common import add_scene_options
+from .scene_options import add_scene_options
 
 __all__ = ["add_parser", "run"]
 

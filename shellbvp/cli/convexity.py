@@ -2,7 +2,8 @@
 
 from __future__ import annotations
 
-from .common import add_scene_options, quantity
+from .common import quantity
+from .scene_options import add_scene_options
 
 __all__ = ["add_parser", "run"]
 

@@ -3,8 +3,9 @@
 from __future__ import annotations
 
 from .common import (
-    add_limit_options, add_mu_h_option, add_overwrite_option, add_radius_option, add_scene_options, number_or, plain_number,
+    add_limit_options, add_mu_h_option, add_overwrite_option, add_radius_option, number_or, plain_number,
 )
+from .scene_options import add_scene_options
 
 __all__ = ["add_parser", "run"]
 

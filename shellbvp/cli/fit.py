@@ -7,7 +7,8 @@ from pathlib import Path
 
 from ..scene_parameters import parameters_that
 from ..shape_parameters import SHAPE_PARAMETERS
-from .common import add_limit_options, add_overwrite_option, add_scene_options, number_or, plain_number, quantity
+from .common import add_limit_options, add_overwrite_option, number_or, plain_number, quantity
+from .scene_options import add_scene_options
 
 __all__ = ["add_parser", "run"]
 

@@ -2,7 +2,8 @@
 
 from __future__ import annotations
 
-from .common import add_scene_options, number_or, plain_number, quantity
+from .common import number_or, plain_number, quantity
+from .scene_options import add_scene_options
 
 __all__ = ["add_parser", "run"]
 

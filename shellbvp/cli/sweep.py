@@ -4,10 +4,8 @@ from __future__ import annotations
 
 from ..edge_models import contact_models
 from ..scene_parameters import parameters_that
-from .common import (
-    add_mu_h_option, add_overwrite_option, add_radius_option, material_help, material_spec, node_budget, number_or,
-    plain_number,
-)
+from .common import add_mu_h_option, add_overwrite_option, add_radius_option, node_budget, number_or, plain_number
+from .scene_options import material_help, material_spec
 
 __all__ = ["add_parser", "run"]
 

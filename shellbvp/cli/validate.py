@@ -2,7 +2,8 @@
 
 from __future__ import annotations
 
-from .common import add_limit_options, add_overwrite_option, add_radius_option, add_scene_options, number_or
+from .common import add_limit_options, add_overwrite_option, add_radius_option, number_or
+from .scene_options import add_scene_options
 
 __all__ = ["add_parser", "run"]
 

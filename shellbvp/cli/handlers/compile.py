@@ -4,8 +4,10 @@ compiled once (its parser: ``shellbvp/cli/compile.py``)."""
 from __future__ import annotations
 
 from ...kernels import compile_for
-from ...scene import PRESETS, Scene
-from ..common import quantity, scene_from_args
+from ...presets import PRESETS
+from ...scene import Scene
+from ..common import quantity
+from ..scene_options import scene_from_args
 
 __all__ = ["run"]
 

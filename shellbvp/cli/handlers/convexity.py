@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from ...convexity import convexity_report
-from ..common import scene_from_args
+from ..scene_options import scene_from_args
 
 __all__ = ["run"]
 

@@ -15,7 +15,8 @@ from ...modal_stability import check_stability_size, stability_size
 from ...paths import check_output_path, partial_path
 from ...progress import curve_progress, progress_bar, wanted
 from ...units import force_unit_of, format_in
-from ..common import MAX_POINTS, checkpoint_seconds, free_default_name, nondimensional, scene_from_args
+from ..common import MAX_POINTS, checkpoint_seconds, free_default_name, nondimensional
+from ..scene_options import scene_from_args
 
 __all__ = ["run"]
 

@@ -31,10 +31,8 @@ from ...textdata import printable
 from ...thickness import model_error_line
 from ...uncertainty import fit_with_geometry
 from ...units import Quantity, format_in, readable_unit, split_quantity, unit_factor, unit_kind
-from ..common import (
-    check_report_path, curve_bars, os_error_line, output_dir, progress_bar, require_sample, say, scene_from_args,
-    strict_json,
-)
+from ..common import check_report_path, curve_bars, os_error_line, output_dir, progress_bar, say, strict_json
+from ..scene_options import require_sample, scene_from_args
 
 __all__ = ["run"]
 

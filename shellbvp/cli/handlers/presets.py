@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from ...scene import PRESETS
+from ...presets import PRESETS
 
 __all__ = ["run"]
 

@@ -8,7 +8,8 @@ import numpy as np
 
 from ...state import solve
 from ...units import force_unit_of, format_in
-from ..common import nondimensional, scene_from_args, strict_json
+from ..common import nondimensional, strict_json
+from ..scene_options import scene_from_args
 
 __all__ = ["run"]
 

@@ -8,7 +8,8 @@ import time
 from ...fe import check_fe_size, check_solid_scene, fe_size
 from ...paths import check_output_path
 from ...validation import validate
-from ..common import free_default_name, nondimensional, plain_numbers, scene_from_args
+from ..common import free_default_name, nondimensional, plain_numbers
+from ..scene_options import scene_from_args
 
 __all__ = ["run"]
 
