@@ -22,6 +22,14 @@ capsule between plates (eps 0.1) and a cell on a substrate under a sphere of rad
 ``--timing`` the cold and warm commands are those of each closed record.  The records are kept
 in the JSON.
 
+``--bending koiter`` fits the shell model with Koiter's bending energy (``sb.KoiterBending()``)
+instead of the trace energy (the default), into files named by it (``thick_fits_koiter.md``,
+``thick_fits_mapped_eps0.05_koiter.md``).  The records are the solid's, whatever the shell's energy;
+the solid's own fit (``model="solid"``) does not use it and is left out.  ``--records FILE.json``
+fits the records kept in an earlier result file instead of making them again (the solid's records
+at eps 0.02 take an hour); a bare name is read from the results folder the run writes to
+(``benchmarks/results/`` or ``--out-dir``'s).
+
 Then the solid's convergence on the paper's seed (the rim face hinged against the pinned
 mid-thickness point; three meshes) and, with ``--timing``, whole ``shellbvp fit`` commands on
 the seed's record: the shell and the solid, cold (no kept model curve) and warm, as ratios
@@ -29,6 +37,8 @@ measured in one run.
 
     python benchmarks/thick_fits.py [--workers 2] [--timing] [--only seed]
     python benchmarks/thick_fits.py --set mapped --eps 0.02 --no-convergence
+    python benchmarks/thick_fits.py --set mapped --eps 0.02 --no-convergence --bending koiter \
+        --records thick_fits_mapped_eps0.02.json
 """
 
 from __future__ import annotations
@@ -86,6 +96,8 @@ SETS = {"held-out": HELD_OUT, "mapped": MAPPED, "closed": CLOSED}
 SCENES = {**HELD_OUT, **MAPPED, **CLOSED}
 #: the record's mesh: 1.5x finer each way than the fitting model's (FE_DEFAULTS: 0.5 H, 3 through H)
 RECORD_MESH = dict(element_length=0.33, through_thickness=4)
+#: the shell's bending energies --bending chooses from (the records' solid has none)
+BENDINGS = {"trace": sb.TraceBending, "koiter": sb.KoiterBending}
 FITS = {"shell": dict(model="shell"), "shell, shear": dict(model="shell", transverse_shear=True),
         "solid": dict(model="solid"), "auto (default)": dict(model="auto")}
 
@@ -147,9 +159,10 @@ def name_of(path):
 
 
 def fit_case(job):
-    name, path, label, design = job
+    name, path, label, design, bending = job
     eps = SCENES[name][2]
     over = {k: v for k, v in FITS[label].items() if k != "model"}
+    over["bending"] = BENDINGS[bending]()  # the shell's; the record's solid is the same for every energy
     scene = scene_of(*SCENES[name], **over)
     rec = sb.read_instrument(cut(path, design))
     t0 = time.perf_counter()
@@ -157,8 +170,8 @@ def fit_case(job):
     truth = MU * eps * R_L
     err = res.model_error
     lo, hi = res.mu_H_ci95
-    return {"scene": name, "fit": label, "record": design, "truth": truth, "mu_H": res.mu_H, "ci95": [lo, hi],
-            "error": res.mu_H / truth - 1, "in_ci": bool(lo <= truth <= hi),
+    return {"scene": name, "fit": label, "record": design, "bending": bending, "truth": truth, "mu_H": res.mu_H,
+            "ci95": [lo, hi], "error": res.mu_H / truth - 1, "in_ci": bool(lo <= truth <= hi),
             "model_error": None if err is None else err[0],
             "in_bound": None if err is None else bool(abs(res.mu_H / truth - 1) <= err[0] + (hi - lo) / 2 / res.mu_H),
             "quality": res.quality, "success": res.success, "seconds": time.perf_counter() - t0,
@@ -217,13 +230,27 @@ def main():
     ap.add_argument("--only", choices=list(SCENES))
     ap.add_argument("--timing", action="store_true")
     ap.add_argument("--no-convergence", action="store_true")
+    ap.add_argument("--bending", choices=list(BENDINGS), default="trace",
+                    help="the shell model's bending energy (default trace); results into files named by it")
+    ap.add_argument("--records", type=Path, metavar="FILE.json",
+                    help="fit the records kept in this result file (its scenes') instead of making them; "
+                         "a bare file name is looked for in the results folder this run writes to")
     args = ap.parse_args()
+    if args.timing and args.bending != "trace":
+        ap.error(f"--timing times the trace energy's commands: not with --bending {args.bending}")
     names = [args.only] if args.only else [n for n, s in SETS[args.set].items() if args.eps in (None, s[2])]
+    if args.records is not None and args.records.parent == Path():  # a bare name: in the results this run writes
+        args.records = results_dir(args.out_dir) / args.records.name
+    kept = kept_records(args.records, names) if args.records else None  # checked before any work
     folder = Path(tempfile.mkdtemp())
     t0 = time.perf_counter()
+    labels = [label for label in FITS if args.bending == "trace" or label != "solid"]  # the solid has no shell energy
     with ProcessPoolExecutor(args.workers) as pool:
-        made = dict(zip(names, pool.map(make_record, names, [folder] * len(names))))
-        jobs = [(n, made[n][0], label, design) for n in names for label in FITS
+        if kept is None:
+            made = dict(zip(names, pool.map(make_record, names, [folder] * len(names))))
+        else:
+            made = {n: write_record(n, folder, *kept[n]) for n in names}
+        jobs = [(n, made[n][0], label, design, args.bending) for n in names for label in labels
                 for design in (DESIGNS if label.startswith("shell") else DESIGNS[:1])]
         fits = list(pool.map(fit_case, jobs))
         conv = None if args.no_convergence else pool.submit(convergence).result()
@@ -236,7 +263,13 @@ def main():
     stem = "thick_fits" if args.set == "held-out" else f"thick_fits_{args.set}"
     if args.eps is not None:
         stem += f"_eps{args.eps:g}"
-    result["set"] = args.set
+    if args.bending != "trace":
+        stem += f"_{args.bending}"
+    result["set"], result["bending"] = args.set, args.bending
+    if args.records:
+        beside = args.records.resolve().parent == results_dir(args.out_dir).resolve()
+        result["records_from"] = args.records.name if beside else str(args.records)  # as --records takes it
+    result["eps"] = args.eps
     write(result, stem, args.out_dir)  # the fits, before the timing
     if args.timing:
         timed = [n for n in names if n in CLOSED] or names[:1]
@@ -248,16 +281,47 @@ def main():
     print(report(result))
 
 
+def kept_records(path, names):
+    """{name: (TSV text, seconds its solid took)} of the records kept in the result file
+    ``path``; exits naming the file where it is not one or lacks a scene of ``names``."""
+    try:
+        scenes = json.loads(Path(path).read_text())["scenes"]
+        kept = {n: (scenes[n]["record_tsv"], scenes[n]["record_seconds"]) for n in names if n in scenes}
+    except (OSError, ValueError, KeyError, TypeError) as e:
+        raise SystemExit(f"--records {path}: not a thick_fits.py result file with kept records ({type(e).__name__})")
+    missing = [n for n in names if n not in kept]
+    if missing or not all(isinstance(t, str) for t, _ in kept.values()):
+        raise SystemExit(f"--records {path}: no kept record of {missing or 'some scenes'}; "
+                         "choose the file of the same --set and --eps")
+    return kept
+
+
+def write_record(name, folder, text, seconds):
+    """A kept record as make_record's file: (path, the seconds its solid took then)."""
+    path = Path(folder) / f"{name.replace(' ', '_')}.tsv"
+    path.write_text(text)
+    return path, seconds
+
+
 def write(result, stem, out_dir=None):
     write_atomic(results_dir(out_dir) / f"{stem}.json", json.dumps(result, indent=1))
     write_atomic(results_dir(out_dir) / f"{stem}.md", report(result))
 
 
+def command(r):
+    """The command line that wrote result ``r``."""
+    args = ["python benchmarks/thick_fits.py", "--set", r.get("set", "held-out")]
+    args += [] if r.get("eps") is None else ["--eps", f"{r['eps']:g}"]
+    args += [] if r.get("convergence") else ["--no-convergence"]
+    args += ["--timing"] if r.get("timing") else []
+    args += [] if r.get("bending", "trace") == "trace" else ["--bending", r["bending"]]
+    args += ["--records", r["records_from"]] if r.get("records_from") else []
+    return " ".join(args)
+
+
 def report(r):
     lines = ["# Fits of thick and curved shells against the solid's records (issue 54)", "",
-             f"`python benchmarks/thick_fits.py --set {r.get('set', 'held-out')}"
-             f"{'' if r.get('convergence') else ' --no-convergence'}{' --timing' if r.get('timing') else ''}` "
-             "(the module's docstring "
+             f"`{command(r)}` (the module's docstring "
              "says how the records are made; "
              f"{r['machine']}, shellbvp {r['version']}, {r['seconds']:.0f} s).", "",
              "| scene | truth mu*H (N/m) | fit | record | mu*H [95 % CI] | error | truth in CI | printed model error | "

@@ -129,13 +129,15 @@ FIT_EPS = (0.02, 0.05)
 #: The shell model's largest error in a fitted mu*H against instrument-like records made by the 3D
 #: solid (``benchmarks/thick_fits.py --set mapped``: the map's six scenes, each record fitted whole,
 #: without its approach and cut to its shallower half), by transverse shear and eps.  Measured with
-#: the trace energy and taken for the other built-in energies too (on the map Koiter's F differs
-#: from the trace energy's by 2.1 % at most: benchmarks/results/bending_koiter_map.md).  A fit
-#: compares the model's mid-surface displacement with the indenter's, which also holds the wall's
-#: thinning under the tip: this error is not the one in F at equal depth, and can be larger.
+#: the trace energy.  Koiter's energy, fitted to the same records (``--bending koiter``:
+#: benchmarks/results/thick_fits_mapped_eps*_koiter.md), stays within it at both thicknesses (3.3
+#: and 11.4 %, shear 3.8 and 15.4 %), so the table stands for it too; for the rotation energy it is
+#: taken unmeasured.  A fit compares the model's mid-surface displacement with the indenter's,
+#: which also holds the wall's thinning under the tip: this error is not the one in F at equal
+#: depth, and can be larger.  The largest are the records without their approach (rho 0.1, shear).
 FIT_MODEL_ERROR = {
-    False: (0.035, 0.120),
-    True: (0.035, 0.102),
+    False: (0.035, 0.122),
+    True: (0.039, 0.156),
 }
 #: The contact models those fits were made with (the records' shells were fitted by them)
 FIT_MODEL_ERROR_CONTACTS = ("smooth",)
