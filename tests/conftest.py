@@ -37,8 +37,8 @@ os.environ.setdefault("SHELLBVP_KERNELS", "numpy")
 
 def _run_code_cache(tmp_path_factory):
     """A fresh code cache for this run, one for all its xdist workers: each structure is derived
-    once per run rather than once per worker (the cache writes atomically, so two workers
-    deriving the same structure at once both write a whole module)."""
+    once per run rather than once per worker (a worker meeting a structure the other is deriving
+    waits for its module: ``shellbvp.model``'s lock)."""
     if not os.environ.get("PYTEST_XDIST_WORKER"):
         return tmp_path_factory.mktemp("codecache")
     shared = tmp_path_factory.getbasetemp().parent / "codecache"  # the run's root, beside popen-gw*
