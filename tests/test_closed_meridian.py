@@ -2,7 +2,6 @@
 is the upper half from pole to equator, the lower half its mirror image (docs/closed.md)."""
 
 import math
-import sys
 
 import numpy as np
 import pytest
