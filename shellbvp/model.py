@@ -6,7 +6,9 @@ the ``symbolic/`` sources and the SymPy version.  Cached modules live in ``$SHEL
 ``$XDG_CACHE_HOME/shellbvp``, else ``~/.cache/shellbvp``; they are written
 atomically (temporary file + rename) and checked on load (their ``KEY`` must
 match), so a concurrent or interrupted writer never leaves a module that is
-used half-written.  A warm load imports neither SymPy nor the derivation.
+used half-written; a process meeting a structure that another is deriving waits for
+that one's module (a lock file beside it) instead of deriving it too.  A warm load
+imports neither SymPy nor the derivation.
 
 Beside each module ``model_<key>.py`` lies ``kernels_<key>.py``, the same structure's
 loop-over-nodes kernels for numba (``symbolic.codegen_numba``; imported only by
@@ -25,6 +27,7 @@ structure's numpy module from source costs ~0.1 s of every process's start
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import importlib.metadata
 import importlib.util
@@ -243,6 +246,60 @@ def _cached_or_generated(path: Path, key: str, generate, regenerate=False, write
             return _import_file(path, key)
         except Exception as exc:  # corrupt or foreign file: derive again
             log.warning("ignoring unusable cached module %s (%s); regenerating", path, exc)
+            regenerate = True
+    with _generation_lock(path):
+        if path.exists() and not regenerate:  # another process derived it while this one waited
+            try:
+                return _import_file(path, key)
+            except Exception as exc:
+                log.warning("ignoring unusable cached module %s (%s); regenerating", path, exc)
+        return _generated(path, key, generate, write_extra)
+
+
+#: A process waits at most this long for another deriving the same structure, then derives it too.
+LOCK_WAIT = 600.0
+
+
+@contextlib.contextmanager
+def _generation_lock(path: Path):
+    """Held while the module ``path`` is derived: a second process (a parallel batch, a test
+    worker) meeting the same new structure waits and reads the first's module instead of
+    deriving it again.  An advisory ``flock`` on ``<module>.lock`` beside it, released when its
+    process ends however it ends; none where ``fcntl`` does not exist (Windows) or the lock
+    file cannot be opened (a read-only cache), and none after ``LOCK_WAIT`` seconds."""
+    try:
+        import fcntl
+    except ImportError:
+        yield
+        return
+    try:
+        path.parent.mkdir(mode=0o700, parents=True, exist_ok=True)
+        fd = os.open(path.with_name(path.name + ".lock"), os.O_RDWR | os.O_CREAT | getattr(os, "O_NOFOLLOW", 0), 0o600)
+    except OSError:
+        yield
+        return
+    try:
+        deadline, said = time.monotonic() + LOCK_WAIT, False
+        while True:
+            try:
+                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+                break
+            except OSError:
+                if time.monotonic() > deadline:
+                    log.warning("another process has been deriving %s for %.0f s; deriving it here too",
+                                path.name, LOCK_WAIT)
+                    break
+                if not said:
+                    log.info("another process is deriving %s; waiting for it", path.name)
+                    said = True
+                time.sleep(0.05)
+        yield
+    finally:
+        os.close(fd)  # releases the lock
+
+
+def _generated(path: Path, key: str, generate, write_extra=None):
+    """``generate()`` -> (source, extra) written to ``path`` (or a private directory) and imported."""
     t0 = time.perf_counter()
     log.info("deriving the equations of a new structure and generating their code, once (%s in %s) ...",
              path.name, path.parent)

@@ -1,4 +1,5 @@
 import os
+from pathlib import Path
 
 import pytest
 
@@ -37,8 +38,8 @@ os.environ.setdefault("SHELLBVP_KERNELS", "numpy")
 
 def _run_code_cache(tmp_path_factory):
     """A fresh code cache for this run, one for all its xdist workers: each structure is derived
-    once per run rather than once per worker (the cache writes atomically, so two workers
-    deriving the same structure at once both write a whole module)."""
+    once per run rather than once per worker (a worker meeting a structure the other is deriving
+    waits for its module: ``shellbvp.model``'s lock)."""
     if not os.environ.get("PYTEST_XDIST_WORKER"):
         return tmp_path_factory.mktemp("codecache")
     shared = tmp_path_factory.getbasetemp().parent / "codecache"  # the run's root, beside popen-gw*
@@ -104,3 +105,31 @@ def cli_main(monkeypatch, capsys):
         return subprocess.CompletedProcess(["shellbvp", *args], code or 0, out, err)
 
     return run
+
+
+@pytest.fixture
+def base_derivation(monkeypatch):
+    """``symbolic.build.generate_sources`` of the base structure answered with the texts of its
+    modules in the run's code cache (derived there once), counted in the returned list; other
+    structures are derived.  For the tests of the cache's trust checks, which regenerate the base
+    module into fresh directories (~3.5 s of CPU each); the derivation itself, and that it
+    regenerates byte for byte, is tests/test_symbolic.py's."""
+    import shellbvp as sb
+    import symbolic.build
+    from shellbvp import model
+
+    desc = sb.Scene.preset("base").structure()
+    key = model.description_key(desc)
+    path = Path(model.load_module(desc).__file__)
+    kernels = path.parent / f"kernels_{key[:20]}.py"
+    if not model.holds_key(kernels, key):  # written beside the module by the same derivation
+        model.kernel_source_path(desc)
+    texts = path.read_text(), kernels.read_text()
+    derive, asked = symbolic.build.generate_sources, []
+
+    def generate_sources(d):
+        asked.append(d)
+        return texts if model.description_key(d) == key else derive(d)
+
+    monkeypatch.setattr(symbolic.build, "generate_sources", generate_sources)
+    return asked

@@ -17,8 +17,8 @@ def run(*args, cwd=None):
                           cwd=cwd, env=env, timeout=600)
 
 
-def test_curve_without_arguments_writes_base_h5(tmp_path):
-    r = run(cwd=tmp_path)
+def test_curve_without_arguments_writes_base_h5(tmp_path, cli_main):
+    r = run(cwd=tmp_path)  # python -m shellbvp, as a user's first run; the checks after it in this process
     assert r.returncode == 0, r.stderr
     assert "wrote base.h5" in r.stdout and " s" in r.stdout
     c = sb.read_curve(tmp_path / "base.h5")
@@ -27,12 +27,12 @@ def test_curve_without_arguments_writes_base_h5(tmp_path):
     # (a loaded machine takes that long)
     assert "\r" not in r.stderr and all(line.startswith("curve base: delta") for line in r.stderr.splitlines())
     first = (tmp_path / "base.h5").read_bytes()
-    again = run(cwd=tmp_path)  # the quick start twice: a new name, the first result kept
+    again = cli_main(cwd=tmp_path)  # the quick start twice: a new name, the first result kept
     assert again.returncode == 0 and "wrote base-2.h5" in again.stdout, again.stderr
     assert (tmp_path / "base.h5").read_bytes() == first
-    taken = run("curve", "-o", "base.h5", cwd=tmp_path)  # a name given: never replaced without --overwrite
+    taken = cli_main("curve", "-o", "base.h5", cwd=tmp_path)  # a name given: never replaced without --overwrite
     assert taken.returncode == 2 and "exists" in taken.stderr and "--overwrite" in taken.stderr
-    info = run("info", "base.h5", cwd=tmp_path)
+    info = cli_main("info", "base.h5", cwd=tmp_path)
     assert info.returncode == 0 and "delta_max = 0.5 reached" in info.stdout and "gamma=1" in info.stdout
 
 

@@ -249,15 +249,12 @@ def test_a_pollen_grain_on_a_substrate_is_fitted():
     ("capsule_plates_synthetic.csv", "capsule-plates", "30um", 0.5),
     pytest.param("cell_glass_synthetic.csv", "cell-glass", "2.5um", 3.3, marks=pytest.mark.slow),
 ])
-def test_the_shipped_closed_shell_records_fit_as_docs_closed_md_shows(name, preset, radius, truth):
+def test_the_shipped_closed_shell_records_fit_as_docs_closed_md_shows(name, preset, radius, truth, cli_main):
     import json
-    import subprocess
-    import sys
     from pathlib import Path
 
     data = Path(sb.__file__).parent / "data" / name
-    r = subprocess.run([sys.executable, "-m", "shellbvp", "fit", str(data), "--preset", preset, "--radius", radius,
-                        "--json"], capture_output=True, text=True)
+    r = cli_main("fit", str(data), "--preset", preset, "--radius", radius, "--json")  # the command, in this process
     assert r.returncode == 0, r.stderr
     out = json.loads(r.stdout)
     lo, hi = out["mu_H_ci95"]

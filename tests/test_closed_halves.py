@@ -83,13 +83,9 @@ def test_an_egg_on_a_substrate_runs_a_curve_with_F_dE_ddelta():
     assert min(sym) < s.force < max(sym)
 
 
-def test_the_command_line_takes_a_lower_meridian_and_refuses_it_without_its_upper_half(tmp_path):
-    import subprocess
-    import sys
-
-    def cli(*args):
-        return subprocess.run([sys.executable, "-m", "shellbvp", "curve", "--closed", *args, "-o", "egg.h5"],
-                              capture_output=True, text=True, cwd=tmp_path, timeout=600)
+def test_the_command_line_takes_a_lower_meridian_and_refuses_it_without_its_upper_half(tmp_path, cli_main):
+    def cli(*args):  # the command's main in this process
+        return cli_main("curve", "--closed", *args, "-o", "egg.h5", cwd=tmp_path)
 
     lower = "; ".join(OBLATE)
     for args, message in ((("--meridian-lower", lower), "--meridian-lower needs --meridian"),

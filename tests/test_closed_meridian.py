@@ -2,8 +2,6 @@
 is the upper half from pole to equator, the lower half its mirror image (docs/closed.md)."""
 
 import math
-import subprocess
-import sys
 
 import numpy as np
 import pytest
@@ -105,12 +103,8 @@ def test_a_flattened_top_between_plates_is_fitted():
     assert res.success, res.message
     assert res.mu_H_ci95[0] < mu_H < res.mu_H_ci95[1] and res.mu_H_ci95[1] - res.mu_H_ci95[0] < 0.05
 
-def cli(*args, cwd):
-    return subprocess.run([sys.executable, "-m", "shellbvp", *args], capture_output=True, text=True, cwd=cwd,
-                          timeout=600)
-
-
-def test_the_command_line_takes_a_closed_meridian(tmp_path):
+def test_the_command_line_takes_a_closed_meridian(tmp_path, cli_main):
+    cli = cli_main  # the command's main in this process
     r = cli("curve", "--closed", "--support", "plates", "--flat-tip", "--meridian", "; ".join(FLAT_TOP), "--beta", "1e-3",
             "--delta-max", "0.05", "-o", "flat.h5", cwd=tmp_path)
     assert r.returncode == 0, r.stderr
@@ -123,10 +117,11 @@ def test_the_command_line_takes_a_closed_meridian(tmp_path):
                           (("--meridian", "sin(S); cos(S)"), "three formulas 'R(S); Z(S); L'")):
         r = cli("curve", "--closed", *args, cwd=tmp_path)
         assert r.returncode == 2 and message in r.stderr, r.stderr
-    rimmed = cli("curve", "--meridian", "sin(S); -2*cos(S); pi/2", "--delta-max", "0.02", "--points", "2", "-o",
-                 "rim.h5", cwd=tmp_path)  # a rimmed shell's meridian, pole to rim (the gamma = 2 spheroid's)
+    # a rimmed shell's meridian, pole to rim (tests/test_symbolic.py's user spheroid: one structure for both)
+    rimmed = cli("curve", "--meridian", "2*sin(S); -2*cos(S); pi/2", "--delta-max", "0.02", "--points", "2", "-o",
+                 "rim.h5", cwd=tmp_path)
     assert rimmed.returncode == 0, rimmed.stderr
-    assert sb.read_curve(tmp_path / "rim.h5").scene.shell == sb.UserShell("sin(S)", "-2*cos(S)", "pi/2")
+    assert sb.read_curve(tmp_path / "rim.h5").scene.shell == sb.UserShell("2*sin(S)", "-2*cos(S)", "pi/2")
 
 
 @pytest.mark.slow  # the user meridian's substrate structure derived and a two-contact curve (~160 s on a fresh cache)

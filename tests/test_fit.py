@@ -1,9 +1,6 @@
 """Fitting mu*H to measured data, units, CSV input (issue: fitting)."""
 
 import json
-import os
-import subprocess
-import sys
 
 import numpy as np
 import pytest
@@ -224,13 +221,11 @@ def test_malformed_csv_messages(tmp_path, text, kwargs, match):
         sb.read_force_csv(p, **kwargs)
 
 
-def test_fit_cli_with_csv(model, tmp_path):
+def test_fit_cli_with_csv(model, tmp_path, cli_main):
     disp, force = synthetic(model, 30, seed=5)
     p = _write(tmp_path, "data.csv", "displacement (mm),force (mN)\n"
                + "\n".join(f"{a * 1e3:.8g},{b * 1e3:.8g}" for a, b in zip(disp, force)))
-    r = subprocess.run([sys.executable, "-m", "shellbvp", "fit", str(p), "--preset", "fit", "--radius", "0.3mm",
-                        "--json", "-o", str(tmp_path / "fit.h5")], capture_output=True, text=True,
-                       env=dict(os.environ), timeout=600)
+    r = cli_main("fit", str(p), "--preset", "fit", "--radius", "0.3mm", "--json", "-o", str(tmp_path / "fit.h5"))
     assert r.returncode == 0, r.stderr
     out = json.loads(r.stdout)
     assert abs(out["mu_H"] - MU_H) < 0.02 * MU_H and out["mu_H_ci95"][0] < out["mu_H"] < out["mu_H_ci95"][1]
