@@ -219,10 +219,11 @@ def closed_continued(guess, control, value, *, tol, max_nodes, eps, bc_tol):
     """The valid state of ``guess``'s configuration at delta = ``value`` by natural continuation
     from it, the step halved while a step fails or lands on an invalid state; None where that
     does not reach ``value`` (or under force control).  Where a ring moves fast with the depth
-    the whole step from a neighbour fails although the configuration holds all the way: the thin
-    egg (eps 0.02) between plates, whose blunt half's ring runs from S 0.265 to 0.293 between
-    delta 0.082 and 0.084, its force falling there; the cold start's guess then gives a contact
-    that pulls."""
+    the whole step from a neighbour fails although its configuration is valid there: the thin
+    egg (eps 0.02) between plates, whose blunt half's ring snaps outwards near delta 0.0825 (S
+    0.265 at 0.082, 0.293 at 0.084; the branch from below folds back in delta at 0.08249 and one
+    of the same configuration goes on, its force lower); the cold start's guess gives a contact
+    that pulls.  A fold is not crossed by shorter steps: a depth just past it stays flagged."""
     if control != "delta" or guess.delta == value:
         return None
     budget = int(min(max_nodes, max(_JOINED_MIN_NODES, _CONTINUATION_NODES * guess.nodes)))

@@ -105,9 +105,9 @@ def test_an_eggs_record_is_fitted_back(where, tmp_path):
 @pytest.mark.slow  # the thin egg's curve to 0.15 and three warm solves (~30 s of CPU warm, the cold start at 0.07125 included; the halves' codes
 #                    for eps 0.02 derived on a fresh cache, ~1 min more)
 def test_a_thin_eggs_ring_running_fast_is_continued_in_shorter_steps():
-    # eps 0.02: the blunt half's ring runs from S 0.265 to 0.293 between delta 0.082 and 0.084, its
-    # force falling there; a step of the curve across it did not converge and the cold start's guess
-    # gave closed-cap-cap with the substrate pulling (7 states of 18 flagged from 0.0825 before)
+    # eps 0.02: the blunt half's ring snaps outwards near delta 0.0825 (S 0.265 at 0.082, 0.293 at
+    # 0.084); the curve's step from 0.07125 did not converge and the cold start's guess gave
+    # closed-cap-cap with the substrate pulling (7 states of 18 flagged from 0.0825 before)
     egg = sb.UserShell.closed_halves(PROLATE, OBLATE)
     scene = sb.Scene(closed=True, shell=egg, support="plates", tip=sb.FlatTip(), thickness=0.02)
     c = sb.curve(scene, delta_max=0.15)
