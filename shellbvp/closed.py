@@ -24,9 +24,10 @@ from .configurations import configuration
 from .configurations.closed import LOWER_NAMES, closed_name
 from .cylinder import solve_chain_from
 from .geometry import FlatTip
+from .march import Steps, march
 from .solution import failure, richardson_error, warm_mesh
 
-__all__ = ["closed_again", "closed_cold", "symmetric_scenes"]
+__all__ = ["closed_again", "closed_continued", "closed_cold", "symmetric_scenes"]
 
 #: States of each symmetric problem computed up to twice the depth, to match their forces.
 HALF_POINTS = 8
@@ -207,3 +208,48 @@ def closed_again(guess, control, value, *, topology, tol, max_nodes, eps, bc_tol
         res = richardson_error(res.system, res, tol, bc_tol)
     return res
 
+
+
+#: Solves of :func:`closed_continued` (its steps halved at most about that often) and its node
+#: budget in multiples of the neighbour's mesh (a step that does not converge must fail fast)
+_CONTINUATION_SOLVES, _CONTINUATION_NODES = 10, 3
+
+
+def closed_continued(guess, control, value, *, tol, max_nodes, eps, bc_tol):
+    """The valid state of ``guess``'s configuration at delta = ``value`` by natural continuation
+    from it, the step halved while a step fails or lands on an invalid state; None where that
+    does not reach ``value`` (or under force control).  Where a ring moves fast with the depth
+    the whole step from a neighbour fails although its configuration is valid there: the thin
+    egg (eps 0.02) between plates, whose blunt half's ring snaps outwards near delta 0.0825 (S
+    0.265 at 0.082, 0.293 at 0.084; the branch from below folds back in delta at 0.08249 and one
+    of the same configuration goes on, its force lower); the cold start's guess gives a contact
+    that pulls.  A fold is not crossed by shorter steps: a depth just past it stays flagged."""
+    if control != "delta" or guess.delta == value:
+        return None
+    budget = int(min(max_nodes, max(_JOINED_MIN_NODES, _CONTINUATION_NODES * guess.nodes)))
+
+    def solve_at(delta, states):
+        near = states[-1]
+        sysm = _system(near.scene, near.topology, "delta", delta, eps)
+        x = warm_mesh(near, tol)
+        y, q = near.sol(x)[:sysm.n_shell], _unknowns(near)
+        if len(states) > 1:  # along the secant through the state before it, over at most its length
+            before = states[-2]
+            a = (delta - near.delta) / (near.delta - before.delta)
+            if abs(a) <= 1:
+                qb = _unknowns(before)
+                q = {k: v + a * (v - qb[k]) for k, v in q.items()}
+                y = y + a * (y - before.sol(x)[:sysm.n_shell])
+        return solve_chain_from(sysm, (x, y, sysm.pack(**q)), tol=tol, max_nodes=budget, bc_tol=bc_tol,
+                                max_jacobians=_JOINED_JACOBIANS)
+
+    # the whole step failed already (closed_again): half of it first; a step that succeeds is
+    # kept.  Halved steps add up to value only to rounding: the last one lands on value itself.
+    landed = []
+    steps = Steps(0.5 * (value - guess.delta), grow=lambda s: s,
+                  advance=lambda u, s, t: t if abs(t - u) <= abs(s) * (1 + 1e-9) else u + s)
+    marched = march(guess.delta, value, solve_at, steps, history=[guess], position=lambda s: s.delta,
+                    accept=lambda s: s.success and s.valid, arrived=lambda u: False,
+                    on_accept=lambda s, u: landed.append(s) if u == value else None,
+                    done=lambda states: "" if landed else None, max_solves=_CONTINUATION_SOLVES)
+    return landed[0] if marched.reached else None

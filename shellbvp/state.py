@@ -15,7 +15,7 @@ import time
 import numpy as np
 
 from .chain import FREE_STATES, ChainBVP
-from .closed import closed_again, closed_cold
+from .closed import closed_again, closed_cold, closed_continued
 from .configurations import ASKED, asked, configuration, is_point_load, is_single_cap, of
 from .corner import edge_model, edge_null_jump, is_corner, limit_estimate, near_limit, other_edge_root
 from .cylinder import cap_onto_wall, wall_again
@@ -307,11 +307,13 @@ def solve(scene, *, delta=None, lambda0=None, force=None, tol=1e-6, max_nodes=10
     if topology != "auto":
         configuration(topology).check_contact(scene)
     again = AGAIN.get(of(guess).family) if guess is not None and of(guess) is not None else None
+    neighbour = None  # a valid closed state: continued in shorter steps where its cold start is not valid
     if again is not None:  # a lifted, split or wall state: its configuration solved again from it
         res = again(guess, control, value, topology=topology, tol=tol, max_nodes=max_nodes, eps=eps,
                     bc_tol=bc_tol, estimate_error=estimate_error)
         if res is not None:
             return res
+        neighbour = guess if scene.two_contacts and of(guess).family == "closed" and guess.valid else None
         guess = None  # back to the cap
 
     near_point = None
@@ -324,6 +326,8 @@ def solve(scene, *, delta=None, lambda0=None, force=None, tol=1e-6, max_nodes=10
     kw = dict(tol=tol, max_nodes=max_nodes, bc_tol=bc_tol)
     if scene.two_contacts:  # a closed shell on a substrate: its own configuration, from the flat plate's
         res = closed_cold(scene, control, value, solve_half=solve, eps=eps, **kw)
+        if not (res.success and res.valid) and neighbour is not None:  # its configuration in shorter steps
+            res = closed_continued(neighbour, control, value, eps=eps, **kw) or res
         if res.success and estimate_error:
             res = richardson_error(res.system, res, tol, bc_tol)
         return res.with_(wall_time=time.perf_counter() - t0)
