@@ -1,6 +1,6 @@
 """Regenerate every benchmark result (issue 5): one command.
 
-    python benchmarks/run.py                 # every result (8.0 h or more on 2 shared cores; below)
+    python benchmarks/run.py                 # every result (9.5 h or more on 2 shared cores; below)
     python benchmarks/run.py --quick         # each step's quick mode, ~6 min: a smoke test (*-quick files)
     python benchmarks/run.py --figures       # ... and the paper's figures (benchmarks/paper_figures.py)
     python benchmarks/run.py --only work_precision,profile    # steps by name
@@ -28,11 +28,11 @@ trust kinds beyond the tally's own quick mode take minutes).  A summary (step, s
 status) goes to ``results/run[-quick].json``; the exit status is non-zero if any step failed.
 
 Time: the full plan's stated costs (each result file's own time for its whole run, or the sum
-of its per-case times; ``--list`` prints them) add up to 28,649 s (8.0 h on 2 shared cores)
-over 41 of the 56 steps; the other 15 (shooting, profile, point_budget, codegen_timing, kernels,
+of its per-case times; ``--list`` prints them) add up to 34,268 s (9.5 h on 2 shared cores)
+over 43 of the 59 steps; the other 16 (shooting, profile, point_budget, codegen_timing, kernels,
 sweep_scaling, sweep_kill_resume, topologies, bending_koiter_map, vella, stability_pressure,
-fit_baseline_coverage, contact_estimate, profile_fit, paper_figures) give no time, so 8.0 h is
-a floor.  ``--quick`` (24 steps; 23 before profile_solid's) took 380 s measured on the same machine at load 6 (nice 10;
+thick_fits_closed_check, fit_baseline_coverage, contact_estimate, profile_fit, paper_figures) give
+no time, so 9.5 h is a floor.  ``--quick`` (25 steps; 23 before profile_solid's and closed_matrix's) took 380 s measured on the same machine at load 6 (nice 10;
 1,260 s at load 10-12 with the whole trust tally), 2-76 s a step; the per-step times go to ``results/run-quick.json``.
 """
 

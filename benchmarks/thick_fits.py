@@ -20,7 +20,13 @@ thickness): the largest errors there are the fit-level bound the package prints 
 capsule between plates (eps 0.1) and a cell on a substrate under a sphere of radius R/2 (eps
 0.15), records to 0.2 R (the indenters' approach, first touch at 10 um) with 2 % noise; with
 ``--timing`` the cold and warm commands are those of each closed record.  The records are kept
-in the JSON.
+in the JSON.  ``--set closed-mapped`` (``--eps`` 0.05 or 0.02) is the map of closed shells' model error:
+spheroids between plates and on a substrate under a sphere tip (``CLOSED_MAPPED``), records made
+as for ``--set closed``, each fitted by the shell with and without transverse shear (whole, loading
+only, shallow half), and the shell's error in F at equal depth against the record's own solid
+curve; its largest errors are ``shellbvp.thickness.CLOSED_*_MODEL_ERROR``.  ``--closed-map-check``
+puts the bound printed from that map beside the shell's error on the two records of ``--set closed``
+(outside the map).
 
 ``--bending koiter`` fits the shell model with Koiter's bending energy (``sb.KoiterBending()``)
 instead of the trace energy (the default), into files named by it (``thick_fits_koiter.md``,
@@ -39,6 +45,8 @@ measured in one run.
     python benchmarks/thick_fits.py --set mapped --eps 0.02 --no-convergence
     python benchmarks/thick_fits.py --set mapped --eps 0.02 --no-convergence --bending koiter \
         --records thick_fits_mapped_eps0.02.json
+    python benchmarks/thick_fits.py --set closed-mapped --eps 0.05
+    python benchmarks/thick_fits.py --closed-map-check
 """
 
 from __future__ import annotations
@@ -92,8 +100,20 @@ CLI_SAMPLE = {"seed": ["--rise", "0.75mm", "--indenter-radius", "0.1mm", "--thic
               "cell substrate eps 0.15": ["--closed", "--gamma", "1", "--indenter-radius", "0.15mm",
                                           "--thickness", "45um"]}
 CLOSED_DEPTH, CLOSED_NOISE = 0.2, 0.02
-SETS = {"held-out": HELD_OUT, "mapped": MAPPED, "closed": CLOSED}
-SCENES = {**HELD_OUT, **MAPPED, **CLOSED}
+#: the map of closed shells' model error (``--set closed-mapped``): at eps 0.05 a sphere, an oblate and
+#: a prolate spheroid (gamma 0.7, 1.4) between plates, and on a substrate a sphere under sphere tips
+#: rho 0.2 and 0.5 and the spheroids under rho 0.5; at eps 0.02 the sphere between plates.  (Left out
+#: for the machine's time: at eps 0.02 the spheroids, whose records' solids took ~30 min each on the
+#: shared machine, and the substrate, whose solid, the whole wall at 0.33 H, is estimated at 14-20 min
+#: of a free core.)
+_CLOSED_SHAPES = (("sphere", 1.0, None, "plates"), ("oblate", 0.7, None, "plates"), ("prolate", 1.4, None, "plates"),
+                  ("sphere", 1.0, 0.5, "substrate"), ("sphere", 1.0, 0.2, "substrate"),
+                  ("oblate", 0.7, 0.5, "substrate"), ("prolate", 1.4, 0.5, "substrate"))
+CLOSED_MAPPED = {f"{shape} {'plates' if rho is None else f'substrate rho {rho:g}'} eps {e:g}": (g, rho, e, support)
+                 for e, shapes in ((0.05, _CLOSED_SHAPES), (0.02, _CLOSED_SHAPES[:1]))
+                 for shape, g, rho, support in shapes}
+SETS = {"held-out": HELD_OUT, "mapped": MAPPED, "closed": CLOSED, "closed-mapped": CLOSED_MAPPED}
+SCENES = {**HELD_OUT, **MAPPED, **CLOSED, **CLOSED_MAPPED}
 #: the record's mesh: 1.5x finer each way than the fitting model's (FE_DEFAULTS: 0.5 H, 3 through H)
 RECORD_MESH = dict(element_length=0.33, through_thickness=4)
 #: the shell's bending energies --bending chooses from (the records' solid has none)
@@ -115,7 +135,7 @@ def scene_of(gamma, rho, eps, support=None, **over):
 def make_record(name, folder):
     """The instrument-like record of scene ``name`` as a TSV file (um, uN); returns its path."""
     eps = SCENES[name][2]
-    closed = name in CLOSED
+    closed = len(SCENES[name]) > 3  # (gamma, rho, eps, support): a closed shell
     depths = (CLOSED_DEPTH if closed else DEPTH) * np.arange(1, 51) / 50
     noise = CLOSED_NOISE if closed else NOISE
     t0 = time.perf_counter()
@@ -131,6 +151,9 @@ def make_record(name, folder):
     path = Path(folder) / f"{name.replace(' ', '_')}.tsv"
     path.write_text("Displacement (um)\tForce (uN)\n" + "".join(f"{d * 1e6:.6f}\t{f * 1e6:.6f}\n"
                                                                 for d, f in zip(disp, noisy)))
+    # the solid's own curve beside it (nondimensional): the shell's error in F at equal depth on it
+    path.with_suffix(".solid.json").write_text(json.dumps({k: getattr(fe, k).tolist() for k in
+                                                           ("delta", "indenter", "force", "contact_radius")}))
     return path, time.perf_counter() - t0
 
 
@@ -146,7 +169,7 @@ def cut(path, design):
         return path
     rows = path.read_text().splitlines()
     d = np.array([float(r.split("\t")[0]) for r in rows[1:]]) * 1e-6
-    depth = CLOSED_DEPTH if name_of(path) in CLOSED else DEPTH
+    depth = CLOSED_DEPTH if len(SCENES[name_of(path)]) > 3 else DEPTH  # a closed shell
     keep = d >= CONTACT if design == "loading only" else d <= CONTACT + depth * R_L / 2
     out = path.with_name(f"{path.stem}-{design.replace(' ', '_')}.tsv")
     out.write_text("\n".join([rows[0], *(r for r, k in zip(rows[1:], keep) if k)]) + "\n")
@@ -225,7 +248,8 @@ def main():
     ap = add_output_args(argparse.ArgumentParser(description=__doc__.splitlines()[0]))
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--set", choices=list(SETS), default="held-out",
-                    help="held-out: issue 54's five scenes (default); mapped: the error map's scenes")
+                    help="held-out: issue 54's five scenes (default); mapped: the error map's scenes; closed: two "
+                         "thick closed shells; closed-mapped: the map of closed shells")
     ap.add_argument("--eps", type=float, help="only the scenes of this thickness")
     ap.add_argument("--only", choices=list(SCENES))
     ap.add_argument("--timing", action="store_true")
@@ -235,12 +259,18 @@ def main():
     ap.add_argument("--records", type=Path, metavar="FILE.json",
                     help="fit the records kept in this result file (its scenes') instead of making them; "
                          "a bare file name is looked for in the results folder this run writes to")
+    ap.add_argument("--closed-map-check", action="store_true",
+                    help="only the closed shells' printed bound against the two thick records of --set closed")
     args = ap.parse_args()
+    if args.closed_map_check:
+        return closed_map_check(args.out_dir)
     if args.timing and args.bending != "trace":
         ap.error(f"--timing times the trace energy's commands: not with --bending {args.bending}")
     names = [args.only] if args.only else [n for n, s in SETS[args.set].items() if args.eps in (None, s[2])]
     if args.records is not None and args.records.parent == Path():  # a bare name: in the results this run writes
         args.records = results_dir(args.out_dir) / args.records.name
+    if args.set == "closed-mapped":
+        return closed_mapped(args, names)
     kept = kept_records(args.records, names) if args.records else None  # checked before any work
     folder = Path(tempfile.mkdtemp())
     t0 = time.perf_counter()
@@ -317,6 +347,177 @@ def command(r):
     args += [] if r.get("bending", "trace") == "trace" else ["--bending", r["bending"]]
     args += ["--records", r["records_from"]] if r.get("records_from") else []
     return " ".join(args)
+
+
+#: depths (of the record's 50) where the shell's force is compared with the solid's at equal depth
+F_DEPTHS = (1, 2, 4, 9, 14, 19, 24, 29, 34, 39, 44, 49)
+CLOSED_FITS = ("shell", "shell, shear")
+
+
+def f_error_case(job):
+    """The shell's error in F against the record's own solid curve at equal depth, from H/4 on: at
+    the solid's mid-surface poles' approach (``error``, `validate`'s convention, the rimmed map's) and
+    at the indenters' approach (``error_indenter``: the shell's delta taken as the instrument's, as a
+    fit does).  Where the contact reaches 0.95 rho the shell wraps the tip (``wraps``: left out of
+    the map, as for rimmed shells)."""
+    from shellbvp.validation import shell_curve
+
+    name, path, label = job
+    gamma, rho, eps, support = SCENES[name]
+    solid = json.loads(Path(path).with_suffix(".solid.json").read_text())
+    idx = [i for i in F_DEPTHS if solid["delta"][i] >= eps / 4]
+    d, f = np.array(solid["delta"])[idx], np.array(solid["force"])[idx]
+    x = np.array(solid["indenter"])[idx]
+    t0 = time.perf_counter()
+    c = shell_curve(scene_of(gamma, rho, eps, support, transverse_shear=label == "shell, shear"), np.union1d(d, x))
+    F, Fx = c.force_at(d), c.force_at(x)
+    rc = np.array(solid["contact_radius"])[idx]
+    wraps = rc >= 0.95 * rho if rho is not None else np.zeros(d.size, bool)
+    return {"scene": name, "fit": label, "delta": d.tolist(), "indenter": x.tolist(), "force_solid": f.tolist(),
+            "force_shell": F.tolist(), "error": (F / f - 1).tolist(), "force_shell_indenter": Fx.tolist(),
+            "error_indenter": (Fx / f - 1).tolist(), "wraps": wraps.tolist(), "seconds": time.perf_counter() - t0}
+
+
+def closed_mapped(args, names):
+    """``--set closed-mapped``: each closed shell's record fitted by the shell with and without
+    transverse shear (whole, loading only, shallow half), and the shell's error in F at equal depth."""
+    folder = Path(tempfile.gettempdir()) / "shellbvp-closed-map-records"  # kept: a rerun fits them again
+    folder.mkdir(exist_ok=True)
+    t0 = time.perf_counter()
+    with ProcessPoolExecutor(args.workers) as pool:
+        made = dict(zip(names, pool.map(kept_record, names, [folder] * len(names))))
+        jobs = [(n, made[n][0], label, design) for n in names for label in CLOSED_FITS for design in DESIGNS]
+        fits = list(pool.map(fit_case, jobs))
+        in_f = list(pool.map(kept_f_error, [(n, made[n][0], label) for n in names for label in CLOSED_FITS]))
+    result = {"set": args.set, "scenes": {n: dict(zip(("gamma", "rho", "eps", "support"), SCENES[n]),
+                                                  record_seconds=made[n][1],
+                                                  fe_size=fe_size(scene_of(*SCENES[n]), SCENES[n][2]).describe(),
+                                                  record_tsv=made[n][0].read_text(),
+                                                  solid=json.loads(made[n][0].with_suffix(".solid.json").read_text()))
+                                      for n in names},
+              "fits": fits, "f_error": in_f, "convergence": None, "machine": platform.platform(),
+              "version": sb.__version__, "seconds": time.perf_counter() - t0}
+    result["worst"] = closed_worst(result)
+    stem = "thick_fits_closed-mapped" + ("" if args.eps is None else f"_eps{args.eps:g}")
+    write(result, stem, args.out_dir)
+    write_atomic(results_dir(args.out_dir) / f"{stem}.md", report(result) + report_closed_map(result))
+    print(report_closed_map(result))
+
+
+def kept_record(name, folder):
+    """make_record's (path, seconds), or the record already made in ``folder`` by an earlier run."""
+    path = Path(folder) / f"{name.replace(' ', '_')}.tsv"
+    seconds = path.with_suffix(".seconds")
+    if path.exists() and path.with_suffix(".solid.json").exists() and seconds.exists():
+        return path, float(seconds.read_text())
+    path, took = make_record(name, folder)
+    seconds.write_text(repr(took))
+    return path, took
+
+
+def kept_f_error(job):
+    """f_error_case's row, or the one an earlier run kept beside the record (the same record and model)."""
+    name, path, label = job
+    kept = Path(path).with_suffix(f".f_error-{label.replace(', ', '-')}.json")
+    if kept.exists():
+        return json.loads(kept.read_text())
+    row = f_error_case(job)
+    kept.write_text(json.dumps(row))
+    return row
+
+
+def closed_worst(r):
+    """The largest abs(error) by (support, fit, eps): in the fitted mu*H and in F at equal depth (the
+    depths where the shell wraps the tip left out), with the scene where it is."""
+    worst = {}
+    for kind, rows in (("fit", r["fits"]), ("F", r["f_error"]), ("F indenter", r["f_error"])):
+        for f in rows:
+            s = r["scenes"][f["scene"]]
+            if kind == "fit":  # a fit that ran and failed a check (its warnings kept) counts: its mu*H is printed
+                e = abs(f["error"])
+            else:
+                errs = np.array(f["error" if kind == "F" else "error_indenter"], float)
+                errs = np.abs(errs)[~np.array(f["wraps"], bool)]
+                e = float(np.max(errs)) if errs.size and np.all(np.isfinite(errs)) else np.nan
+            key = f"{s['support']}|{f['fit']}|{s['eps']:g}|{kind}"
+            old = worst.get(key)
+            if old is None or not np.isfinite(e) or (np.isfinite(old["error"]) and e > old["error"]):
+                worst[key] = {"error": float(e), "scene": f["scene"], "record": f.get("record", "")}
+    return worst
+
+
+def report_closed_map(r):
+    made = sum(s["record_seconds"] for s in r["scenes"].values())
+    eps = sorted({s["eps"] for s in r["scenes"].values()})
+    lines = ["", f"The command: `python benchmarks/thick_fits.py --set closed-mapped"
+             f"{f' --eps {eps[0]:g}' if len(eps) == 1 else ''}` (--no-convergence is implied).", "",
+             f"The records' solids took {made:.0f} s in all (made once and kept in "
+             "`$TMPDIR/shellbvp-closed-map-records`: a rerun fits them again; the run's time above leaves "
+             "out those made by an earlier run).", "",
+             "The shell model's error on closed shells (the closed shells' map; NaN: a fit or curve that "
+             "did not converge):", "", "| support | fit | eps | largest abs(error) in mu*H (scene, record) | "
+             "in F at equal mid-surface poles' approach (scene) | in F at equal indenters' approach (scene) |",
+             "|---|---|---|---|---|---|"]
+    keys = sorted({k.rsplit("|", 1)[0] for k in r["worst"]})
+    cell = (lambda w: "-" if w is None else f"{100 * w['error']:.1f} % ({w['scene']}"
+            f"{', ' + w['record'] if w['record'] else ''})")
+    for k in keys:
+        support, fit, eps = k.split("|")
+        lines.append(f"| {support} | {fit} | {eps} | " + " | ".join(cell(r["worst"].get(f"{k}|{kind}"))
+                                                                  for kind in ("fit", "F", "F indenter")) + " |")
+    failed = [f for f in r["fits"] if not f["success"]]
+    lines += ["", f"Fits that ran and did not succeed (counted above; their mu*H is what a fit prints): {len(failed)}"
+              + "".join(f"; {f['scene']}, {f['fit']}, {f['record']}: {100 * f['error']:+.1f} % "
+                        f"({', '.join(f['warnings'])})" for f in failed) + "."]
+    lines += ["", "The shell's F against the record's solid at equal depth, from H/4 (* the shell wraps the tip, left "
+              "out), at the mid-surface poles' approach delta and at the indenters' approach:", "",
+              "| scene | fit | delta | F error at delta | F error at the indenters' approach |", "|---|---|---|---|---|"]
+    for f in r["f_error"]:
+        errs = [", ".join(f"{100 * e:+.1f}{'*' if w else ''}" for e, w in zip(f[key], f["wraps"]))
+                for key in ("error", "error_indenter")]
+        lines.append(f"| {f['scene']} | {f['fit']} | {f['delta'][0]:.3g}..{f['delta'][-1]:.3g} | {errs[0]} % | "
+                     f"{errs[1]} % |")
+    return "\n".join(lines) + "\n"
+
+
+def closed_map_check(out_dir=None):
+    """``--closed-map-check``: the bound the package prints beside a shell fit of a closed shell
+    (:func:`shellbvp.thickness.model_error`, from the closed shells' map) against the shell's error
+    on the two thick closed records of ``--set closed`` (eps 0.1 and 0.15: outside the map, the bound
+    extrapolated); writes results/thick_fits_closed_check.{json,md}."""
+    from shellbvp.thickness import CLOSED_EPS, model_error
+
+    r = json.loads((HERE / "results" / "thick_fits_closed.json").read_text())
+    rows = []
+    for f in r["fits"]:
+        if not f["fit"].startswith("shell"):
+            continue
+        s = r["scenes"][f["scene"]]
+        scene = scene_of(s["gamma"], s["rho"], s["eps"], s["support"], transverse_shear=f["fit"] == "shell, shear")
+        bound, extrapolated = model_error(scene)
+        half = (f["ci95"][1] - f["ci95"][0]) / 2 / f["mu_H"]
+        rows.append({"scene": f["scene"], "eps": s["eps"], "fit": f["fit"], "record": f["record"], "error": f["error"],
+                     "bound": bound, "extrapolated": extrapolated, "half_ci": half,
+                     "holds": bool(abs(f["error"]) <= bound), "holds_with_ci": bool(abs(f["error"]) <= bound + half)})
+    out = {"mapped_eps": list(CLOSED_EPS), "rows": rows, "version": sb.__version__}
+    lines = ["# The closed shells' printed model error off its map", "",
+             "`python benchmarks/thick_fits.py --closed-map-check`: the bound a shell fit of a closed shell prints "
+             f"(`shellbvp.thickness.model_error`, mapped at eps {', '.join(f'{e:g}' for e in CLOSED_EPS)}: "
+             "`thick_fits_closed-mapped_eps*.md`), extrapolated to the two thick records of "
+             "`thick_fits_closed.md`, against the shell's error there.", "",
+             "| scene | fit | record | error in mu*H | printed bound | extrapolated | holds | holds with the interval's "
+             "half-width |", "|---|---|---|---|---|---|---|---|"]
+    for w in rows:
+        lines.append(f"| {w['scene']} | {w['fit']} | {w['record']} | {100 * w['error']:+.1f} % | {100 * w['bound']:.2g} % | "
+                     f"{'yes' if w['extrapolated'] else 'no'} | {'yes' if w['holds'] else '**no**'} | "
+                     f"{'yes' if w['holds_with_ci'] else '**no**'} |")
+    held = sum(w["holds"] for w in rows)
+    worst = max(rows, key=lambda w: abs(w["error"]) / w["bound"])
+    lines += ["", f"The printed bound holds on {held} of {len(rows)} fits; the error reaches at most "
+              f"{abs(worst['error']) / worst['bound']:.2f} of it ({worst['scene']}, {worst['fit']}, {worst['record']})."]
+    write_atomic(results_dir(out_dir) / "thick_fits_closed_check.json", json.dumps(out, indent=1))
+    write_atomic(results_dir(out_dir) / "thick_fits_closed_check.md", "\n".join(lines) + "\n")
+    print("\n".join(lines))
 
 
 def report(r):
