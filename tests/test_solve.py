@@ -503,3 +503,24 @@ def test_a_guess_from_a_looser_tolerance_starts_on_a_mesh_for_the_tolerance_aske
     assert tight.success and tight.niter <= 2, (tight.niter, tight.nodes)
     assert tight.nodes > 3 * loose.nodes
     assert tight.force == pytest.approx(loose.force, rel=1e-6)
+
+
+def test_a_deep_cold_solve_finds_the_curves_state_by_continuation(monkeypatch):
+    """Deeper than the continuation's start, where a resolved cap converges there, a cold solve
+    continues in delta before trying the point-load route (whose march ends short of the depth:
+    gamma 0 at 0.675 near 0.12), and finds the state the warm continuation reaches."""
+    import shellbvp.state as state
+
+    scene = sb.Scene.preset("flat")
+    warm = sb.solve(scene, delta=0.3)
+    for d in (0.45, 0.6, 0.675):
+        warm = sb.solve(scene, delta=d, guess=warm)
+
+    def no_point_route(*args, **kwargs):
+        raise AssertionError("the point-load route was tried")
+
+    monkeypatch.setattr(state, "_point_route", no_point_route)
+    cold = sb.solve(scene, delta=0.675)
+    assert cold.success and warm.success
+    assert cold.topology == warm.topology
+    assert cold.force == pytest.approx(warm.force, rel=1e-8)
