@@ -6,13 +6,15 @@ substrate under a sphere tip (rho 0.5), open, at eps = H/R 0.05 and 0.02: the so
 and the shell model (``sb.curve``, beta = eps^2/3) at the same approach delta of the indenters
 (the scene's convention: the plates', or the tip's and the substrate's, from first touch, in
 equatorial radii), and at the solid's mid-surface poles' approach (``sb.validate``'s convention),
-with the solid's mesh error (``mesh_check``: 2/3 the elements each way).  ``--sealed`` adds the sealed capsule between plates (volume held).
+with the solid's mesh error (``mesh_check``: 2/3 the elements each way).  ``--sealed`` adds the sealed capsule between plates (volume held);
+``--egg`` the egg of docs/closed.md (halves that differ: prolate 1.3 above, oblate 0.7 below) on
+the substrate under the sphere tip and between plates (its solid the whole wall in both).
 
 Results cached in ``results/closed_solid.json`` (keyed by scene and eps; ``--recompute`` to
 start afresh); the table in ``results/closed_solid.md``; both under ``--out-dir DIR`` if given
 (an empty DIR: every curve computed again).
 
-    nice -n 10 python benchmarks/closed_solid.py [--eps 0.05] [--sealed] [--no-mesh-check] [--out-dir DIR]
+    nice -n 10 python benchmarks/closed_solid.py [--eps 0.05] [--sealed] [--egg] [--no-mesh-check] [--out-dir DIR]
 """
 
 from __future__ import annotations
@@ -41,10 +43,16 @@ SCENES = {
     "substrate, sphere tip rho 0.5": dict(support="substrate", tip=sb.SphereTip(), rho=0.5),
 }
 SEALED = {"plates, sealed": dict(support="plates", tip=sb.FlatTip(), sealed=True)}
+#: An egg: a prolate upper half on an oblate lower half (docs/closed.md, "Halves that differ")
+_EGG = sb.UserShell.closed_halves(upper=("sin(S)", "1.3*cos(S)", "pi/2"), lower=("sin(S)", "0.7*cos(S)", "pi/2"))
+EGG = {"egg, substrate, sphere tip rho 0.5": dict(support="substrate", tip=sb.SphereTip(), rho=0.5, shell=_EGG),
+       "egg, plates": dict(support="plates", tip=sb.FlatTip(), shell=_EGG)}
 
 
 def scene_of(name, eps):
-    return sb.Scene(closed=True, gamma=1.0, material=sb.MooneyRivlin(0.1), thickness=eps, **{**SCENES, **SEALED}[name])
+    kw = {**SCENES, **SEALED, **EGG}[name]
+    shape = {} if "shell" in kw else {"gamma": 1.0}
+    return sb.Scene(closed=True, material=sb.MooneyRivlin(0.1), thickness=eps, **shape, **kw)
 
 
 def key(name, eps):
@@ -92,8 +100,9 @@ def report(cache, args):
     lines = ["# Closed shells: the shell model against the 3D solid", "",
              f"Measured {time.strftime('%Y-%m-%d')} on {platform.machine()} (a shared 2-core machine), shellbvp "
              f"{sb.__version__} at {commit_label() or 'unknown commit'}; `nice -n 10 python "
-             f"benchmarks/closed_solid.py{' --sealed' if args.sealed else ''}`.", "",
-             "A complete sphere (gamma 1, Mooney-Rivlin alpha 0.1, open unless sealed).  `delta`: the approach of "
+             f"benchmarks/closed_solid.py{' --sealed' if args.sealed else ''}{' --egg' if args.egg else ''}`.", "",
+             "A complete sphere (gamma 1, Mooney-Rivlin alpha 0.1, open unless sealed); the egg's halves "
+             "differ (prolate 1.3 above, oblate 0.7 below: its solid the whole wall, also between plates).  `delta`: the approach of "
              "the indenters from first touch (the plates', or the tip's and the substrate's; the shell's on its "
              "mid-surface, the solid's on its outer surface), in equatorial radii R; F / (mu R H).  Solid: `sb.fe_curve` (FElupe, 9-node u/p/J elements, bulk 5000 mu, 3 through H, H/2 "
              "along the meridian, H/4 near the poles; frictionless penalty contacts on the outer surface; between "
@@ -147,6 +156,7 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--eps", default=None, help="only these thicknesses, comma-separated (default 0.05,0.02)")
     ap.add_argument("--sealed", action="store_true", help="also the sealed capsule between plates")
+    ap.add_argument("--egg", action="store_true", help="also the egg on the substrate and between plates")
     ap.add_argument("--no-mesh-check", action="store_false", dest="mesh_check", help="no coarser mesh")
     ap.add_argument("--recompute", action="store_true", help="ignore the cached curves")
     args = add_output_args(ap).parse_args(argv)
@@ -154,7 +164,7 @@ def main(argv=None):
     out = results_dir(args.out_dir)
     store = out / "closed_solid.json"
     cache = {} if args.recompute or not store.exists() else json.loads(store.read_text())
-    names = list(SCENES) + (list(SEALED) if args.sealed else [])
+    names = list(SCENES) + (list(SEALED) if args.sealed else []) + (list(EGG) if args.egg else [])
     for eps in eps_list:
         for name in names:
             if key(name, eps) in cache and cache[key(name, eps)]["success"]:

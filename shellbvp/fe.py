@@ -15,8 +15,10 @@ the solid itself, so that a user sees the model's error for his own scene:
   plane and turning about its fixed mid-thickness point (pinning that point alone does not
   converge under refinement); a clamped rim holds the whole face;
 * a closed shell (:mod:`shellbvp.fe_closed`): between plates the half above the equator on its
-  symmetry plane; on a substrate the whole wall on a second, fixed frictionless contact; delta
-  the approach of the mid-surface poles;
+  symmetry plane; on a substrate the whole wall on a second, fixed frictionless contact; one
+  whose halves differ (an egg) the whole wall, each half's own meridian, on a substrate and
+  between plates (the bottom plate the fixed substrate); delta the approach of the
+  mid-surface poles;
 * the indenter: rigid and frictionless, the scene's tip on its cylinder, pressed on the
   surface that faces it (the shell model presses the mid-surface); a penalty on the
   penetration at Gauss points of that surface with the exact (consistent) tangent
@@ -42,12 +44,13 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .config import OPTIONS
-from .fe_closed import closed_boundary, mirrored, whole
+from .fe_closed import closed_boundary, egg, mirrored, whole
 from .fe_contact import PenaltyContact, TipSurface
 from .fe_newton import Newton
 from .fe_pressure import FollowerPressure
 from .fe_rim import RIM_FACES, HingedFace
 from .materials import MATERIALS
+from .model import load_module, lower_structure
 
 __all__ = ["fe_curve", "FECurve", "TipSurface", "FE_DEFAULTS", "check_solid_scene", "coarser", "FESize", "fe_size",
            "check_fe_size"]
@@ -84,18 +87,36 @@ def _felupe():
 
 
 # ---------------------------------------------------------------- the solid's mesh
-def _meridian(scene, n_table=4001):
+def _meridian(scene, n_table=4001, lower=False):
     """Arclength-parametrised reference mid-surface: s -> (R, Z, Phi), with the total length,
-    and the package's meridian coordinate S of each tabulated point (a profile's H(S))."""
-    mod = scene.model()
+    and the package's meridian coordinate S of each tabulated point (a profile's H(S)); of a
+    closed shell's lower half of its own (``lower``), that half's, in its mirror image."""
+    mod = load_module(lower_structure(scene)) if lower else scene.model()
     par = scene.parameters(mod, pole_rise=0.0)
-    S = np.linspace(0.0, scene.shell_length, n_table)
+    S = np.linspace(0.0, float(scene.shell.lower.geometry.L) if lower else scene.shell_length, n_table)
     ref = mod.reference_shell(S, par)
     R, Z = np.asarray(ref["R"], float), np.asarray(ref["Z"], float)
     ds = np.hypot(np.diff(R), np.diff(Z))
     s = np.concatenate([[0.0], np.cumsum(ds)])
     # chords of 4000 intervals: the arclength to ~1e-8, nodes placed by linear interpolation
     return s, R, Z, np.asarray(ref["Phi"], float), S
+
+
+def _tables(scene, eps, element_length, pole_refinement):
+    """The meridian table ``(s, R, Z, Phi, H, corners)`` the solid is meshed on: the upper half's,
+    or a closed shell's whole wall (on a substrate, or one whose halves differ), each half's
+    elements from its own pole; and the upper half's elements (the equator's corner)."""
+    s, R, Z, Phi, S = _meridian(scene)
+    H = _wall(scene, eps, S)
+    upper = (s, R, Z, Phi, H, _corners(s, H, eps, element_length, pole_refinement))
+    if not whole(scene):
+        return upper, upper[-1].size - 1
+    lower = None
+    if egg(scene):  # its lower half's own table (a uniform wall: an egg has no profile)
+        s, R, Z, Phi, S = _meridian(scene, lower=True)
+        H = _wall(scene, eps, S)
+        lower = (s, R, Z, Phi, H, _corners(s, H, eps, element_length, pole_refinement))
+    return mirrored(upper, lower), upper[-1].size - 1
 
 
 def _wall(scene, eps, S):
@@ -154,12 +175,8 @@ class _Model:
 def _build(scene, eps, *, through_thickness, element_length, pole_refinement, bulk, penalty, gauss_points,
            band=1e-5, rim_face="plane"):
     fem = _felupe()
-    s_tab, R_tab, Z_tab, Phi_tab, S_tab = _meridian(scene)
-    H_tab = _wall(scene, eps, S_tab)  # the wall's thickness at each tabulated point
-    corners = _corners(s_tab, H_tab, eps, element_length, pole_refinement)
-    if whole(scene):  # a closed shell on a substrate: pole to pole, each half its profile from its pole
-        s_tab, R_tab, Z_tab, Phi_tab, corners = mirrored(s_tab, R_tab, Z_tab, Phi_tab, corners)
-        H_tab = np.r_[H_tab, H_tab[::-1][1:]]
+    # the wall's thickness H at each tabulated point; a closed shell's whole wall pole to pole
+    (s_tab, R_tab, Z_tab, Phi_tab, H_tab, corners), n_upper = _tables(scene, eps, element_length, pole_refinement)
     n_s, n_t = corners.size - 1, int(through_thickness)
     # quadratic nodes: element corners plus midpoints, along s and through t
     s_nodes = np.empty(2 * n_s + 1)
@@ -202,7 +219,8 @@ def _build(scene, eps, *, through_thickness, element_length, pole_refinement, bu
         pressure = FollowerPressure(points, bottom, scene.pressure * eps, int(np.sum(field.fieldsizes)), gauss_points)
     if scene.closed:
         fixed, top, supports, weights, approach = closed_boundary(
-            scene, eps, points, node, n_t, ncol, field, penalty=penalty, gauss_points=gauss_points, band=band)
+            scene, eps, points, node, n_t, ncol, field, penalty=penalty, gauss_points=gauss_points, band=band,
+            equator=2 * n_upper)
         contact = PenaltyContact(TipSurface(scene), points, top, penalty / eps, gauss_points, field, band * eps)
         return _Model(mesh, region, field, solid, contact, fixed, node(n_t, 0), eps, (n_s, n_t), None, pressure,
                       supports, weights, approach)
@@ -253,19 +271,26 @@ def fe_size(scene, thickness, **settings) -> FESize:
     overrides)."""
     opts = {**FE_DEFAULTS, **settings}
     eps = float(thickness)
-    s_tab, *_, S_tab = _meridian(scene)
+    n_s = _half_elements(scene, eps, opts)
+    if whole(scene):  # a closed shell's whole wall: both halves, an egg's lower its own
+        n_s += _half_elements(scene, eps, opts, lower=True) if egg(scene) else n_s
+    n_t = int(opts["through_thickness"])
+    # quadratic displacement nodes, two components; pressure and volume ratio: 4 per element each
+    dofs = 2 * (2 * n_s + 1) * (2 * n_t + 1) + 2 * 4 * n_s * n_t
+    seconds = _REFERENCE_SECONDS * (n_s * n_t / _REFERENCE_ELEMENTS) ** 2
+    return FESize((n_s, n_t), dofs, _BASE_MB + _MB_PER_DOF * dofs, seconds)
+
+
+def _half_elements(scene, eps, opts, lower=False):
+    """Elements along the upper half's meridian (``lower``: an egg's lower half's)."""
+    s_tab, *_, S_tab = _meridian(scene, lower=lower)
     H_tab = _wall(scene, eps, S_tab)
     # elements of the local length element_length * H along the arc: exact count below (the loop is
     # cheap), beyond it this integral (a lower bound: the pole's refinement adds elements)
     n_s = math.ceil(np.trapezoid(1.0 / (opts["element_length"] * H_tab), s_tab))
     if n_s < 100_000:
         n_s = _corners(s_tab, H_tab, eps, opts["element_length"], opts["pole_refinement"]).size - 1
-    n_s *= 2 if whole(scene) else 1  # a closed shell on a substrate: both halves
-    n_t = int(opts["through_thickness"])
-    # quadratic displacement nodes, two components; pressure and volume ratio: 4 per element each
-    dofs = 2 * (2 * n_s + 1) * (2 * n_t + 1) + 2 * 4 * n_s * n_t
-    seconds = _REFERENCE_SECONDS * (n_s * n_t / _REFERENCE_ELEMENTS) ** 2
-    return FESize((n_s, n_t), dofs, _BASE_MB + _MB_PER_DOF * dofs, seconds)
+    return n_s
 
 
 def check_fe_size(size: FESize, max_dofs=None) -> None:
@@ -295,11 +320,9 @@ def check_solid_scene(scene):
     without a 3D form.  Every shell the solid holds -- rimmed, or closed between plates or on a
     substrate, open, under a pressure or sealed -- is also a fitting model (``fit --model
     solid``): its curve at the indenters' approach (``at="indenter"``) is what a fit reads.
-    A closed shell whose halves differ has none yet (the solid mirrors the upper half)."""
+    A closed shell whose halves differ (an egg) is the whole wall, on a substrate and between
+    plates."""
     _check_material(scene)
-    if getattr(scene.shell, "lower", None) is not None:
-        raise ValueError("shell: the 3D solid of a closed shell whose halves differ (UserShell.closed_halves) is not "
-                         "offered yet; it mirrors the upper half (give UserShell(R, Z, L) for a symmetric one)")
 
 
 def _check_profile(scene, eps):

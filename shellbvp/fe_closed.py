@@ -18,6 +18,10 @@
   spring carries 1.3e-6 of the force (eps 0.1, delta 0.05), and as it pushes where the substrate
   does, the tip's force changes by less: 2e-9 with a spring ten times softer, 2.4e-7 with one
   a hundred times stiffer (``tests/test_fe_closed.py``).
+* A shell whose halves differ (an egg, ``UserShell.closed_halves``) is the whole wall on a
+  substrate and between plates alike (the same problem: the bottom plate is the fixed
+  substrate, the top one moves by the whole approach): the upper half's meridian from its pole
+  and the lower half's from its own, joined at the equator (:func:`mirrored`).
 
 Points are ``(z, r)``, FElupe's axisymmetric order.  Nondimensional: mu = 1, R_L = 1 (the
 equatorial radius).
@@ -30,7 +34,7 @@ from scipy.sparse import coo_matrix
 
 from .fe_contact import PenaltyContact, Plane
 
-__all__ = ["whole", "mirrored", "AxialSpring", "closed_boundary", "SPRING"]
+__all__ = ["whole", "egg", "mirrored", "AxialSpring", "closed_boundary", "SPRING"]
 
 #: The axial spring on a closed shell's outer bottom pole, in units of eps^2 mu R_L (a thin
 #: sphere's stiffness between plates is ~2 eps^2 mu R_L).
@@ -38,16 +42,27 @@ SPRING = 0.01
 
 
 def whole(scene) -> bool:
-    """A closed shell solved as its whole wall (on a substrate), not the half above the equator."""
-    return bool(scene.closed and scene.support == "substrate")
+    """A closed shell solved as its whole wall (on a substrate, or one whose halves differ), not
+    the half above the equator."""
+    return bool(scene.closed and (scene.support == "substrate" or egg(scene)))
 
 
-def mirrored(s, R, Z, Phi, corners):
-    """The upper half's meridian table and element corners continued through the equator to the
-    lower pole (``z -> -z``, the normal's angle ``Phi -> -pi - Phi``, continuous at the equator)."""
-    total = s[-1]
-    return (np.r_[s, 2 * total - s[::-1][1:]], np.r_[R, R[::-1][1:]], np.r_[Z, -Z[::-1][1:]],
-            np.r_[Phi, -np.pi - Phi[::-1][1:]], np.r_[corners, 2 * total - corners[::-1][1:]])
+def egg(scene) -> bool:
+    """A closed shell whose halves differ (``UserShell.closed_halves``): its lower half its own."""
+    return getattr(scene.shell, "lower", None) is not None
+
+
+def mirrored(upper, lower=None):
+    """The whole wall's meridian table ``(s, R, Z, Phi, H, corners)`` from the upper half's and the
+    lower half's (``lower``: its own table in its mirror image, as an upper half's; None: the upper
+    half's), joined at the equator: the lower half continued from there to its pole (``z -> -z``,
+    the normal's angle ``Phi -> -pi - Phi``, continuous at the equator, where both halves have
+    ``R = 1``, ``Z = 0`` and a vertical tangent)."""
+    s, R, Z, Phi, H, corners = upper
+    sl, Rl, Zl, Phil, Hl, cl = upper if lower is None else lower
+    total, low = s[-1], sl[-1]
+    return (np.r_[s, total + low - sl[::-1][1:]], np.r_[R, Rl[::-1][1:]], np.r_[Z, -Zl[::-1][1:]],
+            np.r_[Phi, -np.pi - Phil[::-1][1:]], np.r_[H, Hl[::-1][1:]], np.r_[corners, total + low - cl[::-1][1:]])
 
 
 class AxialSpring:
@@ -66,9 +81,10 @@ class AxialSpring:
         return r, K, f, 0.0
 
 
-def closed_boundary(scene, eps, points, node, n_t, ncol, field, *, penalty, gauss_points, band):
+def closed_boundary(scene, eps, points, node, n_t, ncol, field, *, penalty, gauss_points, band, equator=None):
     """A closed shell's conditions on the mesh ``node(i, j)`` (i through the thickness, j along
-    the meridian from the upper pole, ``ncol`` columns).
+    the meridian from the upper pole, ``ncol`` columns; of the whole wall, ``equator`` the
+    equator's column, the middle one by default).
 
     Returns ``(fixed, top, supports, delta_weights, approach)``: the held displacement dofs, the
     outer surface's nodes the tip presses (from the upper pole), the substrate's contact and
@@ -82,7 +98,7 @@ def closed_boundary(scene, eps, points, node, n_t, ncol, field, *, penalty, gaus
         fixed = np.unique(np.concatenate([2 * axis + 1, 2 * equator]))
         top = np.array([node(outer, j) for j in range(ncol)])
         return fixed, top, [], {2 * node(n_t, 0): 2.0}, 2.0
-    mid = (ncol - 1) // 2  # the equator's column
+    mid = (ncol - 1) // 2 if equator is None else int(equator)  # the equator's column
     top = np.array([node(outer, j) for j in range(mid + 1)])
     below = np.array([node(outer, j) for j in range(ncol - 1, mid - 1, -1)])  # from the lower pole
     ndof = int(np.sum(field.fieldsizes))

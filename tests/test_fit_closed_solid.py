@@ -146,3 +146,23 @@ def test_a_sealed_capsule_is_fitted_by_the_solid_from_a_finer_solids_record(monk
     res = sb.fit(scene, CONTACT + DEPTHS * R_L, F, R_L=R_L, model="solid")
     lo, hi = res.mu_H_ci95
     assert res.success and lo < MU_H < hi and res.mu_H == pytest.approx(MU_H, rel=0.01)
+
+
+@pytest.mark.slow  # the egg's solid twice, ~40 s
+def test_an_eggs_solid_record_is_fitted_back_with_its_solid():
+    # an egg between plates (its solid the whole wall, each half its own meridian): its own
+    # record fitted back by the solid as the symmetric capsule's is, its kept curve keyed apart
+    # from the symmetric shell of its upper half
+    upper = ("sin(S)", "1.3*cos(S)", "pi/2")
+    egg = sb.UserShell.closed_halves(upper, ("sin(S)", "0.7*cos(S)", "pi/2"))
+    scene = sb.Scene(closed=True, shell=egg, support="plates", tip=sb.FlatTip(), thickness=0.1, material=MR)
+    assert solid.auto_model(scene) == ("both", "")
+    c = sb.fe_curve(scene, scene.thickness, DEPTHS, at="indenter", **COARSE)
+    assert c.success and np.allclose(c.indenter, DEPTHS)
+    res = sb.fit(scene, CONTACT + DEPTHS * R_L, MU_H * R_L * c.force, R_L=R_L, model="solid")
+    assert res.success and res.model == "solid"
+    assert res.mu_H == pytest.approx(MU_H, rel=1e-3)
+    assert res.offset == pytest.approx(CONTACT, abs=1e-3 * DEPTHS[-1] * R_L)
+    grid = np.array([0.02, 0.05])
+    assert solid._place(scene, grid, solid.FE_DEFAULTS)[1] != \
+        solid._place(scene.replace(shell=sb.UserShell(*upper)), grid, solid.FE_DEFAULTS)[1]

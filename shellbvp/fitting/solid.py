@@ -156,6 +156,8 @@ def solid_words(scene):
     if not scene.closed:
         return "the rim face hinged at mid-thickness", "its indenter's displacement from first touch"
     if scene.support == "plates":
+        if getattr(scene.shell, "lower", None) is not None:  # an egg: no symmetry plane
+            return "the whole wall, the bottom plate fixed", "the indenters' approach from first touch"
         return "the half above the equator on its symmetry plane", "the indenters' approach from first touch"
     return "the whole wall on a frictionless substrate", "the tip's approach to the substrate from first touch"
 
