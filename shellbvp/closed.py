@@ -209,7 +209,6 @@ def closed_again(guess, control, value, *, topology, tol, max_nodes, eps, bc_tol
     return res
 
 
-
 #: Solves of :func:`closed_continued` (its steps halved at most about that often) and its node
 #: budget in multiples of the neighbour's mesh (a step that does not converge must fail fast)
 _CONTINUATION_SOLVES, _CONTINUATION_NODES = 10, 3

@@ -88,12 +88,7 @@ def test_energy_along_the_branch_under_pressure():
     dF = (hi.force - lo.force) / (hi.delta - lo.delta)
     form = _elastic(lo, mid, hi, upper, 1.0) + _elastic(lo, mid, hi, lower, -1.0)
     assert abs(form - dF) < 3e-4 * dF
-    total = 0.0
-    for regions, contact, lift in zip(_halves(mid), st.halves_of(mid), (1.0, -1.0)):
-        nodes = fem.mesh(contact.S0, float(mid.system.L), 2 * fem.default_elements(mid.scene), contact.edges)
-        K, _ = fem.stiffness(mid.scene, contact.base, 0, nodes, contact)
-        q = _hermite_dofs(lo, mid, hi, regions, nodes, lift)
-        total += 2 * math.pi * float(q @ (K @ q))
+    total = _assembled_on_tangent(lo, mid, hi)
     assert total == pytest.approx(dF, rel=1e-3)
     assert st.stability(mid).stable
 
@@ -120,17 +115,23 @@ def _hermite_dofs(lo, mid, hi, regions, nodes, lift):
     return q.ravel()
 
 
-def test_the_assembled_stiffness_on_the_tangent_is_dF(branch):
-    """Both halves' K (4 times the form, with the rings) on the tangent interpolated by the cubic
-    Hermite elements of the default mesh (twice the elements): ``2 pi q^T K q`` within 1e-3 of
-    dF/ddelta (measured 1.7e-4)."""
-    lo, mid, hi = branch
+def _assembled_on_tangent(lo, mid, hi):
+    """Both halves' ``2 pi q^T K q`` on the branch tangent (twice the default elements)."""
     total = 0.0
     for regions, contact, lift in zip(_halves(mid), st.halves_of(mid), (1.0, -1.0)):
         nodes = fem.mesh(contact.S0, float(mid.system.L), 2 * fem.default_elements(mid.scene), contact.edges)
         K, _ = fem.stiffness(mid.scene, contact.base, 0, nodes, contact)
         q = _hermite_dofs(lo, mid, hi, regions, nodes, lift)
         total += 2 * math.pi * float(q @ (K @ q))
+    return total
+
+
+def test_the_assembled_stiffness_on_the_tangent_is_dF(branch):
+    """Both halves' K (4 times the form, with the rings) on the tangent interpolated by the cubic
+    Hermite elements of the default mesh (twice the elements): ``2 pi q^T K q`` within 1e-3 of
+    dF/ddelta (measured 1.7e-4)."""
+    lo, mid, hi = branch
+    total = _assembled_on_tangent(lo, mid, hi)
     dF = (hi.force - lo.force) / (hi.delta - lo.delta)
     assert total == pytest.approx(dF, rel=1e-3)
 
